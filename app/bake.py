@@ -1,0 +1,378 @@
+"""The image-based-lighting bake: GLSL compute passes that turn an environment into the
+split sum's maps (Karis 2013, as the seed lecture teaches it).
+
+    equirect --equirect_to_cube--> source cube (+ box mip chain, for filtered importance sampling)
+             --irradiance | sh9--> irradiance cube (E/pi)
+             --prefilter-------->  prefiltered radiance cube, one roughness per mip
+    (independent of the environment)  --brdf_lut--> (A, B) over (n.v, roughness), cached on disk
+
+Every quality choice is in ``QUALITY`` below.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from app.gpu import ShaderLibrary
+from app.shading import D_GGX, hammersley, importance_sample_ggx_tangent
+from app.output import atomic_path
+from app.paths import cache_dir
+
+if TYPE_CHECKING:
+    from app.environment import Environment
+
+IRRADIANCE_METHODS = ("convolution", "sh9")
+
+
+@dataclass(frozen=True)
+class BakeQuality:
+    """One row of the quality table: the resolutions and sample counts of every bake pass."""
+
+    name: str
+    cube_size: int                 # source cube, level 0 face size
+    equirect_subsamples: int       # per axis, per source-cube texel
+    prefiltered_size: int          # grid A's mip 0 face size (roughness 2^(-(levels-1)/2))
+    prefiltered_min_size: int      # grid A's last mip (roughness 1)
+    prefilter_samples: int         # GGX samples per texel of grid A's mip 0
+    prefilter_sample_growth: int   # times more samples per coarser mip: a mip has 4x fewer texels,
+    prefilter_max_samples: int     # so rough mips get many samples for about the same cost
+    filtered_importance_sampling: bool
+    lod_bias: float                # added to the filtered-importance-sampling mip
+    irradiance: str                # 'convolution' (the lecture's) or 'sh9'
+    irradiance_size: int
+    irradiance_source_size: int    # face size of the source mip that the convolution reads
+    irradiance_phi_steps: int
+    irradiance_theta_steps: int
+    sh9_source_width: int          # width of the equirect mip that the SH projection reads
+    lut_size: int
+    lut_samples: int
+
+    @property
+    def prefiltered_levels(self) -> int:
+        return int(math.log2(self.prefiltered_size // self.prefiltered_min_size)) + 1
+
+    def prefilter_samples_at(self, step: int) -> int:
+        """Samples per texel at a grid step (step 2m: grid A's mip m; 2j+1: grid B's mip j)."""
+        return min(self.prefilter_max_samples, int(self.prefilter_samples * self.prefilter_sample_growth ** (step / 2)))
+
+
+# The one place where bake quality is chosen. 'medium' is the default: it keeps the probe within
+# 2% of the converged split sum at roughness >= 0.25 (tests/test_probe_accuracy.py) and bakes a
+# 1k map in well under half a second on llvmpipe (benchmarks/bench_render.py).
+QUALITY: dict[str, BakeQuality] = {
+    "low": BakeQuality(
+        name="low", cube_size=128, equirect_subsamples=2,
+        prefiltered_size=64, prefiltered_min_size=8, prefilter_samples=32, prefilter_sample_growth=4, prefilter_max_samples=1024,
+        filtered_importance_sampling=True, lod_bias=0.0,
+        irradiance="sh9", irradiance_size=16, irradiance_source_size=16,
+        irradiance_phi_steps=32, irradiance_theta_steps=8, sh9_source_width=128,
+        lut_size=64, lut_samples=256,
+    ),
+    "medium": BakeQuality(
+        name="medium", cube_size=256, equirect_subsamples=2,
+        prefiltered_size=128, prefiltered_min_size=8, prefilter_samples=160, prefilter_sample_growth=2, prefilter_max_samples=4096,
+        filtered_importance_sampling=True, lod_bias=0.0,
+        irradiance="convolution", irradiance_size=32, irradiance_source_size=32,
+        irradiance_phi_steps=64, irradiance_theta_steps=16, sh9_source_width=256,
+        lut_size=128, lut_samples=1024,
+    ),
+    "high": BakeQuality(
+        name="high", cube_size=512, equirect_subsamples=2,
+        prefiltered_size=256, prefiltered_min_size=8, prefilter_samples=256, prefilter_sample_growth=4, prefilter_max_samples=16384,
+        filtered_importance_sampling=True, lod_bias=0.0,
+        irradiance="convolution", irradiance_size=32, irradiance_source_size=64,
+        irradiance_phi_steps=128, irradiance_theta_steps=32, sh9_source_width=512,
+        lut_size=256, lut_samples=4096,
+    ),
+}
+DEFAULT_QUALITY = "medium"
+
+
+def quality_named(name: str, irradiance: str | None = None) -> BakeQuality:
+    q = QUALITY[name]
+    return replace(q, irradiance=irradiance) if irradiance else q
+
+
+def grid_roughness(step: int, levels: int) -> float:
+    """Roughness prefiltered at a step of the grid; ibl.glsl's roughness_to_grid_step() inverts it.
+
+    The grid steps alpha = r^2 by sqrt(2): even steps 2m are grid A's mips m, whose resolution
+    halves as alpha doubles (A's last mip is r = 1); odd steps 2j+1 are grid B's mips j, halfway
+    (in log alpha) between A's mips j and j+1 at the resolution of A's mip j+1. Below A's mip 0 the
+    source cube's box mips stand in (the mirror at r = 0). With the lecture's linear steps
+    (r = m / max_mip) trilinear blending alone costs 9% at r = 0.25 on a metal; this grid keeps
+    blends near 1% (tests/test_probe_accuracy.py).
+    """
+    return 2.0 ** (step / 4.0 - (levels - 1) / 2.0)
+
+
+def roughness_to_grid_step(roughness, levels: int):
+    """Numpy twin of ibl.glsl's roughness_to_grid_step."""
+    r = np.maximum(np.asarray(roughness, dtype=np.float64), 1e-4)
+    return 2.0 * (2.0 * np.log2(r) + (levels - 1))
+
+
+def prefilter_sample_set(roughness: float, count: int, source_size: int, lod_bias: float,
+                         filtered: bool) -> np.ndarray:
+    """The prefilter's samples for one roughness: (K, 4) float32 rows of (l.xyz, source mip) in
+    the tangent frame of n = v, with the K <= count samples below the horizon dropped."""
+    h = importance_sample_ggx_tangent(hammersley(np.arange(count), count), roughness)
+    l = 2.0 * h[:, 2:3] * h - np.array([0.0, 0.0, 1.0])   # reflect v = n about h
+    keep = l[:, 2] > 0.0
+    lod = np.zeros(count)
+    if filtered:
+        # pdf over l is D(h) n.h / (4 v.h) = D(h) / 4 when v = n.
+        pdf = D_GGX(h[:, 2], roughness) / 4.0
+        sample_solid_angle = 1.0 / (count * pdf + 1e-6)
+        texel_solid_angle = 4.0 * np.pi / (6.0 * source_size * source_size)
+        lod = np.maximum(0.5 * np.log2(sample_solid_angle / texel_solid_angle) + lod_bias, 0.0)
+    return np.ascontiguousarray(np.column_stack([l[keep], lod[keep]]), dtype=np.float32)
+
+
+@dataclass
+class IBLMaps:
+    """The baked maps of one environment at one quality, ready to bind."""
+
+    environment: moderngl.TextureCube        # source radiance cube with a box mip chain
+    irradiance: moderngl.TextureCube         # E/pi
+    prefiltered_radiance: moderngl.TextureCube       # grid A (see grid_roughness)
+    prefiltered_radiance_mid: moderngl.TextureCube   # grid B
+    brdf_lut: moderngl.Texture               # RG: (A, B)
+    quality: BakeQuality
+    pass_seconds: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def prefiltered_max_mip(self) -> float:
+        return float(self.quality.prefiltered_levels - 1)
+
+    def release(self) -> None:
+        # The LUT is shared between bakes (see LutCache) and released with the cache.
+        for tex in (self.environment, self.irradiance, self.prefiltered_radiance, self.prefiltered_radiance_mid):
+            tex.release()
+
+
+def _groups(size: int, local: int = 8) -> int:
+    return (size + local - 1) // local
+
+
+def _timed(ctx: moderngl.Context, seconds: dict[str, float], name: str, run) -> None:
+    # finish() bounds each pass so its time is its own; it costs a sync, not GPU work.
+    start = time.perf_counter()
+    run()
+    ctx.finish()
+    seconds[name] = seconds.get(name, 0.0) + time.perf_counter() - start
+
+
+def upload_equirect(ctx: moderngl.Context, radiance: np.ndarray, mipmaps: bool) -> moderngl.Texture:
+    """The equirect as a float texture; u wraps (the seam), v clamps (the poles). Mips only when
+    a pass reads them (the SH projection): building them costs more than the upload."""
+    h, w, _ = radiance.shape
+    tex = ctx.texture((w, h), 3, np.ascontiguousarray(radiance, dtype=np.float32).tobytes(), dtype="f4")
+    tex.repeat_x = True
+    tex.repeat_y = False
+    if mipmaps:
+        tex.build_mipmaps()
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    else:
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    return tex
+
+
+def _cube(ctx: moderngl.Context, size: int, levels: int) -> moderngl.TextureCube:
+    tex = ctx.texture_cube((size, size), 4, dtype="f4")
+    # build_mipmaps allocates levels 0..levels-1 and makes the texture complete at that range.
+    tex.build_mipmaps(0, levels - 1)
+    tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    return tex
+
+
+class LutCache:
+    """The BRDF integration map depends only on its size, sample count and shader: bake it once
+    per machine and keep it in the user's cache directory (``app.paths.cache_dir``)."""
+
+    def __init__(self, ctx: moderngl.Context, shaders: ShaderLibrary):
+        self.ctx = ctx
+        self.shaders = shaders
+        self._textures: dict[tuple[int, int], moderngl.Texture] = {}
+        self.last_source = ""   # 'memory', 'disk' or 'baked'
+
+    def path_for(self, size: int, samples: int):
+        digest = self.shaders.digest("bake/brdf_lut.comp")[:16]
+        return cache_dir() / f"brdf_lut-{size}-{samples}-{digest}.npy"
+
+    def get(self, size: int, samples: int) -> moderngl.Texture:
+        key = (size, samples)
+        if key in self._textures:
+            self.last_source = "memory"
+            return self._textures[key]
+        path = self.path_for(size, samples)
+        table = None
+        try:
+            loaded = np.load(path, allow_pickle=False)
+            if loaded.shape == (size, size, 2) and loaded.dtype == np.float32 and np.isfinite(loaded).all():
+                table = loaded
+        except (OSError, ValueError):
+            table = None
+        if table is not None:
+            self.last_source = "disk"
+            tex = self._upload(table)
+        else:
+            self.last_source = "baked"
+            tex = self._bake(size, samples)
+            table = np.frombuffer(tex.read(), dtype=np.float32).reshape(size, size, 2)
+            try:
+                os.makedirs(path.parent, exist_ok=True)
+                with atomic_path(path) as tmp:
+                    with open(tmp, "wb") as f:
+                        np.save(f, table)
+            except OSError:
+                pass  # an unwritable cache only costs a re-bake next time
+        self._textures[key] = tex
+        return tex
+
+    def _upload(self, table: np.ndarray) -> moderngl.Texture:
+        size = table.shape[0]
+        tex = self.ctx.texture((size, size), 2, table.tobytes(), dtype="f4")
+        tex.repeat_x = tex.repeat_y = False
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        return tex
+
+    def _bake(self, size: int, samples: int) -> moderngl.Texture:
+        tex = self._upload(np.zeros((size, size, 2), np.float32))
+        prog = self.shaders.compute("bake/brdf_lut.comp")
+        prog["u_size"] = size
+        prog["u_samples"] = samples
+        tex.bind_to_image(0, read=False, write=True)
+        prog.run(_groups(size), _groups(size), 1)
+        self.ctx.memory_barrier()
+        return tex
+
+    def release(self) -> None:
+        for tex in self._textures.values():
+            tex.release()
+        self._textures.clear()
+
+
+def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
+                     quality: BakeQuality, luts: LutCache) -> IBLMaps:
+    """Run every bake pass for one environment; returns the maps and each pass's seconds."""
+    q = quality
+    seconds: dict[str, float] = {}
+    equirect: list[moderngl.Texture] = []
+    _timed(ctx, seconds, "upload", lambda: equirect.append(upload_equirect(ctx, env.radiance, q.irradiance == "sh9")))
+    equirect_tex = equirect[0]
+
+    # Source cube with a full mip chain (the prefilter's filtered importance sampling reads it).
+    source_levels = int(math.log2(q.cube_size)) + 1
+    source = _cube(ctx, q.cube_size, source_levels)
+
+    def to_cube():
+        prog = shaders.compute("bake/equirect_to_cube.comp")
+        equirect_tex.use(0)
+        prog["u_equirect"] = 0
+        prog["u_size"] = q.cube_size
+        prog["u_subsamples"] = q.equirect_subsamples
+        source.bind_to_image(0, read=False, write=True, level=0)
+        prog.run(_groups(q.cube_size), _groups(q.cube_size), 6)
+        ctx.memory_barrier()
+        source.build_mipmaps(0, source_levels - 1)
+
+    _timed(ctx, seconds, "equirect_to_cube", to_cube)
+
+    irradiance = _cube(ctx, q.irradiance_size, 1)
+    if q.irradiance == "convolution":
+        def convolve():
+            prog = shaders.compute("bake/irradiance.comp")
+            source.use(0)
+            prog["u_environment"] = 0
+            prog["u_size"] = q.irradiance_size
+            prog["u_phi_steps"] = q.irradiance_phi_steps
+            prog["u_theta_steps"] = q.irradiance_theta_steps
+            prog["u_source_mip"] = max(0.0, math.log2(q.cube_size / q.irradiance_source_size))
+            irradiance.bind_to_image(0, read=False, write=True, level=0)
+            prog.run(_groups(q.irradiance_size), _groups(q.irradiance_size), 6)
+            ctx.memory_barrier()
+        _timed(ctx, seconds, "irradiance_convolution", convolve)
+    elif q.irradiance == "sh9":
+        _timed(ctx, seconds, "irradiance_sh9",
+               lambda: _irradiance_sh9(ctx, shaders, equirect_tex, env.radiance.shape, irradiance, q))
+    else:
+        raise ValueError(f"unknown irradiance method {q.irradiance!r}")
+
+    levels = q.prefiltered_levels
+    prefiltered = _cube(ctx, q.prefiltered_size, levels)
+    prefiltered_mid = _cube(ctx, q.prefiltered_size // 2, levels - 1)
+
+    def prefilter():
+        prog = shaders.compute("bake/prefilter.comp")
+        source.use(0)
+        prog["u_environment"] = 0
+        for step in range(2 * levels - 1):
+            target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
+            size = target.size[0] >> mip
+            sample_set = prefilter_sample_set(grid_roughness(step, levels), q.prefilter_samples_at(step),
+                                              q.cube_size, q.lod_bias, q.filtered_importance_sampling)
+            buffer = ctx.buffer(sample_set.tobytes())
+            buffer.bind_to_storage_buffer(1)
+            prog["u_size"] = size
+            prog["u_sample_count"] = len(sample_set)
+            target.bind_to_image(0, read=False, write=True, level=mip)
+            prog.run(_groups(size), _groups(size), 6)
+            buffer.release()
+        ctx.memory_barrier()
+
+    _timed(ctx, seconds, "prefilter", prefilter)
+
+    lut_box: list[moderngl.Texture] = []
+    _timed(ctx, seconds, f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
+           lambda: lut_box.append(luts.get(q.lut_size, q.lut_samples)))
+    equirect_tex.release()
+    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut_box[0], q, seconds)
+
+
+def _irradiance_sh9(ctx, shaders, equirect_tex, shape, irradiance, q: BakeQuality) -> None:
+    h, w, _ = shape
+    level = max(0, int(round(math.log2(max(1, w // q.sh9_source_width)))))
+    lw, lh = max(1, w >> level), max(1, h >> level)
+    gx, gy = _groups(lw), _groups(lh)
+    partials = ctx.buffer(reserve=gx * gy * 9 * 16)
+    prog = shaders.compute("bake/sh9_project.comp")
+    equirect_tex.use(0)
+    prog["u_equirect"] = 0
+    prog["u_level"] = level
+    prog["u_level_size"] = (lw, lh)
+    partials.bind_to_storage_buffer(0)
+    prog.run(gx, gy, 1)
+    ctx.memory_barrier()
+    coeffs = np.frombuffer(partials.read(), dtype=np.float32).reshape(gx * gy, 9, 4)[:, :, :3].sum(axis=0)
+    partials.release()
+    fill = shaders.compute("bake/sh9_to_cube.comp")
+    fill["u_size"] = q.irradiance_size
+    fill["u_coeffs"].write(np.ascontiguousarray(coeffs, dtype=np.float32).tobytes())
+    irradiance.bind_to_image(0, read=False, write=True, level=0)
+    fill.run(_groups(q.irradiance_size), _groups(q.irradiance_size), 6)
+    ctx.memory_barrier()
+
+
+def read_cube(shaders: ShaderLibrary, tex: moderngl.TextureCube, level: int = 0) -> np.ndarray:
+    """Faces of one level as (6, size, size, 4) float32 in OpenGL's face order (+X -X +Y -Y +Z -Z),
+    row 0 = the first row in memory."""
+    ctx = shaders.ctx
+    size = max(1, tex.size[0] >> level)
+    out = ctx.buffer(reserve=6 * size * size * 16)
+    prog = shaders.compute("util/read_cube_level.comp")
+    prog["u_size"] = size
+    tex.bind_to_image(0, read=True, write=False, level=level)
+    out.bind_to_storage_buffer(0)
+    prog.run(_groups(size), _groups(size), 6)
+    ctx.memory_barrier()
+    faces = np.frombuffer(out.read(), dtype=np.float32).reshape(6, size, size, 4).copy()
+    out.release()
+    return faces

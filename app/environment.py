@@ -1,0 +1,324 @@
+"""Environment maps: loading, validation and repair of equirectangular files, and the built-in studio.
+
+Every environment is an (H, W, 3) float32, C-contiguous array of linear scene-referred RGB
+radiance with W == 2*H, finite and >= 0, row 0 at the top (+Y); the mapping between texels and
+directions is CONVENTIONS.md's (see ``app.shading.direction_to_equirect_uv``).
+
+Files are read with OpenImageIO in strips of scanlines (or rows of tiles), repaired strip by
+strip (NaN/Inf/negative texels set to 0) and, when wider than ``max_width``, box-reduced strip by
+strip, so a huge map never sits in memory at full resolution. Every problem with a file becomes
+one :class:`AlightError` line naming the file first; every repair becomes one warning line.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import AlightError
+from .shading import texel_directions
+
+MAX_WIDTH = 4096
+
+# Bytes of float32 RGB read per strip (before reduction); bounds the loader's memory.
+_STRIP_BYTES = 8 * 1024 * 1024
+
+
+@dataclass(eq=False)
+class Environment:
+    """An equirectangular environment ready to bake (see the module docstring for the invariants)."""
+
+    radiance: np.ndarray  # (H, W, 3) float32, linear RGB, W == 2*H, finite, >= 0, C-contiguous
+    name: str  # 'studio', 'constant', or the file path
+    warnings: list[str] = field(default_factory=list)  # repairs made, one line each
+    _hash: str | None = field(default=None, init=False, repr=False, compare=False)
+
+    @property
+    def content_hash(self) -> str:
+        """sha256 hex digest of the radiance's shape and bytes (the bake cache key); computed once."""
+        if self._hash is None:
+            h = hashlib.sha256()
+            h.update(repr(tuple(self.radiance.shape)).encode())
+            h.update(np.ascontiguousarray(self.radiance, dtype=np.float32).tobytes())
+            self._hash = h.hexdigest()
+        return self._hash
+
+    @property
+    def width(self) -> int:
+        return int(self.radiance.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.radiance.shape[0])
+
+
+# --------------------------------------------------------------------------------------------
+# Reduction (shared by the loader and app.converged.downsample_equirect)
+# --------------------------------------------------------------------------------------------
+
+def _row_weights(y0: int, y1: int, height: int) -> np.ndarray:
+    """Solid-angle weights sin(theta) of rows y0..y1-1 of a map `height` rows tall."""
+    return np.sin((np.arange(y0, y1, dtype=np.float64) + 0.5) * (math.pi / height))
+
+
+def _reduce_columns(strip: np.ndarray, factor: int) -> np.ndarray:
+    """Box-average groups of `factor` columns: (h, W, 3) -> (h, W // factor, 3), float64."""
+    h, w, c = strip.shape
+    return strip.reshape(h, w // factor, factor, c).mean(axis=2, dtype=np.float64)
+
+
+def _reduce_rows(strip: np.ndarray, factor: int, y0: int, height: int) -> np.ndarray:
+    """Solid-angle weighted average of groups of `factor` rows (y0 a multiple of factor)."""
+    h, w, c = strip.shape
+    wts = _row_weights(y0, y0 + h, height).reshape(h // factor, factor)
+    s = (strip.reshape(h // factor, factor, w, c) * wts[:, :, None, None]).sum(axis=1)
+    return s / wts.sum(axis=1)[:, None, None]
+
+
+def box_reduce(radiance: np.ndarray, factor: int) -> np.ndarray:
+    """Area-weighted integer box reduction of an equirect map by `factor` in both axes.
+
+    Columns are plain means (equal solid angle within a row); rows are averaged with their
+    solid-angle weights sin(theta), so the integral of radiance times solid angle is kept to
+    second order in the row spacing. H must be divisible by `factor`.
+    """
+    rad = np.asarray(radiance)
+    h = rad.shape[0]
+    if factor < 1 or h % factor or rad.shape[1] % factor:
+        raise ValueError(f"box factor {factor} does not divide the map size {rad.shape[1]}x{h}")
+    if factor == 1:
+        return np.ascontiguousarray(rad, dtype=np.float32)
+    out = _reduce_rows(_reduce_columns(rad, factor), factor, 0, h)
+    return np.ascontiguousarray(out, dtype=np.float32)
+
+
+def _box_factor(width: int, height: int, max_width: int) -> int:
+    """The smallest integer factor >= width / max_width that divides the height (and so the width)."""
+    f = max(1, -(-width // max_width))
+    while height % f:
+        f += 1
+    return f
+
+
+# --------------------------------------------------------------------------------------------
+# Loading files
+# --------------------------------------------------------------------------------------------
+
+def _one_line(msg: str) -> str:
+    """Condense a (possibly multi-line) OIIO error message to one line."""
+    msg = " ".join(str(msg).split())
+    return msg if msg else "unknown read error"
+
+
+def load_environment(spec: str, max_width: int = MAX_WIDTH) -> Environment:
+    """'studio' (the built-in studio) or the path of an equirect file OpenImageIO can read.
+
+    Raises AlightError (one line: file then problem) for a missing, unreadable, corrupt,
+    truncated or empty file, a map that is not 2:1, or a 2-channel image. 1 channel is
+    replicated to RGB, channels beyond the third (alpha) are dropped. NaN/Inf/negative texels
+    are set to 0 and maps wider than ``max_width`` are box-reduced, each with a warning line.
+    """
+    if str(spec) == "studio":
+        return studio_environment()
+    path = os.fspath(spec)
+    if max_width < 2:
+        raise ValueError("max_width must be >= 2")
+    try:
+        return _load_file(path, max_width)
+    except AlightError as e:
+        raise AlightError(str(e)) from None
+    except MemoryError:
+        raise AlightError(f"{path}: not enough memory to read the environment map") from None
+    except Exception as e:  # anything OIIO or numpy throws: one line, no traceback
+        raise AlightError(f"{path}: cannot read environment map ({_one_line(e)})") from None
+
+
+def _load_file(path: str, max_width: int) -> Environment:
+    import OpenImageIO as oiio
+
+    if not os.path.exists(path):
+        raise AlightError(f"{path}: no such file")
+    if os.path.isdir(path):
+        raise AlightError(f"{path}: is a directory, not an image")
+    if os.path.getsize(path) == 0:
+        raise AlightError(f"{path}: empty file")
+
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        raise AlightError(f"{path}: cannot read environment map ({_one_line(oiio.geterror())})")
+    try:
+        ispec = inp.spec()
+        width, height, nch = int(ispec.width), int(ispec.height), int(ispec.nchannels)
+        if width <= 0 or height <= 0 or nch <= 0:
+            raise AlightError(f"{path}: empty image ({width}x{height}, {nch} channels)")
+        if width != 2 * height:
+            raise AlightError(f"{path}: not a 2:1 equirectangular map ({width}x{height})")
+        if nch == 2:
+            raise AlightError(f"{path}: 2-channel image (need 1 = grey, 3 = RGB or 4+ = RGBA)")
+        nread = 1 if nch == 1 else 3
+
+        factor = _box_factor(width, height, max_width) if width > max_width else 1
+        tile_h = int(ispec.tile_height) if int(ispec.tile_width) > 0 else 0
+        # Strip height: a multiple of the box factor (and of the tile height for tiled files).
+        unit = factor if not tile_h else factor * tile_h // math.gcd(factor, tile_h)
+        rows = max(1, _STRIP_BYTES // (width * 3 * 4) // unit) * unit
+
+        out = np.empty((height // factor, width // factor, 3), dtype=np.float32)
+        bad = 0
+        for y0 in range(0, height, rows):
+            y1 = min(height, y0 + rows)
+            if tile_h:
+                strip = inp.read_tiles(ispec.x, ispec.x + width, ispec.y + y0, ispec.y + y1,
+                                       ispec.z, ispec.z + max(1, int(ispec.depth)), 0, nread, oiio.FLOAT)
+            else:
+                strip = inp.read_scanlines(ispec.y + y0, ispec.y + y1, ispec.z, 0, nread, oiio.FLOAT)
+            err = inp.geterror()
+            if strip is None or isinstance(strip, bool) or err:
+                why = _one_line(err or oiio.geterror() or f"read error in rows {y0}..{y1 - 1}")
+                raise AlightError(f"{path}: corrupt or truncated file ({why})")
+            strip = np.asarray(strip, dtype=np.float32).reshape(y1 - y0, width, nread)
+            if nread == 1:
+                strip = np.repeat(strip, 3, axis=2)
+            elif not strip.flags.writeable:
+                strip = strip.copy()
+            broken = ~np.all(np.isfinite(strip) & (strip >= 0.0), axis=2)
+            n = int(np.count_nonzero(broken))
+            if n:
+                bad += n
+                strip[broken] = 0.0
+            if factor > 1:
+                out[y0 // factor:y1 // factor] = _reduce_rows(_reduce_columns(strip, factor), factor, y0, height)
+            else:
+                out[y0:y1] = strip
+    finally:
+        try:
+            inp.close()
+        except Exception:
+            pass
+
+    warnings = []
+    if bad:
+        warnings.append(f"{path}: {bad} NaN/Inf/negative texels set to 0")
+    if factor > 1:
+        warnings.append(f"{path}: {width}x{height} is wider than {max_width}; box-reduced by {factor} "
+                        f"to {width // factor}x{height // factor}")
+    return Environment(np.ascontiguousarray(out, dtype=np.float32), path, warnings)
+
+
+# --------------------------------------------------------------------------------------------
+# Procedural environments
+# --------------------------------------------------------------------------------------------
+
+def constant_environment(value=1.0, width: int = 64) -> Environment:
+    """A uniform environment of radiance `value` (scalar or RGB), width x width/2 (the white furnace)."""
+    if width < 2 or width % 2:
+        raise ValueError("width must be an even number >= 2")
+    v = np.broadcast_to(np.asarray(value, dtype=np.float32), (3,))
+    if not np.all(np.isfinite(v)) or np.any(v < 0):
+        raise ValueError(f"constant radiance must be finite and >= 0, got {value!r}")
+    rad = np.empty((width // 2, width, 3), dtype=np.float32)
+    rad[...] = v
+    return Environment(rad, "constant", [])
+
+
+# The studio, one table. Directions are world directions (CONVENTIONS.md: +Y up, the camera on
+# +Z looking toward -Z at the subject at the origin). Angles in degrees; radiance linear RGB.
+# Each soft box is a rectangle centred on `dir`, `half` = (half-width, half-height) measured as
+# angles in the plane of its own frame (right = up_hint x dir, up = dir x right), with
+# smoothstep edges `soft` degrees wide on each side of the edge, and a mild hotspot (the centre
+# is `hotspot` times brighter than the edge of the plateau, falling off quadratically).
+STUDIO = {
+    # background: a vertical profile over elevation e (degrees, +90 = up)
+    "ceiling_zenith": (0.06, 0.06, 0.065),   # straight up (a dark studio ceiling)
+    "backdrop_horizon": (0.42, 0.42, 0.42),  # the grey backdrop at eye level
+    "backdrop_falloff_deg": 40.0,            # backdrop -> ceiling, smoothstep over 0..this
+    "horizon_soft_deg": 2.0,                 # backdrop/floor seam half-width
+    "floor_horizon": (0.20, 0.195, 0.19),    # floor seen at grazing angles
+    "floor_nadir": (0.025, 0.025, 0.025),    # floor straight down (under the subject, shadowed)
+    "softboxes": [
+        # name, centre direction, up hint, (half w, half h), soft edge, radiance, hotspot
+        {"name": "key", "dir": (-1.0, 0.75, 1.0), "up_hint": (0.0, 1.0, 0.0),
+         "half": (20.0, 14.0), "soft": 4.0, "radiance": (16.0, 15.5, 14.8), "hotspot": 1.12},
+        {"name": "strip", "dir": (1.0, 0.12, -0.35), "up_hint": (0.0, 1.0, 0.0),
+         "half": (5.0, 32.0), "soft": 2.5, "radiance": (9.0, 9.2, 9.6), "hotspot": 1.06},
+        {"name": "top", "dir": (0.0, 1.0, -0.15), "up_hint": (0.0, 0.0, -1.0),
+         "half": (18.0, 18.0), "soft": 6.0, "radiance": (5.5, 5.5, 5.5), "hotspot": 1.10},
+    ],
+}
+
+
+def _smoothstep(e0, e1, x):
+    t = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def studio_environment(width: int = 1024) -> Environment:
+    """The built-in photo studio (the default environment): deterministic, vectorised numpy.
+
+    Layout (world directions; the camera is on +Z looking toward -Z, the subject at the origin):
+    - background: a grey backdrop at the horizon (radiance ~0.42) that fades to a dark ceiling
+      (~0.06) toward the zenith; below a soft seam at the horizon, a floor ~0.2 at grazing
+      angles that darkens toward the nadir (~0.025);
+    - ``key``: the big soft box (40 x 28 degrees, radiance ~16) in front of the subject, up and
+      to the camera's left, centred on normalize(-1, 0.75, 1) (azimuth 45 degrees left of the
+      camera, 28 degrees up). A mirror ball shows it in its upper-left quadrant;
+    - ``strip``: a tall thin strip light (10 x 64 degrees, ~9, slightly cool) on the right side
+      (+X), a little behind the subject (toward -Z): a rim light on the ball's right edge;
+    - ``top``: a square overhead box (36 x 36 degrees, ~5.5) straight above, tilted slightly
+      back (toward -Z).
+    Parameters are in the ``STUDIO`` table at the top of this section.
+    """
+    if width < 4 or width % 2:
+        raise ValueError("width must be an even number >= 4")
+    height = width // 2
+    dirs, _ = texel_directions(height, width)
+    dirs = dirs.astype(np.float32)
+    p = STUDIO
+
+    # Background profile by row (elevation only).
+    elev = 90.0 - (np.arange(height) + 0.5) * (180.0 / height)  # degrees, per row
+    ceil_c = np.asarray(p["ceiling_zenith"], np.float64)
+    back_c = np.asarray(p["backdrop_horizon"], np.float64)
+    floor_h = np.asarray(p["floor_horizon"], np.float64)
+    floor_n = np.asarray(p["floor_nadir"], np.float64)
+    t_up = _smoothstep(0.0, p["backdrop_falloff_deg"], np.maximum(elev, 0.0))[:, None]
+    upper = back_c * (1.0 - t_up) + ceil_c * t_up
+    t_dn = (np.clip(-elev, 0.0, 90.0) / 90.0) ** 0.6
+    lower = floor_h * (1.0 - t_dn[:, None]) + floor_n * t_dn[:, None]
+    s = p["horizon_soft_deg"]
+    seam = _smoothstep(-s, s, elev)[:, None]
+    profile = (lower * (1.0 - seam) + upper * seam).astype(np.float32)  # (H, 3)
+    rad = np.empty((height, width, 3), dtype=np.float32)
+    rad[...] = profile[:, None, :]
+
+    for box in p["softboxes"]:
+        c = np.asarray(box["dir"], np.float64)
+        c /= np.linalg.norm(c)
+        right = np.cross(np.asarray(box["up_hint"], np.float64), c)
+        right /= np.linalg.norm(right)
+        up = np.cross(c, right)
+        hw, hh = box["half"]
+        soft = box["soft"]
+        # Only texels within the box's bounding cone (corner + soft edge) need the work below.
+        reach = math.radians(min(89.0, math.hypot(hw + soft, hh + soft)))
+        flat = rad.reshape(-1, 3)
+        fdirs = dirs.reshape(-1, 3)
+        idx = np.flatnonzero(fdirs @ c.astype(np.float32) > math.cos(reach))
+        local = fdirs[idx] @ np.stack([right, up, c], axis=1).astype(np.float32)  # right, up, centre
+        z = local[:, 2]
+        ax = np.degrees(np.arctan2(np.abs(local[:, 0]), z))
+        ay = np.degrees(np.arctan2(np.abs(local[:, 1]), z))
+        mask = _smoothstep(hw + soft, hw - soft, ax) * _smoothstep(hh + soft, hh - soft, ay)
+        r2 = np.minimum((ax / hw) ** 2 + (ay / hh) ** 2, 2.0) / 2.0
+        gain = box["hotspot"] - (box["hotspot"] - 1.0) * r2
+        # A soft box hangs in front of the backdrop: blend over it rather than add.
+        cover = mask.astype(np.float32)[:, None]
+        lum = (mask * gain).astype(np.float32)[:, None] * np.asarray(box["radiance"], np.float32)
+        flat[idx] = flat[idx] * (1.0 - cover) + lum
+
+    rad = np.ascontiguousarray(np.maximum(rad, 0.0), dtype=np.float32)
+    return Environment(rad, "studio", [])

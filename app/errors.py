@@ -1,0 +1,10 @@
+"""The one exception type a user sees as a message rather than a traceback."""
+
+
+class AlightError(Exception):
+    """A user's mistake or a bad input file.
+
+    The CLI prints it as one line (``alight: error: <message>``) and exits with status 2.
+    Messages name the file (or option) first and the problem second, e.g.
+    ``memorial.exr: not a 2:1 equirectangular map (512x768)``.
+    """

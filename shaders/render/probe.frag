@@ -1,0 +1,24 @@
+#version 450 core
+// The probe view of CONVENTIONS.md: a unit sphere, orthographic, filling a square image, with
+// the exact normal n = (x, y, sqrt(1 - x^2 - y^2)) per pixel and v = (0, 0, 1).
+#include "common/shading.glsl"
+
+uniform float u_size;
+uniform vec3 u_base_color;
+uniform float u_metallic;
+uniform float u_roughness;
+uniform vec3 u_specular_f0;
+uniform vec3 u_emissive;
+
+layout(location = 0) out vec4 out_radiance;
+
+void main() {
+    // GL's window origin is the bottom-left; the written file's row 0 is the top, so
+    // y = 1 - 2 (row + 0.5) / W becomes 2 gl_FragCoord.y / W - 1.
+    vec2 xy = 2.0 * gl_FragCoord.xy / u_size - 1.0;
+    float r2 = dot(xy, xy);
+    if (r2 >= 1.0) discard;
+    vec3 n = vec3(xy, sqrt(1.0 - r2));
+    Surface s = Surface(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
+    out_radiance = vec4(shade(s, n, vec3(0.0, 0.0, 1.0), n), 1.0);
+}
