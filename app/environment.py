@@ -231,22 +231,24 @@ def constant_environment(value=1.0, width: int = 64) -> Environment:
 # angles in the plane of its own frame (right = up_hint x dir, up = dir x right), with
 # smoothstep edges `soft` degrees wide on each side of the edge, and a mild hotspot (the centre
 # is `hotspot` times brighter than the edge of the plateau, falling off quadratically).
+# Levels chosen so that the default 0.8-grey ball sits in ACES's mid-range with visible
+# highlights at exposure 0, rather than clipping to white.
 STUDIO = {
     # background: a vertical profile over elevation e (degrees, +90 = up)
     "ceiling_zenith": (0.06, 0.06, 0.065),   # straight up (a dark studio ceiling)
-    "backdrop_horizon": (0.42, 0.42, 0.42),  # the grey backdrop at eye level
+    "backdrop_horizon": (0.22, 0.22, 0.22),  # the grey backdrop at eye level
     "backdrop_falloff_deg": 40.0,            # backdrop -> ceiling, smoothstep over 0..this
     "horizon_soft_deg": 2.0,                 # backdrop/floor seam half-width
-    "floor_horizon": (0.20, 0.195, 0.19),    # floor seen at grazing angles
+    "floor_horizon": (0.11, 0.107, 0.104),    # floor seen at grazing angles
     "floor_nadir": (0.025, 0.025, 0.025),    # floor straight down (under the subject, shadowed)
     "softboxes": [
         # name, centre direction, up hint, (half w, half h), soft edge, radiance, hotspot
         {"name": "key", "dir": (-1.0, 0.75, 1.0), "up_hint": (0.0, 1.0, 0.0),
-         "half": (20.0, 14.0), "soft": 4.0, "radiance": (16.0, 15.5, 14.8), "hotspot": 1.12},
+         "half": (20.0, 14.0), "soft": 4.0, "radiance": (6.0, 5.8, 5.5), "hotspot": 1.12},
         {"name": "strip", "dir": (1.0, 0.12, -0.35), "up_hint": (0.0, 1.0, 0.0),
-         "half": (5.0, 32.0), "soft": 2.5, "radiance": (9.0, 9.2, 9.6), "hotspot": 1.06},
+         "half": (5.0, 32.0), "soft": 2.5, "radiance": (3.2, 3.3, 3.45), "hotspot": 1.06},
         {"name": "top", "dir": (0.0, 1.0, -0.15), "up_hint": (0.0, 0.0, -1.0),
-         "half": (18.0, 18.0), "soft": 6.0, "radiance": (5.5, 5.5, 5.5), "hotspot": 1.10},
+         "half": (18.0, 18.0), "soft": 6.0, "radiance": (1.6, 1.6, 1.6), "hotspot": 1.10},
     ],
 }
 

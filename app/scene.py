@@ -44,7 +44,7 @@ class Camera:
 
 
 def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float = 1.0,
-                 direction=(0.0, 0.0, 1.0), margin: float = 1.1) -> Camera:
+                 direction=(0.0, 0.0, 1.0), margin: float = 1.3) -> Camera:
     """A camera on ``direction`` from ``center`` (default +Z, CONVENTIONS.md) that fits a sphere
     of ``radius`` in the narrower of the two fields of view."""
     half = math.radians(fov_y_deg) / 2.0

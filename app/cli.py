@@ -1,0 +1,323 @@
+"""``alight``: render materials headless, bake environments, list presets.
+
+A user's mistake (a bad file, a bad option) prints one line ``alight: error: ...`` and exits
+with status 2; nothing is written. Heavy modules are imported after the arguments are parsed,
+so ``--help`` and argument errors are instant.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+
+from app.errors import AlightError
+
+IBL_MODELS = ("lecture",)
+QUALITIES = ("low", "medium", "high")
+
+
+def _number(option: str, low: float | None = None, high: float | None = None):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"'{text}' is not finite")
+        if (low is not None and value < low) or (high is not None and value > high):
+            hi = "inf)" if high is None else f"{high:g}]"
+            raise argparse.ArgumentTypeError(f"{value:g} is out of range [{low:g}, {hi}")
+        return value
+
+    parse.__name__ = option
+    return parse
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        parts = [int(x) for x in text.lower().split("x")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not W or WxH") from None
+    if len(parts) == 1:
+        parts *= 2
+    if len(parts) != 2 or not all(1 <= x <= 16384 for x in parts):
+        raise argparse.ArgumentTypeError(f"'{text}' is not W or WxH with sides 1..16384")
+    return parts[0], parts[1]
+
+
+def _add_scene_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("scene")
+    g.add_argument("--mesh", default="sphere",
+                   help="sphere, cube, plane, or a mesh file (.obj .gltf .glb .ply .stl) (default: sphere)")
+    g.add_argument("--env", default="studio",
+                   help="'studio' (built in) or an equirectangular .hdr/.exr map, 2:1 (default: studio)")
+    g.add_argument("--env-rotation", type=_number("--env-rotation"), default=0.0, metavar="DEG",
+                   help="turn the environment about +Y by DEG degrees, right-handed (default: 0)")
+    g.add_argument("--env-intensity", type=_number("--env-intensity", 0.0), default=1.0, metavar="X",
+                   help="multiply the environment's radiance by X (default: 1)")
+    g.add_argument("--no-ibl", action="store_true", help="no environment light (punctual lights and emission only)")
+    g.add_argument("--light", action="append", default=[], metavar="SPEC",
+                   help="add a light: point:pos=X,Y,Z[:color=R,G,B][:intensity=I] or "
+                        "directional:dir=X,Y,Z[:color=R,G,B][:intensity=I]; repeat for more "
+                        "(point intensity is W/sr-like, divided by distance squared; directional is irradiance)")
+    g.add_argument("--view", choices=("camera", "probe"), default="camera",
+                   help="camera: the mesh framed by a camera on +Z; probe: CONVENTIONS.md's analysis view "
+                        "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)")
+    m = p.add_argument_group("material (flags override the preset's fields)")
+    m.add_argument("--preset", metavar="NAME|PATH",
+                   help="a preset name (see 'alight presets') or a preset .json file; replaces the mesh file's own materials")
+    m.add_argument("--base-color", metavar="R,G,B", help="linear base colour in [0,1]; the F0 of metals")
+    m.add_argument("--metallic", type=_number("--metallic", 0.0, 1.0), metavar="X", help="0 dielectric .. 1 metal")
+    m.add_argument("--roughness", type=_number("--roughness", 0.0, 1.0), metavar="X",
+                   help="perceptual roughness r in [0,1]; alpha = r^2")
+    m.add_argument("--specular-f0", metavar="X|R,G,B", help="F0 of the dielectric part, linear (default 0.04)")
+    m.add_argument("--emissive", metavar="R,G,B", help="linear emitted radiance, >= 0")
+
+
+def _add_bake_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("image-based lighting")
+    g.add_argument("--quality", choices=QUALITIES, default="medium",
+                   help="bake resolution and sample counts (app/bake.py's QUALITY table) (default: medium)")
+    g.add_argument("--irradiance", choices=("convolution", "sh9"),
+                   help="diffuse irradiance by the lecture's hemisphere convolution or by 9 spherical "
+                        "harmonics (default: the quality's choice)")
+    g.add_argument("--ibl", choices=IBL_MODELS, default="lecture",
+                   help="IBL shading model: 'lecture' is the seed lecture's split sum (default: lecture)")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a bad option is one line (no usage dump), like every other user error."""
+
+    def error(self, message: str):
+        self.exit(2, f"alight: error: {' '.join(message.split())} (see '{self.prog} --help')\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="alight", description="A physically based material renderer "
+                                     "(Cook-Torrance, split-sum image-based lighting) on ModernGL.")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    r = sub.add_parser("render", help="render a material to a PNG or EXR, headless",
+                       description="Render a material headless. With only --out: the default material ball "
+                                   "in the built-in studio.")
+    _add_scene_options(r)
+    _add_bake_options(r)
+    d = r.add_argument_group("image")
+    d.add_argument("--size", type=_size, default=(1024, 1024), metavar="W|WxH", help="image size (default: 1024)")
+    d.add_argument("--tonemap", choices=("none", "aces", "neutral"), default="aces",
+                   help="PNG only: none (clamp), ACES fitted (Hill), Khronos PBR Neutral (default: aces)")
+    d.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
+                   help="PNG only: multiply radiance by 2^EV before tone mapping (default: 0)")
+    d.add_argument("--background", choices=("env", "blur", "color", "transparent"), default="env",
+                   help="what lies behind the object (default: env); alpha is 0 there in every mode")
+    d.add_argument("--background-color", metavar="R,G,B", help="linear colour for --background color")
+    d.add_argument("--aa", choices=("none", "msaa", "ssaa"), default="msaa",
+                   help="anti-aliasing: msaa (4 samples) or ssaa (2x2 supersampling) (default: msaa; "
+                        "the probe view never blends pixels)")
+    d.add_argument("--out", required=True, metavar="FILE.png|FILE.exr",
+                   help=".png: 8-bit sRGB after exposure and tone mapping; .exr: linear float32 RGBA radiance, "
+                        "alpha 1 on the surface (CONVENTIONS.md)")
+    d.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer and time per step")
+
+    b = sub.add_parser("bake", help="bake an environment's IBL maps and write them as images",
+                       description="Write the baked maps as equirectangular images (linear .exr and "
+                                   "ACES-tone-mapped .png): the source cube, the irradiance, each "
+                                   "prefiltered roughness step, and the BRDF LUT.")
+    b.add_argument("--env", default="studio", help="'studio' or an equirectangular .hdr/.exr map")
+    _add_bake_options(b)
+    b.add_argument("--width", type=int, default=512, help="width of the written equirect images (default: 512)")
+    b.add_argument("--out", required=True, metavar="DIR", help="folder for the images (created if missing)")
+
+    sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 0
+    try:
+        if args.command == "render":
+            return _render(args)
+        if args.command == "bake":
+            return _bake(args)
+        if args.command == "presets":
+            return _presets()
+    except AlightError as exc:
+        print(f"alight: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("alight: interrupted", file=sys.stderr)
+        return 130
+    return 0
+
+
+def _warn(lines) -> None:
+    for line in lines:
+        print(f"alight: warning: {line}", file=sys.stderr)
+
+
+def build_material(args):
+    """The preset (or the default material) with the field flags on top; also the overrides alone."""
+    from app.material import Material, load_preset, parse_color, with_overrides
+
+    base = load_preset(args.preset) if args.preset else Material()
+    overrides = {
+        "base_color": parse_color(args.base_color, "--base-color") if args.base_color else None,
+        "metallic": args.metallic,
+        "roughness": args.roughness,
+        "specular_f0": parse_color(args.specular_f0, "--specular-f0") if args.specular_f0 else None,
+        "emissive": parse_color(args.emissive, "--emissive") if args.emissive else None,
+    }
+    overrides = {k: v for k, v in overrides.items() if v is not None}
+    if "base_color" in overrides and max(overrides["base_color"]) > 1.0:
+        raise AlightError(f"--base-color: {args.base_color} has a component above 1")
+    if "specular_f0" in overrides and max(overrides["specular_f0"]) > 1.0:
+        raise AlightError(f"--specular-f0: {args.specular_f0} has a component above 1")
+    return with_overrides(base, **overrides), overrides
+
+
+def _render(args) -> int:
+    from app.output import check_output_path
+
+    start = time.perf_counter()
+    out = check_output_path(args.out)
+    width, height = args.size
+    if args.view == "probe" and width != height:
+        raise AlightError(f"--size: the probe view is square; got {width}x{height}")
+    material, overrides = build_material(args)
+
+    from app.environment import load_environment
+    from app.mesh import load_mesh
+    from app.scene import Display, Scene, parse_light
+
+    lights = [parse_light(spec) for spec in args.light]
+    mesh = load_mesh(args.mesh) if args.view == "camera" else None
+    env = None if args.no_ibl else load_environment(args.env)
+    if env is not None:
+        _warn(env.warnings)
+    display = Display(tonemap=args.tonemap, exposure=args.exposure, background=args.background)
+    if args.background_color:
+        from app.material import parse_color
+
+        display.background_color = parse_color(args.background_color, "--background-color")
+    scene = Scene(mesh=mesh, material=material, use_file_materials=not args.preset,
+                  material_overrides=overrides, lights=lights, view=args.view,
+                  env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
+                  ibl_enabled=env is not None, display=display)
+    loaded = time.perf_counter()
+
+    from app.bake import quality_named
+    from app.output import write_image
+    from app.renderer import Renderer
+
+    renderer = Renderer()
+    maps = renderer.bake(env, quality_named(args.quality, args.irradiance)) if env is not None else None
+    baked = time.perf_counter()
+    frame = renderer.render(scene, maps, width, height, aa=args.aa,
+                            read_linear=out.suffix.lower() == ".exr", read_srgb=out.suffix.lower() == ".png")
+    rendered = time.perf_counter()
+    if out.suffix.lower() == ".exr":
+        write_image(out, frame.linear, linear=True)
+    else:
+        pixels = frame.srgb if args.background == "transparent" else frame.srgb[:, :, :3]
+        write_image(out, pixels, linear=False)
+    if args.verbose:
+        from app.gpu import describe
+
+        done = time.perf_counter()
+        print(f"{describe(renderer.ctx)}\nload {loaded - start:.3f}s  bake {baked - loaded:.3f}s "
+              f"render {rendered - baked:.3f}s  write {done - rendered:.3f}s", file=sys.stderr)
+        if maps is not None:
+            print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
+                  file=sys.stderr)
+    print(out)
+    return 0
+
+
+def _bake(args) -> int:
+    import os
+    from pathlib import Path
+
+    import numpy as np
+
+    from app.environment import load_environment
+
+    if args.width < 8 or args.width > 8192 or args.width % 2:
+        raise AlightError(f"--width: {args.width} must be an even number from 8 to 8192")
+    out_dir = Path(args.out)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise AlightError(f"{out_dir}: exists and is not a folder")
+    env = load_environment(args.env)
+    _warn(env.warnings)
+
+    from app.bake import grid_roughness, quality_named
+    from app.output import write_image
+    from app.renderer import Renderer
+    from app.shading import linear_to_srgb, tonemap_aces_fitted
+
+    renderer = Renderer()
+    q = quality_named(args.quality, args.irradiance)
+    maps = renderer.bake(env, q)
+    os.makedirs(out_dir, exist_ok=True)
+    w = args.width
+
+    def save(name: str, linear: np.ndarray) -> None:
+        write_image(out_dir / f"{name}.exr", linear.astype(np.float32), linear=True)
+        srgb = (linear_to_srgb(tonemap_aces_fitted(linear[:, :, :3])) * 255.0 + 0.5).astype(np.uint8)
+        write_image(out_dir / f"{name}.png", srgb, linear=False)
+
+    save("environment", _cube_as_equirect(renderer, maps.environment, 0.0, w))
+    save("irradiance", _cube_as_equirect(renderer, maps.irradiance, 0.0, w))
+    levels = q.prefiltered_levels
+    for step in range(2 * levels - 1):
+        cube = maps.prefiltered_radiance if step % 2 == 0 else maps.prefiltered_radiance_mid
+        save(f"prefiltered_step{step:02d}_r{grid_roughness(step, levels):.3f}",
+             _cube_as_equirect(renderer, cube, float(step // 2), w))
+    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 2)[::-1]
+    lut_rgb = np.concatenate([lut, np.zeros(lut.shape[:2] + (1,), np.float32)], axis=2)
+    write_image(out_dir / "brdf_lut.exr", lut_rgb, linear=True)
+    # The LUT is already in [0,1]: shown as is (red = scale A, green = bias B; n.v right, roughness up).
+    write_image(out_dir / "brdf_lut.png", (linear_to_srgb(lut_rgb) * 255.0 + 0.5).astype(np.uint8), linear=False)
+    for name, seconds in maps.pass_seconds.items():
+        print(f"{name}: {seconds * 1000:.1f} ms")
+    print(out_dir)
+    return 0
+
+
+def _cube_as_equirect(renderer, cube, lod: float, width: int):
+    import moderngl
+    import numpy as np
+
+    ctx = renderer.ctx
+    height = width // 2
+    image = ctx.texture((width, height), 4, dtype="f4")
+    prog = renderer.shaders.compute("util/cube_to_equirect.comp")
+    cube.use(0)
+    prog["u_cube"] = 0
+    prog["u_lod"] = lod
+    prog["u_size"] = (width, height)
+    image.bind_to_image(0, read=False, write=True)
+    prog.run((width + 7) // 8, (height + 7) // 8, 1)
+    ctx.memory_barrier(moderngl.ALL_BARRIER_BITS)
+    pixels = np.frombuffer(image.read(), np.float32).reshape(height, width, 4).copy()
+    image.release()
+    return pixels
+
+
+def _presets() -> int:
+    from app.material import list_presets, load_preset
+    from app.shading import linear_to_srgb
+
+    print(f"{'preset':20s} {'metallic':>8s} {'roughness':>9s}  {'F0 linear':22s} F0 sRGB")
+    for name in list_presets():
+        m = load_preset(name)
+        f0 = m.f0()
+        srgb = linear_to_srgb(f0)
+        print(f"{name:20s} {m.metallic:8.0f} {m.roughness:9.2f}  "
+              f"({f0[0]:.2f}, {f0[1]:.2f}, {f0[2]:.2f})     ({srgb[0]:.2f}, {srgb[1]:.2f}, {srgb[2]:.2f})")
+    return 0
