@@ -1,0 +1,65 @@
+"""No NaN or Inf anywhere at the edges of the parameter space: roughness 0 and 1, metallic 0 and 1,
+n.v -> 0 (the probe's rim and a sphere's silhouette), punctual lights at grazing angles, a very
+bright sun, an all-black environment."""
+
+import numpy as np
+import pytest
+
+from app.environment import Environment, constant_environment, load_environment
+from app.material import Material
+from app.mesh import plane, sphere
+from app.scene import Light, Scene
+from tests.gpu import renderer
+
+LIGHTS = [Light("point", (0.0, 0.0, 1.05)), Light("point", (3.0, 0.0, 0.0), intensity=50.0),
+          Light("directional", (0.0, 0.0, -1.0), intensity=5.0), Light("directional", (1.0, 0.0, -0.001))]
+
+
+@pytest.fixture(scope="module")
+def quarry(shared_data):
+    return load_environment(str(shared_data / "env" / "quarry_01_1k.hdr"))   # sun peak 86,528
+
+
+@pytest.mark.parametrize("roughness", [0.0, 1.0])
+@pytest.mark.parametrize("metallic", [0.0, 1.0])
+@pytest.mark.parametrize("view", ["probe", "camera"])
+def test_finite_at_parameter_extremes(quarry, roughness, metallic, view):
+    r = renderer()
+    maps = r.bake(quarry, "low")
+    m = Material(base_color=(1.0, 1.0, 1.0), metallic=metallic, roughness=roughness,
+                 specular_f0=(1.0, 1.0, 1.0) if metallic == 0 else (0.04, 0.04, 0.04))
+    frame = r.render(Scene(mesh=sphere(), material=m, view=view, lights=LIGHTS), maps, 96, 96)
+    assert np.isfinite(frame.linear).all()
+    assert frame.linear.min() >= 0.0
+    if view == "probe":
+        # The outermost ring of the disk has n.v -> 0: it must be finite and not black by accident.
+        rim = frame.linear[48, 0:3, :3]
+        assert np.isfinite(rim).all()
+
+
+def test_grazing_plane_and_zero_roughness_lights():
+    r = renderer()
+    maps = r.bake(constant_environment(1.0, 64), "low")
+    m = Material(roughness=0.0, metallic=1.0, base_color=(1.0, 1.0, 1.0))
+    from app.scene import Camera
+
+    # The camera skims the plane: n.v is near 0 over most of the image.
+    cam = Camera(position=(0.0, 0.01, 3.0), target=(0.0, 0.0, 0.0))
+    frame = r.render(Scene(mesh=plane(), material=m, camera=cam, lights=LIGHTS), maps, 64, 64)
+    assert np.isfinite(frame.linear).all()
+
+
+def test_black_environment_gives_black_without_lights():
+    r = renderer()
+    black = Environment(radiance=np.zeros((32, 64, 3), np.float32), name="black", warnings=[])
+    maps = r.bake(black, "low")
+    frame = r.render(Scene(material=Material(roughness=0.5), view="probe"), maps, 32, 32)
+    assert np.isfinite(frame.linear).all() and frame.linear[..., :3].max() == 0.0
+
+
+def test_emissive_adds_exactly(quarry):
+    r = renderer()
+    black = Environment(radiance=np.zeros((32, 64, 3), np.float32), name="black", warnings=[])
+    maps = r.bake(black, "low")
+    frame = r.render(Scene(material=Material(emissive=(2.0, 0.5, 0.0)), view="probe"), maps, 16, 16)
+    np.testing.assert_allclose(frame.linear[8, 8, :3], [2.0, 0.5, 0.0], atol=1e-6)
