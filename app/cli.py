@@ -165,7 +165,7 @@ def build_material(args):
     """The preset (or the default material) with the field flags on top; also the overrides alone."""
     from app.material import Material, load_preset, parse_color, with_overrides
 
-    base = load_preset(args.preset) if args.preset else Material()
+    base = load_preset(args.preset) if args.preset is not None else Material()
     overrides = {
         "base_color": parse_color(args.base_color, "--base-color") if args.base_color else None,
         "metallic": args.metallic,
@@ -205,7 +205,7 @@ def _render(args) -> int:
         from app.material import parse_color
 
         display.background_color = parse_color(args.background_color, "--background-color")
-    scene = Scene(mesh=mesh, material=material, use_file_materials=not args.preset,
+    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
                   material_overrides=overrides, lights=lights, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, display=display)

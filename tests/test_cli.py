@@ -313,6 +313,7 @@ BAD_INPUT = [
     pytest.param(["--preset", "{in}/rough.json"], ["{in}/rough.json", "roughness"], id="preset-roughness-range"),
     pytest.param(["--preset", "{in}/notjson.json"], ["{in}/notjson.json"], id="preset-not-json"),
     pytest.param(["--preset", "no_such_preset"], ["no_such_preset"], id="unknown-preset"),
+    pytest.param(["--preset", ""], ["no preset"], id="empty-preset"),
     pytest.param(["--mesh", "{in}/missing.obj"], ["{in}/missing.obj"], id="missing-mesh"),
     pytest.param(["--mesh", "{in}/corrupt.glb"], ["{in}/corrupt.glb"], id="corrupt-glb"),
     pytest.param(["--roughness", "1.5"], ["--roughness"], id="roughness-range"),

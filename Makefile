@@ -1,0 +1,16 @@
+# The two commands of README.md. Each installs whatever is missing first (tools/setup.sh).
+.PHONY: setup demo test bench
+
+setup:
+	@bash tools/setup.sh
+
+# The main job on built-in defaults: the default material ball in the built-in studio.
+demo: setup
+	.venv/bin/alight render --out alight-demo.png
+
+# The test suite, headless (EGL; the editor's tests start their own Xvfb).
+test: setup
+	.venv/bin/python -m pytest -q
+
+bench: setup
+	.venv/bin/python benchmarks/bench_render.py

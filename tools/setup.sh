@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs what alight needs on a Debian machine, skipping what is already there:
+#   Debian: Mesa's EGL and software OpenGL (headless renders), Xvfb (the editor's window tests);
+#   Python: a virtual environment in .venv with alight installed from this checkout (not editable).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1 libgl1 xvfb xauth)
+missing=()
+for pkg in "${packages[@]}"; do
+  dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing Debian packages: ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+python=${PYTHON:-python3}
+if [ ! -x .venv/bin/python ]; then
+  echo "setup: creating .venv"
+  "$python" -m venv .venv
+fi
+# A real (non-editable) install: proves the wheel carries shaders/ and presets/.
+.venv/bin/python -m pip install --quiet --disable-pip-version-check ".[test]" 2>&1 \
+  | grep -v "is ignored: it is neither a file nor a directory" || true
