@@ -41,6 +41,9 @@ def describe(ctx: moderngl.Context) -> str:
 
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
+# Line numbers carry the file: line = file_index * LINE_STRIDE + line_in_file. Drivers disagree
+# on the source-string number of #line (Mesa reports 0 for some errors), never on the line.
+LINE_STRIDE = 100000
 _VERSION = re.compile(r"^\s*#\s*version\b")
 
 
@@ -74,7 +77,8 @@ def load_source(name: str, defines: dict[str, object] | None = None, root: Path 
             raise ShaderCompileError(f"{path}: cannot read shader ({exc.strerror})") from None
         files.append(path)
         index = len(files) - 1
-        out: list[str] = []
+        # Each file's lines carry its own number, so compiler messages name the right file.
+        out: list[str] = [f"#line {index * LINE_STRIDE + 1}"] if index > 0 else []
         for number, line in enumerate(lines, start=1):
             match = _INCLUDE.match(line)
             if match:
@@ -82,7 +86,7 @@ def load_source(name: str, defines: dict[str, object] | None = None, root: Path 
                 if target not in included:
                     included.add(target)
                     out.extend(expand(target))
-                out.append(f"#line {number + 1} {index}")
+                out.append(f"#line {index * LINE_STRIDE + number + 1}")
             else:
                 out.append(line)
         return out
@@ -99,25 +103,28 @@ def load_source(name: str, defines: dict[str, object] | None = None, root: Path 
         header.append(f"#version {GL_VERSION} core")
     for key, value in (defines or {}).items():
         header.append(f"#define {key} {value}" if value is not None else f"#define {key}")
-    header.append(f"#line {first_line} 0")
+    header.append(f"#line {first_line}")
     return ShaderSource("\n".join(header + body) + "\n", files)
 
 
 def translate_log(log: str, files: list[Path], root: Path | None = None) -> str:
-    """Turn Mesa/NVIDIA messages ``N:L(C): error`` / ``N(L) : error`` into ``file:L: error``."""
+    """Turn Mesa's ``S:L(C): error`` and NVIDIA's ``S(L) : error`` into ``file:line: error``,
+    the file being encoded in L (see LINE_STRIDE)."""
     root = root or shader_dir()
 
-    def name(index: str) -> str:
-        i = int(index)
-        if 0 <= i < len(files):
+    def where(line: str) -> str:
+        index, number = divmod(int(line), LINE_STRIDE)
+        if 0 <= index < len(files):
             try:
-                return str(files[i].relative_to(root.parent))
+                name = str(files[index].relative_to(root.parent))
             except ValueError:
-                return str(files[i])
-        return f"<source {index}>"
+                name = str(files[index])
+        else:
+            name = f"<source {index}>"
+        return f"{name}:{number}:"
 
-    log = re.sub(r"\b(\d+):(\d+)\(\d+\):", lambda m: f"{name(m.group(1))}:{m.group(2)}:", log)
-    log = re.sub(r"\b(\d+)\((\d+)\) :", lambda m: f"{name(m.group(1))}:{m.group(2)}:", log)
+    log = re.sub(r"\b\d+:(\d+)\(\d+\):", lambda m: where(m.group(1)), log)
+    log = re.sub(r"\b\d+\((\d+)\) :", lambda m: where(m.group(1)), log)
     return log
 
 

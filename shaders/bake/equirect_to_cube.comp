@@ -19,17 +19,8 @@ void main() {
         for (int i = 0; i < u_subsamples; ++i) {
             vec2 offset = (vec2(i, j) + 0.5) / float(u_subsamples) - 0.5;
             vec2 st = 2.0 * (vec2(texel.xy) + 0.5 + offset) / float(u_size) - 1.0;
-            // Same face table as cube_texel_direction, at a sub-texel position.
-            vec3 d;
-            switch (texel.z) {
-                case 0: d = vec3(1.0, -st.y, -st.x); break;
-                case 1: d = vec3(-1.0, -st.y, st.x); break;
-                case 2: d = vec3(st.x, 1.0, st.y); break;
-                case 3: d = vec3(st.x, -1.0, -st.y); break;
-                case 4: d = vec3(st.x, -st.y, 1.0); break;
-                default: d = vec3(-st.x, -st.y, -1.0); break;
-            }
-            sum += textureLod(u_equirect, direction_to_equirect_uv(normalize(d)), 0.0).rgb;
+            vec3 d = normalize(cube_face_direction(texel.z, st));
+            sum += textureLod(u_equirect, direction_to_equirect_uv(d), 0.0).rgb;
         }
     }
     imageStore(u_cube, texel, vec4(sum / float(u_subsamples * u_subsamples), 1.0));

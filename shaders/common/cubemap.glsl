@@ -1,21 +1,21 @@
 // Directions of cubemap texels, for passes that write cube faces as images.
 
-// Direction through the centre of texel (x, y) of face f (OpenGL's face order +X -X +Y -Y +Z -Z;
-// row y = 0 is the first row in memory, t = 0 in the spec's face table).
-vec3 cube_texel_direction(ivec3 texel, int size) {
-    vec2 st = 2.0 * (vec2(texel.xy) + 0.5) / float(size) - 1.0;
-    float s = st.x;
-    float t = st.y;
-    vec3 d;
-    switch (texel.z) {
-        case 0: d = vec3(1.0, -t, -s); break;
-        case 1: d = vec3(-1.0, -t, s); break;
-        case 2: d = vec3(s, 1.0, t); break;
-        case 3: d = vec3(s, -1.0, -t); break;
-        case 4: d = vec3(s, -t, 1.0); break;
-        default: d = vec3(-s, -t, -1.0); break;
+// Direction (not normalised) through face coordinates st in [-1, 1]^2 of face f, in OpenGL's
+// face order +X -X +Y -Y +Z -Z (t = -1 is the first row in memory; the spec's face table).
+vec3 cube_face_direction(int face, vec2 st) {
+    switch (face) {
+        case 0: return vec3(1.0, -st.y, -st.x);
+        case 1: return vec3(-1.0, -st.y, st.x);
+        case 2: return vec3(st.x, 1.0, st.y);
+        case 3: return vec3(st.x, -1.0, -st.y);
+        case 4: return vec3(st.x, -st.y, 1.0);
+        default: return vec3(-st.x, -st.y, -1.0);
     }
-    return normalize(d);
+}
+
+// Unit direction through the centre of texel (x, y) of face z.
+vec3 cube_texel_direction(ivec3 texel, int size) {
+    return normalize(cube_face_direction(texel.z, 2.0 * (vec2(texel.xy) + 0.5) / float(size) - 1.0));
 }
 
 // Solid angle of one texel of a cube face of the given size, averaged over the sphere.
