@@ -53,7 +53,8 @@ class _GpuPart:
         self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
         self.vao = ctx.vertex_array(program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv",
-                                               "in_tangent")], self.ibo, index_element_size=4)
+                                               "in_tangent")], self.ibo, index_element_size=4,
+                                       skip_errors=True)  # a debug shader may not read every attribute
         self.textures: dict[str, moderngl.Texture] = {}
         fm = part.material
         if fm is not None:
@@ -213,12 +214,16 @@ class Renderer:
         camera = Camera() if scene.view == "probe" else self.camera_for(scene, aspect)
         view_projection = camera.view_projection(aspect)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
-        self._draw_background(scene, maps, inverse_vp)
         self._write_lights(scene)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
         if scene.view == "probe":
             self._draw_probe(scene, maps, width)
         elif scene.mesh is not None:
             self._draw_mesh(scene, maps, camera, view_projection)
+        # After the surfaces: the depth test keeps the background's shading off covered pixels.
+        self._draw_background(scene, maps, inverse_vp)
+        ctx.disable(moderngl.DEPTH_TEST)
         self._finish_radiance(targets)
 
     def camera_for(self, scene: Scene, aspect: float) -> Camera:
@@ -231,7 +236,7 @@ class Renderer:
 
     def _bind_ibl(self, program: moderngl.Program, scene: Scene, maps: IBLMaps | None) -> None:
         enabled = bool(scene.ibl_enabled and maps is not None)
-        program["u_ibl_enabled"] = enabled
+        _set(program, "u_ibl_enabled", enabled)
         if not enabled:
             return
         maps.irradiance.use(UNIT_IRRADIANCE)
@@ -274,7 +279,6 @@ class Renderer:
             _set(prog, "u_inverse_view_projection", inverse_vp.tobytes(), write=True)
             _set(prog, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
             _set(prog, "u_env_intensity", float(scene.env_intensity))
-        self.ctx.disable(moderngl.DEPTH_TEST)
         self._fullscreen(prog)
 
     def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:
@@ -283,13 +287,11 @@ class Renderer:
         prog["u_size"] = float(size)
         _set_material(prog, m)
         self._bind_ibl(prog, scene, maps)
-        self.ctx.disable(moderngl.DEPTH_TEST)
         self._fullscreen(prog)
 
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray) -> None:
         ctx = self.ctx
         prog = self.program("render/pbr.vert", "render/pbr.frag")
-        ctx.enable(moderngl.DEPTH_TEST)
         # Both faces: open meshes and planes are seen from behind too (the shader flips n).
         ctx.disable(moderngl.CULL_FACE)
         _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
@@ -309,7 +311,6 @@ class Renderer:
                 if tex is not None:
                     tex.use(UNIT_MATERIAL[name])
             gpu_part.vao.render(moderngl.TRIANGLES)
-        ctx.disable(moderngl.DEPTH_TEST)
 
     @staticmethod
     def _part_material(scene: Scene, part, gpu_part) -> tuple[Material, bool]:

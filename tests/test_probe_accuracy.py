@@ -4,9 +4,10 @@ prefiltered radiance as the exact ratio of integrals the lecture's loop converge
 weight n.l), the LUT by fine quadrature. What remains is the implementation's own error: sample
 counts, cube resolution, the roughness grid's blending, the LUT's table.
 
-Bound: 2% (sum |render - ideal| / sum |ideal| over the disk) at the default quality, the
-project's target for environments without a dominant sun. Measured here: dielectric 0.9%, metal
-1.1-1.8% (see the printed figures with -s). The metal is the hard case: its whole signal is the
+Bounds (sum |render - ideal| / sum |ideal| over the disk) at the default quality: 2% on
+royal_esplanade (no dominant sun) and 5% on quarry_01 (a sun holding half the map's power),
+the project's targets. Measured here: royal dielectric 0.6%, metal 0.7-1.8%; quarry dielectric
+0.1-0.3%, metal 0.4-0.9% (its sun is added in closed form, app/sun.py). Run with -s to see them. The metal is the hard case: its whole signal is the
 prefiltered map, whose first rough step (r = 0.25) is the least sampled per solid angle. The
 in-between roughness values (0.3, 0.75) are not grid steps: they measure the blending too.
 """
@@ -22,7 +23,6 @@ from app.scene import Scene
 from tests.gpu import renderer
 
 WIDTH = 48
-BOUND = 0.02
 ROUGHNESS = [0.25, 0.3, 0.5, 0.75, 1.0]
 MATERIALS = {
     "dielectric": Material(base_color=(0.8, 0.8, 0.8), metallic=0.0),
@@ -30,25 +30,29 @@ MATERIALS = {
 }
 
 
-@pytest.fixture(scope="module")
-def setup(shared_data):
-    env = load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr"))
-    n, inside = shading.probe_normals(WIDTH)
-    normals = n[inside]
-    return env, inside, normals, irradiance_converged(env.radiance, normals)
+ENVIRONMENTS = {"royal_esplanade_1k.hdr": 0.02, "quarry_01_1k.hdr": 0.05}
+_cache: dict = {}
 
 
-@pytest.fixture(scope="module")
-def prefiltered_ideal(setup):
-    env, _, normals, _ = setup
-    reflected = shading.reflect(-np.array([0.0, 0.0, 1.0]), normals)
-    return {r: prefiltered_converged(env.radiance, reflected, r) for r in ROUGHNESS}
+def ideal_parts(shared_data, env_name, roughness):
+    """The converged irradiance (per map) and prefiltered radiance (per map and roughness)."""
+    if env_name not in _cache:
+        env = load_environment(str(shared_data / "env" / env_name))
+        n, inside = shading.probe_normals(WIDTH)
+        normals = n[inside]
+        _cache[env_name] = (env, inside, normals, irradiance_converged(env.radiance, normals), {})
+    env, inside, normals, irradiance, prefiltered = _cache[env_name]
+    if roughness not in prefiltered:
+        reflected = shading.reflect(-np.array([0.0, 0.0, 1.0]), normals)
+        prefiltered[roughness] = prefiltered_converged(env.radiance, reflected, roughness)
+    return env, inside, normals, irradiance, prefiltered[roughness]
 
 
-@pytest.mark.parametrize("roughness", ROUGHNESS)
+@pytest.mark.parametrize("env_name,roughness", [(e, r) for e in ENVIRONMENTS for r in ROUGHNESS
+                                                if e == "royal_esplanade_1k.hdr" or r in (0.25, 0.5, 1.0)])
 @pytest.mark.parametrize("name", list(MATERIALS))
-def test_probe_within_bound_of_converged_split_sum(setup, prefiltered_ideal, name, roughness):
-    env, inside, normals, irradiance = setup
+def test_probe_within_bound_of_converged_split_sum(shared_data, env_name, name, roughness):
+    env, inside, normals, irradiance, prefiltered = ideal_parts(shared_data, env_name, roughness)
     m = Material(base_color=MATERIALS[name].base_color, metallic=MATERIALS[name].metallic, roughness=roughness)
     r = renderer()
     maps = r.bake(env, "medium")
@@ -59,9 +63,10 @@ def test_probe_within_bound_of_converged_split_sum(setup, prefiltered_ideal, nam
     F = shading.F_SchlickRoughness(n_dot_v, f0, roughness)
     kd = (1 - F) * (1 - m.metallic)
     a, b = brdf_lut_converged(n_dot_v, np.full_like(n_dot_v, roughness))
-    ideal = kd * np.array(m.base_color) * irradiance + prefiltered_ideal[roughness] * (F * a[:, None] + b[:, None])
+    ideal = kd * np.array(m.base_color) * irradiance + prefiltered * (F * a[:, None] + b[:, None])
 
     error = np.abs(got - ideal).sum() / np.abs(ideal).sum()
-    print(f"{name} r={roughness}: {error * 100:.2f}%")
+    bound = ENVIRONMENTS[env_name]
+    print(f"{env_name} {name} r={roughness}: {error * 100:.2f}%")
     assert np.isfinite(got).all()
-    assert error <= BOUND, f"{name} r={roughness}: {error * 100:.2f}% > {BOUND * 100:.0f}%"
+    assert error <= bound, f"{env_name} {name} r={roughness}: {error * 100:.2f}% > {bound * 100:.0f}%"

@@ -22,3 +22,17 @@ vec3 cube_texel_direction(ivec3 texel, int size) {
 float cube_texel_solid_angle(int size) {
     return 4.0 * PI / (6.0 * float(size * size));
 }
+
+// Exact solid angle of texel (x, y) of a cube face of the given size: the area of the face
+// rectangle projected onto the unit sphere, from A(s, t) = atan(s t / sqrt(s^2 + t^2 + 1)).
+float cube_area_element(float s, float t) {
+    return atan(s * t, sqrt(s * s + t * t + 1.0));
+}
+
+float cube_texel_solid_angle_exact(ivec2 texel, int size) {
+    float inv = 1.0 / float(size);
+    vec2 lo = 2.0 * vec2(texel) * inv - 1.0;
+    vec2 hi = lo + 2.0 * inv;
+    return cube_area_element(lo.x, lo.y) - cube_area_element(lo.x, hi.y)
+         - cube_area_element(hi.x, lo.y) + cube_area_element(hi.x, hi.y);
+}

@@ -21,4 +21,5 @@ void main() {
     vec3 n = vec3(xy, sqrt(1.0 - r2));
     Surface s = Surface(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
     out_radiance = vec4(shade(s, n, vec3(0.0, 0.0, 1.0), n), 1.0);
+    gl_FragDepth = 0.0;  // in front of the background, which is drawn after on the far plane
 }

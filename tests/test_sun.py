@@ -1,0 +1,74 @@
+"""A compact bright source is taken out of the map and added back in closed form (app/sun.py)."""
+
+import numpy as np
+import pytest
+
+from app import shading
+from app.bake import read_cube
+from app.converged import irradiance_converged
+from app.environment import Environment, constant_environment, load_environment
+from app.sun import SUN_MIN_POWER_FRACTION, extract_sun
+from tests.gpu import renderer
+
+
+def synthetic_sun(direction, radiance=2.0e4, radius_deg=0.6, sky=0.5, size=512):
+    dirs, omega = shading.texel_directions(size // 2, size)
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    disk = dirs @ d > np.cos(np.radians(radius_deg))
+    env = np.full((size // 2, size, 3), sky, np.float32)
+    env[disk] = radiance
+    return env, d, float((omega[disk] * (radiance - sky)).sum())
+
+
+def power(radiance):
+    _, omega = shading.texel_directions(*radiance.shape[:2])
+    return (radiance * omega[..., None]).sum(axis=(0, 1))
+
+
+def test_extracts_a_synthetic_sun_and_conserves_power():
+    env, d, sun_power = synthetic_sun([0.3, 0.5, -0.8])
+    without, sun = extract_sun(env)
+    assert sun is not None
+    assert np.degrees(np.arccos(np.clip(sun.direction @ d, -1, 1))) < 0.3
+    np.testing.assert_allclose(sun.power, sun_power, rtol=2e-3)
+    np.testing.assert_allclose(power(without) + sun.power, power(env), rtol=1e-5)
+    assert without.max() <= 0.5 + 1e-6          # the hole is filled with the surrounding sky
+
+
+@pytest.mark.parametrize("name", ["royal_esplanade_1k.hdr", "venice_sunset_1k.hdr", "newport_loft.hdr"])
+def test_leaves_broad_light_alone(shared_data, name):
+    env = load_environment(str(shared_data / "env" / name))
+    without, sun = extract_sun(env.radiance)
+    assert sun is None and without is env.radiance
+
+
+def test_constant_and_black_maps_have_no_sun():
+    assert extract_sun(constant_environment(1.0, 64).radiance)[1] is None
+    assert extract_sun(np.zeros((32, 64, 3), np.float32))[1] is None
+
+
+@pytest.mark.parametrize("name,fraction", [("quarry_01_1k.hdr", 0.45), ("pedestrian_overpass_1k.hdr", 0.5),
+                                           ("spot1Lux.hdr", 0.95)])
+def test_finds_the_sun_of_the_shared_maps(shared_data, name, fraction):
+    env = load_environment(str(shared_data / "env" / name))
+    without, sun = extract_sun(env.radiance)
+    assert sun is not None and sun.fraction > max(fraction, SUN_MIN_POWER_FRACTION)
+    np.testing.assert_allclose(power(without) + sun.power, power(env.radiance), rtol=1e-4)
+
+
+def test_baked_irradiance_with_a_sun_matches_the_texel_sum():
+    env_radiance, _, _ = synthetic_sun([0.6, 0.4, 0.2])
+    env = Environment(radiance=env_radiance, name="synthetic sun", warnings=[])
+    r = renderer()
+    maps = r.bake(env, "medium")
+    assert maps.sun is not None
+    irr = read_cube(r.shaders, maps.irradiance)[..., :3]
+    size = irr.shape[1]
+    c = 2 * (np.arange(size) + 0.5) / size - 1
+    s, t = np.meshgrid(c, c)
+    faces = np.stack([np.stack(f, -1) for f in [(np.ones_like(s), -t, -s), (-np.ones_like(s), -t, s), (s, np.ones_like(s), t),
+                                                 (s, -np.ones_like(s), -t), (s, -t, np.ones_like(s)), (-s, -t, -np.ones_like(s))]])
+    dirs = (faces / np.linalg.norm(faces, axis=-1, keepdims=True)).reshape(-1, 3)[::11]
+    ideal = irradiance_converged(env_radiance, dirs)
+    got = irr.reshape(-1, 3)[::11]
+    assert np.abs(got - ideal).sum() / np.abs(ideal).sum() < 0.01
