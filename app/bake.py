@@ -22,7 +22,7 @@ import numpy as np
 
 from app.gpu import ShaderLibrary
 from app.shading import D_GGX, hammersley, importance_sample_ggx_tangent
-from app.sun import Sun, extract_sun
+from app.sun import MAX_SUNS, Sun, extract_suns
 from app.output import atomic_path
 from app.paths import cache_dir
 
@@ -155,7 +155,7 @@ class IBLMaps:
     brdf_lut: moderngl.Texture               # RG: (A, B)
     quality: BakeQuality
     pass_seconds: dict[str, float] = field(default_factory=dict)
-    sun: Sun | None = None                   # a compact source handled in closed form, if any
+    suns: list[Sun] = field(default_factory=list)   # compact sources handled in closed form
 
     @property
     def prefiltered_max_mip(self) -> float:
@@ -275,15 +275,13 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
     q = quality
     seconds: dict[str, float] = {}
     found: list = []
-    _timed(ctx, seconds, "sun", lambda: found.append(extract_sun(env.radiance)))
-    lighting_radiance, sun = found[0]
-    sun_direction = tuple(sun.direction) if sun else (0.0, 1.0, 0.0)
-    sun_power = tuple(sun.power) if sun else (0.0, 0.0, 0.0)
+    _timed(ctx, seconds, "suns", lambda: found.append(extract_suns(env.radiance)))
+    lighting_radiance, suns = found[0]
 
     # The environment as seen (background, mirror) keeps its sun; the lighting passes read a
     # copy without it and add the sun back in closed form.
     source = _source_cube(ctx, shaders, env.radiance, q, seconds, "environment")
-    lighting = source if sun is None else _source_cube(ctx, shaders, lighting_radiance, q, seconds, "lighting")
+    lighting = source if not suns else _source_cube(ctx, shaders, lighting_radiance, q, seconds, "lighting")
 
     irradiance = _cube(ctx, q.irradiance_size, 1)
     if q.irradiance == "convolution":
@@ -295,15 +293,14 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
             prog["u_phi_steps"] = q.irradiance_phi_steps
             prog["u_theta_steps"] = q.irradiance_theta_steps
             prog["u_source_mip"] = max(0.0, math.log2(q.cube_size / q.irradiance_source_size))
-            prog["u_sun_direction"] = sun_direction
-            prog["u_sun_power"] = sun_power
+            _set_suns(prog, suns)
             irradiance.bind_to_image(0, read=False, write=True, level=0)
             prog.run(_groups(q.irradiance_size), _groups(q.irradiance_size), 6)
             ctx.memory_barrier()
         _timed(ctx, seconds, "irradiance_convolution", convolve)
     elif q.irradiance == "sh9":
         _timed(ctx, seconds, "irradiance_sh9",
-               lambda: _irradiance_sh9(ctx, shaders, lighting_radiance, irradiance, q, sun))
+               lambda: _irradiance_sh9(ctx, shaders, lighting_radiance, irradiance, q, suns))
     else:
         raise ValueError(f"unknown irradiance method {q.irradiance!r}")
 
@@ -315,8 +312,7 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
         prog = shaders.compute("bake/prefilter.comp")
         lighting.use(0)
         prog["u_environment"] = 0
-        prog["u_sun_direction"] = sun_direction
-        prog["u_sun_power"] = sun_power
+        _set_suns(prog, suns)
         for step in range(2 * levels - 1):
             target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
             size = target.size[0] >> mip
@@ -342,7 +338,17 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
     lut_box: list[moderngl.Texture] = []
     _timed(ctx, seconds, f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
            lambda: lut_box.append(luts.get(q.lut_size, q.lut_samples)))
-    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut_box[0], q, seconds, sun)
+    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut_box[0], q, seconds, suns)
+
+
+def _set_suns(prog, suns: list[Sun]) -> None:
+    directions = np.zeros((MAX_SUNS, 3), np.float32)
+    powers = np.zeros((MAX_SUNS, 3), np.float32)
+    for i, sun in enumerate(suns[:MAX_SUNS]):
+        directions[i], powers[i] = sun.direction, sun.power
+    prog["u_sun_count"] = len(suns[:MAX_SUNS])
+    prog["u_sun_direction"].write(directions.tobytes())
+    prog["u_sun_power"].write(powers.tobytes())
 
 
 def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuality,
@@ -377,7 +383,7 @@ def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuali
     return cube
 
 
-def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuality, sun: Sun | None) -> None:
+def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuality, suns: list[Sun]) -> None:
     h, w, _ = radiance.shape
     equirect_tex = upload_equirect(ctx, radiance, mipmaps=True)
     level = max(0, int(round(math.log2(max(1, w // q.sh9_source_width)))))
@@ -395,7 +401,7 @@ def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuali
     coeffs = np.frombuffer(partials.read(), dtype=np.float32).reshape(gx * gy, 9, 4)[:, :, :3].sum(axis=0)
     partials.release()
     equirect_tex.release()
-    if sun is not None:
+    for sun in suns:
         coeffs = coeffs + sh9_basis(sun.direction)[:, None] * sun.power[None, :]
     fill = shaders.compute("bake/sh9_to_cube.comp")
     fill["u_size"] = q.irradiance_size

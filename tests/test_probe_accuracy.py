@@ -6,8 +6,9 @@ counts, cube resolution, the roughness grid's blending, the LUT's table.
 
 Bounds (sum |render - ideal| / sum |ideal| over the disk) at the default quality: 2% on
 royal_esplanade (no dominant sun) and 5% on quarry_01 (a sun holding half the map's power),
-the project's targets. Measured here: royal dielectric 0.6%, metal 0.7-1.8%; quarry dielectric
-0.1-0.3%, metal 0.4-0.9% (its sun is added in closed form, app/sun.py). Run with -s to see them. The metal is the hard case: its whole signal is the
+the project's targets. Measured here: royal dielectric 0.5%, metal 0.6-1.5%; quarry dielectric
+0.1-0.3%, metal 0.4-0.9% (bright compact sources are added in closed form, app/sun.py). Run
+with -s to see them. The metal is the hard case: its whole signal is the
 prefiltered map, whose first rough step (r = 0.25) is the least sampled per solid angle. The
 in-between roughness values (0.3, 0.75) are not grid steps: they measure the blending too.
 """

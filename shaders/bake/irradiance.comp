@@ -14,9 +14,7 @@ uniform int u_size;
 uniform int u_phi_steps;
 uniform int u_theta_steps;
 uniform float u_source_mip;   // a blurred source is enough: irradiance is smooth
-// A compact bright source taken out of u_environment (app/sun.py), added back exactly.
-uniform vec3 u_sun_direction;
-uniform vec3 u_sun_power;
+#include "common/suns.glsl"
 
 void main() {
     ivec3 texel = ivec3(gl_GlobalInvocationID);
@@ -37,6 +35,5 @@ void main() {
         }
         weight_sum += w * float(u_phi_steps);
     }
-    vec3 sun = u_sun_power * max(dot(n, u_sun_direction), 0.0) / PI;
-    imageStore(u_irradiance, texel, vec4(sum / weight_sum + sun, 1.0));
+    imageStore(u_irradiance, texel, vec4(sum / weight_sum + suns_irradiance_over_pi(n), 1.0));
 }

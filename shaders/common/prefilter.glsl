@@ -10,9 +10,7 @@ uniform samplerCube u_environment;
 uniform int u_sample_count;      // samples kept (above the horizon)
 uniform float u_sample_total;    // samples drawn, kept or not: the sum's normalisation
 uniform float u_roughness;
-// A compact bright source taken out of u_environment (app/sun.py) and added back in closed form.
-uniform vec3 u_sun_direction;
-uniform vec3 u_sun_power;
+#include "common/suns.glsl"
 
 vec3 prefilter_radiance(vec3 n) {
     mat3 frame = tangent_frame(n);
@@ -25,10 +23,12 @@ vec3 prefilter_radiance(vec3 n) {
     }
     // The sum estimates (N/4) * integral of L (n.l) D(h) over l, since l has pdf D(h)/4 when
     // v = n; a delta source of power P adds (N/4) P (n.l) D(h) to it exactly.
-    float sun_n_dot_l = dot(n, u_sun_direction);
-    if (sun_n_dot_l > 0.0) {
-        float n_dot_h = dot(n, normalize(u_sun_direction + n));
-        sum += 0.25 * u_sample_total * D_GGX(n_dot_h, u_roughness) * sun_n_dot_l * u_sun_power;
+    for (int i = 0; i < u_sun_count; ++i) {
+        float sun_n_dot_l = dot(n, u_sun_direction[i]);
+        if (sun_n_dot_l > 0.0) {
+            float n_dot_h = dot(n, normalize(u_sun_direction[i] + n));
+            sum += 0.25 * u_sample_total * D_GGX(n_dot_h, u_roughness) * sun_n_dot_l * u_sun_power[i];
+        }
     }
     return sum / max(weight, 1e-8);
 }
