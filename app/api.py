@@ -16,6 +16,8 @@ releases every GPU resource.
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import os
 from pathlib import Path
 from typing import Iterable, Literal
@@ -60,15 +62,18 @@ class AlightRenderer:
         if self._renderer is None:
             from app.renderer import Renderer
 
-            self._renderer = Renderer()
+            with _keep_current_context():
+                self._renderer = Renderer()
         return self
 
     def close(self) -> None:
         """Release the GPU resources (bakes, meshes, targets, programs, the context). Idempotent."""
         r, self._renderer = self._renderer, None
         if r is not None:
-            r.release()
-            r.ctx.release()
+            with _keep_current_context():
+                r.ctx.__enter__()
+                r.release()
+                r.ctx.release()
 
     @property
     def is_open(self) -> bool:
@@ -204,6 +209,13 @@ class AlightRenderer:
         from app.bake import QUALITY
 
         self.open()
+        with _keep_current_context():
+            self._renderer.ctx.__enter__()  # another renderer in this process may have made its own current
+            return self._frame_current(w, h, linear, srgb)
+
+    def _frame_current(self, w: int, h: int, linear: bool, srgb: bool):
+        from app.bake import QUALITY
+
         r = self._renderer
         maps = None
         if self._env is not None and self.scene.ibl_enabled:
@@ -214,6 +226,47 @@ class AlightRenderer:
             maps = r.bake(self._env, quality)
             self.bakes_done += len(r._bakes) - before
         return r.render(self.scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
+
+
+_EGL_DRAW, _EGL_READ = 0x3059, 0x305A
+
+
+@contextlib.contextmanager
+def _keep_current_context():
+    """Restore whatever EGL context was current before the block.
+
+    moderngl issues GL calls to the thread's current context, and creating a context makes it
+    current; without this, opening an AlightRenderer would silently redirect another renderer's
+    draws in the same process (another library's, or a test suite's shared one) to ours.
+    """
+    egl = _libegl()
+    state = None
+    if egl is not None:
+        state = (egl.eglGetCurrentDisplay(), egl.eglGetCurrentSurface(_EGL_DRAW),
+                 egl.eglGetCurrentSurface(_EGL_READ), egl.eglGetCurrentContext())
+    try:
+        yield
+    finally:
+        if state is not None and state[3]:
+            egl.eglMakeCurrent(*state)
+
+
+@functools.lru_cache(maxsize=1)
+def _libegl():
+    import ctypes
+    import ctypes.util
+
+    name = ctypes.util.find_library("EGL")
+    if name is None:
+        return None
+    lib = ctypes.CDLL(name)
+    for fn in ("eglGetCurrentDisplay", "eglGetCurrentContext"):
+        getattr(lib, fn).restype = ctypes.c_void_p
+    lib.eglGetCurrentSurface.restype = ctypes.c_void_p
+    lib.eglGetCurrentSurface.argtypes = [ctypes.c_int]
+    lib.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    lib.eglMakeCurrent.restype = ctypes.c_uint
+    return lib
 
 
 def _size(w, h) -> tuple[int, int]:

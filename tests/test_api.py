@@ -135,3 +135,22 @@ def test_every_preset_loads_by_name():
     r = AlightRenderer(8, quality="low")
     for name in list_presets():
         assert r.set_material(name).material.name == name
+
+
+def test_other_renderers_in_the_process_are_not_disturbed():
+    """Opening and closing an AlightRenderer must leave another renderer's context current."""
+    from app.environment import constant_environment
+    from app.scene import Scene
+    from tests.gpu import renderer
+
+    shared = renderer()
+    maps = shared.bake(constant_environment(1.0, 64), "low")
+    scene = Scene(material=Material(base_color=(0.5, 0.5, 0.5), roughness=1.0), view="probe")
+    before = shared.render(scene, maps, 16, 16).linear
+    with AlightRenderer(16, quality="low") as r:
+        r.render()
+        between = shared.render(scene, maps, 16, 16).linear
+    after = shared.render(scene, maps, 16, 16).linear
+    assert before[8, 8, 3] == 1.0 and before[8, 8, :3].min() > 0.1
+    np.testing.assert_array_equal(before, between)
+    np.testing.assert_array_equal(before, after)
