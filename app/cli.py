@@ -148,6 +148,18 @@ def build_parser() -> argparse.ArgumentParser:
     _add_material_options(e)
     e.add_argument("--out", required=True, metavar="FILE.gltf|FILE.glb", help="the file to write")
     # --- end alight export ---------------------------------------------------------------
+    # --- alight batch (app/batch.py) ---------------------------------------------------------
+    bt = sub.add_parser("batch", help="render meshes x environments x materials x angles from a spec",
+                        description="Render every combination in a .toml/.json spec (see app/batch.py), a "
+                                    "labelled contact sheet and optional turntables. Up-to-date outputs are "
+                                    "skipped; failed items are reported and the rest go on (exit 1).")
+    bt.add_argument("spec", metavar="SPEC.toml|SPEC.json")
+    bt.add_argument("--executor", choices=("local", "inline"), default="local",
+                    help="local: a process pool, one GL context per process; inline: this process (default: local)")
+    bt.add_argument("--workers", type=int, default=None, metavar="N", help="worker processes (default: CPU count)")
+    bt.add_argument("--force", action="store_true", help="render every item even if its output is up to date")
+    bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
+    # --- end alight batch ---------------------------------------------------------------------
     sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
     return parser
 
@@ -167,6 +179,12 @@ def main(argv: list[str] | None = None) -> int:
             return _presets()
         if args.command == "export":  # alight export
             return _export(args)
+        if args.command == "batch":  # alight batch
+            if args.workers is not None and args.workers < 1:
+                raise AlightError(f"--workers: {args.workers} must be at least 1")
+            from app.batch import main as batch_main
+
+            return batch_main(args.spec, args.executor, args.workers, args.force, args.out)
     except AlightError as exc:
         print(f"alight: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
