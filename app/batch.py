@@ -376,8 +376,13 @@ def _execute(items: list[Item], executor: str, workers: int | None):
         for item in items:
             yield render_item(item)
         return
+    if executor == "ray":
+        from app.batch_ray import execute
+
+        yield from execute(items, workers, os.environ.get("ALIGHT_RAY_ADDRESS"))
+        return
     if executor != "local":
-        raise AlightError(f"--executor: {executor!r} is not available (use local)")
+        raise AlightError(f"--executor: {executor!r} is not one of local, ray, inline")
     n = max(1, min(workers or os.cpu_count() or 1, len(items)))
     # 'spawn': a forked child would inherit the parent's GL/EGL state, which is not fork-safe.
     ctx = multiprocessing.get_context("spawn")

@@ -154,8 +154,11 @@ def build_parser() -> argparse.ArgumentParser:
                                     "labelled contact sheet and optional turntables. Up-to-date outputs are "
                                     "skipped; failed items are reported and the rest go on (exit 1).")
     bt.add_argument("spec", metavar="SPEC.toml|SPEC.json")
-    bt.add_argument("--executor", choices=("local", "inline"), default="local",
-                    help="local: a process pool, one GL context per process; inline: this process (default: local)")
+    bt.add_argument("--executor", choices=("local", "ray", "inline"), default="local",
+                    help="local: a process pool, one GL context per process; ray: Ray actors, each with its "
+                         "own GL context and bake cache (RAY_ADDRESS or --ray-address picks the cluster; "
+                         "none: a local one); inline: this process (default: local)")
+    bt.add_argument("--ray-address", metavar="ADDR", help="Ray cluster address, e.g. auto or HEAD:6379")
     bt.add_argument("--workers", type=int, default=None, metavar="N", help="worker processes (default: CPU count)")
     bt.add_argument("--force", action="store_true", help="render every item even if its output is up to date")
     bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
@@ -182,7 +185,12 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "batch":  # alight batch
             if args.workers is not None and args.workers < 1:
                 raise AlightError(f"--workers: {args.workers} must be at least 1")
+            import os
+
             from app.batch import main as batch_main
+
+            if args.ray_address:
+                os.environ["ALIGHT_RAY_ADDRESS"] = args.ray_address
 
             return batch_main(args.spec, args.executor, args.workers, args.force, args.out)
     except AlightError as exc:

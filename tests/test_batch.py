@@ -154,3 +154,27 @@ def test_failed_animation_and_summary_lines(folder):
     result = run(plan(write_spec(folder, text)), executor="inline", log=io.StringIO())
     text = summary(result)
     assert "0 rendered" in text and "missing__studio__gold.gif" in text and "not written" in text
+
+
+def test_ray_executor_on_a_local_two_worker_cluster(folder):
+    """A real Ray cluster (head + 2 CPUs) started by this test; two actors, each its own GL context."""
+    ray = pytest.importorskip("ray", reason="Ray is not installed (pip install 'alight[ray]')")
+    spec = write_spec(folder, SPEC.replace('"duck.glb"]', '"duck.glb", "missing.obj"]'))
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, object_store_memory=80 * 1024 * 1024,
+             runtime_env={"env_vars": {"PYTHONPATH": str(REPO)}})
+    try:
+        assert ray.cluster_resources()["CPU"] == 2
+        log = io.StringIO()
+        result = run(plan(spec), executor="ray", workers=2, log=log)
+    finally:
+        ray.shutdown()
+    assert len(result.rendered) == 8 and len(result.failed) == 4
+    assert all("missing.obj: no such file" in reason for _, reason in result.failed)
+    # The same images as an in-process render.
+    ray_images = {p.name: Image.open(p).tobytes() for p in (folder / "spec").glob("*__cam*.png")}
+    assert len(ray_images) == 8
+    local = run(plan(spec, folder / "inline"), executor="inline", log=io.StringIO())
+    assert len(local.rendered) == 8
+    for name, data in ray_images.items():
+        with Image.open(folder / "inline" / name) as im:
+            assert im.tobytes() == data, name
