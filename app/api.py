@@ -49,7 +49,7 @@ class AlightRenderer:
         self._renderer = None  # app.renderer.Renderer, created lazily: importing moderngl is not free
         self.bakes_done = 0    # how many bakes actually ran (cache misses), for callers that measure
         self._mesh: Mesh | None = None
-        self._env: Environment | None = load_environment("studio")
+        self._env: Environment | None = _studio()
         self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
                            display=Display(tonemap=tonemap, exposure=exposure, background=background))
         self.set_display(tonemap=tonemap, exposure=exposure, background=background)
@@ -98,6 +98,8 @@ class AlightRenderer:
         """'studio', an equirectangular .hdr/.exr, a loaded Environment, or None (no IBL)."""
         if env is None or isinstance(env, Environment):
             self._env = env
+        elif os.fspath(env) == "studio":
+            self._env = _studio()
         else:
             self._env = load_environment(os.fspath(env))
         self.scene.ibl_enabled = self._env is not None
@@ -226,6 +228,13 @@ class AlightRenderer:
             maps = r.bake(self._env, quality)
             self.bakes_done += len(r._bakes) - before
         return r.render(self.scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
+
+
+@functools.lru_cache(maxsize=1)
+def _studio() -> Environment:
+    """The built-in studio, built once per process (0.3 s) and shared: environments are not
+    modified after loading, and a shared one also shares its content hash."""
+    return load_environment("studio")
 
 
 _EGL_DRAW, _EGL_READ = 0x3059, 0x305A
