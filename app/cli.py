@@ -65,6 +65,10 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--view", choices=("camera", "probe"), default="camera",
                    help="camera: the mesh framed by a camera on +Z; probe: CONVENTIONS.md's analysis view "
                         "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)")
+    _add_material_options(p)
+
+
+def _add_material_options(p: argparse.ArgumentParser) -> None:
     m = p.add_argument_group("material (flags override the preset's fields)")
     m.add_argument("--preset", metavar="NAME|PATH",
                    help="a preset name (see 'alight presets') or a preset .json file; replaces the mesh file's own materials")
@@ -130,6 +134,35 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--width", type=int, default=512, help="width of the written equirect images (default: 512)")
     b.add_argument("--out", required=True, metavar="DIR", help="folder for the images (created if missing)")
 
+    # --- alight export (glTF material round trip, app/gltf_material.py) -------------------
+    e = sub.add_parser("export", help="write the material as a material-only .gltf, or a mesh with it as .glb",
+                       description="Export a material (the default, a preset, or a glTF file's material, with "
+                                   "the field flags on top) as glTF 2.0: a material-only .gltf, or --mesh with "
+                                   "the material as .glb. A dielectric F0 other than 0.04 is written with "
+                                   "KHR_materials_ior (and KHR_materials_specular when coloured).")
+    e.add_argument("--mesh", help="sphere, cube, plane, or a mesh file; .glb only (default for .glb: sphere)")
+    e.add_argument("--material-from", metavar="FILE.gltf|FILE.glb",
+                   help="start from this glTF file's material instead of a preset")
+    e.add_argument("--material-index", type=int, default=0, metavar="N",
+                   help="which material of --material-from (default: 0)")
+    _add_material_options(e)
+    e.add_argument("--out", required=True, metavar="FILE.gltf|FILE.glb", help="the file to write")
+    # --- end alight export ---------------------------------------------------------------
+    # --- alight batch (app/batch.py) ---------------------------------------------------------
+    bt = sub.add_parser("batch", help="render meshes x environments x materials x angles from a spec",
+                        description="Render every combination in a .toml/.json spec (see app/batch.py), a "
+                                    "labelled contact sheet and optional turntables. Up-to-date outputs are "
+                                    "skipped; failed items are reported and the rest go on (exit 1).")
+    bt.add_argument("spec", metavar="SPEC.toml|SPEC.json")
+    bt.add_argument("--executor", choices=("local", "ray", "inline"), default="local",
+                    help="local: a process pool, one GL context per process; ray: Ray actors, each with its "
+                         "own GL context and bake cache (RAY_ADDRESS or --ray-address picks the cluster; "
+                         "none: a local one); inline: this process (default: local)")
+    bt.add_argument("--ray-address", metavar="ADDR", help="Ray cluster address, e.g. auto or HEAD:6379")
+    bt.add_argument("--workers", type=int, default=None, metavar="N", help="worker processes (default: CPU count)")
+    bt.add_argument("--force", action="store_true", help="render every item even if its output is up to date")
+    bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
+    # --- end alight batch ---------------------------------------------------------------------
     sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
     return parser
 
@@ -147,6 +180,19 @@ def main(argv: list[str] | None = None) -> int:
             return _bake(args)
         if args.command == "presets":
             return _presets()
+        if args.command == "export":  # alight export
+            return _export(args)
+        if args.command == "batch":  # alight batch
+            if args.workers is not None and args.workers < 1:
+                raise AlightError(f"--workers: {args.workers} must be at least 1")
+            import os
+
+            from app.batch import main as batch_main
+
+            if args.ray_address:
+                os.environ["ALIGHT_RAY_ADDRESS"] = args.ray_address
+
+            return batch_main(args.spec, args.executor, args.workers, args.force, args.out)
     except AlightError as exc:
         print(f"alight: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
@@ -321,3 +367,31 @@ def _presets() -> int:
         print(f"{name:20s} {m.metallic:8.0f} {m.roughness:9.2f}  "
               f"({f0[0]:.2f}, {f0[1]:.2f}, {f0[2]:.2f})     ({srgb[0]:.2f}, {srgb[1]:.2f}, {srgb[2]:.2f})")
     return 0
+
+
+# --- alight export ------------------------------------------------------------------------
+def _export(args) -> int:
+    from app.output import check_output_path
+
+    out = check_output_path(args.out, (".gltf", ".glb"))
+    glb = out.suffix.lower() == ".glb"
+    if args.mesh is not None and not glb:
+        raise AlightError(f"{out}: a .gltf export is material-only; use .glb to include --mesh")
+    if args.material_from is not None and args.preset is not None:
+        raise AlightError("--material-from: give either --preset or --material-from, not both")
+    material, overrides = build_material(args)
+
+    from app.gltf_material import export_material_gltf, export_mesh_glb, import_material
+    from app.material import with_overrides
+
+    if args.material_from is not None:
+        material = with_overrides(import_material(args.material_from, args.material_index), **overrides)
+    if glb:
+        from app.mesh import load_mesh
+
+        export_mesh_glb(load_mesh(args.mesh or "sphere"), material, out)
+    else:
+        export_material_gltf(material, out)
+    print(out)
+    return 0
+# --- end alight export --------------------------------------------------------------------

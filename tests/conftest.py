@@ -7,6 +7,14 @@ from pathlib import Path
 
 import pytest
 
+# The alight pytest plugin is registered by its pytest11 entry point once the package is
+# installed; a checkout whose installed copy predates it loads it from here instead.
+from importlib.metadata import entry_points as _entry_points
+
+pytest_plugins = ["pytester"]
+if not any(ep.name == "alight" for ep in _entry_points(group="pytest11")):
+    pytest_plugins.append("app.pytest_plugin")
+
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = REPO.parent / "shared" / "data"
 

@@ -26,3 +26,9 @@ fi
 # A real (non-editable) install: proves the wheel carries shaders/ and presets/.
 .venv/bin/python -m pip install --quiet --disable-pip-version-check ".[test]" 2>&1 \
   | grep -v "is ignored: it is neither a file nor a directory" || true
+
+# The Khronos glTF validator (npm), for the tests of `alight export`; skipped without node.
+if command -v npm >/dev/null 2>&1 && [ ! -d tools/node/node_modules/gltf-validator ]; then
+  echo "setup: installing gltf-validator (npm) into tools/node"
+  npm install --silent --no-save --prefix tools/node gltf-validator >/dev/null
+fi

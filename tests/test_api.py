@@ -1,0 +1,156 @@
+"""The Python API (app/api.py): lazy import, rendering to arrays and files, the bake cache, release."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import app.renderer
+from app import AlightRenderer
+from app.errors import AlightError
+from app.material import Material, list_presets
+
+
+def test_import_app_is_cheap():
+    code = ("import sys, app; assert 'moderngl' not in sys.modules and 'trimesh' not in sys.modules; "
+            "from app import AlightRenderer; assert 'moderngl' not in sys.modules; print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "ok"
+
+
+def test_unknown_attribute_is_an_attribute_error():
+    import app
+
+    with pytest.raises(AttributeError):
+        app.no_such_thing  # noqa: B018
+
+
+def test_hundred_materials_under_one_environment_bake_once(monkeypatch):
+    calls = []
+    real = app.renderer.bake_environment
+
+    def counting(*args, **kwargs):
+        calls.append(args[2].content_hash)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(app.renderer, "bake_environment", counting)
+    with AlightRenderer(16, quality="low") as r:
+        r.set_environment("studio")
+        centres = set()
+        for i in range(100):
+            r.set_material(Material(base_color=(i / 99, 0.5, 0.2), roughness=(i % 10) / 9, name=f"m{i}"))
+            centres.add(tuple(r.render()[8, 8, :3]))
+        assert len(calls) == 1 and r.bakes_done == 1
+        assert len(centres) > 50  # the materials really differ in the images
+        # Another quality of the same environment is another bake; coming back to low is not.
+        r.quality = "medium"
+        r.render()
+        r.quality = "low"
+        r.render()
+        assert len(calls) == 2
+
+
+def test_render_linear_and_srgb_and_presets_differ():
+    with AlightRenderer(32, quality="low") as r:
+        r.set_material("gold")
+        srgb = r.render()
+        lin = r.render(linear=True)
+        assert srgb.dtype == np.uint8 and srgb.shape == (32, 32, 4)
+        assert lin.dtype == np.float32 and lin.shape == (32, 32, 4)
+        assert lin[16, 16, 3] == 1.0 and lin[0, 0, 3] == 0.0  # the ball is hit in the middle only
+        gold = lin[16, 16, :3]
+        assert gold[0] > gold[2] * 1.5  # gold is yellow
+        r.set_material("silver")
+        silver = r.render(linear=True)[16, 16, :3]
+        assert abs(silver[0] - silver[2]) < 0.2 * silver.max()
+
+
+def test_field_overrides_and_probe_view():
+    with AlightRenderer(32, quality="low") as r:
+        r.set_material("gold", roughness=1.0)
+        assert r.material.roughness == 1.0 and r.material.name == "gold"
+        r.set_view("probe")
+        probe = r.render(linear=True)
+        assert probe[0, 0, 3] == 0.0 and probe[16, 16, 3] == 1.0
+        with pytest.raises(AlightError):
+            r.render(32, 16)
+
+
+def test_save_png_and_exr(tmp_path):
+    import OpenImageIO as oiio
+
+    with AlightRenderer(24, 16, quality="low") as r:
+        r.set_mesh("cube").set_camera(orbit_deg=30, elevation_deg=20)
+        png = r.save(tmp_path / "a.png")
+        exr = r.save(tmp_path / "a.exr")
+    assert oiio.ImageInput.open(str(png)).spec().width == 24
+    spec = oiio.ImageInput.open(str(exr)).spec()
+    assert (spec.width, spec.height, spec.nchannels) == (24, 16, 4)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.exr", "a.png"]
+
+
+def test_lights_without_environment():
+    with AlightRenderer(32, quality="low") as r:
+        r.set_environment(None).set_material(Material(base_color=(0.8, 0.8, 0.8)))
+        dark = r.render(linear=True)[16, 16, :3].sum()
+        r.add_light("point:pos=0,0,5:intensity=50")
+        lit = r.render(linear=True)[16, 16, :3].sum()
+        assert dark < 1e-6 < lit
+        assert r.bakes_done == 0
+
+
+def test_close_releases_and_reopens():
+    r = AlightRenderer(16, quality="low")
+    assert not r.is_open
+    with r:
+        r.render()
+        assert r.is_open
+    assert not r.is_open
+    r.close()  # idempotent
+    assert r.render().shape == (16, 16, 4)  # opens a fresh context when used again
+    r.close()
+
+
+@pytest.mark.parametrize("call", [
+    lambda r: r.set_mesh("nosuch.obj"),
+    lambda r: r.set_material("no-such-preset"),
+    lambda r: r.set_material("gold", roughness=2.0),
+    lambda r: r.set_display(tonemap="filmic"),
+    lambda r: r.save("out.jpg"),
+    lambda r: r.render(0),
+])
+def test_bad_input_is_one_alight_error(call):
+    r = AlightRenderer(8, quality="low")
+    with pytest.raises(AlightError) as exc:
+        call(r)
+    assert "\n" not in str(exc.value)
+    r.close()
+
+
+def test_every_preset_loads_by_name():
+    r = AlightRenderer(8, quality="low")
+    for name in list_presets():
+        assert r.set_material(name).material.name == name
+
+
+def test_other_renderers_in_the_process_are_not_disturbed():
+    """Opening and closing an AlightRenderer must leave another renderer's context current."""
+    from app.environment import constant_environment
+    from app.scene import Scene
+    from tests.gpu import renderer
+
+    shared = renderer()
+    maps = shared.bake(constant_environment(1.0, 64), "low")
+    scene = Scene(material=Material(base_color=(0.5, 0.5, 0.5), roughness=1.0), view="probe")
+    before = shared.render(scene, maps, 16, 16).linear
+    with AlightRenderer(16, quality="low") as r:
+        r.render()
+        between = shared.render(scene, maps, 16, 16).linear
+    after = shared.render(scene, maps, 16, 16).linear
+    assert before[8, 8, 3] == 1.0 and before[8, 8, :3].min() > 0.1
+    np.testing.assert_array_equal(before, between)
+    np.testing.assert_array_equal(before, after)

@@ -1,0 +1,112 @@
+"""The pytest plugin (app/pytest_plugin.py), used by inner test files run through pytester."""
+
+from __future__ import annotations
+
+import sys
+import tomllib
+from importlib.metadata import entry_points
+from pathlib import Path
+
+import numpy as np
+import OpenImageIO as oiio  # imported here: pytester restores sys.modules after each test, and a
+import pytest               # nanobind module imported twice in one process aborts it
+
+from app.pytest_plugin import _assert_image_matches
+
+REPO = Path(__file__).resolve().parents[1]
+
+INNER = '''
+import os
+
+def test_render(alight_renderer, assert_image_matches):
+    r = alight_renderer
+    r.set_mesh("sphere").set_environment("studio").set_material(os.environ.get("PRESET", "gold"))
+    metric = os.environ.get("METRIC", "rel")
+    if os.environ.get("HDR"):
+        assert_image_matches(r.render(48, 48, linear=True), "goldens/ball.exr", metric=metric)
+    else:
+        assert_image_matches(r.render(48, 48), "goldens/ball.png", metric=metric)
+'''
+
+
+@pytest.fixture
+def run_inner(pytester, monkeypatch):
+    """Run INNER in a fresh pytest process (its own GL context) with this checkout's app."""
+    monkeypatch.setenv("PYTHONPATH", str(REPO))
+    pytester.makepyfile(test_inner=INNER)
+    plugin = [] if any(ep.name == "alight" for ep in entry_points(group="pytest11")) else ["-p", "app.pytest_plugin"]
+
+    def run(*args, **env):
+        for k in ("PRESET", "METRIC", "HDR"):
+            monkeypatch.delenv(k, raising=False)
+        for k, v in env.items():
+            monkeypatch.setenv(k, v)
+        return pytester.runpytest_subprocess(*plugin, "-p", "no:cacheprovider", *args)
+
+    return run
+
+
+@pytest.mark.parametrize("hdr", [False, True], ids=["srgb-png", "linear-exr"])
+def test_goldens_written_matched_and_a_wrong_render_fails(run_inner, pytester, hdr):
+    env = {"HDR": "1"} if hdr else {}
+    suffix = ".exr" if hdr else ".png"
+    golden = pytester.path / "goldens" / f"ball{suffix}"
+
+    missing = run_inner(**env)
+    missing.assert_outcomes(failed=1)
+    missing.stdout.fnmatch_lines(["*no golden image*--alight-update-goldens*"])
+
+    run_inner("--alight-update-goldens", **env).assert_outcomes(passed=1)
+    assert golden.is_file()
+    run_inner(**env).assert_outcomes(passed=1)
+
+    wrong = run_inner(PRESET="silver", **env)  # a deliberately wrong render
+    wrong.assert_outcomes(failed=1)
+    wrong.stdout.fnmatch_lines(["*rel error * > tolerance*"])
+    for kind in ("actual", "expected", "diff"):
+        path = pytester.path / "goldens" / f"ball.{kind}.png"
+        assert path.is_file(), kind
+    diff = oiio.ImageInput.open(str(pytester.path / "goldens" / "ball.diff.png")).read_image()
+    assert diff.max() > 0.5  # the difference image shows the difference
+    # The golden itself is untouched by a failure, and updating accepts the new look.
+    run_inner(**env).assert_outcomes(passed=1)
+    run_inner("--alight-update-goldens", PRESET="silver", **env).assert_outcomes(passed=1)
+    run_inner(PRESET="silver", **env).assert_outcomes(passed=1)
+
+
+def test_flip_metric_passes_same_and_fails_wrong(run_inner):
+    pytest.importorskip("flip_evaluator")
+    run_inner("--alight-update-goldens", METRIC="flip").assert_outcomes(passed=1)
+    run_inner(METRIC="flip").assert_outcomes(passed=1)
+    wrong = run_inner(METRIC="flip", PRESET="copper")
+    wrong.assert_outcomes(failed=1)
+    wrong.stdout.fnmatch_lines(["*flip error * > tolerance*"])
+
+
+def test_session_renderer_fixture_renders(alight_renderer, assert_image_matches, tmp_path):
+    """The plugin used directly by this suite: the same render twice matches itself."""
+    alight_renderer.set_mesh("sphere").set_environment("studio").set_material("copper")
+    image = alight_renderer.render(32, 32)
+    assert image.shape == (32, 32, 4)
+    _assert_image_matches(image, tmp_path / "g.png", "rel", None, update=True)
+    assert assert_image_matches(alight_renderer.render(32, 32), tmp_path / "g.png") == 0.0
+
+
+def test_relative_error_is_what_it_says(tmp_path):
+    expected = np.full((8, 8, 3), 0.5, np.float32)
+    _assert_image_matches(expected, tmp_path / "g.exr", "rel", None, update=True)
+    assert _assert_image_matches(expected * 1.01, tmp_path / "g.exr", "rel", 0.02, False) == pytest.approx(0.01, rel=1e-4)
+    with pytest.raises(AssertionError, match="rel error 0.03"):
+        _assert_image_matches(expected * 1.03, tmp_path / "g.exr", "rel", 0.02, False)
+    with pytest.raises(AssertionError, match="size 4x8"):
+        _assert_image_matches(expected[:, :4], tmp_path / "g.exr", "rel", 0.02, False)
+    with pytest.raises(ValueError):
+        _assert_image_matches(expected, tmp_path / "g.exr", "mse", None, False)
+
+
+def test_entry_point_is_declared():
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())
+    assert project["project"]["entry-points"]["pytest11"]["alight"] == "app.pytest_plugin"
+    import app.pytest_plugin as plugin
+
+    assert callable(plugin.pytest_addoption) and callable(plugin.assert_image_matches)
