@@ -437,3 +437,25 @@ def _gltf_material_params(path: Path) -> dict[str, dict]:
         return out
     except Exception:
         return {}
+
+
+def is_closed(positions: np.ndarray, indices: np.ndarray) -> bool:
+    """Whether a triangle mesh is closed and consistently wound: after welding vertices at equal
+    positions (UV seams duplicate them), every directed edge (a, b) has exactly one (b, a).
+    Back faces of such a mesh are never visible from outside, so the renderer culls them; an
+    open mesh (a plane, a single-sided shell) is drawn from both sides."""
+    if len(indices) == 0:
+        return False
+    _, weld = np.unique(np.round(np.asarray(positions, np.float64), 6), axis=0, return_inverse=True)
+    tri = weld.reshape(-1)[np.asarray(indices, np.int64)]
+    tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])]
+    if len(tri) == 0:
+        return False
+    edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    n = int(weld.max()) + 1
+    forward = edges[:, 0] * n + edges[:, 1]
+    backward = edges[:, 1] * n + edges[:, 0]
+    uniq, counts = np.unique(forward, return_counts=True)
+    if (counts != 1).any():
+        return False
+    return bool(np.isin(backward, uniq, assume_unique=False).all())

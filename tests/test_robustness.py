@@ -63,3 +63,35 @@ def test_emissive_adds_exactly(quarry):
     maps = r.bake(black, "low")
     frame = r.render(Scene(material=Material(emissive=(2.0, 0.5, 0.0)), view="probe"), maps, 16, 16)
     np.testing.assert_allclose(frame.linear[8, 8, :3], [2.0, 0.5, 0.0], atol=1e-6)
+
+
+@pytest.mark.parametrize("mesh_name", ["sphere", "cube", "Duck.glb"])
+def test_back_face_culling_changes_no_pixel(shared_data, monkeypatch, mesh_name):
+    """Closed meshes are drawn with back faces culled; were any front face wound the wrong way,
+    culling would remove it and the image would change."""
+    import app.renderer as renderer_module
+    from app.mesh import is_closed, load_mesh
+
+    def load():
+        return load_mesh(str(shared_data / "models" / mesh_name) if mesh_name.endswith(".glb") else mesh_name)
+
+    r = renderer()
+    maps = r.bake(constant_environment(1.0, 64), "low")
+    culled_mesh = load()
+    assert all(is_closed(p.positions, p.indices) for p in culled_mesh.parts)
+    culled = r.render(Scene(mesh=culled_mesh, lights=LIGHTS[:2]), maps, 96, 96, aa="none").linear
+    monkeypatch.setattr(renderer_module, "is_closed", lambda *a: False)
+    both_sides = r.render(Scene(mesh=load(), lights=LIGHTS[:2]), maps, 96, 96, aa="none").linear
+    np.testing.assert_allclose(culled, both_sides, atol=1e-6)
+
+
+def test_open_and_closed_meshes():
+    from app.mesh import is_closed
+
+    assert is_closed(sphere().parts[0].positions, sphere().parts[0].indices)
+    assert not is_closed(plane().parts[0].positions, plane().parts[0].indices)
+    p = sphere().parts[0]
+    assert not is_closed(p.positions, p.indices[1:])           # one triangle missing: a hole
+    flipped = p.indices.copy()
+    flipped[0] = flipped[0, ::-1]
+    assert not is_closed(p.positions, flipped)                  # one triangle wound the wrong way

@@ -24,8 +24,16 @@ if [ ! -x .venv/bin/python ]; then
   "$python" -m venv .venv
 fi
 # A real (non-editable) install: proves the wheel carries shaders/ and presets/.
-.venv/bin/python -m pip install --quiet --disable-pip-version-check ".[test]" 2>&1 \
-  | grep -v "is ignored: it is neither a file nor a directory" || true
+# pip's own status decides (a filter in a pipeline would hide a failed install); its noise about
+# this machine's unused local package folders is dropped from what is shown.
+log=$(mktemp)
+if ! .venv/bin/python -m pip install --quiet --disable-pip-version-check ".[test]" >"$log" 2>&1; then
+  grep -v "is ignored: it is neither a file nor a directory" "$log" >&2
+  rm -f "$log"
+  echo "setup: pip install failed" >&2
+  exit 1
+fi
+rm -f "$log"
 
 # The Khronos glTF validator (npm), for the tests of `alight export`; skipped without node.
 if command -v npm >/dev/null 2>&1 && [ ! -d tools/node/node_modules/gltf-validator ]; then
