@@ -171,12 +171,22 @@ def _groups(size: int, local: int = 8) -> int:
     return (size + local - 1) // local
 
 
-def _timed(ctx: moderngl.Context, seconds: dict[str, float], name: str, run) -> None:
-    # finish() bounds each pass so its time is its own; it costs a sync, not GPU work.
+def _timed(ctx: moderngl.Context, seconds: dict[str, float], name: str, run):
+    """run()'s result; its seconds added to seconds[name]. finish() bounds each pass so its time
+    is its own; it costs a sync, not GPU work."""
     start = time.perf_counter()
-    run()
+    result = run()
     ctx.finish()
     seconds[name] = seconds.get(name, 0.0) + time.perf_counter() - start
+    return result
+
+
+def _dispatch_faces(ctx: moderngl.Context, prog: moderngl.ComputeShader, target: moderngl.TextureCube,
+                    size: int, level: int = 0) -> None:
+    """Run a cube pass: one invocation per texel of the six faces of one level of target."""
+    target.bind_to_image(0, read=False, write=True, level=level)
+    prog.run(_groups(size), _groups(size), 6)
+    ctx.memory_barrier()
 
 
 def upload_equirect(ctx: moderngl.Context, radiance: np.ndarray, mipmaps: bool = False) -> moderngl.Texture:
@@ -274,9 +284,7 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
     """Run every bake pass for one environment; returns the maps and each pass's seconds."""
     q = quality
     seconds: dict[str, float] = {}
-    found: list = []
-    _timed(ctx, seconds, "suns", lambda: found.append(extract_suns(env.radiance)))
-    lighting_radiance, suns = found[0]
+    lighting_radiance, suns = _timed(ctx, seconds, "suns", lambda: extract_suns(env.radiance))
 
     # The environment as seen (background, mirror) keeps its sun; the lighting passes read a
     # copy without it and add the sun back in closed form.
@@ -294,9 +302,7 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
             prog["u_theta_steps"] = q.irradiance_theta_steps
             prog["u_source_mip"] = max(0.0, math.log2(q.cube_size / q.irradiance_source_size))
             _set_suns(prog, suns)
-            irradiance.bind_to_image(0, read=False, write=True, level=0)
-            prog.run(_groups(q.irradiance_size), _groups(q.irradiance_size), 6)
-            ctx.memory_barrier()
+            _dispatch_faces(ctx, prog, irradiance, q.irradiance_size)
         _timed(ctx, seconds, "irradiance_convolution", convolve)
     elif q.irradiance == "sh9":
         _timed(ctx, seconds, "irradiance_sh9",
@@ -326,19 +332,16 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
             prog["u_sample_count"] = len(sample_set)
             prog["u_sample_total"] = float(total)
             prog["u_roughness"] = roughness
-            target.bind_to_image(0, read=False, write=True, level=mip)
-            prog.run(_groups(size), _groups(size), 6)
+            _dispatch_faces(ctx, prog, target, size, mip)
             buffer.release()
-        ctx.memory_barrier()
 
     _timed(ctx, seconds, "prefilter", prefilter)
     if lighting is not source:
         lighting.release()
 
-    lut_box: list[moderngl.Texture] = []
-    _timed(ctx, seconds, f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
-           lambda: lut_box.append(luts.get(q.lut_size, q.lut_samples)))
-    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut_box[0], q, seconds, suns)
+    lut = _timed(ctx, seconds, f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
+                 lambda: luts.get(q.lut_size, q.lut_samples))
+    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns)
 
 
 def _set_suns(prog, suns: list[Sun]) -> None:
@@ -356,9 +359,7 @@ def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuali
     """Equirect -> cube level 0, then solid-angle-weighted mips (see bake/cube_downsample.comp)."""
     levels = int(math.log2(q.cube_size)) + 1
     cube = _cube(ctx, q.cube_size, levels)
-    box: list[moderngl.Texture] = []
-    _timed(ctx, seconds, f"upload ({name})", lambda: box.append(upload_equirect(ctx, radiance)))
-    equirect = box[0]
+    equirect = _timed(ctx, seconds, f"upload ({name})", lambda: upload_equirect(ctx, radiance))
 
     def to_cube():
         prog = shaders.compute("bake/equirect_to_cube.comp")
@@ -366,9 +367,7 @@ def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuali
         prog["u_equirect"] = 0
         prog["u_size"] = q.cube_size
         prog["u_subsamples"] = q.equirect_subsamples
-        cube.bind_to_image(0, read=False, write=True, level=0)
-        prog.run(_groups(q.cube_size), _groups(q.cube_size), 6)
-        ctx.memory_barrier()
+        _dispatch_faces(ctx, prog, cube, q.cube_size)
         downsample = shaders.compute("bake/cube_downsample.comp")
         for level in range(1, levels):
             size = q.cube_size >> level
@@ -406,9 +405,7 @@ def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuali
     fill = shaders.compute("bake/sh9_to_cube.comp")
     fill["u_size"] = q.irradiance_size
     fill["u_coeffs"].write(np.ascontiguousarray(coeffs, dtype=np.float32).tobytes())
-    irradiance.bind_to_image(0, read=False, write=True, level=0)
-    fill.run(_groups(q.irradiance_size), _groups(q.irradiance_size), 6)
-    ctx.memory_barrier()
+    _dispatch_faces(ctx, fill, irradiance, q.irradiance_size)
 
 
 def sh9_basis(d) -> np.ndarray:

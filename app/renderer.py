@@ -93,23 +93,30 @@ class _Targets:
 
     def __init__(self, ctx: moderngl.Context, width: int, height: int, aa: str, samples: int):
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
-        scale = 2 if aa == "ssaa" else 1
-        self.draw_size = (width * scale, height * scale)
-        ms = samples if aa == "msaa" else 0
-        self.color = ctx.renderbuffer(self.draw_size, 4, samples=ms, dtype="f4") if ms else \
-            ctx.texture(self.draw_size, 4, dtype="f4")
-        self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
-        self.draw = ctx.framebuffer([self.color], self.depth)
-        # Linear radiance at the output size (the MSAA resolve or the SSAA reduction lands here).
+        # Linear radiance at the output size: drawn into directly without anti-aliasing, else the
+        # MSAA resolve or the SSAA reduction lands here.
         self.radiance = ctx.texture((width, height), 4, dtype="f4")
         self.radiance.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self.radiance_fbo = ctx.framebuffer([self.radiance])
+        scale = 2 if aa == "ssaa" else 1
+        self.draw_size = (width * scale, height * scale)
+        ms = samples if aa == "msaa" else 0
+        if aa == "msaa":
+            self.color = ctx.renderbuffer(self.draw_size, 4, samples=ms, dtype="f4")
+        elif aa == "ssaa":
+            self.color = ctx.texture(self.draw_size, 4, dtype="f4")
+        else:
+            self.color = self.radiance
+        self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
+        self.draw = ctx.framebuffer([self.color], self.depth)
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
 
     def release(self) -> None:
-        for obj in (self.draw, self.color, self.depth, self.radiance_fbo, self.radiance, self.display_fbo,
-                    self.display):
+        owned = [self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo, self.display]
+        if self.color is not self.radiance:
+            owned.append(self.color)
+        for obj in owned:
             obj.release()
 
 
@@ -300,7 +307,7 @@ class Renderer:
         _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
         self._bind_ibl(prog, scene, maps)
         for gpu_part, part in zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts):
-            material, maps_used = self._part_material(scene, part, gpu_part)
+            material, maps_used = self._part_material(scene, part)
             _set_material(prog, material)
             fm = part.material if maps_used else None
             _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
@@ -321,7 +328,7 @@ class Renderer:
         ctx.disable(moderngl.CULL_FACE)
 
     @staticmethod
-    def _part_material(scene: Scene, part, gpu_part) -> tuple[Material, bool]:
+    def _part_material(scene: Scene, part) -> tuple[Material, bool]:
         """The factors for a part, and whether its file's texture maps apply."""
         fm = part.material
         if fm is None or not scene.use_file_materials:
@@ -335,7 +342,7 @@ class Renderer:
 
     def _finish_radiance(self, targets: _Targets) -> None:
         if targets.aa == "msaa":
-            self.ctx.copy_framebuffer(targets.radiance_fbo, targets.draw)
+            self.ctx.copy_framebuffer(targets.radiance_fbo, targets.draw)  # the resolve
         elif targets.aa == "ssaa":
             prog = self.program("render/fullscreen.vert", "render/downsample.frag")
             targets.color.use(UNIT_RADIANCE)
@@ -343,8 +350,6 @@ class Renderer:
             targets.radiance_fbo.use()
             self.ctx.viewport = (0, 0, targets.width, targets.height)
             self._fullscreen(prog)
-        else:
-            self.ctx.copy_framebuffer(targets.radiance_fbo, targets.draw)
 
     def tonemap(self, radiance: moderngl.Texture, display: Display, fbo: moderngl.Framebuffer,
                 opaque: bool = True) -> None:
