@@ -1,0 +1,102 @@
+"""``alight edit``: open the editor, or take a screenshot / run the benchmark and exit."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from app.editor.state import EditorState
+
+
+def build_state(args) -> EditorState:
+    from app.cli import build_material
+
+    state = EditorState(quality=args.quality, aa=args.aa)
+    material, _ = build_material(args)
+    state.material = state.saved_material = material
+    state.load_mesh(args.mesh)
+    state.load_env(args.env)
+    for line in state.env.warnings:
+        print(f"alight: warning: {line}", file=sys.stderr)
+    if args.no_ibl:
+        state.ibl_enabled = False
+    return state
+
+
+def run(args) -> int:
+    from app.editor.window import EditorWindow
+
+    state = build_state(args)
+    size = (1280, 720) if args.benchmark else args.size
+    win = EditorWindow(state, size, show_panel=not args.no_panel)
+    try:
+        if args.benchmark:
+            return _benchmark(win, args.frames or 120)
+        for i, edit in enumerate(args.script):
+            win.frame()            # one frame per edit: the editor runs between them
+            state.apply_edit(edit)
+        if args.screenshot:
+            for _ in range(args.frames or 1):
+                win.frame()
+            win.screenshot(args.screenshot)
+            if state.error:
+                print(f"alight: panel error: {state.error}", file=sys.stderr)
+            print(args.screenshot)
+            return 0
+        while not win.should_close():
+            win.frame()
+        return 0
+    finally:
+        win.close()
+
+
+def _benchmark(win, frames: int) -> int:
+    """Frame times as the user sees them (swap to swap), then each stage alone with a finish()
+    after it, to say where the time goes."""
+    for _ in range(10):   # warm up: shader compiles, the bake, imgui's font atlas
+        win.frame()
+    win.frame_times.clear()
+    for _ in range(frames):
+        win.orbit.orbit(3.0, 0.0)   # the camera moves every frame, as while the artist orbits
+        win.frame()
+    t = np.asarray(win.frame_times) * 1000.0
+    median, p95 = float(np.median(t)), float(np.percentile(t, 95))
+    w, h = win.size
+    print(f"editor benchmark {w}x{h}, {len(t)} frames, material ball, IBL, {len(win.state.lights)} lights, panel, "
+          f"aa={win.state.aa}")
+    print(f"frame time median {median:.1f} ms, p95 {p95:.1f} ms; {1000.0 / median:.1f} FPS median "
+          f"({1000.0 / p95:.1f} FPS at p95)")
+    stages = _profile(win, 30)
+    print("per stage (median, GL finished after each): " + ", ".join(f"{k} {v:.1f} ms" for k, v in stages.items()))
+    return 0
+
+
+def _profile(win, frames: int) -> dict[str, float]:
+    imgui, ctx, r = win.imgui, win.ctx, win.renderer
+    times: dict[str, list[float]] = {k: [] for k in ("panel build", "scene (hdr)", "tonemap", "imgui draw", "swap")}
+    for _ in range(frames):
+        win.orbit.orbit(3.0, 0.0)
+        t0 = time.perf_counter()
+        win.glfw.poll_events()
+        win.impl.process_inputs()
+        imgui.new_frame()
+        win.panel.draw(win)
+        imgui.render()
+        t1 = time.perf_counter()
+        targets = win.targets()
+        r.draw_hdr(win.state.scene(win.orbit.camera()), win.maps(), targets)
+        ctx.finish()
+        t2 = time.perf_counter()
+        r.tonemap(targets.radiance, win.state.display, ctx.screen)
+        ctx.finish()
+        t3 = time.perf_counter()
+        win.impl.render(imgui.get_draw_data())
+        ctx.finish()
+        t4 = time.perf_counter()
+        win.glfw.swap_buffers(win.window)
+        t5 = time.perf_counter()
+        for k, a, b in zip(times, (t0, t1, t2, t3, t4), (t1, t2, t3, t4, t5)):
+            times[k].append((b - a) * 1000.0)
+    return {k: float(np.median(v)) for k, v in times.items()}

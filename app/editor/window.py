@@ -1,0 +1,189 @@
+"""The editor's window: glfw, a ModernGL context made from it, the main loop.
+
+Each frame: build the imgui panel (it edits EditorState), render the scene with the Renderer
+into its offscreen HDR target at the window's size, tone map that into the default
+framebuffer, draw imgui on top, swap. The Renderer never sees imgui; the panel never sees GL.
+
+imgui backend: imgui-bundle's own pure-python GLFW backend (python_backends.glfw_backend). It
+draws with PyOpenGL on the same context ModernGL uses (GL state is the context's, not the
+library's, and the backend saves and restores the state it touches). We chose it over drawing
+imgui's draw lists with ModernGL ourselves because imgui 1.92's dynamic font atlas protocol
+(ImTextureData create/update/destroy requests) is already handled there; redoing it would be
+a second, untested copy of the same code.
+"""
+
+from __future__ import annotations
+
+import collections
+import os
+import time
+
+from app.bake import QUALITY
+from app.errors import AlightError
+from app.editor.camera import OrbitCamera
+from app.editor.state import EditorState, History
+
+
+class EditorWindow:
+    def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
+                 show_panel: bool = True):
+        # PyOpenGL must pick GLX (X11/Xvfb) before the backend imports it.
+        if os.environ.get("XDG_SESSION_TYPE") == "wayland":
+            os.environ.setdefault("PYOPENGL_PLATFORM", "x11")
+        import glfw
+        import moderngl
+        from imgui_bundle import imgui, implot
+        from imgui_bundle.python_backends.glfw_backend import GlfwRenderer
+
+        from app.renderer import Renderer
+
+        self.glfw, self.imgui, self.implot = glfw, imgui, implot
+        if not glfw.init():
+            raise AlightError("editor: cannot open a window (no display? set DISPLAY, or run under xvfb-run -a)")
+        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
+        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 5)
+        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
+        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
+        self.window = glfw.create_window(size[0], size[1], title, None, None)
+        if not self.window:
+            glfw.terminate()
+            raise AlightError("editor: cannot create an OpenGL 4.5 core window")
+        glfw.make_context_current(self.window)
+        glfw.swap_interval(0)  # frame times measure our work, not the display's refresh
+        self.ctx = moderngl.create_context(require=450)
+        self.renderer = Renderer(self.ctx)
+
+        imgui.create_context()
+        implot.create_context()
+        imgui.get_io().set_ini_filename("")   # no imgui.ini littering the working directory
+        self.impl = GlfwRenderer(self.window)
+        glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
+
+        self.state = state
+        self.show_panel = show_panel
+        self.history = History(state.material)
+        self.orbit = OrbitCamera()
+        self.frame_times: collections.deque[float] = collections.deque(maxlen=240)
+        self.bake_seconds: dict[str, float] = {}
+        self._maps_key = None
+        self._maps = None
+        self._last_swap = None
+        self._framed_mesh = None
+        from app.editor.panel import Panel
+
+        self.panel = Panel()
+
+    # --- input --------------------------------------------------------------------------------
+
+    def drop(self, paths: list[str]) -> None:
+        """glfw's drop callback: each file by its suffix; a bad one keeps the previous state."""
+        for path in paths:
+            self.state.open_file(path)
+
+    def _camera_input(self) -> None:
+        imgui, io = self.imgui, self.imgui.get_io()
+        if not io.want_capture_mouse:
+            dx, dy = io.mouse_delta.x, io.mouse_delta.y
+            if imgui.is_mouse_dragging(imgui.MouseButton_.left):
+                self.orbit.orbit(dx, dy)
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) or imgui.is_mouse_dragging(imgui.MouseButton_.middle):
+                self.orbit.pan(dx, dy, self.size[1])
+            if io.mouse_wheel:
+                self.orbit.zoom(io.mouse_wheel)
+        if not io.want_capture_keyboard:
+            if imgui.is_key_pressed(imgui.Key.f):
+                self.frame_mesh()
+            if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
+                m = self.history.redo(self.state.material) if io.key_shift else self.history.undo(self.state.material)
+                self.state.material = m
+
+    def frame_mesh(self) -> None:
+        if self.state.mesh is not None:
+            center, radius = self.state.mesh.bounding_sphere()
+            w, h = self.size
+            self.orbit.frame(center, radius, w / max(h, 1))
+        self._framed_mesh = self.state.mesh
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return tuple(self.glfw.get_framebuffer_size(self.window))
+
+    # --- rendering ----------------------------------------------------------------------------
+
+    def maps(self):
+        """Bake only when the environment or the quality changed (the Renderer caches bakes too)."""
+        s = self.state
+        if s.env is None:
+            return None
+        key = (id(s.env), s.quality)
+        if key != self._maps_key:
+            try:
+                self._maps = self.renderer.bake(s.env, QUALITY[s.quality])
+                self.bake_seconds = dict(self._maps.pass_seconds)
+            except AlightError as exc:
+                s.fail(exc)
+            self._maps_key = key
+        return self._maps
+
+    def targets(self):
+        w, h = self.size
+        return self.renderer._targets_for(w, h, self.state.aa, 4)
+
+    def render_view(self):
+        """The scene into the offscreen HDR target, tone mapped into the default framebuffer."""
+        if self.state.mesh is not self._framed_mesh:
+            self.frame_mesh()   # a new mesh: frame it once
+        w, h = self.size
+        if w == 0 or h == 0:    # minimised
+            return None
+        targets = self.targets()
+        scene = self.state.scene(self.orbit.camera())
+        self.renderer.draw_hdr(scene, self.maps(), targets)
+        self.renderer.tonemap(targets.radiance, self.state.display, self.ctx.screen)
+        return targets
+
+    def frame(self) -> None:
+        glfw, imgui = self.glfw, self.imgui
+        glfw.poll_events()
+        self.impl.process_inputs()
+        imgui.new_frame()
+        if self.show_panel:
+            self.panel.draw(self)
+        self._camera_input()
+        self.history.settle(self.state.material, imgui.is_any_item_active())
+        imgui.render()
+        self.render_view()
+        if self.show_panel:
+            self.impl.render(imgui.get_draw_data())
+        glfw.swap_buffers(self.window)
+        now = time.perf_counter()
+        if self._last_swap is not None:
+            self.frame_times.append(now - self._last_swap)
+        self._last_swap = now
+
+    def screenshot(self, path: str) -> None:
+        """The view without the panel, at window size: the last frame's radiance tone mapped again."""
+        import numpy as np
+
+        from app.output import check_output_path, write_image
+
+        out = check_output_path(path, (".png",))
+        targets = self.render_view()
+        if targets is None:
+            raise AlightError(f"{out}: the window has no area to capture")
+        self.renderer.tonemap(targets.radiance, self.state.display, targets.display_fbo)
+        w, h = targets.width, targets.height
+        pixels = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)
+        write_image(out, pixels[::-1, :, :3].copy(), linear=False)
+
+    def should_close(self) -> bool:
+        return bool(self.glfw.window_should_close(self.window))
+
+    def close(self) -> None:
+        self.impl.shutdown()
+        self.implot.destroy_context()
+        self.imgui.destroy_context()
+        self.renderer.release()
+        self.ctx.release()
+        self.glfw.destroy_window(self.window)
+        self.glfw.terminate()
