@@ -38,6 +38,7 @@ class Panel:
         self.env_path = ""
         self.mesh_path = ""
         self.preset_path = "material.json"
+        self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -46,6 +47,7 @@ class Panel:
         imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
         imgui.set_next_window_size(imgui.ImVec2(380, 680), imgui.Cond_.first_use_ever)
         imgui.begin("alight")
+        self.shown_error = s.error
         if s.error:
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), "error:")
             imgui.same_line()

@@ -1,0 +1,192 @@
+"""The editor in a real window under Xvfb: screenshots from `alight edit`, and drops, undo and
+presets driven in-process on the real glfw window. Xvfb is started here when DISPLAY is unset."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app.errors import AlightError
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def display():
+    """A display for the editor: the caller's, or a private Xvfb started for this module."""
+    if os.environ.get("DISPLAY"):
+        yield os.environ["DISPLAY"]
+        return
+    if shutil.which("Xvfb") is None:
+        pytest.skip("Xvfb is not installed and DISPLAY is unset: the editor needs a display")
+    read, write = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+                            pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write)
+    with os.fdopen(read) as f:
+        number = f.readline().strip()   # Xvfb writes its display number once it is ready
+    assert number, "Xvfb did not start"
+    os.environ["DISPLAY"] = f":{number}"
+    try:
+        yield os.environ["DISPLAY"]
+    finally:
+        del os.environ["DISPLAY"]
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+def edit(*args: str, size: str = "320x240") -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    return subprocess.run([sys.executable, "-m", "app", "edit", "--size", size, *args], cwd=REPO, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def screenshot(tmp_path: Path, name: str, *args: str) -> np.ndarray:
+    import OpenImageIO as oiio
+
+    out = tmp_path / f"{name}.png"
+    result = edit(*args, "--screenshot", str(out), "--frames", "3")
+    assert result.returncode == 0, result.stderr
+    image = oiio.ImageBuf(str(out)).get_pixels(oiio.UINT8)
+    assert image.shape == (240, 320, 3)
+    return image.astype(np.float64)
+
+
+def ball(image: np.ndarray) -> np.ndarray:
+    """Pixels well inside the default ball (it fills the middle of the 320x240 view)."""
+    h, w = image.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.25 * h) ** 2]
+
+
+def test_gold_to_water_and_roughness(display, tmp_path):
+    gold = ball(screenshot(tmp_path, "gold", "--preset", "gold"))
+    water = ball(screenshot(tmp_path, "water", "--preset", "gold", "--script", "preset=water"))
+    # Gold's reflection is yellow (F0 of gold: R well above B); water's F0 is grey (0.02).
+    assert gold[:, 0].mean() > 1.5 * gold[:, 2].mean()
+    assert water[:, 0].mean() < 1.1 * water[:, 2].mean()
+    # Roughness changed through the scripted edit path: a mirror-like ball shows the studio's
+    # sharp panels (high local contrast); a rough one blurs them away.
+    sharp = screenshot(tmp_path, "sharp", "--preset", "gold", "--script", "roughness=0.05")
+    rough = screenshot(tmp_path, "rough", "--preset", "gold", "--script", "roughness=0.9")
+
+    def contrast(img):   # mean horizontal luminance step inside the ball
+        lum = img.mean(axis=2)
+        step = np.zeros_like(lum)
+        step[:, 1:] = np.abs(np.diff(lum, axis=1))
+        return ball(step[:, :, None]).mean()
+
+    assert contrast(sharp) > 1.5 * contrast(rough)
+
+
+def test_editor_cli_bad_input_is_one_line(display, tmp_path):
+    result = edit("--preset", "no_such_preset", "--screenshot", str(tmp_path / "x.png"))
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1 and "alight: error:" in result.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.fixture(scope="module")
+def window(display):
+    from app.editor.state import EditorState
+    from app.editor.window import EditorWindow
+
+    state = EditorState()
+    state.load_mesh("sphere")
+    state.load_env("studio")
+    win = EditorWindow(state, (320, 240))
+    win.frame()
+    yield win
+    win.close()
+
+
+def test_drops_keep_previous_state_and_show_the_error(window, tmp_path, shared_data):
+    from app.mesh import load_mesh
+
+    corrupt = tmp_path / "corrupt.hdr"
+    corrupt.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 64 +X 128\n" + b"\x02\x02" * 40)
+    bad_json = tmp_path / "bad.json"
+    bad_json.write_text('{"name": "x", "rougness": 0.5}')
+    files = sorted((shared_data / "bad").iterdir()) + [corrupt, bad_json, tmp_path / "notes.txt"]
+    errors = 0
+    for path in files:
+        s = window.state
+        before = (s.mesh, s.env, s.material)
+        try:
+            load_mesh(str(path))
+            should_fail = path.suffix.lower() not in (".obj", ".glb", ".gltf", ".ply", ".stl")
+        except AlightError:
+            should_fail = True
+        window.drop([str(path)])   # what glfw's drop callback calls
+        window.frame()             # the editor keeps running and draws the panel
+        window.frame()
+        if should_fail:
+            errors += 1
+            assert (s.mesh, s.env, s.material) == before, path.name
+            assert s.error and "\n" not in s.error
+            assert window.panel.shown_error == s.error, "the panel did not draw the error"
+            assert path.name in s.error
+        else:
+            assert s.error == "", s.error
+            assert s.mesh is not before[0]    # a repaired mesh file is loaded
+    assert errors >= 5   # empty.obj, empty_nodes.glb, the corrupt HDR, the bad preset, the .txt
+    # A good drop afterwards clears the error and replaces the state.
+    window.drop([str(REPO / "presets" / "copper.json")])
+    window.frame()
+    assert window.state.error == "" and window.state.material.name == "copper"
+
+
+def test_undo_redo_of_material_edits(window):
+    import dataclasses
+
+    s, h = window.state, window.history
+    start = s.material
+    s.material = dataclasses.replace(start, roughness=0.11)
+    window.frame()                        # no widget active: the edit becomes one undo step
+    s.material = dataclasses.replace(s.material, metallic=1.0 - start.metallic)
+    window.frame()
+    s.material = h.undo(s.material)
+    assert (s.material.roughness, s.material.metallic) == (0.11, start.metallic)
+    s.material = h.undo(s.material)
+    assert s.material == start
+    s.material = h.redo(s.material)
+    s.material = h.redo(s.material)
+    assert (s.material.roughness, s.material.metallic) == (0.11, 1.0 - start.metallic)
+
+
+def test_preset_saved_from_panel_state_loads_back_equal(window, tmp_path, monkeypatch):
+    import dataclasses
+
+    from app.editor.state import EditorState
+
+    s = window.state
+    s.material = dataclasses.replace(s.material, name="mine", base_color=(0.7, 0.2, 0.1), roughness=0.37,
+                                     metallic=0.25, emissive=(0.5, 0.0, 0.0))
+    path = tmp_path / "mine.json"
+    s.save_material(str(path))
+    other = EditorState()
+    assert other.open_file(str(path)), other.error
+    assert other.material == s.material
+    good = path.read_bytes()
+    # An invalid material is refused before anything is written.
+    s.material = dataclasses.replace(s.material, roughness=2.0)
+    with pytest.raises(AlightError, match="roughness"):
+        s.save_material(str(path))
+    assert path.read_bytes() == good
+    # A write that fails at the last step (the rename) leaves the old file whole and no temporary.
+    s.material = dataclasses.replace(s.material, roughness=0.5)
+
+    def broken_replace(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr("app.output.os.replace", broken_replace)
+    with pytest.raises(AlightError, match="No space left"):
+        s.save_material(str(path))
+    assert path.read_bytes() == good
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.json"]
