@@ -45,7 +45,7 @@ class Panel:
 
         s = win.state
         imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
-        imgui.set_next_window_size(imgui.ImVec2(380, 680), imgui.Cond_.first_use_ever)
+        imgui.set_next_window_size(imgui.ImVec2(470, 700), imgui.Cond_.first_use_ever)
         imgui.begin("alight")
         self.shown_error = s.error
         if s.error:
@@ -85,7 +85,7 @@ class Panel:
                 if imgui.selectable(name, m.name == preset.name)[0]:
                     s.material = s.saved_material = preset
                 imgui.table_next_column()
-                imgui.text(" ".join(f"{x:.3f}" for x in f0))
+                imgui.text(" ".join(f"{x:.2f}" for x in f0))
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0_srgb))
             imgui.end_table()
@@ -219,7 +219,8 @@ class Panel:
 
         times = np.asarray(win.frame_times, np.float32) * 1000.0
         if len(times):
-            imgui.text(f"frame {np.median(times):.1f} ms median, {1000.0 / max(np.median(times), 1e-6):.0f} FPS")
+            imgui.text(f"frame {np.median(times):.1f} ms median, {1000.0 / max(np.median(times), 1e-6):.0f} FPS; "
+                       f"{win.redraws} scene redraws")
         if implot.begin_plot("frame time (ms)", imgui.ImVec2(-1, 140)):
             implot.setup_axes("frame", "ms")
             implot.setup_axes_limits(0, 240, 0, max(50.0, float(times.max()) if len(times) else 50.0),

@@ -15,6 +15,7 @@ a second, untested copy of the same code.
 from __future__ import annotations
 
 import collections
+import dataclasses
 import os
 import time
 
@@ -30,6 +31,11 @@ class EditorWindow:
         # PyOpenGL must pick GLX (X11/Xvfb) before the backend imports it.
         if os.environ.get("XDG_SESSION_TYPE") == "wayland":
             os.environ.setdefault("PYOPENGL_PLATFORM", "x11")
+        # PyOpenGL calls glGetError after every call and raises on any pending error, including
+        # one left by a ModernGL call on the shared context; off, it is also much cheaper per call.
+        import OpenGL
+
+        OpenGL.ERROR_CHECKING = False
         import glfw
         import moderngl
         from imgui_bundle import imgui, implot
@@ -69,6 +75,8 @@ class EditorWindow:
         self._maps = None
         self._last_swap = None
         self._framed_mesh = None
+        self._drawn_key = self._drawn_targets = None
+        self.redraws = 0   # HDR redraws so far (the Performance section shows it)
         from app.editor.panel import Panel
 
         self.panel = Panel()
@@ -129,17 +137,36 @@ class EditorWindow:
         w, h = self.size
         return self.renderer._targets_for(w, h, self.state.aa, 4)
 
-    def render_view(self):
-        """The scene into the offscreen HDR target, tone mapped into the default framebuffer."""
+    def _view_key(self, scene, maps, size) -> tuple:
+        """Everything the HDR image depends on. Material, Camera, Light and Display are plain
+        dataclasses compared by value; the mesh and the bake by identity (they are replaced, never
+        mutated). The shader library's programs count too, so a hot reload redraws."""
+        return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
+                scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
+                size, self.state.aa)
+
+    def render_view(self, force: bool = False):
+        """Draw the scene into the offscreen HDR target and tone map it, but only when something
+        it depends on changed; then blit the tone-mapped image into the default framebuffer.
+        (While the artist orbits every frame redraws; a still view costs only the blit.)"""
         if self.state.mesh is not self._framed_mesh:
             self.frame_mesh()   # a new mesh: frame it once
-        w, h = self.size
-        if w == 0 or h == 0:    # minimised
+        size = self.size
+        if size[0] == 0 or size[1] == 0:    # minimised
             return None
         targets = self.targets()
         scene = self.state.scene(self.orbit.camera())
-        self.renderer.draw_hdr(scene, self.maps(), targets)
-        self.renderer.tonemap(targets.radiance, self.state.display, self.ctx.screen)
+        maps = self.maps()
+        key = self._view_key(scene, maps, size)
+        if force or key != self._drawn_key or targets is not self._drawn_targets:
+            self.renderer.draw_hdr(scene, maps, targets)
+            self.renderer.tonemap(targets.radiance, self.state.display, targets.display_fbo)
+            self._drawn_key, self._drawn_targets = key, targets
+            self.redraws += 1
+        self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
+        # The blit leaves the last used framebuffer (display_fbo) bound; imgui draws into
+        # whatever is bound, and must draw into the window, never into the view's image.
+        self.ctx.screen.use()
         return targets
 
     def frame(self) -> None:
@@ -168,10 +195,9 @@ class EditorWindow:
         from app.output import check_output_path, write_image
 
         out = check_output_path(path, (".png",))
-        targets = self.render_view()
+        targets = self.render_view()   # display_fbo holds the view, without the panel
         if targets is None:
             raise AlightError(f"{out}: the window has no area to capture")
-        self.renderer.tonemap(targets.radiance, self.state.display, targets.display_fbo)
         w, h = targets.width, targets.height
         pixels = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)
         write_image(out, pixels[::-1, :, :3].copy(), linear=False)
