@@ -153,6 +153,22 @@ class Renderer:
             self._targets = _Targets(self.ctx, width, height, aa, samples)
         return self._targets
 
+    def use_shaders(self, shaders: ShaderLibrary) -> None:
+        """Switch to a freshly compiled library (the editor's shader hot reload) and release the
+        old one. Vertex arrays are tied to the program they were made with, so the mesh and
+        full-screen VAOs are rebuilt on the next draw; the bakes stay valid."""
+        old, self.shaders = self.shaders, shaders
+        self.luts.shaders = shaders
+        for vao in self._fullscreen_vaos.values():
+            vao.release()
+        self._fullscreen_vaos.clear()
+        self._units_assigned.clear()
+        for _, parts in self._meshes.values():
+            for part in parts:
+                part.release()
+        self._meshes.clear()
+        old.reload()
+
     def release(self) -> None:
         for maps in self._bakes.values():
             maps.release()

@@ -190,3 +190,44 @@ def test_preset_saved_from_panel_state_loads_back_equal(window, tmp_path, monkey
         s.save_material(str(path))
     assert path.read_bytes() == good
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.json"]
+
+
+def test_shader_hot_reload_keeps_the_last_good_program(window, tmp_path):
+    import dataclasses
+
+    import OpenImageIO as oiio
+
+    from app.editor.hot_reload import ShaderWatcher
+    from app.gpu import ShaderLibrary
+
+    def shot(name):
+        window.frame()
+        window.screenshot(str(tmp_path / name))
+        return ball(oiio.ImageBuf(str(tmp_path / name)).get_pixels(oiio.UINT8).astype(np.float64))
+
+    root = tmp_path / "shaders"
+    shutil.copytree(REPO / "shaders", root)
+    window.renderer.use_shaders(ShaderLibrary(window.ctx, root))
+    window.shader_watcher = ShaderWatcher(root)
+    s = window.state
+    s.material = dataclasses.replace(s.material, roughness=0.6)
+    before = shot("before.png")
+    frag = root / "render" / "pbr.frag"
+    text = frag.read_text()
+    lines = text.splitlines()
+    lines.insert(5, "this is not glsl;")
+    frag.write_text("\n".join(lines) + "\n")
+    window.check_shaders(force=True)
+    assert "render/pbr.frag:6" in s.error, s.error
+    # A nearly equal material forces a redraw: it is drawn, with the last good program.
+    s.material = dataclasses.replace(s.material, roughness=0.601)
+    during = shot("during.png")
+    assert window.panel.shown_error == s.error
+    assert np.abs(during - before).mean() < 2.0 and before.std() > 5.0
+    # Saving a fix is picked up and clears the error.
+    frag.write_text(text.replace("void main()", "// edited\nvoid main()", 1))
+    window.check_shaders(force=True)
+    assert s.error == "" and s.message == "shaders reloaded"
+    after = shot("after.png")
+    assert np.abs(after - before).mean() < 2.0
+    window.renderer.use_shaders(ShaderLibrary(window.ctx))   # back to the repository's shaders

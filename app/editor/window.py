@@ -77,7 +77,10 @@ class EditorWindow:
         self._framed_mesh = None
         self._drawn_key = self._drawn_targets = None
         self.redraws = 0   # HDR redraws so far (the Performance section shows it)
+        from app.editor.hot_reload import ShaderWatcher
         from app.editor.panel import Panel
+
+        self.shader_watcher = ShaderWatcher(self.renderer.shaders.root)
 
         self.panel = Panel()
 
@@ -115,6 +118,19 @@ class EditorWindow:
     @property
     def size(self) -> tuple[int, int]:
         return tuple(self.glfw.get_framebuffer_size(self.window))
+
+    def check_shaders(self, force: bool = False) -> None:
+        """Hot reload: rebuild the programs when a file under shaders/ changed."""
+        from app.editor.hot_reload import rebuild
+
+        if not self.shader_watcher.changed(force):
+            return
+        error = rebuild(self.renderer, self.shader_watcher.root)
+        if error:
+            self.state.error, self.state.message = error, ""
+        else:
+            self.state.error, self.state.message = "", "shaders reloaded"
+            self._drawn_key = None   # redraw with the new programs
 
     # --- rendering ----------------------------------------------------------------------------
 
@@ -177,6 +193,7 @@ class EditorWindow:
         if self.show_panel:
             self.panel.draw(self)
         self._camera_input()
+        self.check_shaders()
         self.history.settle(self.state.material, imgui.is_any_item_active())
         imgui.render()
         self.render_view()
