@@ -113,6 +113,8 @@ def _add_edit_parser(sub) -> None:
     e.add_argument("--script", action="append", default=[], metavar="FIELD=VALUE",
                    help="an edit applied after a frame, e.g. roughness=0.9, preset=water, open=FILE (repeatable)")
     e.add_argument("--no-panel", action="store_true", help="draw the view only")
+    e.add_argument("--new", action="store_true",
+                   help="do not reopen the last session (it is reopened when no scene option is given)")
 
 
 def _edit(args) -> int:

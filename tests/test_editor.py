@@ -231,3 +231,28 @@ def test_shader_hot_reload_keeps_the_last_good_program(window, tmp_path):
     after = shot("after.png")
     assert np.abs(after - before).mean() < 2.0
     window.renderer.use_shaders(ShaderLibrary(window.ctx))   # back to the repository's shaders
+
+
+def test_session_reopens_and_screenshot_button(window, tmp_path, monkeypatch):
+    import dataclasses
+
+    from app.editor.camera import OrbitCamera
+    from app.editor.session import restore_session, save_session
+    from app.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path / "cache"))
+    s = window.state
+    s.load_mesh("cube")
+    s.material = dataclasses.replace(s.material, roughness=0.42, name="session")
+    window.orbit.orbit(40.0, -25.0)
+    save_session(s, window.orbit)
+    fresh, orbit = EditorState(), OrbitCamera()
+    assert restore_session(fresh, orbit) == ""
+    assert fresh.material == s.material and fresh.mesh_spec == "cube" and fresh.env_spec == s.env_spec
+    assert (orbit.yaw_deg, orbit.pitch_deg, orbit.distance) == (window.orbit.yaw_deg, window.orbit.pitch_deg,
+                                                                window.orbit.distance)
+    # What the panel's screenshot button (and F12) asks for is written after the frame.
+    out = tmp_path / "button.png"
+    window.screenshot_request = str(out)
+    window.frame()
+    assert out.is_file() and s.message == f"wrote {out}"

@@ -38,7 +38,8 @@ class Panel:
         self.env_path = ""
         self.mesh_path = ""
         self.preset_path = "material.json"
-        self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
+        self.shown_error = ""
+        self.dialog = None      # a pending native file dialog   # the error line drawn last frame (what the artist sees; tests read it)
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -133,6 +134,26 @@ class Panel:
         imgui.same_line()
         if imgui.button("load preset"):
             s.open_file(self.preset_path)
+        imgui.same_line()
+        self._browse("browse files", ["environments, meshes, presets",
+                                      "*.hdr *.exr *.obj *.gltf *.glb *.ply *.stl *.json"], s)
+
+    def _browse(self, label: str, filters: list[str], s) -> None:
+        """A native dialog (imgui-bundle's portable file dialogs: zenity/kdialog on Linux), polled
+        each frame so it never blocks the window; where none exists, type the path instead."""
+        from imgui_bundle import imgui
+
+        if imgui.button(label) and self.dialog is None:
+            try:
+                from imgui_bundle import portable_file_dialogs as pfd
+
+                self.dialog = pfd.open_file(label, "", filters)
+            except Exception as exc:
+                s.fail(AlightError(f"file dialog: not available ({exc}); type the path"))
+        if self.dialog is not None and self.dialog.ready(0):
+            paths, self.dialog = self.dialog.result(), None
+            for path in paths:
+                s.open_file(path)
 
     def _environment(self, s, win) -> None:
         from imgui_bundle import imgui
@@ -141,6 +162,8 @@ class Panel:
         _, self.env_path = imgui.input_text("env file", self.env_path)
         if imgui.button("open env"):
             s.open_file(self.env_path)
+        imgui.same_line()
+        self._browse("browse env", ["environments", "*.hdr *.exr"], s)
         imgui.same_line()
         if imgui.button("studio"):
             try:
@@ -212,6 +235,9 @@ class Panel:
         _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)
         if imgui.button("frame mesh (F)"):
             win.frame_mesh()
+        imgui.same_line()
+        if imgui.button("screenshot (F12)"):
+            win.screenshot_request = win.next_screenshot_name()   # the window writes it after the frame
         imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
 
     def _performance(self, win) -> None:

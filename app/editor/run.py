@@ -31,6 +31,16 @@ def run(args) -> int:
     state = build_state(args)
     size = (1280, 720) if args.benchmark else args.size
     win = EditorWindow(state, size, show_panel=not args.no_panel)
+    # Interactive only (screenshots and benchmarks must not depend on the last session), and
+    # only with no scene given on the command line.
+    interactive = not (args.benchmark or args.screenshot or args.script)
+    if interactive and not args.new and _no_scene_options(args):
+        from app.editor.session import restore_session
+
+        warning = restore_session(state, win.orbit)
+        if warning:
+            state.error = " ".join(warning.split())
+        win.history.committed = state.material
     try:
         if args.benchmark:
             return _benchmark(win, args.frames or 120)
@@ -47,9 +57,17 @@ def run(args) -> int:
             return 0
         while not win.should_close():
             win.frame()
+        from app.editor.session import save_session
+
+        save_session(state, win.orbit)
         return 0
     finally:
         win.close()
+
+
+def _no_scene_options(args) -> bool:
+    return (args.mesh, args.env, args.preset, args.base_color, args.metallic, args.roughness,
+            args.specular_f0, args.emissive) == ("sphere", "studio", None, None, None, None, None, None)
 
 
 def _benchmark(win, frames: int) -> int:

@@ -76,6 +76,7 @@ class EditorWindow:
         self._last_swap = None
         self._framed_mesh = None
         self._drawn_key = self._drawn_targets = None
+        self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
         self.redraws = 0   # HDR redraws so far (the Performance section shows it)
         from app.editor.hot_reload import ShaderWatcher
         from app.editor.panel import Panel
@@ -104,6 +105,8 @@ class EditorWindow:
         if not io.want_capture_keyboard:
             if imgui.is_key_pressed(imgui.Key.f):
                 self.frame_mesh()
+            if imgui.is_key_pressed(imgui.Key.f12):
+                self.screenshot_request = self.next_screenshot_name()
             if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
                 m = self.history.redo(self.state.material) if io.key_shift else self.history.undo(self.state.material)
                 self.state.material = m
@@ -166,7 +169,10 @@ class EditorWindow:
         it depends on changed; then blit the tone-mapped image into the default framebuffer.
         (While the artist orbits every frame redraws; a still view costs only the blit.)"""
         if self.state.mesh is not self._framed_mesh:
-            self.frame_mesh()   # a new mesh: frame it once
+            if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
+                self.orbit.restored, self._framed_mesh = False, self.state.mesh
+            else:
+                self.frame_mesh()   # a new mesh: frame it once
         size = self.size
         if size[0] == 0 or size[1] == 0:    # minimised
             return None
@@ -200,6 +206,13 @@ class EditorWindow:
         if self.show_panel:
             self.impl.render(imgui.get_draw_data())
         glfw.swap_buffers(self.window)
+        if self.screenshot_request:
+            path, self.screenshot_request = self.screenshot_request, ""
+            try:
+                self.screenshot(path)
+                self.state.error, self.state.message = "", f"wrote {path}"
+            except AlightError as exc:
+                self.state.fail(exc)
         now = time.perf_counter()
         if self._last_swap is not None:
             self.frame_times.append(now - self._last_swap)
@@ -218,6 +231,13 @@ class EditorWindow:
         w, h = targets.width, targets.height
         pixels = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)
         write_image(out, pixels[::-1, :, :3].copy(), linear=False)
+
+    @staticmethod
+    def next_screenshot_name() -> str:
+        n = 1
+        while os.path.exists(f"alight-screenshot-{n}.png"):
+            n += 1
+        return f"alight-screenshot-{n}.png"
 
     def should_close(self) -> bool:
         return bool(self.glfw.window_should_close(self.window))
