@@ -256,3 +256,20 @@ def test_session_reopens_and_screenshot_button(window, tmp_path, monkeypatch):
     window.screenshot_request = str(out)
     window.frame()
     assert out.is_file() and s.message == f"wrote {out}"
+
+
+def test_view_is_redrawn_only_when_needed_and_reduced_while_moving(window):
+    s = window.state
+    s.motion_scale = 0.5
+    window.frame()
+    window.frame()
+    still = window.redraws
+    window.frame()
+    assert window.redraws == still                      # nothing changed: no scene redraw
+    window.orbit.orbit(10.0, 0.0)
+    window.frame()
+    assert window.redraws == still + 1
+    assert window.renderer._targets.width == round(window.size[0] * 0.5)   # drawn reduced while moving
+    window.frame()                                      # the camera stopped: redrawn sharp
+    assert window.redraws == still + 2 and window.renderer._targets.width == window.size[0]
+    s.motion_scale = 1.0

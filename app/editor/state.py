@@ -40,6 +40,8 @@ class EditorState:
     env_rotation_deg: float = 0.0
     env_intensity: float = 1.0
     aa: str = "none"
+    render_scale: float = 1.0     # the view's resolution relative to the window
+    motion_scale: float = 1.0     # times render_scale while the camera moves (0.5: a quarter of the pixels)
     error: str = ""          # the last error, shown in the panel until the next success
     message: str = ""        # the last success ("saved gold.json")
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.

@@ -75,7 +75,8 @@ class EditorWindow:
         self._maps = None
         self._last_swap = None
         self._framed_mesh = None
-        self._drawn_key = self._drawn_targets = None
+        self._drawn_key = self._drawn_targets = self._last_camera = None
+        self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
         self.redraws = 0   # HDR redraws so far (the Performance section shows it)
         from app.editor.hot_reload import ShaderWatcher
@@ -152,32 +153,43 @@ class EditorWindow:
             self._maps_key = key
         return self._maps
 
-    def targets(self):
+    def view_size(self, moving: bool) -> tuple[int, int]:
+        """The HDR view's size: the window's times the render scale, and times the motion scale
+        while the camera moves (llvmpipe's cost is per pixel; a still view is redrawn sharp)."""
         w, h = self.size
+        scale = self.state.render_scale * (self.state.motion_scale if moving else 1.0)
+        return max(1, round(w * scale)), max(1, round(h * scale))
+
+    def targets(self, size=None):
+        w, h = size or self.size
         return self.renderer._targets_for(w, h, self.state.aa, 4)
 
     def _view_key(self, scene, maps, size) -> tuple:
         """Everything the HDR image depends on. Material, Camera, Light and Display are plain
         dataclasses compared by value; the mesh and the bake by identity (they are replaced, never
-        mutated). The shader library's programs count too, so a hot reload redraws."""
+        mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
                 size, self.state.aa)
 
-    def render_view(self, force: bool = False):
+    def render_view(self, force: bool = False, full: bool = False):
         """Draw the scene into the offscreen HDR target and tone map it, but only when something
-        it depends on changed; then blit the tone-mapped image into the default framebuffer.
-        (While the artist orbits every frame redraws; a still view costs only the blit.)"""
+        it depends on changed; then put the tone-mapped image into the default framebuffer.
+        (While the artist orbits every frame redraws; a still view costs only the copy.)
+        ``full``: the window's size whatever the scales (screenshots)."""
         if self.state.mesh is not self._framed_mesh:
             if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
                 self.orbit.restored, self._framed_mesh = False, self.state.mesh
             else:
                 self.frame_mesh()   # a new mesh: frame it once
-        size = self.size
-        if size[0] == 0 or size[1] == 0:    # minimised
+        window = self.size
+        if window[0] == 0 or window[1] == 0:    # minimised
             return None
-        targets = self.targets()
-        scene = self.state.scene(self.orbit.camera())
+        camera = self.orbit.camera()
+        moving, self._last_camera = camera != self._last_camera, camera
+        size = window if full else self.view_size(moving)
+        targets = self.targets(size)
+        scene = self.state.scene(camera)
         maps = self.maps()
         key = self._view_key(scene, maps, size)
         if force or key != self._drawn_key or targets is not self._drawn_targets:
@@ -185,8 +197,17 @@ class EditorWindow:
             self.renderer.tonemap(targets.radiance, self.state.display, targets.display_fbo)
             self._drawn_key, self._drawn_targets = key, targets
             self.redraws += 1
-        self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
-        # The blit leaves the last used framebuffer (display_fbo) bound; imgui draws into
+        if size == window:
+            self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
+        else:
+            prog = self.renderer.program("render/fullscreen.vert", "render/upscale.frag")
+            targets.display.filter = (self._linear, self._linear)
+            targets.display.use(0)
+            prog["u_image"] = 0
+            self.ctx.screen.use()
+            self.ctx.viewport = (0, 0) + window
+            self.renderer._fullscreen(prog)
+        # The copy leaves the last used framebuffer (display_fbo) bound; imgui draws into
         # whatever is bound, and must draw into the window, never into the view's image.
         self.ctx.screen.use()
         return targets
@@ -225,7 +246,7 @@ class EditorWindow:
         from app.output import check_output_path, write_image
 
         out = check_output_path(path, (".png",))
-        targets = self.render_view()   # display_fbo holds the view, without the panel
+        targets = self.render_view(full=True)   # display_fbo holds the view, without the panel
         if targets is None:
             raise AlightError(f"{out}: the window has no area to capture")
         w, h = targets.width, targets.height
