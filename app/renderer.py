@@ -307,7 +307,11 @@ class Renderer:
         prog = self.program("render/pbr.vert", "render/pbr.frag")
         ctx.enable(moderngl.DEPTH_TEST)
         # Both faces: open meshes and planes are seen from behind too (the shader flips n).
-        ctx.disable(moderngl.CULL_FACE)
+        if scene.cull_back_faces:
+            ctx.front_face = "ccw"
+            ctx.enable(moderngl.CULL_FACE)
+        else:
+            ctx.disable(moderngl.CULL_FACE)
         _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
@@ -325,7 +329,7 @@ class Renderer:
                 if tex is not None:
                     tex.use(UNIT_MATERIAL[name])
             gpu_part.vao.render(moderngl.TRIANGLES)
-        ctx.disable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
 
     @staticmethod
     def _part_material(scene: Scene, part, gpu_part) -> tuple[Material, bool]:

@@ -102,3 +102,25 @@ def test_window_checks_in_a_fresh_process(display):
                             cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
     assert " passed" in result.stdout and "skipped" not in result.stdout, result.stdout[-2000:]
+
+
+@pytest.mark.parametrize("mesh_name", ["sphere", "cube"])
+def test_back_face_culling_of_closed_built_ins_changes_no_pixel(mesh_name):
+    """The editor culls back faces of the closed built-in meshes for speed; the image must not
+    change (a wrong winding would show the inside, or nothing)."""
+    from app.environment import load_environment
+    from app.mesh import load_mesh
+    from app.scene import Camera, Display, Scene
+    from app.editor.state import default_lights
+    from tests.gpu import renderer
+
+    r = renderer()
+    maps = r.bake(load_environment("studio"), "low")
+    mesh = load_mesh(mesh_name)
+    camera = Camera(position=(2.0, 1.5, 3.0))   # off-axis: the cube shows three faces
+    frames = [r.render(Scene(mesh=mesh, lights=default_lights(), camera=camera, cull_back_faces=cull,
+                             display=Display(background="transparent")),
+                       maps, 160, 120, aa="none", read_linear=False).srgb for cull in (False, True)]
+    coverage = (frames[0][:, :, 3] > 0).mean()
+    assert 0.1 < coverage < 0.9   # the mesh covers part of the view (alpha 0 elsewhere)
+    assert np.array_equal(frames[0], frames[1])

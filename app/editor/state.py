@@ -18,6 +18,7 @@ from app.scene import Display, Light, Scene
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
+CLOSED_MESHES = ("sphere", "cube")   # built-ins known to be closed: their back faces are never seen
 
 
 def default_lights() -> list[Light]:
@@ -53,7 +54,7 @@ class EditorState:
         return Scene(mesh=self.mesh, material=self.material, use_file_materials=False,
                      lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
                      env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
-                     display=self.display)
+                     display=self.display, cull_back_faces=self.mesh_spec in CLOSED_MESHES)
 
     # --- loading (all or nothing) -----------------------------------------------------------
 
