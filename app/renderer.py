@@ -52,8 +52,11 @@ class _GpuPart:
         vertices = np.hstack([part.positions, part.normals, part.uvs, part.tangents]).astype(np.float32)
         self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
-        self.vao = ctx.vertex_array(program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv",
-                                               "in_tangent")], self.ibo, index_element_size=4)
+        self.ctx = ctx
+        # A vertex array belongs to one program: one per program this part is drawn with (the
+        # shaded pass, a debug view), made on first use.
+        self._vaos: dict[int, moderngl.VertexArray] = {}
+        self.vao = self.vao_for(program)
         self.textures: dict[str, moderngl.Texture] = {}
         fm = part.material
         if fm is not None:
@@ -62,8 +65,17 @@ class _GpuPart:
                 if image is not None:
                     self.textures[name] = _upload_image(ctx, image, srgb=name in SRGB_MAPS)
 
+    def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
+        vao = self._vaos.get(id(program))
+        if vao is None:
+            vao = self._vaos[id(program)] = self.ctx.vertex_array(
+                program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent")],
+                self.ibo, index_element_size=4)
+        return vao
+
     def release(self) -> None:
-        self.vao.release()
+        for vao in self._vaos.values():
+            vao.release()
         self.vbo.release()
         self.ibo.release()
         for tex in self.textures.values():
@@ -189,8 +201,8 @@ class Renderer:
     def __exit__(self, *exc) -> None:
         self.release()
 
-    def program(self, vertex: str, fragment: str) -> moderngl.Program:
-        prog = self.shaders.program(vertex, fragment)
+    def program(self, vertex: str, fragment: str, defines: dict | None = None) -> moderngl.Program:
+        prog = self.shaders.program(vertex, fragment, defines)
         if id(prog) not in self._units_assigned:
             for name, unit in SAMPLER_UNITS.items():
                 _set(prog, name, unit)
@@ -304,7 +316,12 @@ class Renderer:
 
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray) -> None:
         ctx = self.ctx
-        prog = self.program("render/pbr.vert", "render/pbr.frag")
+        # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
+        debug = {"DEBUG_VIEW": None} if scene.debug_view else None
+        prog = self.program("render/pbr.vert", "render/pbr.frag", debug)
+        if debug:
+            _set(prog, "u_debug_view", int(scene.debug_view))
+            _set(prog, "u_debug_mip", float(scene.debug_mip))
         ctx.enable(moderngl.DEPTH_TEST)
         # Both faces: open meshes and planes are seen from behind too (the shader flips n).
         if scene.cull_back_faces:
@@ -328,7 +345,7 @@ class Renderer:
                 _set(prog, f"u_has_{name}_map", tex is not None)
                 if tex is not None:
                     tex.use(UNIT_MATERIAL[name])
-            gpu_part.vao.render(moderngl.TRIANGLES)
+            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
 
     @staticmethod

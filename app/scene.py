@@ -134,3 +134,5 @@ class Scene:
     # Closed meshes only: skip back faces, which would otherwise be shaded wherever they are
     # drawn before the front faces hiding them (~40% of a sphere's fragment cost on llvmpipe).
     cull_back_faces: bool = False
+    debug_view: int = 0        # 0: shaded; else an index of app/editor/state.py's DEBUG_VIEWS
+    debug_mip: float = 0.0     # the prefiltered mip shown by that debug view

@@ -96,7 +96,9 @@ def test_window_checks_in_a_fresh_process(display):
     their own interpreter: the other GPU tests keep a headless EGL context current on this
     thread, and a GLX window context cannot be made current beside it (X error BadAccess), nor
     should it steal the thread from them."""
-    env = dict(os.environ, PYTHONPATH=str(REPO))
+    # No plugin autoloading: the checks need none, and an installed package's pytest11 entry
+    # point may name a module this checkout does not have.
+    env = dict(os.environ, PYTHONPATH=str(REPO), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
     result = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
                              str(REPO / "tests" / "editor_window_checks.py")],
                             cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
@@ -124,3 +126,13 @@ def test_back_face_culling_of_closed_built_ins_changes_no_pixel(mesh_name):
     coverage = (frames[0][:, :, 3] > 0).mean()
     assert 0.1 < coverage < 0.9   # the mesh covers part of the view (alpha 0 elsewhere)
     assert np.array_equal(frames[0], frames[1])
+
+
+def test_debug_views_show_values(display, tmp_path):
+    """Data views bypass exposure and tone mapping: a pixel is the value itself, in 8 bits."""
+    normal = screenshot(tmp_path, "normal", "--preset", "gold", "--script", "debug_view=normal")
+    # The ball's centre faces the camera: n = (0, 0, 1) is shown as (0.5, 0.5, 1).
+    assert np.abs(normal[118:122, 158:162] - [128, 128, 255]).max() <= 3
+    rough = ball(screenshot(tmp_path, "rough", "--preset", "gold", "--script", "roughness=0.3",
+                            "--script", "debug_view=roughness"))
+    assert np.abs(rough - 0.3 * 255).max() <= 1.5

@@ -11,6 +11,7 @@ from app.bake import QUALITY
 from app.errors import AlightError
 from app.material import list_presets, load_preset, validate_material
 from app.scene import BACKGROUNDS, TONEMAPS, Light
+from app.editor.state import DEBUG_VIEWS
 from app.shading import linear_to_srgb, srgb_to_linear
 
 AA_CHOICES = ("none", "msaa")
@@ -229,6 +230,9 @@ class Panel:
         changed, ev = imgui.slider_float("exposure (EV)", d.exposure, -8.0, 8.0)
         if changed:
             s.display = dataclasses.replace(d, exposure=ev)
+        _, s.debug_view = imgui.combo("debug view", s.debug_view, DEBUG_VIEWS)
+        if DEBUG_VIEWS[s.debug_view] == "prefiltered radiance at mip":
+            _, s.debug_mip = imgui.slider_float("mip", s.debug_mip, 0.0, 8.0)
         changed, i = imgui.combo("anti-aliasing", AA_CHOICES.index(s.aa), AA_CHOICES)
         if changed:
             s.aa = AA_CHOICES[i]

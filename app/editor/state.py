@@ -18,6 +18,11 @@ from app.scene import Display, Light, Scene
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
+# shaders/common/debug_views.glsl's u_debug_view, in order; DATA_VIEWS show values, not radiance.
+DEBUG_VIEWS = ("shaded", "base colour", "normal", "roughness", "metallic", "F0", "n.v", "diffuse only (IBL)",
+               "specular only (IBL)", "irradiance", "prefiltered radiance at mip", "BRDF LUT", "D (first light)",
+               "G (first light)", "F (first light)")
+DATA_VIEWS = {1, 2, 3, 4, 5, 6, 11, 12, 13, 14}
 CLOSED_MESHES = ("sphere", "cube")   # built-ins known to be closed: their back faces are never seen
 
 
@@ -43,6 +48,8 @@ class EditorState:
     aa: str = "none"
     render_scale: float = 1.0     # the view's resolution relative to the window
     motion_scale: float = 1.0     # times render_scale while the camera moves (0.5: a quarter of the pixels)
+    debug_view: int = 0
+    debug_mip: float = 0.0
     error: str = ""          # the last error, shown in the panel until the next success
     message: str = ""        # the last success ("saved gold.json")
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
@@ -54,7 +61,11 @@ class EditorState:
         return Scene(mesh=self.mesh, material=self.material, use_file_materials=False,
                      lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
                      env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
-                     display=self.display, cull_back_faces=self.mesh_spec in CLOSED_MESHES)
+                     # Data views are shown as values: no exposure, no tone curve.
+                     display=dataclasses.replace(self.display, tonemap="none", exposure=0.0)
+                     if self.debug_view in DATA_VIEWS else self.display,
+                     cull_back_faces=self.mesh_spec in CLOSED_MESHES, debug_view=self.debug_view,
+                     debug_mip=self.debug_mip)
 
     # --- loading (all or nothing) -----------------------------------------------------------
 
@@ -141,6 +152,12 @@ class EditorState:
                 self.ibl_enabled = value not in ("0", "false", "off")
             elif key == "quality":
                 self.quality = value
+            elif key == "debug_view":
+                if value not in DEBUG_VIEWS:
+                    raise AlightError(f"--script: debug_view '{value}' is not one of {', '.join(DEBUG_VIEWS)}")
+                self.debug_view = DEBUG_VIEWS.index(value)
+            elif key == "debug_mip":
+                self.debug_mip = float(value)
             else:
                 raise AlightError(f"--script: unknown field '{key}'")
         except ValueError:

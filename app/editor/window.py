@@ -21,6 +21,7 @@ import time
 
 from app.bake import QUALITY
 from app.errors import AlightError
+from app.gpu import ShaderCompileError
 from app.editor.camera import OrbitCamera
 from app.editor.state import EditorState, History
 
@@ -170,7 +171,7 @@ class EditorWindow:
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
-                size, self.state.aa)
+                size, self.state.aa, scene.debug_view, scene.debug_mip)
 
     def render_view(self, force: bool = False, full: bool = False):
         """Draw the scene into the offscreen HDR target and tone map it, but only when something
@@ -193,8 +194,13 @@ class EditorWindow:
         maps = self.maps()
         key = self._view_key(scene, maps, size)
         if force or key != self._drawn_key or targets is not self._drawn_targets:
-            self.renderer.draw_hdr(scene, maps, targets)
-            self.renderer.tonemap(targets.radiance, self.state.display, targets.display_fbo)
+            try:
+                self.renderer.draw_hdr(scene, maps, targets)
+            except ShaderCompileError as exc:   # a program first compiled now (a debug view)
+                self.state.fail(exc)
+                self.state.debug_view = 0
+                return None
+            self.renderer.tonemap(targets.radiance, scene.display, targets.display_fbo)
             self._drawn_key, self._drawn_targets = key, targets
             self.redraws += 1
         if size == window:
