@@ -127,6 +127,10 @@ def _edit(args) -> int:
         raise AlightError("--view: the editor shows the camera view")
     if args.frames < 0:
         raise AlightError(f"--frames: {args.frames} is negative")
+    if args.screenshot:   # refuse a bad path before a window opens
+        from app.output import check_output_path
+
+        check_output_path(args.screenshot, (".png",))
     if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
         raise AlightError("editor: no display (DISPLAY is unset); run under xvfb-run -a, or use 'alight render'")
     from app.editor.run import run

@@ -136,3 +136,19 @@ def test_debug_views_show_values(display, tmp_path):
     rough = ball(screenshot(tmp_path, "rough", "--preset", "gold", "--script", "roughness=0.3",
                             "--script", "debug_view=roughness"))
     assert np.abs(rough - 0.3 * 255).max() <= 1.5
+
+
+def test_without_a_display(tmp_path):
+    """`alight` alone prints the help when there is no display; `alight edit` says why it cannot run."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env["PYTHONPATH"] = str(REPO)
+    bare = subprocess.run([sys.executable, "-m", "app"], cwd=REPO, env=env, capture_output=True, text=True,
+                          timeout=60)
+    assert bare.returncode == 0 and "usage: alight" in bare.stdout and " edit " in bare.stdout
+    edit_ = subprocess.run([sys.executable, "-m", "app", "edit"], cwd=REPO, env=env, capture_output=True,
+                           text=True, timeout=60)
+    assert edit_.returncode == 2 and edit_.stderr.startswith("alight: error: editor: no display")
+    assert edit_.stderr.count("\n") == 1
+    bad = subprocess.run([sys.executable, "-m", "app", "edit", "--screenshot", str(tmp_path / "x.jpg")], cwd=REPO,
+                         env=env, capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "unsupported output format" in bad.stderr
