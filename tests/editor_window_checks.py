@@ -89,6 +89,24 @@ def test_undo_redo_of_material_edits(window):
     s.material = h.redo(s.material)
     s.material = h.redo(s.material)
     assert (s.material.roughness, s.material.metallic) == (0.11, 1.0 - start.metallic)
+    # The same through the keyboard, as glfw delivers it: Ctrl+Z undoes, Ctrl+Shift+Z redoes.
+    import glfw
+
+    def key(k, action):
+        window.impl.keyboard_callback(window.window, k, 0, action, 0)
+
+    def chord(*keys):
+        for k in keys:
+            key(k, glfw.PRESS)
+        window.frame()
+        for k in reversed(keys):
+            key(k, glfw.RELEASE)
+        window.frame()
+
+    chord(glfw.KEY_LEFT_CONTROL, glfw.KEY_Z)
+    assert (s.material.roughness, s.material.metallic) == (0.11, start.metallic)
+    chord(glfw.KEY_LEFT_CONTROL, glfw.KEY_LEFT_SHIFT, glfw.KEY_Z)
+    assert (s.material.roughness, s.material.metallic) == (0.11, 1.0 - start.metallic)
 
 
 def test_preset_saved_from_panel_state_loads_back_equal(window, tmp_path, monkeypatch):

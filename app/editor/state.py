@@ -8,13 +8,15 @@ sets ``error``.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.errors import AlightError
 from app.material import Material, load_preset, save_preset, validate_material
-from app.scene import Display, Light, Scene
+from app.bake import QUALITY
+from app.scene import TONEMAPS, Display, Light, Scene
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
@@ -143,25 +145,36 @@ class EditorState:
             elif key == "env":
                 self.load_env(value)
             elif key == "exposure":
-                self.display.exposure = float(value)
+                self.display = dataclasses.replace(self.display, exposure=_finite(value, edit))
             elif key == "tonemap":
+                if value not in TONEMAPS:
+                    raise AlightError(f"--script: tonemap '{value}' is not one of {', '.join(TONEMAPS)}")
                 self.display = dataclasses.replace(self.display, tonemap=value)
             elif key in ("env_rotation", "env_intensity"):
-                setattr(self, key + ("_deg" if key == "env_rotation" else ""), float(value))
+                setattr(self, key + ("_deg" if key == "env_rotation" else ""), _finite(value, edit))
             elif key == "ibl":
                 self.ibl_enabled = value not in ("0", "false", "off")
             elif key == "quality":
+                if value not in QUALITY:
+                    raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}")
                 self.quality = value
             elif key == "debug_view":
                 if value not in DEBUG_VIEWS:
                     raise AlightError(f"--script: debug_view '{value}' is not one of {', '.join(DEBUG_VIEWS)}")
                 self.debug_view = DEBUG_VIEWS.index(value)
             elif key == "debug_mip":
-                self.debug_mip = float(value)
+                self.debug_mip = max(0.0, _finite(value, edit))
             else:
                 raise AlightError(f"--script: unknown field '{key}'")
         except ValueError:
             raise AlightError(f"--script: '{edit}': '{value}' is not a number") from None
+
+
+def _finite(value: str, edit: str) -> float:
+    x = float(value)
+    if not math.isfinite(x):
+        raise AlightError(f"--script: '{edit}': '{value}' is not finite")
+    return x
 
 
 class History:
