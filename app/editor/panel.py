@@ -74,6 +74,7 @@ class Panel:
         from imgui_bundle import imgui
 
         m = s.material
+        _, s.use_file_materials = imgui.checkbox("mesh file's own materials and maps", s.use_file_materials)
         if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
             imgui.table_setup_column("preset")
             imgui.table_setup_column("F0 linear")

@@ -22,6 +22,10 @@ def build_state(args) -> EditorState:
         print(f"alight: warning: {line}", file=sys.stderr)
     if args.no_ibl:
         state.ibl_enabled = False
+    # As in 'alight render': a mesh file without --preset shows its own materials and maps.
+    from app.mesh import BUILTIN_MESHES
+
+    state.use_file_materials = args.preset is None and args.mesh not in BUILTIN_MESHES
     return state
 
 

@@ -50,6 +50,7 @@ class EditorState:
     aa: str = "none"
     render_scale: float = 1.0     # the view's resolution relative to the window
     motion_scale: float = 1.0     # times render_scale while the camera moves (0.5: a quarter of the pixels)
+    use_file_materials: bool = False   # a mesh file's own materials and texture maps instead of the panel's
     debug_view: int = 0
     debug_mip: float = 0.0
     error: str = ""          # the last error, shown in the panel until the next success
@@ -59,8 +60,8 @@ class EditorState:
     env: object = None
 
     def scene(self, camera) -> Scene:
-        # use_file_materials False: the editor's material is what the artist is shaping.
-        return Scene(mesh=self.mesh, material=self.material, use_file_materials=False,
+        # Off by default: the editor's material is what the artist is shaping.
+        return Scene(mesh=self.mesh, material=self.material, use_file_materials=self.use_file_materials,
                      lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
                      env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
                      # Data views are shown as values: no exposure, no tone curve.

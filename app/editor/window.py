@@ -171,7 +171,7 @@ class EditorWindow:
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
-                size, self.state.aa, scene.debug_view, scene.debug_mip)
+                size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials)
 
     def render_view(self, force: bool = False, full: bool = False):
         """Draw the scene into the offscreen HDR target and tone map it, but only when something
