@@ -97,6 +97,52 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):
         self.exit(2, f"alight: error: {' '.join(message.split())} (see '{self.prog} --help')\n")
 
+# ---- alight edit (issue 3: the interactive editor; everything else lives in app/editor/) ----
+
+def _add_edit_parser(sub) -> None:
+    e = sub.add_parser("edit", help="open the interactive material editor (needs a display)",
+                       description="The material editor: a window with a live preview and a panel. "
+                                   "Drop .hdr/.exr, mesh or preset .json files on it.")
+    _add_scene_options(e)
+    e.add_argument("--quality", choices=QUALITIES, default="medium", help="bake quality (default: medium)")
+    e.add_argument("--size", type=_size, default=(1280, 720), metavar="W|WxH", help="window size (default: 1280x720)")
+    e.add_argument("--aa", choices=("none", "msaa"), default="none",
+                   help="anti-aliasing of the preview (default: none; msaa costs ~2x on llvmpipe)")
+    e.add_argument("--motion-scale", type=_number("--motion-scale", 0.25, 1.0), default=0.5, metavar="X",
+                   help="the view's resolution while the camera moves, relative to the window; a still "
+                        "view is redrawn at full resolution (default: 0.5)")
+    e.add_argument("--screenshot", metavar="FILE.png",
+                   help="render --frames frames, write the view (without the panel) at window size, exit")
+    e.add_argument("--frames", type=int, default=0, metavar="N", help="frames before --screenshot (default 1), "
+                                                                       "or measured by --benchmark (default 120)")
+    e.add_argument("--benchmark", action="store_true",
+                   help="1280x720, the material ball, IBL, 3 lights and the panel: print median and p95 frame times")
+    e.add_argument("--script", action="append", default=[], metavar="FIELD=VALUE",
+                   help="an edit applied after a frame, e.g. roughness=0.9, preset=water, open=FILE (repeatable)")
+    e.add_argument("--no-panel", action="store_true", help="draw the view only")
+    e.add_argument("--new", action="store_true",
+                   help="do not reopen the last session (it is reopened when no scene option is given)")
+
+
+def _edit(args) -> int:
+    import os
+
+    if args.view != "camera":
+        raise AlightError("--view: the editor shows the camera view")
+    if args.frames < 0:
+        raise AlightError(f"--frames: {args.frames} is negative")
+    if args.screenshot:   # refuse a bad path before a window opens
+        from app.output import check_output_path
+
+        check_output_path(args.screenshot, (".png",))
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        raise AlightError("editor: no display (DISPLAY is unset); run under xvfb-run -a, or use 'alight render'")
+    from app.editor.run import run
+
+    return run(args)
+
+# ---- end of alight edit ----
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="alight", description="A physically based material renderer "
@@ -164,6 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
     # --- end alight batch ---------------------------------------------------------------------
     sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
+    _add_edit_parser(sub)
     return parser
 
 
@@ -171,9 +218,15 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
-        parser.print_help()
-        return 0
+        import os
+
+        if not os.environ.get("DISPLAY"):
+            parser.print_help()
+            return 0
+        args = parser.parse_args(["edit"])   # with a display, plain 'alight' opens the editor
     try:
+        if args.command == "edit":
+            return _edit(args)
         if args.command == "render":
             return _render(args)
         if args.command == "bake":

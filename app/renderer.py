@@ -53,9 +53,10 @@ class _GpuPart:
         vertices = np.hstack([part.positions, part.normals, part.uvs, part.tangents]).astype(np.float32)
         self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
-        self.vao = ctx.vertex_array(program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv",
-                                               "in_tangent")], self.ibo, index_element_size=4,
-                                       skip_errors=True)  # a debug shader may not read every attribute
+        self.ctx = ctx
+        # A vertex array belongs to one program: one per program this part is drawn with (the
+        # shaded pass, a debug view), made on first use.
+        self._vaos: dict[int, moderngl.VertexArray] = {}
         self.textures: dict[str, moderngl.Texture] = {}
         self.closed = is_closed(part.positions, part.indices)
         fm = part.material
@@ -65,8 +66,18 @@ class _GpuPart:
                 if image is not None:
                     self.textures[name] = _upload_image(ctx, image, srgb=name in SRGB_MAPS)
 
+    def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
+        vao = self._vaos.get(id(program))
+        if vao is None:
+            vao = self._vaos[id(program)] = self.ctx.vertex_array(
+                program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent")],
+                self.ibo, index_element_size=4,
+                skip_errors=True)  # a debug view may not read every attribute
+        return vao
+
     def release(self) -> None:
-        self.vao.release()
+        for vao in self._vaos.values():
+            vao.release()
         self.vbo.release()
         self.ibo.release()
         for tex in self.textures.values():
@@ -163,6 +174,22 @@ class Renderer:
             self._targets = _Targets(self.ctx, width, height, aa, samples)
         return self._targets
 
+    def use_shaders(self, shaders: ShaderLibrary) -> None:
+        """Switch to a freshly compiled library (the editor's shader hot reload) and release the
+        old one. Vertex arrays are tied to the program they were made with, so the mesh and
+        full-screen VAOs are rebuilt on the next draw; the bakes stay valid."""
+        old, self.shaders = self.shaders, shaders
+        self.luts.shaders = shaders
+        for vao in self._fullscreen_vaos.values():
+            vao.release()
+        self._fullscreen_vaos.clear()
+        self._units_assigned.clear()
+        for _, parts in self._meshes.values():
+            for part in parts:
+                part.release()
+        self._meshes.clear()
+        old.reload()
+
     def release(self) -> None:
         for maps in self._bakes.values():
             maps.release()
@@ -183,8 +210,8 @@ class Renderer:
     def __exit__(self, *exc) -> None:
         self.release()
 
-    def program(self, vertex: str, fragment: str) -> moderngl.Program:
-        prog = self.shaders.program(vertex, fragment)
+    def program(self, vertex: str, fragment: str, defines: dict | None = None) -> moderngl.Program:
+        prog = self.shaders.program(vertex, fragment, defines)
         if id(prog) not in self._units_assigned:
             for name, unit in SAMPLER_UNITS.items():
                 _set(prog, name, unit)
@@ -300,7 +327,12 @@ class Renderer:
 
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray) -> None:
         ctx = self.ctx
-        prog = self.program("render/pbr.vert", "render/pbr.frag")
+        # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
+        debug = {"DEBUG_VIEW": None} if scene.debug_view else None
+        prog = self.program("render/pbr.vert", "render/pbr.frag", debug)
+        if debug:
+            _set(prog, "u_debug_view", int(scene.debug_view))
+            _set(prog, "u_debug_mip", float(scene.debug_mip))
         _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
@@ -321,10 +353,11 @@ class Renderer:
             # and stops back faces drawn first from being shaded and then overwritten (35% of
             # the ball's cost on llvmpipe). Open meshes are seen from behind (the shader flips n).
             if gpu_part.closed:
+                ctx.front_face = "ccw"
                 ctx.enable(moderngl.CULL_FACE)
             else:
                 ctx.disable(moderngl.CULL_FACE)
-            gpu_part.vao.render(moderngl.TRIANGLES)
+            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
         ctx.disable(moderngl.CULL_FACE)
 
     @staticmethod

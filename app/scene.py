@@ -131,3 +131,5 @@ class Scene:
     env_intensity: float = 1.0
     ibl_enabled: bool = True
     display: Display = field(default_factory=Display)
+    debug_view: int = 0        # 0: shaded; else an index of app/editor/state.py's DEBUG_VIEWS
+    debug_mip: float = 0.0     # the prefiltered mip shown by that debug view

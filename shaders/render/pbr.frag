@@ -1,6 +1,7 @@
 #version 450 core
 // Forward PBR pass: a mesh with the metal-roughness material (factors times glTF textures).
 #include "common/shading.glsl"
+#include "common/debug_views.glsl"
 
 in vec3 v_position;
 in vec3 v_normal;
@@ -74,5 +75,9 @@ Surface material_surface() {
 void main() {
     vec3 n = shading_normal();
     vec3 v = normalize(u_camera_position - v_position);
+#ifdef DEBUG_VIEW
+    out_radiance = vec4(debug_view(material_surface(), n, v, v_position), 1.0);
+#else
     out_radiance = vec4(shade(material_surface(), n, v, v_position), 1.0);
+#endif
 }

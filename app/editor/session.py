@@ -1,0 +1,59 @@
+"""The last session (mesh, environment, material, camera), so the editor reopens where the
+artist left it. A JSON file in alight's cache directory, written atomically on close."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+from app.errors import AlightError
+from app.material import material_from_dict
+from app.output import write_text_atomic
+from app.paths import cache_dir
+
+CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "radius")
+
+
+def session_path() -> Path:
+    return cache_dir() / "editor-session.json"
+
+
+def save_session(state, orbit) -> None:
+    data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
+            "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS}}
+    path = session_path()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(path, json.dumps(data, indent=1))
+
+
+def restore_session(state, orbit) -> str:
+    """Apply the saved session to ``state`` and ``orbit``. Returns '' or a one-line warning: a
+    missing mesh or environment file (moved since) or a broken session file restores what it can."""
+    path = session_path()
+    if not path.is_file():
+        return ""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+        material = material_from_dict(data["material"], str(path))
+    except (OSError, ValueError, KeyError, TypeError, AlightError) as exc:
+        return f"{path}: last session not restored ({' '.join(str(exc).split())})"
+    warning = ""
+    state.material = state.saved_material = material
+    for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
+        if isinstance(spec, str):
+            try:
+                loader(spec)
+            except AlightError as exc:
+                warning = str(exc)
+    camera = data.get("camera")
+    if isinstance(camera, dict):
+        try:
+            values = {k: (tuple(float(x) for x in camera[k]) if k == "target" else float(camera[k]))
+                      for k in CAMERA_FIELDS}
+            for k, v in values.items():
+                setattr(orbit, k, v)
+            orbit.restored = True
+        except (KeyError, TypeError, ValueError):
+            pass
+    return warning

@@ -1,0 +1,279 @@
+"""The editor's window: glfw, a ModernGL context made from it, the main loop.
+
+Each frame: build the imgui panel (it edits EditorState), render the scene with the Renderer
+into its offscreen HDR target at the window's size, tone map that into the default
+framebuffer, draw imgui on top, swap. The Renderer never sees imgui; the panel never sees GL.
+
+imgui backend: imgui-bundle's own pure-python GLFW backend (python_backends.glfw_backend). It
+draws with PyOpenGL on the same context ModernGL uses (GL state is the context's, not the
+library's, and the backend saves and restores the state it touches). We chose it over drawing
+imgui's draw lists with ModernGL ourselves because imgui 1.92's dynamic font atlas protocol
+(ImTextureData create/update/destroy requests) is already handled there; redoing it would be
+a second, untested copy of the same code.
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import os
+import time
+
+from app.bake import QUALITY
+from app.errors import AlightError
+from app.gpu import ShaderCompileError
+from app.editor.camera import OrbitCamera
+from app.editor.state import EditorState, History
+
+
+class EditorWindow:
+    def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
+                 show_panel: bool = True):
+        # PyOpenGL must pick GLX (X11/Xvfb) before the backend imports it.
+        if os.environ.get("XDG_SESSION_TYPE") == "wayland":
+            os.environ.setdefault("PYOPENGL_PLATFORM", "x11")
+        # PyOpenGL calls glGetError after every call and raises on any pending error, including
+        # one left by a ModernGL call on the shared context; off, it is also much cheaper per call.
+        import OpenGL
+
+        OpenGL.ERROR_CHECKING = False
+        import glfw
+        import moderngl
+        from imgui_bundle import imgui, implot
+        from imgui_bundle.python_backends.glfw_backend import GlfwRenderer
+
+        from app.renderer import Renderer
+
+        self.glfw, self.imgui, self.implot = glfw, imgui, implot
+        if not glfw.init():
+            raise AlightError("editor: cannot open a window (no display? set DISPLAY, or run under xvfb-run -a)")
+        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
+        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 5)
+        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
+        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
+        self.window = glfw.create_window(size[0], size[1], title, None, None)
+        if not self.window:
+            glfw.terminate()
+            raise AlightError("editor: cannot create an OpenGL 4.5 core window")
+        glfw.make_context_current(self.window)
+        glfw.swap_interval(0)  # frame times measure our work, not the display's refresh
+        self.ctx = moderngl.create_context(require=450)
+        self.renderer = Renderer(self.ctx)
+
+        imgui.create_context()
+        implot.create_context()
+        imgui.get_io().set_ini_filename("")   # no imgui.ini littering the working directory
+        self.impl = GlfwRenderer(self.window)
+        glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
+
+        self.state = state
+        self.show_panel = show_panel
+        self.history = History(state.material)
+        self.orbit = OrbitCamera()
+        self.frame_times: collections.deque[float] = collections.deque(maxlen=240)
+        self.bake_seconds: dict[str, float] = {}
+        self._maps_key = None
+        self._maps = None
+        self._last_swap = None
+        self._framed_mesh = None
+        self._drawn_key = self._drawn_targets = self._last_camera = None
+        self._linear = moderngl.LINEAR
+        self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
+        self.redraws = 0   # HDR redraws so far (the Performance section shows it)
+        from app.editor.hot_reload import ShaderWatcher
+        from app.editor.panel import Panel
+
+        self.shader_watcher = ShaderWatcher(self.renderer.shaders.root)
+
+        self.panel = Panel()
+
+    # --- input --------------------------------------------------------------------------------
+
+    def drop(self, paths: list[str]) -> None:
+        """glfw's drop callback: each file by its suffix; a bad one keeps the previous state."""
+        for path in paths:
+            self.state.open_file(path)
+
+    def _camera_input(self) -> None:
+        imgui, io = self.imgui, self.imgui.get_io()
+        if not io.want_capture_mouse:
+            dx, dy = io.mouse_delta.x, io.mouse_delta.y
+            if imgui.is_mouse_dragging(imgui.MouseButton_.left):
+                self.orbit.orbit(dx, dy)
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) or imgui.is_mouse_dragging(imgui.MouseButton_.middle):
+                self.orbit.pan(dx, dy, self.size[1])
+            if io.mouse_wheel:
+                self.orbit.zoom(io.mouse_wheel)
+        if not io.want_capture_keyboard:
+            if imgui.is_key_pressed(imgui.Key.f):
+                self.frame_mesh()
+            if imgui.is_key_pressed(imgui.Key.f12):
+                self.screenshot_request = self.next_screenshot_name()
+            if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
+                m = self.history.redo(self.state.material) if io.key_shift else self.history.undo(self.state.material)
+                self.state.material = m
+
+    def frame_mesh(self) -> None:
+        if self.state.mesh is not None:
+            center, radius = self.state.mesh.bounding_sphere()
+            w, h = self.size
+            self.orbit.frame(center, radius, w / max(h, 1))
+        self._framed_mesh = self.state.mesh
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return tuple(self.glfw.get_framebuffer_size(self.window))
+
+    def check_shaders(self, force: bool = False) -> None:
+        """Hot reload: rebuild the programs when a file under shaders/ changed."""
+        from app.editor.hot_reload import rebuild
+
+        if not self.shader_watcher.changed(force):
+            return
+        error = rebuild(self.renderer, self.shader_watcher.root)
+        if error:
+            self.state.error, self.state.message = error, ""
+        else:
+            self.state.error, self.state.message = "", "shaders reloaded"
+            self._drawn_key = None   # redraw with the new programs
+
+    # --- rendering ----------------------------------------------------------------------------
+
+    def maps(self):
+        """Bake only when the environment or the quality changed (the Renderer caches bakes too)."""
+        s = self.state
+        if s.env is None:
+            return None
+        key = (id(s.env), s.quality)
+        if key != self._maps_key:
+            try:
+                self._maps = self.renderer.bake(s.env, QUALITY[s.quality])
+                self.bake_seconds = dict(self._maps.pass_seconds)
+            except AlightError as exc:
+                s.fail(exc)
+            self._maps_key = key
+        return self._maps
+
+    def view_size(self, moving: bool) -> tuple[int, int]:
+        """The HDR view's size: the window's times the render scale, and times the motion scale
+        while the camera moves (llvmpipe's cost is per pixel; a still view is redrawn sharp)."""
+        w, h = self.size
+        scale = self.state.render_scale * (self.state.motion_scale if moving else 1.0)
+        return max(1, round(w * scale)), max(1, round(h * scale))
+
+    def targets(self, size=None):
+        w, h = size or self.size
+        return self.renderer._targets_for(w, h, self.state.aa, 4)
+
+    def _view_key(self, scene, maps, size) -> tuple:
+        """Everything the HDR image depends on. Material, Camera, Light and Display are plain
+        dataclasses compared by value; the mesh and the bake by identity (they are replaced, never
+        mutated)."""
+        return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
+                scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
+                size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials)
+
+    def render_view(self, force: bool = False, full: bool = False):
+        """Draw the scene into the offscreen HDR target and tone map it, but only when something
+        it depends on changed; then put the tone-mapped image into the default framebuffer.
+        (While the artist orbits every frame redraws; a still view costs only the copy.)
+        ``full``: the window's size whatever the scales (screenshots)."""
+        if self.state.mesh is not self._framed_mesh:
+            if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
+                self.orbit.restored, self._framed_mesh = False, self.state.mesh
+            else:
+                self.frame_mesh()   # a new mesh: frame it once
+        window = self.size
+        if window[0] == 0 or window[1] == 0:    # minimised
+            return None
+        camera = self.orbit.camera()
+        moving, self._last_camera = camera != self._last_camera, camera
+        size = window if full else self.view_size(moving)
+        targets = self.targets(size)
+        scene = self.state.scene(camera)
+        maps = self.maps()
+        key = self._view_key(scene, maps, size)
+        if force or key != self._drawn_key or targets is not self._drawn_targets:
+            try:
+                self.renderer.draw_hdr(scene, maps, targets)
+            except ShaderCompileError as exc:   # a program first compiled now (a debug view)
+                self.state.fail(exc)
+                self.state.debug_view = 0
+                return None
+            self.renderer.tonemap(targets.radiance, scene.display, targets.display_fbo)
+            self._drawn_key, self._drawn_targets = key, targets
+            self.redraws += 1
+        if size == window:
+            self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
+        else:
+            prog = self.renderer.program("render/fullscreen.vert", "render/upscale.frag")
+            targets.display.filter = (self._linear, self._linear)
+            targets.display.use(0)
+            prog["u_image"] = 0
+            self.ctx.screen.use()
+            self.ctx.viewport = (0, 0) + window
+            self.renderer._fullscreen(prog)
+        # The copy leaves the last used framebuffer (display_fbo) bound; imgui draws into
+        # whatever is bound, and must draw into the window, never into the view's image.
+        self.ctx.screen.use()
+        return targets
+
+    def frame(self) -> None:
+        glfw, imgui = self.glfw, self.imgui
+        glfw.poll_events()
+        self.impl.process_inputs()
+        imgui.new_frame()
+        if self.show_panel:
+            self.panel.draw(self)
+        self._camera_input()
+        self.check_shaders()
+        self.history.settle(self.state.material, imgui.is_any_item_active())
+        imgui.render()
+        self.render_view()
+        if self.show_panel:
+            self.impl.render(imgui.get_draw_data())
+        glfw.swap_buffers(self.window)
+        if self.screenshot_request:
+            path, self.screenshot_request = self.screenshot_request, ""
+            try:
+                self.screenshot(path)
+                self.state.error, self.state.message = "", f"wrote {path}"
+            except AlightError as exc:
+                self.state.fail(exc)
+        now = time.perf_counter()
+        if self._last_swap is not None:
+            self.frame_times.append(now - self._last_swap)
+        self._last_swap = now
+
+    def screenshot(self, path: str) -> None:
+        """The view without the panel, at window size: the last frame's radiance tone mapped again."""
+        import numpy as np
+
+        from app.output import check_output_path, write_image
+
+        out = check_output_path(path, (".png",))
+        targets = self.render_view(full=True)   # display_fbo holds the view, without the panel
+        if targets is None:
+            raise AlightError(f"{out}: the window has no area to capture")
+        w, h = targets.width, targets.height
+        pixels = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)
+        write_image(out, pixels[::-1, :, :3].copy(), linear=False)
+
+    @staticmethod
+    def next_screenshot_name() -> str:
+        n = 1
+        while os.path.exists(f"alight-screenshot-{n}.png"):
+            n += 1
+        return f"alight-screenshot-{n}.png"
+
+    def should_close(self) -> bool:
+        return bool(self.glfw.window_should_close(self.window))
+
+    def close(self) -> None:
+        self.impl.shutdown()
+        self.implot.destroy_context()
+        self.imgui.destroy_context()
+        self.renderer.release()
+        self.ctx.release()
+        self.glfw.destroy_window(self.window)
+        self.glfw.terminate()

@@ -1,0 +1,225 @@
+"""The editor's real glfw window driven in-process: drops, undo/redo, presets, hot reload,
+session, redraw policy. Run by tests/test_editor.py in a fresh interpreter with DISPLAY set
+(see test_window_checks_in_a_fresh_process); not collected on its own."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app.errors import AlightError
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def ball(image: np.ndarray) -> np.ndarray:
+    h, w = image.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.25 * h) ** 2]
+
+
+@pytest.fixture(scope="module")
+def window():
+    from app.editor.state import EditorState
+    from app.editor.window import EditorWindow
+
+    assert os.environ.get("DISPLAY"), "run through tests/test_editor.py, which provides a display"
+    state = EditorState()
+    state.load_mesh("sphere")
+    state.load_env("studio")
+    win = EditorWindow(state, (320, 240))
+    win.frame()
+    yield win
+    win.close()
+
+
+def test_drops_keep_previous_state_and_show_the_error(window, tmp_path, shared_data):
+    from app.mesh import load_mesh
+
+    corrupt = tmp_path / "corrupt.hdr"
+    corrupt.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 64 +X 128\n" + b"\x02\x02" * 40)
+    bad_json = tmp_path / "bad.json"
+    bad_json.write_text('{"name": "x", "rougness": 0.5}')
+    files = sorted((shared_data / "bad").iterdir()) + [corrupt, bad_json, tmp_path / "notes.txt"]
+    errors = 0
+    for path in files:
+        s = window.state
+        before = (s.mesh, s.env, s.material)
+        try:
+            load_mesh(str(path))
+            should_fail = path.suffix.lower() not in (".obj", ".glb", ".gltf", ".ply", ".stl")
+        except AlightError:
+            should_fail = True
+        window.drop([str(path)])   # what glfw's drop callback calls
+        window.frame()             # the editor keeps running and draws the panel
+        window.frame()
+        if should_fail:
+            errors += 1
+            assert (s.mesh, s.env, s.material) == before, path.name
+            assert s.error and "\n" not in s.error
+            assert window.panel.shown_error == s.error, "the panel did not draw the error"
+            assert path.name in s.error
+        else:
+            assert s.error == "", s.error
+            assert s.mesh is not before[0]    # a repaired mesh file is loaded
+    assert errors >= 5   # empty.obj, empty_nodes.glb, the corrupt HDR, the bad preset, the .txt
+    # A good drop afterwards clears the error and replaces the state.
+    window.drop([str(REPO / "presets" / "copper.json")])
+    window.frame()
+    assert window.state.error == "" and window.state.material.name == "copper"
+
+
+def test_undo_redo_of_material_edits(window):
+    import dataclasses
+
+    s, h = window.state, window.history
+    start = s.material
+    s.material = dataclasses.replace(start, roughness=0.11)
+    window.frame()                        # no widget active: the edit becomes one undo step
+    s.material = dataclasses.replace(s.material, metallic=1.0 - start.metallic)
+    window.frame()
+    s.material = h.undo(s.material)
+    assert (s.material.roughness, s.material.metallic) == (0.11, start.metallic)
+    s.material = h.undo(s.material)
+    assert s.material == start
+    s.material = h.redo(s.material)
+    s.material = h.redo(s.material)
+    assert (s.material.roughness, s.material.metallic) == (0.11, 1.0 - start.metallic)
+    # The same through the keyboard, as glfw delivers it: Ctrl+Z undoes, Ctrl+Shift+Z redoes.
+    import glfw
+
+    def key(k, action):
+        window.impl.keyboard_callback(window.window, k, 0, action, 0)
+
+    def chord(*keys):
+        for k in keys:
+            key(k, glfw.PRESS)
+        window.frame()
+        for k in reversed(keys):
+            key(k, glfw.RELEASE)
+        window.frame()
+
+    chord(glfw.KEY_LEFT_CONTROL, glfw.KEY_Z)
+    assert (s.material.roughness, s.material.metallic) == (0.11, start.metallic)
+    chord(glfw.KEY_LEFT_CONTROL, glfw.KEY_LEFT_SHIFT, glfw.KEY_Z)
+    assert (s.material.roughness, s.material.metallic) == (0.11, 1.0 - start.metallic)
+
+
+def test_preset_saved_from_panel_state_loads_back_equal(window, tmp_path, monkeypatch):
+    import dataclasses
+
+    from app.editor.state import EditorState
+
+    s = window.state
+    s.material = dataclasses.replace(s.material, name="mine", base_color=(0.7, 0.2, 0.1), roughness=0.37,
+                                     metallic=0.25, emissive=(0.5, 0.0, 0.0))
+    path = tmp_path / "mine.json"
+    s.save_material(str(path))
+    other = EditorState()
+    assert other.open_file(str(path)), other.error
+    assert other.material == s.material
+    good = path.read_bytes()
+    # An invalid material is refused before anything is written.
+    s.material = dataclasses.replace(s.material, roughness=2.0)
+    with pytest.raises(AlightError, match="roughness"):
+        s.save_material(str(path))
+    assert path.read_bytes() == good
+    # A write that fails at the last step (the rename) leaves the old file whole and no temporary.
+    s.material = dataclasses.replace(s.material, roughness=0.5)
+
+    def broken_replace(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr("app.output.os.replace", broken_replace)
+    with pytest.raises(AlightError, match="No space left"):
+        s.save_material(str(path))
+    assert path.read_bytes() == good
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.json"]
+
+
+def test_shader_hot_reload_keeps_the_last_good_program(window, tmp_path):
+    import dataclasses
+
+    import OpenImageIO as oiio
+
+    from app.editor.hot_reload import ShaderWatcher
+    from app.gpu import ShaderLibrary
+
+    def shot(name):
+        window.frame()
+        window.screenshot(str(tmp_path / name))
+        return ball(oiio.ImageBuf(str(tmp_path / name)).get_pixels(oiio.UINT8).astype(np.float64))
+
+    root = tmp_path / "shaders"
+    shutil.copytree(REPO / "shaders", root)
+    window.renderer.use_shaders(ShaderLibrary(window.ctx, root))
+    window.shader_watcher = ShaderWatcher(root)
+    s = window.state
+    s.material = dataclasses.replace(s.material, roughness=0.6)
+    before = shot("before.png")
+    frag = root / "render" / "pbr.frag"
+    text = frag.read_text()
+    lines = text.splitlines()
+    at = lines.index("in vec3 v_position;") + 1
+    lines.insert(at, "this is not glsl;")
+    frag.write_text("\n".join(lines) + "\n")
+    window.check_shaders(force=True)
+    assert f"render/pbr.frag:{at + 1}" in s.error, s.error
+    # A nearly equal material forces a redraw: it is drawn, with the last good program.
+    s.material = dataclasses.replace(s.material, roughness=0.601)
+    during = shot("during.png")
+    assert window.panel.shown_error == s.error
+    assert np.abs(during - before).mean() < 2.0 and before.std() > 5.0
+    # Saving a fix is picked up and clears the error.
+    frag.write_text(text.replace("void main()", "// edited\nvoid main()", 1))
+    window.check_shaders(force=True)
+    assert s.error == "" and s.message == "shaders reloaded"
+    after = shot("after.png")
+    assert np.abs(after - before).mean() < 2.0
+    window.renderer.use_shaders(ShaderLibrary(window.ctx))   # back to the repository's shaders
+
+
+def test_session_reopens_and_screenshot_button(window, tmp_path, monkeypatch):
+    import dataclasses
+
+    from app.editor.camera import OrbitCamera
+    from app.editor.session import restore_session, save_session
+    from app.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path / "cache"))
+    s = window.state
+    s.load_mesh("cube")
+    s.material = dataclasses.replace(s.material, roughness=0.42, name="session")
+    window.orbit.orbit(40.0, -25.0)
+    save_session(s, window.orbit)
+    fresh, orbit = EditorState(), OrbitCamera()
+    assert restore_session(fresh, orbit) == ""
+    assert fresh.material == s.material and fresh.mesh_spec == "cube" and fresh.env_spec == s.env_spec
+    assert (orbit.yaw_deg, orbit.pitch_deg, orbit.distance) == (window.orbit.yaw_deg, window.orbit.pitch_deg,
+                                                                window.orbit.distance)
+    # What the panel's screenshot button (and F12) asks for is written after the frame.
+    out = tmp_path / "button.png"
+    window.screenshot_request = str(out)
+    window.frame()
+    assert out.is_file() and s.message == f"wrote {out}"
+
+
+def test_view_is_redrawn_only_when_needed_and_reduced_while_moving(window):
+    s = window.state
+    s.motion_scale = 0.5
+    window.frame()
+    window.frame()
+    still = window.redraws
+    window.frame()
+    assert window.redraws == still                      # nothing changed: no scene redraw
+    window.orbit.orbit(10.0, 0.0)
+    window.frame()
+    assert window.redraws == still + 1
+    assert window.renderer._targets.width == round(window.size[0] * 0.5)   # drawn reduced while moving
+    window.frame()                                      # the camera stopped: redrawn sharp
+    assert window.redraws == still + 2 and window.renderer._targets.width == window.size[0]
+    s.motion_scale = 1.0

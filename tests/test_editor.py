@@ -1,0 +1,132 @@
+"""The editor in a real window under Xvfb: screenshots from `alight edit`, and drops, undo and
+presets driven in-process on the real glfw window. Xvfb is started here when DISPLAY is unset."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def display():
+    """A display for the editor: the caller's, or a private Xvfb started for this module."""
+    if os.environ.get("DISPLAY"):
+        yield os.environ["DISPLAY"]
+        return
+    if shutil.which("Xvfb") is None:
+        pytest.skip("Xvfb is not installed and DISPLAY is unset: the editor needs a display")
+    read, write = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+                            pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write)
+    with os.fdopen(read) as f:
+        number = f.readline().strip()   # Xvfb writes its display number once it is ready
+    assert number, "Xvfb did not start"
+    os.environ["DISPLAY"] = f":{number}"
+    try:
+        yield os.environ["DISPLAY"]
+    finally:
+        del os.environ["DISPLAY"]
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+def edit(*args: str, size: str = "320x240") -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    return subprocess.run([sys.executable, "-m", "app", "edit", "--size", size, *args], cwd=REPO, env=env,
+                          capture_output=True, text=True, timeout=120)
+
+
+def screenshot(tmp_path: Path, name: str, *args: str) -> np.ndarray:
+    import OpenImageIO as oiio
+
+    out = tmp_path / f"{name}.png"
+    result = edit(*args, "--screenshot", str(out), "--frames", "3")
+    assert result.returncode == 0, result.stderr
+    image = oiio.ImageBuf(str(out)).get_pixels(oiio.UINT8)
+    assert image.shape == (240, 320, 3)
+    return image.astype(np.float64)
+
+
+def ball(image: np.ndarray) -> np.ndarray:
+    """Pixels well inside the default ball (it fills the middle of the 320x240 view)."""
+    h, w = image.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.25 * h) ** 2]
+
+
+def test_gold_to_water_and_roughness(display, tmp_path):
+    gold = ball(screenshot(tmp_path, "gold", "--preset", "gold"))
+    water = ball(screenshot(tmp_path, "water", "--preset", "gold", "--script", "preset=water"))
+    # Gold's reflection is yellow (F0 of gold: R well above B); water's F0 is grey (0.02).
+    assert gold[:, 0].mean() > 1.5 * gold[:, 2].mean()
+    assert water[:, 0].mean() < 1.1 * water[:, 2].mean()
+    # Roughness changed through the scripted edit path: a mirror-like ball shows the studio's
+    # sharp panels (high local contrast); a rough one blurs them away.
+    sharp = screenshot(tmp_path, "sharp", "--preset", "gold", "--script", "roughness=0.05")
+    rough = screenshot(tmp_path, "rough", "--preset", "gold", "--script", "roughness=0.9")
+
+    def contrast(img):   # mean horizontal luminance step inside the ball
+        lum = img.mean(axis=2)
+        step = np.zeros_like(lum)
+        step[:, 1:] = np.abs(np.diff(lum, axis=1))
+        return ball(step[:, :, None]).mean()
+
+    assert contrast(sharp) > 1.5 * contrast(rough)
+
+
+def test_editor_cli_bad_input_is_one_line(display, tmp_path):
+    result = edit("--preset", "no_such_preset", "--screenshot", str(tmp_path / "x.png"))
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1 and "alight: error:" in result.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_window_checks_in_a_fresh_process(display):
+    """The checks that drive the real window in-process (tests/editor_window_checks.py) run in
+    their own interpreter: the other GPU tests keep a headless EGL context current on this
+    thread, and a GLX window context cannot be made current beside it (X error BadAccess), nor
+    should it steal the thread from them."""
+    # No plugin autoloading: the checks need none, and an installed package's pytest11 entry
+    # point may name a module this checkout does not have.
+    env = dict(os.environ, PYTHONPATH=str(REPO), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    result = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                             str(REPO / "tests" / "editor_window_checks.py")],
+                            cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
+    assert " passed" in result.stdout and "skipped" not in result.stdout, result.stdout[-2000:]
+
+
+def test_debug_views_show_values(display, tmp_path):
+    """Data views bypass exposure and tone mapping: a pixel is the value itself, in 8 bits."""
+    normal = screenshot(tmp_path, "normal", "--preset", "gold", "--script", "debug_view=normal")
+    # The ball's centre faces the camera: n = (0, 0, 1) is shown as (0.5, 0.5, 1).
+    assert np.abs(normal[118:122, 158:162] - [128, 128, 255]).max() <= 3
+    rough = ball(screenshot(tmp_path, "rough", "--preset", "gold", "--script", "roughness=0.3",
+                            "--script", "debug_view=roughness"))
+    assert np.abs(rough - 0.3 * 255).max() <= 1.5
+
+
+def test_without_a_display(tmp_path):
+    """`alight` alone prints the help when there is no display; `alight edit` says why it cannot run."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env["PYTHONPATH"] = str(REPO)
+    bare = subprocess.run([sys.executable, "-m", "app"], cwd=REPO, env=env, capture_output=True, text=True,
+                          timeout=60)
+    assert bare.returncode == 0 and "usage: alight" in bare.stdout and " edit " in bare.stdout
+    edit_ = subprocess.run([sys.executable, "-m", "app", "edit"], cwd=REPO, env=env, capture_output=True,
+                           text=True, timeout=60)
+    assert edit_.returncode == 2 and edit_.stderr.startswith("alight: error: editor: no display")
+    assert edit_.stderr.count("\n") == 1
+    bad = subprocess.run([sys.executable, "-m", "app", "edit", "--screenshot", str(tmp_path / "x.jpg")], cwd=REPO,
+                         env=env, capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "unsupported output format" in bad.stderr
