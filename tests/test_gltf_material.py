@@ -212,3 +212,23 @@ def test_cli_export_bad_input(args, problem, tmp_path):
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and problem in r.stderr and "Traceback" not in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_editor_state_exports_the_edited_material(validate, tmp_path):
+    """The editor's export (EditorState.export_gltf, the panel's 'export glTF' button)."""
+    from app.editor.state import EditorState
+    from app.gltf_material import import_material
+    from app.material import with_overrides
+
+    state = EditorState()
+    state.load_mesh("cube")
+    state.material = with_overrides(load_preset("diamond"), roughness=0.33, base_color=(0.2, 0.3, 0.4))
+    state.export_gltf(str(tmp_path / "edited.gltf"))
+    state.export_gltf(str(tmp_path / "edited.glb"))
+    for path in (tmp_path / "edited.gltf", tmp_path / "edited.glb"):
+        assert_same(import_material(path), state.material)
+    for report in validate(tmp_path / "edited.gltf", tmp_path / "edited.glb"):
+        assert report["errors"] == 0, report
+    with pytest.raises(AlightError):
+        state.export_gltf(str(tmp_path / "no_such_folder" / "x.gltf"))
+    assert not (tmp_path / "no_such_folder").exists()

@@ -39,6 +39,7 @@ class Panel:
         self.env_path = ""
         self.mesh_path = ""
         self.preset_path = "material.json"
+        self.gltf_path = "material.gltf"
         self.shown_error = ""
         self.dialog = None      # a pending native file dialog   # the error line drawn last frame (what the artist sees; tests read it)
 
@@ -139,6 +140,13 @@ class Panel:
         imgui.same_line()
         self._browse("browse files", ["environments, meshes, presets",
                                       "*.hdr *.exr *.obj *.gltf *.glb *.ply *.stl *.json"], s)
+        _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
+        if imgui.button("export glTF"):   # .gltf: the material alone; .glb: the mesh with it
+            try:
+                s.export_gltf(self.gltf_path)
+                s.error, s.message = "", f"exported {self.gltf_path}"
+            except AlightError as exc:
+                s.fail(exc)
 
     def _browse(self, label: str, filters: list[str], s) -> None:
         """A native dialog (imgui-bundle's portable file dialogs: zenity/kdialog on Linux), polled

@@ -91,6 +91,16 @@ class EditorState:
         save_preset(self.material, path)
         self.saved_material = self.material
 
+    def export_gltf(self, path: str) -> None:
+        """The edited material as a material-only .gltf, or the mesh with it as a .glb
+        (app.gltf_material: F0 other than 0.04 goes out as KHR_materials_ior/specular)."""
+        from app.gltf_material import export_material_gltf, export_mesh_glb
+
+        if Path(path).suffix.lower() == ".glb":
+            export_mesh_glb(self.mesh, self.material, path)
+        else:
+            export_material_gltf(self.material, path)
+
     def open_file(self, path: str) -> bool:
         """A dropped or typed file, by its suffix. Returns False (and sets ``error``) on failure."""
         from app.mesh import MESH_EXTENSIONS
