@@ -72,8 +72,9 @@ class BakeQuality:
 
 
 # The one place where bake quality is chosen. 'medium' is the default: it keeps the probe within
-# 2% of the converged split sum at roughness >= 0.25 (tests/test_probe_accuracy.py) and bakes a
-# 1k map in well under half a second on llvmpipe (benchmarks/bench_render.py).
+# 1.6% of the converged split sum at roughness >= 0.25 on every shared map (README, "Accuracy
+# and speed"; tests/test_probe_accuracy.py) and bakes a 1k map in 0.3-0.4 s (warm, LUT cached)
+# on 2-core llvmpipe, the prefilter being two thirds of it (benchmarks/bench_render.py).
 QUALITY: dict[str, BakeQuality] = {
     "low": BakeQuality(
         name="low", cube_size=128, equirect_subsamples=2,
