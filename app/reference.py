@@ -19,9 +19,15 @@ total).
 
 Environment level: level L sums over the map box-reduced by 2^L in both axes (area-weighted,
 ``app.environment.box_reduce``, on the CPU, uploaded as its own texture): 4^L times fewer
-texels. The change it makes, measured on royal_esplanade_1k.hdr for app/ground_truth.py: at
-factor 2 below 0.06% for r >= 0.25, 0.7% at r = 0.1. ``choose_env_level`` takes level 1 when
-every roughness is >= 0.25 and the map is at least 1024 wide, else level 0.
+texels. The change level 1 makes against level 0, measured with this module on 32x32 probes
+(relative error over the disk / worst pixel):
+    royal_esplanade_1k (a 6% sun): r = 0.25: dielectric 1.7e-5 / 2.3e-4, gold 1.5e-4 / 1.0e-3;
+        r >= 0.5: <= 2e-5 / 1.4e-4; r = 0.1: 2.4e-3 / 0.10 (dielectric), 5.5e-3 / 0.48 (gold)
+    quarry_01_1k (a sun with 48% of the power in a few texels): r = 0.25: 4e-3 / 3e-2 (dielectric),
+        9e-3 / 4e-2 (gold); r = 1: 9e-4 / 1.8e-2, 1.1e-3 / 2.3e-2
+A compact source moves and spreads when its texels are averaged, so ``choose_env_level`` takes
+level 1 only when every roughness is >= 0.25, the map is at least 1024 wide and no compact source
+(``app.sun.extract_suns``) holds 10% or more of the map's power; otherwise level 0 (exact).
 
 Roughness below ``MIN_ROUGHNESS`` (0.1) is refused when an environment lights the scene: the
 GGX lobe then covers only a few texels and the sum is no longer an integral (see
@@ -47,6 +53,8 @@ from app.shading import probe_normals
 CHUNK_PAIRS = 1 << 28
 # Roughness from which a factor-2 environment level is taken by default.
 LEVEL1_MIN_ROUGHNESS = 0.25
+# ... and while no compact source holds this much of the map's power (quarry_01's sun: 48%).
+LEVEL1_MAX_SUN_FRACTION = 0.10
 # Texels per invocation per dispatch at most. Mesa's llvmpipe (gallivm) stops any shader loop
 # after 65535 iterations (LP_MAX_TGSI_LOOP_ITERATIONS), counting the inner loop's iterations
 # across the outer loop: a 512x256 map in one dispatch summed only its upper half. Measured:
@@ -73,12 +81,16 @@ def check_roughness(roughness: float, what: str = "roughness") -> None:
                           f"few texels and the texel sum is no longer an integral (no reference below {MIN_ROUGHNESS})")
 
 
-def choose_env_level(width: int, roughnesses) -> int:
-    """Level 1 (factor 2) when every roughness is >= 0.25 and the map is >= 1024 wide, else 0."""
+def choose_env_level(radiance: np.ndarray, roughnesses) -> int:
+    """Level 1 (factor 2) when every roughness is >= 0.25, the map is >= 1024 wide and no
+    compact bright source holds >= ``LEVEL1_MAX_SUN_FRACTION`` of its power; else 0."""
     rs = list(roughnesses)
-    if rs and min(rs) >= LEVEL1_MIN_ROUGHNESS and width >= 1024:
-        return 1
-    return 0
+    if not rs or min(rs) < LEVEL1_MIN_ROUGHNESS or radiance.shape[1] < 1024:
+        return 0
+    from app.sun import extract_suns
+
+    _, suns = extract_suns(np.asarray(radiance, np.float32))
+    return 0 if any(sun.fraction >= LEVEL1_MAX_SUN_FRACTION for sun in suns) else 1
 
 
 def env_level_radiance(radiance: np.ndarray, level: int) -> np.ndarray:
@@ -240,7 +252,7 @@ class ReferenceRenderer:
         env_tex = columns = None
         rows, env_w = 0, 0
         if use_env:
-            level = choose_env_level(radiance.shape[1], roughnesses) if env_level is None \
+            level = choose_env_level(radiance, roughnesses) if env_level is None \
                 else int(env_level)
             reduced = env_level_radiance(np.asarray(radiance, np.float32), level)
             rows, env_w = reduced.shape[0], reduced.shape[1]

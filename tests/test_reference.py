@@ -170,3 +170,13 @@ def test_cli_refuses_bad_input(tmp_path, args, name):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("alight: error:"), proc.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_automatic_env_level(royal, shared_data):
+    from app.reference import choose_env_level
+
+    quarry = load_environment(str(shared_data / "env" / "quarry_01_1k.hdr")).radiance
+    assert choose_env_level(royal, [0.5, 0.25]) == 1      # royal's sun holds 6% of the power
+    assert choose_env_level(royal, [0.5, 0.2]) == 0       # a narrow lobe: the full map
+    assert choose_env_level(quarry, [1.0]) == 0           # a sun with 48% of the power
+    assert choose_env_level(box_reduce(royal, 2), [1.0]) == 0   # already only 512 wide
