@@ -87,7 +87,8 @@ def test_half_lit_environment(ref):
 def test_probe_matches_numpy_ground_truth(ref, royal, kind):
     # The numpy ground truth (float32 per chunk, float64 across chunks) and the GPU sum (float32,
     # per-row partial sums) over the same map, box-reduced by 4 (env level 2) for speed.
-    # Measured relative difference: about 1e-6 (see the assertion's message).
+    # Measured relative difference over the disk: dielectric 6e-7 (r = 0.3), 2e-7 (r = 1); metal
+    # 5e-6 (r = 0.3), 2e-7 (r = 1); worst pixel 4e-5. The 1e-4 bound leaves room for another GPU.
     size = 32
     reduced = box_reduce(royal, 4)
     pts, inside = probe_points(size)
@@ -120,7 +121,8 @@ def test_mesh_view_centre_matches_probe(ref, royal):
 
 
 def test_punctual_lights_match_the_real_time_path(ref):
-    # No environment: both paths evaluate punctual.glsl's punctual_light at the same n, v, l.
+    # No environment: both paths evaluate punctual.glsl's punctual_light at the same n, v, l
+    # (measured: 6e-7 relative, 4.5e-5 largest absolute difference).
     m = Material(base_color=(0.9, 0.5, 0.2), metallic=0.3, roughness=0.4, emissive=(0.01, 0.02, 0.03))
     lights = [parse_light("point:pos=2,3,4:intensity=30"), parse_light("directional:dir=-1,-1,-1:color=1,0.9,0.8")]
     scene = Scene(material=m, view="probe", lights=lights, ibl_enabled=False)
