@@ -182,3 +182,22 @@ def test_automatic_env_level(royal, shared_data):
     assert choose_env_level(royal, [0.5, 0.2]) == 0       # a narrow lobe: the full map
     assert choose_env_level(quarry, [1.0]) == 0           # a sun with 48% of the power
     assert choose_env_level(box_reduce(royal, 2), [1.0]) == 0   # already only 512 wide
+
+
+def test_mesh_view_orientation(ref):
+    # Light from one side only: the sphere seen from +Z is bright on that side of the image
+    # (+Y up: top rows; +X: right columns; u = 0.75 is +X in CONVENTIONS.md's mapping). Near
+    # Lambert, E/pi = (1 + n.y)/2 under the upper-half sky: the outer thirds of the disk differ by
+    # about 4x (measured 73.2 vs 18.5); a flipped image would give the inverse ratio.
+    m = Material(roughness=1.0, **WHITE)
+    mesh = load_mesh("sphere")
+    up = np.zeros((64, 128, 3), np.float32)
+    up[:32] = 1.0
+    right = np.zeros((64, 128, 3), np.float32)
+    right[:, 64:] = 1.0
+    size = 31
+    top = ref.render(Scene(mesh=mesh, material=m), up, size, size, env_level=0).linear
+    side = ref.render(Scene(mesh=mesh, material=m), right, size, size, env_level=0).linear
+    third = size // 3
+    assert top[:third, :, 0].sum() > 2.5 * top[-third:, :, 0].sum()
+    assert side[:, -third:, 0].sum() > 2.5 * side[:, :third, 0].sum()
