@@ -209,6 +209,25 @@ def build_parser() -> argparse.ArgumentParser:
     bt.add_argument("--force", action="store_true", help="render every item even if its output is up to date")
     bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
     # --- end alight batch ---------------------------------------------------------------------
+    # --- alight reference (app/reference.py) --------------------------------------------------
+    rf = sub.add_parser("reference", help="the exact IBL ground truth (CONVENTIONS.md) on the GPU, as linear EXR",
+                        description="Compute CONVENTIONS.md's ground truth per pixel on the GPU: the sum over "
+                                    "every texel of the environment of f(l, v) L(l) max(n.l, 0) dOmega (k = r^2/2, "
+                                    "F per direction at v.h), plus emission and the punctual lights (k = (r+1)^2/8), "
+                                    "no occlusion. Roughness below 0.1 is refused when an environment is used.")
+    _add_scene_options(rf)
+    rd = rf.add_argument_group("reference")
+    rd.add_argument("--size", type=_size, default=(256, 256), metavar="W|WxH", help="image size (default: 256)")
+    rd.add_argument("--env-level", default="auto", metavar="N|auto",
+                    help="sum over the map box-reduced by 2^N (area-weighted): 4^N times faster. Level 1 "
+                         "changed royal_esplanade by <= 0.015%% (worst pixel 0.1%%) at r >= 0.25, but by 0.5%% "
+                         "at r = 0.1 and ~1%% on quarry_01's compact sun. auto: 1 when every roughness is >= 0.25, "
+                         "the map is >= 1024 wide and no compact source holds >= 10%% of its power, else 0 "
+                         "(default: auto)")
+    rd.add_argument("--out", required=True, metavar="FILE.exr",
+                    help="linear float32 RGBA radiance, alpha 1 on the surface (CONVENTIONS.md); .exr only")
+    rd.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer, the level and the times")
+    # --- end alight reference -----------------------------------------------------------------
     sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
     _add_edit_parser(sub)
     return parser
@@ -235,6 +254,8 @@ def main(argv: list[str] | None = None) -> int:
             return _presets()
         if args.command == "export":  # alight export
             return _export(args)
+        if args.command == "reference":  # alight reference
+            return _reference(args)
         if args.command == "batch":  # alight batch
             if args.workers is not None and args.workers < 1:
                 raise AlightError(f"--workers: {args.workers} must be at least 1")
@@ -448,3 +469,58 @@ def _export(args) -> int:
     print(out)
     return 0
 # --- end alight export --------------------------------------------------------------------
+
+
+# --- alight reference (app/reference.py) --------------------------------------------------
+def _reference(args) -> int:
+    from app.output import check_output_path
+
+    start = time.perf_counter()
+    out = check_output_path(args.out, (".exr",))
+    width, height = args.size
+    if args.view == "probe" and width != height:
+        raise AlightError(f"--size: the probe view is square; got {width}x{height}")
+    level = None
+    if args.env_level != "auto":
+        try:
+            level = int(args.env_level)
+        except ValueError:
+            raise AlightError(f"--env-level: '{args.env_level}' is not a whole number or 'auto'") from None
+        if not 0 <= level <= 8:
+            raise AlightError(f"--env-level: {level} is out of range [0, 8]")
+    material, overrides = build_material(args)
+
+    from app.environment import load_environment
+    from app.mesh import load_mesh
+    from app.reference import check_roughness
+    from app.scene import Scene, parse_light
+
+    if not args.no_ibl:
+        check_roughness(material.roughness)   # before any file is read
+    lights = [parse_light(spec) for spec in args.light]
+    mesh = load_mesh(args.mesh) if args.view == "camera" else None
+    env = None if args.no_ibl else load_environment(args.env)
+    if env is not None:
+        _warn(env.warnings)
+    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
+                  material_overrides=overrides, lights=lights, view=args.view,
+                  env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
+                  ibl_enabled=env is not None)
+
+    from app.output import write_image
+    from app.reference import ReferenceRenderer
+
+    ref = ReferenceRenderer()
+    result = ref.render(scene, env.radiance if env is not None else None, width, height, env_level=level)
+    write_image(out, result.linear, linear=True)
+    if args.verbose:
+        from app.gpu import describe
+
+        where = "no environment" if result.env_size is None else \
+            f"env level {result.env_level} ({result.env_size[0]}x{result.env_size[1]})"
+        print(f"{describe(ref.ctx)}\n{where}, {result.dispatches} dispatches; total "
+              f"{time.perf_counter() - start:.3f}s; " + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
+              file=sys.stderr)
+    print(out)
+    return 0
+# --- end alight reference -----------------------------------------------------------------

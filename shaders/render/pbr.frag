@@ -1,76 +1,10 @@
 #version 450 core
 // Forward PBR pass: a mesh with the metal-roughness material (factors times glTF textures).
 #include "common/shading.glsl"
+#include "common/mesh_material.glsl"
 #include "common/debug_views.glsl"
 
-in vec3 v_position;
-in vec3 v_normal;
-in vec2 v_uv;
-in vec4 v_tangent;
-
-uniform vec3 u_camera_position;
-uniform vec3 u_base_color;
-uniform float u_metallic;
-uniform float u_roughness;
-uniform vec3 u_specular_f0;
-uniform vec3 u_emissive;
-uniform float u_normal_scale;
-uniform float u_occlusion_strength;
-
-// Texture maps; sRGB ones are uploaded with sRGB formats so sampling returns linear values.
-uniform bool u_has_base_color_map;
-uniform bool u_has_metallic_roughness_map;
-uniform bool u_has_normal_map;
-uniform bool u_has_emissive_map;
-uniform bool u_has_occlusion_map;
-uniform sampler2D u_base_color_map;
-uniform sampler2D u_metallic_roughness_map;
-uniform sampler2D u_normal_map;
-uniform sampler2D u_emissive_map;
-uniform sampler2D u_occlusion_map;
-
 layout(location = 0) out vec4 out_radiance;
-
-vec3 shading_normal() {
-    // Zero-length normals (bad meshes) fall back to the face normal from screen derivatives.
-    vec3 n = v_normal;
-    vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
-    n = dot(n, n) > 1e-12 ? normalize(n) : face;
-    if (!gl_FrontFacing) n = -n;
-    if (u_has_normal_map) {
-        // Gram-Schmidt; a tangent parallel to n (a broken file) gets any perpendicular instead.
-        vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
-        if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
-        t = normalize(t);
-        vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-        vec3 m = texture(u_normal_map, v_uv).xyz * 2.0 - 1.0;
-        m.xy *= u_normal_scale;
-        vec3 mapped = mat3(t, b, n) * m;
-        n = dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
-    }
-    return n;
-}
-
-Surface material_surface() {
-    Surface s;
-    s.base_color = u_base_color;
-    s.metallic = u_metallic;
-    s.roughness = u_roughness;
-    s.specular_f0 = u_specular_f0;
-    s.emissive = u_emissive;
-    s.occlusion = 1.0;
-    if (u_has_base_color_map) s.base_color *= texture(u_base_color_map, v_uv).rgb;
-    if (u_has_metallic_roughness_map) {
-        vec4 mr = texture(u_metallic_roughness_map, v_uv);
-        s.roughness *= mr.g;
-        s.metallic *= mr.b;
-    }
-    if (u_has_emissive_map) s.emissive *= texture(u_emissive_map, v_uv).rgb;
-    if (u_has_occlusion_map) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, v_uv).r - 1.0);
-    s.roughness = clamp(s.roughness, 0.0, 1.0);
-    s.metallic = clamp(s.metallic, 0.0, 1.0);
-    return s;
-}
 
 void main() {
     vec3 n = shading_normal();

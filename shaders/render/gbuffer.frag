@@ -1,0 +1,22 @@
+#version 450 core
+// The reference's G-buffer (app/reference.py): what the texel sum needs at each pixel, from the
+// same material inputs as the forward pass (common/mesh_material.glsl), unshaded. Alpha of
+// target 0 is 1 where the mesh covers the pixel (cleared to 0 elsewhere).
+#include "common/mesh_material.glsl"
+
+layout(location = 0) out vec4 out_position;     // world position, 1
+layout(location = 1) out vec4 out_normal;       // shading normal n, roughness
+layout(location = 2) out vec4 out_view;         // v (surface -> eye), metallic
+layout(location = 3) out vec4 out_base_color;   // base colour, 1
+layout(location = 4) out vec4 out_specular_f0;  // specular F0 of the dielectric part, 1
+layout(location = 5) out vec4 out_emissive;     // emissive, 1
+
+void main() {
+    Surface s = material_surface();
+    out_position = vec4(v_position, 1.0);
+    out_normal = vec4(shading_normal(), s.roughness);
+    out_view = vec4(normalize(u_camera_position - v_position), s.metallic);
+    out_base_color = vec4(s.base_color, 1.0);
+    out_specular_f0 = vec4(s.specular_f0, 1.0);
+    out_emissive = vec4(s.emissive, 1.0);
+}
