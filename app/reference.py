@@ -46,7 +46,7 @@ import numpy as np
 
 from app.errors import AlightError
 from app.ground_truth import MIN_ROUGHNESS
-from app.renderer import MATERIAL_MAPS, UNIT_MATERIAL, Renderer, _GpuPart, _rotation_cos_sin, _set, _set_material
+from app.renderer import Renderer, _rotation_cos_sin, _set
 from app.shading import probe_normals
 
 # Pixel-texel pairs per dispatch at most (a 256^2 probe on a 1024x512 map: ~26 dispatches).
@@ -128,7 +128,6 @@ class ReferenceRenderer:
     def __init__(self, renderer: Renderer | None = None):
         self.renderer = renderer or Renderer()
         self.ctx = self.renderer.ctx
-        self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
 
     # --- G-buffers -----------------------------------------------------------------------
 
@@ -159,28 +158,9 @@ class ReferenceRenderer:
         _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_view_projection", camera.view_projection(width / height).astype(np.float32).tobytes(), write=True)
         _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
-        entry = self._meshes.get(id(scene.mesh))
-        if entry is None or entry[0] is not scene.mesh:
-            entry = (scene.mesh, [_GpuPart(ctx, prog, part) for part in scene.mesh.parts])
-            self._meshes[id(scene.mesh)] = entry
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        for gpu_part, part in zip(entry[1], scene.mesh.parts):
-            material, maps_used = r._part_material(scene, part, gpu_part)
-            _set_material(prog, material)
-            fm = part.material if maps_used else None
-            _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
-            for name in MATERIAL_MAPS:
-                tex = gpu_part.textures.get(name) if maps_used else None
-                _set(prog, f"u_has_{name}_map", tex is not None)
-                if tex is not None:
-                    tex.use(UNIT_MATERIAL[name])
-            if gpu_part.closed:
-                ctx.enable(moderngl.CULL_FACE)
-            else:
-                ctx.disable(moderngl.CULL_FACE)
-            gpu_part.vao.render(moderngl.TRIANGLES)
-        ctx.disable(moderngl.CULL_FACE)
+        r.draw_mesh_parts(scene, prog)
         ctx.disable(moderngl.DEPTH_TEST)
         ctx.finish()
         fbo.release()
@@ -301,7 +281,4 @@ class ReferenceRenderer:
         return ReferenceResult(pixels, level, (env_w, rows) if use_env else None, len(chunks), seconds)
 
     def release(self) -> None:
-        for _, parts in self._meshes.values():
-            for part in parts:
-                part.release()
-        self._meshes.clear()
+        """Meshes live in the Renderer's cache; they go with ``self.renderer.release()``."""

@@ -338,6 +338,12 @@ class Renderer:
         _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
         _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
         self._bind_ibl(prog, scene, maps)
+        self.draw_mesh_parts(scene, prog)
+
+    def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program) -> None:
+        """Draw every part of the scene's mesh with ``prog``: each part's material factors and
+        maps bound, back faces culled where the part is closed. The caller sets the camera."""
+        ctx = self.ctx
         for gpu_part, part in zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts):
             material, maps_used = self._part_material(scene, part)
             _set_material(prog, material)

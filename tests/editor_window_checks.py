@@ -164,7 +164,7 @@ def test_shader_hot_reload_keeps_the_last_good_program(window, tmp_path):
     frag = root / "render" / "pbr.frag"
     text = frag.read_text()
     lines = text.splitlines()
-    at = lines.index("in vec3 v_position;") + 1
+    at = lines.index("layout(location = 0) out vec4 out_radiance;") + 1
     lines.insert(at, "this is not glsl;")
     frag.write_text("\n".join(lines) + "\n")
     window.check_shaders(force=True)
