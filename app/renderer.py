@@ -333,17 +333,19 @@ class Renderer:
         if debug:
             _set(prog, "u_debug_view", int(scene.debug_view))
             _set(prog, "u_debug_mip", float(scene.debug_mip))
+        self._bind_ibl(prog, scene, maps)
+        self.draw_mesh_parts(scene, prog, camera, view_projection)
+
+    def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program, camera: Camera,
+                        view_projection: np.ndarray) -> None:
+        """Draw every part of the scene's mesh with ``prog`` (pbr.vert's transforms, seen from
+        ``camera``): each part's material factors and maps bound, back faces culled where the
+        part is closed."""
+        ctx = self.ctx
         _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
         _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
-        self._bind_ibl(prog, scene, maps)
-        self.draw_mesh_parts(scene, prog)
-
-    def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program) -> None:
-        """Draw every part of the scene's mesh with ``prog``: each part's material factors and
-        maps bound, back faces culled where the part is closed. The caller sets the camera."""
-        ctx = self.ctx
         for gpu_part, part in zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts):
             material, maps_used = self._part_material(scene, part)
             _set_material(prog, material)

@@ -23,23 +23,10 @@ win = EditorWindow(state, (1280, 720))
 try:
     for _ in range(5):
         win.frame()
-    # One more frame drawn as EditorWindow.frame does, read back before the swap.
-    imgui, ctx, r = win.imgui, win.ctx, win.renderer
-    win.glfw.poll_events()
-    win.impl.process_inputs()
-    imgui.new_frame()
-    win.panel.draw(win)
-    imgui.render()
-    targets = win.targets()
-    scene = state.scene(win.orbit.camera())
-    r.draw_hdr(scene, win.maps(), targets)
-    r.tonemap(targets.radiance, scene.display, targets.display_fbo)
-    ctx.copy_framebuffer(ctx.screen, targets.display_fbo)
-    ctx.screen.use()
-    win.impl.render(imgui.get_draw_data())
-    ctx.finish()
+    win.draw()   # one more frame, read back before it would be swapped
+    win.ctx.finish()
     w, h = win.size
-    pixels = np.frombuffer(ctx.screen.read(viewport=(0, 0, w, h), components=3), np.uint8).reshape(h, w, 3)[::-1]
+    pixels = np.frombuffer(win.ctx.screen.read(viewport=(0, 0, w, h), components=3), np.uint8).reshape(h, w, 3)[::-1]
     out = Path(__file__).resolve().parents[1] / "docs" / "editor_window.png"
     write_image(out, pixels, linear=False)
     print(out)

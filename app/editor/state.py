@@ -206,17 +206,16 @@ class History:
         self.committed = current
 
     def undo(self, current: Material) -> Material:
-        self.settle(current, False)
-        if not self.undo_stack:
-            return current
-        self.redo_stack.append(self.committed)
-        self.committed = self.undo_stack.pop()
-        return self.committed
+        return self._step(current, self.undo_stack, self.redo_stack)
 
     def redo(self, current: Material) -> Material:
+        return self._step(current, self.redo_stack, self.undo_stack)
+
+    def _step(self, current: Material, source: list, target: list) -> Material:
+        """Move one state from ``source`` to the committed one, keeping the old in ``target``."""
         self.settle(current, False)
-        if not self.redo_stack:
+        if not source:
             return current
-        self.undo_stack.append(self.committed)
-        self.committed = self.redo_stack.pop()
+        target.append(self.committed)
+        self.committed = source.pop()
         return self.committed

@@ -219,6 +219,23 @@ class EditorWindow:
         return targets
 
     def frame(self) -> None:
+        self.draw()
+        self.glfw.swap_buffers(self.window)
+        if self.screenshot_request:
+            path, self.screenshot_request = self.screenshot_request, ""
+            try:
+                self.screenshot(path)
+                self.state.error, self.state.message = "", f"wrote {path}"
+            except AlightError as exc:
+                self.state.fail(exc)
+        now = time.perf_counter()
+        if self._last_swap is not None:
+            self.frame_times.append(now - self._last_swap)
+        self._last_swap = now
+
+    def draw(self) -> None:
+        """One frame into the window's back buffer (events, panel, view, imgui), not yet shown:
+        ``frame`` swaps it; tools can read the whole window first."""
         glfw, imgui = self.glfw, self.imgui
         glfw.poll_events()
         self.impl.process_inputs()
@@ -232,18 +249,6 @@ class EditorWindow:
         self.render_view()
         if self.show_panel:
             self.impl.render(imgui.get_draw_data())
-        glfw.swap_buffers(self.window)
-        if self.screenshot_request:
-            path, self.screenshot_request = self.screenshot_request, ""
-            try:
-                self.screenshot(path)
-                self.state.error, self.state.message = "", f"wrote {path}"
-            except AlightError as exc:
-                self.state.fail(exc)
-        now = time.perf_counter()
-        if self._last_swap is not None:
-            self.frame_times.append(now - self._last_swap)
-        self._last_swap = now
 
     def screenshot(self, path: str) -> None:
         """The view without the panel, at window size: the last frame's radiance tone mapped again."""
