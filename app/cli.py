@@ -13,8 +13,8 @@ import sys
 import time
 
 from app.errors import AlightError
+from app.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 
-IBL_MODELS = ("lecture",)
 QUALITIES = ("low", "medium", "high")
 
 
@@ -87,8 +87,9 @@ def _add_bake_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--irradiance", choices=("convolution", "sh9"),
                    help="diffuse irradiance by the lecture's hemisphere convolution or by 9 spherical "
                         "harmonics (default: the quality's choice)")
-    g.add_argument("--ibl", choices=IBL_MODELS, default="lecture",
-                   help="IBL shading model: 'lecture' is the seed lecture's split sum (default: lecture)")
+    g.add_argument("--ibl", choices=tuple(IBL_MODELS), default=DEFAULT_IBL_MODEL,
+                   help="IBL shading model (app/ibl_models.py): 'lecture' is the seed lecture's split sum "
+                        f"(default: {DEFAULT_IBL_MODEL})")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -328,7 +329,7 @@ def _render(args) -> int:
     scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
                   material_overrides=overrides, lights=lights, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
-                  ibl_enabled=env is not None, display=display)
+                  ibl_enabled=env is not None, ibl_model=args.ibl, display=display)
     loaded = time.perf_counter()
 
     from app.bake import quality_named

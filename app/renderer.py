@@ -14,6 +14,7 @@ import numpy as np
 
 from app.bake import QUALITY, BakeQuality, IBLMaps, LutCache, bake_environment, roughness_to_grid_step
 from app.gpu import ShaderLibrary, create_headless_context
+from app.ibl_models import ibl_model_index
 from app.material import Material
 from app.mesh import is_closed
 from app.scene import BACKGROUNDS, TONEMAPS, Camera, Display, Scene, frame_camera
@@ -270,6 +271,11 @@ class Renderer:
         center, radius = scene.mesh.bounding_sphere()
         return frame_camera(center, max(radius, 1e-6), aspect=aspect)
 
+    @staticmethod
+    def _ibl_defines(scene: Scene) -> dict:
+        """The shader defines that pick the scene's IBL model (app/ibl_models.py)."""
+        return {"IBL_MODEL": ibl_model_index(scene.ibl_model)}
+
     def _bind_ibl(self, program: moderngl.Program, scene: Scene, maps: IBLMaps | None) -> None:
         enabled = bool(scene.ibl_enabled and maps is not None)
         _set(program, "u_ibl_enabled", enabled)
@@ -318,7 +324,7 @@ class Renderer:
         self._fullscreen(prog)
 
     def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:
-        prog = self.program("render/fullscreen.vert", "render/probe.frag")
+        prog = self.program("render/fullscreen.vert", "render/probe.frag", self._ibl_defines(scene))
         m = scene.material
         prog["u_size"] = float(size)
         _set_material(prog, m)
@@ -328,9 +334,11 @@ class Renderer:
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray) -> None:
         ctx = self.ctx
         # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
-        debug = {"DEBUG_VIEW": None} if scene.debug_view else None
-        prog = self.program("render/pbr.vert", "render/pbr.frag", debug)
-        if debug:
+        defines = self._ibl_defines(scene)
+        if scene.debug_view:
+            defines["DEBUG_VIEW"] = None
+        prog = self.program("render/pbr.vert", "render/pbr.frag", defines)
+        if scene.debug_view:
             _set(prog, "u_debug_view", int(scene.debug_view))
             _set(prog, "u_debug_mip", float(scene.debug_mip))
         self._bind_ibl(prog, scene, maps)

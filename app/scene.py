@@ -10,6 +10,7 @@ import numpy as np
 import pyrr
 
 from app.errors import AlightError
+from app.ibl_models import DEFAULT_IBL_MODEL
 from app.material import Material
 
 if TYPE_CHECKING:
@@ -130,6 +131,7 @@ class Scene:
     env_rotation_deg: float = 0.0
     env_intensity: float = 1.0
     ibl_enabled: bool = True
+    ibl_model: str = DEFAULT_IBL_MODEL                        # a key of app/ibl_models.py's IBL_MODELS
     display: Display = field(default_factory=Display)
     debug_view: int = 0        # 0: shaded; else an index of app/editor/state.py's DEBUG_VIEWS
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view

@@ -66,3 +66,12 @@ vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
     vec3 specular = prefiltered_radiance_at(reflect(-v, n), s.roughness) * (F * ab.x + ab.y);
     return (diffuse + specular) * s.occlusion;
 }
+
+// The model the forward pass uses: IBL_MODEL is the position of its name in app/ibl_models.py's
+// IBL_MODELS, set by app/renderer.py, so only the chosen model is compiled.
+#ifndef IBL_MODEL
+#define IBL_MODEL 0
+#endif
+vec3 ibl_model(Surface s, vec3 n, vec3 v) {
+    return ibl_lecture(s, n, v);
+}
