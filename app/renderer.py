@@ -274,7 +274,10 @@ class Renderer:
     @staticmethod
     def _ibl_defines(scene: Scene) -> dict:
         """The shader defines that pick the scene's IBL model (app/ibl_models.py)."""
-        return {"IBL_MODEL": ibl_model_index(scene.ibl_model)}
+        defines = {"IBL_MODEL": ibl_model_index(scene.ibl_model)}
+        if scene.multiple_scattering:
+            defines["MULTIPLE_SCATTERING"] = None
+        return defines
 
     def _bind_ibl(self, program: moderngl.Program, scene: Scene, maps: IBLMaps | None) -> None:
         enabled = bool(scene.ibl_enabled and maps is not None)

@@ -132,6 +132,7 @@ class Scene:
     env_intensity: float = 1.0
     ibl_enabled: bool = True
     ibl_model: str = DEFAULT_IBL_MODEL                        # a key of app/ibl_models.py's IBL_MODELS
+    multiple_scattering: bool = False                         # Fdez-Aguera 2019 energy compensation
     display: Display = field(default_factory=Display)
     debug_view: int = 0        # 0: shaded; else an index of app/editor/state.py's DEBUG_VIEWS
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view
