@@ -283,65 +283,112 @@ class LutCache:
 def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
                      quality: BakeQuality, luts: LutCache) -> IBLMaps:
     """Run every bake pass for one environment; returns the maps and each pass's seconds."""
+    return run_to_completion(bake_steps(ctx, shaders, env, quality, luts))
+
+
+def run_to_completion(steps):
+    """Drive a step generator (``bake_steps``) to its end; its return value."""
+    while True:
+        try:
+            next(steps)
+        except StopIteration as done:
+            return done.value
+
+
+def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
+               quality: BakeQuality, luts: LutCache):
+    """``bake_environment`` in small GPU passes: yields ``(fraction done, label of the pass just
+    done)`` after each pass (so a caller can spread a bake over frames) and returns the IBLMaps.
+    Each pass ends with a finish() (its time, see _timed), so nothing is left in flight between
+    steps. Closing the generator early releases what it made."""
     q = quality
     seconds: dict[str, float] = {}
-    lighting_radiance, suns = _timed(ctx, seconds, "suns", lambda: extract_suns(env.radiance))
-
-    # The environment as seen (background, mirror) keeps its sun; the lighting passes read a
-    # copy without it and add the sun back in closed form.
-    source = _source_cube(ctx, shaders, env.radiance, q, seconds, "environment")
-    lighting = source if not suns else _source_cube(ctx, shaders, lighting_radiance, q, seconds, "lighting")
-
-    irradiance = _cube(ctx, q.irradiance_size, 1)
-    if q.irradiance == "convolution":
-        def convolve():
-            prog = shaders.compute("bake/irradiance.comp")
-            lighting.use(0)
-            prog["u_environment"] = 0
-            prog["u_size"] = q.irradiance_size
-            prog["u_phi_steps"] = q.irradiance_phi_steps
-            prog["u_theta_steps"] = q.irradiance_theta_steps
-            prog["u_source_mip"] = max(0.0, math.log2(q.cube_size / q.irradiance_source_size))
-            _set_suns(prog, suns)
-            _dispatch_faces(ctx, prog, irradiance, q.irradiance_size)
-        _timed(ctx, seconds, "irradiance_convolution", convolve)
-    elif q.irradiance == "sh9":
-        _timed(ctx, seconds, "irradiance_sh9",
-               lambda: _irradiance_sh9(ctx, shaders, lighting_radiance, irradiance, q, suns))
-    else:
-        raise ValueError(f"unknown irradiance method {q.irradiance!r}")
-
     levels = q.prefiltered_levels
-    prefiltered = _cube(ctx, q.prefiltered_size, levels)
-    prefiltered_mid = _cube(ctx, q.prefiltered_size // 2, levels - 1)
+    prefilter_steps = 2 * levels - 1
+    owned: list = []    # released if the caller stops early
+    # Step weights: a prefilter step or the irradiance counts two, an upload or a cube one.
+    total = 1.0 + 2.0 + 2.0 + 2.0 * prefilter_steps
+    done = 0.0
 
-    def prefilter():
-        prog = shaders.compute("bake/prefilter.comp")
-        lighting.use(0)
-        prog["u_environment"] = 0
-        _set_suns(prog, suns)
-        for step in range(2 * levels - 1):
-            target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
-            size = target.size[0] >> mip
-            roughness = grid_roughness(step, levels)
-            total = q.prefilter_samples_at(step)
-            sample_set = prefilter_sample_set(roughness, total, q.cube_size, q.lod_bias,
-                                              q.filtered_importance_sampling)
-            buffer = ctx.buffer(sample_set.tobytes())
-            buffer.bind_to_storage_buffer(1)
-            prog["u_size"] = size
-            prog["u_sample_count"] = len(sample_set)
-            prog["u_sample_total"] = float(total)
-            prog["u_roughness"] = roughness
-            _dispatch_faces(ctx, prog, target, size, mip)
-            buffer.release()
+    def progress(weight: float, label: str):
+        nonlocal done
+        done += weight
+        return min(done / total, 0.999), label
 
-    _timed(ctx, seconds, "prefilter", prefilter)
-    if lighting is not source:
-        lighting.release()
+    try:
+        lighting_radiance, suns = _timed(ctx, seconds, "suns", lambda: extract_suns(env.radiance))
+        total += 2.0 if suns else 0.0
+        yield progress(1, "suns")
 
-    lut = _timed(ctx, seconds, f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
-                 lambda: luts.get(q.lut_size, q.lut_samples))
+        # The environment as seen (background, mirror) keeps its sun; the lighting passes read a
+        # copy without it and add the sun back in closed form.
+        source = yield from _source_cube_steps(ctx, shaders, env.radiance, q, seconds, "environment", owned,
+                                               progress)
+        lighting = source
+        if suns:
+            lighting = yield from _source_cube_steps(ctx, shaders, lighting_radiance, q, seconds, "lighting",
+                                                     owned, progress)
+
+        irradiance = _cube(ctx, q.irradiance_size, 1)
+        owned.append(irradiance)
+        if q.irradiance == "convolution":
+            def convolve():
+                prog = shaders.compute("bake/irradiance.comp")
+                lighting.use(0)
+                prog["u_environment"] = 0
+                prog["u_size"] = q.irradiance_size
+                prog["u_phi_steps"] = q.irradiance_phi_steps
+                prog["u_theta_steps"] = q.irradiance_theta_steps
+                prog["u_source_mip"] = max(0.0, math.log2(q.cube_size / q.irradiance_source_size))
+                _set_suns(prog, suns)
+                _dispatch_faces(ctx, prog, irradiance, q.irradiance_size)
+            _timed(ctx, seconds, "irradiance_convolution", convolve)
+        elif q.irradiance == "sh9":
+            _timed(ctx, seconds, "irradiance_sh9",
+                   lambda: _irradiance_sh9(ctx, shaders, lighting_radiance, irradiance, q, suns))
+        else:
+            raise ValueError(f"unknown irradiance method {q.irradiance!r}")
+        yield progress(2, "irradiance")
+
+        prefiltered = _cube(ctx, q.prefiltered_size, levels)
+        owned.append(prefiltered)
+        prefiltered_mid = _cube(ctx, q.prefiltered_size // 2, levels - 1)
+        owned.append(prefiltered_mid)
+
+        for step in range(prefilter_steps):
+            def prefilter(step=step):
+                prog = shaders.compute("bake/prefilter.comp")
+                lighting.use(0)
+                prog["u_environment"] = 0
+                _set_suns(prog, suns)
+                target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
+                size = target.size[0] >> mip
+                roughness = grid_roughness(step, levels)
+                total = q.prefilter_samples_at(step)
+                sample_set = prefilter_sample_set(roughness, total, q.cube_size, q.lod_bias,
+                                                  q.filtered_importance_sampling)
+                buffer = ctx.buffer(sample_set.tobytes())
+                buffer.bind_to_storage_buffer(1)
+                prog["u_size"] = size
+                prog["u_sample_count"] = len(sample_set)
+                prog["u_sample_total"] = float(total)
+                prog["u_roughness"] = roughness
+                _dispatch_faces(ctx, prog, target, size, mip)
+                buffer.release()
+
+            _timed(ctx, seconds, "prefilter", prefilter)
+            yield progress(2, f"prefilter {step + 1}/{prefilter_steps}")
+        if lighting is not source:
+            owned.remove(lighting)
+            lighting.release()
+
+        lut = _timed(ctx, seconds,
+                     f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
+                     lambda: luts.get(q.lut_size, q.lut_samples))
+    except BaseException:   # GeneratorExit (closed early) or a failed pass: free the partial bake
+        for tex in owned:
+            tex.release()
+        raise
     return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns)
 
 
@@ -358,28 +405,41 @@ def _set_suns(prog, suns: list[Sun]) -> None:
 def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuality,
                  seconds: dict[str, float], name: str) -> moderngl.TextureCube:
     """Equirect -> cube level 0, then solid-angle-weighted mips (see bake/cube_downsample.comp)."""
+    return run_to_completion(_source_cube_steps(ctx, shaders, radiance, q, seconds, name, [],
+                                                lambda weight, label: None))
+
+
+def _source_cube_steps(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuality,
+                       seconds: dict[str, float], name: str, owned: list, progress):
+    """_source_cube as two steps, the upload then the cube with its mips, each followed by
+    ``yield progress(weight, label)``. The cube goes into ``owned``."""
     levels = int(math.log2(q.cube_size)) + 1
     cube = _cube(ctx, q.cube_size, levels)
+    owned.append(cube)
     equirect = _timed(ctx, seconds, f"upload ({name})", lambda: upload_equirect(ctx, radiance))
+    try:
+        yield progress(1, f"upload ({name})")
 
-    def to_cube():
-        prog = shaders.compute("bake/equirect_to_cube.comp")
-        equirect.use(0)
-        prog["u_equirect"] = 0
-        prog["u_size"] = q.cube_size
-        prog["u_subsamples"] = q.equirect_subsamples
-        _dispatch_faces(ctx, prog, cube, q.cube_size)
-        downsample = shaders.compute("bake/cube_downsample.comp")
-        for level in range(1, levels):
-            size = q.cube_size >> level
-            cube.bind_to_image(0, read=True, write=False, level=level - 1)
-            cube.bind_to_image(1, read=False, write=True, level=level)
-            downsample["u_size"] = size
-            downsample.run(_groups(size), _groups(size), 6)
-            ctx.memory_barrier()
+        def to_cube():
+            prog = shaders.compute("bake/equirect_to_cube.comp")
+            equirect.use(0)
+            prog["u_equirect"] = 0
+            prog["u_size"] = q.cube_size
+            prog["u_subsamples"] = q.equirect_subsamples
+            _dispatch_faces(ctx, prog, cube, q.cube_size)
+            downsample = shaders.compute("bake/cube_downsample.comp")
+            for level in range(1, levels):
+                size = q.cube_size >> level
+                cube.bind_to_image(0, read=True, write=False, level=level - 1)
+                cube.bind_to_image(1, read=False, write=True, level=level)
+                downsample["u_size"] = size
+                downsample.run(_groups(size), _groups(size), 6)
+                ctx.memory_barrier()
 
-    _timed(ctx, seconds, f"equirect_to_cube ({name})", to_cube)
-    equirect.release()
+        _timed(ctx, seconds, f"equirect_to_cube ({name})", to_cube)
+    finally:
+        equirect.release()
+    yield progress(1, f"equirect_to_cube ({name})")
     return cube
 
 

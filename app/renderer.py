@@ -12,12 +12,14 @@ from dataclasses import dataclass, replace
 import moderngl
 import numpy as np
 
-from app.bake import QUALITY, BakeQuality, IBLMaps, LutCache, bake_environment, roughness_to_grid_step
+from app.bake import (QUALITY, BakeQuality, IBLMaps, LutCache, bake_environment, bake_steps,
+                      roughness_to_grid_step)
 from app.gpu import ShaderLibrary, create_headless_context
 from app.ibl_models import ibl_model_index
 from app.material import Material
 from app.mesh import is_closed
 from app.scene import BACKGROUNDS, TONEMAPS, Camera, Display, Scene, frame_camera
+from app.texture_maps import TextureMaps
 
 GL_SRGB8_ALPHA8 = 0x8C43
 AA_MODES = ("none", "msaa", "ssaa")
@@ -25,7 +27,7 @@ MAX_LIGHTS = 16   # punctual.glsl's MAX_LIGHTS
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
-MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion")
+MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 SRGB_MAPS = ("base_color", "emissive")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
@@ -150,6 +152,9 @@ class Renderer:
         self._lights_bytes = b""
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
         self._units_assigned: set[int] = set()
+        # User-loaded texture maps (Scene.texture_maps): (path, sRGB) -> (image, texture),
+        # uploaded once per decoded image.
+        self._map_textures: dict[tuple[str, bool], tuple[np.ndarray, moderngl.Texture]] = {}
 
     # --- resources -----------------------------------------------------------------------
 
@@ -158,6 +163,16 @@ class Renderer:
         key = (env.content_hash, q)
         if key not in self._bakes:
             self._bakes[key] = bake_environment(self.ctx, self.shaders, env, q, self.luts)
+        return self._bakes[key]
+
+    def bake_steps(self, env, quality: BakeQuality | str = "medium"):
+        """``bake`` in steps (app.bake.bake_steps): yields (fraction, label) between GPU passes
+        and returns the maps, cached as ``bake`` caches them (a cached bake yields nothing)."""
+        q = QUALITY[quality] if isinstance(quality, str) else quality
+        key = (env.content_hash, q)
+        if key not in self._bakes:
+            maps = yield from bake_steps(self.ctx, self.shaders, env, q, self.luts)
+            self._bakes[key] = maps
         return self._bakes[key]
 
     def _gpu_mesh(self, mesh, program) -> list[_GpuPart]:
@@ -191,7 +206,31 @@ class Renderer:
         self._meshes.clear()
         old.reload()
 
+    def _user_textures(self, scene: Scene) -> dict[str, moderngl.Texture]:
+        """The scene's user-loaded maps as textures by slot, uploaded on first use of an image."""
+        if scene.texture_maps is None:
+            return {}
+        out = {}
+        for slot, path in scene.texture_maps.paths().items():
+            image = scene.texture_images.get(path)
+            if image is None:
+                continue
+            key = (path, slot in SRGB_MAPS)
+            entry = self._map_textures.get(key)
+            if entry is None or entry[0] is not image:
+                if entry is not None:
+                    entry[1].release()
+                entry = self._map_textures[key] = (image, _upload_image(self.ctx, image, srgb=key[1]))
+            out[slot] = entry[1]
+        return out
+
+    def forget_map_textures(self, keep_paths) -> None:
+        """Release the uploaded maps whose path is not in ``keep_paths``."""
+        for key in [k for k in self._map_textures if k[0] not in keep_paths]:
+            self._map_textures.pop(key)[1].release()
+
     def release(self) -> None:
+        self.forget_map_textures(())
         for maps in self._bakes.values():
             maps.release()
         self._bakes.clear()
@@ -357,14 +396,19 @@ class Renderer:
         _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
         _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
+        user = self._user_textures(scene)
+        tiling = scene.texture_maps or TextureMaps()
         for gpu_part, part in zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts):
             material, maps_used = self._part_material(scene, part)
             _set_material(prog, material)
             fm = part.material if maps_used else None
             _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
             _set(prog, "u_occlusion_strength", float(getattr(fm, "occlusion_strength", 1.0)) if fm else 1.0)
+            # A file's maps use its own UVs as they are; the user's maps are tiled.
+            _set(prog, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
+            _set(prog, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
             for name in MATERIAL_MAPS:
-                tex = gpu_part.textures.get(name) if maps_used else None
+                tex = gpu_part.textures.get(name) if maps_used else user.get(name)
                 _set(prog, f"u_has_{name}_map", tex is not None)
                 if tex is not None:
                     tex.use(UNIT_MATERIAL[name])

@@ -136,3 +136,7 @@ class Scene:
     display: Display = field(default_factory=Display)
     debug_view: int = 0        # 0: shaded; else an index of app/editor/state.py's DEBUG_VIEWS
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view
+    # User-loaded maps for ``material`` (app/texture_maps.py: paths and UV tiling) and their
+    # decoded images by path; parts shaded with a file's own material ignore them.
+    texture_maps: "TextureMaps | None" = None
+    texture_images: dict = field(default_factory=dict)

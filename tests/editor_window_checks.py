@@ -82,12 +82,12 @@ def test_undo_redo_of_material_edits(window):
     window.frame()                        # no widget active: the edit becomes one undo step
     s.material = dataclasses.replace(s.material, metallic=1.0 - start.metallic)
     window.frame()
-    s.material = h.undo(s.material)
+    s.look = h.undo(s.look)
     assert (s.material.roughness, s.material.metallic) == (0.11, start.metallic)
-    s.material = h.undo(s.material)
+    s.look = h.undo(s.look)
     assert s.material == start
-    s.material = h.redo(s.material)
-    s.material = h.redo(s.material)
+    s.look = h.redo(s.look)
+    s.look = h.redo(s.look)
     assert (s.material.roughness, s.material.metallic) == (0.11, 1.0 - start.metallic)
     # The same through the keyboard, as glfw delivers it: Ctrl+Z undoes, Ctrl+Shift+Z redoes.
     import glfw
@@ -219,7 +219,88 @@ def test_view_is_redrawn_only_when_needed_and_reduced_while_moving(window):
     window.orbit.orbit(10.0, 0.0)
     window.frame()
     assert window.redraws == still + 1
-    assert window.renderer._targets.width == round(window.size[0] * 0.5)   # drawn reduced while moving
+    assert window.renderer._targets.width == round(window.view_area()[0] * 0.5)   # drawn reduced while moving
     window.frame()                                      # the camera stopped: redrawn sharp
-    assert window.redraws == still + 2 and window.renderer._targets.width == window.size[0]
+    assert window.redraws == still + 2 and window.renderer._targets.width == window.view_area()[0]
     s.motion_scale = 1.0
+
+
+def test_texture_maps_drop_undo_and_session(window, tmp_path, monkeypatch):
+    """A dropped image fills the armed slot (base colour by default) and the view changes; a bad
+    image shows its one-line error and keeps the maps; undo/redo and the session keep slots."""
+    import dataclasses
+
+    import OpenImageIO as oiio
+
+    from app.editor.camera import OrbitCamera
+    from app.editor.session import restore_session, save_session
+    from app.editor.state import EditorState
+    from app.output import write_image
+    from app.texture_maps import TextureMaps
+
+    def shot(name):
+        window.frame()
+        window.screenshot(str(tmp_path / name))
+        return ball(oiio.ImageBuf(str(tmp_path / name)).get_pixels(oiio.UINT8).astype(np.float64))
+
+    s, h = window.state, window.history
+    s.load_mesh("sphere")
+    s.material = dataclasses.replace(s.material, base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.6)
+    s.texture_maps = TextureMaps()
+    i, j = np.indices((128, 128)) // 16
+    grey = np.where((i + j) % 2 == 0, 20, 235).astype(np.uint8)
+    checker = tmp_path / "checker.png"
+    write_image(str(checker), np.repeat(grey[:, :, None], 3, axis=2), linear=False)
+    plain = shot("plain.png")
+    window.frame()                                   # settled: the plain look is an undo step
+    assert s.armed_slot == "base_color"
+    window.drop([str(checker)])
+    assert s.error == "" and s.texture_maps.base_color == str(checker)
+    mapped = shot("mapped.png")
+    assert mapped.std() > 1.5 * plain.std()
+
+    broken = tmp_path / "broken.png"
+    broken.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)
+    before = s.texture_maps
+    window.drop([str(broken)])
+    window.frame()
+    assert s.texture_maps == before and "broken.png" in s.error and "\n" not in s.error
+    assert window.panel.shown_error == s.error
+
+    s.look = h.undo(s.look)                          # the drop is one undo step
+    assert s.texture_maps.base_color == ""
+    assert np.abs(shot("undone.png") - plain).max() <= 1.0
+    s.look = h.redo(s.look)
+    assert s.texture_maps.base_color == str(checker)
+
+    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path / "cache"))
+    s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=(3.0, 2.0))
+    save_session(s, window.orbit)
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert fresh.texture_maps == s.texture_maps and str(checker) in fresh.map_images
+    checker.unlink()                                 # moved since: restored without it, with a warning
+    fresh = EditorState()
+    assert "checker.png" in restore_session(fresh, OrbitCamera())
+    assert fresh.texture_maps.base_color == "" and fresh.texture_maps.uv_scale == (3.0, 2.0)
+    s.texture_maps = TextureMaps()
+
+
+def test_bake_runs_across_frames_with_the_old_maps_in_use(window, shared_data):
+    s = window.state
+    s.error = ""
+    window.finish_bake()
+    old = window.maps()
+    assert old is not None
+    s.load_env(str(shared_data / "env" / "quarry_01_1k.hdr"))
+    s.quality = "low"
+    window.frame()
+    seen = []
+    while window.bake_progress is not None:          # one slice per frame; the panel shows it
+        seen.append(window.bake_progress)
+        assert window.maps() is old                  # the old maps light the view until the end
+        window.frame()
+    assert len(seen) >= 2 and seen[-1][0] > seen[0][0]
+    new = window.maps()
+    assert new is not old and new.quality.name == "low"
+    assert s.error == ""

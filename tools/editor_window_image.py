@@ -21,6 +21,7 @@ state.load_mesh("sphere")
 state.load_env("studio")
 win = EditorWindow(state, (1280, 720))
 try:
+    win.finish_bake()   # the bake runs across frames; the picture shows its result
     for _ in range(5):
         win.frame()
     win.draw()   # one more frame, read back before it would be swapped

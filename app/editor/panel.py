@@ -4,6 +4,7 @@ as 'frame the mesh'); it never touches a GL object, and the Renderer never sees 
 from __future__ import annotations
 
 import dataclasses
+import os
 
 import numpy as np
 
@@ -11,7 +12,9 @@ from app.bake import QUALITY
 from app.errors import AlightError
 from app.material import list_presets, load_preset, validate_material
 from app.scene import BACKGROUNDS, TONEMAPS, Light
+from app.editor.file_browser import FileBrowser
 from app.editor.state import DEBUG_VIEWS
+from app.texture_maps import IMAGE_SUFFIXES, MAP_SLOTS, SLOT_LABELS
 from app.shading import linear_to_srgb, srgb_to_linear
 
 AA_CHOICES = ("none", "msaa")
@@ -40,16 +43,21 @@ class Panel:
         self.mesh_path = ""
         self.preset_path = "material.json"
         self.gltf_path = "material.gltf"
-        self.shown_error = ""
-        self.dialog = None      # a pending native file dialog   # the error line drawn last frame (what the artist sees; tests read it)
+        self.map_path = ""
+        self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
+        self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
 
         s = win.state
-        imgui.set_next_window_pos(imgui.ImVec2(8, 8), imgui.Cond_.first_use_ever)
-        imgui.set_next_window_size(imgui.ImVec2(470, 700), imgui.Cond_.first_use_ever)
-        imgui.begin("alight")
+        # A side bar on the right, the full height: the view beside it stays uncovered.
+        display = imgui.get_io().display_size
+        width = win.panel_width()
+        imgui.set_next_window_pos(imgui.ImVec2(display.x - width, 0), imgui.Cond_.always)
+        imgui.set_next_window_size(imgui.ImVec2(width, display.y), imgui.Cond_.always)
+        imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+                    | imgui.WindowFlags_.no_collapse)
         self.shown_error = s.error
         if s.error:
             imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), "error:")
@@ -57,6 +65,9 @@ class Panel:
             imgui.text_wrapped(s.error)
         elif s.message:
             imgui.text_disabled(s.message)
+        if win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
+            fraction, label = win.bake_progress
+            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
         if imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
             self._material(s, win)
         if imgui.collapsing_header("Environment"):
@@ -68,6 +79,7 @@ class Panel:
         if imgui.collapsing_header("Performance", imgui.TreeNodeFlags_.default_open):
             self._performance(win)
         imgui.end()
+        self.browser.draw()
 
     # --- sections -------------------------------------------------------------------------------
 
@@ -117,16 +129,19 @@ class Panel:
                 s.material = validate_material(m, "panel")
             except AlightError as exc:
                 s.fail(exc)
+        if imgui.tree_node_ex("texture maps", imgui.TreeNodeFlags_.default_open):
+            self._texture_maps(s)
+            imgui.tree_pop()
         imgui.text_disabled(f"F0 = {' '.join(f'{x:.3f}' for x in s.material.f0())}   "
                             f"undo {len(win.history.undo_stack)}  redo {len(win.history.redo_stack)}")
         if imgui.button("revert"):
             s.material = s.saved_material
         imgui.same_line()
         if imgui.button("undo"):
-            s.material = win.history.undo(s.material)
+            s.look = win.history.undo(s.look)
         imgui.same_line()
         if imgui.button("redo"):
-            s.material = win.history.redo(s.material)
+            s.look = win.history.redo(s.look)
         _, self.preset_path = imgui.input_text("preset file", self.preset_path)
         if imgui.button("save preset"):
             try:
@@ -138,8 +153,8 @@ class Panel:
         if imgui.button("load preset"):
             s.open_file(self.preset_path)
         imgui.same_line()
-        self._browse("browse files", ["environments, meshes, presets",
-                                      "*.hdr *.exr *.obj *.gltf *.glb *.ply *.stl *.json"], s)
+        self._browse("browse files", (".hdr", ".exr", ".obj", ".gltf", ".glb", ".ply", ".stl", ".json"),
+                     s.open_file)
         _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
         if imgui.button("export glTF"):   # .gltf: the material alone; .glb: the mesh with it
             try:
@@ -148,22 +163,56 @@ class Panel:
             except AlightError as exc:
                 s.fail(exc)
 
-    def _browse(self, label: str, filters: list[str], s) -> None:
-        """A native dialog (imgui-bundle's portable file dialogs: zenity/kdialog on Linux), polled
-        each frame so it never blocks the window; where none exists, type the path instead."""
+    def _browse(self, label: str, suffixes: tuple[str, ...], on_pick) -> None:
+        """A button opening the file browser (file_browser.py: native dialog or built-in)."""
         from imgui_bundle import imgui
 
-        if imgui.button(label) and self.dialog is None:
-            try:
-                from imgui_bundle import portable_file_dialogs as pfd
+        if imgui.button(label):
+            self.browser.open(label, suffixes, on_pick)
 
-                self.dialog = pfd.open_file(label, "", filters)
-            except Exception as exc:
-                s.fail(AlightError(f"file dialog: not available ({exc}); type the path"))
-        if self.dialog is not None and self.dialog.ready(0):
-            paths, self.dialog = self.dialog.result(), None
-            for path in paths:
-                s.open_file(path)
+    def _texture_maps(self, s) -> None:
+        """A row per slot: the drop target (radio), the file, load and clear; then the tiling."""
+        from imgui_bundle import imgui
+
+        def loader(slot):
+            def load(path: str) -> None:
+                try:
+                    s.set_map(slot, path)
+                    s.error, s.message = "", f"{SLOT_LABELS[slot]}: {path}"
+                except AlightError as exc:
+                    s.fail(exc)    # the slot keeps its previous map
+            return load
+
+        maps = s.texture_maps
+        for slot in MAP_SLOTS:
+            imgui.push_id(slot)
+            if imgui.radio_button("##armed", s.armed_slot == slot):
+                s.armed_slot = slot
+            if imgui.is_item_hovered():
+                imgui.set_tooltip("a dropped image file goes into this slot")
+            imgui.same_line()
+            if imgui.small_button("load"):
+                self.browser.open(f"load {SLOT_LABELS[slot]} map", IMAGE_SUFFIXES, loader(slot))
+            imgui.same_line()
+            path = getattr(maps, slot)
+            if imgui.small_button("clear") and path:
+                s.clear_map(slot)
+            imgui.same_line()
+            imgui.text(SLOT_LABELS[slot])
+            if path:
+                imgui.same_line()
+                imgui.text_disabled(os.path.basename(path))
+            imgui.pop_id()
+        _, self.map_path = imgui.input_text("map file", self.map_path)
+        imgui.same_line()
+        if imgui.button("load##typed") and self.map_path:
+            loader(s.armed_slot)(self.map_path)
+        changed, v = imgui.drag_float2("UV tiling", list(maps.uv_scale), 0.02, -64.0, 64.0)
+        if changed:
+            s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=tuple(v))
+        changed, v = imgui.drag_float2("UV offset", list(maps.uv_offset), 0.005, -8.0, 8.0)
+        if changed:
+            s.texture_maps = dataclasses.replace(s.texture_maps, uv_offset=tuple(v))
 
     def _environment(self, s, win) -> None:
         from imgui_bundle import imgui
@@ -173,7 +222,7 @@ class Panel:
         if imgui.button("open env"):
             s.open_file(self.env_path)
         imgui.same_line()
-        self._browse("browse env", ["environments", "*.hdr *.exr"], s)
+        self._browse("browse env", (".hdr", ".exr"), s.open_file)
         imgui.same_line()
         if imgui.button("studio"):
             try:

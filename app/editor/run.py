@@ -44,7 +44,7 @@ def run(args) -> int:
         warning = restore_session(state, win.orbit)
         if warning:
             state.error = " ".join(warning.split())
-        win.history.committed = state.material
+        win.history.committed = state.look
     try:
         if args.benchmark:
             return _benchmark(win, args.frames or 120)
@@ -82,6 +82,7 @@ def _benchmark(win, frames: int) -> int:
     motion_scale = state.motion_scale
     for _ in range(10):   # warm up: shader compiles, the bake, imgui's font atlas
         win.frame()
+    win.finish_bake()
     w, h = win.size
     print(f"editor benchmark {w}x{h}, material ball, IBL, {len(state.lights)} lights, panel, aa={state.aa}")
 

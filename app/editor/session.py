@@ -11,6 +11,7 @@ from app.errors import AlightError
 from app.material import material_from_dict
 from app.output import write_text_atomic
 from app.paths import cache_dir
+from app.texture_maps import TextureMaps
 
 CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "radius")
 
@@ -21,6 +22,7 @@ def session_path() -> Path:
 
 def save_session(state, orbit) -> None:
     data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
+            "texture_maps": state.texture_maps.to_dict(),
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS}}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -36,10 +38,18 @@ def restore_session(state, orbit) -> str:
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
         material = material_from_dict(data["material"], str(path))
+        maps = TextureMaps.from_dict(data.get("texture_maps", {}), str(path))
     except (OSError, ValueError, KeyError, TypeError, AlightError) as exc:
         return f"{path}: last session not restored ({' '.join(str(exc).split())})"
     warning = ""
     state.material = state.saved_material = material
+    # Each map is read again; one that no longer reads (moved, broken since) is left empty.
+    state.texture_maps = TextureMaps(uv_scale=maps.uv_scale, uv_offset=maps.uv_offset)
+    for slot, map_path in maps.paths().items():
+        try:
+            state.set_map(slot, map_path)
+        except AlightError as exc:
+            warning = str(exc)
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
         if isinstance(spec, str):
             try:

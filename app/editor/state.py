@@ -17,6 +17,7 @@ from app.errors import AlightError
 from app.material import Material, load_preset, save_preset, validate_material
 from app.bake import QUALITY
 from app.scene import TONEMAPS, Display, Light, Scene
+from app.texture_maps import IMAGE_SUFFIXES, MAP_SLOTS, TextureMaps, load_map_image
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
@@ -39,6 +40,8 @@ class EditorState:
     mesh_spec: str = "sphere"
     env_spec: str = "studio"
     material: Material = field(default_factory=Material)
+    texture_maps: TextureMaps = field(default_factory=TextureMaps)   # user-loaded maps, UV tiling
+    armed_slot: str = "base_color"     # the texture slot a dropped image file fills
     saved_material: Material = field(default_factory=Material)   # what 'revert' goes back to
     quality: str = "medium"
     display: Display = field(default_factory=Display)
@@ -57,6 +60,16 @@ class EditorState:
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
     mesh: object = None
     env: object = None
+    map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
+
+    @property
+    def look(self) -> tuple[Material, TextureMaps]:
+        """What undo/redo and 'revert' act on: the material's factors and its maps."""
+        return (self.material, self.texture_maps)
+
+    @look.setter
+    def look(self, value: tuple[Material, TextureMaps]) -> None:
+        self.material, self.texture_maps = value
 
     def scene(self, camera) -> Scene:
         # Off by default: the editor's material is what the artist is shaping.
@@ -67,7 +80,9 @@ class EditorState:
                      display=dataclasses.replace(self.display, tonemap="none", exposure=0.0)
                      if self.debug_view in DATA_VIEWS else self.display,
                      debug_view=self.debug_view,
-                     debug_mip=self.debug_mip)
+                     debug_mip=self.debug_mip,
+                     texture_maps=self.texture_maps,
+                     texture_images=self.map_images)
 
     # --- loading (all or nothing) -----------------------------------------------------------
 
@@ -82,6 +97,28 @@ class EditorState:
 
         env = load_environment(spec)
         self.env, self.env_spec = env, spec
+
+    def set_map(self, slot: str, path: str) -> None:
+        """Fill a texture slot from an image file (read now: a bad file raises, nothing changes)."""
+        maps = self.texture_maps.with_slot(slot, path)
+        image = load_map_image(path)
+        self.map_images = {p: self.map_images[p] for p in maps.paths().values() if p in self.map_images}
+        self.map_images[path] = image
+        self.texture_maps = maps
+
+    def clear_map(self, slot: str) -> None:
+        self.texture_maps = self.texture_maps.with_slot(slot, "")
+
+    def sync_map_images(self) -> None:
+        """Decode any slot's file not yet decoded (after undo/redo or a restored session); a file
+        that no longer reads empties its slot and sets ``error``."""
+        for slot, path in self.texture_maps.paths().items():
+            if path not in self.map_images:
+                try:
+                    self.map_images[path] = load_map_image(path)
+                except AlightError as exc:
+                    self.texture_maps = self.texture_maps.with_slot(slot, "")
+                    self.fail(exc)
 
     def load_material(self, name_or_path: str) -> None:
         m = load_preset(name_or_path)
@@ -113,9 +150,12 @@ class EditorState:
                 self.load_mesh(path)
             elif suffix in PRESET_SUFFIXES:
                 self.load_material(path)
+            elif suffix in IMAGE_SUFFIXES:    # a texture map, into the armed slot
+                self.set_map(self.armed_slot, path)
             else:
                 raise AlightError(f"{path}: not an environment (.hdr .exr), a mesh "
-                                  f"({' '.join(MESH_EXTENSIONS)}) or a preset (.json)")
+                                  f"({' '.join(MESH_EXTENSIONS)}), a preset (.json) "
+                                  f"or a texture map ({' '.join(IMAGE_SUFFIXES)})")
         except Exception as exc:
             self.fail(exc)
             return False
@@ -133,7 +173,8 @@ class EditorState:
     def apply_edit(self, edit: str) -> None:
         """``field=value``: roughness / metallic (numbers), base_color / emissive / specular_f0
         (R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
-        env_rotation, env_intensity, ibl (0/1), quality."""
+        env_rotation, env_intensity, ibl (0/1), quality; map_SLOT (an image path, '' clears;
+        SLOT one of app.texture_maps.MAP_SLOTS), uv_scale / uv_offset (U,V)."""
         from app.material import parse_color
 
         key, sep, value = edit.partition("=")
@@ -172,6 +213,16 @@ class EditorState:
                 if value not in DEBUG_VIEWS:
                     raise AlightError(f"--script: debug_view '{value}' is not one of {', '.join(DEBUG_VIEWS)}")
                 self.debug_view = DEBUG_VIEWS.index(value)
+            elif key.startswith("map_") and key[4:] in MAP_SLOTS:
+                if value:
+                    self.set_map(key[4:], value)
+                else:
+                    self.clear_map(key[4:])
+            elif key in ("uv_scale", "uv_offset"):
+                pair = tuple(_finite(x, edit) for x in value.split(","))
+                if len(pair) != 2:
+                    raise AlightError(f"--script: '{edit}': {key} takes U,V")
+                self.texture_maps = dataclasses.replace(self.texture_maps, **{key: pair})
             elif key == "debug_mip":
                 self.debug_mip = max(0.0, _finite(value, edit))
             else:
@@ -188,30 +239,31 @@ def _finite(value: str, edit: str) -> float:
 
 
 class History:
-    """Undo/redo of material edits as snapshots (Material is frozen, so a snapshot is the value).
+    """Undo/redo of material edits as snapshots of EditorState.look (the Material and the
+    TextureMaps are frozen, so a snapshot is the value).
 
     A drag of a slider is one step: ``settle`` records a step only once no widget is active.
     """
 
-    def __init__(self, material: Material):
-        self.committed = material
-        self.undo_stack: list[Material] = []
-        self.redo_stack: list[Material] = []
+    def __init__(self, look):
+        self.committed = look
+        self.undo_stack: list = []
+        self.redo_stack: list = []
 
-    def settle(self, current: Material, editing: bool) -> None:
+    def settle(self, current, editing: bool) -> None:
         if editing or current == self.committed:
             return
         self.undo_stack.append(self.committed)
         self.redo_stack.clear()
         self.committed = current
 
-    def undo(self, current: Material) -> Material:
+    def undo(self, current) -> tuple:
         return self._step(current, self.undo_stack, self.redo_stack)
 
-    def redo(self, current: Material) -> Material:
+    def redo(self, current) -> tuple:
         return self._step(current, self.redo_stack, self.undo_stack)
 
-    def _step(self, current: Material, source: list, target: list) -> Material:
+    def _step(self, current, source: list, target: list) -> tuple:
         """Move one state from ``source`` to the committed one, keeping the old in ``target``."""
         self.settle(current, False)
         if not source:

@@ -25,6 +25,13 @@ from app.gpu import ShaderCompileError
 from app.editor.camera import OrbitCamera
 from app.editor.state import EditorState, History
 
+# The time a frame gives the environment bake at most (about one step more): the window stays
+# responsive while a bake runs over several frames.
+BAKE_SLICE_S = 0.03
+# The panel is a side bar on the window's right (at most half the window): the view is the
+# rest, so the panel never covers the mesh, and the view starts at the framebuffer's origin.
+PANEL_WIDTH = 420
+
 
 class EditorWindow:
     def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
@@ -68,12 +75,14 @@ class EditorWindow:
 
         self.state = state
         self.show_panel = show_panel
-        self.history = History(state.material)
+        self.history = History(state.look)
         self.orbit = OrbitCamera()
         self.frame_times: collections.deque[float] = collections.deque(maxlen=240)
         self.bake_seconds: dict[str, float] = {}
         self._maps_key = None
         self._maps = None
+        self._bake_job = None          # (key, generator) of the bake in progress
+        self.bake_progress = None      # (fraction, label) while a bake runs; the panel shows it
         self._last_swap = None
         self._framed_mesh = None
         self._drawn_key = self._drawn_targets = self._last_camera = None
@@ -110,19 +119,31 @@ class EditorWindow:
             if imgui.is_key_pressed(imgui.Key.f12):
                 self.screenshot_request = self.next_screenshot_name()
             if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
-                m = self.history.redo(self.state.material) if io.key_shift else self.history.undo(self.state.material)
-                self.state.material = m
+                s = self.state
+                s.look = self.history.redo(s.look) if io.key_shift else self.history.undo(s.look)
 
     def frame_mesh(self) -> None:
         if self.state.mesh is not None:
             center, radius = self.state.mesh.bounding_sphere()
-            w, h = self.size
+            w, h = self.view_area()
             self.orbit.frame(center, radius, w / max(h, 1))
         self._framed_mesh = self.state.mesh
 
     @property
     def size(self) -> tuple[int, int]:
         return tuple(self.glfw.get_framebuffer_size(self.window))
+
+    def panel_width(self) -> int:
+        """The side bar's width in window coordinates (imgui's), 0 without the panel."""
+        if not self.show_panel:
+            return 0
+        return min(PANEL_WIDTH, self.glfw.get_window_size(self.window)[0] // 2)
+
+    def view_area(self) -> tuple[int, int]:
+        """The framebuffer pixels left of the side bar: where the view is drawn."""
+        w, h = self.size
+        window_w = max(1, self.glfw.get_window_size(self.window)[0])
+        return max(1, w - round(self.panel_width() * w / window_w)), h
 
     def check_shaders(self, force: bool = False) -> None:
         """Hot reload: rebuild the programs when a file under shaders/ changed."""
@@ -140,24 +161,49 @@ class EditorWindow:
     # --- rendering ----------------------------------------------------------------------------
 
     def maps(self):
-        """Bake only when the environment or the quality changed (the Renderer caches bakes too)."""
+        """The maps in use. A new environment or quality starts a bake that ``advance_bake`` runs
+        a slice at a time between frames; until it completes the previous maps stay in use (the
+        Renderer caches bakes, so going back to an environment costs nothing)."""
         s = self.state
         if s.env is None:
             return None
         key = (id(s.env), s.quality)
-        if key != self._maps_key:
-            try:
-                self._maps = self.renderer.bake(s.env, QUALITY[s.quality])
-                self.bake_seconds = dict(self._maps.pass_seconds)
-            except AlightError as exc:
-                s.fail(exc)
-            self._maps_key = key
+        if key != self._maps_key and (self._bake_job is None or self._bake_job[0] != key):
+            if self._bake_job is not None:
+                self._bake_job[1].close()    # superseded: frees its partial maps
+            self._bake_job = (key, self.renderer.bake_steps(s.env, QUALITY[s.quality]))
+            self.bake_progress = (0.0, "starting")
         return self._maps
+
+    def advance_bake(self, budget_s: float = BAKE_SLICE_S) -> None:
+        """Run the pending bake's steps for about ``budget_s`` (at least one step)."""
+        if self._bake_job is None:
+            return
+        key, job = self._bake_job
+        start = time.perf_counter()
+        try:
+            while True:
+                self.bake_progress = next(job)
+                if time.perf_counter() - start >= budget_s:
+                    return
+        except StopIteration as done:
+            self._maps, self._maps_key = done.value, key
+            self.bake_seconds = dict(done.value.pass_seconds)
+        except AlightError as exc:
+            self.state.fail(exc)
+            self._maps_key = key    # not retried until the environment or quality changes
+        self._bake_job, self.bake_progress = None, None
+
+    def finish_bake(self) -> None:
+        """Complete the pending bake now (screenshots, scripts and the benchmark want the final maps)."""
+        self.maps()
+        while self._bake_job is not None:
+            self.advance_bake(float("inf"))
 
     def view_size(self, moving: bool) -> tuple[int, int]:
         """The HDR view's size: the window's times the render scale, and times the motion scale
         while the camera moves (llvmpipe's cost is per pixel; a still view is redrawn sharp)."""
-        w, h = self.size
+        w, h = self.view_area()
         scale = self.state.render_scale * (self.state.motion_scale if moving else 1.0)
         return max(1, round(w * scale)), max(1, round(h * scale))
 
@@ -171,7 +217,8 @@ class EditorWindow:
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
-                size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials)
+                size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials,
+                scene.texture_maps, tuple(id(scene.texture_images.get(p)) for p in scene.texture_maps.paths().values()))
 
     def render_view(self, force: bool = False, full: bool = False):
         """Draw the scene into the offscreen HDR target and tone map it, but only when something
@@ -183,9 +230,9 @@ class EditorWindow:
                 self.orbit.restored, self._framed_mesh = False, self.state.mesh
             else:
                 self.frame_mesh()   # a new mesh: frame it once
-        window = self.size
-        if window[0] == 0 or window[1] == 0:    # minimised
+        if 0 in self.size:    # minimised
             return None
+        window = self.size if full else self.view_area()   # the screenshot is the view at window size
         camera = self.orbit.camera()
         moving, self._last_camera = camera != self._last_camera, camera
         size = window if full else self.view_size(moving)
@@ -213,6 +260,7 @@ class EditorWindow:
             self.ctx.screen.use()
             self.ctx.viewport = (0, 0) + window
             self.renderer._fullscreen(prog)
+            self.ctx.viewport = (0, 0) + self.size
         # The copy leaves the last used framebuffer (display_fbo) bound; imgui draws into
         # whatever is bound, and must draw into the window, never into the view's image.
         self.ctx.screen.use()
@@ -244,9 +292,11 @@ class EditorWindow:
             self.panel.draw(self)
         self._camera_input()
         self.check_shaders()
-        self.history.settle(self.state.material, imgui.is_any_item_active())
+        self.history.settle(self.state.look, imgui.is_any_item_active())
+        self.state.sync_map_images()   # undo/redo may bring back a map not decoded now
         imgui.render()
         self.render_view()
+        self.advance_bake()
         if self.show_panel:
             self.impl.render(imgui.get_draw_data())
 
@@ -257,6 +307,7 @@ class EditorWindow:
         from app.output import check_output_path, write_image
 
         out = check_output_path(path, (".png",))
+        self.finish_bake()
         targets = self.render_view(full=True)   # display_fbo holds the view, without the panel
         if targets is None:
             raise AlightError(f"{out}: the window has no area to capture")

@@ -16,6 +16,9 @@ uniform vec3 u_specular_f0;
 uniform vec3 u_emissive;
 uniform float u_normal_scale;
 uniform float u_occlusion_strength;
+// The maps' coordinates: uv * u_uv_scale + u_uv_offset (the editor's tiling; identity for files).
+uniform vec2 u_uv_scale;
+uniform vec2 u_uv_offset;
 
 // Texture maps; sRGB ones are uploaded with sRGB formats so sampling returns linear values.
 uniform bool u_has_base_color_map;
@@ -23,11 +26,21 @@ uniform bool u_has_metallic_roughness_map;
 uniform bool u_has_normal_map;
 uniform bool u_has_emissive_map;
 uniform bool u_has_occlusion_map;
+// Separate greyscale maps (R), as many texture sets ship: over a metallic-roughness map they
+// replace its B (metallic) or G (roughness) channel.
+uniform bool u_has_metallic_map;
+uniform bool u_has_roughness_map;
 uniform sampler2D u_base_color_map;
 uniform sampler2D u_metallic_roughness_map;
 uniform sampler2D u_normal_map;
 uniform sampler2D u_emissive_map;
 uniform sampler2D u_occlusion_map;
+uniform sampler2D u_metallic_map;
+uniform sampler2D u_roughness_map;
+
+vec2 material_uv() {
+    return v_uv * u_uv_scale + u_uv_offset;
+}
 
 vec3 shading_normal() {
     // Zero-length normals (bad meshes) fall back to the face normal from screen derivatives.
@@ -41,7 +54,7 @@ vec3 shading_normal() {
         if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
         t = normalize(t);
         vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-        vec3 m = texture(u_normal_map, v_uv).xyz * 2.0 - 1.0;
+        vec3 m = texture(u_normal_map, material_uv()).xyz * 2.0 - 1.0;
         m.xy *= u_normal_scale;
         vec3 mapped = mat3(t, b, n) * m;
         n = dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
@@ -57,14 +70,17 @@ Surface material_surface() {
     s.specular_f0 = u_specular_f0;
     s.emissive = u_emissive;
     s.occlusion = 1.0;
-    if (u_has_base_color_map) s.base_color *= texture(u_base_color_map, v_uv).rgb;
-    if (u_has_metallic_roughness_map) {
-        vec4 mr = texture(u_metallic_roughness_map, v_uv);
-        s.roughness *= mr.g;
-        s.metallic *= mr.b;
-    }
-    if (u_has_emissive_map) s.emissive *= texture(u_emissive_map, v_uv).rgb;
-    if (u_has_occlusion_map) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, v_uv).r - 1.0);
+    vec2 uv = material_uv();
+    if (u_has_base_color_map) s.base_color *= texture(u_base_color_map, uv).rgb;
+    // glTF's packing: G = roughness, B = metallic; a separate greyscale map takes precedence.
+    vec2 metal_rough = vec2(1.0);
+    if (u_has_metallic_roughness_map) metal_rough = texture(u_metallic_roughness_map, uv).bg;
+    if (u_has_metallic_map) metal_rough.x = texture(u_metallic_map, uv).r;
+    if (u_has_roughness_map) metal_rough.y = texture(u_roughness_map, uv).r;
+    s.metallic *= metal_rough.x;
+    s.roughness *= metal_rough.y;
+    if (u_has_emissive_map) s.emissive *= texture(u_emissive_map, uv).rgb;
+    if (u_has_occlusion_map) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, uv).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
     return s;
