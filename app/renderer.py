@@ -106,6 +106,7 @@ class _Targets:
     """Framebuffers for one output size and anti-aliasing mode, kept between frames."""
 
     def __init__(self, ctx: moderngl.Context, width: int, height: int, aa: str, samples: int):
+        self.ctx = ctx
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
         # Linear radiance at the output size: drawn into directly without anti-aliasing, else the
         # MSAA resolve or the SSAA reduction lands here.
@@ -125,9 +126,18 @@ class _Targets:
         self.draw = ctx.framebuffer([self.color], self.depth)
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
+        self._display_draw = None
+
+    def display_draw(self) -> moderngl.Framebuffer:
+        """The display image with the depth buffer, for Renderer.draw_display (no AA only)."""
+        if self._display_draw is None:
+            self._display_draw = self.ctx.framebuffer([self.display], self.depth)
+        return self._display_draw
 
     def release(self) -> None:
         owned = [self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo, self.display]
+        if self._display_draw is not None:
+            owned.insert(0, self._display_draw)
         if self.color is not self.radiance:
             owned.append(self.color)
         for obj in owned:
@@ -152,6 +162,7 @@ class Renderer:
         self._lights_bytes = b""
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
         self._units_assigned: set[int] = set()
+        self._display_output: Display | None = None   # set while draw_display runs
         # User-loaded texture maps (Scene.texture_maps): (path, sRGB) -> (image, texture),
         # uploaded once per decoded image.
         self._map_textures: dict[tuple[str, bool], tuple[np.ndarray, moderngl.Texture]] = {}
@@ -280,11 +291,27 @@ class Renderer:
         return Frame(linear, srgb)
 
     def draw_hdr(self, scene: Scene, maps: IBLMaps | None, targets: _Targets) -> None:
+        self._draw_scene(scene, maps, targets, targets.draw)
+
+    def draw_display(self, scene: Scene, maps: IBLMaps | None, targets: _Targets) -> None:
+        """What ``draw_hdr`` then ``tonemap`` (opaque) leave in ``targets.display``, in one pass:
+        the scene's programs tone map as they write (common/output_encoding.glsl), so neither the
+        float image nor the tone map pass is needed (the editor's view). Without anti-aliasing
+        only: a resolve must average radiance, not display values."""
+        if targets.aa != "none" or scene.view == "probe":
+            self.draw_hdr(scene, maps, targets)
+            self.tonemap(targets.radiance, scene.display, targets.display_fbo)
+            return
+        self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display)
+
+    def _draw_scene(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, fbo: moderngl.Framebuffer,
+                    display_output: Display | None = None) -> None:
         ctx = self.ctx
+        self._display_output = display_output
         width, height = targets.draw_size
-        targets.draw.use()
+        fbo.use()
         ctx.viewport = (0, 0, width, height)
-        targets.draw.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         aspect = width / height
         # The probe's own camera is orthographic; its backdrop is drawn as the default camera sees it.
         camera = Camera() if scene.view == "probe" else self.camera_for(scene, aspect)
@@ -300,7 +327,9 @@ class Renderer:
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         self._draw_background(scene, maps, inverse_vp)
         ctx.disable(moderngl.DEPTH_TEST)
-        self._finish_radiance(targets)
+        if display_output is None:
+            self._finish_radiance(targets)
+        self._display_output = None
 
     def camera_for(self, scene: Scene, aspect: float) -> Camera:
         if scene.camera is not None:
@@ -317,6 +346,17 @@ class Renderer:
         if scene.multiple_scattering:
             defines["MULTIPLE_SCATTERING"] = None
         return defines
+
+    def _scene_program(self, vertex: str, fragment: str, defines: dict | None = None) -> moderngl.Program:
+        """A scene pass's program: with DISPLAY_OUTPUT and the display's uniforms while
+        ``draw_display`` runs (common/output_encoding.glsl)."""
+        display = self._display_output
+        if display is None:
+            return self.program(vertex, fragment, defines)
+        prog = self.program(vertex, fragment, {**(defines or {}), "DISPLAY_OUTPUT": None})
+        _set(prog, "u_exposure_scale", float(2.0 ** display.exposure))
+        _set(prog, "u_tonemap", TONEMAPS.index(display.tonemap))
+        return prog
 
     def _bind_ibl(self, program: moderngl.Program, scene: Scene, maps: IBLMaps | None) -> None:
         enabled = bool(scene.ibl_enabled and maps is not None)
@@ -350,7 +390,7 @@ class Renderer:
         mode = scene.display.background
         if mode == "transparent" or (mode in ("env", "blur") and maps is None):
             return
-        prog = self.program("render/fullscreen.vert", "render/background.frag")
+        prog = self._scene_program("render/fullscreen.vert", "render/background.frag")
         prog["u_mode"] = {"env": 0, "blur": 1, "color": 2}[mode]
         if mode == "color":
             prog["u_color"] = tuple(scene.display.background_color)
@@ -377,14 +417,24 @@ class Renderer:
         ctx = self.ctx
         # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
         defines = self._ibl_defines(scene)
+        defines["MATERIAL_MAPS_MASK"] = self._map_mask(scene)
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
-        prog = self.program("render/pbr.vert", "render/pbr.frag", defines)
+        prog = self._scene_program("render/pbr.vert", "render/pbr.frag", defines)
         if scene.debug_view:
             _set(prog, "u_debug_view", int(scene.debug_view))
             _set(prog, "u_debug_mip", float(scene.debug_mip))
         self._bind_ibl(prog, scene, maps)
         self.draw_mesh_parts(scene, prog, camera, view_projection)
+
+    def _map_mask(self, scene: Scene) -> int:
+        """mesh_material.glsl's MATERIAL_MAPS_MASK: a bit per map any part is drawn with."""
+        user = scene.texture_maps.paths() if scene.texture_maps is not None else {}
+        used = {name for name, path in user.items() if path in scene.texture_images}
+        for gpu_part, part in zip(self._gpu_mesh(scene.mesh, None), scene.mesh.parts):
+            if part.material is not None and scene.use_file_materials:
+                used.update(gpu_part.textures)
+        return sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in used)
 
     def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program, camera: Camera,
                         view_projection: np.ndarray) -> None:

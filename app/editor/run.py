@@ -112,7 +112,8 @@ def _benchmark(win, frames: int) -> int:
 
 def _profile(win, frames: int) -> dict[str, float]:
     imgui, ctx, r = win.imgui, win.ctx, win.renderer
-    times: dict[str, list[float]] = {k: [] for k in ("panel build", "scene (hdr)", "tonemap+blit", "imgui draw", "swap")}
+    times: dict[str, list[float]] = {k: [] for k in ("panel build", "scene (tone mapped)", "copy to window",
+                                                     "imgui draw", "swap")}
     for _ in range(frames):
         win.orbit.orbit(3.0, 0.0)
         t0 = time.perf_counter()
@@ -122,12 +123,11 @@ def _profile(win, frames: int) -> dict[str, float]:
         win.panel.draw(win)
         imgui.render()
         t1 = time.perf_counter()
-        targets = win.targets()
+        targets = win.targets(win.view_area())
         scene = win.state.scene(win.orbit.camera())
-        r.draw_hdr(scene, win.maps(), targets)
+        r.draw_display(scene, win.maps(), targets)
         ctx.finish()
         t2 = time.perf_counter()
-        r.tonemap(targets.radiance, scene.display, targets.display_fbo)
         ctx.copy_framebuffer(ctx.screen, targets.display_fbo)
         ctx.screen.use()
         ctx.finish()

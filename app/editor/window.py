@@ -1,8 +1,9 @@
 """The editor's window: glfw, a ModernGL context made from it, the main loop.
 
-Each frame: build the imgui panel (it edits EditorState), render the scene with the Renderer
-into its offscreen HDR target at the window's size, tone map that into the default
-framebuffer, draw imgui on top, swap. The Renderer never sees imgui; the panel never sees GL.
+Each frame: build the imgui panel (it edits EditorState; a side bar on the right), render the
+scene with the Renderer, tone mapped as it is drawn (Renderer.draw_display), into its offscreen
+view image the size of the area left of the panel, and only when something it depends on
+changed; copy that into the default framebuffer, draw imgui on top, swap. The Renderer never sees imgui; the panel never sees GL.
 
 imgui backend: imgui-bundle's own pure-python GLFW backend (python_backends.glfw_backend). It
 draws with PyOpenGL on the same context ModernGL uses (GL state is the context's, not the
@@ -88,7 +89,7 @@ class EditorWindow:
         self._drawn_key = self._drawn_targets = self._last_camera = None
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
-        self.redraws = 0   # HDR redraws so far (the Performance section shows it)
+        self.redraws = 0   # scene redraws so far (the Performance section shows it)
         from app.editor.hot_reload import ShaderWatcher
         from app.editor.panel import Panel
 
@@ -201,7 +202,7 @@ class EditorWindow:
             self.advance_bake(float("inf"))
 
     def view_size(self, moving: bool) -> tuple[int, int]:
-        """The HDR view's size: the window's times the render scale, and times the motion scale
+        """The view image's size: the view area's times the render scale, and times the motion scale
         while the camera moves (llvmpipe's cost is per pixel; a still view is redrawn sharp)."""
         w, h = self.view_area()
         scale = self.state.render_scale * (self.state.motion_scale if moving else 1.0)
@@ -212,7 +213,7 @@ class EditorWindow:
         return self.renderer._targets_for(w, h, self.state.aa, 4)
 
     def _view_key(self, scene, maps, size) -> tuple:
-        """Everything the HDR image depends on. Material, Camera, Light and Display are plain
+        """Everything the view image depends on. Material, Camera, Light and Display are plain
         dataclasses compared by value; the mesh and the bake by identity (they are replaced, never
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
@@ -221,8 +222,8 @@ class EditorWindow:
                 scene.texture_maps, tuple(id(scene.texture_images.get(p)) for p in scene.texture_maps.paths().values()))
 
     def render_view(self, force: bool = False, full: bool = False):
-        """Draw the scene into the offscreen HDR target and tone map it, but only when something
-        it depends on changed; then put the tone-mapped image into the default framebuffer.
+        """Draw the scene, tone mapped as it is drawn, into the offscreen view image, but only when
+        something it depends on changed; then put the tone-mapped image into the default framebuffer.
         (While the artist orbits every frame redraws; a still view costs only the copy.)
         ``full``: the window's size whatever the scales (screenshots)."""
         if self.state.mesh is not self._framed_mesh:
@@ -241,13 +242,12 @@ class EditorWindow:
         maps = self.maps()
         key = self._view_key(scene, maps, size)
         if force or key != self._drawn_key or targets is not self._drawn_targets:
-            try:
-                self.renderer.draw_hdr(scene, maps, targets)
+            try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
+                self.renderer.draw_display(scene, maps, targets)
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
                 self.state.debug_view = 0
                 return None
-            self.renderer.tonemap(targets.radiance, scene.display, targets.display_fbo)
             self._drawn_key, self._drawn_targets = key, targets
             self.redraws += 1
         if size == window:

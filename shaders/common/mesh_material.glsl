@@ -38,6 +38,24 @@ uniform sampler2D u_occlusion_map;
 uniform sampler2D u_metallic_map;
 uniform sampler2D u_roughness_map;
 
+// The maps compiled in, a bit each (app/renderer.py MATERIAL_MAPS order). llvmpipe runs both
+// sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
+// passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
+#ifndef MATERIAL_MAPS_MASK
+#define MATERIAL_MAPS_MASK 127
+#endif
+const int MAP_BASE_COLOR = 1;
+const int MAP_METALLIC_ROUGHNESS = 2;
+const int MAP_NORMAL = 4;
+const int MAP_EMISSIVE = 8;
+const int MAP_OCCLUSION = 16;
+const int MAP_METALLIC = 32;
+const int MAP_ROUGHNESS = 64;
+
+bool has_map(int bit, bool present) {
+    return (MATERIAL_MAPS_MASK & bit) != 0 && present;
+}
+
 vec2 material_uv() {
     return v_uv * u_uv_scale + u_uv_offset;
 }
@@ -48,7 +66,7 @@ vec3 shading_normal() {
     vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
     n = dot(n, n) > 1e-12 ? normalize(n) : face;
     if (!gl_FrontFacing) n = -n;
-    if (u_has_normal_map) {
+    if (has_map(MAP_NORMAL, u_has_normal_map)) {
         // Gram-Schmidt; a tangent parallel to n (a broken file) gets any perpendicular instead.
         vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
         if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
@@ -71,16 +89,16 @@ Surface material_surface() {
     s.emissive = u_emissive;
     s.occlusion = 1.0;
     vec2 uv = material_uv();
-    if (u_has_base_color_map) s.base_color *= texture(u_base_color_map, uv).rgb;
+    if (has_map(MAP_BASE_COLOR, u_has_base_color_map)) s.base_color *= texture(u_base_color_map, uv).rgb;
     // glTF's packing: G = roughness, B = metallic; a separate greyscale map takes precedence.
     vec2 metal_rough = vec2(1.0);
-    if (u_has_metallic_roughness_map) metal_rough = texture(u_metallic_roughness_map, uv).bg;
-    if (u_has_metallic_map) metal_rough.x = texture(u_metallic_map, uv).r;
-    if (u_has_roughness_map) metal_rough.y = texture(u_roughness_map, uv).r;
+    if (has_map(MAP_METALLIC_ROUGHNESS, u_has_metallic_roughness_map)) metal_rough = texture(u_metallic_roughness_map, uv).bg;
+    if (has_map(MAP_METALLIC, u_has_metallic_map)) metal_rough.x = texture(u_metallic_map, uv).r;
+    if (has_map(MAP_ROUGHNESS, u_has_roughness_map)) metal_rough.y = texture(u_roughness_map, uv).r;
     s.metallic *= metal_rough.x;
     s.roughness *= metal_rough.y;
-    if (u_has_emissive_map) s.emissive *= texture(u_emissive_map, uv).rgb;
-    if (u_has_occlusion_map) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, uv).r - 1.0);
+    if (has_map(MAP_EMISSIVE, u_has_emissive_map)) s.emissive *= texture(u_emissive_map, uv).rgb;
+    if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, uv).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
     return s;

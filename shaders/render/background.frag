@@ -3,6 +3,7 @@
 // Alpha is 0 everywhere here: only surfaces count as hits (CONVENTIONS.md, image outputs).
 #include "common/brdf.glsl"
 #include "common/equirect.glsl"
+#include "common/output_encoding.glsl"
 
 const int BACKGROUND_ENV = 0;
 const int BACKGROUND_BLUR = 1;
@@ -23,7 +24,7 @@ layout(location = 0) out vec4 out_radiance;
 
 void main() {
     if (u_mode == BACKGROUND_COLOR) {
-        out_radiance = vec4(u_color, 0.0);
+        out_radiance = encode_output(u_color, 0.0);
         return;
     }
     vec4 near = u_inverse_view_projection * vec4(v_ndc, -1.0, 1.0);
@@ -32,5 +33,5 @@ void main() {
     vec3 radiance = u_mode == BACKGROUND_BLUR
         ? textureLod(u_prefiltered_radiance, d, u_blur_mip).rgb
         : textureLod(u_environment, d, 0.0).rgb;
-    out_radiance = vec4(u_env_intensity * radiance, 0.0);
+    out_radiance = encode_output(u_env_intensity * radiance, 0.0);
 }
