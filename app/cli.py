@@ -109,9 +109,9 @@ def _add_edit_parser(sub) -> None:
     e.add_argument("--size", type=_size, default=(1280, 720), metavar="W|WxH", help="window size (default: 1280x720)")
     e.add_argument("--aa", choices=("none", "msaa"), default="none",
                    help="anti-aliasing of the preview (default: none; msaa costs ~2x on llvmpipe)")
-    e.add_argument("--motion-scale", type=_number("--motion-scale", 0.25, 1.0), default=0.5, metavar="X",
-                   help="the view's resolution while the camera moves, relative to the window; a still "
-                        "view is redrawn at full resolution (default: 0.5)")
+    e.add_argument("--motion-scale", type=_number("--motion-scale", 0.25, 1.0), default=None, metavar="X",
+                   help="the view's resolution while the camera moves, relative to the view area; a still "
+                        "view is redrawn at full resolution (default: adaptive, the scale that holds 30 FPS)")
     e.add_argument("--screenshot", metavar="FILE.png",
                    help="render --frames frames, write the view (without the panel) at window size, exit")
     e.add_argument("--frames", type=int, default=0, metavar="N", help="frames before --screenshot (default 1), "

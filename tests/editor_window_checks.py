@@ -304,3 +304,36 @@ def test_bake_runs_across_frames_with_the_old_maps_in_use(window, shared_data):
     new = window.maps()
     assert new is not old and new.quality.name == "low"
     assert s.error == ""
+
+
+def test_adaptive_scale_follows_the_frame_time(window):
+    """Slow moving frames lower the adaptive scale a step at a time down to its floor, fast ones
+    raise it to 1; the still view is drawn at full size whatever the scale."""
+    from app.editor.window import ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP
+
+    s = window.state
+    s.adaptive_motion = True
+    window.adaptive_scale = 1.0
+    window.frame_times.append(0.5)                      # a 2 FPS frame
+    window.adapt_motion_scale()
+    assert window.adaptive_scale == 1.0 - ADAPTIVE_STEP  # one step per frame, not a jump
+    for _ in range(40):
+        window.frame_times.append(0.5)
+        window.adapt_motion_scale()
+    assert window.adaptive_scale == ADAPTIVE_MIN_SCALE
+    for _ in range(40):
+        window.frame_times.append(0.001)                 # far faster than the target
+        window.adapt_motion_scale()
+    assert window.adaptive_scale == 1.0
+    window.frame_times.append(1.0 / 30.0)                # on target: stays
+    window.adapt_motion_scale()
+    assert window.adaptive_scale == 1.0
+    window.adaptive_scale = 0.5
+    window.orbit.orbit(5.0, 0.0)
+    window.frame()
+    window.orbit.orbit(5.0, 0.0)
+    window.frame()                                       # moving: drawn reduced
+    assert window.renderer._targets.width < window.view_area()[0]
+    window.frame()                                       # still: full size
+    assert window.renderer._targets.width == window.view_area()[0]
+    s.adaptive_motion = False

@@ -52,6 +52,7 @@ class EditorState:
     aa: str = "none"
     render_scale: float = 1.0     # the view's resolution relative to the window
     motion_scale: float = 1.0     # times render_scale while the camera moves (0.5: a quarter of the pixels)
+    adaptive_motion: bool = False  # while moving, the scale that holds TARGET_FPS instead (at least 0.25)
     use_file_materials: bool = False   # a mesh file's own materials and texture maps instead of the panel's
     debug_view: int = 0
     debug_mip: float = 0.0

@@ -32,6 +32,10 @@ BAKE_SLICE_S = 0.03
 # The panel is a side bar on the window's right (at most half the window): the view is the
 # rest, so the panel never covers the mesh, and the view starts at the framebuffer's origin.
 PANEL_WIDTH = 420
+# Adaptive resolution while the camera moves: the view's scale follows the frame time toward
+# this rate, in steps (a new size reallocates the view's targets), between these bounds.
+TARGET_FPS = 30.0
+ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP = 0.25, 1.0 / 16.0
 
 
 class EditorWindow:
@@ -90,6 +94,8 @@ class EditorWindow:
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
+        self.adaptive_scale = 0.5      # the adaptive motion scale now (see adapt_motion_scale)
+        self._was_moving = False
         from app.editor.hot_reload import ShaderWatcher
         from app.editor.panel import Panel
 
@@ -201,11 +207,24 @@ class EditorWindow:
         while self._bake_job is not None:
             self.advance_bake(float("inf"))
 
+    def adapt_motion_scale(self) -> None:
+        """Move the adaptive scale toward TARGET_FPS from the last frame's time (swap to swap):
+        the scene's cost is per pixel, so the scale goes with the square root of the time ratio,
+        by at most one step a frame; the still view is always redrawn at full scale."""
+        if not self.frame_times:
+            return
+        ratio = (1.0 / TARGET_FPS) / max(self.frame_times[-1], 1e-6)
+        want = self.adaptive_scale * ratio ** 0.5
+        if abs(want - self.adaptive_scale) >= ADAPTIVE_STEP:
+            step = ADAPTIVE_STEP if want > self.adaptive_scale else -ADAPTIVE_STEP
+            self.adaptive_scale = min(1.0, max(ADAPTIVE_MIN_SCALE, self.adaptive_scale + step))
+
     def view_size(self, moving: bool) -> tuple[int, int]:
         """The view image's size: the view area's times the render scale, and times the motion scale
         while the camera moves (llvmpipe's cost is per pixel; a still view is redrawn sharp)."""
         w, h = self.view_area()
-        scale = self.state.render_scale * (self.state.motion_scale if moving else 1.0)
+        motion = self.adaptive_scale if self.state.adaptive_motion else self.state.motion_scale
+        scale = self.state.render_scale * (motion if moving else 1.0)
         return max(1, round(w * scale)), max(1, round(h * scale))
 
     def targets(self, size=None):
@@ -236,6 +255,9 @@ class EditorWindow:
         window = self.size if full else self.view_area()   # the screenshot is the view at window size
         camera = self.orbit.camera()
         moving, self._last_camera = camera != self._last_camera, camera
+        if moving and self._was_moving and not full:
+            self.adapt_motion_scale()
+        self._was_moving = moving
         size = window if full else self.view_size(moving)
         targets = self.targets(size)
         scene = self.state.scene(camera)
