@@ -3,7 +3,9 @@
 Run under a display, e.g. ``xvfb-run -a -s "-screen 0 1400x800x24" .venv/bin/python tools/editor_window_image.py``.
 """
 
+import dataclasses
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +21,17 @@ state = EditorState(quality="medium")
 state.material = state.saved_material = load_preset("gold")
 state.load_mesh("sphere")
 state.load_env("studio")
+# Two texture maps made here (the repository ships no images): a tiled base colour that darkens
+# every other tile, and a greyscale roughness map of stripes, tiled twice.
+maps_dir = Path(tempfile.mkdtemp())
+i, j = np.indices((256, 256)) // 32
+tiles = np.where(((i + j) % 2 == 0)[:, :, None], [255, 255, 255], [150, 110, 90]).astype(np.uint8)
+stripes = np.repeat(np.where((i % 2 == 0)[:, :, None], 40, 200).astype(np.uint8), 3, axis=2)
+write_image(maps_dir / "tiles_base_colour.png", tiles, linear=False)
+write_image(maps_dir / "stripes_roughness.png", stripes, linear=False)
+state.set_map("base_color", str(maps_dir / "tiles_base_colour.png"))
+state.set_map("roughness", str(maps_dir / "stripes_roughness.png"))
+state.texture_maps = dataclasses.replace(state.texture_maps, uv_scale=(2.0, 2.0))
 win = EditorWindow(state, (1280, 720))
 try:
     win.finish_bake()   # the bake runs across frames; the picture shows its result
