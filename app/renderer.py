@@ -390,8 +390,8 @@ class Renderer:
         mode = scene.display.background
         if mode == "transparent" or (mode in ("env", "blur") and maps is None):
             return
-        prog = self._scene_program("render/fullscreen.vert", "render/background.frag")
-        prog["u_mode"] = {"env": 0, "blur": 1, "color": 2}[mode]
+        prog = self._scene_program("render/background.vert", "render/background.frag",
+                                   {"BACKGROUND_MODE": {"env": 0, "blur": 1, "color": 2}[mode]})
         if mode == "color":
             prog["u_color"] = tuple(scene.display.background_color)
         else:

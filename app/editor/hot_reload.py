@@ -12,9 +12,10 @@ from pathlib import Path
 
 from app.gpu import ShaderCompileError, ShaderLibrary
 
-# The programs the editor draws with (renderer.py's names).
+# The programs the editor draws with (renderer.py's names); every variant the renderer has
+# compiled so far (its defines: debug view, display output, maps, ...) is rebuilt too.
 EDITOR_PROGRAMS = (("render/pbr.vert", "render/pbr.frag"),
-                   ("render/fullscreen.vert", "render/background.frag"),
+                   ("render/background.vert", "render/background.frag"),
                    ("render/fullscreen.vert", "render/tonemap.frag"))
 
 
@@ -57,6 +58,9 @@ def rebuild(renderer, root: Path) -> str:
     try:
         for vertex, fragment in EDITOR_PROGRAMS:
             library.program(vertex, fragment)
+        for key in list(renderer.shaders._programs):
+            if key[0] == "program":
+                library.program(key[1], key[2], dict(key[3]))
     except ShaderCompileError as exc:
         library.reload()   # release whatever compiled; the renderer keeps its programs
         return " ".join(str(exc).split())

@@ -5,14 +5,17 @@
 #include "common/equirect.glsl"
 #include "common/output_encoding.glsl"
 
-const int BACKGROUND_ENV = 0;
-const int BACKGROUND_BLUR = 1;
-const int BACKGROUND_COLOR = 2;
+#define BACKGROUND_ENV 0
+#define BACKGROUND_BLUR 1
+#define BACKGROUND_COLOR 2
+// The mode is compiled in (app/renderer.py sets it): llvmpipe runs both sides of a branch, so a
+// uniform mode would cost the sharp and the blurred fetch at every pixel.
+#ifndef BACKGROUND_MODE
+#define BACKGROUND_MODE BACKGROUND_ENV
+#endif
 
-in vec2 v_ndc;
+in vec3 v_ray;    // render/background.vert: world-space, not normalised
 
-uniform int u_mode;
-uniform mat4 u_inverse_view_projection;
 uniform samplerCube u_environment;            // the source cube (sharp)
 uniform samplerCube u_prefiltered_radiance;   // for the blurred background
 uniform float u_blur_mip;
@@ -23,15 +26,15 @@ uniform vec3 u_color;
 layout(location = 0) out vec4 out_radiance;
 
 void main() {
-    if (u_mode == BACKGROUND_COLOR) {
-        out_radiance = encode_output(u_color, 0.0);
-        return;
-    }
-    vec4 near = u_inverse_view_projection * vec4(v_ndc, -1.0, 1.0);
-    vec4 far = u_inverse_view_projection * vec4(v_ndc, 1.0, 1.0);
-    vec3 d = rotate_world_to_map(normalize(far.xyz / far.w - near.xyz / near.w), u_env_rotation);
-    vec3 radiance = u_mode == BACKGROUND_BLUR
-        ? textureLod(u_prefiltered_radiance, d, u_blur_mip).rgb
-        : textureLod(u_environment, d, 0.0).rgb;
+#if BACKGROUND_MODE == BACKGROUND_COLOR
+    out_radiance = encode_output(u_color, 0.0);
+#else
+    vec3 d = rotate_world_to_map(normalize(v_ray), u_env_rotation);
+#if BACKGROUND_MODE == BACKGROUND_BLUR
+    vec3 radiance = textureLod(u_prefiltered_radiance, d, u_blur_mip).rgb;
+#else
+    vec3 radiance = textureLod(u_environment, d, 0.0).rgb;
+#endif
     out_radiance = encode_output(u_env_intensity * radiance, 0.0);
+#endif
 }
