@@ -337,3 +337,33 @@ def test_adaptive_scale_follows_the_frame_time(window):
     window.frame()                                       # still: full size
     assert window.renderer._targets.width == window.view_area()[0]
     s.adaptive_motion = False
+
+
+def test_built_in_file_browser(window, tmp_path):
+    """Where no native dialog exists the panel's browser is an imgui window: it lists folders
+    and the files of the asked types, and a pick goes to the caller (here: the texture slot)."""
+    from app.editor.file_browser import FileBrowser
+    from app.output import write_image
+
+    (tmp_path / "sub").mkdir()
+    (tmp_path / ".hidden.png").write_bytes(b"x")
+    (tmp_path / "notes.txt").write_text("x")
+    image = tmp_path / "grey.png"
+    write_image(str(image), np.full((8, 8, 3), 128, np.uint8), linear=False)
+    browser = window.panel.browser = FileBrowser(native=False)
+    picked = []
+    browser.open("load base colour map", (".png",), picked.append, start=str(image))
+    assert browser.visible and browser.directory == tmp_path.resolve()
+    assert browser.entries() == (["sub"], ["grey.png"])
+    window.frame()                                   # drawn as an imgui window, the editor runs on
+    window.frame()
+    assert browser.visible and not picked
+    browser.pick(str(image))
+    assert picked == [str(image)] and not browser.busy
+    # The panel's own use: a pick fills the slot it was opened for.
+    s = window.state
+    browser.open("load roughness map", (".png",), lambda p: s.set_map("roughness", p))
+    browser.pick(str(image))
+    assert s.texture_maps.roughness == str(image)
+    s.clear_map("roughness")
+    window.frame()
