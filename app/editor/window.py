@@ -90,7 +90,7 @@ class EditorWindow:
         self.bake_progress = None      # (fraction, label) while a bake runs; the panel shows it
         self._last_swap = None
         self._framed_mesh = None
-        self._drawn_key = self._drawn_targets = self._last_camera = None
+        self._drawn_key = self._drawn_targets = self._last_camera = self._drawn_maps = None
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
@@ -196,7 +196,7 @@ class EditorWindow:
         except StopIteration as done:
             self._maps, self._maps_key = done.value, key
             self.bake_seconds = dict(done.value.pass_seconds)
-        except AlightError as exc:
+        except Exception as exc:    # one line in the panel; the editor keeps the old maps
             self.state.fail(exc)
             self._maps_key = key    # not retried until the environment or quality changes
         self._bake_job, self.bake_progress = None, None
@@ -272,6 +272,9 @@ class EditorWindow:
                 return None
             self._drawn_key, self._drawn_targets = key, targets
             self.redraws += 1
+            if scene.texture_maps != self._drawn_maps:   # uploaded maps no slot uses any more
+                self.renderer.forget_map_textures(set(scene.texture_maps.paths().values()))
+                self._drawn_maps = scene.texture_maps
         if size == window:
             self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
         else:
