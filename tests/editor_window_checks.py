@@ -219,9 +219,9 @@ def test_view_is_redrawn_only_when_needed_and_reduced_while_moving(window):
     window.orbit.orbit(10.0, 0.0)
     window.frame()
     assert window.redraws == still + 1
-    assert window.renderer._targets.width == round(window.view_area()[0] * 0.5)   # drawn reduced while moving
+    assert window._drawn_targets.width == round(window.view_area()[0] * 0.5)   # drawn reduced while moving
     window.frame()                                      # the camera stopped: redrawn sharp
-    assert window.redraws == still + 2 and window.renderer._targets.width == window.view_area()[0]
+    assert window.redraws == still + 2 and window._drawn_targets.width == window.view_area()[0]
     s.motion_scale = 1.0
 
 
@@ -314,7 +314,8 @@ def test_adaptive_scale_follows_the_frame_time(window):
     s = window.state
     s.adaptive_motion = True
     window.adaptive_scale = 1.0
-    window.frame_times.append(0.5)                      # a 2 FPS frame
+    window.frame_times.clear()
+    window.frame_times.extend([0.5, 0.5, 0.5])          # 2 FPS frames
     window.adapt_motion_scale()
     assert window.adaptive_scale == 1.0 - ADAPTIVE_STEP  # one step per frame, not a jump
     for _ in range(40):
@@ -325,7 +326,7 @@ def test_adaptive_scale_follows_the_frame_time(window):
         window.frame_times.append(0.001)                 # far faster than the target
         window.adapt_motion_scale()
     assert window.adaptive_scale == 1.0
-    window.frame_times.append(1.0 / 30.0)                # on target: stays
+    window.frame_times.extend([1.0 / 30.0] * 3)          # on target: stays
     window.adapt_motion_scale()
     assert window.adaptive_scale == 1.0
     window.adaptive_scale = 0.5
@@ -333,9 +334,9 @@ def test_adaptive_scale_follows_the_frame_time(window):
     window.frame()
     window.orbit.orbit(5.0, 0.0)
     window.frame()                                       # moving: drawn reduced
-    assert window.renderer._targets.width < window.view_area()[0]
+    assert window._drawn_targets.width < window.view_area()[0]
     window.frame()                                       # still: full size
-    assert window.renderer._targets.width == window.view_area()[0]
+    assert window._drawn_targets.width == window.view_area()[0]
     s.adaptive_motion = False
 
 

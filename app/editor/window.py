@@ -36,6 +36,7 @@ PANEL_WIDTH = 420
 # this rate, in steps (a new size reallocates the view's targets), between these bounds.
 TARGET_FPS = 30.0
 ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP = 0.25, 1.0 / 16.0
+TARGET_CACHE = 4   # view framebuffers kept, by size
 
 
 class EditorWindow:
@@ -91,6 +92,7 @@ class EditorWindow:
         self._last_swap = None
         self._framed_mesh = None
         self._drawn_key = self._drawn_targets = self._last_camera = self._drawn_maps = None
+        self._target_cache: collections.OrderedDict = collections.OrderedDict()
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
@@ -208,12 +210,13 @@ class EditorWindow:
             self.advance_bake(float("inf"))
 
     def adapt_motion_scale(self) -> None:
-        """Move the adaptive scale toward TARGET_FPS from the last frame's time (swap to swap):
+        """Move the adaptive scale toward TARGET_FPS from the last frames' time (swap to swap):
         the scene's cost is per pixel, so the scale goes with the square root of the time ratio,
         by at most one step a frame; the still view is always redrawn at full scale."""
         if not self.frame_times:
             return
-        ratio = (1.0 / TARGET_FPS) / max(self.frame_times[-1], 1e-6)
+        recent = sorted(list(self.frame_times)[-3:])   # the median of the last three: one slow frame is no trend
+        ratio = (1.0 / TARGET_FPS) / max(recent[len(recent) // 2], 1e-6)
         want = self.adaptive_scale * ratio ** 0.5
         if abs(want - self.adaptive_scale) >= ADAPTIVE_STEP:
             step = ADAPTIVE_STEP if want > self.adaptive_scale else -ADAPTIVE_STEP
@@ -228,8 +231,17 @@ class EditorWindow:
         return max(1, round(w * scale)), max(1, round(h * scale))
 
     def targets(self, size=None):
+        """The view's framebuffers for a size, kept for the last few sizes: the adaptive scale
+        moves between neighbouring sizes, and a reallocation per change would cost frame time."""
+        from app.renderer import _Targets
+
         w, h = size or self.size
-        return self.renderer._targets_for(w, h, self.state.aa, 4)
+        key = (w, h, self.state.aa)
+        targets = self._target_cache.pop(key, None) or _Targets(self.ctx, w, h, self.state.aa, 4)
+        self._target_cache[key] = targets
+        while len(self._target_cache) > TARGET_CACHE:
+            self._target_cache.popitem(last=False)[1].release()
+        return targets
 
     def _view_key(self, scene, maps, size) -> tuple:
         """Everything the view image depends on. Material, Camera, Light and Display are plain
@@ -351,6 +363,9 @@ class EditorWindow:
         return bool(self.glfw.window_should_close(self.window))
 
     def close(self) -> None:
+        for targets in self._target_cache.values():
+            targets.release()
+        self._target_cache.clear()
         self.impl.shutdown()
         self.implot.destroy_context()
         self.imgui.destroy_context()
