@@ -286,6 +286,18 @@ def bake_environment(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environ
     return run_to_completion(bake_steps(ctx, shaders, env, quality, luts))
 
 
+# Prefilter levels at least this size are dispatched two faces at a time in bake_steps, and
+# one at a time from twice the size (the medium bake's first level, all six faces, took about
+# 0.3 s on a loaded 2-core llvmpipe: a visible stall in the editor).
+PREFILTER_SPLIT_SIZE = 64
+
+
+def _set_uniform(prog, name: str, value) -> None:
+    member = prog.get(name, None)
+    if member is not None:
+        member.value = value
+
+
 def run_to_completion(steps):
     """Drive a step generator (``bake_steps``) to its end; its return value."""
     while True:
@@ -356,28 +368,36 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
         owned.append(prefiltered_mid)
 
         for step in range(prefilter_steps):
-            def prefilter(step=step):
-                prog = shaders.compute("bake/prefilter.comp")
-                lighting.use(0)
-                prog["u_environment"] = 0
-                _set_suns(prog, suns)
-                target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
-                size = target.size[0] >> mip
-                roughness = grid_roughness(step, levels)
-                total = q.prefilter_samples_at(step)
-                sample_set = prefilter_sample_set(roughness, total, q.cube_size, q.lod_bias,
-                                                  q.filtered_importance_sampling)
-                buffer = ctx.buffer(sample_set.tobytes())
-                buffer.bind_to_storage_buffer(1)
-                prog["u_size"] = size
-                prog["u_sample_count"] = len(sample_set)
-                prog["u_sample_total"] = float(total)
-                prog["u_roughness"] = roughness
-                _dispatch_faces(ctx, prog, target, size, mip)
-                buffer.release()
+            target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
+            size = target.size[0] >> mip
+            # The big levels go a few faces at a time, so that no step holds a frame long.
+            faces = 6 if size < PREFILTER_SPLIT_SIZE else 2 if size < 2 * PREFILTER_SPLIT_SIZE else 1
+            for first in range(0, 6, faces):
+                def prefilter(step=step, target=target, mip=mip, size=size, first=first):
+                    prog = shaders.compute("bake/prefilter.comp")
+                    lighting.use(0)
+                    prog["u_environment"] = 0
+                    _set_suns(prog, suns)
+                    roughness = grid_roughness(step, levels)
+                    total = q.prefilter_samples_at(step)
+                    sample_set = prefilter_sample_set(roughness, total, q.cube_size, q.lod_bias,
+                                                      q.filtered_importance_sampling)
+                    buffer = ctx.buffer(sample_set.tobytes())
+                    buffer.bind_to_storage_buffer(1)
+                    prog["u_size"] = size
+                    prog["u_sample_count"] = len(sample_set)
+                    prog["u_sample_total"] = float(total)
+                    prog["u_roughness"] = roughness
+                    _set_uniform(prog, "u_face_offset", first)
+                    target.bind_to_image(0, read=False, write=True, level=mip)
+                    prog.run(_groups(size), _groups(size), faces)
+                    ctx.memory_barrier()
+                    buffer.release()
 
-            _timed(ctx, seconds, "prefilter", prefilter)
-            yield progress(2, f"prefilter {step + 1}/{prefilter_steps}")
+                _timed(ctx, seconds, "prefilter", prefilter)
+                yield progress(2.0 * faces / 6, f"prefilter {step + 1}/{prefilter_steps}"
+                               + (f" (faces {first + 1}-{first + faces})" if faces > 1 and faces < 6 else
+                                  f" (face {first + 1})" if faces == 1 else ""))
         if lighting is not source:
             owned.remove(lighting)
             lighting.release()
