@@ -90,6 +90,9 @@ def _add_bake_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--ibl", choices=tuple(IBL_MODELS), default=DEFAULT_IBL_MODEL,
                    help="IBL shading model (app/ibl_models.py): 'lecture' is the seed lecture's split sum "
                         f"(default: {DEFAULT_IBL_MODEL})")
+    g.add_argument("--multiple-scattering", action="store_true",
+                   help="add the energy that single scattering loses on rough surfaces (Fdez-Aguera 2019): "
+                        "a white furnace then gives 1, but the result leaves CONVENTIONS.md's single-scattering truth")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -329,7 +332,8 @@ def _render(args) -> int:
     scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
                   material_overrides=overrides, lights=lights, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
-                  ibl_enabled=env is not None, ibl_model=args.ibl, display=display)
+                  ibl_enabled=env is not None, ibl_model=args.ibl,
+                  multiple_scattering=args.multiple_scattering, display=display)
     loaded = time.perf_counter()
 
     from app.bake import quality_named
