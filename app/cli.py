@@ -403,11 +403,17 @@ def _bake(args) -> int:
         cube = maps.prefiltered_radiance if step % 2 == 0 else maps.prefiltered_radiance_mid
         save(f"prefiltered_step{step:02d}_r{grid_roughness(step, levels):.3f}",
              _cube_as_equirect(renderer, cube, float(step // 2), w))
-    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 2)[::-1]
-    lut_rgb = np.concatenate([lut, np.zeros(lut.shape[:2] + (1,), np.float32)], axis=2)
-    write_image(out_dir / "brdf_lut.exr", lut_rgb, linear=True)
-    # The LUT is already in [0,1]: shown as is (red = scale A, green = bias B; n.v right, roughness up).
-    write_image(out_dir / "brdf_lut.png", (linear_to_srgb(lut_rgb) * 255.0 + 0.5).astype(np.uint8), linear=False)
+    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 4)[::-1]
+    zero = np.zeros(lut.shape[:2] + (1,), np.float32)
+    # The LUT is already in [0,1]: shown as is (n.v right, roughness up). brdf_lut: red = scale A,
+    # green = bias B; brdf_lut_directions: red = t_A, green = t_B (brdf_lut.comp).
+    for name, rg in (("brdf_lut", lut[..., :2]), ("brdf_lut_directions", lut[..., 2:])):
+        rgb = np.concatenate([rg, zero], axis=2)
+        write_image(out_dir / f"{name}.exr", rgb, linear=True)
+        write_image(out_dir / f"{name}.png", (linear_to_srgb(rgb) * 255.0 + 0.5).astype(np.uint8), linear=False)
+    if maps.suns:
+        print(f"{len(maps.suns)} compact source(s) ({', '.join(f'{100 * s.fraction:.0f}%' for s in maps.suns)} of the "
+              "power) are not in the irradiance and prefiltered maps: the forward pass adds them per pixel")
     for name, seconds in maps.pass_seconds.items():
         print(f"{name}: {seconds * 1000:.1f} ms")
     print(out_dir)
