@@ -159,8 +159,8 @@ def test_other_renderers_in_the_process_are_not_disturbed():
 def test_ibl_model_is_chosen_by_name_and_changes_the_image(shared_data):
     with AlightRenderer(48, quality="low") as r:
         r.set_environment(str(shared_data / "env" / "quarry_01_1k.hdr")).set_material("gold").set_view("probe")
-        default = r.render().linear
-        lecture = r.set_ibl_model("lecture").render().linear
+        default = r.render(linear=True)
+        lecture = r.set_ibl_model("lecture").render(linear=True)
         assert r.bakes_done == 1                       # a model is a shader choice, not a bake
         assert np.abs(default - lecture).max() > 0.05
         with pytest.raises(AlightError, match="ibl model"):
