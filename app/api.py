@@ -168,6 +168,18 @@ class AlightRenderer:
         self.scene.view = view
         return self
 
+    def set_ibl_model(self, model: str, *, multiple_scattering: bool | None = None) -> "AlightRenderer":
+        """An IBL model of app/ibl_models.py ('alight' by default, 'lecture' for the seed lecture's
+        split sum), and optionally Fdez-Aguera's multiple-scattering compensation."""
+        from app.ibl_models import IBL_MODELS
+
+        if model not in IBL_MODELS:
+            raise AlightError(f"ibl model: {model!r} is not one of {', '.join(IBL_MODELS)}")
+        self.scene.ibl_model = model
+        if multiple_scattering is not None:
+            self.scene.multiple_scattering = bool(multiple_scattering)
+        return self
+
     def set_display(self, *, tonemap: str | None = None, exposure: float | None = None,
                     background: str | None = None) -> "AlightRenderer":
         d = self.scene.display

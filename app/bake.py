@@ -22,7 +22,7 @@ import numpy as np
 
 from app.gpu import ShaderLibrary
 from app.shading import D_GGX, hammersley, importance_sample_ggx_tangent
-from app.sun import MAX_SUNS, Sun, extract_suns
+from app.sun import Sun, extract_suns
 from app.output import atomic_path
 from app.paths import cache_dir
 
@@ -153,10 +153,14 @@ class IBLMaps:
     irradiance: moderngl.TextureCube         # E/pi
     prefiltered_radiance: moderngl.TextureCube       # grid A (see grid_roughness)
     prefiltered_radiance_mid: moderngl.TextureCube   # grid B
-    brdf_lut: moderngl.Texture               # RG: (A, B)
+    brdf_lut: moderngl.Texture               # RGBA: (A, B, t_A, t_B), see brdf_lut.comp
     quality: BakeQuality
     pass_seconds: dict[str, float] = field(default_factory=dict)
-    suns: list[Sun] = field(default_factory=list)   # compact sources handled in closed form
+    # Compact bright sources (app/sun.py): not in the irradiance and prefiltered maps; the forward
+    # pass adds them exactly. sun_prefilter_scale[step]: what a delta source of power P adds to
+    # that roughness step of the prefiltered map per unit P (n.l) D(h) (prefilter.glsl).
+    suns: list[Sun] = field(default_factory=list)
+    sun_prefilter_scale: list[float] = field(default_factory=list)
 
     @property
     def prefiltered_max_mip(self) -> float:
@@ -236,7 +240,7 @@ class LutCache:
         table = None
         try:
             loaded = np.load(path, allow_pickle=False)
-            if loaded.shape == (size, size, 2) and loaded.dtype == np.float32 and np.isfinite(loaded).all():
+            if loaded.shape == (size, size, 4) and loaded.dtype == np.float32 and np.isfinite(loaded).all():
                 table = loaded
         except (OSError, ValueError):
             table = None
@@ -246,7 +250,7 @@ class LutCache:
         else:
             self.last_source = "baked"
             tex = self._bake(size, samples)
-            table = np.frombuffer(tex.read(), dtype=np.float32).reshape(size, size, 2)
+            table = np.frombuffer(tex.read(), dtype=np.float32).reshape(size, size, 4)
             try:
                 os.makedirs(path.parent, exist_ok=True)
                 with atomic_path(path) as tmp:
@@ -259,13 +263,13 @@ class LutCache:
 
     def _upload(self, table: np.ndarray) -> moderngl.Texture:
         size = table.shape[0]
-        tex = self.ctx.texture((size, size), 2, table.tobytes(), dtype="f4")
+        tex = self.ctx.texture((size, size), 4, table.tobytes(), dtype="f4")
         tex.repeat_x = tex.repeat_y = False
         tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
         return tex
 
     def _bake(self, size: int, samples: int) -> moderngl.Texture:
-        tex = self._upload(np.zeros((size, size, 2), np.float32))
+        tex = self._upload(np.zeros((size, size, 4), np.float32))
         prog = self.shaders.compute("bake/brdf_lut.comp")
         prog["u_size"] = size
         prog["u_samples"] = samples
@@ -333,7 +337,7 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
         yield progress(1, "suns")
 
         # The environment as seen (background, mirror) keeps its sun; the lighting passes read a
-        # copy without it and add the sun back in closed form.
+        # copy without it, and the forward pass adds the sun back exactly (shaders/common/ibl.glsl).
         source = yield from _source_cube_steps(ctx, shaders, env.radiance, q, seconds, "environment", owned,
                                                progress)
         lighting = source
@@ -352,12 +356,11 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
                 prog["u_phi_steps"] = q.irradiance_phi_steps
                 prog["u_theta_steps"] = q.irradiance_theta_steps
                 prog["u_source_mip"] = max(0.0, math.log2(q.cube_size / q.irradiance_source_size))
-                _set_suns(prog, suns)
                 _dispatch_faces(ctx, prog, irradiance, q.irradiance_size)
             _timed(ctx, seconds, "irradiance_convolution", convolve)
         elif q.irradiance == "sh9":
             _timed(ctx, seconds, "irradiance_sh9",
-                   lambda: _irradiance_sh9(ctx, shaders, lighting_radiance, irradiance, q, suns))
+                   lambda: _irradiance_sh9(ctx, shaders, lighting_radiance, irradiance, q))
         else:
             raise ValueError(f"unknown irradiance method {q.irradiance!r}")
         yield progress(2, "irradiance")
@@ -367,6 +370,7 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
         prefiltered_mid = _cube(ctx, q.prefiltered_size // 2, levels - 1)
         owned.append(prefiltered_mid)
 
+        sun_scale: list[float] = []
         for step in range(prefilter_steps):
             target, mip = (prefiltered, step // 2) if step % 2 == 0 else (prefiltered_mid, step // 2)
             size = target.size[0] >> mip
@@ -377,7 +381,6 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
                     prog = shaders.compute("bake/prefilter.comp")
                     lighting.use(0)
                     prog["u_environment"] = 0
-                    _set_suns(prog, suns)
                     roughness = grid_roughness(step, levels)
                     total = q.prefilter_samples_at(step)
                     sample_set = prefilter_sample_set(roughness, total, q.cube_size, q.lod_bias,
@@ -386,8 +389,10 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
                     buffer.bind_to_storage_buffer(1)
                     prog["u_size"] = size
                     prog["u_sample_count"] = len(sample_set)
-                    prog["u_sample_total"] = float(total)
-                    prog["u_roughness"] = roughness
+                    if first == 0:
+                        # What a delta source of power P adds to this step's sum per unit P (n.l) D(h):
+                        # the forward pass adds compact sources with it (prefilter.glsl says why).
+                        sun_scale.append(0.25 * total / max(float(sample_set[:, 2].sum()), 1e-8))
                     _set_uniform(prog, "u_face_offset", first)
                     target.bind_to_image(0, read=False, write=True, level=mip)
                     prog.run(_groups(size), _groups(size), faces)
@@ -409,17 +414,8 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
         for tex in owned:
             tex.release()
         raise
-    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns)
+    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns, sun_scale)
 
-
-def _set_suns(prog, suns: list[Sun]) -> None:
-    directions = np.zeros((MAX_SUNS, 3), np.float32)
-    powers = np.zeros((MAX_SUNS, 3), np.float32)
-    for i, sun in enumerate(suns[:MAX_SUNS]):
-        directions[i], powers[i] = sun.direction, sun.power
-    prog["u_sun_count"] = len(suns[:MAX_SUNS])
-    prog["u_sun_direction"].write(directions.tobytes())
-    prog["u_sun_power"].write(powers.tobytes())
 
 
 def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuality,
@@ -463,7 +459,7 @@ def _source_cube_steps(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: Bak
     return cube
 
 
-def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuality, suns: list[Sun]) -> None:
+def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuality) -> None:
     h, w, _ = radiance.shape
     equirect_tex = upload_equirect(ctx, radiance, mipmaps=True)
     level = max(0, int(round(math.log2(max(1, w // q.sh9_source_width)))))
@@ -481,8 +477,6 @@ def _irradiance_sh9(ctx, shaders, radiance: np.ndarray, irradiance, q: BakeQuali
     coeffs = np.frombuffer(partials.read(), dtype=np.float32).reshape(gx * gy, 9, 4)[:, :, :3].sum(axis=0)
     partials.release()
     equirect_tex.release()
-    for sun in suns:
-        coeffs = coeffs + sh9_basis(sun.direction)[:, None] * sun.power[None, :]
     fill = shaders.compute("bake/sh9_to_cube.comp")
     fill["u_size"] = q.irradiance_size
     fill["u_coeffs"].write(np.ascontiguousarray(coeffs, dtype=np.float32).tobytes())

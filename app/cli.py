@@ -90,6 +90,9 @@ def _add_bake_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--ibl", choices=tuple(IBL_MODELS), default=DEFAULT_IBL_MODEL,
                    help="IBL shading model (app/ibl_models.py): 'lecture' is the seed lecture's split sum "
                         f"(default: {DEFAULT_IBL_MODEL})")
+    g.add_argument("--multiple-scattering", action="store_true",
+                   help="add the energy that single scattering loses on rough surfaces (Fdez-Aguera 2019): "
+                        "a white furnace then gives 1, but the result leaves CONVENTIONS.md's single-scattering truth")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -329,7 +332,8 @@ def _render(args) -> int:
     scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
                   material_overrides=overrides, lights=lights, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
-                  ibl_enabled=env is not None, ibl_model=args.ibl, display=display)
+                  ibl_enabled=env is not None, ibl_model=args.ibl,
+                  multiple_scattering=args.multiple_scattering, display=display)
     loaded = time.perf_counter()
 
     from app.bake import quality_named
@@ -399,11 +403,17 @@ def _bake(args) -> int:
         cube = maps.prefiltered_radiance if step % 2 == 0 else maps.prefiltered_radiance_mid
         save(f"prefiltered_step{step:02d}_r{grid_roughness(step, levels):.3f}",
              _cube_as_equirect(renderer, cube, float(step // 2), w))
-    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 2)[::-1]
-    lut_rgb = np.concatenate([lut, np.zeros(lut.shape[:2] + (1,), np.float32)], axis=2)
-    write_image(out_dir / "brdf_lut.exr", lut_rgb, linear=True)
-    # The LUT is already in [0,1]: shown as is (red = scale A, green = bias B; n.v right, roughness up).
-    write_image(out_dir / "brdf_lut.png", (linear_to_srgb(lut_rgb) * 255.0 + 0.5).astype(np.uint8), linear=False)
+    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 4)[::-1]
+    zero = np.zeros(lut.shape[:2] + (1,), np.float32)
+    # The LUT is already in [0,1]: shown as is (n.v right, roughness up). brdf_lut: red = scale A,
+    # green = bias B; brdf_lut_directions: red = t_A, green = t_B (brdf_lut.comp).
+    for name, rg in (("brdf_lut", lut[..., :2]), ("brdf_lut_directions", lut[..., 2:])):
+        rgb = np.concatenate([rg, zero], axis=2)
+        write_image(out_dir / f"{name}.exr", rgb, linear=True)
+        write_image(out_dir / f"{name}.png", (linear_to_srgb(rgb) * 255.0 + 0.5).astype(np.uint8), linear=False)
+    if maps.suns:
+        print(f"{len(maps.suns)} compact source(s) ({', '.join(f'{100 * s.fraction:.0f}%' for s in maps.suns)} of the "
+              "power) are not in the irradiance and prefiltered maps: the forward pass adds them per pixel")
     for name, seconds in maps.pass_seconds.items():
         print(f"{name}: {seconds * 1000:.1f} ms")
     print(out_dir)

@@ -193,6 +193,83 @@ def brdf_lut_converged(n_dot_v, roughness, n_u: int = 512, n_phi: int = 128):
     return A.reshape(shape), B.reshape(shape)
 
 
+def lobe_directions_converged(n_dot_v, roughness, n_u: int = 512, n_phi: int = 128):
+    """Numpy twin of brdf_lut.comp's t_A and t_B: where the specular lobe points.
+
+    The lobe f (n.l) over l, split like A and B into its (1 - Fc) and Fc parts, has a mean
+    vector m (the integral of the lobe times l); t is the lerp factor with
+    normalize(mix(n, R, t)) on m's angle from n toward R: tan(phi) = t sin / (1 - t + t cos),
+    clamped to [0, 1], and 1 at n.v = 1 (R = n). Same midpoint grid and guards as
+    ``brdf_lut_converged``. Returns (t_A, t_B) of the broadcast shape.
+    """
+    nv, r = np.broadcast_arrays(np.asarray(n_dot_v, dtype=np.float64), np.asarray(roughness, dtype=np.float64))
+    shape = nv.shape
+    nv = np.clip(nv.reshape(-1), 1e-4, 1.0)
+    r = np.clip(r.reshape(-1), 0.0, 1.0)
+    sg = (np.arange(n_u) + 0.5) / n_u
+    u = 1.0 - (1.0 - sg) ** 2
+    wu = 2.0 * (1.0 - sg) / n_u
+    phi = (np.arange(n_phi) + 0.5) * (PI / n_phi)
+    cphi = np.cos(phi)
+    out = np.empty((2, nv.shape[0]))
+    for i in range(nv.shape[0]):
+        a2 = r[i] ** 4
+        cos_t = np.sqrt((1.0 - u) / (1.0 + (a2 - 1.0) * u))
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+        vx, vz = np.sqrt(1.0 - nv[i] * nv[i]), nv[i]
+        hx = sin_t[:, None] * cphi[None, :]
+        hz = np.broadcast_to(cos_t[:, None], hx.shape)
+        vh = vx * hx + vz * hz
+        lx = 2.0 * vh * hx - vx   # l = 2 (v.h) h - v; its y part averages out over phi
+        nl = 2.0 * vh * hz - vz
+        ok = nl > 0.0
+        nl_s = np.where(ok, nl, 1.0)
+        vh_c = np.clip(vh, 0.0, 1.0)
+        g = G_Smith(vz, nl_s, k_ibl(r[i]))
+        g_vis = np.where(ok, g * vh_c / (hz * vz), 0.0) * wu[:, None]
+        fc = (1.0 - vh_c) ** 5
+        sin_v = np.sqrt(max(1.0 - vz * vz, 0.0))
+        for j, w in enumerate(((1.0 - fc) * g_vis, fc * g_vis)):
+            toward_r = float(np.sum(w * -lx))
+            along_n = float(np.sum(w * np.where(ok, nl, 0.0)))
+            if sin_v < 1e-4 or along_n <= 0.0:
+                out[j, i] = 1.0
+                continue
+            tan_phi = max(toward_r, 0.0) / along_n
+            out[j, i] = np.clip(tan_phi / (sin_v + tan_phi * (1.0 - vz)), 0.0, 1.0)
+    return out[0].reshape(shape), out[1].reshape(shape)
+
+
+# ibl.glsl's diffuse_fresnel: a quartic in 1 - n.v fitted to diffuse_fresnel_converged.
+DIFFUSE_FRESNEL_COEFFS = (8.233601e-05, 0.002021979, 0.009310647, 0.007795988, 0.0089526)
+
+
+def diffuse_fresnel(n_dot_v):
+    """Numpy twin of ibl.glsl's diffuse_fresnel (the fit)."""
+    x = 1.0 - np.asarray(n_dot_v, dtype=np.float64)
+    return np.polynomial.polynomial.polyval(x, DIFFUSE_FRESNEL_COEFFS)
+
+
+def diffuse_fresnel_converged(n_dot_v, n_theta: int = 600, n_phi: int = 600):
+    """(1/pi) * integral over the hemisphere of (1 - v.h)^5 (n.l) dl, by a midpoint rule in
+    (theta_l, phi_l): the Fresnel part of the Lambert lobe under uniform light. Independent of
+    the roughness, since h = normalize(l + v)."""
+    nv = np.atleast_1d(np.asarray(n_dot_v, dtype=np.float64))
+    th = (np.arange(n_theta) + 0.5) * (0.5 * PI / n_theta)
+    ph = (np.arange(n_phi) + 0.5) * (2.0 * PI / n_phi)
+    st, ct = np.sin(th)[:, None], np.cos(th)[:, None]
+    lx, ly, lz = st * np.cos(ph)[None, :], st * np.sin(ph)[None, :], np.broadcast_to(ct, (n_theta, n_phi))
+    w = st * (0.5 * PI / n_theta) * (2.0 * PI / n_phi)
+    out = np.empty(nv.shape[0])
+    for i, c in enumerate(np.clip(nv, 1e-4, 1.0)):
+        vx, vz = np.sqrt(1.0 - c * c), c
+        # v.h = (1 + l.v) / |l + v| = sqrt((1 + l.v) / 2)
+        vh = np.sqrt(np.maximum(0.5 * (1.0 + lx * vx + lz * vz), 0.0))
+        out[i] = float(np.sum((1.0 - vh) ** 5 * lz * w)) / PI
+    del ly
+    return out.reshape(np.shape(n_dot_v))
+
+
 def split_sum_converged(radiance, normals, view, base_color, metallic, roughness, specular_f0) -> np.ndarray:
     """The lecture's ``cook_torrance_IBL`` ambient term with converged parts, (P, 3) float64.
 
@@ -216,6 +293,86 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
     A, B = brdf_lut_converged(nv, r)
     specular = prefiltered_converged(radiance, R, r) * (F * A[:, None] + B[:, None])
     return diffuse + specular
+
+
+def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
+                  multiple_scattering: bool = False) -> np.ndarray:
+    """What the forward pass's IBL model ``model`` (app/ibl_models.py) tends to with a converged
+    bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
+
+    The compact sources are taken out of ``radiance`` as the bake does (``app.sun.extract_suns``);
+    the models in SUNS_AS_BAKED see them as if filtered into the maps (the converged texel sums of
+    the whole map), ``alight`` shades them as delta lights through the exact BRDF. ``lecture`` is
+    ``split_sum_converged``. Roughness must be >= MIN_PREFILTER_ROUGHNESS for the non-lecture
+    models (the sun's mirror image below the grid is the source cube's business, not this twin's).
+    """
+    from .ibl_models import IBL_MODELS, SUNS_AS_BAKED
+    from .sun import extract_suns
+
+    if model not in IBL_MODELS:
+        raise ValueError(f"unknown IBL model '{model}'")
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    r = float(roughness)
+    m = float(metallic)
+    base = np.asarray(base_color, dtype=np.float64)
+    f0 = f0_of(base, m, np.asarray(specular_f0, dtype=np.float64))
+    nv = np.maximum(np.sum(n * v, axis=-1), 0.0)
+    A, B = brdf_lut_converged(nv, r)
+    A, B = A[:, None], B[:, None]
+    R = reflect(-v, n)
+    rad = np.asarray(radiance, dtype=np.float32)
+    suns = []
+    if model in SUNS_AS_BAKED:
+        lighting = rad
+    else:
+        lighting, suns = extract_suns(rad)
+    if model in ("lecture", "lecture-schlick"):
+        F = F_SchlickRoughness(nv, f0, r) if model == "lecture" else f0 + (1.0 - f0) * ((1.0 - nv) ** 5)[:, None]
+        diffuse_weight, spec_weight, direction = 1.0 - F, F * A + B, R
+    else:
+        diffuse_weight = (1.0 - f0) * (1.0 - diffuse_fresnel(nv))[:, None]
+        spec_weight = f0 * A + B
+        direction = R
+        if model in ("dominant", "alight"):
+            t_a, t_b = lobe_directions_converged(nv, r)
+            weight_a = float(np.dot(f0, (0.2126, 0.7152, 0.0722))) * A[:, 0]
+            t = (weight_a * t_a + B[:, 0] * t_b) / np.maximum(weight_a + B[:, 0], 1e-6)
+            direction = _unit_rows(n + t[:, None] * (R - n))
+    irradiance = irradiance_converged(lighting, n)
+    prefiltered = prefiltered_converged(lighting, direction, r)
+    albedo = base * (1.0 - m)
+    if multiple_scattering:
+        e_ss = A + B
+        e_ms = 1.0 - e_ss
+        f_avg = f0 + (1.0 - f0) / 21.0
+        f_ms = spec_weight * f_avg / (1.0 - e_ms * f_avg)
+        out = spec_weight * prefiltered + (f_ms * e_ms + albedo * (1.0 - (spec_weight + f_ms * e_ms))) * irradiance
+    else:
+        out = diffuse_weight * albedo * irradiance + spec_weight * prefiltered
+    for sun in suns:
+        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r)
+    return out
+
+
+def _sun_exact(n, v, l, power, base, metallic, f0, roughness):
+    """ibl.glsl's sun_light: the exact BRDF (IBL k, F at v.h) times a delta of power P."""
+    l = np.asarray(l, dtype=np.float64)
+    nl = n @ l
+    nv = np.maximum(np.sum(n * v, axis=-1), 1e-4)
+    h = _unit_rows(l[None, :] + v)
+    nh = np.clip(np.sum(n * h, axis=-1), 0.0, 1.0)
+    vh = np.clip(np.sum(v * h, axis=-1), 0.0, 1.0)
+    rr = max(roughness, 0.045)
+    a2 = rr ** 4
+    D = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0) ** 2)
+    nlc = np.maximum(nl, 0.0)
+    k = k_ibl(rr)
+    G = G_Smith(nv, np.where(nl > 0, nl, 1.0), k)
+    F = f0 + (1.0 - f0) * ((1.0 - vh) ** 5)[:, None]
+    spec = (D * G / (4.0 * np.where(nl > 0, nl, 1.0) * nv))[:, None] * F
+    diffuse = (1.0 - F) * (1.0 - metallic) * base / PI
+    return np.where((nl > 0)[:, None], (diffuse + spec) * nlc[:, None] * np.asarray(power)[None, :], 0.0)
 
 
 def downsample_equirect(radiance, factor: int) -> np.ndarray:

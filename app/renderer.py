@@ -19,11 +19,14 @@ from app.ibl_models import ibl_model_index
 from app.material import Material
 from app.mesh import is_closed
 from app.scene import BACKGROUNDS, TONEMAPS, Camera, Display, Scene, frame_camera
+from app.shading import rotate_world_to_map
+from app.sun import MAX_SUNS
 from app.texture_maps import TextureMaps
 
 GL_SRGB8_ALPHA8 = 0x8C43
 AA_MODES = ("none", "msaa", "ssaa")
 MAX_LIGHTS = 16   # punctual.glsl's MAX_LIGHTS
+MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2 levels - 1)
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
@@ -371,6 +374,24 @@ class Renderer:
         _set(program, "u_prefiltered_max_mip", maps.prefiltered_max_mip)
         _set(program, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
         _set(program, "u_env_intensity", float(scene.env_intensity))
+        self._write_suns(program, scene, maps)
+
+    @staticmethod
+    def _write_suns(program: moderngl.Program, scene: Scene, maps: IBLMaps) -> None:
+        """The compact sources the bake left out of the maps, in world space (ibl.glsl adds them)."""
+        suns = maps.suns[:MAX_SUNS]
+        directions = np.zeros((MAX_SUNS, 3), np.float32)
+        powers = np.zeros((MAX_SUNS, 3), np.float32)
+        for i, sun in enumerate(suns):
+            # The map texel in direction m lights world direction R_y(+deg) m (CONVENTIONS.md).
+            directions[i] = rotate_world_to_map(sun.direction, -scene.env_rotation_deg)
+            powers[i] = np.asarray(sun.power) * scene.env_intensity
+        scale = np.zeros(MAX_GRID_STEPS, np.float32)
+        scale[:len(maps.sun_prefilter_scale)] = maps.sun_prefilter_scale[:MAX_GRID_STEPS]
+        _set(program, "u_sun_count", len(suns))
+        _set(program, "u_sun_direction", directions.tobytes(), write=True)
+        _set(program, "u_sun_power", powers.tobytes(), write=True)
+        _set(program, "u_sun_prefilter_scale", scale.tobytes(), write=True)
 
     def _write_lights(self, scene: Scene) -> None:
         vectors = np.zeros((MAX_LIGHTS, 4), np.float32)

@@ -154,3 +154,14 @@ def test_other_renderers_in_the_process_are_not_disturbed():
     assert before[8, 8, 3] == 1.0 and before[8, 8, :3].min() > 0.1
     np.testing.assert_array_equal(before, between)
     np.testing.assert_array_equal(before, after)
+
+
+def test_ibl_model_is_chosen_by_name_and_changes_the_image(shared_data):
+    with AlightRenderer(48, quality="low") as r:
+        r.set_environment(str(shared_data / "env" / "quarry_01_1k.hdr")).set_material("gold").set_view("probe")
+        default = r.render(linear=True)
+        lecture = r.set_ibl_model("lecture").render(linear=True)
+        assert r.bakes_done == 1                       # a model is a shader choice, not a bake
+        assert np.abs(default - lecture).max() > 0.05
+        with pytest.raises(AlightError, match="ibl model"):
+            r.set_ibl_model("nonsense")

@@ -1,11 +1,12 @@
-"""The BRDF integration map (the lecture's integrate_brdf, k = r^2/2) against an independent
-deterministic quadrature of the same formula (app.converged.brdf_lut_converged)."""
+"""The BRDF integration map (the lecture's integrate_brdf, k = r^2/2, plus the specular lobe's
+mean directions t_A, t_B) against an independent deterministic quadrature of the same formulas
+(app.converged.brdf_lut_converged and lobe_directions_converged)."""
 
 import numpy as np
 import pytest
 
 from app.bake import QUALITY, LutCache
-from app.converged import brdf_lut_converged
+from app.converged import brdf_lut_converged, diffuse_fresnel, diffuse_fresnel_converged, lobe_directions_converged
 from tests.gpu import renderer
 
 # (n.v, roughness) points spread over the table, including grazing and the smooth end.
@@ -14,7 +15,7 @@ POINTS = [(0.02, 0.1), (0.05, 0.5), (0.1, 0.9), (0.25, 0.25), (0.5, 0.5), (0.5, 
 
 
 def read_lut(tex, size):
-    return np.frombuffer(tex.read(), np.float32).reshape(size, size, 2)
+    return np.frombuffer(tex.read(), np.float32).reshape(size, size, 4)
 
 
 @pytest.mark.parametrize("quality", ["low", "medium"])
@@ -35,7 +36,38 @@ def test_lut_matches_quadrature_at_texel_centres(quality):
     np.testing.assert_allclose(got[:, 0], a, atol=tol)
     np.testing.assert_allclose(got[:, 1], b, atol=tol)
     assert np.isfinite(lut).all() and (lut >= 0).all()
-    assert (lut.sum(axis=2) <= 1.0 + 1e-3).all()    # single scattering never gains energy
+    assert (lut[..., :2].sum(axis=2) <= 1.0 + 1e-3).all()    # single scattering never gains energy
+    assert (lut[..., 2:] <= 1.0).all()                       # lerp factors between n and R
+
+
+@pytest.mark.parametrize("quality", ["low", "medium"])
+def test_lobe_directions_match_quadrature(quality):
+    """t_A, t_B (where the lobe points, between n and R) against the quadrature's mean directions.
+    A mean direction from N quasi-random samples is noisier than A and B where the lobe is wide
+    and grazing, hence the looser tolerance; the shading tests bound what that costs."""
+    q = QUALITY[quality]
+    r = renderer()
+    lut = read_lut(r.luts.get(q.lut_size, q.lut_samples), q.lut_size)
+    s = q.lut_size
+    cols = [min(s - 1, int(nv * s)) for nv, _ in POINTS]
+    rows = [min(s - 1, int(rr * s)) for _, rr in POINTS]
+    t_a, t_b = lobe_directions_converged((np.array(cols) + 0.5) / s, (np.array(rows) + 0.5) / s)
+    got = lut[rows, cols]
+    tol = 0.02 if q.lut_samples >= 1024 else 0.04
+    np.testing.assert_allclose(got[:, 2], t_a, atol=tol)
+    np.testing.assert_allclose(got[:, 3], t_b, atol=tol)
+    # The physics: a smooth lobe sits on R; a rough one leans toward n, the more so at grazing.
+    assert lobe_directions_converged(0.5, 0.05)[0] > 0.99
+    t_rough = lobe_directions_converged([0.2, 0.5, 0.8], 0.7)[0]
+    assert (t_rough < 0.7).all() and t_rough[0] < t_rough[1] < t_rough[2]
+
+
+def test_diffuse_fresnel_fit_matches_its_integral():
+    """ibl.glsl's quartic for the Fresnel part of the Lambert lobe against the integral it fits."""
+    nv = np.linspace(0.0, 1.0, 21)
+    exact = diffuse_fresnel_converged(nv)
+    np.testing.assert_allclose(diffuse_fresnel(nv), exact, atol=2e-5)
+    assert 0.027 < exact[0] < 0.029 and exact[-1] < 1e-4   # grazing peak, vanishing head-on
 
 
 def test_lut_is_cached_on_disk_and_a_corrupt_cache_is_rebaked(tmp_path, monkeypatch):

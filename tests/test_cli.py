@@ -258,7 +258,7 @@ def test_bake_writes_all_maps(tmp_path):
     assert {"environment", "irradiance", "brdf_lut"} <= stems
     steps = sorted(s for s in stems if s.startswith("prefiltered_step"))
     assert steps, names
-    assert stems == {"environment", "irradiance", "brdf_lut", *steps}, names
+    assert stems == {"environment", "irradiance", "brdf_lut", "brdf_lut_directions", *steps}, names
     numbers, roughness = [], []
     for s in steps:
         m = re.fullmatch(r"prefiltered_step(\d\d)_r(\d\.\d{3})", s)

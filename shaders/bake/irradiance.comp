@@ -2,7 +2,8 @@
 // Diffuse irradiance by the lecture's hemisphere convolution: a regular (phi, theta) grid over
 // the hemisphere of n, each sample weighted by cos(theta) sin(theta). Midpoints of the grid
 // cells and normalising by the weights' own sum make a constant environment give exactly 1.
-// Stores E/pi, the cosine-weighted mean radiance (what the lecture calls irradiance).
+// Stores E/pi, the cosine-weighted mean radiance (what the lecture calls irradiance), of the
+// environment without its compact sources: the forward pass adds those exactly (ibl.glsl).
 #include "common/brdf.glsl"
 #include "common/sampling.glsl"
 #include "common/cubemap.glsl"
@@ -14,7 +15,6 @@ uniform int u_size;
 uniform int u_phi_steps;
 uniform int u_theta_steps;
 uniform float u_source_mip;   // a blurred source is enough: irradiance is smooth
-#include "common/suns.glsl"
 
 void main() {
     ivec3 texel = ivec3(gl_GlobalInvocationID);
@@ -35,5 +35,5 @@ void main() {
         }
         weight_sum += w * float(u_phi_steps);
     }
-    imageStore(u_irradiance, texel, vec4(sum / weight_sum + suns_irradiance_over_pi(n), 1.0));
+    imageStore(u_irradiance, texel, vec4(sum / weight_sum, 1.0));
 }

@@ -2,7 +2,8 @@
 // is defined, so the normal shading path pays nothing for them. Views 1-8 and 11-14 show data,
 // not radiance: the editor displays them without exposure or tone mapping, and they are
 // returned through srgb_to_linear_approx so that the tone map pass's sRGB encoding shows the
-// raw value. Views 9, 10 and the diffuse/specular splits are radiance and are shown as such.
+// raw value. Views 9, 10 and the diffuse/specular splits are radiance and are shown as such;
+// the splits (7, 8) are the lecture's, with the compact sources added (ibl.glsl).
 // The guard is here, not around the #include: app/gpu.py's #line after an include must not sit
 // inside a skipped conditional, or compile errors would name the wrong line.
 #ifdef DEBUG_VIEW
@@ -39,15 +40,15 @@ vec3 debug_view(Surface s, vec3 n, vec3 v, vec3 position) {
     case 4: return srgb_to_linear_approx(vec3(s.metallic));
     case 5: return srgb_to_linear_approx(f0);
     case 6: return srgb_to_linear_approx(vec3(n_dot_v));
-    case 7: return u_ibl_enabled ? (1.0 - F_ibl) * (1.0 - s.metallic) * s.base_color * irradiance_at(n) : vec3(0.0);
+    case 7: return u_ibl_enabled ? (1.0 - F_ibl) * (1.0 - s.metallic) * s.base_color * irradiance_at(n, true) : vec3(0.0);
     case 8: {
-        vec2 ab = brdf_lut_at(n_dot_v, s.roughness);
-        return u_ibl_enabled ? prefiltered_radiance_at(reflect(-v, n), s.roughness) * (F_ibl * ab.x + ab.y) : vec3(0.0);
+        vec2 ab = brdf_lut_at(n_dot_v, s.roughness).xy;
+        return u_ibl_enabled ? prefiltered_radiance_at(reflect(-v, n), s.roughness, true) * (F_ibl * ab.x + ab.y) : vec3(0.0);
     }
-    case 9: return u_ibl_enabled ? irradiance_at(n) : vec3(0.0);
+    case 9: return u_ibl_enabled ? irradiance_at(n, true) : vec3(0.0);
     case 10: return u_ibl_enabled ? u_env_intensity * textureLod(u_prefiltered_radiance,
                  rotate_world_to_map(reflect(-v, n), u_env_rotation), u_debug_mip).rgb : vec3(0.0);
-    case 11: return srgb_to_linear_approx(vec3(brdf_lut_at(n_dot_v, s.roughness), 0.0));
+    case 11: return srgb_to_linear_approx(vec3(brdf_lut_at(n_dot_v, s.roughness).xy, 0.0));
     // D can exceed 1 by far (1/(pi a^2) at the peak): shown as D / (1 + D) so the lobe's shape reads.
     case 12: { float D = D_GGX(max(dot(n, h), 0.0), roughness); return srgb_to_linear_approx(vec3(D / (1.0 + D))); }
     case 13: return srgb_to_linear_approx(vec3(G_Smith(max(n_dot_v, MIN_N_DOT_V), max(dot(n, l), 0.0), k_direct(roughness))));

@@ -1,14 +1,26 @@
-// Image-based lighting by the split sum (Karis 2013), as the seed lecture's cook_torrance_IBL.
+// Image-based lighting: the seed lecture's split sum (Karis 2013) and the models that improve on
+// it, measured against CONVENTIONS.md's ground truth (app/ibl_models.py lists them).
 // Maps are baked in the environment map's own frame; lookups rotate world directions into it.
+// Compact bright sources (the sun) are not in the irradiance and prefiltered maps (app/sun.py):
+// every model adds them here, exactly, in world space.
+
+#include "common/suns.glsl"
 
 uniform samplerCube u_irradiance;            // E/pi: the cosine-weighted mean radiance
 uniform samplerCube u_environment;           // source radiance with box mips: the mirror (r = 0)
 uniform samplerCube u_prefiltered_radiance;  // grid A: mip m holds alpha = 2^(m - max_mip)
 uniform samplerCube u_prefiltered_radiance_mid;  // grid B: mip j holds alpha_A(j + 1) / sqrt(2)
-uniform sampler2D u_brdf_lut;                // (scale A, bias B) over (n.v, roughness)
+uniform sampler2D u_brdf_lut;                // (A, B, t_A, t_B) over (n.v, roughness): brdf_lut.comp
 uniform float u_prefiltered_max_mip;         // last mip of grid A (roughness 1)
 uniform vec2 u_env_rotation;                 // (cos, sin) of minus the rotation angle
 uniform float u_env_intensity;
+
+// What a delta source adds to each roughness step of the prefiltered map, per unit
+// P (d.l) D(h) (app/bake.py records it from the step's sample set; prefilter.glsl says why).
+const int MAX_GRID_STEPS = 32;
+uniform float u_sun_prefilter_scale[MAX_GRID_STEPS];
+
+// ---- the roughness grid of the prefiltered map ---------------------------------------------
 
 // Prefiltered radiance lives on a grid of roughness steps where alpha = r^2 grows by sqrt(2)
 // per step, alternating between two cubes: even steps are grid A's mips, odd steps grid B's.
@@ -19,20 +31,38 @@ float roughness_to_grid_step(float roughness) {
     return 2.0 * (2.0 * log2(max(roughness, 1e-4)) + u_prefiltered_max_mip);
 }
 
+float grid_step_roughness(int step) {
+    return exp2(float(step) / 4.0 - 0.5 * u_prefiltered_max_mip);
+}
+
 vec3 prefiltered_grid(vec3 d, int step) {
     float mip = float(step >> 1);
     return (step & 1) == 0 ? textureLod(u_prefiltered_radiance, d, mip).rgb
                            : textureLod(u_prefiltered_radiance_mid, d, mip).rgb;
 }
 
-vec3 irradiance_at(vec3 n) {
-    return u_env_intensity * texture(u_irradiance, rotate_world_to_map(n, u_env_rotation)).rgb;
+// The compact sources as a grid step of the prefiltered map would hold them (world space d).
+vec3 suns_prefiltered_step(vec3 d, int step) {
+    float roughness = grid_step_roughness(step);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < u_sun_count; ++i) {
+        float d_dot_l = dot(d, u_sun_direction[i]);
+        if (d_dot_l > 0.0) {
+            float n_dot_h = dot(d, normalize(u_sun_direction[i] + d));
+            sum += D_GGX(n_dot_h, roughness) * d_dot_l * u_sun_power[i];
+        }
+    }
+    return u_sun_prefilter_scale[step] * sum;
 }
 
-vec3 prefiltered_radiance_at(vec3 r, float roughness) {
+// The prefiltered radiance around world direction r for a roughness, blended between grid steps.
+// with_suns adds the compact sources (their power carries the intensity already) as the map
+// would hold them had they been baked in: the lecture's maps filter the whole environment.
+// The source cube below the grid keeps its sun.
+vec3 prefiltered_radiance_at(vec3 r, float roughness, bool with_suns) {
     vec3 d = rotate_world_to_map(r, u_env_rotation);
     float step = roughness_to_grid_step(roughness);
-    vec3 radiance;
+    bool suns = with_suns && u_sun_count > 0;
     if (step < 0.0) {
         // Below grid A's first step (r = 2^(-max_mip/2)): the source cube's box mips whose texel
         // matches the lobe width alpha, fading into the first prefiltered step.
@@ -40,19 +70,98 @@ vec3 prefiltered_radiance_at(vec3 r, float roughness) {
         float texel_angle = 0.5 * PI / float(textureSize(u_environment, 0).x);
         float lod = max(log2(roughness * roughness / texel_angle), 0.0);
         float t = (roughness / r0) * (roughness / r0);
-        radiance = mix(textureLod(u_environment, d, lod).rgb, prefiltered_grid(d, 0), t);
-    } else {
-        float last = 2.0 * u_prefiltered_max_mip;
-        step = min(step, last);
-        int lo = int(floor(step));
-        radiance = mix(prefiltered_grid(d, lo), prefiltered_grid(d, min(lo + 1, int(last))), step - float(lo));
+        vec3 radiance = u_env_intensity * mix(textureLod(u_environment, d, lod).rgb, prefiltered_grid(d, 0), t);
+        return suns ? radiance + t * suns_prefiltered_step(r, 0) : radiance;
     }
-    return u_env_intensity * radiance;
+    float last = 2.0 * u_prefiltered_max_mip;
+    step = min(step, last);
+    int lo = int(floor(step));
+    int hi = min(lo + 1, int(last));
+    float t = step - float(lo);
+    vec3 radiance = u_env_intensity * mix(prefiltered_grid(d, lo), prefiltered_grid(d, hi), t);
+    return suns ? radiance + mix(suns_prefiltered_step(r, lo), suns_prefiltered_step(r, hi), t) : radiance;
 }
 
-vec2 brdf_lut_at(float n_dot_v, float roughness) {
-    return texture(u_brdf_lut, vec2(n_dot_v, roughness)).rg;
+// How much of prefiltered_radiance_at(.., roughness, false) came from the sun-free grid: below
+// the grid the source cube, which still holds the sun, takes the rest.
+float prefiltered_sun_free_fraction(float roughness) {
+    float r0 = exp2(-0.5 * u_prefiltered_max_mip);
+    return min((roughness / r0) * (roughness / r0), 1.0);
 }
+
+// E/pi at normal n; with_suns adds the compact sources' P max(n.l, 0) / pi.
+vec3 irradiance_at(vec3 n, bool with_suns) {
+    vec3 e = u_env_intensity * texture(u_irradiance, rotate_world_to_map(n, u_env_rotation)).rgb;
+    return with_suns ? e + suns_irradiance_over_pi(n) : e;
+}
+
+vec4 brdf_lut_at(float n_dot_v, float roughness) {
+    return texture(u_brdf_lut, vec2(n_dot_v, roughness));
+}
+
+// ---- terms the improved models share -------------------------------------------------------
+
+// The Fresnel part of the diffuse lobe under uniform light: (1/pi) times the integral of
+// (1 - v.h)^5 (n.l) over the hemisphere. It depends on n.v only (h = normalize(l + v)), peaks
+// at 0.028 at grazing, and this quartic in 1 - n.v fits it within 1e-5
+// (app/converged.py's diffuse_fresnel_converged integrates it).
+float diffuse_fresnel(float n_dot_v) {
+    float x = 1.0 - n_dot_v;
+    return 8.233601e-05 + x * (0.002021979 + x * (0.009310647 + x * (0.007795988 + x * 0.0089526)));
+}
+
+// The specular lobe's mean direction for this material (brdf_lut.comp): t_A for the part scaled
+// by F0, t_B for the bias, mixed by their weights so one fetch serves both.
+vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
+    float weight_a = dot(f0, vec3(0.2126, 0.7152, 0.0722)) * lut.x;
+    float t = (weight_a * lut.z + lut.y * lut.w) / max(weight_a + lut.y, 1e-6);
+    return normalize(mix(n, r, t));
+}
+
+// A compact source as the ground truth sees it: the Cook-Torrance BRDF with the IBL k and the
+// Fresnel per direction, times a delta of power P (the specular part scaled by `specular`).
+vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float specular) {
+    float n_dot_l = dot(n, l);
+    if (n_dot_l <= 0.0) return vec3(0.0);
+    float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    vec3 h = normalize(l + v);
+    float n_dot_h = max(dot(n, h), 0.0);
+    vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s));
+    float roughness = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
+    float D = D_GGX(n_dot_h, roughness);
+    float G = G_Smith(n_dot_v, n_dot_l, k_ibl(roughness));
+    vec3 diffuse = (1.0 - F) * (1.0 - s.metallic) * Fd_Lambert(s.base_color);
+    return (diffuse + specular * D * G * F / (4.0 * n_dot_l * n_dot_v)) * power * n_dot_l;
+}
+
+vec3 suns_exact(Surface s, vec3 n, vec3 v, float specular) {
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < u_sun_count; ++i) {
+        sum += sun_light(s, n, v, u_sun_direction[i], u_sun_power[i], specular);
+    }
+    return sum;
+}
+
+// Diffuse and specular image-based light from the split sum's parts. spec_weight is the
+// specular factor on the prefiltered radiance (F A + B or F0 A + B), diffuse_weight the factor
+// on the diffuse albedo. With MULTIPLE_SCATTERING, Fdez-Aguera 2019 ("A Multiple-Scattering
+// Microfacet Model for Real-Time Image-based Lighting") adds the energy single scattering loses.
+vec3 ibl_combine(Surface s, vec3 f0, vec3 diffuse_weight, vec3 spec_weight, vec4 lut,
+                 vec3 irradiance, vec3 prefiltered) {
+    vec3 albedo = s.base_color * (1.0 - s.metallic);
+#ifdef MULTIPLE_SCATTERING
+    float e_ss = lut.x + lut.y;
+    float e_ms = 1.0 - e_ss;
+    vec3 f_avg = f0 + (1.0 - f0) / 21.0;
+    vec3 f_ms = spec_weight * f_avg / (1.0 - e_ms * f_avg);
+    vec3 e_dss = 1.0 - (spec_weight + f_ms * e_ms);
+    return spec_weight * prefiltered + (f_ms * e_ms + albedo * e_dss) * irradiance;
+#else
+    return diffuse_weight * albedo * irradiance + spec_weight * prefiltered;
+#endif
+}
+
+// ---- the models ----------------------------------------------------------------------------
 
 // The lecture's cook_torrance_IBL: kd from the roughness-aware Fresnel at n.v, Lambert times the
 // irradiance map, and the prefiltered radiance times the LUT's (F * A + B).
@@ -60,18 +169,72 @@ vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec3 f0 = surface_f0(s);
     vec3 F = F_SchlickRoughness(n_dot_v, f0, s.roughness);
-    vec3 kd = (1.0 - F) * (1.0 - s.metallic);
-    vec3 diffuse = kd * s.base_color * irradiance_at(n);
-    vec2 ab = brdf_lut_at(n_dot_v, s.roughness);
-    vec3 specular = prefiltered_radiance_at(reflect(-v, n), s.roughness) * (F * ab.x + ab.y);
-    return (diffuse + specular) * s.occlusion;
+    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
+    return ibl_combine(s, f0, 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true),
+                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true)) * s.occlusion;
+}
+
+// The lecture with plain Schlick at n.v for kd and F (the diffuse weight ignores roughness).
+vec3 ibl_lecture_schlick(Surface s, vec3 n, vec3 v) {
+    float n_dot_v = max(dot(n, v), 0.0);
+    vec3 f0 = surface_f0(s);
+    vec3 F = F_Schlick(n_dot_v, f0);
+    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
+    return ibl_combine(s, f0, 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true),
+                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true)) * s.occlusion;
+}
+
+// Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
+// is F0 A + B (the lecture's F A + B counts Fresnel twice at grazing); the diffuse weight is the
+// ground truth's (1 - F0)(1 - Fc) averaged over the cosine lobe.
+vec3 ibl_karis(Surface s, vec3 n, vec3 v) {
+    float n_dot_v = max(dot(n, v), 0.0);
+    vec3 f0 = surface_f0(s);
+    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
+    return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
+                       irradiance_at(n, true),
+                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true)) * s.occlusion;
+}
+
+// Karis' split fetched at the lobe's mean direction (brdf_lut.comp) instead of R.
+vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
+    float n_dot_v = max(dot(n, v), 0.0);
+    vec3 f0 = surface_f0(s);
+    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
+    vec3 d = specular_dominant_direction(n, reflect(-v, n), f0, lut);
+    return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
+                       irradiance_at(n, true), prefiltered_radiance_at(d, s.roughness, true)) * s.occlusion;
+}
+
+// alight's model: ibl_dominant for the environment without its compact sources, and those
+// sources through the exact BRDF as delta lights (below the prefiltered grid the source cube,
+// which keeps the sun, takes over the specular part).
+vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
+    float n_dot_v = max(dot(n, v), 0.0);
+    vec3 f0 = surface_f0(s);
+    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
+    vec3 d = specular_dominant_direction(n, reflect(-v, n), f0, lut);
+    vec3 environment = ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
+                                   irradiance_at(n, false), prefiltered_radiance_at(d, s.roughness, false));
+    vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v, prefiltered_sun_free_fraction(s.roughness)) : vec3(0.0);
+    return (environment + suns) * s.occlusion;
 }
 
 // The model the forward pass uses: IBL_MODEL is the position of its name in app/ibl_models.py's
 // IBL_MODELS, set by app/renderer.py, so only the chosen model is compiled.
 #ifndef IBL_MODEL
-#define IBL_MODEL 0
+#define IBL_MODEL 4
 #endif
 vec3 ibl_model(Surface s, vec3 n, vec3 v) {
+#if IBL_MODEL == 0
     return ibl_lecture(s, n, v);
+#elif IBL_MODEL == 1
+    return ibl_lecture_schlick(s, n, v);
+#elif IBL_MODEL == 2
+    return ibl_karis(s, n, v);
+#elif IBL_MODEL == 3
+    return ibl_dominant(s, n, v);
+#else
+    return ibl_alight(s, n, v);
+#endif
 }
