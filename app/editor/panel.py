@@ -184,6 +184,8 @@ class Panel:
             return load
 
         maps = s.texture_maps
+        if s.use_file_materials:
+            imgui.text_disabled("parts with a material of their own use the file's maps")
         for slot in MAP_SLOTS:
             imgui.push_id(slot)
             if imgui.radio_button("##armed", s.armed_slot == slot):
