@@ -134,7 +134,7 @@ def test_below_first_grid_step_with_a_sun(env_of):
 def test_probe_rim_against_converged(env_of):
     """The probe's outer ring (n.v < 0.2) is where the LUT is read at its first column and F is
     largest. Against the converged split sum over that ring alone, at the default quality on
-    royal_esplanade, the error stays under 3% (measured: dielectric r = 0.5 0.6%, gold 0.8%),
+    royal_esplanade, the error stays under 3% (measured: dielectric r = 0.5 0.6%, gold 2.4%),
     and no rim pixel is NaN or negative."""
     env = env_of("royal_esplanade_1k.hdr")
     r = renderer()
@@ -213,8 +213,8 @@ def cube_directions(size: int) -> np.ndarray:
 
 # (map, quality): (neighbour-ratio bound, bound on the step's error against converged)
 FIREFLY_BOUNDS = {
-    ("quarry_01_1k.hdr", "low"): (1.25, 0.04), ("quarry_01_1k.hdr", "medium"): (1.25, 0.025),
-    ("spot1Lux.hdr", "low"): (1.25, 0.08), ("spot1Lux.hdr", "medium"): (1.25, 0.06),
+    ("quarry_01_1k.hdr", "low"): (1.25, 0.03), ("quarry_01_1k.hdr", "medium"): (1.25, 0.025),
+    ("spot1Lux.hdr", "low"): (1.25, 0.04), ("spot1Lux.hdr", "medium"): (1.25, 0.05),
 }
 
 
@@ -225,10 +225,11 @@ def test_no_fireflies_in_prefiltered_map(env_of, env_name, quality):
     carries a huge weight. app/sun.py takes them out and adds them back in closed form, so:
     - every step's neighbour ratio (texel / median of its 8 neighbours) stays <= 1.25
       (measured <= 1.09 on quarry, <= 1.16 on spot1Lux; with the sources left in the map the same
-      measure reads 1.3-2.3 on quarry and ~1e24 on spot1Lux, test_fireflies_without_sun_handling);
+      measure reads 1.4-2.3 on quarry and ~1e24 on spot1Lux: test_fireflies_without_sun_handling);
     - each step's error against prefiltered_converged over 1000 random texels,
-      sum |bake - converged| / sum converged, stays within the table's bound (measured at
-      medium: quarry 0.2-1.3%, spot1Lux 0.4-3.8%, largest at the first step r = 0.25)."""
+      sum |bake - converged| / sum converged, stays within the table's bound (measured: quarry
+      low 0.2-1.9%, medium 0.2-1.4%; spot1Lux low 0.5-2.3%, medium 0.4-3.3%; largest at the
+      first step, r = 0.25)."""
     env = env_of(env_name)
     small = downsample_equirect(env.radiance, 2)
     r = renderer()
@@ -254,8 +255,8 @@ def test_no_fireflies_in_prefiltered_map(env_of, env_name, quality):
 
 def test_fireflies_without_sun_handling(env_of, monkeypatch):
     """The control for the test above: with app/sun.py's extraction switched off, quarry's
-    prefiltered steps do have fireflies by the same measure (> 1.25 at some step), so the
-    measure can fail."""
+    prefiltered steps do have fireflies by the same measure (> 1.25 at some step; measured
+    1.37-1.55 at low), so the measure can fail."""
     import app.bake as bake
 
     monkeypatch.setattr(bake, "extract_suns", lambda radiance: (radiance, []))
@@ -504,9 +505,10 @@ def test_white_furnace_dielectric(furnace, model, f0):
     """A white dielectric (base colour 1) under radiance 1. CONVENTIONS.md's BRDF itself is not
     energy-conserving here: its albedo reaches 1.72 at n.v = 0.05, r = 0, and app/ground_truth.py
     gives 1.20 at r = 0.25, n.v -> 0. The lecture's split sum reaches 1 + Fc (1 - F) at r = 0
-    (kd = 1 - F plus F A + B with the Fresnel counted in both F and B): 1.23-1.24 near
-    n.v = 0.1 (measured here: see -s). So the stated bounds are: <= 1.25 everywhere, and
-    <= 1 + 3e-3 where n.v >= 0.8 (away from grazing, where the truth is <= 1 too)."""
+    (kd = 1 - F plus F A + B, the Fresnel counted in both F and B; Fc = (1 - n.v)^5), at most
+    1.24 for F0 = 0.04 and exactly 1.25 for F0 = 0 (F = Fc, where Fc = 1/2). Measured: 1.2396 and
+    1.2496. So the stated bounds are: <= 1.25 + 2e-3 everywhere, and <= 1 + 3e-3 where
+    n.v >= 0.8 (away from grazing, where the truth is <= 1 too; measured 1.0003 and 1.0013)."""
     r = renderer()
     maps = r.bake(furnace, "medium")
     n, inside = shading.probe_normals(64)
@@ -519,5 +521,5 @@ def test_white_furnace_dielectric(furnace, model, f0):
         worst = max(worst, float(probe[inside].max()))
         worst_front = max(worst_front, float(probe[front].max()))
     print(f"{model} F0={f0}: max {worst:.4f}, max at n.v >= 0.8 {worst_front:.5f}")
-    assert worst <= 1.25
+    assert worst <= 1.25 + 2e-3
     assert worst_front <= 1.0 + 3e-3
