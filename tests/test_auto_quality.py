@@ -5,9 +5,11 @@ benchmarks/bench_auto_quality.py (figures in the README)."""
 from __future__ import annotations
 
 import math
+import os
 import subprocess
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -86,11 +88,14 @@ def test_rough_materials_get_a_smaller_cube_and_fewer_mips():
 
 
 def test_smooth_irradiance_allows_sh9_and_a_sun_does_not():
-    """A rough dielectric: under a smooth sky without a compact source, SH9 is within budget and
-    chosen (it is the cheaper method); with a compact source (SH9 residual 5%) it is not."""
+    """A rough dielectric: under a smooth sky without a compact source, SH9 is within a 5% budget
+    and chosen (it is the cheaper method; its worst channel is 1.3-3.7% off on those maps); with
+    a compact source (SH9 residual 5%, SH9 up to 24% off on quarry) it is not. A metal never
+    reads the irradiance: SH9 is taken whatever the sky."""
     need = [material_need(0.0, 0.8)]
-    assert choose_quality(need, SMOOTH).quality.irradiance == "sh9"
-    assert choose_quality(need, SUN).quality.irradiance == "convolution"
+    assert choose_quality(need, SMOOTH, 0.05).quality.irradiance == "sh9"
+    assert choose_quality(need, SUN, 0.05).quality.irradiance == "convolution"
+    assert choose_quality([material_need(1.0, 0.8)], SUN, 0.05).quality.irradiance == "sh9"
 
 
 def test_more_budget_is_never_slower_and_a_tiny_budget_says_so():
@@ -153,19 +158,22 @@ def test_max_roughness_changes_nothing_the_material_reads(shared_data):
     assert np.isfinite(rough).all()
 
 
+REPO = Path(__file__).resolve().parents[1]
+
+
 def test_cli_prints_the_choice(tmp_path):
     from app.cli import main
 
     out = tmp_path / "a.png"
     code = subprocess.run([sys.executable, "-m", "app", "render", "--quality", "auto", "--preset", "copper",
                            "--roughness", "0.8", "--size", "32", "--out", str(out)],
-                          capture_output=True, text=True, timeout=120)
+                          capture_output=True, text=True, timeout=120, cwd=REPO)
     assert code.returncode == 0, code.stderr
     lines = [line for line in code.stderr.splitlines() if "quality auto" in line]
     assert len(lines) == 1 and "predicted error" in lines[0] and "within the 2% budget" in lines[0]
     assert out.stat().st_size > 0
     off = subprocess.run([sys.executable, "-m", "app", "render", "--quality", "auto", "--no-ibl", "--size", "32",
-                          "--out", str(tmp_path / "b.png")], capture_output=True, text=True, timeout=120)
+                          "--out", str(tmp_path / "b.png")], capture_output=True, text=True, timeout=120, cwd=REPO)
     assert off.returncode == 0 and "no bake" in off.stderr
     assert main(["render", "--error-budget", "3", "--out", str(tmp_path / "c.png")]) == 2
     assert main(["render", "--quality", "auto", "--irradiance", "sh9", "--out", str(tmp_path / "c.png")]) == 2
@@ -189,3 +197,16 @@ def test_python_api_auto():
         r.set_environment(None)
         r.render()
         assert r.last_auto_choice.quality is None
+
+
+def test_installed_package_carries_the_table(tmp_path):
+    """The measured table ships inside the wheel (make test installs it first)."""
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)
+    code = "import app.auto_quality as a; print(a.TABLE_PATH); print(len(a.load_table()['environments']))"
+    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
+    if out.returncode != 0 and "No module named 'app'" in out.stderr:
+        pytest.skip("alight is not installed in this interpreter (make setup installs it)")
+    assert out.returncode == 0, out.stderr
+    path, count = out.stdout.split()
+    assert "site-packages" in path and int(count) >= 8

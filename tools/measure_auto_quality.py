@@ -6,7 +6,9 @@ time (the fastest of --runs fresh bakes, LUT cached, and their median) on a map 
     .venv/bin/python tools/measure_auto_quality.py            # writes app/auto_quality_table.json
 
 Takes a few minutes on 2 cores. The error is sum |render - converged| / sum |converged| over a
-48x48 probe, the metric of tests/test_probe_accuracy.py.
+48x48 probe (tests/test_probe_accuracy.py's metric), per channel, and the worst channel is kept:
+a material of another colour weights the channels differently, and its error cannot exceed the
+worst channel's.
 """
 
 from __future__ import annotations
@@ -100,6 +102,7 @@ def main() -> int:
     p.add_argument("--out", default=str(TABLE_PATH))
     p.add_argument("--runs", type=int, default=5, help="timed bakes per candidate (the fastest is kept)")
     p.add_argument("--only", nargs="*", help="environment file names (default: all, and studio)")
+    p.add_argument("--errors-only", action="store_true", help="keep the bake times of --out, measure the errors")
     p.add_argument("--timings-only", action="store_true",
                    help="keep the errors of --out and measure the bake times again (on a quiet machine)")
     args = p.parse_args()
@@ -114,7 +117,8 @@ def main() -> int:
         renderer.luts.get(*q)
 
     table = {"about": "app/auto_quality.py's measured table; written by tools/measure_auto_quality.py",
-             "metric": f"sum|probe - converged| / sum|converged|, {WIDTH}x{WIDTH} probe, lecture IBL model",
+             "metric": f"max over RGB of sum|probe - converged| / sum|converged|, {WIDTH}x{WIDTH} probe, "
+                       "lecture IBL model",
              "machine": f"{platform.machine()} {platform.node()}, {renderer.ctx.info['GL_RENDERER']}",
              "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
              "roughness": list(ROUGHNESS_POINTS), "archetypes": {k: str(v) for k, v in ARCHETYPES.items()},
@@ -140,8 +144,10 @@ def main() -> int:
                     got = renderer.render(Scene(material=m, view="probe"), maps, WIDTH, WIDTH,
                                           read_srgb=False).linear[..., :3][inside]
                     want = ideal(m, r, normals, irr, pre, luts)
-                    denom = float(np.abs(want).sum())
-                    err = float(np.abs(got - want).sum()) / denom if denom > 0 else float("inf")
+                    # The worst channel: a material of any colour mixes the channels' errors with
+                    # its own weights, so its error is at most the worst channel's.
+                    denom = np.abs(want).sum(axis=0)
+                    err = float((np.abs(got - want).sum(axis=0) / denom).max()) if (denom > 0).all() else float("inf")
                     row.append(round(err, 5) if np.isfinite(err) else None)   # None: no signal to compare
                 errors[cname][arch] = row
             maps.release()
@@ -151,7 +157,11 @@ def main() -> int:
         print(f"{name}: {features.describe()}; {time.perf_counter() - t0:.0f} s", file=sys.stderr)
         for cname in CANDIDATES:
             print(f"  {cname:11s} " + "  ".join(
-                f"{a[:4]} " + "/".join(f"{e * 100:.1f}" for e in errors[cname][a]) for a in ARCHETYPES), file=sys.stderr)
+                f"{a[:4]} " + "/".join("-" if e is None else f"{e * 100:.1f}" for e in errors[cname][a]) for a in ARCHETYPES), file=sys.stderr)
+    if args.errors_only:
+        old = json.loads(Path(args.out).read_text())
+        table["bake_seconds"], table["timing_environments"] = old["bake_seconds"], old["timing_environments"]
+        timing_envs = {}
     for kind, env in timing_envs.items():
         print(f"timing on {env.name} ({kind})", file=sys.stderr)
         for cname, t in timed_bakes(renderer, env, args.runs).items():
@@ -160,7 +170,8 @@ def main() -> int:
         row = table["bake_seconds"].setdefault(cname, {})
         for kind in ("sun", "no_sun"):
             row.setdefault(kind, row.get("no_sun" if kind == "sun" else "sun"))
-    table["timing_environments"] = {k: Path(env.name).name for k, env in timing_envs.items()}
+    if not args.errors_only:
+        table["timing_environments"] = {k: Path(env.name).name for k, env in timing_envs.items()}
     with atomic_path(args.out) as tmp:
         Path(tmp).write_text(json.dumps(table, indent=1) + "\n")
     print(args.out)
