@@ -30,7 +30,7 @@ from app.material import Material, load_preset, validate_material, with_override
 from app.mesh import Mesh, load_mesh
 from app.scene import BACKGROUNDS, TONEMAPS, Camera, Display, Light, Scene, frame_camera, parse_light
 
-Quality = Literal["low", "medium", "high"]
+Quality = Literal["low", "medium", "high", "auto"]
 AA = Literal["none", "msaa", "ssaa"]
 
 
@@ -42,9 +42,15 @@ class AlightRenderer:
     """
 
     def __init__(self, width: int = 512, height: int | None = None, *, quality: Quality | str = "medium",
-                 aa: AA = "msaa", tonemap: str = "aces", exposure: float = 0.0, background: str = "env"):
+                 aa: AA = "msaa", tonemap: str = "aces", exposure: float = 0.0, background: str = "env",
+                 error_budget: float = 0.02):
         self.width, self.height = _size(width, width if height is None else height)
         self.quality = quality
+        # quality="auto": app/auto_quality.py chooses per render within this error budget (a
+        # fraction); the last choice is kept in self.last_auto_choice.
+        self.error_budget = float(error_budget)
+        self.last_auto_choice = None
+        self._features: dict[str, object] = {}
         self.aa: str = aa
         self._renderer = None  # app.renderer.Renderer, created lazily: importing moderngl is not free
         self.bakes_done = 0    # how many bakes actually ran (cache misses), for callers that measure
@@ -232,6 +238,8 @@ class AlightRenderer:
 
         r = self._renderer
         maps = None
+        if self.quality == "auto":
+            return self._frame_auto(w, h, linear, srgb)
         if self._env is not None and self.scene.ibl_enabled:
             before = len(r._bakes)
             quality = self.quality if not isinstance(self.quality, str) else QUALITY.get(self.quality)
@@ -240,6 +248,31 @@ class AlightRenderer:
             maps = r.bake(self._env, quality)
             self.bakes_done += len(r._bakes) - before
         return r.render(self.scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
+
+
+    def _frame_auto(self, w: int, h: int, linear: bool, srgb: bool):
+        """quality="auto": the cheapest measured bake within error_budget for this scene."""
+        from dataclasses import replace
+
+        from app.auto_quality import choose_quality, environment_features, scene_needs
+
+        r = self._renderer
+        scene = self.scene
+        on = self._env is not None and scene.ibl_enabled and scene.env_intensity > 0.0
+        features = None
+        if on:
+            key = self._env.content_hash
+            if key not in self._features:
+                self._features[key] = environment_features(self._env.radiance)
+            features = self._features[key]
+        choice = self.last_auto_choice = choose_quality(scene_needs(scene), features, self.error_budget)
+        maps = None
+        if choice.quality is not None:
+            before = len(r._bakes)
+            maps = r.bake(self._env, choice.quality)
+            self.bakes_done += len(r._bakes) - before
+        return r.render(scene if on else replace(scene, ibl_enabled=False), maps, w, h, aa=self.aa,
+                        read_linear=linear, read_srgb=srgb)
 
 
 @functools.lru_cache(maxsize=1)

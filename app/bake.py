@@ -30,6 +30,9 @@ if TYPE_CHECKING:
     from app.environment import Environment
 
 IRRADIANCE_METHODS = ("convolution", "sh9")
+# Samples per texel of a grid step above a quality's max_roughness: never read by the scene's
+# materials, so it is only kept finite and roughly right (the background's blur may read it).
+SKIPPED_STEP_SAMPLES = 16
 
 
 @dataclass(frozen=True)
@@ -53,6 +56,9 @@ class BakeQuality:
     sh9_source_width: int          # width of the equirect mip that the SH projection reads
     lut_size: int
     lut_samples: int
+    # Steps rougher than this get only a few samples (finite and roughly right, not accurate):
+    # a scene whose roughest material is r needs the grid only up to the first step >= r.
+    max_roughness: float = 1.0
 
     @property
     def prefiltered_levels(self) -> int:
@@ -67,7 +73,11 @@ class BakeQuality:
         return max(1, self.irradiance_phi_steps // 4)
 
     def prefilter_samples_at(self, step: int) -> int:
-        """Samples per texel at a grid step (step 2m: grid A's mip m; 2j+1: grid B's mip j)."""
+        """Samples per texel at a grid step (step 2m: grid A's mip m; 2j+1: grid B's mip j).
+        Steps beyond the first one at or above ``max_roughness`` get SKIPPED_STEP_SAMPLES."""
+        if self.max_roughness < 1.0 and step > 0 and \
+                grid_roughness(step - 1, self.prefiltered_levels) >= self.max_roughness:
+            return SKIPPED_STEP_SAMPLES
         return min(self.prefilter_max_samples, int(self.prefilter_samples * self.prefilter_sample_growth ** (step / 2)))
 
 

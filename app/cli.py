@@ -80,10 +80,19 @@ def _add_material_options(p: argparse.ArgumentParser) -> None:
     m.add_argument("--emissive", metavar="R,G,B", help="linear emitted radiance, >= 0")
 
 
-def _add_bake_options(p: argparse.ArgumentParser) -> None:
+def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:
     g = p.add_argument_group("image-based lighting")
-    g.add_argument("--quality", choices=QUALITIES, default="medium",
-                   help="bake resolution and sample counts (app/bake.py's QUALITY table) (default: medium)")
+    if auto:
+        g.add_argument("--quality", choices=QUALITIES + ("auto",), default="medium",
+                       help="bake resolution and sample counts (app/bake.py's QUALITY table); auto: the "
+                            "cheapest measured bake whose predicted error against the converged split sum "
+                            "stays within --error-budget for this scene's materials and environment "
+                            "(app/auto_quality.py) (default: medium)")
+        g.add_argument("--error-budget", type=_number("--error-budget", 0.01, 100.0), default=None, metavar="PCT",
+                       help="with --quality auto: the probe's implementation error allowed, in percent (default: 2)")
+    else:
+        g.add_argument("--quality", choices=QUALITIES, default="medium",
+                       help="bake resolution and sample counts (app/bake.py's QUALITY table) (default: medium)")
     g.add_argument("--irradiance", choices=("convolution", "sh9"),
                    help="diffuse irradiance by the lecture's hemisphere convolution or by 9 spherical "
                         "harmonics (default: the quality's choice)")
@@ -157,7 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Render a material headless. With only --out: the default material ball "
                                    "in the built-in studio.")
     _add_scene_options(r)
-    _add_bake_options(r)
+    _add_bake_options(r, auto=True)
     d = r.add_argument_group("image")
     d.add_argument("--size", type=_size, default=(1024, 1024), metavar="W|WxH", help="image size (default: 1024)")
     d.add_argument("--tonemap", choices=("none", "aces", "neutral"), default="aces",
@@ -313,6 +322,10 @@ def _render(args) -> int:
     width, height = args.size
     if args.view == "probe" and width != height:
         raise AlightError(f"--size: the probe view is square; got {width}x{height}")
+    if args.quality == "auto" and args.irradiance:
+        raise AlightError("--irradiance: --quality auto chooses the irradiance method itself")
+    if args.quality != "auto" and args.error_budget is not None:
+        raise AlightError("--error-budget: only with --quality auto")
     material, overrides = build_material(args)
 
     from app.environment import load_environment
@@ -341,7 +354,14 @@ def _render(args) -> int:
     from app.renderer import Renderer
 
     renderer = Renderer()
-    maps = renderer.bake(env, quality_named(args.quality, args.irradiance)) if env is not None else None
+    if args.quality == "auto":
+        quality = _auto_quality(args, scene, env)
+        if quality is None:
+            env = None
+            scene.ibl_enabled = False
+    else:
+        quality = quality_named(args.quality, args.irradiance)
+    maps = renderer.bake(env, quality) if env is not None else None
     baked = time.perf_counter()
     frame = renderer.render(scene, maps, width, height, aa=args.aa,
                             read_linear=out.suffix.lower() == ".exr", read_srgb=out.suffix.lower() == ".png")
@@ -362,6 +382,18 @@ def _render(args) -> int:
                   file=sys.stderr)
     print(out)
     return 0
+
+
+def _auto_quality(args, scene, env):
+    """--quality auto: the chosen BakeQuality (None: nothing to bake), said in one line."""
+    from app.auto_quality import DEFAULT_ERROR_BUDGET, choose_quality, environment_features, scene_needs
+
+    budget = DEFAULT_ERROR_BUDGET if args.error_budget is None else args.error_budget / 100.0
+    off = env is None or scene.env_intensity == 0.0
+    choice = choose_quality(scene_needs(scene), None if off else environment_features(env.radiance), budget,
+                            off_reason="--no-ibl" if env is None else "--env-intensity 0")
+    print(f"alight: {choice.line(budget)}", file=sys.stderr)
+    return choice.quality
 
 
 def _bake(args) -> int:

@@ -37,6 +37,17 @@ class Environment:
     warnings: list[str] = field(default_factory=list)  # repairs made, one line each
     _hash: str | None = field(default=None, init=False, repr=False, compare=False)
 
+    def __post_init__(self):
+        # The loader repairs files; an array handed in directly (the Python API takes one) gets
+        # the same repair here, on a copy, so NaN never reaches the bake's mips.
+        rad = np.asarray(self.radiance)
+        if rad.size and not (np.isfinite(rad).all() and rad.min() >= 0.0):
+            broken = ~np.all(np.isfinite(rad) & (rad >= 0.0), axis=-1)
+            rad = np.array(rad, dtype=np.float32, order="C")
+            rad[broken] = 0.0
+            self.radiance = rad
+            self.warnings = [*self.warnings, f"{self.name}: {int(broken.sum())} NaN/Inf/negative texels set to 0"]
+
     @property
     def content_hash(self) -> str:
         """sha256 hex digest of the radiance's shape and bytes (the bake cache key); computed once."""

@@ -23,6 +23,10 @@ from app.shading import texel_directions
 # and 5.5% of its power; quarry_01's sun 48%.)
 SUN_RADIUS_DEG = 3.0
 SUN_RING_DEG = (3.0, 4.5)        # where the sky that fills the hole is measured
+# A source is only compact if the map resolves its cone: texels at most SUN_RADIUS_DEG tall. A
+# coarser map has none (a 2x1 map's two texels are hemispheres; taken as suns they turned a
+# constant map into two point lights, irradiance 0.07-3.1 instead of 1).
+_MIN_HEIGHT = int(np.ceil(180.0 / SUN_RADIUS_DEG))
 SUN_MIN_POWER_FRACTION = 0.05
 MAX_SUNS = 4
 
@@ -61,6 +65,8 @@ def extract_sun(radiance: np.ndarray, total: float | None = None) -> tuple[np.nd
     """The brightest compact source, if it holds SUN_MIN_POWER_FRACTION of ``total`` (default:
     this map's power): the radiance without it, and it; else the radiance unchanged and None."""
     h, w, _ = radiance.shape
+    if h < _MIN_HEIGHT:
+        return radiance, None
     dirs, omega = _directions(h, w)
     lum = radiance.mean(axis=2)
     if total is None:
@@ -75,8 +81,9 @@ def extract_sun(radiance: np.ndarray, total: float | None = None) -> tuple[np.nd
     cos_to_peak = band_dirs @ dirs[peak]
     cone = cos_to_peak > np.cos(np.radians(SUN_RADIUS_DEG))
     ring = (cos_to_peak <= np.cos(np.radians(SUN_RING_DEG[0]))) & (cos_to_peak > np.cos(np.radians(SUN_RING_DEG[1])))
-    fill = (band[ring] * band_omega[ring, None]).sum(axis=0) / max(float(band_omega[ring].sum()), 1e-30) \
-        if ring.any() else np.zeros(3, np.float32)
+    if not ring.any():   # no sky around the peak to measure: nothing is compact at this resolution
+        return radiance, None
+    fill = (band[ring] * band_omega[ring, None]).sum(axis=0) / max(float(band_omega[ring].sum()), 1e-30)
     excess = np.maximum(band[cone] - fill, 0.0)
     power = (excess * band_omega[cone, None]).sum(axis=0)
     fraction = float(power.mean()) / total
