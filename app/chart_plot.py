@@ -1,0 +1,156 @@
+"""The PNGs of ``alight chart`` (matplotlib, Agg, written atomically): error against time with
+the Pareto frontier marked, the white furnace, and the map of error over (n.v, roughness)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+FACTOR_STYLE = {   # factor -> (colour, marker)
+    "baseline": ("black", "*"),
+    "irradiance": ("tab:blue", "o"),
+    "specular cube": ("tab:orange", "s"),
+    "prefilter samples": ("tab:green", "^"),
+    "FIS": ("tab:red", "D"),
+    "LUT size": ("tab:purple", "v"),
+    "LUT samples": ("tab:brown", "P"),
+    "IBL model": ("tab:pink", "X"),
+    "multiple scattering": ("tab:gray", "h"),
+}
+
+
+def _figure(width_in: float, height_in: float):
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width_in, height_in), dpi=110, layout="constrained")
+
+
+def _save(fig, path: Path) -> None:
+    from app.output import atomic_path
+
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+
+
+def _plain_log_ticks(axis, lo: float | None = None, hi: float | None = None) -> None:
+    """Log-axis tick labels as plain numbers (2, 5, 10, 20) instead of 2x10^0; over a narrow
+    range (hi / lo < 4) the minor ticks are labelled too."""
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    fmt = FuncFormatter(lambda v, _: f"{v:.3g}")
+    axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(fmt)
+    narrow = lo is not None and hi is not None and lo > 0 and hi / lo < 4.0
+    axis.set_minor_locator(LogLocator(base=10.0, subs=tuple(range(1, 10))))
+    axis.set_minor_formatter(fmt if narrow else FuncFormatter(lambda v, _: ""))
+
+
+def _error_panel(ax, rows, time_key: str, front_key: str, xlabel: str) -> None:
+    seen = set()
+    pts = [r for r in rows if math.isfinite(r[time_key]) and math.isfinite(r["rel_mae_mean"])]
+    for r in pts:
+        colour, marker = FACTOR_STYLE.get(r["factor"], ("tab:olive", "o"))
+        label = r["factor"] if r["factor"] not in seen else None
+        seen.add(r["factor"])
+        ax.scatter(r[time_key], r["rel_mae_mean"] * 100, c=colour, marker=marker, s=70 if marker == "*" else 36,
+                   label=label, zorder=3, edgecolors="none")
+    front = sorted((r for r in pts if r[front_key]), key=lambda r: r[time_key])
+    if front:
+        xs = [r[time_key] for r in front]
+        ys = [r["rel_mae_mean"] * 100 for r in front]
+        ax.step(xs, ys, where="post", color="black", lw=1.0, alpha=0.6, zorder=2, label="Pareto frontier")
+        ax.scatter(xs, ys, s=130, facecolors="none", edgecolors="black", lw=1.0, zorder=4)
+        for r in front:
+            ax.annotate(r["setting"], (r[time_key], r["rel_mae_mean"] * 100), xytext=(5, 4),
+                        textcoords="offset points", fontsize=7)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    if pts:
+        xs = [r[time_key] for r in pts]
+        ys = [r["rel_mae_mean"] * 100 for r in pts]
+        _plain_log_ticks(ax.xaxis, min(xs), max(xs))
+        _plain_log_ticks(ax.yaxis, min(ys), max(ys))
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("probe error against the ground truth:\nmean relMAE over cases (%)")
+    ax.grid(True, which="both", alpha=0.25)
+
+
+def plot_chart(rows: list[dict], results, path: Path, title: str, frame_size, furnace_truth=None) -> Path:
+    fig = _figure(18.0, 6.2)
+    axes = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.15, 1.15, 0.9]})
+    _error_panel(axes[0], rows, "bake_ms", "pareto_bake",
+                 "bake time per environment, warm, LUT cached (ms, log)")
+    axes[0].set_title("error against bake time")
+    _error_panel(axes[1], rows, "frame_ms", "pareto_frame",
+                 f"frame time: material ball at {frame_size[0]}x{frame_size[1]}, median (ms, log)")
+    axes[1].set_title("error against frame time")
+    axes[0].legend(fontsize=7, loc="best", framealpha=0.85)
+
+    ax = axes[2]
+    cmap = __import__("matplotlib").colormaps["tab10"]
+    models = []
+    for res in results:
+        s = res.setting
+        if s.factor not in ("baseline", "IBL model", "multiple scattering") or not res.furnace:
+            continue
+        if s.ibl_model not in models:
+            models.append(s.ibl_model)
+        colour = cmap(models.index(s.ibl_model) % 10)
+        rs = [f[0] for f in res.furnace]
+        ax.plot(rs, [f[1] for f in res.furnace], "-o" if not s.multiple_scattering else "--s", color=colour, ms=4,
+                label=f"{s.ibl_model}, MS {'on' if s.multiple_scattering else 'off'}")
+        ax.fill_between(rs, [f[2] for f in res.furnace], [f[3] for f in res.furnace], color=colour, alpha=0.12)
+    truth = furnace_truth
+    if truth:
+        ax.plot([t[0] for t in truth], [t[1] for t in truth], "k:", lw=1.6, label="ground truth (single scattering)")
+    ax.axhline(1.0, color="black", lw=0.8, ls="-", alpha=0.4)
+    ax.set_xlabel("roughness")
+    ax.set_ylabel("probe radiance, mean over the ball (band: min..max)")
+    ax.set_title("white furnace: metal F0 = 1, radiance 1\n(MS on should give 1)", fontsize=10)
+    ax.legend(fontsize=7, loc="lower left")
+    ax.grid(True, alpha=0.25)
+    fig.suptitle(f"alight chart: split-sum IBL settings around 'medium', one factor at a time\n{title}", fontsize=10)
+    _save(fig, path)
+    return path
+
+
+def plot_error_map(error_map, path: Path, title: str) -> Path:
+    from matplotlib.colors import LogNorm
+
+    models = list(error_map.num)
+    fig = _figure(6.2 * len(models) + 1.0, 5.2)
+    axes = np.atleast_1d(fig.subplots(1, len(models), squeeze=False)[0])
+    rs = np.asarray(error_map.roughness)
+    edges_r = np.arange(len(rs) + 1) - 0.5     # one equal row per roughness value
+    nb = error_map.bins.max() + 1
+    edges_nv = np.linspace(0.0, 1.0, int(nb) + 1)
+    rels = {m: error_map.relative(m) * 100 for m in models}
+    finite = np.concatenate([v[np.isfinite(v) & (v > 0)] for v in rels.values()])
+    lo, hi = (max(float(finite.min()), 0.1), float(finite.max())) if finite.size else (0.1, 100.0)
+    norm = LogNorm(vmin=lo, vmax=max(hi, lo * 10))
+    mesh = None
+    for ax, m in zip(axes, models):
+        v = rels[m]
+        mesh = ax.pcolormesh(edges_nv, edges_r, np.ma.masked_invalid(v), cmap="magma", norm=norm)
+        for i, r in enumerate(rs):
+            for b in range(v.shape[1]):
+                if np.isfinite(v[i, b]):
+                    dark = norm(v[i, b]) < 0.6
+                    ax.text((edges_nv[b] + edges_nv[b + 1]) / 2, i, f"{v[i, b]:.3g}", ha="center", va="center",
+                            fontsize=6, color="white" if dark else "black")
+        ax.set_xlabel("n.v (probe pixel: n.z; 0 = grazing at the rim)")
+        ax.set_ylabel("roughness")
+        ax.set_yticks(range(len(rs)), [f"{r:g}" for r in rs])
+        ax.set_title(f"IBL model '{m}': relMAE per bin (%)", fontsize=9)
+    if mesh is not None:
+        bar = fig.colorbar(mesh, ax=list(axes), label="sum|render - truth| / sum|truth| in the bin (%, log)")
+        _plain_log_ticks(bar.ax.yaxis, norm.vmin, norm.vmax)
+    fig.suptitle(f"Where the split sum fails: quality medium, all presets and environments pooled\n{title}",
+                 fontsize=9)
+    _save(fig, path)
+    return path
