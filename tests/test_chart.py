@@ -112,10 +112,17 @@ def test_error_map_bins_by_nv_and_roughness():
     assert np.allclose(rel[1, :3], 0.5) and np.all(rel[1, 3:] == 0.0)
 
 
-def test_chart_quick_end_to_end(tmp_path):
-    out = tmp_path / "chart"
+@pytest.fixture(scope="module")
+def quick_chart(tmp_path_factory):
+    """``alight chart --quick`` run once for the tests below: (its output folder, the process)."""
+    out = tmp_path_factory.mktemp("chart") / "chart"
     proc = subprocess.run([sys.executable, "-m", "app", "chart", "--quick", "--size", "16", "--out", str(out)],
                           cwd=REPO, env=dict(os.environ), capture_output=True, text=True, timeout=600)
+    return out, proc
+
+
+def test_chart_quick_end_to_end(quick_chart):
+    out, proc = quick_chart
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "Traceback" not in proc.stderr
     steps = [l for l in proc.stderr.splitlines() if "step " in l]
@@ -164,3 +171,47 @@ def test_chart_refuses_a_bad_environment(tmp_path, shared_data):
     lines = proc.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("alight: error: ") and "memorial.exr" in lines[0], proc.stderr
     assert not (tmp_path / "c").exists()
+
+
+def test_editor_chart_view_reads_and_draws_the_latest_chart(quick_chart):
+    """The panel's view finds the chart the last run noted, loads its series and draws them with
+    implot (an imgui frame without a window: the draw calls run, nothing is shown)."""
+    from app.editor.chart_view import ChartView, find_chart_csv, load_chart
+
+    out, proc = quick_chart
+    assert proc.returncode == 0
+    assert find_chart_csv() == (out / "chart.csv").resolve()      # noted in ALIGHT_CACHE_DIR by the run
+    data = load_chart(out / "chart.csv")
+    rows = read_summary(out / "chart.csv")
+    judged = [r for r in rows if math.isfinite(r["rel_mae_mean"])]
+    assert sum(len(x) for x, _, _ in data.factors.values()) == len(judged)
+    assert data.frontier[2] and set(data.frontier[2]) == {r["setting"] for r in judged if r["pareto_bake"] == 1.0}
+    assert np.all(np.diff(data.frontier[0]) >= 0) and np.all(np.diff(data.frontier[1]) <= 0)
+
+    from imgui_bundle import imgui, implot
+
+    ctx = imgui.create_context()
+    implot.create_context()
+    try:
+        io = imgui.get_io()
+        io.display_size = imgui.ImVec2(600, 500)
+        io.delta_time = 1 / 60
+        io.backend_flags |= imgui.BackendFlags_.renderer_has_textures.value
+        view = ChartView()
+        for _ in range(2):
+            imgui.new_frame()
+            imgui.begin("chart")
+            view.draw()
+            imgui.end()
+            imgui.render()
+        assert view.error == "" and view.data is not None and view.data.settings == len(rows)
+        broken = ChartView(out / "error_map.png")        # not a chart CSV: one line, no exception
+        imgui.new_frame()
+        imgui.begin("chart")
+        broken.draw()
+        imgui.end()
+        imgui.render()
+        assert broken.data is None and "error_map.png" in broken.error
+    finally:
+        implot.destroy_context()
+        imgui.destroy_context(ctx)
