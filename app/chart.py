@@ -66,6 +66,7 @@ NV_BINS = 10
 LEVEL1_FROM = 0.25
 LATEST_FILE = "latest_chart.txt"   # in app.paths.cache_dir(): where the last chart's CSV is
 FRAME_REPEATS = 5
+REFERENCE_WEIGHT = 10.0   # a reference's time in settings' times (for the ETA)
 
 
 @dataclass(frozen=True)
@@ -226,23 +227,22 @@ class SettingResult:
     cases: list[tuple[str, str, float, float, float]] = field(default_factory=list)  # env, preset, r, rel, flip
     furnace: list[tuple[float, float, float, float]] = field(default_factory=list)   # r, mean, min, max
 
-    def summary_cases(self):
-        return [c for c in self.cases if not any(x in c[0] for x in SUMMARY_EXCLUDED)]
+    def _over_cases(self, reduce, column: int) -> float:
+        """reduce() of a column of the cases outside SUMMARY_EXCLUDED's environments; NaN if none."""
+        c = [x[column] for x in self.cases if not any(e in x[0] for e in SUMMARY_EXCLUDED)]
+        return float(reduce(c)) if c else math.nan
 
     @property
     def rel_mean(self) -> float:
-        c = self.summary_cases()
-        return float(np.mean([x[3] for x in c])) if c else math.nan
+        return self._over_cases(np.mean, 3)
 
     @property
     def rel_max(self) -> float:
-        c = self.summary_cases()
-        return float(np.max([x[3] for x in c])) if c else math.nan
+        return self._over_cases(np.max, 3)
 
     @property
     def flip_mean(self) -> float:
-        c = self.summary_cases()
-        return float(np.mean([x[4] for x in c])) if c else math.nan
+        return self._over_cases(np.mean, 4)
 
     @property
     def bake_median(self) -> float:
@@ -250,27 +250,28 @@ class SettingResult:
 
 
 class Progress:
-    """'step i/N ... ETA' lines on stderr (one rewritten line on a terminal)."""
+    """'step i/N ... ETA' lines on stderr (one rewritten line on a terminal). Steps may weigh
+    more than 1 (a reference costs about as much as ten settings) so the ETA is not fooled by
+    the order of the work."""
 
-    def __init__(self, total: int, stream=None):
-        self.total, self.done = total, 0
+    def __init__(self, weights: list[float], stream=None):
+        self.weights = list(weights)
+        self.total, self.done = len(self.weights), 0
+        self.total_weight, self.done_weight = float(sum(self.weights)), 0.0
         self.stream = stream or sys.stderr
         self.start = time.perf_counter()
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
 
     def step(self, what: str) -> None:
+        self.done_weight += self.weights[self.done]
         self.done += 1
         elapsed = time.perf_counter() - self.start
-        eta = elapsed / self.done * (self.total - self.done)
+        eta = elapsed / self.done_weight * (self.total_weight - self.done_weight)
         line = f"alight chart: step {self.done}/{self.total} {what}  elapsed {_mmss(elapsed)}  ETA {_mmss(eta)}"
         if self.tty:
             self.stream.write("\r" + line[:150].ljust(150) + ("\n" if self.done == self.total else ""))
         else:
             self.stream.write(line + "\n")
-        self.stream.flush()
-
-    def note(self, text: str) -> None:
-        self.stream.write(("\n" if self.tty else "") + f"alight chart: {text}\n")
         self.stream.flush()
 
 
@@ -440,8 +441,9 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
 
     settings = config.settings
     results = [SettingResult(s) for s in settings]
-    judged = [res for res in results if res.setting.judged_by_truth]
-    progress = Progress(1 + len(envs) * (1 + len(settings)), stream)
+    # Step weights, measured: a reference ~ 10 settings; the furnace and cold LUTs ~ 5.
+    progress = Progress([5.0] + ([REFERENCE_WEIGHT * len(config.roughness) / len(ROUGHNESS)] + [1.0] * len(settings))
+                        * len(envs), stream)
     renderer = Renderer()
     ref_renderer = ReferenceRenderer(renderer)
     error_map = ErrorMap(config.roughness, config.size)

@@ -174,16 +174,17 @@ def write_heatmap(path: str | os.PathLike, values: np.ndarray, vmax: float, labe
     dpi = 100.0
     fig = Figure(figsize=(W / dpi, H / dpi), dpi=dpi, facecolor="white")
     fig.figimage(rgb, xo=0, yo=COLORBAR_HEIGHT, origin="upper")
-    ax = fig.add_axes((0.04, 24.0 / H, 0.92, 10.0 / H))
+    # The strip under the map, bottom up: tick labels (0-18 px), the bar (20-28), the label (31-43).
+    ax = fig.add_axes((0.04, 20.0 / H, 0.92, 8.0 / H))
     gradient = np.linspace(0.0, 1.0, 256)[None, :]
     ax.imshow(gradient, aspect="auto", cmap=cmap, extent=(0.0, vmax, 0.0, 1.0))
     ax.set_yticks([])
-    ticks = np.linspace(0.0, vmax, 5)
+    ticks = np.linspace(0.0, vmax, 6)
     ax.set_xticks(ticks)
     ax.set_xticklabels([f"{t * 100:g}%" if percent else f"{t:g}" for t in ticks], fontsize=6)
     ax.tick_params(axis="x", length=2, pad=1)
-    fig.text(0.5, 36.0 / H, label + (f" (clipped at {vmax * 100:g}%)" if percent else ""),
-             ha="center", va="bottom", fontsize=6.5)
+    fig.text(0.5, 31.0 / H, label + (f" (clipped at {vmax * 100:g}%)" if percent else ""),
+             ha="center", va="bottom", fontsize=6)
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi, format="png")
