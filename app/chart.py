@@ -328,24 +328,28 @@ def _probe_scene(setting: Setting, material):
                  multiple_scattering=setting.multiple_scattering)
 
 
-def _frame_seconds(renderer, setting: Setting, maps, mesh, size, repeats: int) -> float:
+def frame_seconds_interleaved(renderer, items, mesh, size, repeats: int) -> list[float]:
     """Median seconds of a frame of the material ball (default material, camera view, the
-    environment behind it), render + finish, no read-back."""
+    environment behind it; render + finish, no read-back) for each (setting, maps) of ``items``.
+    The repeats go round the settings in turn, so a burst of load from other work on the machine
+    falls on all of them alike rather than on one."""
     from app.material import Material
     from app.scene import Scene
 
-    scene = Scene(mesh=mesh, material=Material(), ibl_model=setting.ibl_model,
-                  multiple_scattering=setting.multiple_scattering)
     w, h = size
-    renderer.render(scene, maps, w, h, read_linear=False, read_srgb=False)   # programs, targets
-    renderer.ctx.finish()
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
+    scenes = [Scene(mesh=mesh, material=Material(), ibl_model=s.ibl_model, multiple_scattering=s.multiple_scattering)
+              for s, _ in items]
+    for scene, (_, maps) in zip(scenes, items):    # compile the programs, make the targets
         renderer.render(scene, maps, w, h, read_linear=False, read_srgb=False)
-        renderer.ctx.finish()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
+    renderer.ctx.finish()
+    times = [[] for _ in items]
+    for _ in range(repeats):
+        for k, (scene, (_, maps)) in enumerate(zip(scenes, items)):
+            t = time.perf_counter()
+            renderer.render(scene, maps, w, h, read_linear=False, read_srgb=False)
+            renderer.ctx.finish()
+            times[k].append(time.perf_counter() - t)
+    return [statistics.median(t) for t in times]
 
 
 def _furnace(renderer, setting: Setting, maps, size: int) -> list[tuple[float, float, float, float]]:
@@ -478,6 +482,7 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                     for p in presets for r in config.roughness}
             ref_srgb = {k: tonemapped_srgb(v) for k, v in refs.items()}
             bakes = {}
+            frame_items = []
             for res in results:
                 s = res.setting
                 if s.bake_key not in bakes:
@@ -486,8 +491,7 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                 res.bake_seconds.append(bake_s)
                 maps = _with_lut(renderer, maps, s.quality)
                 if e == 0:
-                    res.frame_seconds = _frame_seconds(renderer, s, maps, ball, config.frame_size,
-                                                       config.frame_repeats)
+                    frame_items.append((res, maps))
                 if s.judged_by_truth:
                     test_tiles, ref_tiles, cells = [], [], []
                     for p in presets:
@@ -511,6 +515,11 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                         tile = flip_map[i * cell + pad:i * cell + pad + size, j * cell + pad:j * cell + pad + size]
                         res.cases.append((env_name, pname, r, rel, float(tile[terms.inside].mean())))
                 progress.step(f"{env_name}: {s.name}")
+            if frame_items:
+                medians = frame_seconds_interleaved(renderer, [(r.setting, m) for r, m in frame_items], ball,
+                                                    config.frame_size, config.frame_repeats)
+                for (res, _), seconds in zip(frame_items, medians):
+                    res.frame_seconds = seconds
             for maps, _ in bakes.values():
                 maps.release()
     finally:

@@ -65,9 +65,10 @@ def _error_panel(ax, rows, time_key: str, front_key: str, xlabel: str) -> None:
         ys = [r["rel_mae_mean"] * 100 for r in front]
         ax.step(xs, ys, where="post", color="black", lw=1.0, alpha=0.6, zorder=2, label="Pareto frontier")
         ax.scatter(xs, ys, s=130, facecolors="none", edgecolors="black", lw=1.0, zorder=4)
-        for r in front:
-            ax.annotate(r["setting"], (r[time_key], r["rel_mae_mean"] * 100), xytext=(5, 4),
-                        textcoords="offset points", fontsize=7)
+        offsets = ((5, 4), (5, -11), (-10, 12), (-10, -16))   # neighbours' labels apart
+        for k, r in enumerate(front):
+            ax.annotate(r["setting"], (r[time_key], r["rel_mae_mean"] * 100), xytext=offsets[k % len(offsets)],
+                        textcoords="offset points", fontsize=7, ha="left" if k % 4 < 2 else "right")
     ax.set_xscale("log")
     ax.set_yscale("log")
     if pts:

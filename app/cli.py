@@ -610,7 +610,7 @@ def _chart(args) -> int:
     config = ChartConfig(envs=envs, presets=presets, size=args.size,
                          roughness=QUICK_ROUGHNESS if args.quick else ChartConfig.__dataclass_fields__["roughness"].default,
                          frame_size=(320, 180) if args.quick else (1280, 720),
-                         frame_repeats=3 if args.quick else 5, settings=sweep(args.quick))
+                         frame_repeats=3 if args.quick else 7, settings=sweep(args.quick))
     start = time.perf_counter()
     results = run_chart(config, args.out)
     out = Path(args.out)
