@@ -91,13 +91,14 @@ class Setting:
 
 
 def sweep(quick: bool = False) -> list[Setting]:
-    """The settings, one factor at a time around ``medium`` and the first IBL model."""
-    from app.ibl_models import IBL_MODELS
+    """The settings, one factor at a time around ``medium`` and the default IBL model; then the
+    other models at ``medium``; then multiple scattering on, for every model."""
+    from app.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 
     base = QUALITY["medium"]
-    models = list(IBL_MODELS)
-    lead = models[0]
-    out = [Setting("medium", "baseline", base, lead)]
+    lead = DEFAULT_IBL_MODEL if DEFAULT_IBL_MODEL in IBL_MODELS else next(iter(IBL_MODELS))
+    models = [lead] + [m for m in IBL_MODELS if m != lead]
+    out = [Setting(f"medium ({lead})", "baseline", base, lead)]
 
     def add(name, factor, **changes):
         out.append(Setting(name, factor, replace(base, name=name, **changes), lead))

@@ -124,8 +124,13 @@ def plot_error_map(error_map, path: Path, title: str) -> Path:
     from matplotlib.colors import LogNorm
 
     models = list(error_map.num)
-    fig = _figure(6.2 * len(models) + 1.0, 5.2)
-    axes = np.atleast_1d(fig.subplots(1, len(models), squeeze=False)[0])
+    cols = min(3, len(models))
+    rows = (len(models) + cols - 1) // cols
+    fig = _figure(6.0 * cols + 1.2, 4.6 * rows + 0.6)
+    grid = fig.subplots(rows, cols, squeeze=False)
+    axes = grid.ravel()[:len(models)]
+    for ax in grid.ravel()[len(models):]:
+        ax.set_visible(False)
     rs = np.asarray(error_map.roughness)
     edges_r = np.arange(len(rs) + 1) - 0.5     # one equal row per roughness value
     nb = error_map.bins.max() + 1
@@ -149,7 +154,7 @@ def plot_error_map(error_map, path: Path, title: str) -> Path:
         ax.set_yticks(range(len(rs)), [f"{r:g}" for r in rs])
         ax.set_title(f"IBL model '{m}': relMAE per bin (%)", fontsize=9)
     if mesh is not None:
-        bar = fig.colorbar(mesh, ax=list(axes), label="sum|render - truth| / sum|truth| in the bin (%, log)")
+        bar = fig.colorbar(mesh, ax=list(grid.ravel()), label="sum|render - truth| / sum|truth| in the bin (%, log)")
         _plain_log_ticks(bar.ax.yaxis, norm.vmin, norm.vmax)
     fig.suptitle(f"Where the split sum fails: quality medium, all presets and environments pooled\n{title}",
                  fontsize=9)
