@@ -34,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
+import json
 import math
 import os
 import statistics
@@ -615,13 +616,34 @@ def write_outputs(results, error_map: ErrorMap, config: ChartConfig, out_dir: Pa
             for b in range(NV_BINS):
                 map_rows.append([model, _fmt(r), _fmt(b / NV_BINS), _fmt((b + 1) / NV_BINS), _fmt(float(rel[i, b]))])
     write_text_atomic(out_dir / "error_map.csv", _csv_text(("ibl_model", "roughness", "nv_lo", "nv_hi", "rel_mae"), map_rows))
-    from app.chart_plot import plot_chart, plot_error_map
-
     title = (f"{len(config.envs)} environment(s), {len(config.presets)} presets, roughness "
              f"{', '.join(f'{r:g}' for r in config.roughness)}, probe {config.size}x{config.size}")
-    plot_chart(rows, results, out_dir / "chart.png", title, config.frame_size, truth_furnace)
-    if error_map.num:
-        plot_error_map(error_map, out_dir / "error_map.png", title)
+    frame = f"material ball at {config.frame_size[0]}x{config.frame_size[1]}, median"
+    write_text_atomic(out_dir / "chart_meta.json", json.dumps({"title": title, "frame": frame}) + "\n")
+    replot(out_dir)
+
+
+def replot(out_dir: str | os.PathLike) -> list[Path]:
+    """Draw chart.png and error_map.png from the CSVs (and chart_meta.json) in ``out_dir``."""
+    from app.chart_plot import plot_chart, plot_error_map
+
+    out_dir = Path(out_dir)
+    try:
+        meta = json.loads((out_dir / "chart_meta.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        meta = {"title": "", "frame": "material ball, median"}
+    written = [plot_chart(read_summary(out_dir / "chart.csv"), read_summary(out_dir / "furnace.csv"),
+                          out_dir / "chart.png", meta["title"], meta["frame"])]
+    maps: dict[str, dict[float, dict[float, float]]] = {}
+    for row in read_summary(out_dir / "error_map.csv"):
+        maps.setdefault(row["ibl_model"], {}).setdefault(row["roughness"], {})[row["nv_lo"]] = row["rel_mae"]
+    if maps:
+        arrays = {}
+        for model, by_r in maps.items():
+            rs = sorted(by_r)
+            arrays[model] = (rs, np.array([[by_r[r][b] for b in sorted(by_r[r])] for r in rs]))
+        written.append(plot_error_map(arrays, out_dir / "error_map.png", meta["title"]))
+    return written
 
 
 def _remember(csv_path: Path) -> None:

@@ -69,6 +69,10 @@ def _error_panel(ax, rows, time_key: str, front_key: str, xlabel: str) -> None:
         for k, r in enumerate(front):
             ax.annotate(r["setting"], (r[time_key], r["rel_mae_mean"] * 100), xytext=offsets[k % len(offsets)],
                         textcoords="offset points", fontsize=7, ha="left" if k % 4 < 2 else "right")
+    for r in pts:   # the models (and the baseline, which is the default model) are always named
+        if r["factor"] in ("IBL model", "baseline") and not r[front_key]:
+            ax.annotate(r["setting"].replace("model ", ""), (r[time_key], r["rel_mae_mean"] * 100), xytext=(6, -3),
+                        textcoords="offset points", fontsize=7, color="tab:pink" if r["factor"] == "IBL model" else "black")
     ax.set_xscale("log")
     ax.set_yscale("log")
     if pts:
@@ -81,37 +85,41 @@ def _error_panel(ax, rows, time_key: str, front_key: str, xlabel: str) -> None:
     ax.grid(True, which="both", alpha=0.25)
 
 
-def plot_chart(rows: list[dict], results, path: Path, title: str, frame_size, furnace_truth=None) -> Path:
+def plot_chart(rows: list[dict], furnace: list[dict], path: Path, title: str, frame_label: str) -> Path:
+    """chart.png from chart.csv's rows and furnace.csv's rows (dicts, numbers as float)."""
     fig = _figure(18.0, 6.2)
     axes = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.15, 1.15, 0.9]})
     _error_panel(axes[0], rows, "bake_ms", "pareto_bake",
                  "bake time per environment, warm, LUT cached (ms, log)")
     axes[0].set_title("error against bake time")
-    _error_panel(axes[1], rows, "frame_ms", "pareto_frame",
-                 f"frame time: material ball at {frame_size[0]}x{frame_size[1]}, median (ms, log)")
+    _error_panel(axes[1], rows, "frame_ms", "pareto_frame", f"frame time: {frame_label} (ms, log)")
     axes[1].set_title("error against frame time")
     axes[0].legend(fontsize=7, loc="best", framealpha=0.85)
 
     ax = axes[2]
     cmap = __import__("matplotlib").colormaps["tab10"]
+    factor = {r["setting"]: r["factor"] for r in rows}
     models = []
-    for res in results:
-        s = res.setting
-        if s.factor not in ("baseline", "IBL model", "multiple scattering") or not res.furnace:
+    for name in dict.fromkeys(f["setting"] for f in furnace):
+        fs = [f for f in furnace if f["setting"] == name]
+        if name == "ground truth":
+            ax.plot([f["roughness"] for f in fs], [f["mean"] for f in fs], "k:", lw=1.6,
+                    label="ground truth (single scattering)")
             continue
-        if s.ibl_model not in models:
-            models.append(s.ibl_model)
-        colour = cmap(models.index(s.ibl_model) % 10)
-        rs = [f[0] for f in res.furnace]
-        ax.plot(rs, [f[1] for f in res.furnace], "-o" if not s.multiple_scattering else "--s", color=colour, ms=4,
-                label=f"{s.ibl_model}, MS {'on' if s.multiple_scattering else 'off'}")
-        ax.fill_between(rs, [f[2] for f in res.furnace], [f[3] for f in res.furnace], color=colour, alpha=0.12)
-    truth = furnace_truth
-    if truth:
-        ax.plot([t[0] for t in truth], [t[1] for t in truth], "k:", lw=1.6, label="ground truth (single scattering)")
+        if factor.get(name) not in ("baseline", "IBL model", "multiple scattering"):
+            continue
+        model, ms = fs[0]["ibl_model"], bool(fs[0]["multiple_scattering"])
+        if model not in models:
+            models.append(model)
+        colour = cmap(models.index(model) % 10)
+        rs = [f["roughness"] for f in fs]
+        ax.plot(rs, [f["mean"] for f in fs], "--s" if ms else "-o", color=colour, ms=4,
+                label=f"{model}, MS {'on' if ms else 'off'}")
+        ax.fill_between(rs, [f["min"] for f in fs], [f["max"] for f in fs], color=colour, alpha=0.12)
     ax.axhline(1.0, color="black", lw=0.8, ls="-", alpha=0.4)
     ax.set_xlabel("roughness")
     ax.set_ylabel("probe radiance, mean over the ball (band: min..max)")
+    ax.set_ylim(top=1.06)
     ax.set_title("white furnace: metal F0 = 1, radiance 1\n(MS on should give 1)", fontsize=10)
     ax.legend(fontsize=7, loc="lower left")
     ax.grid(True, alpha=0.25)
@@ -120,10 +128,11 @@ def plot_chart(rows: list[dict], results, path: Path, title: str, frame_size, fu
     return path
 
 
-def plot_error_map(error_map, path: Path, title: str) -> Path:
+def plot_error_map(maps: dict[str, tuple[list[float], np.ndarray]], path: Path, title: str) -> Path:
+    """error_map.png: per IBL model, (roughness values, relMAE (R, n.v bins) as a fraction)."""
     from matplotlib.colors import LogNorm
 
-    models = list(error_map.num)
+    models = list(maps)
     cols = min(3, len(models))
     rows = (len(models) + cols - 1) // cols
     fig = _figure(6.0 * cols + 1.2, 4.6 * rows + 0.6)
@@ -131,11 +140,11 @@ def plot_error_map(error_map, path: Path, title: str) -> Path:
     axes = grid.ravel()[:len(models)]
     for ax in grid.ravel()[len(models):]:
         ax.set_visible(False)
-    rs = np.asarray(error_map.roughness)
+    rs = np.asarray(maps[models[0]][0])
     edges_r = np.arange(len(rs) + 1) - 0.5     # one equal row per roughness value
-    nb = error_map.bins.max() + 1
+    nb = maps[models[0]][1].shape[1]
     edges_nv = np.linspace(0.0, 1.0, int(nb) + 1)
-    rels = {m: error_map.relative(m) * 100 for m in models}
+    rels = {m: np.asarray(maps[m][1], np.float64) * 100 for m in models}
     finite = np.concatenate([v[np.isfinite(v) & (v > 0)] for v in rels.values()])
     lo, hi = (max(float(finite.min()), 0.1), float(finite.max())) if finite.size else (0.1, 100.0)
     norm = LogNorm(vmin=lo, vmax=max(hi, lo * 10))
