@@ -599,7 +599,7 @@ def _chart(args) -> int:
             envs = ["studio"]
         else:
             envs, skipped = equirect_envs(env_dir)
-            for line in skipped:
+            for line in [] if args.quick else skipped:
                 print(f"alight chart: skipped {line}", file=sys.stderr)
             if args.quick:
                 pick = [e for e in envs if "royal_esplanade" in e]
