@@ -72,27 +72,27 @@ def test_reference_terms_combine_to_the_direct_reference():
     from app.reference import ReferenceRenderer, probe_gbuffer
     from app.scene import Scene
 
+    from tests.gpu import renderer
+
     rng = np.random.default_rng(3)
     radiance = (rng.uniform(0.0, 1.0, (16, 32, 3)) * np.linspace(0.2, 3.0, 32)[None, :, None]).astype(np.float32)
-    ref = ReferenceRenderer()
-    try:
-        size, rs = 12, (0.3, 0.8)
-        terms = reference_terms(ref, radiance, size, rs)
-        for mat in (load_preset("gold"), load_preset("water"), Material(base_color=(0.2, 0.5, 0.9), metallic=0.4,
-                                                                        specular_f0=(0.1, 0.05, 0.02),
-                                                                        emissive=(0.1, 0.0, 0.0))):
-            for r in rs:
-                m = replace(mat, roughness=r)
-                direct = ref.render_gbuffer(probe_gbuffer(size, m), Scene(view="probe"), radiance, env_level=1).linear
-                combined = terms.combine(m, r)
-                inside = terms.inside
-                assert np.array_equal(combined[..., 3] > 0, inside)
-                err = np.abs(combined[..., :3] - direct[..., :3])[inside].sum() / np.abs(direct[..., :3])[inside].sum()
-                assert err < 1e-4, (mat.name, r, err)
-        with pytest.raises(ValueError):
-            terms.combine(load_preset("gold"), 0.5)
-    finally:
-        ref.renderer.release()
+    # The tests' one shared GL context: a second context would leave the others' not current.
+    ref = ReferenceRenderer(renderer())
+    size, rs = 12, (0.3, 0.8)
+    terms = reference_terms(ref, radiance, size, rs)
+    for mat in (load_preset("gold"), load_preset("water"), Material(base_color=(0.2, 0.5, 0.9), metallic=0.4,
+                                                                    specular_f0=(0.1, 0.05, 0.02),
+                                                                    emissive=(0.1, 0.0, 0.0))):
+        for r in rs:
+            m = replace(mat, roughness=r)
+            direct = ref.render_gbuffer(probe_gbuffer(size, m), Scene(view="probe"), radiance, env_level=1).linear
+            combined = terms.combine(m, r)
+            inside = terms.inside
+            assert np.array_equal(combined[..., 3] > 0, inside)
+            err = np.abs(combined[..., :3] - direct[..., :3])[inside].sum() / np.abs(direct[..., :3])[inside].sum()
+            assert err < 1e-4, (mat.name, r, err)
+    with pytest.raises(ValueError):
+        terms.combine(load_preset("gold"), 0.5)
 
 
 def test_error_map_bins_by_nv_and_roughness():
