@@ -241,6 +241,33 @@ def build_parser() -> argparse.ArgumentParser:
                     help="linear float32 RGBA radiance, alpha 1 on the surface (CONVENTIONS.md); .exr only")
     rd.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer, the level and the times")
     # --- end alight reference -----------------------------------------------------------------
+    # --- alight compare / alight chart (app/metrics.py, app/chart.py) -----------------------
+    cp = sub.add_parser("compare", help="error of a linear image against a reference: relMAE and FLIP",
+                        description="Compare two linear .exr images (e.g. 'alight render --view probe --out t.exr' "
+                                    "against 'alight reference --out r.exr'): the relative mean absolute error "
+                                    "sum|test-ref|/sum|ref| over the covered pixels (alpha > 0) and RGB, and NVIDIA's "
+                                    "FLIP on the ACES-tone-mapped sRGB images.")
+    cp.add_argument("test", metavar="TEST.exr")
+    cp.add_argument("ref", metavar="REF.exr")
+    cp.add_argument("--heatmap", metavar="OUT.png", help="write the per-pixel relative error as a heat map")
+    cp.add_argument("--flip-heatmap", metavar="OUT.png", help="write the per-pixel FLIP error as a heat map")
+    cp.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
+                    help="exposure before tone mapping, for FLIP (default: 0)")
+    ch = sub.add_parser("chart", help="sweep the IBL settings: bake time, frame time, error against the ground truth",
+                        description="Measure, one factor at a time around the medium quality, every IBL setting "
+                                    "(irradiance method and size, specular cube size, sample counts, filtered "
+                                    "importance sampling, LUT size and samples, every IBL model, multiple "
+                                    "scattering judged by the white furnace) against the GPU ground truth on the "
+                                    "presets x roughness x environments. Writes CSVs and PNG charts (app/chart.py).")
+    ch.add_argument("--quick", action="store_true",
+                    help="a small sweep: royal_esplanade only, 3 presets, 3 roughness values, a few settings")
+    ch.add_argument("--env", action="append", metavar="MAP",
+                    help="an environment (repeatable; default: every 2:1 map in ../shared/data/env, else studio)")
+    ch.add_argument("--presets", metavar="A,B,...", help="presets to measure (default: all; --quick: gold, "
+                                                          "plastic_high, water)")
+    ch.add_argument("--size", type=int, default=32, metavar="N", help="probe size for the errors (default: 32)")
+    ch.add_argument("--out", default="alight-chart", metavar="DIR", help="output folder (default: alight-chart)")
+    # --- end alight compare / alight chart ---------------------------------------------------
     sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
     _add_edit_parser(sub)
     return parser
@@ -269,6 +296,10 @@ def main(argv: list[str] | None = None) -> int:
             return _export(args)
         if args.command == "reference":  # alight reference
             return _reference(args)
+        if args.command == "compare":  # alight compare
+            return _compare(args)
+        if args.command == "chart":  # alight chart
+            return _chart(args)
         if args.command == "batch":  # alight batch
             if args.workers is not None and args.workers < 1:
                 raise AlightError(f"--workers: {args.workers} must be at least 1")
@@ -567,3 +598,74 @@ def _reference(args) -> int:
     print(out)
     return 0
 # --- end alight reference -----------------------------------------------------------------
+
+
+# --- alight compare / alight chart (app/metrics.py, app/chart.py) ---------------------------
+def _compare(args) -> int:
+    from app.output import check_output_path
+
+    for opt, path in (("--heatmap", args.heatmap), ("--flip-heatmap", args.flip_heatmap)):
+        if path:
+            check_output_path(path, (".png",))
+    from app.metrics import compare_linear, read_linear, write_flip_heatmap, write_relative_heatmap
+
+    test, ref = read_linear(args.test), read_linear(args.ref)
+    if test.shape[:2] != ref.shape[:2]:
+        raise AlightError(f"{args.test}: {test.shape[1]}x{test.shape[0]} does not match {args.ref}'s "
+                          f"{ref.shape[1]}x{ref.shape[0]}")
+    c = compare_linear(test, ref, args.exposure)
+    if c.covered == 0:
+        raise AlightError(f"{args.ref}: no covered pixel (alpha is 0 everywhere)")
+    print(f"relMAE {c.relative_mae * 100:.4g}%  FLIP {c.flip:.4g}  over {c.covered} covered pixels")
+    if args.heatmap:
+        print(write_relative_heatmap(args.heatmap, c.relative_map))
+    if args.flip_heatmap:
+        print(write_flip_heatmap(args.flip_heatmap, c.flip_map))
+    return 0
+
+
+def _chart(args) -> int:
+    from pathlib import Path
+
+    from app.chart import (QUICK_PRESETS, QUICK_ROUGHNESS, ChartConfig, default_env_dir, equirect_envs, run_chart,
+                           sweep)
+    from app.material import list_presets
+
+    if args.size < 8 or args.size > 256:
+        raise AlightError(f"--size: {args.size} must be from 8 to 256")
+    if args.env:
+        envs = list(args.env)
+    else:
+        env_dir = default_env_dir()
+        if env_dir is None:
+            envs = ["studio"]
+        else:
+            envs, skipped = equirect_envs(env_dir)
+            for line in [] if args.quick else skipped:
+                print(f"alight chart: skipped {line}", file=sys.stderr)
+            if args.quick:
+                pick = [e for e in envs if "royal_esplanade" in e]
+                envs = pick or envs[:1] or ["studio"]
+    presets = list(QUICK_PRESETS) if args.quick else list_presets()
+    if args.presets:
+        presets = [p.strip() for p in args.presets.split(",") if p.strip()]
+    config = ChartConfig(envs=envs, presets=presets, size=args.size,
+                         roughness=QUICK_ROUGHNESS if args.quick else ChartConfig.__dataclass_fields__["roughness"].default,
+                         frame_size=(320, 180) if args.quick else (1280, 720),
+                         frame_repeats=3 if args.quick else 7, settings=sweep(args.quick))
+    start = time.perf_counter()
+    results = run_chart(config, args.out)
+    out = Path(args.out)
+    print(f"{len(results)} settings x {len(envs)} environment(s) in {time.perf_counter() - start:.0f} s")
+    print(f"{'setting':34s} {'bake ms':>8s} {'frame ms':>9s} {'relMAE %':>9s} {'max %':>7s} {'FLIP':>6s} "
+          f"{'furnace r=1':>11s}")
+    for res in results:
+        fr = [f[1] for f in res.furnace if f[0] == 1.0]
+        print(f"{res.setting.name:34s} {res.bake_median * 1000:8.0f} {res.frame_seconds * 1000:9.1f} "
+              f"{res.rel_mean * 100:9.2f} {res.rel_max * 100:7.1f} {res.flip_mean:6.3f} "
+              f"{fr[0] if fr else float('nan'):11.3f}")
+    for name in ("chart.csv", "chart_cases.csv", "furnace.csv", "error_map.csv", "chart.png", "error_map.png"):
+        if (out / name).exists():
+            print(out / name)
+    return 0
+# --- end alight compare / alight chart ---------------------------------------------------

@@ -78,6 +78,11 @@ class Panel:
             self._display(s, win)
         if imgui.collapsing_header("Performance", imgui.TreeNodeFlags_.default_open):
             self._performance(win)
+        if imgui.collapsing_header("Accuracy chart"):   # the latest 'alight chart' (app/editor/chart_view.py)
+            from app.editor.chart_view import ChartView
+
+            self.chart_view = getattr(self, "chart_view", None) or ChartView()
+            self.chart_view.draw()
         imgui.end()
         self.browser.draw()
 

@@ -1,0 +1,217 @@
+"""app/chart.py: the sweep's design, the reference's basis-material decomposition, the Pareto
+frontier, the error map, and ``alight chart --quick`` end to end. No timing is asserted."""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import subprocess
+import sys
+from dataclasses import fields, replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app.bake import QUALITY
+from app.chart import (NV_BINS, ErrorMap, Setting, pareto, read_summary, reference_terms, sweep)
+from app.ibl_models import IBL_MODELS
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+# Fields that are one knob together: the convolution's step counts; the prefilter's sample count
+# and its per-mip cap (raised with it so the first mip gets the count asked for).
+KNOBS = {"irradiance_theta_steps": "irradiance_phi_steps", "prefilter_max_samples": "prefilter_samples"}
+
+
+def _changed_fields(setting: Setting) -> set[str]:
+    base = QUALITY["medium"]
+    return {KNOBS.get(f.name, f.name) for f in fields(base)
+            if f.name != "name" and getattr(setting.quality, f.name) != getattr(base, f.name)}
+
+
+def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
+    settings = sweep()
+    names = [s.name for s in settings]
+    assert len(names) == len(set(names))
+    assert settings[0].factor == "baseline" and not _changed_fields(settings[0])
+    for s in settings[1:]:
+        changed = _changed_fields(s)
+        if s.factor in ("IBL model", "multiple scattering"):
+            assert not changed, (s.name, changed)
+        else:
+            assert len(changed) == 1 and s.ibl_model == settings[0].ibl_model, (s.name, changed)
+    qs = [s.quality for s in settings]
+    assert {q.irradiance for q in qs} == {"convolution", "sh9"}
+    assert len({(q.irradiance_phi_steps, q.irradiance_theta_steps) for q in qs}) >= 3
+    assert len({q.irradiance_size for q in qs}) >= 3
+    assert len({q.prefiltered_size for q in qs}) >= 3
+    samples = {q.prefilter_samples for q in qs}
+    assert min(samples) == 4 and max(samples) == 1024
+    assert {q.filtered_importance_sampling for q in qs} == {True, False}
+    assert len({q.lut_size for q in qs}) >= 3 and len({q.lut_samples for q in qs}) >= 3
+    # every IBL model, each judged against the truth with MS off and by the furnace with MS on
+    judged = {s.ibl_model for s in settings if s.judged_by_truth}
+    furnace_only = {s.ibl_model for s in settings if s.multiple_scattering}
+    assert judged == set(IBL_MODELS) == furnace_only
+    quick = sweep(quick=True)
+    assert len(quick) < len(settings) and {s.ibl_model for s in quick} == set(IBL_MODELS)
+
+
+def test_pareto_frontier():
+    pts = [(1.0, 10.0), (2.0, 5.0), (3.0, 6.0), (4.0, 1.0), (2.0, 5.0), (math.nan, 0.1), (5.0, 1.0)]
+    assert pareto(pts) == [True, True, False, True, True, False, False]
+
+
+def test_reference_terms_combine_to_the_direct_reference():
+    """The three basis materials give any material's ground truth (the BRDF is linear in F0 and
+    the base colour): checked against a direct GPU reference of each material."""
+    from app.material import Material, load_preset
+    from app.reference import ReferenceRenderer, probe_gbuffer
+    from app.scene import Scene
+
+    from tests.gpu import renderer
+
+    rng = np.random.default_rng(3)
+    radiance = (rng.uniform(0.0, 1.0, (16, 32, 3)) * np.linspace(0.2, 3.0, 32)[None, :, None]).astype(np.float32)
+    # The tests' one shared GL context: a second context would leave the others' not current.
+    ref = ReferenceRenderer(renderer())
+    size, rs = 12, (0.3, 0.8)
+    terms = reference_terms(ref, radiance, size, rs)
+    for mat in (load_preset("gold"), load_preset("water"), Material(base_color=(0.2, 0.5, 0.9), metallic=0.4,
+                                                                    specular_f0=(0.1, 0.05, 0.02),
+                                                                    emissive=(0.1, 0.0, 0.0))):
+        for r in rs:
+            m = replace(mat, roughness=r)
+            direct = ref.render_gbuffer(probe_gbuffer(size, m), Scene(view="probe"), radiance, env_level=1).linear
+            combined = terms.combine(m, r)
+            inside = terms.inside
+            assert np.array_equal(combined[..., 3] > 0, inside)
+            err = np.abs(combined[..., :3] - direct[..., :3])[inside].sum() / np.abs(direct[..., :3])[inside].sum()
+            assert err < 1e-4, (mat.name, r, err)
+    with pytest.raises(ValueError):
+        terms.combine(load_preset("gold"), 0.5)
+
+
+def test_error_map_bins_by_nv_and_roughness():
+    size = 32
+    em = ErrorMap((0.25, 0.5), size)
+    ref = np.ones((size, size, 4), np.float32)
+    test = ref.copy()
+    from app.shading import probe_normals
+
+    n, inside = probe_normals(size)
+    test[..., :3] += np.where(n[..., 2:3] < 0.3, 0.5, 0.0)     # wrong only near grazing
+    em.add("m", 0.5, test, ref)
+    em.add("m", 0.25, ref, ref)
+    rel = em.relative("m")
+    assert rel.shape == (2, NV_BINS)
+    assert np.all(rel[0] == 0.0)                                  # r = 0.25: exact
+    assert np.allclose(rel[1, :3], 0.5) and np.all(rel[1, 3:] == 0.0)
+
+
+@pytest.fixture(scope="module")
+def quick_chart(tmp_path_factory):
+    """``alight chart --quick`` run once for the tests below: (its output folder, the process)."""
+    out = tmp_path_factory.mktemp("chart") / "chart"
+    proc = subprocess.run([sys.executable, "-m", "app", "chart", "--quick", "--size", "16", "--out", str(out)],
+                          cwd=REPO, env=dict(os.environ), capture_output=True, text=True, timeout=600)
+    return out, proc
+
+
+def test_chart_quick_end_to_end(quick_chart):
+    out, proc = quick_chart
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "Traceback" not in proc.stderr
+    steps = [l for l in proc.stderr.splitlines() if "step " in l]
+    assert steps and "ETA" in steps[-1] and steps[-1].split("step ")[1].split()[0].split("/")[0] == \
+        steps[-1].split("step ")[1].split()[0].split("/")[1]
+    for name in ("chart.csv", "chart_cases.csv", "furnace.csv", "error_map.csv", "chart.png", "error_map.png"):
+        assert (out / name).is_file() and (out / name).stat().st_size > 0, name
+    rows = read_summary(out / "chart.csv")
+    assert [r["setting"] for r in rows] == [s.name for s in sweep(quick=True)]
+    for r in rows:
+        assert r["bake_ms"] > 0 and r["frame_ms"] > 0 and r["lut_cold_ms"] > 0
+        assert 0.0 < r["furnace_min"] <= r["furnace_mean"] <= r["furnace_max"] <= 1.05
+        if r["multiple_scattering"]:
+            assert math.isnan(r["rel_mae_mean"]) and math.isnan(r["flip_mean"])   # kept out of the truth
+        else:
+            assert 0.0 < r["rel_mae_mean"] <= r["rel_mae_max"] < 2.0
+            assert 0.0 < r["flip_mean"] < 1.0
+    assert any(r["pareto_bake"] for r in rows) and any(r["pareto_frame"] for r in rows)
+    with open(out / "chart_cases.csv", newline="") as f:
+        cases = list(csv.DictReader(f))
+    judged = [r for r in rows if not r["multiple_scattering"]]
+    assert len(cases) == len(judged) * 3 * 3          # 3 presets x 3 roughness values, one environment
+    # The baseline's summary is the mean of its cases.
+    base = [float(c["rel_mae"]) for c in cases if c["setting"] == rows[0]["setting"]]
+    assert rows[0]["rel_mae_mean"] == pytest.approx(np.mean(base), rel=1e-4)
+    # The furnace: a constant environment of 1, a metal with F0 = 1: at r = 0 the mirror gives 1.
+    with open(out / "furnace.csv", newline="") as f:
+        furnace = list(csv.DictReader(f))
+    mirror = [float(r["mean"]) for r in furnace if float(r["roughness"]) == 0.0]
+    assert mirror and all(abs(v - 1.0) < 0.01 for v in mirror)
+    truth = [r for r in furnace if r["setting"] == "ground truth"]
+    assert truth and all(0.0 < float(r["mean"]) <= 1.0 for r in truth)
+    import OpenImageIO as oiio
+
+    for png in ("chart.png", "error_map.png"):
+        spec = oiio.ImageInput.open(str(out / png)).spec()
+        assert spec.width > 500 and spec.height > 300
+
+
+def test_chart_refuses_a_bad_environment(tmp_path, shared_data):
+    bad = shared_data / "env" / "memorial.exr"
+    proc = subprocess.run([sys.executable, "-m", "app", "chart", "--quick", "--env", str(bad), "--out",
+                           str(tmp_path / "c")], cwd=REPO, env=dict(os.environ), capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("alight: error: ") and "memorial.exr" in lines[0], proc.stderr
+    assert not (tmp_path / "c").exists()
+
+
+def test_editor_chart_view_reads_and_draws_the_latest_chart(quick_chart):
+    """The panel's view finds the chart the last run noted, loads its series and draws them with
+    implot (an imgui frame without a window: the draw calls run, nothing is shown)."""
+    from app.editor.chart_view import ChartView, find_chart_csv, load_chart
+
+    out, proc = quick_chart
+    assert proc.returncode == 0
+    assert find_chart_csv() == (out / "chart.csv").resolve()      # noted in ALIGHT_CACHE_DIR by the run
+    data = load_chart(out / "chart.csv")
+    rows = read_summary(out / "chart.csv")
+    judged = [r for r in rows if math.isfinite(r["rel_mae_mean"])]
+    assert sum(len(x) for x, _, _ in data.factors.values()) == len(judged)
+    assert data.frontier[2] and set(data.frontier[2]) == {r["setting"] for r in judged if r["pareto_bake"] == 1.0}
+    assert np.all(np.diff(data.frontier[0]) >= 0) and np.all(np.diff(data.frontier[1]) <= 0)
+
+    from imgui_bundle import imgui, implot
+
+    ctx = imgui.create_context()
+    implot.create_context()
+    try:
+        io = imgui.get_io()
+        io.display_size = imgui.ImVec2(600, 500)
+        io.delta_time = 1 / 60
+        io.backend_flags |= imgui.BackendFlags_.renderer_has_textures.value
+        view = ChartView()
+        for _ in range(2):
+            imgui.new_frame()
+            imgui.begin("chart")
+            view.draw()
+            imgui.end()
+            imgui.render()
+        assert view.error == "" and view.data is not None and view.data.settings == len(rows)
+        broken = ChartView(out / "error_map.png")        # not a chart CSV: one line, no exception
+        imgui.new_frame()
+        imgui.begin("chart")
+        broken.draw()
+        imgui.end()
+        imgui.render()
+        assert broken.data is None and "error_map.png" in broken.error
+    finally:
+        implot.destroy_context()
+        imgui.destroy_context(ctx)
