@@ -171,6 +171,9 @@ class IBLMaps:
     # that roughness step of the prefiltered map per unit P (n.l) D(h) (prefilter.glsl).
     suns: list[Sun] = field(default_factory=list)
     sun_prefilter_scale: list[float] = field(default_factory=list)
+    # The source cube without the compact sources (None when there are none): below the
+    # prefiltered grid the models that shade the sources exactly read it instead of environment.
+    lighting_environment: moderngl.TextureCube | None = None
 
     @property
     def prefiltered_max_mip(self) -> float:
@@ -178,8 +181,10 @@ class IBLMaps:
 
     def release(self) -> None:
         # The LUT is shared between bakes (see LutCache) and released with the cache.
-        for tex in (self.environment, self.irradiance, self.prefiltered_radiance, self.prefiltered_radiance_mid):
-            tex.release()
+        for tex in (self.environment, self.irradiance, self.prefiltered_radiance, self.prefiltered_radiance_mid,
+                    self.lighting_environment):
+            if tex is not None:
+                tex.release()
 
 
 def _groups(size: int, local: int = 8) -> int:
@@ -413,10 +418,6 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
                 yield progress(2.0 * faces / 6, f"prefilter {step + 1}/{prefilter_steps}"
                                + (f" (faces {first + 1}-{first + faces})" if faces > 1 and faces < 6 else
                                   f" (face {first + 1})" if faces == 1 else ""))
-        if lighting is not source:
-            owned.remove(lighting)
-            lighting.release()
-
         lut = _timed(ctx, seconds,
                      f"brdf_lut ({'cached' if luts.path_for(q.lut_size, q.lut_samples).exists() else 'baked'})",
                      lambda: luts.get(q.lut_size, q.lut_samples))
@@ -424,7 +425,8 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
         for tex in owned:
             tex.release()
         raise
-    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns, sun_scale)
+    return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns, sun_scale,
+                   lighting if lighting is not source else None)
 
 
 

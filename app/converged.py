@@ -351,23 +351,24 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     else:
         out = diffuse_weight * albedo * irradiance + spec_weight * prefiltered
     for sun in suns:
-        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r)
+        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
     return out
 
 
-def _sun_exact(n, v, l, power, base, metallic, f0, roughness):
-    """ibl.glsl's sun_light: the exact BRDF (IBL k, F at v.h) times a delta of power P."""
+def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0):
+    """ibl.glsl's sun_light: the exact BRDF (IBL k, F at v.h) times the power P, D widened to
+    alpha' = sqrt(alpha^2 + spread^2) for the source's size."""
     l = np.asarray(l, dtype=np.float64)
     nl = n @ l
     nv = np.maximum(np.sum(n * v, axis=-1), 1e-4)
     h = _unit_rows(l[None, :] + v)
     nh = np.clip(np.sum(n * h, axis=-1), 0.0, 1.0)
     vh = np.clip(np.sum(v * h, axis=-1), 0.0, 1.0)
-    rr = max(roughness, 0.045)
-    a2 = rr ** 4
+    widened = max(float(np.sqrt(np.sqrt(roughness ** 4 + spread ** 2))), 0.045)
+    a2 = widened ** 4
     D = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0) ** 2)
     nlc = np.maximum(nl, 0.0)
-    k = k_ibl(rr)
+    k = k_ibl(max(roughness, 0.045))
     G = G_Smith(nv, np.where(nl > 0, nl, 1.0), k)
     F = f0 + (1.0 - f0) * ((1.0 - vh) ** 5)[:, None]
     spec = (D * G / (4.0 * np.where(nl > 0, nl, 1.0) * nv))[:, None] * F

@@ -15,7 +15,7 @@ import numpy as np
 from app.bake import (QUALITY, BakeQuality, IBLMaps, LutCache, bake_environment, bake_steps,
                       roughness_to_grid_step)
 from app.gpu import ShaderLibrary, create_headless_context
-from app.ibl_models import ibl_model_index
+from app.ibl_models import SUNS_AS_BAKED, ibl_model_index
 from app.material import Material
 from app.mesh import is_closed
 from app.scene import BACKGROUNDS, TONEMAPS, Camera, Display, Scene, frame_camera
@@ -367,7 +367,12 @@ class Renderer:
         if not enabled:
             return
         maps.irradiance.use(UNIT_IRRADIANCE)
-        maps.environment.use(UNIT_ENVIRONMENT)
+        # Models that shade the compact sources exactly read the source cube without them below
+        # the prefiltered grid; the lecture's models read it as seen (ibl.glsl).
+        if scene.ibl_model not in SUNS_AS_BAKED and maps.lighting_environment is not None:
+            maps.lighting_environment.use(UNIT_ENVIRONMENT)
+        else:
+            maps.environment.use(UNIT_ENVIRONMENT)
         maps.prefiltered_radiance.use(UNIT_PREFILTERED)
         maps.prefiltered_radiance_mid.use(UNIT_PREFILTERED_MID)
         maps.brdf_lut.use(UNIT_LUT)
@@ -382,7 +387,9 @@ class Renderer:
         suns = maps.suns[:MAX_SUNS]
         directions = np.zeros((MAX_SUNS, 3), np.float32)
         powers = np.zeros((MAX_SUNS, 3), np.float32)
+        spreads = np.zeros(MAX_SUNS, np.float32)
         for i, sun in enumerate(suns):
+            spreads[i] = sun.spread
             # The map texel in direction m lights world direction R_y(+deg) m (CONVENTIONS.md).
             directions[i] = rotate_world_to_map(sun.direction, -scene.env_rotation_deg)
             powers[i] = np.asarray(sun.power) * scene.env_intensity
@@ -391,6 +398,7 @@ class Renderer:
         _set(program, "u_sun_count", len(suns))
         _set(program, "u_sun_direction", directions.tobytes(), write=True)
         _set(program, "u_sun_power", powers.tobytes(), write=True)
+        _set(program, "u_sun_spread", spreads.tobytes(), write=True)
         _set(program, "u_sun_prefilter_scale", scale.tobytes(), write=True)
 
     def _write_lights(self, scene: Scene) -> None:

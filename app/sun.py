@@ -37,6 +37,7 @@ class Sun:
     power: np.ndarray       # (3,) RGB: the integral of the removed radiance over solid angle
     fraction: float         # of the map's total power (mean over RGB)
     texels: int
+    spread: float = 0.0     # power-weighted RMS angle (radians) of the removed radiance from direction
 
 
 @functools.lru_cache(maxsize=4)
@@ -92,6 +93,8 @@ def extract_sun(radiance: np.ndarray, total: float | None = None) -> tuple[np.nd
     weights = excess.mean(axis=1) * band_omega[cone]
     direction = (band_dirs[cone] * weights[:, None]).sum(axis=0)
     direction = direction / np.linalg.norm(direction)
+    angle = np.arccos(np.clip(band_dirs[cone] @ direction, -1.0, 1.0))
+    spread = float(np.sqrt((weights * angle * angle).sum() / max(float(weights.sum()), 1e-30)))
     without = radiance.copy()
     without[r0:r1][cone] = band[cone] - excess
-    return without, Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()))
+    return without, Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()), spread)

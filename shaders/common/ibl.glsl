@@ -35,12 +35,6 @@ float grid_step_roughness(int step) {
     return exp2(float(step) / 4.0 - 0.5 * u_prefiltered_max_mip);
 }
 
-vec3 prefiltered_grid(vec3 d, int step) {
-    float mip = float(step >> 1);
-    return (step & 1) == 0 ? textureLod(u_prefiltered_radiance, d, mip).rgb
-                           : textureLod(u_prefiltered_radiance_mid, d, mip).rgb;
-}
-
 // The compact sources as a grid step of the prefiltered map would hold them (world space d).
 vec3 suns_prefiltered_step(vec3 d, int step) {
     float roughness = grid_step_roughness(step);
@@ -58,35 +52,33 @@ vec3 suns_prefiltered_step(vec3 d, int step) {
 // The prefiltered radiance around world direction r for a roughness, blended between grid steps.
 // with_suns adds the compact sources (their power carries the intensity already) as the map
 // would hold them had they been baked in: the lecture's maps filter the whole environment.
-// The source cube below the grid keeps its sun.
+// Neighbouring steps are one even (grid A) and one odd (grid B), so each cube is read once.
+// Below grid A's first step (r0 = 2^(-max_mip/2)) the source cube's box mips, whose texel
+// matches the lobe width alpha, fade into that step: app/renderer.py binds the cube as seen
+// (with its sun) for the lecture's models, the cube without compact sources for the others.
 vec3 prefiltered_radiance_at(vec3 r, float roughness, bool with_suns) {
     vec3 d = rotate_world_to_map(r, u_env_rotation);
     float step = roughness_to_grid_step(roughness);
-    bool suns = with_suns && u_sun_count > 0;
+    float last = 2.0 * u_prefiltered_max_mip;
+    float clamped = clamp(step, 0.0, last);
+    int lo = int(floor(clamped));
+    int hi = min(lo + 1, int(last));
+    float t = clamped - float(lo);
+    bool lo_is_a = (lo & 1) == 0;
+    vec3 a = textureLod(u_prefiltered_radiance, d, float((lo_is_a ? lo : hi) >> 1)).rgb;
+    vec3 b = textureLod(u_prefiltered_radiance_mid, d, float((lo_is_a ? hi : lo) >> 1)).rgb;
+    vec3 radiance = u_env_intensity * (lo_is_a ? mix(a, b, t) : mix(b, a, t));
+    if (with_suns && u_sun_count > 0) {
+        radiance += mix(suns_prefiltered_step(r, lo), suns_prefiltered_step(r, hi), t);
+    }
     if (step < 0.0) {
-        // Below grid A's first step (r = 2^(-max_mip/2)): the source cube's box mips whose texel
-        // matches the lobe width alpha, fading into the first prefiltered step.
         float r0 = exp2(-0.5 * u_prefiltered_max_mip);
         float texel_angle = 0.5 * PI / float(textureSize(u_environment, 0).x);
         float lod = max(log2(roughness * roughness / texel_angle), 0.0);
-        float t = (roughness / r0) * (roughness / r0);
-        vec3 radiance = u_env_intensity * mix(textureLod(u_environment, d, lod).rgb, prefiltered_grid(d, 0), t);
-        return suns ? radiance + t * suns_prefiltered_step(r, 0) : radiance;
+        float w = (roughness / r0) * (roughness / r0);
+        radiance = mix(u_env_intensity * textureLod(u_environment, d, lod).rgb, radiance, w);
     }
-    float last = 2.0 * u_prefiltered_max_mip;
-    step = min(step, last);
-    int lo = int(floor(step));
-    int hi = min(lo + 1, int(last));
-    float t = step - float(lo);
-    vec3 radiance = u_env_intensity * mix(prefiltered_grid(d, lo), prefiltered_grid(d, hi), t);
-    return suns ? radiance + mix(suns_prefiltered_step(r, lo), suns_prefiltered_step(r, hi), t) : radiance;
-}
-
-// How much of prefiltered_radiance_at(.., roughness, false) came from the sun-free grid: below
-// the grid the source cube, which still holds the sun, takes the rest.
-float prefiltered_sun_free_fraction(float roughness) {
-    float r0 = exp2(-0.5 * u_prefiltered_max_mip);
-    return min((roughness / r0) * (roughness / r0), 1.0);
+    return radiance;
 }
 
 // E/pi at normal n; with_suns adds the compact sources' P max(n.l, 0) / pi.
@@ -119,25 +111,29 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
 }
 
 // A compact source as the ground truth sees it: the Cook-Torrance BRDF with the IBL k and the
-// Fresnel per direction, times a delta of power P (the specular part scaled by `specular`).
-vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float specular) {
+// Fresnel per direction, times its power P. The source is not a point: its RMS angular radius
+// widens the normal distribution to alpha' = sqrt(alpha^2 + spread^2) (D stays normalised), so a
+// mirror shows a spot of the source's size and power (after Karis 2013's sphere lights; it
+// matters only where alpha is near the source's size, e.g. royal_esplanade's 2-degree lamps).
+vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
     float n_dot_l = dot(n, l);
     if (n_dot_l <= 0.0) return vec3(0.0);
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
     float n_dot_h = max(dot(n, h), 0.0);
     vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s));
-    float roughness = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
-    float D = D_GGX(n_dot_h, roughness);
-    float G = G_Smith(n_dot_v, n_dot_l, k_ibl(roughness));
+    float alpha = s.roughness * s.roughness;
+    float widened = max(sqrt(sqrt(alpha * alpha + spread * spread)), MIN_PUNCTUAL_ROUGHNESS);
+    float D = D_GGX(n_dot_h, widened);
+    float G = G_Smith(n_dot_v, n_dot_l, k_ibl(max(s.roughness, MIN_PUNCTUAL_ROUGHNESS)));
     vec3 diffuse = (1.0 - F) * (1.0 - s.metallic) * Fd_Lambert(s.base_color);
-    return (diffuse + specular * D * G * F / (4.0 * n_dot_l * n_dot_v)) * power * n_dot_l;
+    return (diffuse + D * G * F / (4.0 * n_dot_l * n_dot_v)) * power * n_dot_l;
 }
 
-vec3 suns_exact(Surface s, vec3 n, vec3 v, float specular) {
+vec3 suns_exact(Surface s, vec3 n, vec3 v) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < u_sun_count; ++i) {
-        sum += sun_light(s, n, v, u_sun_direction[i], u_sun_power[i], specular);
+        sum += sun_light(s, n, v, u_sun_direction[i], u_sun_power[i], u_sun_spread[i]);
     }
     return sum;
 }
@@ -207,8 +203,8 @@ vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
 }
 
 // alight's model: ibl_dominant for the environment without its compact sources, and those
-// sources through the exact BRDF as delta lights (below the prefiltered grid the source cube,
-// which keeps the sun, takes over the specular part).
+// sources through the exact BRDF as delta lights at every roughness (below the prefiltered
+// grid too, where the source cube without them is read).
 vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec3 f0 = surface_f0(s);
@@ -216,7 +212,7 @@ vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
     vec3 d = specular_dominant_direction(n, reflect(-v, n), f0, lut);
     vec3 environment = ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
                                    irradiance_at(n, false), prefiltered_radiance_at(d, s.roughness, false));
-    vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v, prefiltered_sun_free_fraction(s.roughness)) : vec3(0.0);
+    vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v) : vec3(0.0);
     return (environment + suns) * s.occlusion;
 }
 

@@ -4,6 +4,7 @@ const int MAX_SUNS = 4;
 uniform int u_sun_count;
 uniform vec3 u_sun_direction[MAX_SUNS];
 uniform vec3 u_sun_power[MAX_SUNS];
+uniform float u_sun_spread[MAX_SUNS];   // RMS angular radius (radians) of each source
 
 // Their E/pi at normal n: P max(n.l, 0) / pi each.
 vec3 suns_irradiance_over_pi(vec3 n) {
