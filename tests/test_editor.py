@@ -130,3 +130,20 @@ def test_without_a_display(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "app", "edit", "--screenshot", str(tmp_path / "x.jpg")], cwd=REPO,
                          env=env, capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "unsupported output format" in bad.stderr
+
+
+def test_ibl_model_and_multiple_scattering_reach_the_scene():
+    """The panel's IBL model and multiple-scattering controls edit plain state that the scene
+    carries to the renderer; a wrong name from a script is one line."""
+    from app.editor.state import EditorState
+    from app.errors import AlightError
+    from app.ibl_models import DEFAULT_IBL_MODEL
+
+    state = EditorState()
+    assert state.scene(None).ibl_model == DEFAULT_IBL_MODEL
+    state.apply_edit("ibl_model=lecture")
+    state.apply_edit("multiple_scattering=1")
+    scene = state.scene(None)
+    assert scene.ibl_model == "lecture" and scene.multiple_scattering
+    with pytest.raises(AlightError, match="ibl_model 'nope'"):
+        state.apply_edit("ibl_model=nope")

@@ -10,6 +10,7 @@ import numpy as np
 
 from app.bake import QUALITY
 from app.errors import AlightError
+from app.ibl_models import IBL_MODELS
 from app.material import list_presets, load_preset, validate_material
 from app.scene import BACKGROUNDS, TONEMAPS, Light
 from app.editor.file_browser import FileBrowser
@@ -248,6 +249,16 @@ class Panel:
         changed, i = imgui.combo("background", BACKGROUNDS.index(d.background), BACKGROUNDS)
         if changed:
             s.display = dataclasses.replace(d, background=BACKGROUNDS[i])
+        models = list(IBL_MODELS)
+        changed, i = imgui.combo("IBL model", models.index(s.ibl_model), models)
+        if changed:
+            s.ibl_model = models[i]
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(IBL_MODELS[s.ibl_model])
+        _, s.multiple_scattering = imgui.checkbox("multiple scattering", s.multiple_scattering)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("Fdez-Aguera 2019: the energy single scattering loses on rough surfaces "
+                              "(a white furnace gives 1; the single-scattering ground truth does not)")
         names = list(QUALITY)
         changed, i = imgui.combo("bake quality", names.index(s.quality), names)
         if changed:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from app.errors import AlightError
+from app.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 from app.material import Material, load_preset, save_preset, validate_material
 from app.bake import QUALITY
 from app.scene import TONEMAPS, Display, Light, Scene
@@ -47,6 +48,8 @@ class EditorState:
     display: Display = field(default_factory=Display)
     lights: list[Light] = field(default_factory=default_lights)
     ibl_enabled: bool = True
+    ibl_model: str = DEFAULT_IBL_MODEL     # app/ibl_models.py
+    multiple_scattering: bool = False
     env_rotation_deg: float = 0.0
     env_intensity: float = 1.0
     aa: str = "none"
@@ -77,6 +80,7 @@ class EditorState:
         return Scene(mesh=self.mesh, material=self.material, use_file_materials=self.use_file_materials,
                      lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
                      env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
+                     ibl_model=self.ibl_model, multiple_scattering=self.multiple_scattering,
                      # Data views are shown as values: no exposure, no tone curve.
                      display=dataclasses.replace(self.display, tonemap="none", exposure=0.0)
                      if self.debug_view in DATA_VIEWS else self.display,
@@ -174,8 +178,9 @@ class EditorState:
     def apply_edit(self, edit: str) -> None:
         """``field=value``: roughness / metallic (numbers), base_color / emissive / specular_f0
         (R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
-        env_rotation, env_intensity, ibl (0/1), quality; map_SLOT (an image path, '' clears;
-        SLOT one of app.texture_maps.MAP_SLOTS), uv_scale / uv_offset (U,V)."""
+        env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), quality;
+        map_SLOT (an image path, '' clears; SLOT one of app.texture_maps.MAP_SLOTS), uv_scale /
+        uv_offset (U,V)."""
         from app.material import parse_color
 
         key, sep, value = edit.partition("=")
@@ -206,6 +211,12 @@ class EditorState:
                 setattr(self, key + ("_deg" if key == "env_rotation" else ""), _finite(value, edit))
             elif key == "ibl":
                 self.ibl_enabled = value not in ("0", "false", "off")
+            elif key == "ibl_model":
+                if value not in IBL_MODELS:
+                    raise AlightError(f"--script: ibl_model '{value}' is not one of {', '.join(IBL_MODELS)}")
+                self.ibl_model = value
+            elif key == "multiple_scattering":
+                self.multiple_scattering = value not in ("0", "false", "off")
             elif key == "quality":
                 if value not in QUALITY:
                     raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}")
