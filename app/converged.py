@@ -279,20 +279,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
     F0 = f0_of(base_color, metallic, specular_f0). The material (base_color, metallic,
     roughness, specular_f0) is one material; ``view`` is one direction (3,) or one per normal.
     """
-    n = _unit_rows(normals)
-    v = np.broadcast_to(_unit_rows(view), n.shape)
-    r = float(roughness)
-    m = float(metallic)
-    base = np.asarray(base_color, dtype=np.float64)
-    f0 = f0_of(base, m, np.asarray(specular_f0, dtype=np.float64))
-    nv = np.maximum(np.sum(n * v, axis=-1), 0.0)
-    F = F_SchlickRoughness(nv, f0, r)  # (P, 3)
-    kd = (1.0 - F) * (1.0 - m)
-    diffuse = kd * base * irradiance_converged(radiance, n)
-    R = reflect(-v, n)
-    A, B = brdf_lut_converged(nv, r)
-    specular = prefiltered_converged(radiance, R, r) * (F * A[:, None] + B[:, None])
-    return diffuse + specular
+    return ibl_converged("lecture", radiance, normals, view, base_color, metallic, roughness, specular_f0)
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,

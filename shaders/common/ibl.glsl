@@ -158,62 +158,58 @@ vec3 ibl_combine(Surface s, vec3 f0, vec3 diffuse_weight, vec3 spec_weight, vec4
 }
 
 // ---- the models ----------------------------------------------------------------------------
+// Each model is a small function named after it; the shared split sums below take constant
+// flags, which the compiler folds, so a model pays only for its own choices.
 
-// The lecture's cook_torrance_IBL: kd from the roughness-aware Fresnel at n.v, Lambert times the
-// irradiance map, and the prefiltered radiance times the LUT's (F * A + B).
-vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
+// The lecture's split sum with the Fresnel F at n.v it is given: kd = 1 - F, specular F A + B.
+vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
     float n_dot_v = max(dot(n, v), 0.0);
-    vec3 f0 = surface_f0(s);
-    vec3 F = F_SchlickRoughness(n_dot_v, f0, s.roughness);
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
-    return ibl_combine(s, f0, 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true),
-                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true)) * s.occlusion;
-}
-
-// The lecture with plain Schlick at n.v for kd and F (the diffuse weight ignores roughness).
-vec3 ibl_lecture_schlick(Surface s, vec3 n, vec3 v) {
-    float n_dot_v = max(dot(n, v), 0.0);
-    vec3 f0 = surface_f0(s);
-    vec3 F = F_Schlick(n_dot_v, f0);
-    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
-    return ibl_combine(s, f0, 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true),
-                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true)) * s.occlusion;
+    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true),
+                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true));
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
 // is F0 A + B (the lecture's F A + B counts Fresnel twice at grazing); the diffuse weight is the
-// ground truth's (1 - F0)(1 - Fc) averaged over the cosine lobe.
-vec3 ibl_karis(Surface s, vec3 n, vec3 v) {
+// ground truth's (1 - F0)(1 - Fc) averaged over the cosine lobe. toward_lobe_mean fetches at the
+// lobe's mean direction (brdf_lut.comp) instead of R; with_suns as in prefiltered_radiance_at.
+vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with_suns) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec3 f0 = surface_f0(s);
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
+    vec3 r = reflect(-v, n);
+    vec3 d = toward_lobe_mean ? specular_dominant_direction(n, r, f0, lut) : r;
     return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
-                       irradiance_at(n, true),
-                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true)) * s.occlusion;
+                       irradiance_at(n, with_suns), prefiltered_radiance_at(d, s.roughness, with_suns));
 }
 
-// Karis' split fetched at the lobe's mean direction (brdf_lut.comp) instead of R.
+// The lecture's cook_torrance_IBL: kd and F from the roughness-aware Fresnel at n.v.
+vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
+    vec3 F = F_SchlickRoughness(max(dot(n, v), 0.0), surface_f0(s), s.roughness);
+    return lecture_split_sum(s, n, v, F) * s.occlusion;
+}
+
+// The lecture with plain Schlick at n.v for kd and F (the diffuse weight ignores roughness).
+vec3 ibl_lecture_schlick(Surface s, vec3 n, vec3 v) {
+    vec3 F = F_Schlick(max(dot(n, v), 0.0), surface_f0(s));
+    return lecture_split_sum(s, n, v, F) * s.occlusion;
+}
+
+vec3 ibl_karis(Surface s, vec3 n, vec3 v) {
+    return karis_split_sum(s, n, v, false, true) * s.occlusion;
+}
+
+// Karis' split fetched at the lobe's mean direction instead of R.
 vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
-    float n_dot_v = max(dot(n, v), 0.0);
-    vec3 f0 = surface_f0(s);
-    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
-    vec3 d = specular_dominant_direction(n, reflect(-v, n), f0, lut);
-    return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
-                       irradiance_at(n, true), prefiltered_radiance_at(d, s.roughness, true)) * s.occlusion;
+    return karis_split_sum(s, n, v, true, true) * s.occlusion;
 }
 
 // alight's model: ibl_dominant for the environment without its compact sources, and those
-// sources through the exact BRDF as delta lights at every roughness (below the prefiltered
-// grid too, where the source cube without them is read).
+// sources through the exact BRDF at every roughness (below the prefiltered grid too, where
+// app/renderer.py binds the source cube without them).
 vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
-    float n_dot_v = max(dot(n, v), 0.0);
-    vec3 f0 = surface_f0(s);
-    vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
-    vec3 d = specular_dominant_direction(n, reflect(-v, n), f0, lut);
-    vec3 environment = ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
-                                   irradiance_at(n, false), prefiltered_radiance_at(d, s.roughness, false));
     vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v) : vec3(0.0);
-    return (environment + suns) * s.occlusion;
+    return (karis_split_sum(s, n, v, true, false) + suns) * s.occlusion;
 }
 
 // The model the forward pass uses: IBL_MODEL is the position of its name in app/ibl_models.py's
