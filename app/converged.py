@@ -146,6 +146,22 @@ def sample_equirect_bilinear(radiance, directions) -> np.ndarray:
     return top * (1 - fy) + bot * fy
 
 
+def _lut_quadrature(n_dot_v, roughness, n_u: int, n_phi: int):
+    """The LUT twins' shared set-up: the broadcast shape, flat n.v (>= 1e-4) and roughness, and
+    the midpoint grid over the GGX inverse CDF's u (weights wu summing to 1) and phi in [0, pi)."""
+    nv, r = np.broadcast_arrays(np.asarray(n_dot_v, dtype=np.float64), np.asarray(roughness, dtype=np.float64))
+    shape = nv.shape
+    nv = np.clip(nv.reshape(-1), 1e-4, 1.0)
+    r = np.clip(r.reshape(-1), 0.0, 1.0)
+    # u = 1 - (1 - s)^2 with a midpoint grid in s: near u = 1 (grazing h, where
+    # 1 - u ~ cos^2(theta_h)) cos(theta_h) becomes linear in s instead of a square root.
+    sg = (np.arange(n_u) + 0.5) / n_u
+    u = 1.0 - (1.0 - sg) ** 2
+    wu = 2.0 * (1.0 - sg) / n_u  # du, sums to 1
+    phi = (np.arange(n_phi) + 0.5) * (PI / n_phi)
+    return shape, nv, r, u, wu, phi
+
+
 def brdf_lut_converged(n_dot_v, roughness, n_u: int = 512, n_phi: int = 128):
     """The lecture's integrate_brdf (k = r^2/2), integrated by a deterministic midpoint rule.
 
@@ -160,17 +176,8 @@ def brdf_lut_converged(n_dot_v, roughness, n_u: int = 512, n_phi: int = 128):
     (A, B) of their broadcast shape, float64. n.v is clamped to >= 1e-4; at r = 0 (a = 0, all
     h = n) the integral is A = 1 - Fc(nv), B = Fc(nv) and the code gives exactly that.
     """
-    nv, r = np.broadcast_arrays(np.asarray(n_dot_v, dtype=np.float64), np.asarray(roughness, dtype=np.float64))
-    shape = nv.shape
-    nv = np.clip(nv.reshape(-1), 1e-4, 1.0)
-    r = np.clip(r.reshape(-1), 0.0, 1.0)
-    # u = 1 - (1 - s)^2 with a midpoint grid in s: near u = 1 (grazing h, where
-    # 1 - u ~ cos^2(theta_h)) cos(theta_h) becomes linear in s instead of a square root.
-    sg = (np.arange(n_u) + 0.5) / n_u
-    u = 1.0 - (1.0 - sg) ** 2
-    wu = 2.0 * (1.0 - sg) / n_u  # du, sums to 1
-    phi = (np.arange(n_phi) + 0.5) * (PI / n_phi)
-    cphi, sphi = np.cos(phi), np.sin(phi)
+    shape, nv, r, u, wu, phi = _lut_quadrature(n_dot_v, roughness, n_u, n_phi)
+    cphi = np.cos(phi)
     A = np.empty(nv.shape[0])
     B = np.empty(nv.shape[0])
     for i in range(nv.shape[0]):  # one (nv, r) pair at a time: a (n_u, n_phi) grid each
@@ -202,14 +209,7 @@ def lobe_directions_converged(n_dot_v, roughness, n_u: int = 512, n_phi: int = 1
     clamped to [0, 1], and 1 at n.v = 1 (R = n). Same midpoint grid and guards as
     ``brdf_lut_converged``. Returns (t_A, t_B) of the broadcast shape.
     """
-    nv, r = np.broadcast_arrays(np.asarray(n_dot_v, dtype=np.float64), np.asarray(roughness, dtype=np.float64))
-    shape = nv.shape
-    nv = np.clip(nv.reshape(-1), 1e-4, 1.0)
-    r = np.clip(r.reshape(-1), 0.0, 1.0)
-    sg = (np.arange(n_u) + 0.5) / n_u
-    u = 1.0 - (1.0 - sg) ** 2
-    wu = 2.0 * (1.0 - sg) / n_u
-    phi = (np.arange(n_phi) + 0.5) * (PI / n_phi)
+    shape, nv, r, u, wu, phi = _lut_quadrature(n_dot_v, roughness, n_u, n_phi)
     cphi = np.cos(phi)
     out = np.empty((2, nv.shape[0]))
     for i in range(nv.shape[0]):
