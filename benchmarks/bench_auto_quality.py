@@ -53,7 +53,7 @@ def probe_error(renderer, maps, env, m) -> float:
     # converged split sum; the map halved for r >= 0.25 (app/converged.py: <= 6e-4 added)
     src = downsample_equirect(rad, 2) if m.roughness >= 0.25 and rad.shape[1] >= 1024 else rad
     want = split_sum_converged(src, n[inside], (0.0, 0.0, 1.0), m.base_color, m.metallic, m.roughness, m.specular_f0)
-    got = renderer.render(Scene(material=m, view="probe"), maps, WIDTH, WIDTH, read_srgb=False).linear[..., :3][inside]
+    got = renderer.render(Scene(material=m, view="probe", ibl_model="lecture"), maps, WIDTH, WIDTH, read_srgb=False).linear[..., :3][inside]
     return float(np.abs(got - want).sum() / np.abs(want).sum())
 
 

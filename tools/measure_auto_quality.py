@@ -141,7 +141,7 @@ def main() -> int:
                 row = []
                 for r in ROUGHNESS_POINTS:
                     m = replace(base, roughness=r)
-                    got = renderer.render(Scene(material=m, view="probe"), maps, WIDTH, WIDTH,
+                    got = renderer.render(Scene(material=m, view="probe", ibl_model="lecture"), maps, WIDTH, WIDTH,
                                           read_srgb=False).linear[..., :3][inside]
                     want = ideal(m, r, normals, irr, pre, luts)
                     # The worst channel: a material of any colour mixes the channels' errors with
