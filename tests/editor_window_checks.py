@@ -368,3 +368,32 @@ def test_built_in_file_browser(window, tmp_path):
     assert s.texture_maps.roughness == str(image)
     s.clear_map("roughness")
     window.frame()
+
+
+def test_quality_auto_bakes_the_choice_and_says_why(window):
+    """Bake quality 'auto': the window bakes what app/auto_quality.py chose for the material's
+    kind and roughness band, and the panel's line (the same Choice) names it with its predicted
+    error. A rough gold gets a cheap bake within the budget; a nearly mirror gold, which no
+    measured bake brings within 2% on a sharp map, keeps medium and says so."""
+    s = window.state
+    s.error = ""
+    s.load_env("studio")
+    s.quality = "auto"
+    s.material = s.material.__class__(**{**s.material.__dict__, "base_color": (1.0, 0.71, 0.29),
+                                         "metallic": 1.0, "roughness": 0.7})
+    window.frame()
+    window.finish_bake()
+    rough = window.auto_choice()
+    assert rough.meets_budget and "within the 2% budget" in rough.line(0.02)
+    assert window.maps().quality is rough.quality and rough.name != "medium"
+    s.material = s.material.__class__(**{**s.material.__dict__, "roughness": 0.1})
+    window.frame()
+    window.finish_bake()
+    smooth = window.auto_choice()
+    assert smooth.name == "medium" and "so the default, medium" in smooth.line(0.02)
+    assert window.maps().quality.name == "auto:medium"
+    s.material = s.material.__class__(**{**s.material.__dict__, "roughness": 0.15})
+    window.frame()
+    assert window.auto_choice() is smooth and window.bake_progress is None   # same band: no new bake
+    s.quality = "medium"
+    assert s.error == ""

@@ -147,3 +147,28 @@ def test_ibl_model_and_multiple_scattering_reach_the_scene():
     assert scene.ibl_model == "lecture" and scene.multiple_scattering
     with pytest.raises(AlightError, match="ibl_model 'nope'"):
         state.apply_edit("ibl_model=nope")
+
+
+def test_quality_auto_in_the_editor(display, tmp_path):
+    """Bake quality 'auto' in the editor: the window bakes the measured choice for the studio
+    and a rough gold (not medium) and renders the same ball as a medium bake to within the
+    implementation-error budget: the ball's mean colour moves by less than 3%."""
+    auto = ball(screenshot(tmp_path, "auto", "--preset", "gold", "--roughness", "0.7", "--quality", "auto"))
+    medium = ball(screenshot(tmp_path, "medium", "--preset", "gold", "--roughness", "0.7"))
+    assert np.abs(auto.mean(axis=0) - medium.mean(axis=0)).max() < 0.03 * medium.mean()
+    from app.auto_quality import MaterialNeed, choose_quality, environment_features
+    from app.bake import QUALITY
+    from app.environment import load_environment
+
+    # What the window chose for it (a metal in the roughness band 0.5-1): within the budget and
+    # a cheaper bake than medium.
+    choice = choose_quality([MaterialNeed(("metal",), 0.5, 1.0)],
+                            environment_features(load_environment("studio").radiance))
+    assert choice.meets_budget and "within" in choice.line(0.02)
+    assert choice.predicted_seconds < 0.5 * choice_seconds_of_medium(choice)
+
+
+def choice_seconds_of_medium(choice) -> float:
+    from app.auto_quality import load_table, predicted_seconds
+
+    return predicted_seconds(load_table(), "medium", 1.0, False)

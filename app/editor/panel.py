@@ -8,6 +8,7 @@ import os
 
 import numpy as np
 
+from app.auto_quality import DEFAULT_ERROR_BUDGET
 from app.bake import QUALITY
 from app.errors import AlightError
 from app.ibl_models import IBL_MODELS
@@ -259,10 +260,13 @@ class Panel:
         if imgui.is_item_hovered():
             imgui.set_tooltip("Fdez-Aguera 2019: the energy single scattering loses on rough surfaces "
                               "(a white furnace gives 1; the single-scattering ground truth does not)")
-        names = list(QUALITY)
+        names = list(QUALITY) + ["auto"]
         changed, i = imgui.combo("bake quality", names.index(s.quality), names)
         if changed:
             s.quality = names[i]
+        if s.quality == "auto" and s.env is not None:
+            # What auto chose and why, with the predicted error (app/auto_quality.py).
+            imgui.text_wrapped(win.auto_choice().line(DEFAULT_ERROR_BUDGET))
         if win.bake_seconds:
             imgui.text(f"last bake: {sum(win.bake_seconds.values()) * 1000:.0f} ms")
 

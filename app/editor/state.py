@@ -218,8 +218,8 @@ class EditorState:
             elif key == "multiple_scattering":
                 self.multiple_scattering = value not in ("0", "false", "off")
             elif key == "quality":
-                if value not in QUALITY:
-                    raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}")
+                if value not in (*QUALITY, "auto"):
+                    raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}, auto")
                 self.quality = value
             elif key == "debug_view":
                 if value not in DEBUG_VIEWS:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import math
 import os
 import time
 
@@ -88,6 +89,8 @@ class EditorWindow:
         self._maps_key = None
         self._maps = None
         self._bake_job = None          # (key, generator) of the bake in progress
+        self._auto = None              # (key, app.auto_quality.Choice) for bake quality 'auto'
+        self._auto_features = None     # (id of the environment, its EnvironmentFeatures)
         self.bake_progress = None      # (fraction, label) while a bake runs; the panel shows it
         self._last_swap = None
         self._framed_mesh = None
@@ -176,13 +179,51 @@ class EditorWindow:
         s = self.state
         if s.env is None:
             return None
-        key = (id(s.env), s.quality)
+        if s.quality == "auto":
+            choice = self.auto_choice()
+            key, quality = (id(s.env), "auto", choice.name, choice.quality.max_roughness), choice.quality
+        else:
+            key, quality = (id(s.env), s.quality), QUALITY[s.quality]
         if key != self._maps_key and (self._bake_job is None or self._bake_job[0] != key):
             if self._bake_job is not None:
                 self._bake_job[1].close()    # superseded: frees its partial maps
-            self._bake_job = (key, self.renderer.bake_steps(s.env, QUALITY[s.quality]))
+            self._bake_job = (key, self.renderer.bake_steps(s.env, quality))
             self.bake_progress = (0.0, "starting")
         return self._maps
+
+    def auto_choice(self):
+        """Bake quality 'auto' (app/auto_quality.py): the cheapest measured bake within the 2%
+        budget for this environment and the material being edited: its kind (dielectric, metal
+        or both) and its roughness band (a quarter wide: from the band's lower edge up to 1), so
+        that dragging the roughness starts a new bake only when it crosses into another band.
+        The panel shows the one-line reason. Cached per environment, kind and band."""
+        from app.auto_quality import (MaterialNeed, choose_quality, environment_features, load_table, material_need,
+                                      predicted_error, predicted_seconds)
+
+        s = self.state
+        m = s.material
+        maps_present = s.texture_maps.paths()
+        roughness_map = "roughness" in maps_present or "metallic_roughness" in maps_present
+        kind = material_need(m.metallic, m.roughness, roughness_map=roughness_map,
+                             metallic_map="metallic" in maps_present or "metallic_roughness" in maps_present)
+        band = 0.0 if roughness_map else min(0.75, math.floor(m.roughness / 0.25) * 0.25)
+        need = MaterialNeed(kind.archetypes, band, 1.0)
+        key = (id(s.env), need)
+        if self._auto is None or self._auto[0] != key:
+            if self._auto_features is None or self._auto_features[0] != id(s.env):
+                self._auto_features = (id(s.env), environment_features(s.env.radiance))
+            choice = choose_quality([need], self._auto_features[1])
+            if not choice.meets_budget:
+                # Nothing measured meets the budget (a metal below r = 0.25 under a sharp map):
+                # the editor keeps the default bake rather than a many-second 'high'.
+                err, _ = predicted_error(load_table(), "medium", [need], self._auto_features[1])
+                choice = dataclasses.replace(
+                    choice, quality=dataclasses.replace(QUALITY["medium"], name="auto:medium"), name="medium",
+                    predicted_error=err, predicted_seconds=predicted_seconds(load_table(), "medium", 1.0,
+                                                                             self._auto_features[1].has_compact_source),
+                    reason=choice.reason.replace("so the most accurate one", "so the default, medium"))
+            self._auto = (key, choice)
+        return self._auto[1]
 
     def advance_bake(self, budget_s: float = BAKE_SLICE_S) -> None:
         """Run the pending bake's steps for about ``budget_s`` (at least one step)."""
