@@ -232,6 +232,15 @@ def _cube(ctx: moderngl.Context, size: int, levels: int) -> moderngl.TextureCube
     return tex
 
 
+LUT_CHANNELS = 4   # brdf_lut.comp: A, B, t_A, t_B
+
+
+def read_lut(tex: moderngl.Texture) -> np.ndarray:
+    """The BRDF LUT texture as a (size, size, LUT_CHANNELS) float32 array, row 0 = roughness 0."""
+    size = tex.size[0]
+    return np.frombuffer(tex.read(), dtype=np.float32).reshape(size, size, LUT_CHANNELS)
+
+
 class LutCache:
     """The BRDF integration map depends only on its size, sample count and shader: bake it once
     per machine and keep it in the user's cache directory (``app.paths.cache_dir``)."""
@@ -255,7 +264,7 @@ class LutCache:
         table = None
         try:
             loaded = np.load(path, allow_pickle=False)
-            if loaded.shape == (size, size, 4) and loaded.dtype == np.float32 and np.isfinite(loaded).all():
+            if loaded.shape == (size, size, LUT_CHANNELS) and loaded.dtype == np.float32 and np.isfinite(loaded).all():
                 table = loaded
         except (OSError, ValueError):
             table = None
@@ -265,7 +274,7 @@ class LutCache:
         else:
             self.last_source = "baked"
             tex = self._bake(size, samples)
-            table = np.frombuffer(tex.read(), dtype=np.float32).reshape(size, size, 4)
+            table = read_lut(tex)
             try:
                 os.makedirs(path.parent, exist_ok=True)
                 with atomic_path(path) as tmp:
@@ -278,13 +287,13 @@ class LutCache:
 
     def _upload(self, table: np.ndarray) -> moderngl.Texture:
         size = table.shape[0]
-        tex = self.ctx.texture((size, size), 4, table.tobytes(), dtype="f4")
+        tex = self.ctx.texture((size, size), LUT_CHANNELS, table.tobytes(), dtype="f4")
         tex.repeat_x = tex.repeat_y = False
         tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
         return tex
 
     def _bake(self, size: int, samples: int) -> moderngl.Texture:
-        tex = self._upload(np.zeros((size, size, 4), np.float32))
+        tex = self._upload(np.zeros((size, size, LUT_CHANNELS), np.float32))
         prog = self.shaders.compute("bake/brdf_lut.comp")
         prog["u_size"] = size
         prog["u_samples"] = samples
@@ -428,13 +437,6 @@ def bake_steps(ctx: moderngl.Context, shaders: ShaderLibrary, env: Environment,
     return IBLMaps(source, irradiance, prefiltered, prefiltered_mid, lut, q, seconds, suns, sun_scale,
                    lighting if lighting is not source else None)
 
-
-
-def _source_cube(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuality,
-                 seconds: dict[str, float], name: str) -> moderngl.TextureCube:
-    """Equirect -> cube level 0, then solid-angle-weighted mips (see bake/cube_downsample.comp)."""
-    return run_to_completion(_source_cube_steps(ctx, shaders, radiance, q, seconds, name, [],
-                                                lambda weight, label: None))
 
 
 def _source_cube_steps(ctx, shaders: ShaderLibrary, radiance: np.ndarray, q: BakeQuality,

@@ -445,7 +445,7 @@ def _bake(args) -> int:
     env = load_environment(args.env)
     _warn(env.warnings)
 
-    from app.bake import grid_roughness, quality_named
+    from app.bake import grid_roughness, quality_named, read_lut
     from app.output import write_image
     from app.renderer import Renderer
     from app.shading import linear_to_srgb, tonemap_aces_fitted
@@ -468,7 +468,7 @@ def _bake(args) -> int:
         cube = maps.prefiltered_radiance if step % 2 == 0 else maps.prefiltered_radiance_mid
         save(f"prefiltered_step{step:02d}_r{grid_roughness(step, levels):.3f}",
              _cube_as_equirect(renderer, cube, float(step // 2), w))
-    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 4)[::-1]
+    lut = read_lut(maps.brdf_lut)[::-1]
     zero = np.zeros(lut.shape[:2] + (1,), np.float32)
     # The LUT is already in [0,1]: shown as is (n.v right, roughness up). brdf_lut: red = scale A,
     # green = bias B; brdf_lut_directions: red = t_A, green = t_B (brdf_lut.comp).

@@ -21,7 +21,7 @@ import pytest
 from numpy.lib.stride_tricks import sliding_window_view
 
 from app import shading
-from app.bake import QUALITY, grid_roughness, quality_named, read_cube
+from app.bake import QUALITY, grid_roughness, quality_named, read_cube, read_lut
 from app.converged import (brdf_lut_converged, diffuse_fresnel, downsample_equirect, ibl_converged,
                            irradiance_converged, prefiltered_converged)
 from app.environment import Environment, constant_environment, load_environment
@@ -180,7 +180,7 @@ def test_lut_at_grazing_is_bounded(quality):
     estimate's noise (1e-3). Measured max A + B over the table: 0.9999 (medium)."""
     r = renderer()
     q = QUALITY[quality]
-    lut = np.frombuffer(r.luts.get(q.lut_size, q.lut_samples).read(), np.float32).reshape(q.lut_size, q.lut_size, 4)
+    lut = read_lut(r.luts.get(q.lut_size, q.lut_samples))
     assert np.isfinite(lut).all() and lut.min() >= 0.0
     assert lut[..., 2:].max() <= 1.0          # the lobe directions: lerp factors between n and R
     total = lut[..., :2].sum(axis=2)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from app import shading
-from app.bake import QUALITY, read_cube
+from app.bake import QUALITY, read_cube, read_lut
 from app.converged import diffuse_fresnel
 from app.ibl_models import IBL_MODELS
 from app.environment import constant_environment
@@ -75,7 +75,7 @@ def test_full_material_gives_the_split_sum_prediction(furnace, material, model):
     frame = r.render(Scene(material=material, view="probe", ibl_model=model), maps, w, w)
     n, inside = shading.probe_normals(w)
     n_dot_v = n[..., 2][inside]
-    lut = np.frombuffer(maps.brdf_lut.read(), np.float32).reshape(q.lut_size, q.lut_size, 4)
+    lut = read_lut(maps.brdf_lut)
     ab = lut_bilinear(lut, n_dot_v, material.roughness)
     f0 = shading.f0_of(material.base_color, material.metallic, material.specular_f0)
     albedo = np.array(material.base_color) * (1 - material.metallic)
