@@ -1,16 +1,39 @@
-"""alight: a physically based material editor and headless renderer."""
+"""alight: a physically based material editor and headless renderer.
+
+The public names, imported on first use so that ``import alight`` stays cheap (no moderngl,
+trimesh or GL until something renders)::
+
+    import alight
+
+    with alight.Renderer(256, quality="low") as r:
+        r.set_material("gold", roughness=0.3).save("gold.png")
+
+- ``Renderer``: the headless renderer (``alight.frontends.api``);
+- ``Material``, ``Camera``, ``Light``: the scene's plain state (``alight.core``);
+- ``Environment``, ``load_environment``: equirectangular maps (``alight.ibl.environment``);
+- ``load_preset``, ``list_presets``, ``save_preset``: the F0 table's preset files;
+- ``Error``: what a bad input raises (one line naming the file or field, then the problem).
+
+The subpackages, by concern (a lower layer never imports a higher one):
+``core`` (math, GPU context, material, scene, meshes) < ``exchange`` (files in and out) <
+``ibl`` (environments and the bake) < ``render`` (the forward renderer) < ``accuracy``
+(ground truth, twins, metrics, chart, auto quality) < ``frontends`` (CLI, API, batch, pytest
+plugin, editor). ``shaders/`` mirrors it: ``common/``, ``ibl/``, ``render/``, ``accuracy/``.
+"""
 
 __version__ = "0.1.0"
 
-# The Python API (app/api.py), imported on first use so that ``import app`` stays cheap
-# (no moderngl, no trimesh): ``from app import AlightRenderer`` triggers it.
 _LAZY = {
-    "AlightRenderer": "app.api",
-    "Material": "app.material",
-    "load_preset": "app.material",
-    "Camera": "app.scene",
-    "Light": "app.scene",
-    "AlightError": "app.errors",
+    "Renderer": "alight.frontends.api",
+    "Material": "alight.core.material",
+    "Camera": "alight.core.scene",
+    "Light": "alight.core.scene",
+    "Environment": "alight.ibl.environment",
+    "load_environment": "alight.ibl.environment",
+    "load_preset": "alight.exchange.presets",
+    "list_presets": "alight.exchange.presets",
+    "save_preset": "alight.exchange.presets",
+    "Error": "alight.errors",
 }
 __all__ = ["__version__", *_LAZY]
 
@@ -18,7 +41,13 @@ __all__ = ["__version__", *_LAZY]
 def __getattr__(name: str):
     module = _LAZY.get(name)
     if module is None:
-        raise AttributeError(f"module 'app' has no attribute {name!r}")
+        raise AttributeError(f"module 'alight' has no attribute {name!r}")
     import importlib
 
-    return getattr(importlib.import_module(module), name)
+    value = getattr(importlib.import_module(module), name if name != "Error" else "AlightError")
+    globals()[name] = value   # later lookups skip this function
+    return value
+
+
+def __dir__():
+    return sorted(__all__)

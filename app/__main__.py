@@ -1,5 +1,7 @@
+"""``python -m alight``: the same as the ``alight`` command."""
+
 import sys
 
-from app.cli import main
+from alight.frontends.cli import main
 
 sys.exit(main())

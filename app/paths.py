@@ -1,4 +1,5 @@
-"""Where the shader and preset files are, in a source checkout and in an installed wheel."""
+"""Where alight's files are: its shaders and presets (in a checkout or an installed wheel), and
+the user's cache and config folders (platformdirs; never the working directory)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ _PACKAGE = Path(__file__).resolve().parent
 
 
 def _data_dir(name: str) -> Path:
-    # An installed wheel carries the folder inside the package; a checkout has it beside app/.
+    # An installed wheel carries the folder inside the package; a checkout (and an editable
+    # install, which maps the package onto app/) has it beside app/.
     for candidate in (_PACKAGE / name, _PACKAGE.parent / name):
         if candidate.is_dir():
             return candidate
@@ -25,9 +27,22 @@ def preset_dir() -> Path:
 
 
 def cache_dir() -> Path:
-    """The user's cache directory for alight (ALIGHT_CACHE_DIR, else XDG_CACHE_HOME/alight)."""
+    """Caches alight can rebuild (bakes, the BRDF LUT, chart references): ``ALIGHT_CACHE_DIR``,
+    else the platform's user cache folder (``~/.cache/alight`` on Linux, honouring XDG_CACHE_HOME)."""
     explicit = os.environ.get("ALIGHT_CACHE_DIR")
     if explicit:
         return Path(explicit)
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "alight"
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("alight", appauthor=False))
+
+
+def config_dir() -> Path:
+    """The editor's own state (its last session, imgui's window layout): ``ALIGHT_CONFIG_DIR``,
+    else the platform's user config folder (``~/.config/alight`` on Linux, honouring XDG_CONFIG_HOME)."""
+    explicit = os.environ.get("ALIGHT_CONFIG_DIR")
+    if explicit:
+        return Path(explicit)
+    import platformdirs
+
+    return Path(platformdirs.user_config_dir("alight", appauthor=False))

@@ -9,14 +9,12 @@ material; the bake count shows the cache at work.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
-from app import AlightRenderer, Material  # noqa: E402
+from alight import Material, Renderer
 
 ENV = REPO.parent / "shared" / "data" / "env" / "venice_sunset_1k.hdr"
 
@@ -28,7 +26,7 @@ def main() -> None:
     ap.add_argument("--quality", default="medium")
     args = ap.parse_args()
     t0 = time.perf_counter()
-    with AlightRenderer(args.size, quality=args.quality) as r:
+    with Renderer(args.size, quality=args.quality) as r:
         r.open().set_environment(str(ENV))
         t1 = time.perf_counter()
         r.render()

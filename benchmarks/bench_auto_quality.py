@@ -3,7 +3,7 @@
 For a few scenes (a rough-only material, a mirror, the environment off, ...) this prints what
 `--quality auto` chooses, the median bake time of that choice and of `high` (interleaved runs,
 warm process, LUTs cached; auto's time includes its environment analysis), the speed-up, and the
-probe's implementation error of both against app/converged.py's converged split sum, next to
+probe's implementation error of both against app/accuracy/converged.py's converged split sum, next to
 the budget. Nothing is asserted: the figures go in the README.
 
     .venv/bin/python benchmarks/bench_auto_quality.py [--runs 3] [--budget 2]
@@ -21,17 +21,20 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 os.environ.setdefault("ALIGHT_CACHE_DIR", tempfile.mkdtemp(prefix="alight-bench-"))
 
-from app import shading  # noqa: E402
-from app.auto_quality import choose_quality, environment_features, scene_needs  # noqa: E402
-from app.bake import QUALITY, bake_environment  # noqa: E402
-from app.converged import split_sum_converged, downsample_equirect  # noqa: E402
-from app.environment import load_environment  # noqa: E402
-from app.material import Material  # noqa: E402
-from app.renderer import Renderer  # noqa: E402
-from app.scene import Scene  # noqa: E402
+from alight.accuracy.auto_quality import (
+    choose_quality,
+    environment_features,
+    scene_needs,
+)
+from alight.accuracy.converged import downsample_equirect, split_sum_converged
+from alight.core import shading
+from alight.core.material import Material
+from alight.core.scene import Scene
+from alight.ibl.bake import QUALITY, bake_environment
+from alight.ibl.environment import load_environment
+from alight.render.renderer import ForwardRenderer
 
 ENV = Path(__file__).resolve().parents[2] / "shared" / "data" / "env"
 WIDTH = 48
@@ -50,7 +53,7 @@ SCENES = [
 def probe_error(renderer, maps, env, m) -> float:
     n, inside = shading.probe_normals(WIDTH)
     rad = env.radiance
-    # converged split sum; the map halved for r >= 0.25 (app/converged.py: <= 6e-4 added)
+    # converged split sum; the map halved for r >= 0.25 (app/accuracy/converged.py: <= 6e-4 added)
     src = downsample_equirect(rad, 2) if m.roughness >= 0.25 and rad.shape[1] >= 1024 else rad
     want = split_sum_converged(src, n[inside], (0.0, 0.0, 1.0), m.base_color, m.metallic, m.roughness, m.specular_f0)
     got = renderer.render(Scene(material=m, view="probe", ibl_model="lecture"), maps, WIDTH, WIDTH, read_srgb=False).linear[..., :3][inside]
@@ -63,7 +66,7 @@ def main() -> int:
     p.add_argument("--budget", type=float, default=2.0, help="percent (default 2)")
     args = p.parse_args()
     budget = args.budget / 100.0
-    r = Renderer()
+    r = ForwardRenderer()
     for q in (QUALITY["medium"], QUALITY["high"]):
         r.luts.get(q.lut_size, q.lut_samples)
     rows = []
@@ -99,7 +102,7 @@ def main() -> int:
         print(f"  auto {a * 1000:.0f} ms, high {h * 1000:.0f} ms, speed-up {h / a:.1f}x; error auto "
               f"{err_auto * 100:.2f}% (predicted {choice.predicted_error * 100:.2f}%), high {err_high * 100:.2f}%"
               + (f"; {note}" if note else ""), file=sys.stderr)
-    print(f"\n| scene | auto's choice | auto bake (median) | high bake | speed-up | error auto (predicted) | error high |")
+    print("\n| scene | auto's choice | auto bake (median) | high bake | speed-up | error auto (predicted) | error high |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
     for label, choice, a, h, ea, eh, _ in rows:
         name = choice.name if choice.quality is None else f"{choice.name}, max r {choice.quality.max_roughness:g}"

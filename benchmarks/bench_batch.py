@@ -10,15 +10,13 @@ from __future__ import annotations
 
 import argparse
 import io
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
-from app.batch import plan, run  # noqa: E402
+from alight.frontends.batch import plan, run
 
 ENV = REPO.parent / "shared" / "data" / "env" / "venice_sunset_1k.hdr"
 
@@ -42,8 +40,7 @@ def main() -> None:
             import ray
 
             # One local cluster for both runs, so neither pays Ray's start-up.
-            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
-                     runtime_env={"env_vars": {"PYTHONPATH": str(REPO)}})
+            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
         for n in (int(x) for x in args.workers.split(",")):
             p.out_dir = Path(tmp) / f"out{n}"
             for item in p.stills:

@@ -8,19 +8,16 @@ the same radiance.
 
 import argparse
 import statistics
-import sys
 import time
 from pathlib import Path
 
 import moderngl
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from app.bake import QUALITY, grid_roughness, prefilter_sample_set, read_cube  # noqa: E402
-from app.environment import load_environment  # noqa: E402
-from app.gpu import describe  # noqa: E402
-from app.renderer import Renderer  # noqa: E402
+from alight.core.gpu import describe
+from alight.ibl.bake import QUALITY, grid_roughness, prefilter_sample_set, read_cube
+from alight.ibl.environment import load_environment
+from alight.render.renderer import ForwardRenderer
 
 DEFAULT_ENV = Path(__file__).resolve().parents[2] / "shared" / "data" / "env" / "royal_esplanade_1k.hdr"
 
@@ -32,13 +29,13 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()
 
-    r = Renderer()
+    r = ForwardRenderer()
     ctx = r.ctx
     q = QUALITY[args.quality]
     maps = r.bake(load_environment(args.env), q)
     source = maps.environment
-    compute = r.shaders.compute("bake/prefilter.comp")
-    fragment = r.shaders.program("render/fullscreen.vert", "bake/prefilter.frag")
+    compute = r.shaders.compute("ibl/prefilter.comp")
+    fragment = r.shaders.program("render/fullscreen.vert", "ibl/prefilter.frag")
     vao = ctx.vertex_array(fragment, [])
     levels = q.prefiltered_levels
     print(f"{describe(ctx)}; quality {q.name}; median of {args.repeats}")

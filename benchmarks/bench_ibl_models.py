@@ -1,16 +1,16 @@
-"""Every IBL model of app/ibl_models.py against CONVENTIONS.md's ground truth, and its frame cost.
+"""Every IBL model of app/core/ibl_models.py against CONVENTIONS.md's ground truth, and its frame cost.
 Prints the figures and writes results/ibl_models.csv and results/ibl_models.md; not a test.
 
     python benchmarks/bench_ibl_models.py            # every shared 2:1 map, every preset (~10 min on 2 cores)
     python benchmarks/bench_ibl_models.py --quick    # two maps, three presets, two roughness values
 
 Error: the probe view (CONVENTIONS.md) rendered by the GPU at the `medium` bake, against the exact
-texel sum of app/ground_truth.py over the map reduced by 2 (app.converged.downsample_equirect),
+texel sum of app/accuracy/ground_truth.py over the map reduced by 2 (alight.accuracy.converged.downsample_equirect),
 as sum |render - truth| / sum |truth| over the disk and RGB (relative mean absolute error).
 The goal of issue 4: at most half the lecture's error for every preset at r >= 0.3 on every
 shared map (spot1Lux aside: its truth is near zero over most of the ball), at no more than 10%
 more frame time. The frame time is the material ball at 1280x720 with 3 point lights and the
-environment as background (`Renderer.render` + `ctx.finish()`, no read-back), median of repeats,
+environment as background (`ForwardRenderer.render` + `ctx.finish()`, no read-back), median of repeats,
 given as a ratio to the lecture's measured in the same loop (the machine is shared and noisy).
 Where the bake found compact sources (royal_esplanade: 2 lamps, quarry_01: the sun) every model
 adds them per pixel; venice_sunset has none, so there the ratio is the models' own cost.
@@ -21,16 +21,14 @@ from __future__ import annotations
 import argparse
 import csv
 import statistics
-import sys
 import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from benchmarks.bench_render import RESULTS, section, shared_environments  # noqa: E402
+from benchmarks.bench_render import RESULTS, section, shared_environments
 
 ROUGHNESS = (0.3, 0.5, 0.7, 1.0)
 PROBE = 32
@@ -38,14 +36,14 @@ EXEMPT = ("spot1Lux.hdr",)
 
 
 def errors(envs, presets, roughnesses):
-    from app.converged import downsample_equirect
-    from app.ground_truth import ground_truth_terms, probe_points
-    from app.ibl_models import IBL_MODELS
-    from app.material import load_preset
-    from app.renderer import Renderer
-    from app.scene import Scene
+    from alight.accuracy.converged import downsample_equirect
+    from alight.accuracy.ground_truth import ground_truth_terms, probe_points
+    from alight.core.ibl_models import IBL_MODELS
+    from alight.core.scene import Scene
+    from alight.exchange.presets import load_preset
+    from alight.render.renderer import ForwardRenderer
 
-    r = Renderer()
+    r = ForwardRenderer()
     pts, inside = probe_points(PROBE)
     rows = []
     for label, env in envs:
@@ -73,15 +71,15 @@ FRAME_MAPS = ("royal_esplanade_1k.hdr", "quarry_01_1k.hdr", "venice_sunset_1k.hd
 
 
 def frame_times(repeats, maps_named=FRAME_MAPS):
-    from app.environment import load_environment
-    from app.ibl_models import IBL_MODELS
-    from app.material import load_preset
-    from app.mesh import sphere
-    from app.renderer import Renderer
-    from app.scene import Light, Scene
+    from alight.core.ibl_models import IBL_MODELS
+    from alight.core.mesh import sphere
+    from alight.core.scene import Light, Scene
+    from alight.exchange.presets import load_preset
+    from alight.ibl.environment import load_environment
+    from alight.render.renderer import ForwardRenderer
 
     env_dir = REPO.parent / "shared" / "data" / "env"
-    r = Renderer()
+    r = ForwardRenderer()
     lights = [Light(vector=(2.0, 3.0, 4.0)), Light(vector=(-3.0, 1.0, 2.0), color=(0.6, 0.7, 1.0)),
               Light(vector=(0.0, -2.0, 3.0), intensity=4.0)]
     out = {}
@@ -105,7 +103,7 @@ def frame_times(repeats, maps_named=FRAME_MAPS):
 
 
 def report(rows, frames, path_md):
-    from app.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
+    from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 
     models = list(IBL_MODELS)
     envs = sorted({x["environment"] for x in rows})
@@ -154,7 +152,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeats", type=int, default=15)
     args = ap.parse_args(argv)
-    from app.material import list_presets
+    from alight.exchange.presets import list_presets
 
     envs = shared_environments()
     presets = list_presets()

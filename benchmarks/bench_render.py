@@ -22,9 +22,8 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 ENV_DIR = REPO.parent / "shared" / "data" / "env"
 BENCH_ENV = ENV_DIR / "royal_esplanade_1k.hdr"
@@ -48,9 +47,7 @@ def section(title):
 
 
 def _child_env():
-    env = dict(os.environ)
-    env["PYTHONPATH"] = str(REPO) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-    return env
+    return dict(os.environ)   # the installed alight (make setup), as a user runs it
 
 
 def run_child(args, cwd=None):
@@ -75,10 +72,10 @@ def run_child(args, cwd=None):
 _COLD_BAKE = r"""
 import json, sys, time
 t0 = time.perf_counter()
-from app.renderer import Renderer
-from app.environment import load_environment
+from alight.render.renderer import ForwardRenderer
+from alight.ibl.environment import load_environment
 t1 = time.perf_counter()
-r = Renderer()
+r = ForwardRenderer()
 t2 = time.perf_counter()
 env = load_environment(sys.argv[1])
 t3 = time.perf_counter()
@@ -91,12 +88,12 @@ print(json.dumps({"import": t1 - t0, "context": t2 - t1, "load": t3 - t2, "bake"
 
 
 def bench_bake(qualities, repeats_cold, repeats_warm):
-    from app.bake import QUALITY, LutCache, bake_environment
-    from app.environment import load_environment
-    from app.renderer import Renderer
+    from alight.ibl.bake import QUALITY, LutCache, bake_environment
+    from alight.ibl.environment import load_environment
+    from alight.render.renderer import ForwardRenderer
 
     section(f"Bake of {BENCH_ENV.name} (medians; cold = fresh process, LUT already on disk)")
-    r = Renderer()
+    r = ForwardRenderer()
     env = load_environment(str(BENCH_ENV))
     for q in qualities:  # put every quality's LUT on disk so the cold runs measure the usual case
         r.bake(env, q)
@@ -158,15 +155,15 @@ def bench_bake(qualities, repeats_cold, repeats_warm):
 # --------------------------------------------------------------------------------------------
 
 def bench_frames(repeats):
-    from app.environment import load_environment
-    from app.material import Material
-    from app.mesh import sphere
-    from app.renderer import Renderer
-    from app.scene import Light, Scene
+    from alight.core.material import Material
+    from alight.core.mesh import sphere
+    from alight.core.scene import Light, Scene
+    from alight.ibl.environment import load_environment
+    from alight.render.renderer import ForwardRenderer
 
     section("Frame time: material ball (sphere, camera view, env background), "
             f"IBL ({BENCH_ENV.name}, medium) + 3 point lights")
-    r = Renderer()
+    r = ForwardRenderer()
     maps = r.bake(load_environment(str(BENCH_ENV)), "medium")
     scene = Scene(mesh=sphere(), material=Material(),
                   lights=[Light(vector=(2.0, 3.0, 4.0)), Light(vector=(-3.0, 1.0, 2.0), color=(0.6, 0.7, 1.0)),
@@ -205,10 +202,10 @@ def bench_frames(repeats):
 # --------------------------------------------------------------------------------------------
 
 def bench_cli(repeats):
-    section("Process start to PNG: python -m app render --out x.png (1024x1024, studio, medium, msaa)")
+    section("Process start to PNG: python -m alight render --out x.png (1024x1024, studio, medium, msaa)")
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "x.png"
-        cmd = [sys.executable, "-m", "app", "render", "--out", str(out)]
+        cmd = [sys.executable, "-m", "alight", "render", "--out", str(out)]
         first, _, first_rss = run_child(cmd)  # fills the LUT disk cache (not counted below)
         walls, rss = [], []
         for _ in range(repeats):
@@ -228,8 +225,8 @@ def bench_cli(repeats):
 
 def shared_environments():
     """Every 2:1 map in ../shared/data/env, loaded; prints the ones skipped and why."""
-    from app.environment import load_environment
-    from app.errors import AlightError
+    from alight.errors import AlightError
+    from alight.ibl.environment import load_environment
 
     envs = []
     for path in sorted(glob.glob(str(ENV_DIR / "*.hdr")) + glob.glob(str(ENV_DIR / "*.exr"))):
@@ -244,11 +241,15 @@ def shared_environments():
 
 
 def bench_split_sum_error(envs, roughnesses, size=48):
-    from app.converged import brdf_lut_converged, irradiance_converged, prefiltered_converged
-    from app.material import Material
-    from app.renderer import Renderer
-    from app.scene import Scene
-    from app.shading import F_SchlickRoughness, f0_of, probe_normals, reflect
+    from alight.accuracy.converged import (
+        brdf_lut_converged,
+        irradiance_converged,
+        prefiltered_converged,
+    )
+    from alight.core.material import Material
+    from alight.core.scene import Scene
+    from alight.core.shading import F_SchlickRoughness, f0_of, probe_normals, reflect
+    from alight.render.renderer import ForwardRenderer
 
     section(f"Probe error vs the converged split sum, quality 'medium', probe {size}x{size}: "
             "sum|render - ideal| / sum|ideal| in %")
@@ -263,7 +264,7 @@ def bench_split_sum_error(envs, roughnesses, size=48):
           f"{time.perf_counter() - t:.1f} s, reused for every environment and material)")
     mats = (("grey dielectric", GREY), ("gold", GOLD))
     print(f"{'environment':34s} {'material':16s} " + " ".join(f"r={rr:<5g}" for rr in roughnesses))
-    r = Renderer()
+    r = ForwardRenderer()
     worst = {}
     for name, env in envs:
         maps = r.bake(env, "medium")
@@ -293,27 +294,27 @@ def bench_split_sum_error(envs, roughnesses, size=48):
 
 
 def _rel(render, ref, mask):
-    from app.ground_truth import relative_error
+    from alight.accuracy.ground_truth import relative_error
 
     return relative_error(render, ref, mask)
 
 
 def bench_ground_truth_curve(envs, roughnesses, size=32, factor=2, suffix=""):
-    from app.converged import downsample_equirect
-    from app.ground_truth import ground_truth_terms, probe_points
-    from app.material import Material
-    from app.renderer import Renderer
-    from app.scene import Scene
+    from alight.accuracy.converged import downsample_equirect
+    from alight.accuracy.ground_truth import ground_truth_terms, probe_points
+    from alight.core.material import Material
+    from alight.core.scene import Scene
+    from alight.render.renderer import ForwardRenderer
 
-    section(f"Probe error vs the ground truth of CONVENTIONS.md (app/ground_truth.py), quality 'medium', "
+    section(f"Probe error vs the ground truth of CONVENTIONS.md (app/accuracy/ground_truth.py), quality 'medium', "
             f"probe {size}x{size}, in %")
-    print(f"The ground truth sums over the environment DOWNSAMPLED BY {factor} (app.converged.downsample_equirect, "
+    print(f"The ground truth sums over the environment DOWNSAMPLED BY {factor} (alight.accuracy.converged.downsample_equirect, "
           f"e.g. 1024x512 -> {1024 // factor}x{512 // factor}) to keep it fast; the GPU bakes the full map. "
-          "At r = 0.1 the lobe spans only a few texels of the reduced map (see app/ground_truth.py).")
+          "At r = 0.1 the lobe spans only a few texels of the reduced map (see app/accuracy/ground_truth.py).")
     pts, inside = probe_points(size)
     mats = (("gold", GOLD), ("white dielectric", WHITE))
     print(f"{'environment':34s} {'material':16s} " + " ".join(f"r={rr:<5g}" for rr in roughnesses))
-    r = Renderer()
+    r = ForwardRenderer()
     rows = []
     for name, env in envs:
         maps = r.bake(env, "medium")
@@ -391,10 +392,10 @@ def main(argv=None):
     # Keep the benchmark's LUT cache away from the user's.
     cache = tempfile.TemporaryDirectory(prefix="alight-bench-cache-")
     os.environ["ALIGHT_CACHE_DIR"] = cache.name
-    from app.gpu import describe
-    from app.renderer import Renderer
+    from alight.core.gpu import describe
+    from alight.render.renderer import ForwardRenderer
 
-    r = Renderer()
+    r = ForwardRenderer()
     print(f"alight benchmark ({'quick' if quick else 'full'}); {describe(r.ctx)}; "
           f"{os.cpu_count()} CPUs; python {sys.version.split()[0]}; numpy {np.__version__}")
     r.release()
@@ -407,7 +408,7 @@ def main(argv=None):
 
     section("Environments for the accuracy figures")
     if quick:
-        from app.environment import load_environment
+        from alight.ibl.environment import load_environment
 
         envs = [(BENCH_ENV.name, load_environment(str(BENCH_ENV)))]
         print(f"  --quick: {BENCH_ENV.name} only")

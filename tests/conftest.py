@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
-
-import pytest
 
 # The alight pytest plugin is registered by its pytest11 entry point once the package is
 # installed; a checkout whose installed copy predates it loads it from here instead.
 from importlib.metadata import entry_points as _entry_points
+from pathlib import Path
+
+import pytest
 
 pytest_plugins = ["pytester"]
 if not any(ep.name == "alight" for ep in _entry_points(group="pytest11")):
-    pytest_plugins.append("app.pytest_plugin")
+    pytest_plugins.append("alight.frontends.pytest_plugin")
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = REPO.parent / "shared" / "data"
@@ -28,12 +28,14 @@ def shared_data() -> Path:
 
 
 @pytest.fixture(scope="session", autouse=True)
-def _private_cache(tmp_path_factory):
-    """Keep the tests' LUT cache away from the user's own cache directory."""
-    old = os.environ.get("ALIGHT_CACHE_DIR")
+def _private_cache_and_config(tmp_path_factory):
+    """Keep the tests' caches and the editor's session away from the user's own folders."""
+    old = {k: os.environ.get(k) for k in ("ALIGHT_CACHE_DIR", "ALIGHT_CONFIG_DIR")}
     os.environ["ALIGHT_CACHE_DIR"] = str(tmp_path_factory.mktemp("alight-cache"))
+    os.environ["ALIGHT_CONFIG_DIR"] = str(tmp_path_factory.mktemp("alight-config"))
     yield
-    if old is None:
-        os.environ.pop("ALIGHT_CACHE_DIR", None)
-    else:
-        os.environ["ALIGHT_CACHE_DIR"] = old
+    for k, v in old.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.errors import AlightError
+from alight.errors import AlightError
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -24,8 +24,8 @@ def ball(image: np.ndarray) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def window():
-    from app.editor.state import EditorState
-    from app.editor.window import EditorWindow
+    from alight.frontends.editor.state import EditorState
+    from alight.frontends.editor.window import EditorWindow
 
     assert os.environ.get("DISPLAY"), "run through tests/test_editor.py, which provides a display"
     state = EditorState()
@@ -38,7 +38,7 @@ def window():
 
 
 def test_drops_keep_previous_state_and_show_the_error(window, tmp_path, shared_data):
-    from app.mesh import load_mesh
+    from alight.exchange.meshes import load_mesh
 
     corrupt = tmp_path / "corrupt.hdr"
     corrupt.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 64 +X 128\n" + b"\x02\x02" * 40)
@@ -112,7 +112,7 @@ def test_undo_redo_of_material_edits(window):
 def test_preset_saved_from_panel_state_loads_back_equal(window, tmp_path, monkeypatch):
     import dataclasses
 
-    from app.editor.state import EditorState
+    from alight.frontends.editor.state import EditorState
 
     s = window.state
     s.material = dataclasses.replace(s.material, name="mine", base_color=(0.7, 0.2, 0.1), roughness=0.37,
@@ -134,7 +134,7 @@ def test_preset_saved_from_panel_state_loads_back_equal(window, tmp_path, monkey
     def broken_replace(src, dst):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("app.output.os.replace", broken_replace)
+    monkeypatch.setattr("alight.exchange.output.os.replace", broken_replace)
     with pytest.raises(AlightError, match="No space left"):
         s.save_material(str(path))
     assert path.read_bytes() == good
@@ -146,8 +146,8 @@ def test_shader_hot_reload_keeps_the_last_good_program(window, tmp_path):
 
     import OpenImageIO as oiio
 
-    from app.editor.hot_reload import ShaderWatcher
-    from app.gpu import ShaderLibrary
+    from alight.core.gpu import ShaderLibrary
+    from alight.frontends.editor.hot_reload import ShaderWatcher
 
     def shot(name):
         window.frame()
@@ -186,11 +186,11 @@ def test_shader_hot_reload_keeps_the_last_good_program(window, tmp_path):
 def test_session_reopens_and_screenshot_button(window, tmp_path, monkeypatch):
     import dataclasses
 
-    from app.editor.camera import OrbitCamera
-    from app.editor.session import restore_session, save_session
-    from app.editor.state import EditorState
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session
+    from alight.frontends.editor.state import EditorState
 
-    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path / "config"))
     s = window.state
     s.load_mesh("cube")
     s.material = dataclasses.replace(s.material, roughness=0.42, name="session")
@@ -232,11 +232,11 @@ def test_texture_maps_drop_undo_and_session(window, tmp_path, monkeypatch):
 
     import OpenImageIO as oiio
 
-    from app.editor.camera import OrbitCamera
-    from app.editor.session import restore_session, save_session
-    from app.editor.state import EditorState
-    from app.output import write_image
-    from app.texture_maps import TextureMaps
+    from alight.core.texture_maps import TextureMaps
+    from alight.exchange.output import write_image
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session
+    from alight.frontends.editor.state import EditorState
 
     def shot(name):
         window.frame()
@@ -273,7 +273,7 @@ def test_texture_maps_drop_undo_and_session(window, tmp_path, monkeypatch):
     s.look = h.redo(s.look)
     assert s.texture_maps.base_color == str(checker)
 
-    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path / "config"))
     s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=(3.0, 2.0))
     save_session(s, window.orbit)
     fresh = EditorState()
@@ -309,7 +309,7 @@ def test_bake_runs_across_frames_with_the_old_maps_in_use(window, shared_data):
 def test_adaptive_scale_follows_the_frame_time(window):
     """Slow moving frames lower the adaptive scale a step at a time down to its floor, fast ones
     raise it to 1; the still view is drawn at full size whatever the scale."""
-    from app.editor.window import ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP
+    from alight.frontends.editor.window import ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP
 
     s = window.state
     s.adaptive_motion = True
@@ -343,8 +343,8 @@ def test_adaptive_scale_follows_the_frame_time(window):
 def test_built_in_file_browser(window, tmp_path):
     """Where no native dialog exists the panel's browser is an imgui window: it lists folders
     and the files of the asked types, and a pick goes to the caller (here: the texture slot)."""
-    from app.editor.file_browser import FileBrowser
-    from app.output import write_image
+    from alight.exchange.output import write_image
+    from alight.frontends.editor.file_browser import FileBrowser
 
     (tmp_path / "sub").mkdir()
     (tmp_path / ".hidden.png").write_bytes(b"x")
@@ -371,7 +371,7 @@ def test_built_in_file_browser(window, tmp_path):
 
 
 def test_quality_auto_bakes_the_choice_and_says_why(window):
-    """Bake quality 'auto': the window bakes what app/auto_quality.py chose for the material's
+    """Bake quality 'auto': the window bakes what app/accuracy/auto_quality.py chose for the material's
     kind and roughness band, and the panel's line (the same Choice) names it with its predicted
     error. A rough gold gets a cheap bake within the budget; a nearly mirror gold, which no
     measured bake brings within 2% on a sharp map, keeps medium and says so."""

@@ -6,12 +6,12 @@ import functools
 
 import numpy as np
 
-from app.renderer import Renderer
+from alight.render.renderer import ForwardRenderer
 
 
 @functools.lru_cache(maxsize=1)
-def renderer() -> Renderer:
-    return Renderer()
+def renderer() -> ForwardRenderer:
+    return ForwardRenderer()
 
 
 TERMS = {name: i for i, name in enumerate([
@@ -21,13 +21,13 @@ TERMS = {name: i for i, name in enumerate([
 
 
 def evaluate(term: str, inputs: np.ndarray, uniforms: dict | None = None) -> np.ndarray:
-    """Run shaders/util/evaluate_terms.comp on rows of up to 4 inputs; returns (N, 4) outputs."""
+    """Run shaders/accuracy/evaluate_terms.comp on rows of up to 4 inputs; returns (N, 4) outputs."""
     r = renderer()
     ctx = r.ctx
     rows = np.zeros((len(inputs), 4), np.float32)
     inputs = np.asarray(inputs, np.float32).reshape(len(inputs), -1)
     rows[:, : inputs.shape[1]] = inputs
-    prog = r.shaders.compute("util/evaluate_terms.comp")
+    prog = r.shaders.compute("accuracy/evaluate_terms.comp")
     src = ctx.buffer(rows.tobytes())
     dst = ctx.buffer(reserve=rows.nbytes)
     src.bind_to_storage_buffer(0)

@@ -1,4 +1,4 @@
-"""The Python API (app/api.py): lazy import, rendering to arrays and files, the bake cache, release."""
+"""The Python API (app/frontends/api.py): lazy import, rendering to arrays and files, the bake cache, release."""
 
 from __future__ import annotations
 
@@ -8,37 +8,38 @@ import sys
 import numpy as np
 import pytest
 
-import app.renderer
-from app import AlightRenderer
-from app.errors import AlightError
-from app.material import Material, list_presets
+import alight.render.renderer
+from alight import Renderer
+from alight.core.material import Material
+from alight.errors import AlightError
+from alight.exchange.presets import list_presets
 
 
-def test_import_app_is_cheap():
-    code = ("import sys, app; assert 'moderngl' not in sys.modules and 'trimesh' not in sys.modules; "
-            "from app import AlightRenderer; assert 'moderngl' not in sys.modules; print('ok')")
+def test_import_alight_is_cheap():
+    code = ("import sys, alight; assert 'moderngl' not in sys.modules and 'trimesh' not in sys.modules; "
+            "from alight import Renderer; assert 'moderngl' not in sys.modules; print('ok')")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "ok"
 
 
 def test_unknown_attribute_is_an_attribute_error():
-    import app
+    import alight
 
     with pytest.raises(AttributeError):
-        app.no_such_thing  # noqa: B018
+        alight.no_such_thing  # noqa: B018
 
 
 def test_hundred_materials_under_one_environment_bake_once(monkeypatch):
     calls = []
-    real = app.renderer.bake_environment
+    real = alight.render.renderer.bake_environment
 
     def counting(*args, **kwargs):
         calls.append(args[2].content_hash)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(app.renderer, "bake_environment", counting)
-    with AlightRenderer(16, quality="low") as r:
+    monkeypatch.setattr(alight.render.renderer, "bake_environment", counting)
+    with Renderer(16, quality="low") as r:
         r.set_environment("studio")
         centres = set()
         for i in range(100):
@@ -55,7 +56,7 @@ def test_hundred_materials_under_one_environment_bake_once(monkeypatch):
 
 
 def test_render_linear_and_srgb_and_presets_differ():
-    with AlightRenderer(32, quality="low") as r:
+    with Renderer(32, quality="low") as r:
         r.set_material("gold")
         srgb = r.render()
         lin = r.render(linear=True)
@@ -70,7 +71,7 @@ def test_render_linear_and_srgb_and_presets_differ():
 
 
 def test_field_overrides_and_probe_view():
-    with AlightRenderer(32, quality="low") as r:
+    with Renderer(32, quality="low") as r:
         r.set_material("gold", roughness=1.0)
         assert r.material.roughness == 1.0 and r.material.name == "gold"
         r.set_view("probe")
@@ -83,7 +84,7 @@ def test_field_overrides_and_probe_view():
 def test_save_png_and_exr(tmp_path):
     import OpenImageIO as oiio
 
-    with AlightRenderer(24, 16, quality="low") as r:
+    with Renderer(24, 16, quality="low") as r:
         r.set_mesh("cube").set_camera(orbit_deg=30, elevation_deg=20)
         png = r.save(tmp_path / "a.png")
         exr = r.save(tmp_path / "a.exr")
@@ -94,7 +95,7 @@ def test_save_png_and_exr(tmp_path):
 
 
 def test_lights_without_environment():
-    with AlightRenderer(32, quality="low") as r:
+    with Renderer(32, quality="low") as r:
         r.set_environment(None).set_material(Material(base_color=(0.8, 0.8, 0.8)))
         dark = r.render(linear=True)[16, 16, :3].sum()
         r.add_light("point:pos=0,0,5:intensity=50")
@@ -104,7 +105,7 @@ def test_lights_without_environment():
 
 
 def test_close_releases_and_reopens():
-    r = AlightRenderer(16, quality="low")
+    r = Renderer(16, quality="low")
     assert not r.is_open
     with r:
         r.render()
@@ -124,7 +125,7 @@ def test_close_releases_and_reopens():
     lambda r: r.render(0),
 ])
 def test_bad_input_is_one_alight_error(call):
-    r = AlightRenderer(8, quality="low")
+    r = Renderer(8, quality="low")
     with pytest.raises(AlightError) as exc:
         call(r)
     assert "\n" not in str(exc.value)
@@ -132,22 +133,22 @@ def test_bad_input_is_one_alight_error(call):
 
 
 def test_every_preset_loads_by_name():
-    r = AlightRenderer(8, quality="low")
+    r = Renderer(8, quality="low")
     for name in list_presets():
         assert r.set_material(name).material.name == name
 
 
 def test_other_renderers_in_the_process_are_not_disturbed():
-    """Opening and closing an AlightRenderer must leave another renderer's context current."""
-    from app.environment import constant_environment
-    from app.scene import Scene
+    """Opening and closing an Renderer must leave another renderer's context current."""
+    from alight.core.scene import Scene
+    from alight.ibl.environment import constant_environment
     from tests.gpu import renderer
 
     shared = renderer()
     maps = shared.bake(constant_environment(1.0, 64), "low")
     scene = Scene(material=Material(base_color=(0.5, 0.5, 0.5), roughness=1.0), view="probe")
     before = shared.render(scene, maps, 16, 16).linear
-    with AlightRenderer(16, quality="low") as r:
+    with Renderer(16, quality="low") as r:
         r.render()
         between = shared.render(scene, maps, 16, 16).linear
     after = shared.render(scene, maps, 16, 16).linear
@@ -157,7 +158,7 @@ def test_other_renderers_in_the_process_are_not_disturbed():
 
 
 def test_ibl_model_is_chosen_by_name_and_changes_the_image(shared_data):
-    with AlightRenderer(48, quality="low") as r:
+    with Renderer(48, quality="low") as r:
         r.set_environment(str(shared_data / "env" / "quarry_01_1k.hdr")).set_material("gold").set_view("probe")
         default = r.render(linear=True)
         lecture = r.set_ibl_model("lecture").render(linear=True)

@@ -1,4 +1,4 @@
-"""--quality auto (app/auto_quality.py): the measured table, the pure choice, max_roughness and
+"""--quality auto (app/accuracy/auto_quality.py): the measured table, the pure choice, max_roughness and
 the command line. The error the choices achieve against the converged split sum is measured by
 benchmarks/bench_auto_quality.py (figures in the README)."""
 
@@ -14,13 +14,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.auto_quality import (ARCHETYPES, CANDIDATES, EXCLUDED, ROUGHNESS_POINTS, EnvironmentFeatures,
-                              choose_quality, environment_features, load_table, material_need,
-                              predicted_error, prefilter_work, scene_needs)
-from app.bake import QUALITY, SKIPPED_STEP_SAMPLES, grid_roughness
-from app.environment import Environment, constant_environment, load_environment
-from app.material import Material
-from app.scene import Display, Scene
+from alight.accuracy.auto_quality import (
+    ARCHETYPES,
+    CANDIDATES,
+    EXCLUDED,
+    ROUGHNESS_POINTS,
+    EnvironmentFeatures,
+    choose_quality,
+    environment_features,
+    load_table,
+    material_need,
+    predicted_error,
+    prefilter_work,
+    scene_needs,
+)
+from alight.core.material import Material
+from alight.core.scene import Display, Scene
+from alight.ibl.bake import QUALITY, SKIPPED_STEP_SAMPLES, grid_roughness
+from alight.ibl.environment import constant_environment, load_environment
 from tests.gpu import renderer
 
 SUN = EnvironmentFeatures(True, 0.05)
@@ -71,7 +82,7 @@ def test_choice_is_the_cheapest_within_budget():
                     for name in CANDIDATES:
                         err, _ = predicted_error(t, name, needs, env)
                         if err <= budget:
-                            from app.auto_quality import predicted_seconds
+                            from alight.accuracy.auto_quality import predicted_seconds
                             assert predicted_seconds(t, name, c.quality.max_roughness, env.has_compact_source) \
                                 >= c.predicted_seconds - 1e-12
                     assert c.predicted_seconds <= previous + 1e-12
@@ -162,17 +173,17 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def test_cli_prints_the_choice(tmp_path):
-    from app.cli import main
+    from alight.frontends.cli import main
 
     out = tmp_path / "a.png"
-    code = subprocess.run([sys.executable, "-m", "app", "render", "--quality", "auto", "--preset", "copper",
+    code = subprocess.run([sys.executable, "-m", "alight", "render", "--quality", "auto", "--preset", "copper",
                            "--roughness", "0.8", "--size", "32", "--out", str(out)],
                           capture_output=True, text=True, timeout=120, cwd=REPO)
     assert code.returncode == 0, code.stderr
     lines = [line for line in code.stderr.splitlines() if "quality auto" in line]
     assert len(lines) == 1 and "predicted error" in lines[0] and "within the 2% budget" in lines[0]
     assert out.stat().st_size > 0
-    off = subprocess.run([sys.executable, "-m", "app", "render", "--quality", "auto", "--no-ibl", "--size", "32",
+    off = subprocess.run([sys.executable, "-m", "alight", "render", "--quality", "auto", "--no-ibl", "--size", "32",
                           "--out", str(tmp_path / "b.png")], capture_output=True, text=True, timeout=120, cwd=REPO)
     assert off.returncode == 0 and "no bake" in off.stderr
     assert main(["render", "--error-budget", "3", "--out", str(tmp_path / "c.png")]) == 2
@@ -181,11 +192,11 @@ def test_cli_prints_the_choice(tmp_path):
 
 
 def test_python_api_auto():
-    """AlightRenderer(quality="auto") chooses per render and keeps the choice; a rough material
+    """Renderer(quality="auto") chooses per render and keeps the choice; a rough material
     gets a cheaper bake than a mirror, and no environment bakes nothing."""
-    from app import AlightRenderer
+    from alight import Renderer
 
-    with AlightRenderer(32, quality="auto") as r:
+    with Renderer(32, quality="auto") as r:
         r.set_material("copper", roughness=0.8)
         assert np.isfinite(r.render(linear=True)).all()
         rough = r.last_auto_choice
@@ -200,13 +211,12 @@ def test_python_api_auto():
 
 
 def test_installed_package_carries_the_table(tmp_path):
-    """The measured table ships inside the wheel (make test installs it first)."""
+    """The measured table loads from the installed package, from any folder (that the wheel holds
+    it is tests/test_packaging.py's check)."""
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
-    code = "import app.auto_quality as a; print(a.TABLE_PATH); print(len(a.load_table()['environments']))"
+    code = "import alight.accuracy.auto_quality as a; print(a.TABLE_PATH); print(len(a.load_table()['environments']))"
     out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
-    if out.returncode != 0 and "No module named 'app'" in out.stderr:
-        pytest.skip("alight is not installed in this interpreter (make setup installs it)")
     assert out.returncode == 0, out.stderr
     path, count = out.stdout.split()
-    assert "site-packages" in path and int(count) >= 8
+    assert Path(path).is_file() and Path(path).parent.name == "accuracy" and int(count) >= 8

@@ -1,4 +1,4 @@
-"""The bake in steps (app/bake.py bake_steps), which the editor spreads over frames: the same
+"""The bake in steps (app/ibl/bake.py bake_steps), which the editor spreads over frames: the same
 maps as bake_environment, progress after every pass, nothing left behind when stopped early."""
 
 from __future__ import annotations
@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.bake import QUALITY, bake_environment, bake_steps, read_cube
-from app.environment import load_environment
+from alight.ibl.bake import QUALITY, bake_environment, bake_steps, read_cube
+from alight.ibl.environment import load_environment
 from tests.gpu import renderer
 
 

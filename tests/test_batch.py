@@ -1,4 +1,4 @@
-"""alight batch (app/batch.py): names, failures, reruns, contact sheet, turntables, the process pool."""
+"""alight batch (app/frontends/batch.py): names, failures, reruns, contact sheet, turntables, the process pool."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
-from app.batch import main, plan, run, summary
-from app.errors import AlightError
+from alight.errors import AlightError
+from alight.frontends.batch import main, plan, run, summary
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -126,8 +126,8 @@ def test_bad_specs_are_one_line_errors(folder, text, problem):
 
 
 def cli(*args, cwd):
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    return subprocess.run([sys.executable, "-m", "app", "batch", *args], capture_output=True, text=True,
+    env = dict(os.environ)
+    return subprocess.run([sys.executable, "-m", "alight", "batch", *args], capture_output=True, text=True,
                           cwd=cwd, env=env)
 
 
@@ -160,8 +160,7 @@ def test_ray_executor_on_a_local_two_worker_cluster(folder):
     """A real Ray cluster (head + 2 CPUs) started by this test; two actors, each its own GL context."""
     ray = pytest.importorskip("ray", reason="Ray is not installed (pip install 'alight[ray]')")
     spec = write_spec(folder, SPEC.replace('"duck.glb"]', '"duck.glb", "missing.obj"]'))
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, object_store_memory=80 * 1024 * 1024,
-             runtime_env={"env_vars": {"PYTHONPATH": str(REPO)}})
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, object_store_memory=80 * 1024 * 1024)
     try:
         assert ray.cluster_resources()["CPU"] == 2
         log = io.StringIO()

@@ -1,12 +1,17 @@
 """The BRDF integration map (the lecture's integrate_brdf, k = r^2/2, plus the specular lobe's
 mean directions t_A, t_B) against an independent deterministic quadrature of the same formulas
-(app.converged.brdf_lut_converged and lobe_directions_converged)."""
+(alight.accuracy.converged.brdf_lut_converged and lobe_directions_converged)."""
 
 import numpy as np
 import pytest
 
-from app.bake import QUALITY, LutCache, read_lut
-from app.converged import brdf_lut_converged, diffuse_fresnel, diffuse_fresnel_converged, lobe_directions_converged
+from alight.accuracy.converged import (
+    brdf_lut_converged,
+    diffuse_fresnel,
+    diffuse_fresnel_converged,
+    lobe_directions_converged,
+)
+from alight.ibl.bake import QUALITY, LutCache, read_lut
 from tests.gpu import renderer
 
 # (n.v, roughness) points spread over the table, including grazing and the smooth end.

@@ -1,4 +1,4 @@
-"""app/chart.py: the sweep's design, the reference's basis-material decomposition, the Pareto
+"""app/accuracy/chart.py: the sweep's design, the reference's basis-material decomposition, the Pareto
 frontier, the error map, and ``alight chart --quick`` end to end. No timing is asserted."""
 
 from __future__ import annotations
@@ -14,9 +14,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.bake import QUALITY
-from app.chart import (NV_BINS, ErrorMap, Setting, pareto, read_summary, reference_terms, sweep)
-from app.ibl_models import IBL_MODELS
+from alight.accuracy.chart import (
+    NV_BINS,
+    ErrorMap,
+    Setting,
+    pareto,
+    read_summary,
+    reference_terms,
+    sweep,
+)
+from alight.core.ibl_models import IBL_MODELS
+from alight.ibl.bake import QUALITY
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -68,10 +76,10 @@ def test_pareto_frontier():
 def test_reference_terms_combine_to_the_direct_reference():
     """The three basis materials give any material's ground truth (the BRDF is linear in F0 and
     the base colour): checked against a direct GPU reference of each material."""
-    from app.material import Material, load_preset
-    from app.reference import ReferenceRenderer, probe_gbuffer
-    from app.scene import Scene
-
+    from alight.accuracy.reference import ReferenceRenderer, probe_gbuffer
+    from alight.core.material import Material
+    from alight.core.scene import Scene
+    from alight.exchange.presets import load_preset
     from tests.gpu import renderer
 
     rng = np.random.default_rng(3)
@@ -100,7 +108,7 @@ def test_error_map_bins_by_nv_and_roughness():
     em = ErrorMap((0.25, 0.5), size)
     ref = np.ones((size, size, 4), np.float32)
     test = ref.copy()
-    from app.shading import probe_normals
+    from alight.core.shading import probe_normals
 
     n, inside = probe_normals(size)
     test[..., :3] += np.where(n[..., 2:3] < 0.3, 0.5, 0.0)     # wrong only near grazing
@@ -116,7 +124,7 @@ def test_error_map_bins_by_nv_and_roughness():
 def quick_chart(tmp_path_factory):
     """``alight chart --quick`` run once for the tests below: (its output folder, the process)."""
     out = tmp_path_factory.mktemp("chart") / "chart"
-    proc = subprocess.run([sys.executable, "-m", "app", "chart", "--quick", "--size", "16", "--out", str(out)],
+    proc = subprocess.run([sys.executable, "-m", "alight", "chart", "--quick", "--size", "16", "--out", str(out)],
                           cwd=REPO, env=dict(os.environ), capture_output=True, text=True, timeout=600)
     return out, proc
 
@@ -164,7 +172,7 @@ def test_chart_quick_end_to_end(quick_chart):
 
 def test_chart_refuses_a_bad_environment(tmp_path, shared_data):
     bad = shared_data / "env" / "memorial.exr"
-    proc = subprocess.run([sys.executable, "-m", "app", "chart", "--quick", "--env", str(bad), "--out",
+    proc = subprocess.run([sys.executable, "-m", "alight", "chart", "--quick", "--env", str(bad), "--out",
                            str(tmp_path / "c")], cwd=REPO, env=dict(os.environ), capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 2
@@ -176,7 +184,7 @@ def test_chart_refuses_a_bad_environment(tmp_path, shared_data):
 def test_editor_chart_view_reads_and_draws_the_latest_chart(quick_chart):
     """The panel's view finds the chart the last run noted, loads its series and draws them with
     implot (an imgui frame without a window: the draw calls run, nothing is shown)."""
-    from app.editor.chart_view import ChartView, find_chart_csv, load_chart
+    from alight.frontends.editor.chart_view import ChartView, find_chart_csv, load_chart
 
     out, proc = quick_chart
     assert proc.returncode == 0
@@ -194,6 +202,7 @@ def test_editor_chart_view_reads_and_draws_the_latest_chart(quick_chart):
     implot.create_context()
     try:
         io = imgui.get_io()
+        io.set_ini_filename("")   # imgui would write imgui.ini into the working directory
         io.display_size = imgui.ImVec2(600, 500)
         io.delta_time = 1 / 60
         io.backend_flags |= imgui.BackendFlags_.renderer_has_textures.value

@@ -1,4 +1,4 @@
-"""End-to-end tests of the ``alight`` command line (``python -m app ...``) through subprocesses.
+"""End-to-end tests of the ``alight`` command line (``python -m alight ...``) through subprocesses.
 
 Success paths check the written images against CONVENTIONS.md's output rules; bad input must
 give exit status 2, exactly one ``alight: error:`` line naming the file or option, no traceback,
@@ -36,8 +36,8 @@ PRESETS = ["water", "plastic_glass_low", "plastic_high", "glass_high_ruby", "dia
 # ----------------------------------------------------------------------------- helpers
 
 def run(*args, timeout: float = 120) -> subprocess.CompletedProcess:
-    """``python -m app ARGS`` from the repository root, keeping the environment (ALIGHT_CACHE_DIR)."""
-    return subprocess.run([sys.executable, "-m", "app", *map(str, args)], cwd=REPO, env=dict(os.environ),
+    """``python -m alight ARGS`` from the repository root, keeping the environment (ALIGHT_CACHE_DIR)."""
+    return subprocess.run([sys.executable, "-m", "alight", *map(str, args)], cwd=REPO, env=dict(os.environ),
                           capture_output=True, text=True, timeout=timeout)
 
 

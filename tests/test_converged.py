@@ -1,11 +1,11 @@
-"""app.converged: the converged split sum against analytic cases and Monte Carlo runs of the lecture's loops."""
+"""alight.accuracy.converged: the converged split sum against analytic cases and Monte Carlo runs of the lecture's loops."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from app.converged import (
+from alight.accuracy.converged import (
     brdf_lut_converged,
     downsample_equirect,
     irradiance_converged,
@@ -13,14 +13,18 @@ from app.converged import (
     sample_equirect_bilinear,
     split_sum_converged,
 )
-from app.environment import constant_environment, load_environment, studio_environment
-from app.shading import (
-    G_Smith,
+from alight.core.shading import (
     F_SchlickRoughness,
+    G_Smith,
     hammersley,
     importance_sample_ggx_tangent,
     k_ibl,
     texel_directions,
+)
+from alight.ibl.environment import (
+    constant_environment,
+    load_environment,
+    studio_environment,
 )
 
 

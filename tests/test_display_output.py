@@ -1,17 +1,15 @@
-"""Renderer.draw_display (the editor's view: tone mapped as it is drawn) gives the pixels that
+"""ForwardRenderer.draw_display (the editor's view: tone mapped as it is drawn) gives the pixels that
 draw_hdr followed by the tone map pass gives."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
-from app.environment import load_environment
-from app.material import load_preset
-from app.mesh import sphere
-from app.scene import Display, Light, Scene
+from alight.core.mesh import sphere
+from alight.core.scene import Display, Light, Scene
+from alight.exchange.presets import load_preset
+from alight.ibl.environment import load_environment
 from tests.gpu import renderer
 
 

@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -41,8 +40,8 @@ def display():
 
 
 def edit(*args: str, size: str = "320x240") -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONPATH=str(REPO))
-    return subprocess.run([sys.executable, "-m", "app", "edit", "--size", size, *args], cwd=REPO, env=env,
+    env = dict(os.environ)
+    return subprocess.run([sys.executable, "-m", "alight", "edit", "--size", size, *args], cwd=REPO, env=env,
                           capture_output=True, text=True, timeout=120)
 
 
@@ -96,9 +95,8 @@ def test_window_checks_in_a_fresh_process(display):
     their own interpreter: the other GPU tests keep a headless EGL context current on this
     thread, and a GLX window context cannot be made current beside it (X error BadAccess), nor
     should it steal the thread from them."""
-    # No plugin autoloading: the checks need none, and an installed package's pytest11 entry
-    # point may name a module this checkout does not have.
-    env = dict(os.environ, PYTHONPATH=str(REPO), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    # No plugin autoloading: the checks need none.
+    env = dict(os.environ, PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
     result = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
                              str(REPO / "tests" / "editor_window_checks.py")],
                             cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
@@ -119,15 +117,14 @@ def test_debug_views_show_values(display, tmp_path):
 def test_without_a_display(tmp_path):
     """`alight` alone prints the help when there is no display; `alight edit` says why it cannot run."""
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    env["PYTHONPATH"] = str(REPO)
-    bare = subprocess.run([sys.executable, "-m", "app"], cwd=REPO, env=env, capture_output=True, text=True,
+    bare = subprocess.run([sys.executable, "-m", "alight"], cwd=REPO, env=env, capture_output=True, text=True,
                           timeout=60)
     assert bare.returncode == 0 and "usage: alight" in bare.stdout and " edit " in bare.stdout
-    edit_ = subprocess.run([sys.executable, "-m", "app", "edit"], cwd=REPO, env=env, capture_output=True,
+    edit_ = subprocess.run([sys.executable, "-m", "alight", "edit"], cwd=REPO, env=env, capture_output=True,
                            text=True, timeout=60)
     assert edit_.returncode == 2 and edit_.stderr.startswith("alight: error: editor: no display")
     assert edit_.stderr.count("\n") == 1
-    bad = subprocess.run([sys.executable, "-m", "app", "edit", "--screenshot", str(tmp_path / "x.jpg")], cwd=REPO,
+    bad = subprocess.run([sys.executable, "-m", "alight", "edit", "--screenshot", str(tmp_path / "x.jpg")], cwd=REPO,
                          env=env, capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "unsupported output format" in bad.stderr
 
@@ -135,9 +132,9 @@ def test_without_a_display(tmp_path):
 def test_ibl_model_and_multiple_scattering_reach_the_scene():
     """The panel's IBL model and multiple-scattering controls edit plain state that the scene
     carries to the renderer; a wrong name from a script is one line."""
-    from app.editor.state import EditorState
-    from app.errors import AlightError
-    from app.ibl_models import DEFAULT_IBL_MODEL
+    from alight.core.ibl_models import DEFAULT_IBL_MODEL
+    from alight.errors import AlightError
+    from alight.frontends.editor.state import EditorState
 
     state = EditorState()
     assert state.scene(None).ibl_model == DEFAULT_IBL_MODEL
@@ -156,9 +153,12 @@ def test_quality_auto_in_the_editor(display, tmp_path):
     auto = ball(screenshot(tmp_path, "auto", "--preset", "gold", "--roughness", "0.7", "--quality", "auto"))
     medium = ball(screenshot(tmp_path, "medium", "--preset", "gold", "--roughness", "0.7"))
     assert np.abs(auto.mean(axis=0) - medium.mean(axis=0)).max() < 0.03 * medium.mean()
-    from app.auto_quality import MaterialNeed, choose_quality, environment_features
-    from app.bake import QUALITY
-    from app.environment import load_environment
+    from alight.accuracy.auto_quality import (
+        MaterialNeed,
+        choose_quality,
+        environment_features,
+    )
+    from alight.ibl.environment import load_environment
 
     # What the window chose for it (a metal in the roughness band 0.5-1): within the budget and
     # a cheaper bake than medium.
@@ -169,6 +169,6 @@ def test_quality_auto_in_the_editor(display, tmp_path):
 
 
 def choice_seconds_of_medium(choice) -> float:
-    from app.auto_quality import load_table, predicted_seconds
+    from alight.accuracy.auto_quality import load_table, predicted_seconds
 
     return predicted_seconds(load_table(), "medium", 1.0, False)

@@ -1,4 +1,4 @@
-"""app.environment: the studio, loading the shared maps, refusing and repairing bad files."""
+"""alight.ibl.environment: the studio, loading the shared maps, refusing and repairing bad files."""
 
 from __future__ import annotations
 
@@ -8,7 +8,9 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 
-from app.environment import (
+from alight.core.shading import equirect_uv_to_direction, texel_directions
+from alight.errors import AlightError
+from alight.ibl.environment import (
     MAX_WIDTH,
     STUDIO,
     Environment,
@@ -16,8 +18,6 @@ from app.environment import (
     load_environment,
     studio_environment,
 )
-from app.errors import AlightError
-from app.shading import equirect_uv_to_direction, texel_directions
 
 ENV_FILES = [
     "royal_esplanade_1k.hdr", "venice_sunset_1k.hdr", "quarry_01_1k.hdr", "moonless_golf_1k.hdr",

@@ -1,4 +1,4 @@
-"""Each shared GLSL function against its numpy twin in app/shading.py, on the same inputs.
+"""Each shared GLSL function against its numpy twin in app/core/shading.py, on the same inputs.
 
 Tolerances: GLSL runs in float32, the twins in float64, so agreement is to float32 rounding
 (relative ~1e-5) except where a function amplifies it (D_GGX near its peak at low roughness).
@@ -7,8 +7,8 @@ Tolerances: GLSL runs in float32, the twins in float64, so agreement is to float
 import numpy as np
 import pytest
 
-from app import shading
-from app.bake import roughness_to_grid_step
+from alight.core import shading
+from alight.ibl.bake import roughness_to_grid_step
 from tests.gpu import evaluate
 
 rng = np.random.default_rng(7)

@@ -1,9 +1,8 @@
-"""glTF material round trip (app/gltf_material.py, alight export), checked by the Khronos validator."""
+"""glTF material round trip (app/exchange/gltf_material.py, alight export), checked by the Khronos validator."""
 
 from __future__ import annotations
 
 import json
-import math
 import shutil
 import subprocess
 import sys
@@ -12,11 +11,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.errors import AlightError
-from app.gltf_material import (EXT_EMISSIVE, EXT_IOR, EXT_SPECULAR, export_material_gltf, export_mesh_glb,
-                               import_material, read_gltf_json)
-from app.material import Material, list_presets, load_preset
-from app.mesh import load_mesh
+from alight.core.material import Material
+from alight.errors import AlightError
+from alight.exchange.gltf_material import (
+    EXT_EMISSIVE,
+    EXT_IOR,
+    EXT_SPECULAR,
+    export_material_gltf,
+    export_mesh_glb,
+    import_material,
+    read_gltf_json,
+)
+from alight.exchange.meshes import load_mesh
+from alight.exchange.presets import list_presets, load_preset
 
 REPO = Path(__file__).resolve().parents[1]
 VALIDATOR_PACKAGE = REPO / "tools" / "node" / "node_modules" / "gltf-validator"
@@ -181,8 +188,8 @@ def test_bad_files_are_one_line_errors(content, problem, tmp_path):
 def cli(*args, cwd=None):
     import os
 
-    env = {**os.environ, "PYTHONPATH": str(REPO)}  # this checkout's app, from any working directory
-    return subprocess.run([sys.executable, "-m", "app", *args], capture_output=True, text=True, cwd=cwd, env=env)
+    env = dict(os.environ)
+    return subprocess.run([sys.executable, "-m", "alight", *args], capture_output=True, text=True, cwd=cwd, env=env)
 
 
 def test_cli_export_gltf_and_glb(tmp_path, validate):
@@ -216,9 +223,9 @@ def test_cli_export_bad_input(args, problem, tmp_path):
 
 def test_editor_state_exports_the_edited_material(validate, tmp_path):
     """The editor's export (EditorState.export_gltf, the panel's 'export glTF' button)."""
-    from app.editor.state import EditorState
-    from app.gltf_material import import_material
-    from app.material import with_overrides
+    from alight.core.material import with_overrides
+    from alight.exchange.gltf_material import import_material
+    from alight.frontends.editor.state import EditorState
 
     state = EditorState()
     state.load_mesh("cube")

@@ -3,8 +3,8 @@
 import moderngl
 import pytest
 
-from app import gpu
-from app.errors import AlightError
+from alight.core import gpu
+from alight.errors import AlightError
 from tests.gpu import renderer
 
 

@@ -1,4 +1,4 @@
-"""app.ground_truth: CONVENTIONS.md's exact IBL texel sum, checked against analytic values and an
+"""alight.accuracy.ground_truth: CONVENTIONS.md's exact IBL texel sum, checked against analytic values and an
 independent Monte Carlo estimate."""
 
 from __future__ import annotations
@@ -6,17 +6,25 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.converged import downsample_equirect, sample_equirect_bilinear
-from app.environment import constant_environment, load_environment
-from app.ground_truth import (
+from alight.accuracy.converged import downsample_equirect, sample_equirect_bilinear
+from alight.accuracy.ground_truth import (
     MIN_ROUGHNESS,
     ground_truth_terms,
     probe_ground_truth,
     reflectance_ground_truth,
     relative_error,
 )
-from app.material import Material
-from app.shading import D_GGX, F_Schlick, G_Smith, f0_of, k_ibl, probe_normals, rotate_world_to_map
+from alight.core.material import Material
+from alight.core.shading import (
+    D_GGX,
+    F_Schlick,
+    G_Smith,
+    f0_of,
+    k_ibl,
+    probe_normals,
+    rotate_world_to_map,
+)
+from alight.ibl.environment import constant_environment, load_environment
 
 WHITE_LAMBERT = dict(base_color=(1.0, 1.0, 1.0), metallic=0.0, specular_f0=(0.0, 0.0, 0.0))
 
@@ -35,7 +43,7 @@ def _frame(n):
 
 
 def _brdf_cos(n, v, l, base, metallic, roughness, specular_f0):
-    """f(l, v) max(n.l, 0) of CONVENTIONS.md, straight from app.shading's twins: (S, 3)."""
+    """f(l, v) max(n.l, 0) of CONVENTIONS.md, straight from alight.core.shading's twins: (S, 3)."""
     f0 = f0_of(np.asarray(base, float), metallic, np.asarray(specular_f0, float))
     nl = l @ n
     nv = max(float(n @ v), 1e-4)
@@ -149,7 +157,7 @@ def test_half_lit_white_material_is_nearly_lambertian():
 
 def _monte_carlo(radiance, n, v, base_color, metallic, roughness, specular_f0, samples: int = 1 << 16, seed: int = 7):
     """Uniform hemisphere sampling about n (pdf 1/(2 pi)), stratified on a sqrt(S) x sqrt(S) grid
-    with one jittered sample per cell, bilinear environment lookups, BRDF from app.shading."""
+    with one jittered sample per cell, bilinear environment lookups, BRDF from alight.core.shading."""
     rng = np.random.default_rng(seed)
     side = int(round(np.sqrt(samples)))
     i, j = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")

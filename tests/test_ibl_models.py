@@ -1,5 +1,5 @@
-"""The IBL models of app/ibl_models.py against CONVENTIONS.md's ground truth, through their numpy
-twins (app.converged.ibl_converged: each model with converged maps, so only the model's own
+"""The IBL models of app/core/ibl_models.py against CONVENTIONS.md's ground truth, through their numpy
+twins (alight.accuracy.converged.ibl_converged: each model with converged maps, so only the model's own
 approximation is measured, not the bake's sampling). The maps are reduced by 4 (256x128) to keep
 this fast; both sides of every comparison use the same reduced map.
 
@@ -16,11 +16,11 @@ What is expected, and why:
 import numpy as np
 import pytest
 
-from app.converged import downsample_equirect, ibl_converged
-from app.environment import constant_environment, load_environment
-from app.ground_truth import ground_truth_terms, probe_points
-from app.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS, ibl_model_index
-from app.material import load_preset
+from alight.accuracy.converged import downsample_equirect, ibl_converged
+from alight.accuracy.ground_truth import ground_truth_terms, probe_points
+from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS, ibl_model_index
+from alight.exchange.presets import load_preset
+from alight.ibl.environment import constant_environment, load_environment
 
 PROBE = 24
 _maps: dict = {}

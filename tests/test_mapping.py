@@ -4,10 +4,10 @@ in numpy and through the whole GPU path (bake -> cube -> forward pass -> read-ba
 import numpy as np
 import pytest
 
-from app import shading
-from app.environment import Environment
-from app.material import Material
-from app.scene import Display, Scene
+from alight.core import shading
+from alight.core.material import Material
+from alight.core.scene import Display, Scene
+from alight.ibl.environment import Environment
 from tests.gpu import renderer
 
 

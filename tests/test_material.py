@@ -1,4 +1,4 @@
-"""app/material.py: the presets against the lecture's F0 table, strict file validation, I/O."""
+"""app/core/material.py: the presets against the lecture's F0 table, strict file validation, I/O."""
 
 from __future__ import annotations
 
@@ -9,21 +9,19 @@ from pathlib import Path
 
 import pytest
 
-from app import material as mat
-from app.errors import AlightError
-from app.material import (
+from alight.core.material import (
     PRESET_NAMES,
     Material,
-    list_presets,
-    load_preset,
     material_from_dict,
     parse_color,
-    save_preset,
     validate_material,
     with_overrides,
 )
-from app.paths import preset_dir
-from app.shading import linear_to_srgb
+from alight.core.shading import linear_to_srgb
+from alight.errors import AlightError
+from alight.exchange import presets
+from alight.exchange.presets import list_presets, load_preset, save_preset
+from alight.paths import preset_dir
 
 # The lecture's F0 table, typed in independently of the preset files: name -> (linear, sRGB, metal).
 TABLE: dict[str, tuple[tuple[float, float, float], tuple[float, float, float], bool]] = {
@@ -297,13 +295,13 @@ def test_failed_rename_leaves_old_file_and_no_temporary(tmp_path, monkeypatch):
     p = tmp_path / "keep.json"
     save_preset(Material(name="keep"), p)
     before = p.read_bytes()
-    import app.output
+    import alight.exchange.output
 
     def broken_replace(src, dst):
         assert Path(src).exists()  # the temporary really was written before the failure
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(app.output.os, "replace", broken_replace)
+    monkeypatch.setattr(alight.exchange.output.os, "replace", broken_replace)
     with pytest.raises(AlightError) as e:
         save_preset(Material(roughness=0.9, name="new"), p)
     _one_line_error(e, str(p), "No space left on device")
@@ -316,7 +314,7 @@ def test_failed_serialisation_leaves_no_temporary(tmp_path, monkeypatch):
     def boom(*a, **k):
         raise ValueError("cannot serialise")
 
-    monkeypatch.setattr(mat.json, "dumps", boom)
+    monkeypatch.setattr(presets.json, "dumps", boom)
     with pytest.raises(ValueError):
         save_preset(Material(), tmp_path / "x.json")
     monkeypatch.undo()

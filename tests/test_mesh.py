@@ -1,4 +1,4 @@
-"""app.mesh: built-in meshes, tangents, file loading and the refusal of bad files."""
+"""alight.core.mesh: built-in meshes, tangents, file loading and the refusal of bad files."""
 
 from __future__ import annotations
 
@@ -9,18 +9,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.errors import AlightError
-from app.mesh import (
+from alight.core.mesh import (
     BUILTIN_MESHES,
     FileMaterial,
     Mesh,
     MeshPart,
     compute_tangents,
     cube,
-    load_mesh,
     plane,
     sphere,
 )
+from alight.errors import AlightError
+from alight.exchange.meshes import load_mesh
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -442,6 +442,6 @@ def test_degenerate_faces_dropped(tmp_path):
 
 
 def test_import_does_not_import_trimesh():
-    code = "import sys, app.mesh; app.mesh.sphere(); app.mesh.load_mesh('cube'); print('trimesh' in sys.modules)"
+    code = "import sys, alight.exchange.meshes as m; m.sphere(); m.load_mesh('cube'); print('trimesh' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

@@ -1,4 +1,4 @@
-"""app/metrics.py (relMAE, FLIP, heat maps) and ``alight compare``."""
+"""app/accuracy/metrics.py (relMAE, FLIP, heat maps) and ``alight compare``."""
 
 from __future__ import annotations
 
@@ -10,9 +10,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.metrics import (COLORBAR_HEIGHT, compare_linear, covered_mask, flip, heatmap_size, relative_error_map,
-                         relative_mae, tonemapped_srgb, write_relative_heatmap)
-from app.output import write_image
+from alight.accuracy.metrics import (
+    COLORBAR_HEIGHT,
+    compare_linear,
+    covered_mask,
+    flip,
+    heatmap_size,
+    relative_error_map,
+    relative_mae,
+    tonemapped_srgb,
+    write_relative_heatmap,
+)
+from alight.exchange.output import write_image
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -115,7 +124,7 @@ def test_heatmap_is_written_atomically_with_the_right_size(tmp_path, monkeypatch
 # --- alight compare ------------------------------------------------------------------------
 
 def run(*args) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "app", *map(str, args)], cwd=REPO, env=dict(os.environ),
+    return subprocess.run([sys.executable, "-m", "alight", *map(str, args)], cwd=REPO, env=dict(os.environ),
                           capture_output=True, text=True, timeout=120)
 
 

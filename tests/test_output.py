@@ -7,8 +7,8 @@ import stat
 import numpy as np
 import pytest
 
-from app.errors import AlightError
-from app.output import atomic_path, write_image, write_text_atomic
+from alight.errors import AlightError
+from alight.exchange.output import atomic_path, write_image, write_text_atomic
 
 
 def mode(path):

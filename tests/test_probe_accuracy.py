@@ -1,5 +1,5 @@
 """Probe renders of royal_esplanade_1k.hdr against a numpy twin of the *converged* split sum of
-the same formulas (app/converged.py): irradiance as E/pi summed over the map's texels, the
+the same formulas (app/accuracy/converged.py): irradiance as E/pi summed over the map's texels, the
 prefiltered radiance as the exact ratio of integrals the lecture's loop converges to (N = V = R,
 weight n.l), the LUT by fine quadrature. What remains is the implementation's own error: sample
 counts, cube resolution, the roughness grid's blending, the LUT's table.
@@ -7,7 +7,7 @@ counts, cube resolution, the roughness grid's blending, the LUT's table.
 Bounds (sum |render - ideal| / sum |ideal| over the disk) at the default quality: 2% on
 royal_esplanade (no dominant sun) and 5% on quarry_01 (a sun holding half the map's power),
 the project's targets. Measured here: royal dielectric 0.5%, metal 0.6-1.5%; quarry dielectric
-0.1-0.3%, metal 0.4-0.9% (bright compact sources are added in closed form, app/sun.py). Run
+0.1-0.3%, metal 0.4-0.9% (bright compact sources are added in closed form, app/ibl/sun.py). Run
 with -s to see them. The metal is the hard case: its whole signal is the
 prefiltered map, whose first rough step (r = 0.25) is the least sampled per solid angle. The
 in-between roughness values (0.3, 0.75) are not grid steps: they measure the blending too.
@@ -16,11 +16,17 @@ in-between roughness values (0.3, 0.75) are not grid steps: they measure the ble
 import numpy as np
 import pytest
 
-from app import shading
-from app.converged import brdf_lut_converged, downsample_equirect, ibl_converged, irradiance_converged, prefiltered_converged
-from app.environment import load_environment
-from app.material import Material
-from app.scene import Scene
+from alight.accuracy.converged import (
+    brdf_lut_converged,
+    downsample_equirect,
+    ibl_converged,
+    irradiance_converged,
+    prefiltered_converged,
+)
+from alight.core import shading
+from alight.core.material import Material
+from alight.core.scene import Scene
+from alight.ibl.environment import load_environment
 from tests.gpu import renderer
 
 WIDTH = 48
@@ -79,10 +85,10 @@ MODEL_CASES = [(e, r) for e in ENVIRONMENTS for r in (0.3, 0.5, 1.0)]
 @pytest.mark.parametrize("env_name,roughness", MODEL_CASES)
 @pytest.mark.parametrize("name", list(MATERIALS))
 def test_default_model_within_bound_of_its_converged_twin(shared_data, env_name, name, roughness):
-    """The default model (alight) against app.converged.ibl_converged, its numpy twin with
+    """The default model (alight) against alight.accuracy.converged.ibl_converged, its numpy twin with
     converged maps: the same bounds as the lecture's. This checks the shader's lobe directions,
     diffuse weight and exact compact sources, not only the bake. The twin sums over the map
-    reduced by 2 (app.converged.downsample_equirect: <= 0.06% at r >= 0.25) to keep it fast.
+    reduced by 2 (alight.accuracy.converged.downsample_equirect: <= 0.06% at r >= 0.25) to keep it fast.
     Measured: royal 0.5% (dielectric), 0.7-1.4% (metal); quarry 0.2-0.5%, 0.6-1.5%."""
     model = "alight"
     env = load_environment(str(shared_data / "env" / env_name))

@@ -1,17 +1,15 @@
-"""The pytest plugin (app/pytest_plugin.py), used by inner test files run through pytester."""
+"""The pytest plugin (app/frontends/pytest_plugin.py), used by inner test files run through pytester."""
 
 from __future__ import annotations
 
-import sys
-import tomllib
-from importlib.metadata import entry_points
 from pathlib import Path
 
 import numpy as np
 import OpenImageIO as oiio  # imported here: pytester restores sys.modules after each test, and a
-import pytest               # nanobind module imported twice in one process aborts it
+import pytest  # nanobind module imported twice in one process aborts it
+import tomllib
 
-from app.pytest_plugin import _assert_image_matches
+from alight.frontends.pytest_plugin import _assert_image_matches
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -31,10 +29,10 @@ def test_render(alight_renderer, assert_image_matches):
 
 @pytest.fixture
 def run_inner(pytester, monkeypatch):
-    """Run INNER in a fresh pytest process (its own GL context) with this checkout's app."""
-    monkeypatch.setenv("PYTHONPATH", str(REPO))
+    """Run INNER in a fresh pytest process (its own GL context) with the installed alight."""
     pytester.makepyfile(test_inner=INNER)
-    plugin = [] if any(ep.name == "alight" for ep in entry_points(group="pytest11")) else ["-p", "app.pytest_plugin"]
+    # The installed package registers the plugin through its pytest11 entry point.
+    plugin: list[str] = []
 
     def run(*args, **env):
         for k in ("PRESET", "METRIC", "HDR"):
@@ -106,7 +104,7 @@ def test_relative_error_is_what_it_says(tmp_path):
 
 def test_entry_point_is_declared():
     project = tomllib.loads((REPO / "pyproject.toml").read_text())
-    assert project["project"]["entry-points"]["pytest11"]["alight"] == "app.pytest_plugin"
-    import app.pytest_plugin as plugin
+    assert project["project"]["entry-points"]["pytest11"]["alight"] == "alight.frontends.pytest_plugin"
+    import alight.frontends.pytest_plugin as plugin
 
     assert callable(plugin.pytest_addoption) and callable(plugin.assert_image_matches)

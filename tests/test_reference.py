@@ -1,5 +1,5 @@
-"""alight reference (app/reference.py): CONVENTIONS.md's ground truth on the GPU, against analytic
-values, the numpy ground truth (app/ground_truth.py) and the real-time punctual path."""
+"""alight reference (app/accuracy/reference.py): CONVENTIONS.md's ground truth on the GPU, against analytic
+values, the numpy ground truth (app/accuracy/ground_truth.py) and the real-time punctual path."""
 
 from __future__ import annotations
 
@@ -11,12 +11,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.environment import box_reduce, constant_environment, load_environment
-from app.ground_truth import ground_truth_terms, probe_points, relative_error
-from app.material import Material
-from app.mesh import load_mesh
-from app.scene import Scene, parse_light
-
+from alight.accuracy.ground_truth import (
+    ground_truth_terms,
+    probe_points,
+    relative_error,
+)
+from alight.core.equirect import box_reduce
+from alight.core.material import Material
+from alight.core.scene import Scene, parse_light
+from alight.exchange.meshes import load_mesh
+from alight.ibl.environment import constant_environment, load_environment
 from tests.gpu import renderer
 
 REPO = Path(__file__).resolve().parents[1]
@@ -25,7 +29,7 @@ WHITE = dict(base_color=(1.0, 1.0, 1.0), metallic=0.0, specular_f0=(0.0, 0.0, 0.
 
 @pytest.fixture(scope="module")
 def ref():
-    from app.reference import ReferenceRenderer
+    from alight.accuracy.reference import ReferenceRenderer
 
     return ReferenceRenderer(renderer())
 
@@ -37,7 +41,7 @@ def royal(shared_data):
 
 def _points(ref, radiance, normals, views, material, env_level=0):
     """The reference at arbitrary (n, v) pairs: a 1-row G-buffer through the same compute pass."""
-    from app.reference import GBUFFER
+    from alight.accuracy.reference import GBUFFER
 
     n = len(normals)
     g = {name: np.zeros((1, n, 4), np.float32) for name in GBUFFER}
@@ -57,7 +61,7 @@ def test_white_furnace_at_normal_incidence(ref):
     # n.v = 1, r = 1. Tolerance 1e-3: the texel sum is a midpoint rule in theta, off by about
     # (pi/H)^2/24 = 1.6e-6 at H = 512, plus float32 rounding; measured 0.999953 (3e-6 off).
     # A full 1024x512 map needs 16 dispatches: llvmpipe cut a single one short at 65535 loop
-    # iterations (0.012 instead of 1; app/reference.py's MAX_TEXELS_PER_DISPATCH).
+    # iterations (0.012 instead of 1; app/accuracy/reference.py's MAX_TEXELS_PER_DISPATCH).
     m = Material(roughness=1.0, **WHITE)
     env = constant_environment(1.0, 1024)
     result = ref.render(Scene(material=m, view="probe"), env.radiance, 9, 9, env_level=0)
@@ -137,8 +141,7 @@ def test_punctual_lights_match_the_real_time_path(ref):
 
 def run(*args):
     env = dict(os.environ)
-    env["PYTHONPATH"] = str(REPO) + os.pathsep + env.get("PYTHONPATH", "")
-    return subprocess.run([sys.executable, "-m", "app", "reference", *map(str, args)], cwd=REPO, env=env,
+    return subprocess.run([sys.executable, "-m", "alight", "reference", *map(str, args)], cwd=REPO, env=env,
                           capture_output=True, text=True, timeout=300)
 
 
@@ -175,7 +178,7 @@ def test_cli_refuses_bad_input(tmp_path, args, name):
 
 
 def test_automatic_env_level(royal, shared_data):
-    from app.reference import choose_env_level
+    from alight.accuracy.reference import choose_env_level
 
     quarry = load_environment(str(shared_data / "env" / "quarry_01_1k.hdr")).radiance
     assert choose_env_level(royal, [0.5, 0.25]) == 1      # royal's sun holds 6% of the power

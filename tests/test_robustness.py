@@ -5,10 +5,10 @@ bright sun, an all-black environment."""
 import numpy as np
 import pytest
 
-from app.environment import Environment, constant_environment, load_environment
-from app.material import Material
-from app.mesh import plane, sphere
-from app.scene import Light, Scene
+from alight.core.material import Material
+from alight.core.mesh import plane, sphere
+from alight.core.scene import Light, Scene
+from alight.ibl.environment import Environment, constant_environment, load_environment
 from tests.gpu import renderer
 
 LIGHTS = [Light("point", (0.0, 0.0, 1.05)), Light("point", (3.0, 0.0, 0.0), intensity=50.0),
@@ -41,7 +41,7 @@ def test_grazing_plane_and_zero_roughness_lights():
     r = renderer()
     maps = r.bake(constant_environment(1.0, 64), "low")
     m = Material(roughness=0.0, metallic=1.0, base_color=(1.0, 1.0, 1.0))
-    from app.scene import Camera
+    from alight.core.scene import Camera
 
     # The camera skims the plane: n.v is near 0 over most of the image.
     cam = Camera(position=(0.0, 0.01, 3.0), target=(0.0, 0.0, 0.0))
@@ -69,8 +69,9 @@ def test_emissive_adds_exactly(quarry):
 def test_back_face_culling_changes_no_pixel(shared_data, monkeypatch, mesh_name):
     """Closed meshes are drawn with back faces culled; were any front face wound the wrong way,
     culling would remove it and the image would change."""
-    import app.renderer as renderer_module
-    from app.mesh import is_closed, load_mesh
+    import alight.render.renderer as renderer_module
+    from alight.core.mesh import is_closed
+    from alight.exchange.meshes import load_mesh
 
     def load():
         return load_mesh(str(shared_data / "models" / mesh_name) if mesh_name.endswith(".glb") else mesh_name)
@@ -86,7 +87,7 @@ def test_back_face_culling_changes_no_pixel(shared_data, monkeypatch, mesh_name)
 
 
 def test_open_and_closed_meshes():
-    from app.mesh import is_closed
+    from alight.core.mesh import is_closed
 
     assert is_closed(sphere().parts[0].positions, sphere().parts[0].indices)
     assert not is_closed(plane().parts[0].positions, plane().parts[0].indices)

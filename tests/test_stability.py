@@ -4,7 +4,7 @@ tests/test_robustness.py checks that nothing is NaN at the parameter extremes; t
 test_white_furnace.py checks the furnace at the default quality for the lecture's metal;
 tests/test_probe_accuracy.py bounds the probe against the converged split sum at r >= 0.25.
 This file goes to the edges those leave out and states a bound for each: the error against
-app/converged.py's converged split sum (the implementation error), the white furnace, finite
+app/accuracy/converged.py's converged split sum (the implementation error), the white furnace, finite
 output, or a clear refusal. The figures in the docstrings were measured on this 2-core llvmpipe
 machine (run with -s to see them).
 """
@@ -20,16 +20,22 @@ import OpenImageIO as oiio
 import pytest
 from numpy.lib.stride_tricks import sliding_window_view
 
-from app import shading
-from app.bake import QUALITY, grid_roughness, quality_named, read_cube, read_lut
-from app.converged import (brdf_lut_converged, diffuse_fresnel, downsample_equirect, ibl_converged,
-                           irradiance_converged, prefiltered_converged)
-from app.environment import Environment, constant_environment, load_environment
-from app.ibl_models import IBL_MODELS
-from app.material import Material
-from app.sun import extract_suns
-from app.mesh import FileMaterial, Mesh, MeshPart, plane, sphere
-from app.scene import Camera, Scene
+from alight.accuracy.converged import (
+    brdf_lut_converged,
+    diffuse_fresnel,
+    downsample_equirect,
+    ibl_converged,
+    irradiance_converged,
+    prefiltered_converged,
+)
+from alight.core import shading
+from alight.core.ibl_models import IBL_MODELS
+from alight.core.material import Material
+from alight.core.mesh import FileMaterial, Mesh, MeshPart, plane, sphere
+from alight.core.scene import Camera, Scene
+from alight.ibl.bake import QUALITY, grid_roughness, quality_named, read_cube, read_lut
+from alight.ibl.environment import Environment, constant_environment, load_environment
+from alight.ibl.sun import extract_suns
 from tests.gpu import renderer
 
 WIDTH = 48
@@ -65,7 +71,7 @@ def env_of(shared_data):
 
 
 def converged_probe(radiance, m: Material, width: int = WIDTH):
-    """app/converged.py's split sum on the probe: (P, 3) over the disk, and the disk mask."""
+    """app/accuracy/converged.py's split sum on the probe: (P, 3) over the disk, and the disk mask."""
     n, inside = shading.probe_normals(width)
     normals = n[inside]
     nv = np.maximum(normals[:, 2], 0.0)
@@ -112,10 +118,10 @@ def test_below_first_grid_step_with_a_sun(env_of):
     source cube's box mips (which keep the sun as texels) into step 0 (which has the sun in
     closed form). A box filter is not a GGX lobe: under pedestrian_overpass's low sun, gold at
     r = 0.15 is far off the converged split sum (measured 47% at medium, 9% at the finer
-    'medium-fine' candidate of app/auto_quality.py). This documents the failure (a bound, not
+    'medium-fine' candidate of app/accuracy/auto_quality.py). This documents the failure (a bound, not
     a pass mark): the error stays finite and below 60% at medium, and the finer grid, whose first
     step is at r = 0.18, brings it under 15%. --quality auto knows it from its table."""
-    from app.auto_quality import CANDIDATES
+    from alight.accuracy.auto_quality import CANDIDATES
 
     env = env_of("pedestrian_overpass_1k.hdr")
     m = Material(base_color=GOLD.base_color, metallic=1.0, roughness=0.15)
@@ -136,7 +142,7 @@ def test_default_model_below_first_grid_step_with_a_sun(env_of):
     """The default model (alight) has no such failure: it reads the source cube *without* the
     compact sources below the grid (a smooth map, which box mips filter well) and shades the sun
     through the exact BRDF at every roughness, widened by the source's own size. Against its
-    numpy twin (app.converged.ibl_converged: the sun-free map's texel sums plus the same sun
+    numpy twin (alight.accuracy.converged.ibl_converged: the sun-free map's texel sums plus the same sun
     term), the same case as above stays under 5% (measured 1.8%) where the lecture's blend is 47% off
     its own converged value."""
     env = env_of("pedestrian_overpass_1k.hdr")
@@ -205,7 +211,7 @@ def test_grazing_camera_white_furnace(furnace):
 
 
 def _no_background():
-    from app.scene import Display
+    from alight.core.scene import Display
 
     return Display(background="transparent")
 
@@ -246,7 +252,7 @@ FIREFLY_BOUNDS = {
 def test_no_fireflies_in_prefiltered_map(env_of, env_name, quality):
     """quarry_01's sun (peak 86,528, 48% of the power in a few texels) and spot1Lux's spot (all
     of it) would make fireflies in every prefiltered step: a sample that lands on the source
-    carries a huge weight. app/sun.py takes them out (the forward pass adds them per pixel in
+    carries a huge weight. app/ibl/sun.py takes them out (the forward pass adds them per pixel in
     closed form), so the prefiltered map is that of the environment without them, and:
     - every step's neighbour ratio (texel / median of its 8 neighbours) stays <= 1.25
       (measured <= 1.07 on quarry; spot1Lux is black without its spot, and so is every step;
@@ -290,10 +296,10 @@ def test_no_fireflies_in_prefiltered_map(env_of, env_name, quality):
 
 
 def test_fireflies_without_sun_handling(env_of, monkeypatch):
-    """The control for the test above: with app/sun.py's extraction switched off, quarry's
+    """The control for the test above: with app/ibl/sun.py's extraction switched off, quarry's
     prefiltered steps do have fireflies by the same measure (> 1.25 at some step; measured
     1.37-1.55 at low), so the measure can fail."""
-    import app.bake as bake
+    import alight.ibl.bake as bake
 
     monkeypatch.setattr(bake, "extract_suns", lambda radiance: (radiance, []))
     env = env_of("quarry_01_1k.hdr")
@@ -317,7 +323,7 @@ def test_black_environment_bakes_exact_zeros(quality, irradiance):
     cube, irradiance, every prefiltered step of both grids) is exactly 0, not NaN (the
     prefilter divides by its weight sum, the sun search by the map's power). A mesh view renders
     exactly 0 too."""
-    from app.sun import extract_suns
+    from alight.ibl.sun import extract_suns
 
     black = Environment(np.zeros((64, 128, 3), np.float32), "black")
     assert extract_suns(black.radiance)[1] == []
@@ -423,7 +429,7 @@ def test_huge_environment_memory_stays_bounded(tmp_path):
             for line in open('/proc/self/status'):
                 if line.startswith('VmHWM'):
                     return int(line.split()[1]) * 1024
-        from app.environment import load_environment
+        from alight.ibl.environment import load_environment
         before = hwm()
         env = load_environment({str(path)!r})
         growth = hwm() - before

@@ -1,13 +1,13 @@
-"""A compact bright source is taken out of the map and added back in closed form (app/sun.py)."""
+"""A compact bright source is taken out of the map and added back in closed form (app/ibl/sun.py)."""
 
 import numpy as np
 import pytest
 
-from app import shading
-from app.bake import read_cube
-from app.converged import irradiance_converged
-from app.environment import Environment, constant_environment, load_environment
-from app.sun import SUN_MIN_POWER_FRACTION, extract_sun, extract_suns
+from alight.accuracy.converged import irradiance_converged
+from alight.core import shading
+from alight.ibl.bake import read_cube
+from alight.ibl.environment import Environment, constant_environment, load_environment
+from alight.ibl.sun import SUN_MIN_POWER_FRACTION, extract_sun, extract_suns
 from tests.gpu import renderer
 
 

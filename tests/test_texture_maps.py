@@ -1,17 +1,18 @@
-"""User-loaded texture maps (app/texture_maps.py) in the forward pass."""
+"""User-loaded texture maps (app/core/texture_maps.py) in the forward pass."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from app.environment import load_environment
-from app.errors import AlightError
-from app.material import Material
-from app.mesh import sphere
-from app.output import write_image
-from app.scene import Light, Scene
-from app.texture_maps import TextureMaps, load_map_image
+from alight.core.material import Material
+from alight.core.mesh import sphere
+from alight.core.scene import Light, Scene
+from alight.core.texture_maps import TextureMaps
+from alight.errors import AlightError
+from alight.exchange.images import load_map_image
+from alight.exchange.output import write_image
+from alight.ibl.environment import load_environment
 from tests.gpu import renderer
 
 

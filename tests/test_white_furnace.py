@@ -8,13 +8,13 @@
 import numpy as np
 import pytest
 
-from app import shading
-from app.bake import QUALITY, read_cube, read_lut
-from app.converged import diffuse_fresnel
-from app.ibl_models import IBL_MODELS
-from app.environment import constant_environment
-from app.material import Material
-from app.scene import Scene
+from alight.accuracy.converged import diffuse_fresnel
+from alight.core import shading
+from alight.core.ibl_models import IBL_MODELS
+from alight.core.material import Material
+from alight.core.scene import Scene
+from alight.ibl.bake import QUALITY, read_cube, read_lut
+from alight.ibl.environment import constant_environment
 from tests.gpu import renderer
 
 
@@ -26,7 +26,7 @@ def furnace():
 @pytest.mark.parametrize("quality,irradiance,tol", [("medium", "convolution", 1e-5), ("low", "sh9", 5e-4)])
 def test_irradiance_is_one_everywhere(furnace, quality, irradiance, tol):
     # The SH constants are rounded to 6 digits in sh9.glsl: hence the looser bound for SH9.
-    from app.bake import quality_named
+    from alight.ibl.bake import quality_named
 
     r = renderer()
     maps = r.bake(furnace, quality_named(quality, irradiance))
@@ -95,7 +95,7 @@ def test_metal_never_exceeds_one(furnace, roughness, model):
     white_metal = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=roughness)
     probe = r.render(Scene(material=white_metal, view="probe", ibl_model=model), maps, 64, 64).linear
     assert probe[..., :3].max() <= 1.0 + 1e-5
-    from app.mesh import sphere
+    from alight.core.mesh import sphere
 
     camera = r.render(Scene(mesh=sphere(), material=white_metal, ibl_model=model), maps, 64, 64).linear
     assert camera[..., :3][camera[..., 3] > 0].max() <= 1.0 + 1e-5

@@ -4,18 +4,15 @@ Run under a display, e.g. ``xvfb-run -a -s "-screen 0 1400x800x24" .venv/bin/pyt
 """
 
 import dataclasses
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from app.editor.state import EditorState  # noqa: E402
-from app.editor.window import EditorWindow  # noqa: E402
-from app.material import load_preset  # noqa: E402
-from app.output import write_image  # noqa: E402
+from alight.core.material import load_preset
+from alight.exchange.output import write_image
+from alight.frontends.editor.state import EditorState
+from alight.frontends.editor.window import EditorWindow
 
 state = EditorState(quality="medium")
 state.material = state.saved_material = load_preset("gold")

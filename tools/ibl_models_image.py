@@ -16,9 +16,8 @@ import tempfile
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 ENV_DIR = REPO.parent / "shared" / "data" / "env"
 CASES = [("quarry_01_1k.hdr", "gold", 0.5), ("venice_sunset_1k.hdr", "water", 0.5),
@@ -27,7 +26,7 @@ SIZE = 128
 
 
 def run(*args):
-    subprocess.run([sys.executable, "-m", "app", *args], check=True, cwd=REPO)
+    subprocess.run([sys.executable, "-m", "alight", *args], check=True, cwd=REPO)
 
 
 def read_exr(path):
@@ -42,7 +41,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from app.shading import linear_to_srgb, tonemap_aces_fitted
+    from alight.core.shading import linear_to_srgb, tonemap_aces_fitted
 
     fig, axes = plt.subplots(len(CASES), 3, figsize=(7.5, 2.6 * len(CASES)))
     with tempfile.TemporaryDirectory() as tmp:

@@ -1,9 +1,9 @@
-"""Measure app/auto_quality.py's table: every candidate bake on every shared environment (and the
-built-in studio), the probe's implementation error against app/converged.py's converged split
+"""Measure app/accuracy/auto_quality.py's table: every candidate bake on every shared environment (and the
+built-in studio), the probe's implementation error against app/accuracy/converged.py's converged split
 sum for two archetypes (grey dielectric, gold) at ROUGHNESS_POINTS, and each candidate's bake
 time (the fastest of --runs fresh bakes, LUT cached, and their median) on a map with a compact source and one without.
 
-    .venv/bin/python tools/measure_auto_quality.py            # writes app/auto_quality_table.json
+    .venv/bin/python tools/measure_auto_quality.py            # writes app/accuracy/auto_quality_table.json
 
 Takes a few minutes on 2 cores. The error is sum |render - converged| / sum |converged| over a
 48x48 probe (tests/test_probe_accuracy.py's metric), per channel, and the worst channel is kept:
@@ -24,17 +24,25 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from app import shading  # noqa: E402
-from app.auto_quality import CANDIDATES, ROUGHNESS_POINTS, TABLE_PATH, environment_features  # noqa: E402
-from app.bake import bake_environment  # noqa: E402
-from app.converged import brdf_lut_converged, downsample_equirect, irradiance_converged, prefiltered_converged  # noqa: E402
-from app.environment import load_environment  # noqa: E402
-from app.material import Material  # noqa: E402
-from app.output import atomic_path  # noqa: E402
-from app.renderer import Renderer  # noqa: E402
-from app.scene import Scene  # noqa: E402
+from alight.accuracy.auto_quality import (
+    CANDIDATES,
+    ROUGHNESS_POINTS,
+    TABLE_PATH,
+    environment_features,
+)
+from alight.accuracy.converged import (
+    brdf_lut_converged,
+    downsample_equirect,
+    irradiance_converged,
+    prefiltered_converged,
+)
+from alight.core import shading
+from alight.core.material import Material
+from alight.core.scene import Scene
+from alight.exchange.output import atomic_path
+from alight.ibl.bake import bake_environment
+from alight.ibl.environment import load_environment
+from alight.render.renderer import ForwardRenderer
 
 SHARED_ENV = Path(__file__).resolve().parents[2] / "shared" / "data" / "env"
 WIDTH = 48
@@ -62,7 +70,7 @@ def converged_parts(env, normals, luts):
     coarse = downsample_equirect(rad, 2) if rad.shape[0] % 2 == 0 and rad.shape[1] >= 1024 else rad
     irr = irradiance_converged(coarse, normals)
     reflected = shading.reflect(-np.array([0.0, 0.0, 1.0]), normals)
-    # Below r = 0.25 the lobe spans few texels: the full-resolution map (see app/converged.py).
+    # Below r = 0.25 the lobe spans few texels: the full-resolution map (see app/accuracy/converged.py).
     pre = {r: prefiltered_converged(rad if r < 0.25 else coarse, reflected, r) for r in ROUGHNESS_POINTS}
     return irr, pre
 
@@ -107,7 +115,7 @@ def main() -> int:
                    help="keep the errors of --out and measure the bake times again (on a quiet machine)")
     args = p.parse_args()
 
-    renderer = Renderer()
+    renderer = ForwardRenderer()
     n, inside = shading.probe_normals(WIDTH)
     normals = n[inside]
     n_dot_v = np.maximum(normals[:, 2], 0.0)
@@ -116,7 +124,7 @@ def main() -> int:
     for q in {(q.lut_size, q.lut_samples) for q in CANDIDATES.values()}:
         renderer.luts.get(*q)
 
-    table = {"about": "app/auto_quality.py's measured table; written by tools/measure_auto_quality.py",
+    table = {"about": "app/accuracy/auto_quality.py's measured table; written by tools/measure_auto_quality.py",
              "metric": f"max over RGB of sum|probe - converged| / sum|converged|, {WIDTH}x{WIDTH} probe, "
                        "lecture IBL model",
              "machine": f"{platform.machine()} {platform.node()}, {renderer.ctx.info['GL_RENDERER']}",

@@ -1,23 +1,20 @@
 """Renders docs/presets.png for the README: a row of preset balls in the built-in studio."""
 
-import sys
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from app.environment import studio_environment  # noqa: E402
-from app.material import load_preset  # noqa: E402
-from app.mesh import sphere  # noqa: E402
-from app.output import write_image  # noqa: E402
-from app.renderer import Renderer  # noqa: E402
-from app.scene import Scene  # noqa: E402
+from alight.core.material import load_preset
+from alight.core.mesh import sphere
+from alight.core.scene import Scene
+from alight.exchange.output import write_image
+from alight.ibl.environment import studio_environment
+from alight.render.renderer import ForwardRenderer
 
 PRESETS = ["gold", "copper", "silver", "iron", "plastic_glass_low", "plastic_high", "water"]
 SIZE = 256
 
-with Renderer() as renderer:
+with ForwardRenderer() as renderer:
     maps = renderer.bake(studio_environment(), "high")
     ball = sphere()
     tiles = [renderer.render(Scene(mesh=ball, material=load_preset(name)), maps, SIZE, SIZE,

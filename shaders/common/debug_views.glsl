@@ -4,11 +4,11 @@
 // returned through srgb_to_linear_approx so that the tone map pass's sRGB encoding shows the
 // raw value. Views 9, 10 and the diffuse/specular splits are radiance and are shown as such;
 // the splits (7, 8) are the lecture's, with the compact sources added (ibl.glsl).
-// The guard is here, not around the #include: app/gpu.py's #line after an include must not sit
+// The guard is here, not around the #include: app/core/gpu.py's #line after an include must not sit
 // inside a skipped conditional, or compile errors would name the wrong line.
 #ifdef DEBUG_VIEW
 
-uniform int u_debug_view;   // app/editor/state.py's DEBUG_VIEWS index
+uniform int u_debug_view;   // app/frontends/editor/state.py's DEBUG_VIEWS index
 uniform float u_debug_mip;  // view 10: the prefiltered cube's mip (grid A)
 
 vec3 srgb_to_linear_approx(vec3 c) {

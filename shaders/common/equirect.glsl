@@ -1,5 +1,5 @@
 // The equirectangular mapping and environment rotation of CONVENTIONS.md.
-// Numpy twins: app/shading.py.
+// Numpy twins: app/core/shading.py.
 
 // u = 0.5 + atan2(d.x, -d.z)/(2 pi) left to right; v = acos(d.y)/pi, v = 0 at the top row (+Y).
 vec2 direction_to_equirect_uv(vec3 d) {

@@ -1,7 +1,7 @@
 // Image-based lighting: the seed lecture's split sum (Karis 2013) and the models that improve on
-// it, measured against CONVENTIONS.md's ground truth (app/ibl_models.py lists them).
+// it, measured against CONVENTIONS.md's ground truth (app/core/ibl_models.py lists them).
 // Maps are baked in the environment map's own frame; lookups rotate world directions into it.
-// Compact bright sources (the sun) are not in the irradiance and prefiltered maps (app/sun.py):
+// Compact bright sources (the sun) are not in the irradiance and prefiltered maps (app/ibl/sun.py):
 // every model adds them here, exactly, in world space.
 
 #include "common/suns.glsl"
@@ -16,7 +16,7 @@ uniform vec2 u_env_rotation;                 // (cos, sin) of minus the rotation
 uniform float u_env_intensity;
 
 // What a delta source adds to each roughness step of the prefiltered map, per unit
-// P (d.l) D(h) (app/bake.py records it from the step's sample set; prefilter.glsl says why).
+// P (d.l) D(h) (app/ibl/bake.py records it from the step's sample set; prefilter.glsl says why).
 const int MAX_GRID_STEPS = 32;
 uniform float u_sun_prefilter_scale[MAX_GRID_STEPS];
 
@@ -26,7 +26,7 @@ uniform float u_sun_prefilter_scale[MAX_GRID_STEPS];
 // per step, alternating between two cubes: even steps are grid A's mips, odd steps grid B's.
 // Each A mip halves the resolution as alpha doubles; B fills the gaps, so blending neighbours
 // costs two bilinear fetches (as one trilinear fetch would) but with steps half as coarse.
-// app/bake.py's grid_roughness() gives the roughness of each step; this is its inverse.
+// app/ibl/bake.py's grid_roughness() gives the roughness of each step; this is its inverse.
 float roughness_to_grid_step(float roughness) {
     return 2.0 * (2.0 * log2(max(roughness, 1e-4)) + u_prefiltered_max_mip);
 }
@@ -54,7 +54,7 @@ vec3 suns_prefiltered_step(vec3 d, int step) {
 // would hold them had they been baked in: the lecture's maps filter the whole environment.
 // Neighbouring steps are one even (grid A) and one odd (grid B), so each cube is read once.
 // Below grid A's first step (r0 = 2^(-max_mip/2)) the source cube's box mips, whose texel
-// matches the lobe width alpha, fade into that step: app/renderer.py binds the cube as seen
+// matches the lobe width alpha, fade into that step: app/render/renderer.py binds the cube as seen
 // (with its sun) for the lecture's models, the cube without compact sources for the others.
 vec3 prefiltered_radiance_at(vec3 r, float roughness, bool with_suns) {
     vec3 d = rotate_world_to_map(r, u_env_rotation);
@@ -96,7 +96,7 @@ vec4 brdf_lut_at(float n_dot_v, float roughness) {
 // The Fresnel part of the diffuse lobe under uniform light: (1/pi) times the integral of
 // (1 - v.h)^5 (n.l) over the hemisphere. It depends on n.v only (h = normalize(l + v)), peaks
 // at 0.028 at grazing, and this quartic in 1 - n.v fits it within 1e-5
-// (app/converged.py's diffuse_fresnel_converged integrates it).
+// (app/accuracy/converged.py's diffuse_fresnel_converged integrates it).
 float diffuse_fresnel(float n_dot_v) {
     float x = 1.0 - n_dot_v;
     return 8.233601e-05 + x * (0.002021979 + x * (0.009310647 + x * (0.007795988 + x * 0.0089526)));
@@ -206,14 +206,14 @@ vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
 
 // alight's model: ibl_dominant for the environment without its compact sources, and those
 // sources through the exact BRDF at every roughness (below the prefiltered grid too, where
-// app/renderer.py binds the source cube without them).
+// app/render/renderer.py binds the source cube without them).
 vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
     vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v) : vec3(0.0);
     return (karis_split_sum(s, n, v, true, false) + suns) * s.occlusion;
 }
 
-// The model the forward pass uses: IBL_MODEL is the position of its name in app/ibl_models.py's
-// IBL_MODELS, set by app/renderer.py, so only the chosen model is compiled.
+// The model the forward pass uses: IBL_MODEL is the position of its name in app/core/ibl_models.py's
+// IBL_MODELS, set by app/render/renderer.py, so only the chosen model is compiled.
 #ifndef IBL_MODEL
 #define IBL_MODEL 4
 #endif

@@ -38,7 +38,7 @@ uniform sampler2D u_occlusion_map;
 uniform sampler2D u_metallic_map;
 uniform sampler2D u_roughness_map;
 
-// The maps compiled in, a bit each (app/renderer.py MATERIAL_MAPS order). llvmpipe runs both
+// The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK

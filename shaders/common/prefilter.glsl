@@ -1,6 +1,6 @@
-// The prefilter's sum for one direction, shared by the compute pass (bake/prefilter.comp) and
-// its fragment twin (bake/prefilter.frag, kept to measure compute against fragment shaders).
-// The sample set depends only on the roughness, so app/bake.py computes it once per step
+// The prefilter's sum for one direction, shared by the compute pass (ibl/prefilter.comp) and
+// its fragment twin (ibl/prefilter.frag, kept to measure compute against fragment shaders).
+// The sample set depends only on the roughness, so app/ibl/bake.py computes it once per step
 // (prefilter_sample_set): directions l in the tangent frame of n = v (samples below the horizon
 // already dropped) and the source mip of filtered importance sampling for each.
 #include "common/sampling.glsl"
@@ -18,9 +18,9 @@ vec3 prefilter_radiance(vec3 n) {
         sum += textureLod(u_environment, frame * s.xyz, s.w).rgb * s.z;  // s.z = n.l
         weight += s.z;
     }
-    // Compact sources are not in this environment (app/sun.py): the sum estimates
+    // Compact sources are not in this environment (app/ibl/sun.py): the sum estimates
     // (N/4) * integral of L (n.l) D(h) over l (l has pdf D(h)/4 when v = n), so a delta source of
     // power P would add (N/4) P (n.l) D(h) / weight; ibl.glsl adds exactly that per pixel, with
-    // the scale (N/4) / weight that app/bake.py records per roughness step.
+    // the scale (N/4) / weight that app/ibl/bake.py records per roughness step.
     return sum / max(weight, 1e-8);
 }

@@ -1,5 +1,5 @@
 // Low-discrepancy points and GGX importance sampling (Karis 2013; Hammersley 1964).
-// Numpy twins: app/shading.py.
+// Numpy twins: app/core/shading.py.
 
 // Van der Corput radical inverse, base 2.
 float radical_inverse_vdc(uint bits) {

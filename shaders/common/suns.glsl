@@ -1,4 +1,4 @@
-// Compact bright sources taken out of the environment the bake samples (app/sun.py), to be
+// Compact bright sources taken out of the environment the bake samples (app/ibl/sun.py), to be
 // added back in closed form: each is a delta of power P (radiance integrated over its disk).
 const int MAX_SUNS = 4;
 uniform int u_sun_count;

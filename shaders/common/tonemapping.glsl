@@ -1,4 +1,4 @@
-// Exposure, tone mapping and the sRGB curve. Numpy twins: app/shading.py.
+// Exposure, tone mapping and the sRGB curve. Numpy twins: app/core/shading.py.
 
 const int TONEMAP_NONE = 0;
 const int TONEMAP_ACES = 1;

@@ -8,7 +8,7 @@
 #define BACKGROUND_ENV 0
 #define BACKGROUND_BLUR 1
 #define BACKGROUND_COLOR 2
-// The mode is compiled in (app/renderer.py sets it): llvmpipe runs both sides of a branch, so a
+// The mode is compiled in (app/render/renderer.py sets it): llvmpipe runs both sides of a branch, so a
 // uniform mode would cost the sharp and the blurred fetch at every pixel.
 #ifndef BACKGROUND_MODE
 #define BACKGROUND_MODE BACKGROUND_ENV

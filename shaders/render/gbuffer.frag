@@ -1,5 +1,5 @@
 #version 450 core
-// The reference's G-buffer (app/reference.py): what the texel sum needs at each pixel, from the
+// The reference's G-buffer (app/accuracy/reference.py): what the texel sum needs at each pixel, from the
 // same material inputs as the forward pass (common/mesh_material.glsl), unshaded. Alpha of
 // target 0 is 1 where the mesh covers the pixel (cleared to 0 elsewhere).
 #include "common/mesh_material.glsl"

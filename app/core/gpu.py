@@ -1,0 +1,192 @@
+"""The OpenGL context (headless EGL) and shader programs read from ``shaders/`` with #include."""
+
+from __future__ import annotations
+
+import ctypes.util
+import hashlib
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import moderngl
+
+from alight.errors import AlightError
+from alight.paths import shader_dir
+
+# What to install when EGL or Mesa is missing; the message names them on one line.
+EGL_PACKAGES = "libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1"
+
+GL_VERSION = 450
+
+
+def create_headless_context() -> moderngl.Context:
+    """An OpenGL 4.5 core context through EGL, with no window and no display server.
+
+    Mesa's llvmpipe answers on a machine without a GPU; NVIDIA's EGL on a machine with one.
+    """
+    if ctypes.util.find_library("EGL") is None:
+        raise AlightError(f"OpenGL: libEGL is not installed: apt-get install {EGL_PACKAGES}")
+    try:
+        return moderngl.create_context(standalone=True, backend="egl", require=GL_VERSION)
+    except Exception as exc:  # glcontext raises plain Exceptions with multi-line text
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise AlightError(
+            f"OpenGL: no EGL context with OpenGL {GL_VERSION // 100}.{GL_VERSION % 100 // 10} ({reason}); "
+            f"on Debian install {EGL_PACKAGES}"
+        ) from None
+
+
+def describe(ctx: moderngl.Context) -> str:
+    return f"{ctx.info['GL_RENDERER']} / OpenGL {ctx.info['GL_VERSION']}"
+
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
+# Line numbers carry the file: line = file_index * LINE_STRIDE + line_in_file. Drivers disagree
+# on the source-string number of #line (Mesa reports 0 for some errors), never on the line.
+LINE_STRIDE = 100000
+_VERSION = re.compile(r"^\s*#\s*version\b")
+
+
+@dataclass
+class ShaderSource:
+    """A shader's text with its includes resolved, and the files it came from (for error lines)."""
+
+    text: str
+    files: list[Path] = field(default_factory=list)
+
+    def digest(self) -> str:
+        return hashlib.sha256(self.text.encode()).hexdigest()
+
+
+class ShaderCompileError(AlightError):
+    pass
+
+
+def load_source(name: str, defines: dict[str, object] | None = None, root: Path | None = None) -> ShaderSource:
+    """Read ``shaders/<name>``, inline each ``#include "path"`` once (relative to shaders/), and put
+    ``#define``s after ``#version``. ``#line`` directives carry a file number so that compiler
+    messages can be mapped back to the file and line (see ``translate_log``)."""
+    root = root or shader_dir()
+    files: list[Path] = []
+    included: set[Path] = set()
+
+    def expand(path: Path) -> list[str]:
+        try:
+            lines = path.read_text(encoding="utf-8").splitlines()
+        except OSError as exc:
+            raise ShaderCompileError(f"{path}: cannot read shader ({exc.strerror})") from None
+        files.append(path)
+        index = len(files) - 1
+        # Each file's lines carry its own number, so compiler messages name the right file.
+        out: list[str] = [f"#line {index * LINE_STRIDE + 1}"] if index > 0 else []
+        for number, line in enumerate(lines, start=1):
+            match = _INCLUDE.match(line)
+            if match:
+                target = (root / match.group(1)).resolve()
+                if target not in included:
+                    included.add(target)
+                    out.extend(expand(target))
+                out.append(f"#line {index * LINE_STRIDE + number + 1}")
+            else:
+                out.append(line)
+        return out
+
+    top = (root / name).resolve()
+    included.add(top)
+    body = expand(top)
+    header: list[str] = []
+    first_line = 1
+    if body and _VERSION.match(body[0]):
+        header.append(body.pop(0))
+        first_line = 2
+    else:
+        header.append(f"#version {GL_VERSION} core")
+    for key, value in (defines or {}).items():
+        header.append(f"#define {key} {value}" if value is not None else f"#define {key}")
+    header.append(f"#line {first_line}")
+    return ShaderSource("\n".join(header + body) + "\n", files)
+
+
+def translate_log(log: str, files: list[Path], root: Path | None = None) -> str:
+    """Turn Mesa's ``S:L(C): error`` and NVIDIA's ``S(L) : error`` into ``file:line: error``,
+    the file being encoded in L (see LINE_STRIDE)."""
+    root = root or shader_dir()
+
+    def where(line: str) -> str:
+        index, number = divmod(int(line), LINE_STRIDE)
+        if 0 <= index < len(files):
+            try:
+                name = str(files[index].relative_to(root.parent))
+            except ValueError:
+                name = str(files[index])
+        else:
+            name = f"<source {index}>"
+        return f"{name}:{number}:"
+
+    log = re.sub(r"\b\d+:(\d+)\(\d+\):", lambda m: where(m.group(1)), log)
+    log = re.sub(r"\b\d+\((\d+)\) :", lambda m: where(m.group(1)), log)
+    return log
+
+
+def first_error_line(log: str) -> str:
+    for line in log.splitlines():
+        if "error" in line.lower():
+            return line.strip()
+    return " ".join(log.split())[:300]
+
+
+class ShaderLibrary:
+    """Compiles programs from ``shaders/`` on demand and keeps them until ``reload``.
+
+    Programs are keyed by their stage files and defines, so asking twice costs nothing.
+    """
+
+    def __init__(self, ctx: moderngl.Context, root: Path | None = None):
+        self.ctx = ctx
+        self.root = root or shader_dir()
+        self._programs: dict[tuple, moderngl.Program | moderngl.ComputeShader] = {}
+
+    def _compile(self, key, build):
+        if key not in self._programs:
+            self._programs[key] = build()
+        return self._programs[key]
+
+    def program(self, vertex: str, fragment: str, defines: dict[str, object] | None = None) -> moderngl.Program:
+        defines = defines or {}
+        key = ("program", vertex, fragment, tuple(sorted(defines.items())))
+
+        def build():
+            vs = load_source(vertex, defines, self.root)
+            fs = load_source(fragment, defines, self.root)
+            try:
+                return self.ctx.program(vertex_shader=vs.text, fragment_shader=fs.text)
+            except Exception as exc:
+                # Both stages share file indices only by accident; try each stage's file list.
+                log = str(exc)
+                files = fs.files if "fragment" in log.lower() else vs.files
+                raise ShaderCompileError(first_error_line(translate_log(log, files, self.root))) from None
+
+        return self._compile(key, build)
+
+    def compute(self, name: str, defines: dict[str, object] | None = None) -> moderngl.ComputeShader:
+        defines = defines or {}
+        key = ("compute", name, tuple(sorted(defines.items())))
+
+        def build():
+            src = load_source(name, defines, self.root)
+            try:
+                return self.ctx.compute_shader(src.text)
+            except Exception as exc:
+                raise ShaderCompileError(first_error_line(translate_log(str(exc), src.files, self.root))) from None
+
+        return self._compile(key, build)
+
+    def digest(self, name: str, defines: dict[str, object] | None = None) -> str:
+        """Hash of a shader's fully expanded text: changes whenever it or an include changes."""
+        return load_source(name, defines, self.root).digest()
+
+    def reload(self) -> None:
+        """Forget compiled programs; the next request recompiles from the files."""
+        for prog in self._programs.values():
+            prog.release()
+        self._programs.clear()

@@ -1,0 +1,240 @@
+"""Meshes as plain numpy arrays ready for GPU buffers (no GL here: the renderer uploads them).
+
+The built-in meshes (``sphere``, ``cube``, ``plane``), normals and tangents, and the closed-mesh
+test live here; files are read by ``alight.exchange.meshes``.
+
+Conventions: world space is right-handed, +Y up (``../shared/CONVENTIONS.md``); faces are
+counter-clockwise seen from the front; uvs follow OpenGL (v = 0 is the image's bottom row)
+while texture arrays keep PIL's order (row 0 = top row), so a texel is found at
+``row = (1 - v) * H``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+BUILTIN_MESHES = ("sphere", "cube", "plane")
+@dataclass
+class FileMaterial:
+    """A glTF/OBJ material as the file gives it (metal-roughness model)."""
+
+    base_color: tuple[float, float, float]  # linear factor
+    metallic: float
+    roughness: float
+    emissive: tuple[float, float, float]  # linear, times KHR_materials_emissive_strength
+    alpha: float
+    base_color_texture: np.ndarray | None  # (H, W, 4) uint8, sRGB, row 0 = top
+    metallic_roughness_texture: np.ndarray | None  # linear; G = roughness, B = metallic
+    normal_texture: np.ndarray | None  # tangent-space normal map
+    normal_scale: float
+    emissive_texture: np.ndarray | None  # sRGB
+    occlusion_texture: np.ndarray | None  # R = occlusion
+    occlusion_strength: float
+
+
+@dataclass
+class MeshPart:
+    """One geometry with one material, in world space."""
+
+    name: str
+    positions: np.ndarray  # (N, 3) float32
+    normals: np.ndarray  # (N, 3) float32, unit length
+    uvs: np.ndarray  # (N, 2) float32, OpenGL convention (v = 0 bottom); zeros when absent
+    tangents: np.ndarray  # (N, 4) float32, bitangent = w * cross(n, t)
+    indices: np.ndarray  # (M, 3) uint32, counter-clockwise front faces
+    material: FileMaterial | None
+
+
+@dataclass
+class Mesh:
+    parts: list[MeshPart]
+    source: str  # 'sphere' / 'cube' / 'plane' or the file path
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """World-space min and max corners over all parts."""
+        allp = np.concatenate([p.positions for p in self.parts]).astype(np.float64)
+        return allp.min(axis=0), allp.max(axis=0)
+
+    def bounding_sphere(self) -> tuple[np.ndarray, float]:
+        """Centre of the bounding box and the distance to the farthest vertex (camera framing)."""
+        lo, hi = self.bounds()
+        centre = (lo + hi) / 2.0
+        radius = max(float(np.linalg.norm(p.positions - centre, axis=1).max()) for p in self.parts)
+        return centre, radius
+
+
+# --- vector helpers ------------------------------------------------------------------------
+
+def _normalize(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors and a mask of the rows that could be normalised (finite, non-zero)."""
+    v = np.asarray(v, dtype=np.float64)
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    ok = np.isfinite(length[..., 0]) & (length[..., 0] > 1e-30)
+    out = np.where(ok[..., None], v / np.where(ok[..., None], length, 1.0), 0.0)
+    return out, ok
+
+
+def _any_orthogonal(n: np.ndarray) -> np.ndarray:
+    """A unit vector orthogonal to each unit normal (the axis least aligned with it, projected)."""
+    axis = np.where((np.abs(n[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    t = axis - n * np.sum(n * axis, axis=1, keepdims=True)
+    return t / np.linalg.norm(t, axis=1, keepdims=True)
+
+
+def _scatter_add(index: np.ndarray, values: np.ndarray, count: int) -> np.ndarray:
+    """Sum rows of ``values`` into ``count`` bins (faster than np.add.at)."""
+    return np.stack(
+        [np.bincount(index, weights=values[:, c], minlength=count) for c in range(values.shape[1])],
+        axis=1,
+    )
+
+
+def smooth_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """Area-weighted vertex normals (unnormalised; zero where a vertex has no area around it)."""
+    p = np.asarray(positions, dtype=np.float64)
+    f = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
+    fn = np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]])
+    return _scatter_add(f.ravel(), np.repeat(fn, 3, axis=0), len(p))
+
+
+def compute_tangents(positions, normals, uvs, indices) -> np.ndarray:
+    """Per-vertex tangents (N, 4) from per-triangle UV derivatives.
+
+    Each triangle's dP/du and dP/dv are normalised and accumulated per vertex weighted by the
+    triangle's area (so a near-degenerate UV triangle cannot dominate its neighbours), then the
+    tangent is Gram-Schmidt orthogonalised against the normal, and w = sign of
+    dot(cross(n, t), dP/dv) so that bitangent = w * cross(n, t). Where UVs are missing or
+    degenerate the tangent is any unit vector orthogonal to the normal with w = 1. Never NaN.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    n, n_ok = _normalize(normals)
+    n[~n_ok] = (0.0, 1.0, 0.0)
+    uv = np.nan_to_num(np.asarray(uvs, dtype=np.float64).reshape(len(p), 2))
+    f = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
+
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    d1, d2 = uv[f[:, 1]] - uv[f[:, 0]], uv[f[:, 2]] - uv[f[:, 0]]
+    r = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]  # twice the signed UV area
+    sign = np.sign(r)[:, None]
+    # dP/du and dP/dv times r; multiplying by sign(r) instead of dividing by r keeps direction.
+    sdir, s_ok = _normalize((e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * sign)
+    tdir, t_ok = _normalize((e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * sign)
+    area = np.linalg.norm(np.cross(e1, e2), axis=1)[:, None]
+    use = (s_ok & t_ok & (r != 0) & np.isfinite(area[:, 0]))[:, None]
+    w_face = np.where(use, area, 0.0)
+    acc_t = _scatter_add(f.ravel(), np.repeat(sdir * w_face, 3, axis=0), len(p))
+    acc_b = _scatter_add(f.ravel(), np.repeat(tdir * w_face, 3, axis=0), len(p))
+
+    t = acc_t - n * np.sum(n * acc_t, axis=1, keepdims=True)
+    t_len = np.linalg.norm(t, axis=1)
+    acc_len = np.linalg.norm(acc_t, axis=1)
+    good = np.isfinite(t_len) & (acc_len > 0) & (t_len > 1e-6 * acc_len)
+    t = np.where(good[:, None], t / np.where(good, t_len, 1.0)[:, None], _any_orthogonal(n))
+    w = np.where(good & (np.sum(np.cross(n, t) * acc_b, axis=1) < 0), -1.0, 1.0)
+    return np.concatenate([t, w[:, None]], axis=1).astype(np.float32)
+
+
+# --- built-in meshes -----------------------------------------------------------------------
+
+def _part(name: str, positions, normals, uvs, tangents, indices) -> MeshPart:
+    return MeshPart(
+        name=name,
+        positions=np.ascontiguousarray(positions, dtype=np.float32),
+        normals=np.ascontiguousarray(normals, dtype=np.float32),
+        uvs=np.ascontiguousarray(uvs, dtype=np.float32),
+        tangents=np.ascontiguousarray(tangents, dtype=np.float32),
+        indices=np.ascontiguousarray(np.asarray(indices).reshape(-1, 3), dtype=np.uint32),
+        material=None,
+    )
+
+
+def sphere(segments: int = 128, rings: int = 64, radius: float = 1.0) -> Mesh:
+    """UV sphere at the origin with analytic normals and tangents.
+
+    u runs counter-clockwise about +Y (east on a globe), so a texture reads un-mirrored from
+    outside (w = +1); the seam u = 0/1 is at -Z, away from the default camera on +Z, and u = 0.5
+    faces +Z. v = 1 at the north pole (+Y). Pole triangles of zero area are left out.
+    """
+    i, j = np.meshgrid(np.arange(rings + 1), np.arange(segments + 1), indexing="ij")
+    u, v = j / segments, 1.0 - i / rings
+    theta, phi = np.pi * i / rings, 2.0 * np.pi * u
+    normals = np.stack([-np.sin(theta) * np.sin(phi), np.cos(theta), -np.sin(theta) * np.cos(phi)], -1)
+    tangents = np.stack([-np.cos(phi), np.zeros_like(phi), np.sin(phi), np.ones_like(phi)], -1)
+    a = (i[:-1, :-1] * (segments + 1) + j[:-1, :-1]).ravel()
+    row = np.repeat(np.arange(rings), segments)
+    b, c = a + 1, a + segments + 1
+    d = c + 1
+    upper = np.stack([a, c, d], -1)[row != rings - 1]  # degenerate on the south pole row
+    lower = np.stack([a, d, b], -1)[row != 0]  # degenerate on the north pole row
+    part = _part(
+        "sphere",
+        (normals * radius).reshape(-1, 3),
+        normals.reshape(-1, 3),
+        np.stack([u, v], -1).reshape(-1, 2),
+        tangents.reshape(-1, 4),
+        np.concatenate([upper, lower]),
+    )
+    return Mesh([part], "sphere")
+
+
+# (normal, tangent = +u direction); bitangent (+v) = cross(normal, tangent), so w = +1.
+_CUBE_FACES = (
+    ((1, 0, 0), (0, 0, -1)),
+    ((-1, 0, 0), (0, 0, 1)),
+    ((0, 1, 0), (1, 0, 0)),
+    ((0, -1, 0), (1, 0, 0)),
+    ((0, 0, 1), (1, 0, 0)),
+    ((0, 0, -1), (-1, 0, 0)),
+)
+
+
+def _quads(faces, half: float, offset: bool) -> tuple[np.ndarray, ...]:
+    """Square faces (normal, tangent): 4 vertices each, uvs (0,0)..(1,1), two CCW triangles."""
+    pos, nor, uvs, tan, idx = [], [], [], [], []
+    corners = ((-1, -1), (1, -1), (1, 1), (-1, 1))
+    for k, (n, t) in enumerate(faces):
+        n, t = np.array(n, float), np.array(t, float)
+        b = np.cross(n, t)
+        for cu, cv in corners:
+            pos.append((n if offset else 0.0) * half + (cu * t + cv * b) * half)
+            nor.append(n)
+            uvs.append(((cu + 1) / 2, (cv + 1) / 2))
+            tan.append((*t, 1.0))
+        idx += [(4 * k, 4 * k + 1, 4 * k + 2), (4 * k, 4 * k + 2, 4 * k + 3)]
+    return tuple(np.array(x) for x in (pos, nor, uvs, tan, idx))
+
+
+def cube(size: float = 2.0) -> Mesh:
+    """Axis-aligned cube centred at the origin: 24 vertices, flat normals, a full uv square per face."""
+    return Mesh([_part("cube", *_quads(_CUBE_FACES, size / 2.0, True))], "cube")
+
+
+def plane(size: float = 2.0) -> Mesh:
+    """Square in the XZ plane facing +Y; u along +X, v along -Z."""
+    return Mesh([_part("plane", *_quads([((0, 1, 0), (1, 0, 0))], size / 2.0, False))], "plane")
+
+
+# --- topology ------------------------------------------------------------------------------
+
+def is_closed(positions: np.ndarray, indices: np.ndarray) -> bool:
+    """Whether a triangle mesh is closed and consistently wound: after welding vertices at equal
+    positions (UV seams duplicate them), every directed edge (a, b) has exactly one (b, a).
+    Back faces of such a mesh are never visible from outside, so the renderer culls them; an
+    open mesh (a plane, a single-sided shell) is drawn from both sides."""
+    if len(indices) == 0:
+        return False
+    _, weld = np.unique(np.round(np.asarray(positions, np.float64), 6), axis=0, return_inverse=True)
+    tri = weld.reshape(-1)[np.asarray(indices, np.int64)]
+    tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])]
+    if len(tri) == 0:
+        return False
+    edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    n = int(weld.max()) + 1
+    forward = edges[:, 0] * n + edges[:, 1]
+    backward = edges[:, 1] * n + edges[:, 0]
+    uniq, counts = np.unique(forward, return_counts=True)
+    if (counts != 1).any():
+        return False
+    return bool(np.isin(backward, uniq, assume_unique=False).all())

@@ -1,0 +1,68 @@
+"""Texture maps loaded by the user for the edited material: which file fills each slot (plain,
+comparable state the editor's undo and session keep). ``alight.exchange.images`` reads the files.
+
+Slots follow glTF's metal-roughness model, plus separate greyscale metallic and roughness maps
+as many texture sets ship them (their R channel is read; over a metallic-roughness map they
+replace its B or G channel). Colour maps (base colour, emissive) are sRGB-encoded; the others
+hold data. The renderer gets paths and decoded images, never a file to read.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, replace
+
+from alight.errors import AlightError
+
+MAP_SLOTS = ("base_color", "metallic_roughness", "metallic", "roughness", "normal", "emissive", "occlusion")
+SLOT_LABELS = {"base_color": "base colour", "metallic_roughness": "metal-rough (G rough, B metal)",
+               "metallic": "metallic (grey)", "roughness": "roughness (grey)", "normal": "normal (tangent)",
+               "emissive": "emissive", "occlusion": "occlusion (R)"}
+SRGB_SLOTS = ("base_color", "emissive")
+@dataclass(frozen=True)
+class TextureMaps:
+    """A path per slot ('' = none) and the UV transform ``uv * uv_scale + uv_offset``."""
+
+    base_color: str = ""
+    metallic_roughness: str = ""
+    metallic: str = ""
+    roughness: str = ""
+    normal: str = ""
+    emissive: str = ""
+    occlusion: str = ""
+    uv_scale: tuple[float, float] = (1.0, 1.0)
+    uv_offset: tuple[float, float] = (0.0, 0.0)
+
+    def paths(self) -> dict[str, str]:
+        """The filled slots: slot -> path."""
+        return {slot: getattr(self, slot) for slot in MAP_SLOTS if getattr(self, slot)}
+
+    def with_slot(self, slot: str, path: str) -> "TextureMaps":
+        if slot not in MAP_SLOTS:
+            raise AlightError(f"texture slot '{slot}' is not one of {', '.join(MAP_SLOTS)}")
+        return replace(self, **{slot: path})
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict, where: str) -> "TextureMaps":
+        """The session file's form back; a value of the wrong type is an AlightError naming ``where``."""
+        if not isinstance(data, dict):
+            raise AlightError(f"{where}: texture_maps is not an object")
+        kwargs = {}
+        for slot in MAP_SLOTS:
+            value = data.get(slot, "")
+            if not isinstance(value, str):
+                raise AlightError(f"{where}: texture_maps.{slot} is not a path")
+            kwargs[slot] = value
+        for name in ("uv_scale", "uv_offset"):
+            value = data.get(name, getattr(cls, name))
+            try:
+                pair = tuple(float(x) for x in value)
+            except (TypeError, ValueError):
+                raise AlightError(f"{where}: texture_maps.{name} is not two numbers") from None
+            if len(pair) != 2 or not all(math.isfinite(x) for x in pair):
+                raise AlightError(f"{where}: texture_maps.{name} is not two finite numbers")
+            kwargs[name] = pair
+        return cls(**kwargs)

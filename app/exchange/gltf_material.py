@@ -1,0 +1,249 @@
+"""glTF material round trip: a glTF/GLB material into alight.core.material.Material, and back out as a
+material-only ``.gltf`` or a mesh with the material as ``.glb``.
+
+The two models meet like this (glTF 2.0 core, KHR_materials_ior, KHR_materials_specular,
+KHR_materials_emissive_strength):
+
+    base_color  = baseColorFactor.rgb          (alpha is dropped: the model is opaque)
+    metallic    = metallicFactor, roughness = roughnessFactor
+    emissive    = emissiveFactor * emissiveStrength
+    specular_f0 = min(((ior - 1) / (ior + 1))^2 * specularColorFactor, 1) * specularFactor
+
+Export inverts the last line exactly: a grey F0 other than 0.04 becomes an ior
+(ior = (1 + sqrt(F0)) / (1 - sqrt(F0))), and a coloured F0 the ior of its largest channel
+with specularColorFactor = F0 / max(F0) <= 1, so engines that know the extensions shade the
+same dielectric reflectance. Textures are not carried (the material model has none).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import struct
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from alight.core.material import Material, validate_material
+from alight.errors import AlightError
+from alight.exchange.output import atomic_path
+
+EXT_IOR = "KHR_materials_ior"
+EXT_SPECULAR = "KHR_materials_specular"
+EXT_EMISSIVE = "KHR_materials_emissive_strength"
+DEFAULT_F0 = 0.04  # ((1.5 - 1) / (1.5 + 1))^2, glTF's default dielectric
+# Above this F0 the ior would grow without bound (F0 = 1 needs ior = inf); there the default
+# ior 1.5 with specularColorFactor = F0 / 0.04 (allowed above 1, clamped by the formula) is used.
+_MAX_IOR_F0 = 0.9
+GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
+
+
+def _fail(source: str, message: str) -> AlightError:
+    return AlightError(f"{source}: {message}".replace("\n", "\\n"))
+
+
+# --- reading ---------------------------------------------------------------------------------
+
+def read_gltf_json(path: str | os.PathLike) -> dict:
+    """The JSON document of a .gltf or .glb file."""
+    p = Path(path)
+    source = str(p)
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise _fail(source, f"cannot read ({e.strerror or e})") from None
+    if data[:4] == b"glTF":
+        if len(data) < 20:
+            raise _fail(source, "truncated GLB header")
+        length, kind = struct.unpack("<II", data[12:20])
+        if kind != GLB_JSON or 20 + length > len(data):
+            raise _fail(source, "GLB without a valid JSON chunk")
+        data = data[20:20 + length]
+    try:
+        doc = json.loads(data.decode("utf-8-sig"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as e:
+        raise _fail(source, f"not valid glTF JSON ({' '.join(str(e).split())})") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("asset"), dict):
+        raise _fail(source, "not a glTF document (no 'asset')")
+    return doc
+
+
+def _numbers(value: Any, n: int, default: list[float], source: str, where: str) -> list[float]:
+    if value is None:
+        return list(default)
+    if not isinstance(value, list) or len(value) != n or not all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in value):
+        raise _fail(source, f"{where}: expected {n} finite numbers")
+    return [float(x) for x in value]
+
+
+def _number(value: Any, default: float, source: str, where: str) -> float:
+    return _numbers(None if value is None else [value], 1, [default], source, where)[0]
+
+
+def dielectric_f0(ior: float, specular_factor: float = 1.0,
+                  specular_color: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> tuple[float, float, float]:
+    """KHR_materials_specular's dielectric F0 for an ior (KHR_materials_ior)."""
+    base = ((ior - 1.0) / (ior + 1.0)) ** 2
+    return tuple(min(base * c, 1.0) * specular_factor for c in specular_color)  # type: ignore[return-value]
+
+
+def material_from_gltf(gm: dict, source: str, name: str = "material") -> Material:
+    """One glTF material object (a dict from the JSON's ``materials``) as a Material."""
+    if not isinstance(gm, dict):
+        raise _fail(source, "material: expected a JSON object")
+    pbr = gm.get("pbrMetallicRoughness") or {}
+    ext = gm.get("extensions") or {}
+    if not isinstance(pbr, dict) or not isinstance(ext, dict):
+        raise _fail(source, "material: pbrMetallicRoughness and extensions must be objects")
+    base = _numbers(pbr.get("baseColorFactor"), 4, [1, 1, 1, 1], source, "baseColorFactor")
+    metallic = _number(pbr.get("metallicFactor"), 1.0, source, "metallicFactor")
+    roughness = _number(pbr.get("roughnessFactor"), 1.0, source, "roughnessFactor")
+    emissive = _numbers(gm.get("emissiveFactor"), 3, [0, 0, 0], source, "emissiveFactor")
+    strength = _number((ext.get(EXT_EMISSIVE) or {}).get("emissiveStrength"), 1.0, source, "emissiveStrength")
+    ior = _number((ext.get(EXT_IOR) or {}).get("ior"), 1.5, source, "ior")
+    spec = ext.get(EXT_SPECULAR) or {}
+    spec_factor = _number(spec.get("specularFactor"), 1.0, source, "specularFactor")
+    spec_color = _numbers(spec.get("specularColorFactor"), 3, [1, 1, 1], source, "specularColorFactor")
+    if ior == 0.0:
+        ior = 1.5  # the extension's legacy 'ior 0' means no ior; F0 then stays the default
+    if ior < 1.0:
+        raise _fail(source, f"ior: {ior:g} is below 1")
+    m = Material(base_color=tuple(base[:3]), metallic=metallic, roughness=roughness,  # type: ignore[arg-type]
+                 specular_f0=dielectric_f0(ior, spec_factor, tuple(spec_color)),  # type: ignore[arg-type]
+                 emissive=tuple(e * strength for e in emissive),  # type: ignore[arg-type]
+                 name=str(gm.get("name") or name))
+    return validate_material(m, source)
+
+
+def import_material(path: str | os.PathLike, index: int = 0) -> Material:
+    """The ``index``-th material of a .gltf/.glb file (a file without one is an error)."""
+    doc = read_gltf_json(path)
+    materials = doc.get("materials") or []
+    if not isinstance(materials, list) or not materials:
+        raise _fail(str(path), "no materials in the file")
+    if not 0 <= index < len(materials):
+        raise _fail(str(path), f"material {index} does not exist (the file has {len(materials)})")
+    return material_from_gltf(materials[index], str(path), name=Path(path).stem)
+
+
+# --- writing ---------------------------------------------------------------------------------
+
+def material_to_gltf(m: Material) -> tuple[dict, list[str]]:
+    """A glTF material object for ``m`` and the extensions it uses."""
+    m = validate_material(m)
+    gm: dict[str, Any] = {
+        "name": m.name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [*m.base_color, 1.0],
+            "metallicFactor": m.metallic,
+            "roughnessFactor": m.roughness,
+        },
+    }
+    ext: dict[str, Any] = {}
+    peak = max(m.emissive)
+    if peak > 0.0:
+        # emissiveFactor is limited to [0,1]: anything brighter goes through the strength.
+        scale = peak if peak > 1.0 else 1.0
+        gm["emissiveFactor"] = [e / scale for e in m.emissive]
+        if scale != 1.0:
+            ext[EXT_EMISSIVE] = {"emissiveStrength": scale}
+    f0 = m.specular_f0
+    f0_max = max(f0)
+    if f0 != (DEFAULT_F0,) * 3:
+        if f0_max == 0.0:
+            ext[EXT_IOR] = {"ior": 1.0}  # ior 1 reflects nothing
+        elif f0_max <= _MAX_IOR_F0:
+            s = math.sqrt(f0_max)
+            ext[EXT_IOR] = {"ior": (1.0 + s) / (1.0 - s)}
+            if min(f0) != f0_max:
+                ext[EXT_SPECULAR] = {"specularColorFactor": [c / f0_max for c in f0]}
+        else:
+            ext[EXT_SPECULAR] = {"specularColorFactor": [c / DEFAULT_F0 for c in f0]}
+    if ext:
+        gm["extensions"] = ext
+    return gm, sorted(ext)
+
+
+def _document(m: Material) -> dict:
+    gm, used = material_to_gltf(m)
+    doc: dict[str, Any] = {"asset": {"version": "2.0", "generator": "alight"}, "materials": [gm]}
+    if used:
+        doc["extensionsUsed"] = used
+    return doc
+
+
+def _check_out(path: str | os.PathLike, suffixes: tuple[str, ...]) -> Path:
+    from alight.exchange.output import check_output_path
+
+    return check_output_path(path, suffixes)
+
+
+def export_material_gltf(m: Material, path: str | os.PathLike) -> Path:
+    """A material-only glTF 2.0 asset (valid: glTF needs no mesh; validators note the unused
+    material as information only)."""
+    out = _check_out(path, (".gltf",))
+    text = json.dumps(_document(m), indent=2) + "\n"
+    _write(out, text.encode("utf-8"))
+    return out
+
+
+def export_mesh_glb(mesh, m: Material, path: str | os.PathLike) -> Path:
+    """Every part of an alight.core.mesh.Mesh (world space) as one node each, all with material ``m``.
+
+    Only positions, normals and indices are written: the material has no textures, so uvs and
+    tangents would be unused data.
+    """
+    out = _check_out(path, (".glb",))
+    doc = _document(m)
+    blob = bytearray()
+    views: list[dict] = []
+    accessors: list[dict] = []
+
+    def add(array: np.ndarray, component: int, kind: str, target: int, bounds: bool) -> int:
+        while len(blob) % 4:
+            blob.append(0)
+        data = np.ascontiguousarray(array).tobytes()
+        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
+        blob.extend(data)
+        acc: dict[str, Any] = {"bufferView": len(views) - 1, "componentType": component,
+                               "count": int(array.shape[0]) if kind != "SCALAR" else int(array.size), "type": kind}
+        if bounds:
+            acc["min"] = [float(x) for x in array.min(axis=0)]
+            acc["max"] = [float(x) for x in array.max(axis=0)]
+        accessors.append(acc)
+        return len(accessors) - 1
+
+    meshes, nodes = [], []
+    for part in mesh.parts:
+        positions = np.asarray(part.positions, np.float32)
+        normals = np.asarray(part.normals, np.float64)
+        # The validator wants unit normals to float32 precision: renormalise in float64.
+        normals = (normals / np.linalg.norm(normals, axis=1, keepdims=True)).astype(np.float32)
+        indices = np.asarray(part.indices, np.uint32).reshape(-1)
+        attrs = {"POSITION": add(positions, 5126, "VEC3", 34962, True),
+                 "NORMAL": add(normals, 5126, "VEC3", 34962, False)}
+        idx = add(indices, 5125, "SCALAR", 34963, False)
+        meshes.append({"name": part.name, "primitives": [{"attributes": attrs, "indices": idx, "material": 0}]})
+        nodes.append({"name": part.name, "mesh": len(meshes) - 1})
+    while len(blob) % 4:
+        blob.append(0)
+    doc.update({"scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
+                "accessors": accessors, "bufferViews": views, "buffers": [{"byteLength": len(blob)}]})
+    json_bytes = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    json_bytes += b" " * (-len(json_bytes) % 4)  # chunks are 4-byte aligned; JSON pads with spaces
+    total = 12 + 8 + len(json_bytes) + 8 + len(blob)
+    glb = b"".join([struct.pack("<III", GLB_MAGIC, 2, total), struct.pack("<II", len(json_bytes), GLB_JSON),
+                    json_bytes, struct.pack("<II", len(blob), GLB_BIN), bytes(blob)])
+    _write(out, glb)
+    return out
+
+
+def _write(out: Path, data: bytes) -> None:
+    try:
+        with atomic_path(out) as tmp:
+            tmp.write_bytes(data)
+    except OSError as e:
+        raise _fail(str(out), f"cannot write ({e.strerror or e})") from None

@@ -1,0 +1,347 @@
+"""The Python API: one object that renders materials headless, without the CLI.
+
+    from alight import Renderer
+
+    with Renderer(width=256, height=256, quality="low") as r:
+        r.set_environment("studio")
+        for name in ("gold", "copper", "silver"):
+            r.set_material(name)
+            r.save(f"{name}.png")
+
+The GL context and shader programs are created once (on the first render); bakes are cached
+per environment content and quality by :class:`alight.render.renderer.ForwardRenderer`, so any number of
+materials under one environment cost one bake. Leaving the ``with`` block (or ``close()``)
+releases every GPU resource.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+from pathlib import Path
+from typing import Iterable, Literal
+
+import numpy as np
+
+from alight.core.material import Material, validate_material, with_overrides
+from alight.core.mesh import Mesh
+from alight.core.scene import (
+    BACKGROUNDS,
+    TONEMAPS,
+    Camera,
+    Display,
+    Light,
+    Scene,
+    frame_camera,
+    parse_light,
+)
+from alight.errors import AlightError
+from alight.exchange.meshes import load_mesh
+from alight.exchange.presets import load_preset
+from alight.ibl.environment import Environment, load_environment
+
+Quality = Literal["low", "medium", "high", "auto"]
+AA = Literal["none", "msaa", "ssaa"]
+
+
+class Renderer:
+    """A headless renderer with its own scene state.
+
+    Parameters are the defaults for :meth:`render`; every ``set_*`` method returns ``self`` so
+    calls can be chained. Nothing touches the GPU until the first render (or :meth:`open`).
+    """
+
+    def __init__(self, width: int = 512, height: int | None = None, *, quality: Quality | str = "medium",
+                 aa: AA = "msaa", tonemap: str = "aces", exposure: float = 0.0, background: str = "env",
+                 error_budget: float = 0.02):
+        self.width, self.height = _size(width, width if height is None else height)
+        self.quality = quality
+        # quality="auto": app/accuracy/auto_quality.py chooses per render within this error budget (a
+        # fraction); the last choice is kept in self.last_auto_choice.
+        self.error_budget = float(error_budget)
+        self.last_auto_choice = None
+        self._features: dict[str, object] = {}
+        self.aa: str = aa
+        self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
+        self.bakes_done = 0    # how many bakes actually ran (cache misses), for callers that measure
+        self._mesh: Mesh | None = None
+        self._env: Environment | None = _studio()
+        self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
+                           display=Display(tonemap=tonemap, exposure=exposure, background=background))
+        self.set_display(tonemap=tonemap, exposure=exposure, background=background)
+        self.set_mesh("sphere")
+
+    # --- lifetime ------------------------------------------------------------------------
+
+    def open(self) -> "Renderer":
+        """Create the EGL context and programs now rather than on the first render."""
+        if self._renderer is None:
+            from alight.render.renderer import ForwardRenderer
+
+            with _keep_current_context():
+                self._renderer = ForwardRenderer()
+        return self
+
+    def close(self) -> None:
+        """Release the GPU resources (bakes, meshes, targets, programs, the context). Idempotent."""
+        r, self._renderer = self._renderer, None
+        if r is not None:
+            with _keep_current_context():
+                r.ctx.__enter__()
+                r.release()
+                r.ctx.release()
+
+    @property
+    def is_open(self) -> bool:
+        return self._renderer is not None
+
+    def __enter__(self) -> "Renderer":
+        return self.open()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # --- scene state ---------------------------------------------------------------------
+
+    def set_mesh(self, mesh: str | os.PathLike | Mesh) -> "Renderer":
+        """'sphere', 'cube', 'plane', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh."""
+        self._mesh = mesh if isinstance(mesh, Mesh) else load_mesh(os.fspath(mesh))
+        self.scene.mesh = self._mesh
+        return self
+
+    def set_environment(self, env: str | os.PathLike | Environment | None, *, rotation_deg: float | None = None,
+                        intensity: float | None = None) -> "Renderer":
+        """'studio', an equirectangular .hdr/.exr, a loaded Environment, or None (no IBL)."""
+        if env is None or isinstance(env, Environment):
+            self._env = env
+        elif os.fspath(env) == "studio":
+            self._env = _studio()
+        else:
+            self._env = load_environment(os.fspath(env))
+        self.scene.ibl_enabled = self._env is not None
+        if rotation_deg is not None:
+            self.scene.env_rotation_deg = float(rotation_deg)
+        if intensity is not None:
+            if not intensity >= 0:
+                raise AlightError(f"intensity: {intensity} must be >= 0")
+            self.scene.env_intensity = float(intensity)
+        return self
+
+    @property
+    def environment(self) -> Environment | None:
+        return self._env
+
+    def set_material(self, material: Material | str | os.PathLike | None = None, *,
+                     use_file_materials: bool | None = None, **fields) -> "Renderer":
+        """A Material, a preset name or preset file; keyword fields (``roughness=0.3``) on top.
+
+        A material given here replaces a mesh file's own materials unless ``use_file_materials``
+        is True; with no material, only the fields, the current material is edited.
+        """
+        if material is None:
+            base = self.scene.material
+        elif isinstance(material, Material):
+            base = validate_material(material)
+        else:
+            base = load_preset(material)
+        self.scene.material = with_overrides(base, **fields) if fields else base
+        if use_file_materials is not None:
+            self.scene.use_file_materials = bool(use_file_materials)
+        elif material is not None:
+            self.scene.use_file_materials = False
+        return self
+
+    @property
+    def material(self) -> Material:
+        return self.scene.material
+
+    def set_lights(self, lights: Iterable[Light | str]) -> "Renderer":
+        """Punctual lights: Light objects or CLI specs such as 'point:pos=2,3,4:intensity=30'."""
+        self.scene.lights = [parse_light(x) if isinstance(x, str) else x for x in lights]
+        return self
+
+    def add_light(self, light: Light | str) -> "Renderer":
+        self.scene.lights.append(parse_light(light) if isinstance(light, str) else light)
+        return self
+
+    def set_camera(self, camera: Camera | None = None, *, orbit_deg: float | None = None,
+                   elevation_deg: float = 0.0) -> "Renderer":
+        """A Camera, None (frame the mesh from +Z), or ``orbit_deg``: frame the mesh from a direction
+        turned that many degrees about +Y from +Z (right-handed), raised by ``elevation_deg``."""
+        if orbit_deg is not None:
+            import math
+
+            a, e = math.radians(orbit_deg), math.radians(elevation_deg)
+            direction = (math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e))
+            centre, radius = self._mesh.bounding_sphere() if self._mesh is not None else ((0, 0, 0), 1.0)
+            camera = frame_camera(centre, max(radius, 1e-6), aspect=self.width / self.height, direction=direction)
+        self.scene.camera = camera
+        return self
+
+    def set_view(self, view: Literal["camera", "probe"]) -> "Renderer":
+        if view not in ("camera", "probe"):
+            raise AlightError(f"view: {view!r} is not 'camera' or 'probe'")
+        self.scene.view = view
+        return self
+
+    def set_ibl_model(self, model: str, *, multiple_scattering: bool | None = None) -> "Renderer":
+        """An IBL model of app/core/ibl_models.py ('alight' by default, 'lecture' for the seed lecture's
+        split sum), and optionally Fdez-Aguera's multiple-scattering compensation."""
+        from alight.core.ibl_models import IBL_MODELS
+
+        if model not in IBL_MODELS:
+            raise AlightError(f"ibl model: {model!r} is not one of {', '.join(IBL_MODELS)}")
+        self.scene.ibl_model = model
+        if multiple_scattering is not None:
+            self.scene.multiple_scattering = bool(multiple_scattering)
+        return self
+
+    def set_display(self, *, tonemap: str | None = None, exposure: float | None = None,
+                    background: str | None = None) -> "Renderer":
+        d = self.scene.display
+        if tonemap is not None:
+            if tonemap not in TONEMAPS:
+                raise AlightError(f"tonemap: {tonemap!r} is not one of {', '.join(TONEMAPS)}")
+            d.tonemap = tonemap
+        if exposure is not None:
+            d.exposure = float(exposure)
+        if background is not None:
+            if background not in BACKGROUNDS:
+                raise AlightError(f"background: {background!r} is not one of {', '.join(BACKGROUNDS)}")
+            d.background = background
+        return self
+
+    # --- output --------------------------------------------------------------------------
+
+    def render(self, width: int | None = None, height: int | None = None, *,
+               linear: bool = False) -> np.ndarray:
+        """Render the scene; returns (H, W, 4) float32 linear radiance (``linear=True``) or
+        (H, W, 4) uint8 sRGB after exposure and tone mapping. Row 0 is the top."""
+        w, h = _size(width or self.width, height or (self.height if width is None else width))
+        if self.scene.view == "probe" and w != h:
+            raise AlightError(f"size: the probe view is square; got {w}x{h}")
+        frame = self._frame(w, h, linear=linear, srgb=not linear)
+        return frame.linear if linear else frame.srgb
+
+    def save(self, path: str | os.PathLike, width: int | None = None, height: int | None = None) -> Path:
+        """Render and write ``path`` atomically: .png (sRGB, tone mapped) or .exr (linear float32)."""
+        from alight.exchange.output import check_output_path, write_image
+
+        out = check_output_path(path)
+        exr = out.suffix.lower() == ".exr"
+        pixels = self.render(width, height, linear=exr)
+        if not exr and self.scene.display.background != "transparent":
+            pixels = pixels[:, :, :3]
+        write_image(out, pixels, linear=exr)
+        return out
+
+    def _frame(self, w: int, h: int, linear: bool, srgb: bool):
+
+        self.open()
+        with _keep_current_context():
+            self._renderer.ctx.__enter__()  # another renderer in this process may have made its own current
+            return self._frame_current(w, h, linear, srgb)
+
+    def _frame_current(self, w: int, h: int, linear: bool, srgb: bool):
+        from alight.ibl.bake import QUALITY
+
+        r = self._renderer
+        maps = None
+        if self.quality == "auto":
+            return self._frame_auto(w, h, linear, srgb)
+        if self._env is not None and self.scene.ibl_enabled:
+            before = len(r._bakes)
+            quality = self.quality if not isinstance(self.quality, str) else QUALITY.get(self.quality)
+            if quality is None:
+                raise AlightError(f"quality: {self.quality!r} is not one of {', '.join(QUALITY)}")
+            maps = r.bake(self._env, quality)
+            self.bakes_done += len(r._bakes) - before
+        return r.render(self.scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
+
+
+    def _frame_auto(self, w: int, h: int, linear: bool, srgb: bool):
+        """quality="auto": the cheapest measured bake within error_budget for this scene."""
+        from dataclasses import replace
+
+        from alight.accuracy.auto_quality import (
+            choose_quality,
+            environment_features,
+            scene_needs,
+        )
+
+        r = self._renderer
+        scene = self.scene
+        on = self._env is not None and scene.ibl_enabled and scene.env_intensity > 0.0
+        features = None
+        if on:
+            key = self._env.content_hash
+            if key not in self._features:
+                self._features[key] = environment_features(self._env.radiance)
+            features = self._features[key]
+        choice = self.last_auto_choice = choose_quality(scene_needs(scene), features, self.error_budget)
+        maps = None
+        if choice.quality is not None:
+            before = len(r._bakes)
+            maps = r.bake(self._env, choice.quality)
+            self.bakes_done += len(r._bakes) - before
+        return r.render(scene if on else replace(scene, ibl_enabled=False), maps, w, h, aa=self.aa,
+                        read_linear=linear, read_srgb=srgb)
+
+
+@functools.lru_cache(maxsize=1)
+def _studio() -> Environment:
+    """The built-in studio, built once per process (0.3 s) and shared: environments are not
+    modified after loading, and a shared one also shares its content hash."""
+    return load_environment("studio")
+
+
+_EGL_DRAW, _EGL_READ = 0x3059, 0x305A
+
+
+@contextlib.contextmanager
+def _keep_current_context():
+    """Restore whatever EGL context was current before the block.
+
+    moderngl issues GL calls to the thread's current context, and creating a context makes it
+    current; without this, opening an Renderer would silently redirect another renderer's
+    draws in the same process (another library's, or a test suite's shared one) to ours.
+    """
+    egl = _libegl()
+    state = None
+    if egl is not None:
+        state = (egl.eglGetCurrentDisplay(), egl.eglGetCurrentSurface(_EGL_DRAW),
+                 egl.eglGetCurrentSurface(_EGL_READ), egl.eglGetCurrentContext())
+    try:
+        yield
+    finally:
+        if state is not None and state[3]:
+            egl.eglMakeCurrent(*state)
+
+
+@functools.lru_cache(maxsize=1)
+def _libegl():
+    import ctypes
+    import ctypes.util
+
+    name = ctypes.util.find_library("EGL")
+    if name is None:
+        return None
+    lib = ctypes.CDLL(name)
+    for fn in ("eglGetCurrentDisplay", "eglGetCurrentContext"):
+        getattr(lib, fn).restype = ctypes.c_void_p
+    lib.eglGetCurrentSurface.restype = ctypes.c_void_p
+    lib.eglGetCurrentSurface.argtypes = [ctypes.c_int]
+    lib.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
+    lib.eglMakeCurrent.restype = ctypes.c_uint
+    return lib
+
+
+def _size(w, h) -> tuple[int, int]:
+    try:
+        w, h = int(w), int(h)
+    except (TypeError, ValueError):
+        raise AlightError(f"size: {w}x{h} is not two integers") from None
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise AlightError(f"size: {w}x{h} must have sides 1..16384")
+    return w, h

@@ -1,0 +1,418 @@
+"""``alight batch SPEC.toml|.json``: meshes x environments x materials x angles -> images.
+
+A spec (paths are relative to the spec file's folder)::
+
+    out = "renders"                 # output folder (default: the spec's stem)
+    size = 256                      # or [W, H]
+    quality = "low"                 # bake quality: low | medium | high
+    meshes = ["sphere", "models/duck.glb"]
+    environments = ["studio", "env/venice.hdr"]
+    materials = ["gold", "my_preset.json", "model.glb", {name = "rough_gold", preset = "gold", roughness = 0.6}]
+    camera_angles = [0, 90]         # orbit about +Y, degrees (default [0])
+    environment_angles = [0]        # environment rotation, degrees (default [0])
+    contact_sheet = true            # contact_sheet.png with every still, labelled
+    [turntable]                     # optional: N frames per mesh x environment x material
+    frames = 24
+    rotate = "camera"               # or "environment"
+    format = "gif"                  # or "apng"
+
+Stills are named ``{mesh}__{env}__{material}__cam{deg}_env{deg}.png``; turntables go to
+``turntable/{mesh}__{env}__{material}/frame_{i:03d}.png`` plus ``{...}.gif`` (or ``.apng``).
+An output newer than the spec and every input file is up to date and skipped on a rerun.
+A failed item is reported with its reason and the rest go on; the run ends with a summary.
+Items run in a process pool (``spawn``: one GL context per worker process, created lazily).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import itertools
+import json
+import math
+import multiprocessing
+import os
+import re
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+from alight.errors import AlightError
+from alight.frontends.batch_worker import MATERIAL_FIELDS, render_item
+
+_KEYS = {"out", "size", "quality", "meshes", "environments", "materials", "camera_angles",
+         "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background"}
+_TURNTABLE_KEYS = {"frames", "rotate", "format", "fps"}
+
+
+@dataclass
+class Item:
+    """One image to render; plain data so it pickles to a worker process."""
+
+    name: str
+    out: str
+    mesh: str
+    environment: str
+    material: Any  # a string (preset name or file) or a dict with "preset"/"from" and fields
+    camera_deg: float
+    environment_deg: float
+    size: tuple[int, int]
+    quality: str
+    aa: str = "msaa"
+    tonemap: str = "aces"
+    background: str = "env"
+    inputs: list[str] = field(default_factory=list)  # files whose change makes the output stale
+    label: str = ""
+
+
+@dataclass
+class Animation:
+    out: Path
+    frames: list[Path]
+    fps: float
+
+
+@dataclass
+class Plan:
+    spec_path: Path
+    out_dir: Path
+    stills: list[Item]
+    frames: list[Item]
+    animations: list[Animation]
+    contact_sheet: bool
+
+
+# --- the spec ------------------------------------------------------------------------------
+
+def load_spec(path: str | os.PathLike) -> dict:
+    p = Path(path)
+    if p.suffix.lower() not in (".toml", ".json"):
+        raise AlightError(f"{p}: a batch spec is .toml or .json, not '{p.suffix}'")
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise AlightError(f"{p}: cannot read ({e.strerror or e})") from None
+    try:
+        if p.suffix.lower() == ".toml":
+            import tomllib
+
+            spec = tomllib.loads(data.decode("utf-8"))
+        else:
+            spec = json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError) as e:  # TOMLDecodeError and JSONDecodeError are ValueErrors
+        raise AlightError(f"{p}: not valid {p.suffix[1:].upper()} ({' '.join(str(e).split())})") from None
+    if not isinstance(spec, dict):
+        raise AlightError(f"{p}: expected a table/object at the top")
+    return spec
+
+
+def _list(spec: dict, key: str, default: list, source: Path, kind: type | tuple = str) -> list:
+    value = spec.get(key, default)
+    if not isinstance(value, list) or not value:
+        raise AlightError(f"{source}: '{key}' must be a non-empty list")
+    for v in value:
+        if not isinstance(v, kind) or isinstance(v, bool):
+            raise AlightError(f"{source}: '{key}': {v!r} is not a {getattr(kind, '__name__', 'valid entry')}")
+    return value
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_") or "x"
+
+
+def _resolve(base: Path, spec: str, builtins: tuple[str, ...]) -> str:
+    return spec if spec in builtins else str((base / spec) if not Path(spec).is_absolute() else Path(spec))
+
+
+def _material_label(m: Any, source: Path) -> str:
+    if isinstance(m, str):
+        return Path(m).stem if ("/" in m or "." in m) else m
+    if isinstance(m, dict):
+        unknown = set(m) - MATERIAL_FIELDS - {"name", "preset", "from"}
+        if unknown:
+            raise AlightError(f"{source}: material {m!r}: unknown field {sorted(unknown)[0]!r}")
+        return str(m.get("name") or m.get("preset") or Path(str(m.get("from", "material"))).stem)
+    raise AlightError(f"{source}: material {m!r} is not a name, a file or a table")
+
+
+def _material_inputs(m: Any, base: Path) -> tuple[Any, list[str]]:
+    """The material with file paths made absolute, and the files it depends on."""
+    from alight.paths import preset_dir
+
+    def one(text: str) -> tuple[str, str | None]:
+        preset = preset_dir() / f"{text}.json"
+        if preset.is_file():
+            return text, str(preset)
+        p = Path(text) if Path(text).is_absolute() else base / text
+        return str(p), str(p)
+
+    if isinstance(m, str):
+        spec, dep = one(m)
+        return spec, [dep] if dep else []
+    m = dict(m)
+    deps = []
+    for key in ("preset", "from"):
+        if key in m:
+            m[key], dep = one(str(m[key]))
+            deps += [dep] if dep else []
+    return m, deps
+
+
+def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> Plan:
+    """Every item of a spec, named, with its inputs (no rendering)."""
+    from alight.core.mesh import BUILTIN_MESHES
+
+    source = Path(spec_path)
+    spec = load_spec(source)
+    unknown = set(spec) - _KEYS
+    if unknown:
+        raise AlightError(f"{source}: unknown key {sorted(unknown)[0]!r} (known: {', '.join(sorted(_KEYS))})")
+    base = source.resolve().parent
+    size = spec.get("size", 256)
+    size = [size, size] if isinstance(size, int) and not isinstance(size, bool) else size
+    if not (isinstance(size, list) and len(size) == 2 and all(isinstance(x, int) and 1 <= x <= 8192 for x in size)):
+        raise AlightError(f"{source}: 'size' must be an integer or [W, H], 1..8192")
+    quality = spec.get("quality", "medium")
+    if quality not in ("low", "medium", "high"):
+        raise AlightError(f"{source}: 'quality' must be low, medium or high")
+    meshes = _list(spec, "meshes", ["sphere"], source)
+    envs = _list(spec, "environments", ["studio"], source)
+    materials = _list(spec, "materials", ["gold"], source, (str, dict))
+    cams = _list(spec, "camera_angles", [0], source, (int, float))
+    env_angles = _list(spec, "environment_angles", [0], source, (int, float))
+    options = {k: spec[k] for k in ("aa", "tonemap", "background") if k in spec}
+    out_dir = Path(out) if out is not None else base / str(spec.get("out", source.stem))
+
+    mesh_names = [Path(m).stem for m in meshes]
+    env_names = [Path(e).stem for e in envs]
+    mat_names = [_slug(_material_label(m, source)) for m in materials]
+    for what, names in (("meshes", mesh_names), ("environments", env_names), ("materials", mat_names)):
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise AlightError(f"{source}: two {what} share the name {sorted(dup)[0]!r}; output names would collide")
+
+    spec_deps = [str(source)]
+
+    def item(mi, ei, ki, cam, env_deg, out_path: Path, label: str) -> Item:
+        mesh = _resolve(base, meshes[mi], BUILTIN_MESHES)
+        env = _resolve(base, envs[ei], ("studio",))
+        material, mat_deps = _material_inputs(materials[ki], base)
+        deps = spec_deps + mat_deps + [p for p in (mesh, env) if p not in BUILTIN_MESHES and p != "studio"]
+        return Item(name=out_path.relative_to(out_dir).as_posix(), out=str(out_path), mesh=mesh, environment=env,
+                    material=material, camera_deg=float(cam), environment_deg=float(env_deg),
+                    size=(size[0], size[1]), quality=quality, inputs=deps, label=label, **options)
+
+    stills = []
+    for (mi, ei, ki), cam, env_deg in itertools.product(
+            itertools.product(range(len(meshes)), range(len(envs)), range(len(materials))), cams, env_angles):
+        stem = f"{mesh_names[mi]}__{env_names[ei]}__{mat_names[ki]}"
+        name = f"{stem}__cam{_deg(cam)}_env{_deg(env_deg)}.png"
+        label = f"{mesh_names[mi]} / {env_names[ei]}\n{mat_names[ki]}  cam {cam:g} env {env_deg:g}"
+        stills.append(item(mi, ei, ki, cam, env_deg, out_dir / name, label))
+
+    frames, animations = [], []
+    tt = spec.get("turntable")
+    if tt is not None:
+        if not isinstance(tt, dict) or set(tt) - _TURNTABLE_KEYS:
+            raise AlightError(f"{source}: 'turntable' takes {', '.join(sorted(_TURNTABLE_KEYS))}")
+        n = tt.get("frames", 24)
+        rotate, fmt, fps = tt.get("rotate", "camera"), tt.get("format", "gif"), tt.get("fps", 12)
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 3600:
+            raise AlightError(f"{source}: turntable 'frames' must be an integer 1..3600")
+        if rotate not in ("camera", "environment") or fmt not in ("gif", "apng"):
+            raise AlightError(f"{source}: turntable 'rotate' is camera|environment and 'format' gif|apng")
+        if not isinstance(fps, (int, float)) or not 0 < fps <= 100:
+            raise AlightError(f"{source}: turntable 'fps' must be in (0, 100]")
+        for mi, ei, ki in itertools.product(range(len(meshes)), range(len(envs)), range(len(materials))):
+            stem = f"{mesh_names[mi]}__{env_names[ei]}__{mat_names[ki]}"
+            paths = []
+            for i in range(n):
+                angle = 360.0 * i / n
+                cam, env_deg = (angle, env_angles[0]) if rotate == "camera" else (cams[0], angle)
+                p = out_dir / "turntable" / stem / f"frame_{i:03d}.png"
+                frames.append(item(mi, ei, ki, cam, env_deg, p, stem))
+                paths.append(p)
+            animations.append(Animation(out_dir / "turntable" / f"{stem}.{fmt}", paths, float(fps)))
+    return Plan(source, out_dir, stills, frames, animations, bool(spec.get("contact_sheet", True)))
+
+
+def _deg(x: float) -> str:
+    return f"{x:03.0f}" if float(x).is_integer() else f"{x:g}".replace(".", "p")
+
+
+# --- up to date ----------------------------------------------------------------------------
+
+def up_to_date(item: Item) -> bool:
+    """The output exists and is newer than the spec and every input file."""
+    try:
+        made = os.stat(item.out).st_mtime_ns
+    except OSError:
+        return False
+    for dep in item.inputs:
+        try:
+            if os.stat(dep).st_mtime_ns >= made:
+                return False
+        except OSError:
+            return False  # a missing input: let the render report it
+    return True
+
+
+# --- running -------------------------------------------------------------------------------
+
+@dataclass
+class Result:
+    rendered: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    failed: list[tuple[str, str]] = field(default_factory=list)
+    seconds: float = 0.0
+
+
+def run(plan_: Plan, executor: str = "local", workers: int | None = None, force: bool = False,
+        log: TextIO = sys.stderr) -> Result:
+    """Render every stale item, then the animations and the contact sheet."""
+    result = Result()
+    start = time.perf_counter()
+    todo = []
+    for item in plan_.stills + plan_.frames:
+        if not force and up_to_date(item):
+            result.skipped.append(item.name)
+        else:
+            todo.append(item)
+    if result.skipped:
+        print(f"alight batch: {len(result.skipped)} up to date, {len(todo)} to render", file=log)
+    plan_.out_dir.mkdir(parents=True, exist_ok=True)
+    progress = _Progress(len(todo), log)
+    for name, error, _ in _execute(todo, executor, workers):
+        if error is None:
+            result.rendered.append(name)
+        else:
+            result.failed.append((name, error))
+        progress.step(name, error)
+    for anim in plan_.animations:
+        try:
+            _animation(anim, force or any(str(f) in {i.out for i in todo} for f in anim.frames))
+        except AlightError as e:
+            result.failed.append((anim.out.name, str(e)))
+    if plan_.contact_sheet and plan_.stills:
+        try:
+            _contact_sheet(plan_, force or bool(todo) or not (plan_.out_dir / "contact_sheet.png").exists())
+        except AlightError as e:
+            result.failed.append(("contact_sheet.png", str(e)))
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _execute(items: list[Item], executor: str, workers: int | None):
+    if not items:
+        return
+    if executor == "inline":  # in this process: for debugging and for callers that own a context
+        for item in items:
+            yield render_item(item)
+        return
+    if executor == "ray":
+        from alight.frontends.batch_ray import execute
+
+        yield from execute(items, workers, os.environ.get("ALIGHT_RAY_ADDRESS"))
+        return
+    if executor != "local":
+        raise AlightError(f"--executor: {executor!r} is not one of local, ray, inline")
+    n = max(1, min(workers or os.cpu_count() or 1, len(items)))
+    # 'spawn': a forked child would inherit the parent's GL/EGL state, which is not fork-safe.
+    ctx = multiprocessing.get_context("spawn")
+    # Items sorted by environment so each worker meets few environments (one bake each).
+    ordered = sorted(items, key=lambda i: (i.environment, i.quality, i.mesh))
+    with concurrent.futures.ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+        futures = [pool.submit(render_item, item) for item in ordered]
+        for fut in concurrent.futures.as_completed(futures):
+            try:
+                yield fut.result()
+            except Exception as e:  # the worker process died (e.g. killed): report, go on
+                yield "?", f"worker failed: {type(e).__name__}: {' '.join(str(e).split())}", 0.0
+
+
+class _Progress:
+    """One line per finished item: count, percent, time left (from the mean time so far)."""
+
+    def __init__(self, total: int, log: TextIO):
+        self.total, self.done, self.log, self.start = total, 0, log, time.perf_counter()
+
+    def step(self, name: str, error: str | None) -> None:
+        self.done += 1
+        elapsed = time.perf_counter() - self.start
+        left = elapsed / self.done * (self.total - self.done)
+        width = len(str(self.total))
+        bar = "#" * round(20 * self.done / self.total)
+        status = "ok" if error is None else f"FAILED: {error}"
+        print(f"[{bar:20s}] {self.done:{width}d}/{self.total} {_clock(elapsed)} elapsed, {_clock(left)} left  "
+              f"{name} {status}", file=self.log, flush=True)
+
+
+def _clock(seconds: float) -> str:
+    s = int(math.ceil(seconds))
+    return f"{s // 60}:{s % 60:02d}"
+
+
+def _animation(anim: Animation, stale: bool) -> None:
+    from PIL import Image
+
+    from alight.exchange.output import atomic_path
+
+    if not stale and anim.out.exists():
+        return
+    missing = [f for f in anim.frames if not f.exists()]
+    if missing:
+        raise AlightError(f"{anim.out}: not written, {len(missing)} frame(s) failed")
+    images = [Image.open(f).convert("RGBA") for f in anim.frames]
+    duration = int(round(1000.0 / anim.fps))
+    fmt = "GIF" if anim.out.suffix == ".gif" else "PNG"
+    with atomic_path(anim.out) as tmp:
+        images[0].save(tmp, format=fmt, save_all=True, append_images=images[1:], duration=duration, loop=0,
+                       **({"disposal": 2} if fmt == "GIF" else {}))
+
+
+def _contact_sheet(plan_: Plan, stale: bool) -> None:
+    """Every still as a thumbnail in a grid, each labelled with its mesh, environment, material
+    and angles (Pillow's default font); missing stills (failed items) are left blank."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    from alight.exchange.output import atomic_path
+
+    out = plan_.out_dir / "contact_sheet.png"
+    if not stale:
+        return
+    thumb = 160
+    font = ImageFont.load_default()
+    label_h = 28
+    cols = max(1, min(len(plan_.stills), math.ceil(math.sqrt(len(plan_.stills)))))
+    rows = math.ceil(len(plan_.stills) / cols)
+    sheet = Image.new("RGB", (cols * thumb, rows * (thumb + label_h)), (24, 24, 24))
+    draw = ImageDraw.Draw(sheet)
+    for i, item in enumerate(plan_.stills):
+        x, y = (i % cols) * thumb, (i // cols) * (thumb + label_h)
+        if Path(item.out).exists():
+            with Image.open(item.out) as im:
+                im = im.convert("RGB")
+                scale = thumb / max(im.size)  # small renders are enlarged too, so labels fit under them
+                im = im.resize((max(1, round(im.width * scale)), max(1, round(im.height * scale))), Image.LANCZOS)
+                sheet.paste(im, (x + (thumb - im.width) // 2, y + (thumb - im.height) // 2))
+        else:
+            draw.text((x + 4, y + thumb // 2), "FAILED", fill=(255, 80, 80), font=font)
+        draw.multiline_text((x + 3, y + thumb + 2), item.label, fill=(230, 230, 230), font=font, spacing=2)
+    with atomic_path(out) as tmp:
+        sheet.save(tmp, format="PNG")
+
+
+def summary(result: Result) -> str:
+    lines = [f"alight batch: {len(result.rendered)} rendered, {len(result.skipped)} up to date, "
+             f"{len(result.failed)} failed in {result.seconds:.1f}s"]
+    lines += [f"  FAILED {name}: {reason}" for name, reason in result.failed]
+    return "\n".join(lines)
+
+
+def main(spec: str, executor: str = "local", workers: int | None = None, force: bool = False,
+         out: str | None = None, log: TextIO = sys.stderr) -> int:
+    """The CLI's entry: 0 when everything was written, 1 when an item failed."""
+    result = run(plan(spec, out), executor, workers, force, log)
+    print(summary(result), file=log)
+    return 1 if result.failed else 0

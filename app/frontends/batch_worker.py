@@ -1,0 +1,83 @@
+"""One batch item rendered in this process: the worker side of ``alight batch``.
+
+A worker process (the local pool's or a Ray actor) keeps one renderer, its loaded meshes and
+environments, and its bake cache for its whole life, so it bakes each environment once however
+many items it renders. Both executors (``alight.frontends.batch`` and ``batch_ray``) call
+``render_item``; it never raises, so one bad item cannot stop a batch.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from alight.errors import AlightError
+
+# The material fields a spec may set on top of a preset.
+MATERIAL_FIELDS = {"base_color", "metallic", "roughness", "specular_f0", "emissive"}
+
+
+_WORKER: dict[str, Any] = {}
+
+
+def render_item(item) -> tuple[str, str | None, float]:
+    """Render one item in this process (its renderer and caches live as long as the process).
+    Returns (name, error or None, seconds); never raises, so one bad item cannot stop a batch."""
+    start = time.perf_counter()
+    try:
+        _render(item)
+        return item.name, None, time.perf_counter() - start
+    except AlightError as e:
+        return item.name, " ".join(str(e).split()), time.perf_counter() - start
+    except Exception as e:  # a bug or a driver failure: still one line, and the batch goes on
+        return item.name, f"{type(e).__name__}: {' '.join(str(e).split())}", time.perf_counter() - start
+
+
+def _render(item) -> None:
+    from alight.exchange.meshes import load_mesh
+    from alight.frontends.api import Renderer
+    from alight.ibl.environment import load_environment
+
+    r = _WORKER.get("renderer")
+    if r is None:
+        r = _WORKER["renderer"] = Renderer(quality=item.quality)
+        _WORKER["meshes"], _WORKER["envs"] = {}, {}
+    meshes, envs = _WORKER["meshes"], _WORKER["envs"]
+    if item.mesh not in meshes:
+        meshes[item.mesh] = load_mesh(item.mesh)
+    if item.environment not in envs:
+        envs[item.environment] = load_environment(item.environment)
+    r.quality, r.aa = item.quality, item.aa
+    r.width, r.height = item.size
+    r.set_mesh(meshes[item.mesh]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)
+    r.set_material(_material(item.material)).set_display(tonemap=item.tonemap, background=item.background)
+    r.set_camera(orbit_deg=item.camera_deg)
+    Path(item.out).parent.mkdir(parents=True, exist_ok=True)
+    r.save(item.out)
+
+
+def _material(m: Any):
+    from alight.core.material import with_overrides
+    from alight.exchange.presets import load_preset
+
+    def load(text: str):
+        if Path(text).suffix.lower() in (".gltf", ".glb"):
+            from alight.exchange.gltf_material import import_material
+
+            return import_material(text)
+        return load_preset(text)
+
+    if isinstance(m, str):
+        return load(m)
+    base = load(m["from"]) if "from" in m else load(m.get("preset", "gold")) if "preset" in m else None
+    if base is None:
+        from alight.core.material import Material
+
+        base = Material()
+    fields = {k: (tuple(v) if isinstance(v, list) else v) for k, v in m.items() if k in MATERIAL_FIELDS}
+    if "name" in m:
+        fields["name"] = str(m["name"])
+    import dataclasses
+
+    return with_overrides(dataclasses.replace(base, name=fields.pop("name", base.name)), **fields)

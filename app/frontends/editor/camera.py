@@ -1,0 +1,56 @@
+"""Orbit camera: yaw/pitch/distance about a target, turned into alight.core.scene's Camera each frame."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from alight.core.scene import Camera
+
+
+@dataclass
+class OrbitCamera:
+    target: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    yaw_deg: float = 0.0       # 0: on +Z looking toward -Z (CONVENTIONS.md's default camera)
+    pitch_deg: float = 0.0
+    distance: float = 4.0
+    fov_y_deg: float = 35.0
+    radius: float = 1.0        # the framed object's size: sets near/far and pan speed
+
+    def _offset(self) -> np.ndarray:
+        y, p = math.radians(self.yaw_deg), math.radians(self.pitch_deg)
+        return np.array([math.sin(y) * math.cos(p), math.sin(p), math.cos(y) * math.cos(p)]) * self.distance
+
+    def camera(self) -> Camera:
+        t = np.asarray(self.target, dtype=np.float64)
+        pos = t + self._offset()
+        near = max(self.distance - 2.0 * self.radius, self.distance * 1e-3)
+        return Camera(tuple(pos), tuple(t), (0.0, 1.0, 0.0), self.fov_y_deg, near=near,
+                      far=self.distance + 8.0 * self.radius)
+
+    def orbit(self, dx_px: float, dy_px: float) -> None:
+        self.yaw_deg -= dx_px * 0.3
+        # Stop short of the poles, where the look-at 'up' would be parallel to the view.
+        self.pitch_deg = max(-89.0, min(89.0, self.pitch_deg + dy_px * 0.3))
+
+    def pan(self, dx_px: float, dy_px: float, height_px: int) -> None:
+        # One pixel moves the target by one pixel's worth of the view at the target's distance.
+        scale = 2.0 * self.distance * math.tan(math.radians(self.fov_y_deg) / 2) / max(height_px, 1)
+        forward = -self._offset() / self.distance
+        right = np.cross(forward, [0.0, 1.0, 0.0])
+        right /= max(np.linalg.norm(right), 1e-9)
+        up = np.cross(right, forward)
+        self.target = tuple(np.asarray(self.target) + (-dx_px * right + dy_px * up) * scale)
+
+    def zoom(self, wheel: float) -> None:
+        self.distance = max(self.radius * 0.05, self.distance * 0.9 ** wheel)
+
+    def frame(self, center, radius: float, aspect: float, margin: float = 1.3) -> None:
+        """Fit a sphere in the narrower field of view (as alight.core.scene.frame_camera does)."""
+        half = math.radians(self.fov_y_deg) / 2.0
+        half_narrow = min(half, math.atan(math.tan(half) * aspect))
+        self.radius = max(float(radius), 1e-6)
+        self.distance = margin * self.radius / math.sin(half_narrow)
+        self.target = tuple(float(x) for x in center)

@@ -1,0 +1,349 @@
+"""The imgui panel. It edits the plain EditorState (and asks the window for a few actions such
+as 'frame the mesh'); it never touches a GL object, and the ForwardRenderer never sees imgui."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+
+import numpy as np
+
+from alight.accuracy.auto_quality import DEFAULT_ERROR_BUDGET
+from alight.core.ibl_models import IBL_MODELS
+from alight.core.material import validate_material
+from alight.core.scene import BACKGROUNDS, TONEMAPS, Light
+from alight.core.shading import linear_to_srgb, srgb_to_linear
+from alight.core.texture_maps import MAP_SLOTS, SLOT_LABELS
+from alight.errors import AlightError
+from alight.exchange.images import IMAGE_SUFFIXES
+from alight.exchange.presets import list_presets, load_preset
+from alight.frontends.editor.file_browser import FileBrowser
+from alight.frontends.editor.state import DEBUG_VIEWS
+from alight.ibl.bake import QUALITY
+
+AA_CHOICES = ("none", "msaa")
+
+
+def _srgb(c) -> list[float]:
+    return [float(x) for x in np.clip(linear_to_srgb(np.asarray(c, np.float64)), 0.0, 1.0)]
+
+
+def _linear(c) -> tuple[float, float, float]:
+    return tuple(float(x) for x in np.clip(srgb_to_linear(np.asarray(c, np.float64)), 0.0, 1.0))
+
+
+class Panel:
+    def __init__(self):
+        # The F0 table, read once: (name, material, linear F0, sRGB F0).
+        self.presets = []
+        for name in list_presets():
+            try:
+                m = load_preset(name)
+            except AlightError:
+                continue   # a broken extra file in presets/ must not stop the editor
+            f0 = m.f0()
+            self.presets.append((name, m, f0, _srgb(f0)))
+        self.env_path = ""
+        self.mesh_path = ""
+        self.preset_path = "material.json"
+        self.gltf_path = "material.gltf"
+        self.map_path = ""
+        self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
+        self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
+
+    def draw(self, win) -> None:
+        from imgui_bundle import imgui
+
+        s = win.state
+        # A side bar on the right, the full height: the view beside it stays uncovered.
+        display = imgui.get_io().display_size
+        width = win.panel_width()
+        imgui.set_next_window_pos(imgui.ImVec2(display.x - width, 0), imgui.Cond_.always)
+        imgui.set_next_window_size(imgui.ImVec2(width, display.y), imgui.Cond_.always)
+        imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
+                    | imgui.WindowFlags_.no_collapse)
+        self.shown_error = s.error
+        if s.error:
+            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), "error:")
+            imgui.same_line()
+            imgui.text_wrapped(s.error)
+        elif s.message:
+            imgui.text_disabled(s.message)
+        if win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
+            fraction, label = win.bake_progress
+            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
+        if imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
+            self._material(s, win)
+        if imgui.collapsing_header("Environment"):
+            self._environment(s, win)
+        if imgui.collapsing_header("Lights"):
+            self._lights(s)
+        if imgui.collapsing_header("Display & camera"):
+            self._display(s, win)
+        if imgui.collapsing_header("Performance", imgui.TreeNodeFlags_.default_open):
+            self._performance(win)
+        if imgui.collapsing_header("Accuracy chart"):   # the latest 'alight chart' (app/frontends/editor/chart_view.py)
+            from alight.frontends.editor.chart_view import ChartView
+
+            self.chart_view = getattr(self, "chart_view", None) or ChartView()
+            self.chart_view.draw()
+        imgui.end()
+        self.browser.draw()
+
+    # --- sections -------------------------------------------------------------------------------
+
+    def _material(self, s, win) -> None:
+        from imgui_bundle import imgui
+
+        m = s.material
+        _, s.use_file_materials = imgui.checkbox("mesh file's own materials and maps", s.use_file_materials)
+        if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
+            imgui.table_setup_column("preset")
+            imgui.table_setup_column("F0 linear")
+            imgui.table_setup_column("F0 sRGB")
+            imgui.table_headers_row()
+            for name, preset, f0, f0_srgb in self.presets:
+                imgui.table_next_row()
+                imgui.table_next_column()
+                imgui.color_button(f"##sw{name}", imgui.ImVec4(*f0_srgb, 1.0), 0, imgui.ImVec2(14, 14))
+                imgui.same_line()
+                if imgui.selectable(name, m.name == preset.name)[0]:
+                    s.material = s.saved_material = preset
+                imgui.table_next_column()
+                imgui.text(" ".join(f"{x:.2f}" for x in f0))
+                imgui.table_next_column()
+                imgui.text(" ".join(f"{x:.2f}" for x in f0_srgb))
+            imgui.end_table()
+        # Base colour is stored linear (CONVENTIONS.md) and shown sRGB, as artists pick colours.
+        changed, col = imgui.color_edit3("base colour (sRGB)", _srgb(m.base_color))
+        if changed:
+            m = dataclasses.replace(m, base_color=_linear(col))
+        changed, v = imgui.slider_float("metallic", m.metallic, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, metallic=v)
+        changed, v = imgui.slider_float("roughness", m.roughness, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, roughness=v)
+        changed, v = imgui.drag_float3("specular F0", list(m.specular_f0), 0.002, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, specular_f0=tuple(min(max(x, 0.0), 1.0) for x in v))
+        changed, v = imgui.drag_float3("emissive", list(m.emissive), 0.01, 0.0, 100.0)
+        if changed:
+            m = dataclasses.replace(m, emissive=tuple(max(x, 0.0) for x in v))
+        changed, name = imgui.input_text("name", m.name)
+        if changed and name.strip() and name.isprintable():
+            m = dataclasses.replace(m, name=name)
+        if m != s.material:
+            try:
+                s.material = validate_material(m, "panel")
+            except AlightError as exc:
+                s.fail(exc)
+        if imgui.tree_node_ex("texture maps", imgui.TreeNodeFlags_.default_open):
+            self._texture_maps(s)
+            imgui.tree_pop()
+        imgui.text_disabled(f"F0 = {' '.join(f'{x:.3f}' for x in s.material.f0())}   "
+                            f"undo {len(win.history.undo_stack)}  redo {len(win.history.redo_stack)}")
+        if imgui.button("revert"):
+            s.material = s.saved_material
+        imgui.same_line()
+        if imgui.button("undo"):
+            s.look = win.history.undo(s.look)
+        imgui.same_line()
+        if imgui.button("redo"):
+            s.look = win.history.redo(s.look)
+        _, self.preset_path = imgui.input_text("preset file", self.preset_path)
+        if imgui.button("save preset"):
+            try:
+                s.save_material(self.preset_path)
+                s.error, s.message = "", f"saved {self.preset_path}"
+            except AlightError as exc:
+                s.fail(exc)
+        imgui.same_line()
+        if imgui.button("load preset"):
+            s.open_file(self.preset_path)
+        imgui.same_line()
+        self._browse("browse files", (".hdr", ".exr", ".obj", ".gltf", ".glb", ".ply", ".stl", ".json"),
+                     s.open_file)
+        _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
+        if imgui.button("export glTF"):   # .gltf: the material alone; .glb: the mesh with it
+            try:
+                s.export_gltf(self.gltf_path)
+                s.error, s.message = "", f"exported {self.gltf_path}"
+            except AlightError as exc:
+                s.fail(exc)
+
+    def _browse(self, label: str, suffixes: tuple[str, ...], on_pick) -> None:
+        """A button opening the file browser (file_browser.py: native dialog or built-in)."""
+        from imgui_bundle import imgui
+
+        if imgui.button(label):
+            self.browser.open(label, suffixes, on_pick)
+
+    def _texture_maps(self, s) -> None:
+        """A row per slot: the drop target (radio), the file, load and clear; then the tiling."""
+        from imgui_bundle import imgui
+
+        def loader(slot):
+            def load(path: str) -> None:
+                try:
+                    s.set_map(slot, path)
+                    s.error, s.message = "", f"{SLOT_LABELS[slot]}: {path}"
+                except AlightError as exc:
+                    s.fail(exc)    # the slot keeps its previous map
+            return load
+
+        maps = s.texture_maps
+        if s.use_file_materials:
+            imgui.text_disabled("parts with a material of their own use the file's maps")
+        for slot in MAP_SLOTS:
+            imgui.push_id(slot)
+            if imgui.radio_button("##armed", s.armed_slot == slot):
+                s.armed_slot = slot
+            if imgui.is_item_hovered():
+                imgui.set_tooltip("a dropped image file goes into this slot")
+            imgui.same_line()
+            if imgui.small_button("load"):
+                self.browser.open(f"load {SLOT_LABELS[slot]} map", IMAGE_SUFFIXES, loader(slot))
+            imgui.same_line()
+            path = getattr(maps, slot)
+            if imgui.small_button("clear") and path:
+                s.clear_map(slot)
+            imgui.same_line()
+            imgui.text(SLOT_LABELS[slot])
+            if path:
+                imgui.same_line()
+                imgui.text_disabled(os.path.basename(path))
+            imgui.pop_id()
+        _, self.map_path = imgui.input_text("map file", self.map_path)
+        imgui.same_line()
+        if imgui.button("load##typed") and self.map_path:
+            loader(s.armed_slot)(self.map_path)
+        changed, v = imgui.drag_float2("UV tiling", list(maps.uv_scale), 0.02, -64.0, 64.0)
+        if changed:
+            s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=tuple(v))
+        changed, v = imgui.drag_float2("UV offset", list(maps.uv_offset), 0.005, -8.0, 8.0)
+        if changed:
+            s.texture_maps = dataclasses.replace(s.texture_maps, uv_offset=tuple(v))
+
+    def _environment(self, s, win) -> None:
+        from imgui_bundle import imgui
+
+        imgui.text(f"environment: {s.env_spec}")
+        _, self.env_path = imgui.input_text("env file", self.env_path)
+        if imgui.button("open env"):
+            s.open_file(self.env_path)
+        imgui.same_line()
+        self._browse("browse env", (".hdr", ".exr"), s.open_file)
+        imgui.same_line()
+        if imgui.button("studio"):
+            try:
+                s.load_env("studio")
+            except AlightError as exc:
+                s.fail(exc)
+        _, self.mesh_path = imgui.input_text("mesh", self.mesh_path)
+        if imgui.button("open mesh"):
+            try:
+                s.load_mesh(self.mesh_path)
+            except AlightError as exc:
+                s.fail(exc)
+        _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
+        _, s.env_intensity = imgui.slider_float("intensity", s.env_intensity, 0.0, 4.0)
+        d = s.display
+        changed, i = imgui.combo("background", BACKGROUNDS.index(d.background), BACKGROUNDS)
+        if changed:
+            s.display = dataclasses.replace(d, background=BACKGROUNDS[i])
+        models = list(IBL_MODELS)
+        changed, i = imgui.combo("IBL model", models.index(s.ibl_model), models)
+        if changed:
+            s.ibl_model = models[i]
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(IBL_MODELS[s.ibl_model])
+        _, s.multiple_scattering = imgui.checkbox("multiple scattering", s.multiple_scattering)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("Fdez-Aguera 2019: the energy single scattering loses on rough surfaces "
+                              "(a white furnace gives 1; the single-scattering ground truth does not)")
+        names = list(QUALITY) + ["auto"]
+        changed, i = imgui.combo("bake quality", names.index(s.quality), names)
+        if changed:
+            s.quality = names[i]
+        if s.quality == "auto" and s.env is not None:
+            # What auto chose and why, with the predicted error (app/accuracy/auto_quality.py).
+            imgui.text_wrapped(win.auto_choice().line(DEFAULT_ERROR_BUDGET))
+        if win.bake_seconds:
+            imgui.text(f"last bake: {sum(win.bake_seconds.values()) * 1000:.0f} ms")
+
+    def _lights(self, s) -> None:
+        from imgui_bundle import imgui
+
+        _, s.ibl_enabled = imgui.checkbox("image-based lighting", s.ibl_enabled)
+        remove = None
+        # Lights are replaced, not mutated, so the renderer's "lights changed?" check stays honest.
+        for i, light in enumerate(s.lights):
+            imgui.push_id(i)
+            imgui.separator()
+            imgui.text(f"{i}: {light.kind}")
+            imgui.same_line()
+            if imgui.small_button("remove"):
+                remove = i
+            label = "position" if light.kind == "point" else "direction"
+            c1, vec = imgui.drag_float3(label, list(light.vector), 0.05)
+            c2, col = imgui.color_edit3("colour", list(light.color))
+            c3, inten = imgui.drag_float("intensity", light.intensity, 0.1, 0.0, 1000.0)
+            if c1 or c2 or c3:
+                if light.kind == "directional" and not any(vec):
+                    vec = list(light.vector)   # a zero direction has no meaning
+                s.lights[i] = Light(light.kind, tuple(vec), tuple(max(0.0, x) for x in col), max(0.0, inten))
+            imgui.pop_id()
+        if remove is not None:
+            del s.lights[remove]
+        if imgui.button("add point"):
+            s.lights.append(Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0))
+        imgui.same_line()
+        if imgui.button("add directional"):
+            s.lights.append(Light("directional", (0.0, -1.0, -1.0), (1.0, 1.0, 1.0), 2.0))
+
+    def _display(self, s, win) -> None:
+        from imgui_bundle import imgui
+
+        d = s.display
+        changed, i = imgui.combo("tone map", TONEMAPS.index(d.tonemap), TONEMAPS)
+        if changed:
+            s.display = d = dataclasses.replace(d, tonemap=TONEMAPS[i])
+        changed, ev = imgui.slider_float("exposure (EV)", d.exposure, -8.0, 8.0)
+        if changed:
+            s.display = dataclasses.replace(d, exposure=ev)
+        _, s.debug_view = imgui.combo("debug view", s.debug_view, DEBUG_VIEWS)
+        if DEBUG_VIEWS[s.debug_view] == "prefiltered radiance at mip":
+            _, s.debug_mip = imgui.slider_float("mip", s.debug_mip, 0.0, 8.0)
+        changed, i = imgui.combo("anti-aliasing", AA_CHOICES.index(s.aa), AA_CHOICES)
+        if changed:
+            s.aa = AA_CHOICES[i]
+        _, s.render_scale = imgui.slider_float("render scale", s.render_scale, 0.25, 1.0)
+        _, s.adaptive_motion = imgui.checkbox(f"adaptive scale while moving ({win.adaptive_scale:.2f})",
+                                              s.adaptive_motion)
+        if not s.adaptive_motion:
+            _, s.motion_scale = imgui.slider_float("scale while moving", s.motion_scale, 0.25, 1.0)
+        _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)
+        if imgui.button("frame mesh (F)"):
+            win.frame_mesh()
+        imgui.same_line()
+        if imgui.button("screenshot (F12)"):
+            win.screenshot_request = win.next_screenshot_name()   # the window writes it after the frame
+        imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
+
+    def _performance(self, win) -> None:
+        from imgui_bundle import imgui, implot
+
+        times = np.asarray(win.frame_times, np.float32) * 1000.0
+        if len(times):
+            imgui.text(f"frame {np.median(times):.1f} ms median, {1000.0 / max(np.median(times), 1e-6):.0f} FPS; "
+                       f"{win.redraws} scene redraws")
+        if implot.begin_plot("frame time (ms)", imgui.ImVec2(-1, 140)):
+            implot.setup_axes("frame", "ms")
+            implot.setup_axes_limits(0, 240, 0, max(50.0, float(times.max()) if len(times) else 50.0),
+                                     imgui.Cond_.always)
+            if len(times):
+                implot.plot_line("frame", times)
+            implot.end_plot()
+        for name, seconds in win.bake_seconds.items():
+            imgui.text(f"{name}: {seconds * 1000:.1f} ms")

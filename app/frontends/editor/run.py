@@ -1,0 +1,169 @@
+"""``alight edit``: open the editor, or take a screenshot / run the benchmark and exit."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from alight.frontends.editor.state import EditorState
+
+
+def build_state(args) -> EditorState:
+    from alight.frontends.options import build_material
+
+    # --motion-scale fixes the scale while moving; without it the scale adapts to hold 30 FPS.
+    state = EditorState(quality=args.quality, aa=args.aa, motion_scale=args.motion_scale or 0.5,
+                        adaptive_motion=args.motion_scale is None)
+    material, _ = build_material(args)
+    state.material = state.saved_material = material
+    state.load_mesh(args.mesh)
+    state.load_env(args.env)
+    for line in state.env.warnings:
+        print(f"alight: warning: {line}", file=sys.stderr)
+    if args.no_ibl:
+        state.ibl_enabled = False
+    # As in 'alight render': a mesh file without --preset shows its own materials and maps.
+    from alight.core.mesh import BUILTIN_MESHES
+
+    state.use_file_materials = args.preset is None and args.mesh not in BUILTIN_MESHES
+    return state
+
+
+def run(args) -> int:
+    from alight.frontends.editor.window import EditorWindow
+
+    state = build_state(args)
+    size = (1280, 720) if args.benchmark else args.size
+    # Interactive only (screenshots and benchmarks must not depend on the last session), and
+    # only with no scene given on the command line.
+    interactive = not (args.benchmark or args.screenshot or args.script)
+    win = EditorWindow(state, size, show_panel=not args.no_panel, ini_path=_imgui_ini() if interactive else None)
+    if interactive and not args.new and _no_scene_options(args):
+        from alight.frontends.editor.session import restore_session
+
+        warning = restore_session(state, win.orbit)
+        if warning:
+            state.error = " ".join(warning.split())
+        win.history.committed = state.look
+    try:
+        if args.benchmark:
+            return _benchmark(win, args.frames or 120)
+        for i, edit in enumerate(args.script):
+            win.frame()            # one frame per edit: the editor runs between them
+            state.apply_edit(edit)
+        if args.screenshot:
+            for _ in range(args.frames or 1):
+                win.frame()
+            win.screenshot(args.screenshot)
+            if state.error:
+                print(f"alight: panel error: {state.error}", file=sys.stderr)
+            print(args.screenshot)
+            return 0
+        while not win.should_close():
+            win.frame()
+        from alight.frontends.editor.session import save_session
+
+        save_session(state, win.orbit)
+        return 0
+    finally:
+        win.close()
+
+
+def _imgui_ini():
+    """imgui's layout file in the user's config folder (made if missing); None if it cannot be."""
+    from alight.paths import config_dir
+
+    try:
+        config_dir().mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return config_dir() / "imgui.ini"
+
+
+def _no_scene_options(args) -> bool:
+    return (args.mesh, args.env, args.preset, args.base_color, args.metallic, args.roughness,
+            args.specular_f0, args.emissive) == ("sphere", "studio", None, None, None, None, None, None)
+
+
+def _benchmark(win, frames: int) -> int:
+    """Frame times as the user sees them (swap to swap) while the camera orbits (every frame
+    redraws the scene): at full resolution, then at the motion scale; then a still view; then
+    each stage alone with a finish() after it, to say where the time goes."""
+    state = win.state
+    motion_scale = state.motion_scale
+    for _ in range(10):   # warm up: shader compiles, the bake, imgui's font atlas
+        win.frame()
+    win.finish_bake()
+    w, h = win.size
+    print(f"editor benchmark {w}x{h}, material ball, IBL, {len(state.lights)} lights, panel, aa={state.aa}")
+
+    def measure(label: str, n: int, orbit: bool) -> None:
+        win.frame_times.clear()
+        for _ in range(n):
+            if orbit:
+                win.orbit.orbit(3.0, 0.0)   # the camera moves every frame, as while the artist orbits
+            win.frame()
+        t = np.asarray(win.frame_times) * 1000.0
+        median, p95 = float(np.median(t)), float(np.percentile(t, 95))
+        print(f"{label}: {len(t)} frames, median {median:.1f} ms, p95 {p95:.1f} ms; "
+              f"{1000.0 / median:.1f} FPS median, {1000.0 / p95:.1f} FPS at p95")
+
+    adaptive = state.adaptive_motion
+    state.motion_scale, state.adaptive_motion = 1.0, False
+    measure("orbiting, full resolution", frames, True)
+    if motion_scale < 1.0:
+        state.motion_scale = motion_scale
+        measure(f"orbiting, view at {motion_scale:g} x window while moving", frames, True)
+    state.adaptive_motion = True
+    scales = []
+    win.frame_times.clear()
+    for _ in range(frames):
+        win.orbit.orbit(3.0, 0.0)
+        win.frame()
+        scales.append(win.adaptive_scale)
+    t = np.asarray(win.frame_times) * 1000.0
+    median, p95 = float(np.median(t)), float(np.percentile(t, 95))
+    print(f"orbiting, adaptive scale (target 30 FPS; scale median {np.median(scales):.2f}, "
+          f"range {min(scales):.2f}-{max(scales):.2f}): {len(t)} frames, median {median:.1f} ms, p95 {p95:.1f} ms; "
+          f"{1000.0 / median:.1f} FPS median, {1000.0 / p95:.1f} FPS at p95")
+    state.adaptive_motion = adaptive
+    measure("still view (scene not redrawn)", frames // 2, False)
+    state.motion_scale, state.adaptive_motion = 1.0, False
+    stages = _profile(win, 30)
+    print("full resolution, per stage (median, GL finished after each): "
+          + ", ".join(f"{k} {v:.1f} ms" for k, v in stages.items()))
+    return 0
+
+
+def _profile(win, frames: int) -> dict[str, float]:
+    imgui, ctx, r = win.imgui, win.ctx, win.renderer
+    times: dict[str, list[float]] = {k: [] for k in ("panel build", "scene (tone mapped)", "copy to window",
+                                                     "imgui draw", "swap")}
+    for _ in range(frames):
+        win.orbit.orbit(3.0, 0.0)
+        t0 = time.perf_counter()
+        win.glfw.poll_events()
+        win.impl.process_inputs()
+        imgui.new_frame()
+        win.panel.draw(win)
+        imgui.render()
+        t1 = time.perf_counter()
+        targets = win.targets(win.view_area())
+        scene = win.state.scene(win.orbit.camera())
+        r.draw_display(scene, win.maps(), targets)
+        ctx.finish()
+        t2 = time.perf_counter()
+        ctx.copy_framebuffer(ctx.screen, targets.display_fbo)
+        ctx.screen.use()
+        ctx.finish()
+        t3 = time.perf_counter()
+        win.impl.render(imgui.get_draw_data())
+        ctx.finish()
+        t4 = time.perf_counter()
+        win.glfw.swap_buffers(win.window)
+        t5 = time.perf_counter()
+        for k, a, b in zip(times, (t0, t1, t2, t3, t4), (t1, t2, t3, t4, t5)):
+            times[k].append((b - a) * 1000.0)
+    return {k: float(np.median(v)) for k, v in times.items()}

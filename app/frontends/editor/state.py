@@ -1,0 +1,287 @@
+"""The editor's plain state: what the panel edits and the renderer draws. No GL, no imgui here.
+
+Loading a file (a drop, the panel's path box, ``--script``) happens before anything is
+assigned, so a bad file leaves the previous mesh, environment or material in place and only
+sets ``error``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
+from alight.core.material import Material, validate_material
+from alight.core.scene import TONEMAPS, Display, Light, Scene
+from alight.core.texture_maps import MAP_SLOTS, TextureMaps
+from alight.errors import AlightError
+from alight.exchange.images import IMAGE_SUFFIXES, load_map_image
+from alight.exchange.presets import load_preset, save_preset
+from alight.ibl.bake import QUALITY
+
+ENV_SUFFIXES = (".hdr", ".exr")
+PRESET_SUFFIXES = (".json",)
+# shaders/common/debug_views.glsl's u_debug_view, in order; DATA_VIEWS show values, not radiance.
+DEBUG_VIEWS = ("shaded", "base colour", "normal", "roughness", "metallic", "F0", "n.v", "diffuse only (IBL)",
+               "specular only (IBL)", "irradiance", "prefiltered radiance at mip", "BRDF LUT", "D (first light)",
+               "G (first light)", "F (first light)")
+DATA_VIEWS = {1, 2, 3, 4, 5, 6, 11, 12, 13, 14}
+
+
+def default_lights() -> list[Light]:
+    """Three lights, so the default view exercises the punctual path (issue 3's benchmark scene)."""
+    return [Light("point", (2.0, 3.0, 4.0), (1.0, 0.95, 0.9), 10.0),
+            Light("point", (-3.0, 1.0, 2.0), (0.6, 0.7, 1.0), 6.0),
+            Light("directional", (-0.3, -1.0, -0.5), (1.0, 1.0, 1.0), 1.0)]
+
+
+@dataclass
+class EditorState:
+    mesh_spec: str = "sphere"
+    env_spec: str = "studio"
+    material: Material = field(default_factory=Material)
+    texture_maps: TextureMaps = field(default_factory=TextureMaps)   # user-loaded maps, UV tiling
+    armed_slot: str = "base_color"     # the texture slot a dropped image file fills
+    saved_material: Material = field(default_factory=Material)   # what 'revert' goes back to
+    quality: str = "medium"
+    display: Display = field(default_factory=Display)
+    lights: list[Light] = field(default_factory=default_lights)
+    ibl_enabled: bool = True
+    ibl_model: str = DEFAULT_IBL_MODEL     # app/core/ibl_models.py
+    multiple_scattering: bool = False
+    env_rotation_deg: float = 0.0
+    env_intensity: float = 1.0
+    aa: str = "none"
+    render_scale: float = 1.0     # the view's resolution relative to the window
+    motion_scale: float = 1.0     # times render_scale while the camera moves (0.5: a quarter of the pixels)
+    adaptive_motion: bool = False  # while moving, the scale that holds TARGET_FPS instead (at least 0.25)
+    use_file_materials: bool = False   # a mesh file's own materials and texture maps instead of the panel's
+    debug_view: int = 0
+    debug_mip: float = 0.0
+    error: str = ""          # the last error, shown in the panel until the next success
+    message: str = ""        # the last success ("saved gold.json")
+    # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
+    mesh: object = None
+    env: object = None
+    map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
+
+    @property
+    def look(self) -> tuple[Material, TextureMaps]:
+        """What undo/redo and 'revert' act on: the material's factors and its maps."""
+        return (self.material, self.texture_maps)
+
+    @look.setter
+    def look(self, value: tuple[Material, TextureMaps]) -> None:
+        self.material, self.texture_maps = value
+
+    def scene(self, camera) -> Scene:
+        # Off by default: the editor's material is what the artist is shaping.
+        return Scene(mesh=self.mesh, material=self.material, use_file_materials=self.use_file_materials,
+                     lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
+                     env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
+                     ibl_model=self.ibl_model, multiple_scattering=self.multiple_scattering,
+                     # Data views are shown as values: no exposure, no tone curve.
+                     display=dataclasses.replace(self.display, tonemap="none", exposure=0.0)
+                     if self.debug_view in DATA_VIEWS else self.display,
+                     debug_view=self.debug_view,
+                     debug_mip=self.debug_mip,
+                     texture_maps=self.texture_maps,
+                     texture_images=self.map_images)
+
+    # --- loading (all or nothing) -----------------------------------------------------------
+
+    def load_mesh(self, spec: str) -> None:
+        from alight.exchange.meshes import load_mesh
+
+        mesh = load_mesh(spec)
+        self.mesh, self.mesh_spec = mesh, spec
+
+    def load_env(self, spec: str) -> None:
+        from alight.ibl.environment import load_environment
+
+        env = load_environment(spec)
+        self.env, self.env_spec = env, spec
+
+    def set_map(self, slot: str, path: str) -> None:
+        """Fill a texture slot from an image file (read now: a bad file raises, nothing changes)."""
+        maps = self.texture_maps.with_slot(slot, path)
+        image = load_map_image(path)
+        self.map_images = {p: self.map_images[p] for p in maps.paths().values() if p in self.map_images}
+        self.map_images[path] = image
+        self.texture_maps = maps
+
+    def clear_map(self, slot: str) -> None:
+        self.texture_maps = self.texture_maps.with_slot(slot, "")
+
+    def sync_map_images(self) -> None:
+        """Decode any slot's file not yet decoded (after undo/redo or a restored session); a file
+        that no longer reads empties its slot and sets ``error``."""
+        for slot, path in self.texture_maps.paths().items():
+            if path not in self.map_images:
+                try:
+                    self.map_images[path] = load_map_image(path)
+                except AlightError as exc:
+                    self.texture_maps = self.texture_maps.with_slot(slot, "")
+                    self.fail(exc)
+
+    def load_material(self, name_or_path: str) -> None:
+        m = load_preset(name_or_path)
+        self.material = self.saved_material = m
+
+    def save_material(self, path: str) -> None:
+        save_preset(self.material, path)
+        self.saved_material = self.material
+
+    def export_gltf(self, path: str) -> None:
+        """The edited material as a material-only .gltf, or the mesh with it as a .glb
+        (alight.exchange.gltf_material: F0 other than 0.04 goes out as KHR_materials_ior/specular)."""
+        from alight.exchange.gltf_material import export_material_gltf, export_mesh_glb
+
+        if Path(path).suffix.lower() == ".glb":
+            export_mesh_glb(self.mesh, self.material, path)
+        else:
+            export_material_gltf(self.material, path)
+
+    def open_file(self, path: str) -> bool:
+        """A dropped or typed file, by its suffix. Returns False (and sets ``error``) on failure."""
+        from alight.exchange.meshes import MESH_EXTENSIONS
+
+        suffix = Path(path).suffix.lower()
+        try:
+            if suffix in ENV_SUFFIXES:
+                self.load_env(path)
+            elif suffix in MESH_EXTENSIONS:
+                self.load_mesh(path)
+            elif suffix in PRESET_SUFFIXES:
+                self.load_material(path)
+            elif suffix in IMAGE_SUFFIXES:    # a texture map, into the armed slot
+                self.set_map(self.armed_slot, path)
+            else:
+                raise AlightError(f"{path}: not an environment (.hdr .exr), a mesh "
+                                  f"({' '.join(MESH_EXTENSIONS)}), a preset (.json) "
+                                  f"or a texture map ({' '.join(IMAGE_SUFFIXES)})")
+        except Exception as exc:
+            self.fail(exc)
+            return False
+        self.error, self.message = "", f"opened {os.path.basename(path)}"
+        return True
+
+    def fail(self, exc: Exception) -> None:
+        """One line, never a traceback: a loader's surprise is named by its type."""
+        text = str(exc) if isinstance(exc, AlightError) else f"{type(exc).__name__}: {exc}"
+        self.error = " ".join(text.split())
+        self.message = ""
+
+    # --- scripted edits (``alight edit --script``; the tests drive the editor with these) ------
+
+    def apply_edit(self, edit: str) -> None:
+        """``field=value``: roughness / metallic (numbers), base_color / emissive / specular_f0
+        (R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
+        env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), quality;
+        map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
+        uv_offset (U,V)."""
+        from alight.core.material import parse_color
+
+        key, sep, value = edit.partition("=")
+        key = key.strip().replace("-", "_")
+        if not sep:
+            raise AlightError(f"--script: '{edit}' is not FIELD=VALUE")
+        try:
+            if key in ("roughness", "metallic"):
+                self.material = validate_material(dataclasses.replace(self.material, **{key: float(value)}), "--script")
+            elif key in ("base_color", "emissive", "specular_f0"):
+                self.material = validate_material(
+                    dataclasses.replace(self.material, **{key: parse_color(value, "--script")}), "--script")
+            elif key == "preset":
+                self.load_material(value)
+            elif key == "open":
+                self.open_file(value)
+            elif key == "mesh":
+                self.load_mesh(value)
+            elif key == "env":
+                self.load_env(value)
+            elif key == "exposure":
+                self.display = dataclasses.replace(self.display, exposure=_finite(value, edit))
+            elif key == "tonemap":
+                if value not in TONEMAPS:
+                    raise AlightError(f"--script: tonemap '{value}' is not one of {', '.join(TONEMAPS)}")
+                self.display = dataclasses.replace(self.display, tonemap=value)
+            elif key in ("env_rotation", "env_intensity"):
+                setattr(self, key + ("_deg" if key == "env_rotation" else ""), _finite(value, edit))
+            elif key == "ibl":
+                self.ibl_enabled = value not in ("0", "false", "off")
+            elif key == "ibl_model":
+                if value not in IBL_MODELS:
+                    raise AlightError(f"--script: ibl_model '{value}' is not one of {', '.join(IBL_MODELS)}")
+                self.ibl_model = value
+            elif key == "multiple_scattering":
+                self.multiple_scattering = value not in ("0", "false", "off")
+            elif key == "quality":
+                if value not in (*QUALITY, "auto"):
+                    raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}, auto")
+                self.quality = value
+            elif key == "debug_view":
+                if value not in DEBUG_VIEWS:
+                    raise AlightError(f"--script: debug_view '{value}' is not one of {', '.join(DEBUG_VIEWS)}")
+                self.debug_view = DEBUG_VIEWS.index(value)
+            elif key.startswith("map_") and key[4:] in MAP_SLOTS:
+                if value:
+                    self.set_map(key[4:], value)
+                else:
+                    self.clear_map(key[4:])
+            elif key in ("uv_scale", "uv_offset"):
+                pair = tuple(_finite(x, edit) for x in value.split(","))
+                if len(pair) != 2:
+                    raise AlightError(f"--script: '{edit}': {key} takes U,V")
+                self.texture_maps = dataclasses.replace(self.texture_maps, **{key: pair})
+            elif key == "debug_mip":
+                self.debug_mip = max(0.0, _finite(value, edit))
+            else:
+                raise AlightError(f"--script: unknown field '{key}'")
+        except ValueError:
+            raise AlightError(f"--script: '{edit}': '{value}' is not a number") from None
+
+
+def _finite(value: str, edit: str) -> float:
+    x = float(value)
+    if not math.isfinite(x):
+        raise AlightError(f"--script: '{edit}': '{value}' is not finite")
+    return x
+
+
+class History:
+    """Undo/redo of material edits as snapshots of EditorState.look (the Material and the
+    TextureMaps are frozen, so a snapshot is the value).
+
+    A drag of a slider is one step: ``settle`` records a step only once no widget is active.
+    """
+
+    def __init__(self, look):
+        self.committed = look
+        self.undo_stack: list = []
+        self.redo_stack: list = []
+
+    def settle(self, current, editing: bool) -> None:
+        if editing or current == self.committed:
+            return
+        self.undo_stack.append(self.committed)
+        self.redo_stack.clear()
+        self.committed = current
+
+    def undo(self, current) -> tuple:
+        return self._step(current, self.undo_stack, self.redo_stack)
+
+    def redo(self, current) -> tuple:
+        return self._step(current, self.redo_stack, self.undo_stack)
+
+    def _step(self, current, source: list, target: list) -> tuple:
+        """Move one state from ``source`` to the committed one, keeping the old in ``target``."""
+        self.settle(current, False)
+        if not source:
+            return current
+        target.append(self.committed)
+        self.committed = source.pop()
+        return self.committed

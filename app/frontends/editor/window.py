@@ -1,0 +1,426 @@
+"""The editor's window: glfw, a ModernGL context made from it, the main loop.
+
+Each frame: build the imgui panel (it edits EditorState; a side bar on the right), render the
+scene with the ForwardRenderer, tone mapped as it is drawn (ForwardRenderer.draw_display), into its offscreen
+view image the size of the area left of the panel, and only when something it depends on
+changed; copy that into the default framebuffer, draw imgui on top, swap. The ForwardRenderer never sees imgui; the panel never sees GL.
+
+imgui backend: imgui-bundle's own pure-python GLFW backend (python_backends.glfw_backend). It
+draws with PyOpenGL on the same context ModernGL uses (GL state is the context's, not the
+library's, and the backend saves and restores the state it touches). We chose it over drawing
+imgui's draw lists with ModernGL ourselves because imgui 1.92's dynamic font atlas protocol
+(ImTextureData create/update/destroy requests) is already handled there; redoing it would be
+a second, untested copy of the same code.
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+import math
+import os
+import time
+
+from alight.core.gpu import ShaderCompileError
+from alight.errors import AlightError
+from alight.frontends.editor.camera import OrbitCamera
+from alight.frontends.editor.state import EditorState, History
+from alight.ibl.bake import QUALITY
+
+# The time a frame gives the environment bake at most (about one step more): the window stays
+# responsive while a bake runs over several frames.
+BAKE_SLICE_S = 0.03
+# The panel is a side bar on the window's right (at most half the window): the view is the
+# rest, so the panel never covers the mesh, and the view starts at the framebuffer's origin.
+PANEL_WIDTH = 420
+# Adaptive resolution while the camera moves: the view's scale follows the frame time toward
+# this rate, in steps (a new size reallocates the view's targets), between these bounds.
+TARGET_FPS = 30.0
+ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP = 0.25, 1.0 / 16.0
+TARGET_CACHE = 4   # view framebuffers kept, by size
+
+
+class EditorWindow:
+    def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
+                 show_panel: bool = True, ini_path=None):
+        # PyOpenGL must pick GLX (X11/Xvfb) before the backend imports it.
+        if os.environ.get("XDG_SESSION_TYPE") == "wayland":
+            os.environ.setdefault("PYOPENGL_PLATFORM", "x11")
+        # PyOpenGL calls glGetError after every call and raises on any pending error, including
+        # one left by a ModernGL call on the shared context; off, it is also much cheaper per call.
+        import OpenGL
+
+        OpenGL.ERROR_CHECKING = False
+        import glfw
+        import moderngl
+        from imgui_bundle import imgui, implot
+        from imgui_bundle.python_backends.glfw_backend import GlfwRenderer
+
+        from alight.render.renderer import ForwardRenderer
+
+        self.glfw, self.imgui, self.implot = glfw, imgui, implot
+        if not glfw.init():
+            raise AlightError("editor: cannot open a window (no display? set DISPLAY, or run under xvfb-run -a)")
+        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
+        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 5)
+        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
+        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
+        self.window = glfw.create_window(size[0], size[1], title, None, None)
+        if not self.window:
+            glfw.terminate()
+            raise AlightError("editor: cannot create an OpenGL 4.5 core window")
+        glfw.make_context_current(self.window)
+        glfw.swap_interval(0)  # frame times measure our work, not the display's refresh
+        self.ctx = moderngl.create_context(require=450)
+        self.renderer = ForwardRenderer(self.ctx)
+
+        imgui.create_context()
+        implot.create_context()
+        # imgui's window layout lives in the user's config folder, never the working directory;
+        # screenshots and benchmarks keep none, so they never depend on the last session.
+        imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
+        self.impl = GlfwRenderer(self.window)
+        glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
+
+        self.state = state
+        self.show_panel = show_panel
+        self.history = History(state.look)
+        self.orbit = OrbitCamera()
+        self.frame_times: collections.deque[float] = collections.deque(maxlen=240)
+        self.bake_seconds: dict[str, float] = {}
+        self._maps_key = None
+        self._maps = None
+        self._bake_job = None          # (key, generator) of the bake in progress
+        self._auto = None              # (key, alight.accuracy.auto_quality.Choice) for bake quality 'auto'
+        self._auto_features = None     # (id of the environment, its EnvironmentFeatures)
+        self.bake_progress = None      # (fraction, label) while a bake runs; the panel shows it
+        self._last_swap = None
+        self._framed_mesh = None
+        self._drawn_key = self._drawn_targets = self._last_camera = self._drawn_maps = None
+        self._target_cache: collections.OrderedDict = collections.OrderedDict()
+        self._linear = moderngl.LINEAR
+        self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
+        self.redraws = 0   # scene redraws so far (the Performance section shows it)
+        self.adaptive_scale = 0.5      # the adaptive motion scale now (see adapt_motion_scale)
+        self._was_moving = False
+        from alight.frontends.editor.hot_reload import ShaderWatcher
+        from alight.frontends.editor.panel import Panel
+
+        self.shader_watcher = ShaderWatcher(self.renderer.shaders.root)
+
+        self.panel = Panel()
+
+    # --- input --------------------------------------------------------------------------------
+
+    def drop(self, paths: list[str]) -> None:
+        """glfw's drop callback: each file by its suffix; a bad one keeps the previous state."""
+        for path in paths:
+            self.state.open_file(path)
+
+    def _camera_input(self) -> None:
+        imgui, io = self.imgui, self.imgui.get_io()
+        if not io.want_capture_mouse:
+            dx, dy = io.mouse_delta.x, io.mouse_delta.y
+            if imgui.is_mouse_dragging(imgui.MouseButton_.left):
+                self.orbit.orbit(dx, dy)
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) or imgui.is_mouse_dragging(imgui.MouseButton_.middle):
+                self.orbit.pan(dx, dy, self.size[1])
+            if io.mouse_wheel:
+                self.orbit.zoom(io.mouse_wheel)
+        if not io.want_capture_keyboard:
+            if imgui.is_key_pressed(imgui.Key.f):
+                self.frame_mesh()
+            if imgui.is_key_pressed(imgui.Key.f12):
+                self.screenshot_request = self.next_screenshot_name()
+            if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
+                s = self.state
+                s.look = self.history.redo(s.look) if io.key_shift else self.history.undo(s.look)
+
+    def frame_mesh(self) -> None:
+        if self.state.mesh is not None:
+            center, radius = self.state.mesh.bounding_sphere()
+            w, h = self.view_area()
+            self.orbit.frame(center, radius, w / max(h, 1))
+        self._framed_mesh = self.state.mesh
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return tuple(self.glfw.get_framebuffer_size(self.window))
+
+    def panel_width(self) -> int:
+        """The side bar's width in window coordinates (imgui's), 0 without the panel."""
+        if not self.show_panel:
+            return 0
+        return min(PANEL_WIDTH, self.glfw.get_window_size(self.window)[0] // 2)
+
+    def view_area(self) -> tuple[int, int]:
+        """The framebuffer pixels left of the side bar: where the view is drawn."""
+        w, h = self.size
+        window_w = max(1, self.glfw.get_window_size(self.window)[0])
+        return max(1, w - round(self.panel_width() * w / window_w)), h
+
+    def check_shaders(self, force: bool = False) -> None:
+        """Hot reload: rebuild the programs when a file under shaders/ changed."""
+        from alight.frontends.editor.hot_reload import rebuild
+
+        if not self.shader_watcher.changed(force):
+            return
+        error = rebuild(self.renderer, self.shader_watcher.root)
+        if error:
+            self.state.error, self.state.message = error, ""
+        else:
+            self.state.error, self.state.message = "", "shaders reloaded"
+            self._drawn_key = None   # redraw with the new programs
+
+    # --- rendering ----------------------------------------------------------------------------
+
+    def maps(self):
+        """The maps in use. A new environment or quality starts a bake that ``advance_bake`` runs
+        a slice at a time between frames; until it completes the previous maps stay in use (the
+        ForwardRenderer caches bakes, so going back to an environment costs nothing)."""
+        s = self.state
+        if s.env is None:
+            return None
+        if s.quality == "auto":
+            choice = self.auto_choice()
+            key, quality = (id(s.env), "auto", choice.name, choice.quality.max_roughness), choice.quality
+        else:
+            key, quality = (id(s.env), s.quality), QUALITY[s.quality]
+        if key != self._maps_key and (self._bake_job is None or self._bake_job[0] != key):
+            if self._bake_job is not None:
+                self._bake_job[1].close()    # superseded: frees its partial maps
+            self._bake_job = (key, self.renderer.bake_steps(s.env, quality))
+            self.bake_progress = (0.0, "starting")
+        return self._maps
+
+    def auto_choice(self):
+        """Bake quality 'auto' (app/accuracy/auto_quality.py): the cheapest measured bake within the 2%
+        budget for this environment and the material being edited: its kind (dielectric, metal
+        or both) and its roughness band (a quarter wide: from the band's lower edge up to 1), so
+        that dragging the roughness starts a new bake only when it crosses into another band.
+        The panel shows the one-line reason. Cached per environment, kind and band."""
+        from alight.accuracy.auto_quality import (
+            MaterialNeed,
+            choose_quality,
+            environment_features,
+            load_table,
+            material_need,
+            predicted_error,
+            predicted_seconds,
+        )
+
+        s = self.state
+        m = s.material
+        maps_present = s.texture_maps.paths()
+        roughness_map = "roughness" in maps_present or "metallic_roughness" in maps_present
+        kind = material_need(m.metallic, m.roughness, roughness_map=roughness_map,
+                             metallic_map="metallic" in maps_present or "metallic_roughness" in maps_present)
+        band = 0.0 if roughness_map else min(0.75, math.floor(m.roughness / 0.25) * 0.25)
+        need = MaterialNeed(kind.archetypes, band, 1.0)
+        key = (id(s.env), need)
+        if self._auto is None or self._auto[0] != key:
+            if self._auto_features is None or self._auto_features[0] != id(s.env):
+                self._auto_features = (id(s.env), environment_features(s.env.radiance))
+            choice = choose_quality([need], self._auto_features[1])
+            if not choice.meets_budget:
+                # Nothing measured meets the budget (a metal below r = 0.25 under a sharp map):
+                # the editor keeps the default bake rather than a many-second 'high'.
+                err, _ = predicted_error(load_table(), "medium", [need], self._auto_features[1])
+                choice = dataclasses.replace(
+                    choice, quality=dataclasses.replace(QUALITY["medium"], name="auto:medium"), name="medium",
+                    predicted_error=err, predicted_seconds=predicted_seconds(load_table(), "medium", 1.0,
+                                                                             self._auto_features[1].has_compact_source),
+                    reason=choice.reason.replace("so the most accurate one", "so the default, medium"))
+            self._auto = (key, choice)
+        return self._auto[1]
+
+    def advance_bake(self, budget_s: float = BAKE_SLICE_S) -> None:
+        """Run the pending bake's steps for about ``budget_s`` (at least one step)."""
+        if self._bake_job is None:
+            return
+        key, job = self._bake_job
+        start = time.perf_counter()
+        try:
+            while True:
+                self.bake_progress = next(job)
+                if time.perf_counter() - start >= budget_s:
+                    return
+        except StopIteration as done:
+            self._maps, self._maps_key = done.value, key
+            self.bake_seconds = dict(done.value.pass_seconds)
+        except Exception as exc:    # one line in the panel; the editor keeps the old maps
+            self.state.fail(exc)
+            self._maps_key = key    # not retried until the environment or quality changes
+        self._bake_job, self.bake_progress = None, None
+
+    def finish_bake(self) -> None:
+        """Complete the pending bake now (screenshots, scripts and the benchmark want the final maps)."""
+        self.maps()
+        while self._bake_job is not None:
+            self.advance_bake(float("inf"))
+
+    def adapt_motion_scale(self) -> None:
+        """Move the adaptive scale toward TARGET_FPS from the last frames' time (swap to swap):
+        the scene's cost is per pixel, so the scale goes with the square root of the time ratio,
+        by at most one step a frame; the still view is always redrawn at full scale."""
+        if not self.frame_times:
+            return
+        recent = sorted(list(self.frame_times)[-3:])   # the median of the last three: one slow frame is no trend
+        ratio = (1.0 / TARGET_FPS) / max(recent[len(recent) // 2], 1e-6)
+        want = self.adaptive_scale * ratio ** 0.5
+        if abs(want - self.adaptive_scale) >= ADAPTIVE_STEP:
+            step = ADAPTIVE_STEP if want > self.adaptive_scale else -ADAPTIVE_STEP
+            self.adaptive_scale = min(1.0, max(ADAPTIVE_MIN_SCALE, self.adaptive_scale + step))
+
+    def view_size(self, moving: bool) -> tuple[int, int]:
+        """The view image's size: the view area's times the render scale, and times the motion scale
+        while the camera moves (llvmpipe's cost is per pixel; a still view is redrawn sharp)."""
+        w, h = self.view_area()
+        motion = self.adaptive_scale if self.state.adaptive_motion else self.state.motion_scale
+        scale = self.state.render_scale * (motion if moving else 1.0)
+        return max(1, round(w * scale)), max(1, round(h * scale))
+
+    def targets(self, size=None):
+        """The view's framebuffers for a size, kept for the last few sizes: the adaptive scale
+        moves between neighbouring sizes, and a reallocation per change would cost frame time."""
+        from alight.render.renderer import _Targets
+
+        w, h = size or self.size
+        key = (w, h, self.state.aa)
+        targets = self._target_cache.pop(key, None) or _Targets(self.ctx, w, h, self.state.aa, 4)
+        self._target_cache[key] = targets
+        while len(self._target_cache) > TARGET_CACHE:
+            self._target_cache.popitem(last=False)[1].release()
+        return targets
+
+    def _view_key(self, scene, maps, size) -> tuple:
+        """Everything the view image depends on. Material, Camera, Light and Display are plain
+        dataclasses compared by value; the mesh and the bake by identity (they are replaced, never
+        mutated)."""
+        return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
+                scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
+                scene.ibl_model, scene.multiple_scattering,
+                size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials,
+                scene.texture_maps, tuple(id(scene.texture_images.get(p)) for p in scene.texture_maps.paths().values()))
+
+    def render_view(self, force: bool = False, full: bool = False):
+        """Draw the scene, tone mapped as it is drawn, into the offscreen view image, but only when
+        something it depends on changed; then put the tone-mapped image into the default framebuffer.
+        (While the artist orbits every frame redraws; a still view costs only the copy.)
+        ``full``: the window's size whatever the scales (screenshots)."""
+        if self.state.mesh is not self._framed_mesh:
+            if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
+                self.orbit.restored, self._framed_mesh = False, self.state.mesh
+            else:
+                self.frame_mesh()   # a new mesh: frame it once
+        if 0 in self.size:    # minimised
+            return None
+        window = self.size if full else self.view_area()   # the screenshot is the view at window size
+        camera = self.orbit.camera()
+        moving, self._last_camera = camera != self._last_camera, camera
+        if moving and self._was_moving and not full:
+            self.adapt_motion_scale()
+        self._was_moving = moving
+        size = window if full else self.view_size(moving)
+        targets = self.targets(size)
+        scene = self.state.scene(camera)
+        maps = self.maps()
+        key = self._view_key(scene, maps, size)
+        if force or key != self._drawn_key or targets is not self._drawn_targets:
+            try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
+                self.renderer.draw_display(scene, maps, targets)
+            except ShaderCompileError as exc:   # a program first compiled now (a debug view)
+                self.state.fail(exc)
+                self.state.debug_view = 0
+                return None
+            self._drawn_key, self._drawn_targets = key, targets
+            self.redraws += 1
+            if scene.texture_maps != self._drawn_maps:   # uploaded maps no slot uses any more
+                self.renderer.forget_map_textures(set(scene.texture_maps.paths().values()))
+                self._drawn_maps = scene.texture_maps
+        if size == window:
+            self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
+        else:
+            prog = self.renderer.program("render/fullscreen.vert", "render/upscale.frag")
+            targets.display.filter = (self._linear, self._linear)
+            targets.display.use(0)
+            prog["u_image"] = 0
+            self.ctx.screen.use()
+            self.ctx.viewport = (0, 0) + window
+            self.renderer._fullscreen(prog)
+            self.ctx.viewport = (0, 0) + self.size
+        # The copy leaves the last used framebuffer (display_fbo) bound; imgui draws into
+        # whatever is bound, and must draw into the window, never into the view's image.
+        self.ctx.screen.use()
+        return targets
+
+    def frame(self) -> None:
+        self.draw()
+        self.glfw.swap_buffers(self.window)
+        if self.screenshot_request:
+            path, self.screenshot_request = self.screenshot_request, ""
+            try:
+                self.screenshot(path)
+                self.state.error, self.state.message = "", f"wrote {path}"
+            except AlightError as exc:
+                self.state.fail(exc)
+        now = time.perf_counter()
+        if self._last_swap is not None:
+            self.frame_times.append(now - self._last_swap)
+        self._last_swap = now
+
+    def draw(self) -> None:
+        """One frame into the window's back buffer (events, panel, view, imgui), not yet shown:
+        ``frame`` swaps it; tools can read the whole window first."""
+        glfw, imgui = self.glfw, self.imgui
+        glfw.poll_events()
+        self.impl.process_inputs()
+        imgui.new_frame()
+        if self.show_panel:
+            self.panel.draw(self)
+        self._camera_input()
+        self.check_shaders()
+        self.history.settle(self.state.look, imgui.is_any_item_active())
+        self.state.sync_map_images()   # undo/redo may bring back a map not decoded now
+        imgui.render()
+        self.render_view()
+        self.advance_bake()
+        if self.show_panel:
+            self.impl.render(imgui.get_draw_data())
+
+    def screenshot(self, path: str) -> None:
+        """The view without the panel, at window size: the last frame's radiance tone mapped again."""
+        import numpy as np
+
+        from alight.exchange.output import check_output_path, write_image
+
+        out = check_output_path(path, (".png",))
+        self.finish_bake()
+        targets = self.render_view(full=True)   # display_fbo holds the view, without the panel
+        if targets is None:
+            raise AlightError(f"{out}: the window has no area to capture")
+        w, h = targets.width, targets.height
+        pixels = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)
+        write_image(out, pixels[::-1, :, :3].copy(), linear=False)
+
+    @staticmethod
+    def next_screenshot_name() -> str:
+        n = 1
+        while os.path.exists(f"alight-screenshot-{n}.png"):
+            n += 1
+        return f"alight-screenshot-{n}.png"
+
+    def should_close(self) -> bool:
+        return bool(self.glfw.window_should_close(self.window))
+
+    def close(self) -> None:
+        for targets in self._target_cache.values():
+            targets.release()
+        self._target_cache.clear()
+        self.impl.shutdown()
+        self.implot.destroy_context()
+        self.imgui.destroy_context()
+        self.renderer.release()
+        self.ctx.release()
+        self.glfw.destroy_window(self.window)
+        self.glfw.terminate()

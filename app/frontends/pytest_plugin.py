@@ -1,0 +1,159 @@
+"""pytest plugin (entry point ``pytest11: alight``): headless renders in other projects' tests.
+
+Fixtures:
+  ``alight_renderer``        one :class:`alight.frontends.api.Renderer` for the session (256x256, low
+                             quality bakes); its scene state carries over between tests, so
+                             set what a test depends on.
+  ``assert_image_matches``   :func:`assert_image_matches` with relative golden paths taken
+                             from the test file's folder and ``--alight-update-goldens`` applied.
+
+``pytest --alight-update-goldens`` writes the current render as the golden instead of
+comparing. On a mismatch ``<golden>.actual.png``, ``<golden>.expected.png`` and
+``<golden>.diff.png`` are written beside the golden image.
+
+Metrics: ``rel`` (relative mean absolute error: mean |a - e| / mean |e| over RGB) and ``flip``
+(mean NVIDIA FLIP error, from the optional ``flip-evaluator`` package).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+METRICS = ("rel", "flip")
+DEFAULT_TOLERANCE = {"rel": 0.02, "flip": 0.05}
+_UPDATE = False  # set from --alight-update-goldens by pytest_configure
+
+
+def pytest_addoption(parser) -> None:
+    group = parser.getgroup("alight")
+    group.addoption("--alight-update-goldens", action="store_true", default=False,
+                    help="write renders compared by assert_image_matches as the new golden images")
+
+
+def pytest_configure(config) -> None:
+    global _UPDATE
+    _UPDATE = bool(config.getoption("alight_update_goldens", default=False))
+
+
+@pytest.fixture(scope="session")
+def alight_renderer():
+    """A headless renderer shared by the session; released at its end."""
+    from alight.frontends.api import Renderer
+
+    with Renderer(256, 256, quality="low") as r:
+        yield r
+
+
+@pytest.fixture(name="assert_image_matches")
+def _assert_image_matches_fixture(request):
+    """``assert_image_matches(actual, golden, metric="rel", tolerance=None)``; a relative golden
+    path is taken from the folder of the test file."""
+    here = Path(str(request.node.fspath)).parent
+    update = request.config.getoption("alight_update_goldens")
+
+    def check(actual, golden_path, metric: str = "rel", tolerance: float | None = None) -> float:
+        golden = Path(golden_path)
+        return _assert_image_matches(actual, golden if golden.is_absolute() else here / golden, metric,
+                                     tolerance, update)
+
+    return check
+
+
+def assert_image_matches(actual: np.ndarray, golden_path: str | os.PathLike, metric: str = "rel",
+                         tolerance: float | None = None) -> float:
+    """Compare an image with a golden file; returns the error.
+
+    ``actual`` is (H, W, 3|4): uint8 sRGB (goldens are .png) or float linear radiance
+    (goldens are .exr). Alpha is ignored. On failure the actual, expected and difference images
+    are written beside the golden and an AssertionError says where.
+    """
+    return _assert_image_matches(actual, Path(golden_path), metric, tolerance, _UPDATE)
+
+
+def _assert_image_matches(actual, golden: Path, metric: str, tolerance: float | None, update: bool) -> float:
+    from alight.exchange.output import write_image
+
+    if metric not in METRICS:
+        raise ValueError(f"metric {metric!r} is not one of {METRICS}")
+    tol = DEFAULT_TOLERANCE[metric] if tolerance is None else float(tolerance)
+    actual = np.asarray(actual)
+    if actual.ndim != 3 or actual.shape[2] not in (3, 4):
+        raise ValueError(f"actual: expected an (H, W, 3|4) image, got shape {actual.shape}")
+    hdr = actual.dtype.kind == "f"
+    if update or not golden.exists():
+        if not update:
+            pytest.fail(f"{golden}: no golden image (run pytest --alight-update-goldens to write it)")
+        golden.parent.mkdir(parents=True, exist_ok=True)
+        write_image(golden, actual.astype(np.float32) if hdr else actual.astype(np.uint8), linear=hdr)
+        return 0.0
+    expected = _read(golden)
+    a, e = _as_float(actual), _as_float(expected)
+    if a.shape != e.shape:
+        _write_failure(golden, a, e, None, hdr)
+        raise AssertionError(f"{golden}: size {a.shape[1]}x{a.shape[0]} differs from the golden's "
+                             f"{e.shape[1]}x{e.shape[0]}")
+    if metric == "rel":
+        diff = np.abs(a - e)
+        error = float(diff.mean() / max(float(np.abs(e).mean()), 1e-12))
+        diff_image = diff / max(float(diff.max()), 1e-12)
+    else:
+        error, diff_image = _flip(a, e, hdr)
+    if not error <= tol:
+        paths = _write_failure(golden, a, e, diff_image, hdr)
+        raise AssertionError(f"{golden}: {metric} error {error:.4g} > tolerance {tol:g}; "
+                             f"wrote {', '.join(p.name for p in paths)} in {golden.parent}")
+    return error
+
+
+def _read(path: Path) -> np.ndarray:
+    import OpenImageIO as oiio
+
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        raise AssertionError(f"{path}: cannot read the golden image ({oiio.geterror()})")
+    try:
+        fmt = oiio.FLOAT if path.suffix.lower() == ".exr" else oiio.UINT8
+        return np.asarray(image.read_image(format=fmt))
+    finally:
+        image.close()
+
+
+def _as_float(image: np.ndarray) -> np.ndarray:
+    """RGB as float in [0,1] for uint8, or as is for float; alpha dropped."""
+    rgb = np.asarray(image)[:, :, :3]
+    return rgb.astype(np.float32) / 255.0 if rgb.dtype.kind in "ui" else rgb.astype(np.float32)
+
+
+def _flip(a: np.ndarray, e: np.ndarray, hdr: bool) -> tuple[float, np.ndarray]:
+    try:
+        import flip_evaluator
+    except ImportError:
+        pytest.fail("metric 'flip' needs the flip-evaluator package (pip install flip-evaluator)")
+    error_map, mean, _ = flip_evaluator.evaluate(np.ascontiguousarray(e), np.ascontiguousarray(a),
+                                                 "HDR" if hdr else "LDR", applyMagma=True)
+    return float(mean), np.asarray(error_map, np.float32)
+
+
+def _write_failure(golden: Path, a, e, diff, hdr: bool) -> list[Path]:
+    """actual / expected / diff as 8-bit PNGs people can open (HDR images clipped to [0,1])."""
+    from alight.core.shading import linear_to_srgb
+    from alight.exchange.output import write_image
+
+    def png(x):
+        x = np.clip(np.nan_to_num(x), 0.0, 1.0)
+        if hdr:
+            x = linear_to_srgb(x)
+        return (np.asarray(x) * 255.0 + 0.5).astype(np.uint8)
+
+    stem = golden.with_suffix("")
+    out = [Path(f"{stem}.actual.png"), Path(f"{stem}.expected.png")]
+    write_image(out[0], png(a), linear=False)
+    write_image(out[1], png(e), linear=False)
+    if diff is not None:
+        out.append(Path(f"{stem}.diff.png"))
+        write_image(out[2], (np.clip(diff, 0, 1) * 255.0 + 0.5).astype(np.uint8), linear=False)
+    return out

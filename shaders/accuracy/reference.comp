@@ -1,0 +1,48 @@
+#version 450 core
+// alight reference (app/accuracy/reference.py): CONVENTIONS.md's ground truth at every G-buffer pixel.
+// One dispatch sums the environment rows [u_row_begin, u_row_end) into the accumulator; the
+// first one (u_first) starts it from emission plus the punctual lights (punctual.glsl's
+// punctual_light, k = (r+1)^2/8, no occlusion). Pixels the G-buffer marks empty stay 0.
+layout(local_size_x = 8, local_size_y = 8) in;
+#include "accuracy/ground_truth.glsl"
+#include "common/punctual.glsl"
+
+uniform sampler2D u_g_position;     // xyz world position, w coverage (0 or 1)
+uniform sampler2D u_g_normal;       // xyz n, w roughness
+uniform sampler2D u_g_view;         // xyz v, w metallic
+uniform sampler2D u_g_base_color;
+uniform sampler2D u_g_specular_f0;
+uniform sampler2D u_g_emissive;
+uniform sampler2D u_env;            // the (possibly downsampled) equirect, level 0
+layout(rgba32f, binding = 0) uniform image2D u_accum;
+
+uniform ivec2 u_size;
+uniform bool u_first;
+uniform bool u_env_enabled;
+uniform int u_row_begin;
+uniform int u_row_end;
+uniform vec2 u_env_rotation;        // (cos(-deg), sin(-deg)): world -> map
+uniform float u_env_intensity;
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= u_size.x || p.y >= u_size.y) return;
+    vec4 position = texelFetch(u_g_position, p, 0);
+    if (position.w < 0.5) {
+        if (u_first) imageStore(u_accum, p, vec4(0.0));
+        return;
+    }
+    vec4 nr = texelFetch(u_g_normal, p, 0);
+    vec4 vm = texelFetch(u_g_view, p, 0);
+    Surface s = Surface(texelFetch(u_g_base_color, p, 0).rgb, vm.w, nr.w,
+                        texelFetch(u_g_specular_f0, p, 0).rgb, texelFetch(u_g_emissive, p, 0).rgb, 1.0);
+    vec3 n = normalize(nr.xyz);
+    vec3 v = normalize(vm.xyz);
+    vec3 sum = u_first ? s.emissive + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
+    if (u_env_enabled && u_row_end > u_row_begin) {
+        vec3 n_map = rotate_world_to_map(n, u_env_rotation);
+        vec3 v_map = rotate_world_to_map(v, u_env_rotation);
+        sum += u_env_intensity * ground_truth_rows(u_env, 0, u_row_begin, u_row_end, s, n_map, v_map);
+    }
+    imageStore(u_accum, p, vec4(sum, 1.0));
+}
