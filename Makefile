@@ -1,8 +1,12 @@
 # The two commands of README.md. Each installs whatever is missing first (tools/setup.sh).
-.PHONY: setup demo test bench
+.PHONY: setup dev demo test bench
 
 setup:
 	@bash tools/setup.sh
+
+# For developers: the same .venv with alight installed editable (app/ mapped to the name alight).
+dev: setup
+	.venv/bin/python -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
 # The main job on built-in defaults: the default material ball in the built-in studio.
 demo: setup

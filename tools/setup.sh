@@ -23,7 +23,9 @@ if [ ! -x .venv/bin/python ]; then
   echo "setup: creating .venv"
   "$python" -m venv .venv
 fi
-# A real (non-editable) install: proves the wheel carries shaders/ and presets/.
+# A real (non-editable) install: the tests run against what users get. setuptools builds in
+# build/, where a module deleted from app/ would live on and slip into the wheel: start clean.
+rm -rf build
 # pip's own status decides (a filter in a pipeline would hide a failed install); its noise about
 # this machine's unused local package folders is dropped from what is shown.
 log=$(mktemp)
