@@ -283,7 +283,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
-                  multiple_scattering: bool = False) -> np.ndarray:
+                  multiple_scattering: bool = False, material=None) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -337,8 +337,62 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         out = spec_weight * prefiltered + (f_ms * e_ms + albedo * (1.0 - (spec_weight + f_ms * e_ms))) * irradiance
     else:
         out = diffuse_weight * albedo * irradiance + spec_weight * prefiltered
+    layered = material is not None and bool(material.layers())
+    if layered:
+        out = layered_ibl_converged(material, lighting, n, v, out)
     for sun in suns:
-        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
+        if layered:
+            from alight.core.layers.stack import Pairs, layered_brdf_cos, probe_tangents
+
+            l = _unit_rows(sun.direction)
+            pairs = Pairs(n=n, v=v, l=l, t=probe_tangents(n), b=np.cross(n, probe_tangents(n)), spread=sun.spread)
+            out = out + layered_brdf_cos(material, pairs)[:, 0, :] * np.asarray(sun.power)[None, :]
+        else:
+            out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
+    return out
+
+
+def _prefiltered_per_point(radiance, directions, roughness) -> np.ndarray:
+    """prefiltered_converged with a roughness per direction (one texel sum per distinct value)."""
+    out = np.empty((directions.shape[0], 3))
+    roughness = np.asarray(roughness, np.float64)
+    for value in np.unique(roughness):
+        sel = roughness == value
+        out[sel] = prefiltered_converged(radiance, directions[sel], float(value))
+    return out
+
+
+def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray:
+    """Numpy twin of common/layers.glsl's layered_ibl with converged maps: (P, 3). ``base`` is the
+    IBL model's result (P, 3); ``radiance`` the map the maps are baked from (without the compact
+    sources for the alight model). The sheen reads the numpy twin of its LUT
+    (alight.core.layers.sheen.sheen_lut_table), the clearcoat brdf_lut_converged."""
+    from alight.core.layers import clearcoat as cc
+    from alight.core.layers import sheen as sh
+
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    out = np.asarray(base, np.float64)
+    used = material.layers()
+    if "sheen" in used:
+        nv = np.clip(np.sum(n * v, axis=-1), 0.0, 1.0)
+        lut = sh.lut_bilinear(sh.sheen_lut_table(), nv, material.sheen_roughness)   # (P, 4)
+        toward_v = v - n * np.sum(n * v, axis=-1, keepdims=True)
+        length = np.linalg.norm(toward_v, axis=-1, keepdims=True)
+        t = np.where(length > 1e-6, toward_v / np.maximum(length, 1e-300), 0.0)
+        d = _unit_rows(n * np.sqrt(np.maximum(1.0 - lut[:, 1:2] ** 2, 0.0)) + t * lut[:, 1:2])
+        sheen = np.minimum(lut[:, :1], 1.0) * _prefiltered_per_point(radiance, d, lut[:, 2])
+        out = out * sh.sheen_scaling(material.sheen_color, lut[:, :1]) + sheen * np.asarray(material.sheen_color)
+    if "clearcoat" in used:
+        rc = float(material.clearcoat_roughness)
+        nv = np.maximum(np.sum(n * v, axis=-1), 0.0)
+        A, B = brdf_lut_converged(nv, rc)
+        t_a, t_b = lobe_directions_converged(nv, rc)
+        t = (A * t_a + B * t_b) / np.maximum(A + B, 1e-6)   # ibl.glsl's mix with F0 = 1
+        R = reflect(-v, n)
+        d = _unit_rows(n + t[:, None] * (R - n))
+        weight = material.clearcoat * cc.clearcoat_fresnel(nv)[:, None]
+        out = out * (1.0 - weight) + weight * (A + B)[:, None] * prefiltered_converged(radiance, d, rc)
     return out
 
 

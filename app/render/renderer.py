@@ -44,9 +44,11 @@ MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
-MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness")
+MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
+                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
-SRGB_MAPS = ("base_color", "emissive")
+UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
+SRGB_MAPS = ("base_color", "emissive", "sheen_color")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {
@@ -54,6 +56,7 @@ SAMPLER_UNITS = {
     "u_prefiltered_radiance_mid": UNIT_PREFILTERED_MID, "u_brdf_lut": UNIT_LUT,
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
+    "u_sheen_lut": UNIT_SHEEN_LUT,
 }
 
 
@@ -454,6 +457,7 @@ class ForwardRenderer:
         m = scene.material
         prog["u_size"] = float(size)
         _set_material(prog, m)
+        self._bind_layer_luts(defines)
         self._bind_ibl(prog, scene, maps)
         self._fullscreen(prog)
 
@@ -470,7 +474,13 @@ class ForwardRenderer:
             _set(prog, "u_debug_view", int(scene.debug_view))
             _set(prog, "u_debug_mip", float(scene.debug_mip))
         self._bind_ibl(prog, scene, maps)
+        self._bind_layer_luts(defines)
         self.draw_mesh_parts(scene, prog, camera, view_projection)
+
+    def _bind_layer_luts(self, defines: dict) -> None:
+        """The tables a compiled-in layer reads (the sheen LUT), baked on first use."""
+        if "HAS_SHEEN" in defines:
+            self.luts.sheen().use(UNIT_SHEEN_LUT)
 
     def layer_defines(self, scene: Scene) -> dict:
         """The HAS_* defines of the layers any part of the scene's mesh is drawn with
@@ -505,6 +515,7 @@ class ForwardRenderer:
             _set_material(prog, material)
             fm = part.material if maps_used else None
             _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
+            _set(prog, "u_clearcoat_normal_scale", float(getattr(fm, "clearcoat_normal_scale", 1.0)) if fm else 1.0)
             _set(prog, "u_occlusion_strength", float(getattr(fm, "occlusion_strength", 1.0)) if fm else 1.0)
             # A file's maps use its own UVs as they are; the user's maps are tiled.
             _set(prog, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
