@@ -157,11 +157,10 @@ def _read_rows(inp, path: str, part: _Part, spec, layout: _Layout, r0: int, r1: 
     dx, dy, dw, dh = layout.data
     fx, fy, fw, _ = layout.display
     ch0, ch1 = min(part.channels), max(part.channels) + 1
-    out = np.zeros((r1 - r0, fw, len(part.channels)), np.float32)
     a0, a1 = max(fy + r0, dy), min(fy + r1, dy + dh)        # stored rows with data
     c0, c1 = max(fx, dx), min(fx + fw, dx + dw)              # stored columns with data and shown
     if a0 >= a1 or c0 >= c1:
-        return out
+        return np.zeros((r1 - r0, fw, len(part.channels)), np.float32)
     tile_w, tile_h = int(spec.tile_width), int(spec.tile_height)
     if tile_w > 0:
         # Tiles are read whole: widen the rows to tile boundaries (counted from the data window).
@@ -182,6 +181,9 @@ def _read_rows(inp, path: str, part: _Part, spec, layout: _Layout, r0: int, r1: 
         raise AlightError(f"{path}: corrupt or truncated file ({why})")
     block = np.asarray(block, dtype=np.float32).reshape(shape)
     picked = [c - ch0 for c in part.channels]
+    if (a0, a1, t0, c0, c1) == (fy + r0, fy + r1, a0, dx, dx + dw) and picked == list(range(len(picked))):
+        return block        # the usual file: rows and channels as read, nothing to place
+    out = np.zeros((r1 - r0, fw, len(part.channels)), np.float32)
     out[a0 - fy - r0:a1 - fy - r0, c0 - fx:c1 - fx] = block[a0 - t0:a1 - t0, c0 - dx:c1 - dx][..., picked]
     return out
 
@@ -211,6 +213,9 @@ class Repairs:
 def repair_radiance(rgb: np.ndarray, repairs: Repairs) -> np.ndarray:
     """Set NaN/Inf/negative texels of an (..., 3) float32 array to 0 and clamp the rest to
     RADIANCE_MAX, in place where the array is writable; counts go to ``repairs``."""
+    lo, hi = rgb.min(initial=0.0), rgb.max(initial=0.0)     # NaN makes both NaN: not taken below
+    if lo >= 0.0 and hi <= RADIANCE_MAX:
+        return rgb          # the usual strip: two fast reductions, nothing to repair
     broken = ~np.all(np.isfinite(rgb) & (rgb >= 0.0), axis=-1)
     hot = np.any(rgb > RADIANCE_MAX, axis=-1) & ~broken     # NaN compares False; Inf is broken
     n_broken, n_hot = int(np.count_nonzero(broken)), int(np.count_nonzero(hot))
