@@ -356,3 +356,23 @@ def test_shared_huge_texel_case(shared_data):
     env = load_environment(str(shared_data / "cases" / "exr_texel_1e30_float.exr"))
     assert np.isfinite(env.radiance).all() and env.radiance.max() == RADIANCE_MAX
     assert len(env.warnings) == 1 and "clamped to 1e+10" in env.warnings[0]
+
+
+@pytest.mark.parametrize("orientation", range(1, 9))
+def test_exif_orientation_of_other_formats(tmp_path, orientation):
+    """A TIFF's Orientation tag (TIFF 6.0: how the stored rows and columns lie in the picture) is
+    applied like a Radiance file's: each of the eight gives the picture back."""
+    pic = _picture()
+    stored = {1: pic, 2: pic[:, ::-1], 3: pic[::-1, ::-1], 4: pic[::-1],
+              5: pic.transpose(1, 0, 2), 6: pic[:, ::-1].transpose(1, 0, 2),    # 6: turn 90 CW to see it
+              7: pic[::-1, ::-1].transpose(1, 0, 2), 8: pic[::-1].transpose(1, 0, 2)}[orientation]
+    h, w, c = stored.shape
+    spec = oiio.ImageSpec(w, h, c, oiio.FLOAT)
+    spec.attribute("Orientation", orientation)
+    path = str(tmp_path / "oriented.tif")
+    out = oiio.ImageOutput.create(path)
+    assert out.open(path, spec), out.geterror()
+    assert out.write_image(np.ascontiguousarray(stored)), out.geterror()
+    out.close()
+    assert oiio.ImageInput.open(path).spec().get_int_attribute("Orientation") == orientation
+    np.testing.assert_array_equal(load_environment(path).radiance, pic)

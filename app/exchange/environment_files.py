@@ -92,6 +92,7 @@ def _choose_part(inp, path: str) -> tuple[_Part, list[str]]:
         spec = inp.spec()
         parts.append((index, spec, list(spec.channelnames)))
         index += 1
+    inp.geterror()      # seeking past the last part left an error behind: clear it
     if not parts:
         raise AlightError(f"{path}: no image in the file")
     found = None
