@@ -137,16 +137,20 @@ def _compare(one: np.ndarray, tiled: np.ndarray, edge_fraction: float) -> tuple[
     return rel, differing
 
 
-SCENES = {
+SCENES = {   # name: (scene, anti-aliasing, size)
     "probe aces": (lambda: Scene(view="probe", material=GOLD), "msaa", (72, 72)),
-    "probe none transparent": (lambda: Scene(view="probe", material=GOLD,
-                                             display=Display(tonemap="none", background="transparent")), "none", (72, 72)),
+    "probe none transparent": (
+        lambda: Scene(view="probe", material=GOLD, display=Display(tonemap="none", background="transparent")),
+        "none", (72, 72)),
     "ball msaa": (lambda: Scene(mesh=sphere(), material=GOLD, lights=LIGHTS), "msaa", (96, 64)),
-    "ball ssaa neutral": (lambda: Scene(mesh=sphere(), material=GOLD, display=Display(tonemap="neutral")), "ssaa", (96, 64)),
+    "ball ssaa neutral": (
+        lambda: Scene(mesh=sphere(), material=GOLD, display=Display(tonemap="neutral")), "ssaa", (96, 64)),
     "ball none exposure": (lambda: Scene(mesh=sphere(), display=Display(exposure=1.5)), "none", (64, 96)),
     "cube blur": (lambda: Scene(mesh=cube(), display=Display(background="blur")), "msaa", (90, 70)),
-    "cube colour": (lambda: Scene(mesh=cube(), camera=Camera(position=(2.5, 2.0, 3.0)),
-                                  display=Display(background="color", background_color=(0.2, 0.3, 0.4))), "msaa", (90, 70)),
+    "cube colour": (
+        lambda: Scene(mesh=cube(), camera=Camera(position=(2.5, 2.0, 3.0)),
+                      display=Display(background="color", background_color=(0.2, 0.3, 0.4))),
+        "msaa", (90, 70)),
     "ball transparent": (lambda: Scene(mesh=sphere(), display=Display(background="transparent")), "msaa", (80, 80)),
 }
 
