@@ -81,9 +81,9 @@ class _GpuPart:
         fm = part.material
         if fm is not None:
             for name in MATERIAL_MAPS:
-                image = getattr(fm, f"{name}_texture", None)
-                if image is not None:
-                    self.textures[name] = _upload_image(ctx, image, srgb=name in SRGB_MAPS)
+                info = getattr(fm, f"{name}_texture", None)
+                if info is not None:
+                    self.textures[name] = _upload_image(ctx, info.image, srgb=name in SRGB_MAPS)
 
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
