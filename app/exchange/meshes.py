@@ -52,6 +52,10 @@ def load_mesh(spec: str) -> Mesh:
         )
     if not path.is_file():
         raise AlightError(f"{spec}: no such file")
+    if ext in (".gltf", ".glb"):
+        from alight.exchange.gltf import load_gltf
+
+        return load_gltf(path, spec)
 
     import trimesh  # lazily: importing trimesh costs start-up time the built-ins do not need
 
