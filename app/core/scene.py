@@ -66,6 +66,25 @@ def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float =
                   near=max(distance - radius * 1.5, distance * 1e-3), far=distance + radius * 4.0)
 
 
+def orbit_camera(center, radius: float, aspect: float, orbit_deg: float = 0.0, elevation_deg: float = 0.0,
+                 distance: float | None = None, fov_y_deg: float = 35.0, target=None) -> Camera:
+    """A camera looking at ``target`` (default: ``center``) from a direction turned ``orbit_deg``
+    about +Y from +Z (right-handed) and raised by ``elevation_deg``, at ``distance`` (default:
+    the distance that frames a sphere of ``radius``, frame_camera's), with a vertical field of
+    view of ``fov_y_deg`` degrees. The near and far planes enclose the sphere."""
+    a, e = math.radians(orbit_deg), math.radians(elevation_deg)
+    direction = np.array([math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e)])
+    look_at = np.asarray(center if target is None else target, dtype=np.float64)
+    framed = frame_camera(look_at, max(radius, 1e-6), fov_y_deg, aspect, direction)
+    if distance is None:
+        return framed
+    position = look_at + direction * distance
+    reach = float(np.linalg.norm(position - np.asarray(center, np.float64))) + max(radius, 1e-6)
+    near = max(reach - 2.5 * max(radius, 1e-6), reach * 1e-4)
+    up = (0.0, 1.0, 0.0) if abs(math.cos(e)) > 1e-6 else (0.0, 0.0, -math.copysign(1.0, math.sin(e)))
+    return Camera(tuple(position), tuple(look_at), up, fov_y_deg, near=near, far=reach + max(radius, 1e-6) * 2.0)
+
+
 @dataclass
 class Light:
     """A punctual light (KHR_lights_punctual's three kinds). ``vector`` is the position (point,
