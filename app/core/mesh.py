@@ -54,8 +54,9 @@ class TextureTransform:
         """(3, 3) float64, acting on glTF uvs as column vectors (u, v, 1)."""
         c, s = math.cos(self.rotation), math.sin(self.rotation)
         t = np.array([[1.0, 0.0, self.offset[0]], [0.0, 1.0, self.offset[1]], [0.0, 0.0, 1.0]])
-        # The extension's GLSL mat3(c, s, 0, -s, c, 0, 0, 0, 1) is column-major: these are its rows.
-        r = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        # The extension's GLSL mat3(c, -s, 0, s, c, 0, 0, 0, 1) is column-major: these are its rows
+        # (checked against TextureTransformTest's rotation markers).
+        r = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
         sc = np.diag([self.scale[0], self.scale[1], 1.0])
         return t @ r @ sc
 

@@ -1,4 +1,7 @@
-"""Mesh files (.obj .gltf .glb .ply .stl) read with trimesh into ``alight.core.mesh.Mesh``.
+"""Mesh files into ``alight.core.mesh.Mesh``: glTF/GLB by ``alight.exchange.gltf``; OBJ, PLY and
+STL by trimesh, with what trimesh leaves out added here: vertex colours (PLY ``red green blue
+[alpha]``, OBJ ``v x y z r g b``; sRGB-encoded, decoded to linear) and MTL ``map_Kd`` statements
+with options (``alight.exchange.mtl``: ``-o``/``-s`` become the map's texture transform).
 
 trimesh is imported lazily inside the loader so that start-up and the built-in meshes never pay
 for it. Every problem with a file becomes a one-line :class:`AlightError` naming the file.
@@ -66,6 +69,8 @@ def load_mesh(spec: str) -> Mesh:
     try:
         extras = _gltf_material_params(path) if ext in (".gltf", ".glb") else {}
         textures: dict[int, np.ndarray] = {}
+        if ext == ".obj":
+            _attach_diffuse_maps(spec, path, extras, textures)
         parts = []
         for node in scene.graph.nodes_geometry:
             transform, geom_name = scene.graph[node]
@@ -128,6 +133,15 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
     else:
         uvs = np.zeros((len(positions), 2))
 
+    colors = None
+    if getattr(geom.visual, "kind", None) == "vertex":
+        from alight.core.shading import srgb_to_linear
+
+        rgba = np.asarray(geom.visual.vertex_colors, dtype=np.float64)
+        if rgba.shape == (len(positions), 4):
+            rgba = np.clip(np.nan_to_num(rgba / 255.0 if rgba.max(initial=0.0) > 1.0 else rgba), 0.0, 1.0)
+            colors = np.concatenate([srgb_to_linear(rgba[:, :3]), rgba[:, 3:]], axis=1)
+
     return MeshPart(
         name=name,
         positions=np.ascontiguousarray(positions, dtype=np.float32),
@@ -136,6 +150,7 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
         tangents=compute_tangents(positions, normals, uvs, faces),
         indices=np.ascontiguousarray(faces, dtype=np.uint32),
         material=_file_material(getattr(geom.visual, "material", None), textures, extras),
+        colors=None if colors is None else np.ascontiguousarray(colors, dtype=np.float32),
     )
 
 
@@ -185,6 +200,7 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             # trimesh's placeholder (a grey 2x2 image) for an OBJ with uvs but no usable .mtl
             return None
         diffuse = _factor(mat.diffuse, (1.0, 1.0, 1.0, 1.0))
+        own_map = extras.get("map_Kd", {}).get(mat.name)
         return FileMaterial(
             # MTL Kd is display-referred in practice; (x/255)**2.2 approximates the sRGB decode.
             base_color=tuple(float(x) ** 2.2 for x in diffuse[:3]),
@@ -192,7 +208,7 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             roughness=0.5,
             emissive=(0.0, 0.0, 0.0),
             alpha=float(diffuse[3]) if len(diffuse) > 3 else 1.0,
-            base_color_texture=_texture(mat.image, textures),
+            base_color_texture=own_map if own_map is not None else _texture(mat.image, textures),
             metallic_roughness_texture=None,
             normal_texture=None,
             normal_scale=1.0,
@@ -201,6 +217,32 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             occlusion_strength=1.0,
         )
     return None
+
+
+def _attach_diffuse_maps(spec: str, path: Path, extras: dict, cache: dict) -> None:
+    """The OBJ's MTL map_Kd statements, read by alight.exchange.mtl (options applied), as
+    TextureInfos by material name in ``extras['map_Kd']``; a map that does not read is an error."""
+    from alight.core.mesh import TextureInfo, TextureTransform
+    from alight.exchange.images import decode_texture
+    from alight.exchange.mtl import diffuse_maps
+
+    out = {}
+    for name, diffuse in diffuse_maps(path).items():
+        key = str(diffuse.path)
+        if key not in cache:
+            try:
+                data = diffuse.path.read_bytes()
+            except OSError as e:
+                raise AlightError(f"{spec}: material {name}: map_Kd '{diffuse.path.name}' cannot be read "
+                                  f"({e.strerror or e})") from None
+            cache[key] = decode_texture(data, f"{spec}: material {name}: map_Kd '{diffuse.path.name}'")
+        transform = None
+        if diffuse.offset != (0.0, 0.0) or diffuse.scale != (1.0, 1.0):
+            (ou, ov), (su, sv) = diffuse.offset, diffuse.scale
+            # uv' = s uv + o on OpenGL uvs is, in glTF's v-down space, scale s and offset (ou, 1 - sv - ov).
+            transform = TextureTransform(offset=(ou, 1.0 - sv - ov), scale=(su, sv))
+        out[name] = TextureInfo(cache[key], transform=transform)
+    extras["map_Kd"] = out
 
 
 def _gltf_material_params(path: Path) -> dict[str, dict]:
