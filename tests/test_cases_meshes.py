@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_gltf import SIZE, assert_equivalent, render
+from tests.test_gltf import SIZE, assert_equivalent, render
 
 from alight.core.scene import Camera, Light
 from alight.exchange.meshes import load_mesh

@@ -11,7 +11,7 @@ import sys
 
 import numpy as np
 import pytest
-from gltf_builder import FLOAT, UBYTE, USHORT, Gltf, checker, grid_plane
+from tests.gltf_builder import UBYTE, USHORT, Gltf, checker, grid_plane
 
 from alight.accuracy.metrics import relative_mae
 from alight.core.scene import Camera, Light, Scene, parse_light
@@ -25,7 +25,7 @@ LIGHTS = [Light(kind="directional", vector=(-0.4, -0.5, -1.0), intensity=2.0)]
 
 @functools.lru_cache(maxsize=1)
 def _maps():
-    from gpu import renderer
+    from tests.gpu import renderer
 
     from alight.ibl.environment import load_environment
 
@@ -35,7 +35,7 @@ def _maps():
 def render(path, camera: Camera = CAMERA, lights=LIGHTS, background: str = "env", ibl: bool = True,
            aa: str = "none", **scene) -> np.ndarray:
     """(H, W, 4) linear radiance of a mesh file, with its own materials."""
-    from gpu import renderer
+    from tests.gpu import renderer
 
     from alight.core.scene import Display
 
@@ -514,7 +514,7 @@ def test_ior_and_specular_reach_the_renderer(tmp_path):
     fm = load_mesh(str(g.save(tmp_path / "s.glb"))).parts[0].material
     np.testing.assert_allclose(fm.specular_f0, dielectric_f0(1.8, 0.7, (1.0, 0.5, 0.5)))
     np.testing.assert_allclose(fm.emissive, (2.0, 1.0, 0.0))
-    from gpu import renderer
+    from tests.gpu import renderer
 
     from alight.core.material import Material
 
