@@ -11,7 +11,7 @@ import sys
 
 import numpy as np
 import pytest
-from tests.gltf_builder import UBYTE, USHORT, Gltf, checker, grid_plane
+from tests.gltf_builder import FLOAT, UBYTE, USHORT, Gltf, checker, grid_plane
 
 from alight.accuracy.metrics import relative_mae
 from alight.core.scene import Camera, Light, Scene, parse_light
@@ -520,3 +520,29 @@ def test_ior_and_specular_reach_the_renderer(tmp_path):
 
     material, maps_used = renderer()._part_material(Scene(), load_mesh(str(tmp_path / "s.glb")).parts[0])
     assert maps_used and np.allclose(material.specular_f0, fm.specular_f0) and isinstance(material, Material)
+
+
+def test_draco_equals_plain(tmp_path):
+    """KHR_draco_mesh_compression, decoded with DracoPy (Google's Draco), against the same plane
+    stored plainly."""
+    DracoPy = pytest.importorskip("DracoPy")
+    positions, normals, uvs, idx = grid_plane(4)
+    textured_plane(tmp_path / "plain.glb")
+    data = DracoPy.encode(positions.astype(np.float32), idx.astype(np.uint32), normals=normals, tex_coord=uvs,
+                          preserve_order=True, quantization_bits=16)
+    ids = {a["attribute_type"]: a["unique_id"] for a in DracoPy.decode(data).attributes}   # 0 position, 1 normal, 3 uv
+    g = Gltf()
+    tex = g.image(checker())
+    mat = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": tex}, "metallicFactor": 0.0, "roughnessFactor": 0.6})
+    view = g._view(data)
+    count = len(positions)
+    for array in (positions, normals, uvs):
+        g.doc["accessors"].append({"componentType": FLOAT, "count": count, "type": "VEC3" if array.shape[1] == 3 else "VEC2",
+                                   **({"min": positions.min(0).tolist(), "max": positions.max(0).tolist()} if array is positions else {})})
+    g.doc["accessors"].append({"componentType": USHORT, "count": idx.size, "type": "SCALAR"})
+    g.mesh([{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": mat,
+             "extensions": {"KHR_draco_mesh_compression": {"bufferView": view, "attributes": {
+                 "POSITION": ids[0], "NORMAL": ids[1], "TEXCOORD_0": ids[3]}}}}])
+    g.use("KHR_draco_mesh_compression", required=True)
+    g.save(tmp_path / "draco.glb")
+    assert_equivalent(render(tmp_path / "draco.glb"), render(tmp_path / "plain.glb"))
