@@ -144,3 +144,21 @@ def test_ply_obj_vertex_colours(shared_data, name):
     image = render(case(shared_data, name), TILTED)
     hue = np.argmax(image[image[..., 3] == 1][:, :3], axis=1)
     assert len(np.unique(hue)) >= 2
+
+
+def test_mtl_offset_and_scale_equal_moved_uvs(tmp_path):
+    """map_Kd -o/-s: the map read at s * uv + o, against an OBJ whose uvs are moved in the file."""
+    from PIL import Image
+
+    from tests.gltf_builder import checker
+
+    Image.fromarray(checker(4, 32)).save(tmp_path / "c.png")
+    quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\n"
+    faces = "usemtl m\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n"
+    uv = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], float)
+    moved = uv * (1.5, 0.75) + (0.25, 0.1)
+    (tmp_path / "opt.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd -blendu on -s 1.5 0.75 1 -o 0.25 0.1 c.png\n")
+    (tmp_path / "plain.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd c.png\n")
+    (tmp_path / "opt.obj").write_text("mtllib opt.mtl\n" + quad + "".join(f"vt {u} {v}\n" for u, v in uv) + faces)
+    (tmp_path / "plain.obj").write_text("mtllib plain.mtl\n" + quad + "".join(f"vt {u} {v}\n" for u, v in moved) + faces)
+    assert_equivalent(render(tmp_path / "opt.obj"), render(tmp_path / "plain.obj"))

@@ -411,6 +411,9 @@ class _Reader:
                 computed, computed_ok = _normalize(smooth_normals(positions, faces))
                 normals[~ok] = np.where(computed_ok[~ok, None], computed[~ok], (0.0, 1.0, 0.0))
         uvs = uv0 if uv0 is not None else np.zeros((len(positions), 2))
+        if uv1 is None and material is not None and any(i.tex_coord == 1 for i in material.textures().values()):
+            self.warn(f"uv1:{element}", f"{element}: a texture reads texCoord 1 but there is no TEXCOORD_1; "
+                                        f"TEXCOORD_0 is used")
         normal_info = material.normal_texture if material is not None else None
         if tangents is not None:
             t_xyz, t_ok = _normalize(tangents[:, :3])

@@ -9,8 +9,6 @@ for it. Every problem with a file becomes a one-line :class:`AlightError` naming
 
 from __future__ import annotations
 
-import json
-import struct
 from pathlib import Path
 from typing import Any, Callable
 
@@ -67,7 +65,7 @@ def load_mesh(spec: str) -> Mesh:
     except Exception as exc:  # trimesh raises anything from ValueError to KeyError on bad files
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     try:
-        extras = _gltf_material_params(path) if ext in (".gltf", ".glb") else {}
+        extras: dict[str, dict] = {}
         textures: dict[int, np.ndarray] = {}
         if ext == ".obj":
             _attach_diffuse_maps(spec, path, extras, textures)
@@ -175,26 +173,6 @@ def _factor(value: Any, default: tuple[float, ...]) -> np.ndarray:
 def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, dict]) -> FileMaterial | None:
     """The file's material in our terms; None for vertex colours or trimesh's placeholder."""
     kind = type(mat).__name__
-    if kind == "PBRMaterial":
-        extra = extras.get(mat.name, {}) if mat.name is not None else {}
-        base = _factor(mat.baseColorFactor, (1.0, 1.0, 1.0, 1.0))
-        if "base_color_factor" in extra:  # exact linear factor rather than trimesh's uint8
-            base = np.asarray(extra["base_color_factor"], dtype=np.float64)
-        emissive = _factor(mat.emissiveFactor, (0.0, 0.0, 0.0))[:3] * extra.get("emissive_strength", 1.0)
-        return FileMaterial(
-            base_color=tuple(float(x) for x in base[:3]),
-            metallic=float(1.0 if mat.metallicFactor is None else mat.metallicFactor),
-            roughness=float(1.0 if mat.roughnessFactor is None else mat.roughnessFactor),
-            emissive=tuple(float(x) for x in emissive),
-            alpha=float(base[3]) if len(base) > 3 else 1.0,
-            base_color_texture=_texture(mat.baseColorTexture, textures),
-            metallic_roughness_texture=_texture(mat.metallicRoughnessTexture, textures),
-            normal_texture=_texture(mat.normalTexture, textures),
-            normal_scale=float(extra.get("normal_scale", 1.0)),
-            emissive_texture=_texture(mat.emissiveTexture, textures),
-            occlusion_texture=_texture(mat.occlusionTexture, textures),
-            occlusion_strength=float(extra.get("occlusion_strength", 1.0)),
-        )
     if kind == "SimpleMaterial":
         if getattr(mat, "_name", None) is None:
             # trimesh's placeholder (a grey 2x2 image) for an OBJ with uvs but no usable .mtl
@@ -243,44 +221,3 @@ def _attach_diffuse_maps(spec: str, path: Path, extras: dict, cache: dict) -> No
             transform = TextureTransform(offset=(ou, 1.0 - sv - ov), scale=(su, sv))
         out[name] = TextureInfo(cache[key], transform=transform)
     extras["map_Kd"] = out
-
-
-def _gltf_material_params(path: Path) -> dict[str, dict]:
-    """Material values trimesh drops, read from the glTF JSON, keyed by (unique) material name.
-
-    trimesh keeps neither normalTexture.scale, occlusionTexture.strength nor
-    KHR_materials_emissive_strength, and it quantises baseColorFactor to uint8. Materials are
-    matched to trimesh's by name, so nameless or duplicate-named ones keep the defaults.
-    Any problem here just means defaults: trimesh has already validated the file.
-    """
-    try:
-        data = path.read_bytes()
-        if data[:4] == b"glTF":
-            length, kind = struct.unpack("<II", data[12:20])
-            if kind != 0x4E4F534A:  # 'JSON'
-                return {}
-            doc = json.loads(data[20:20 + length])
-        else:
-            doc = json.loads(data)
-        materials = doc.get("materials", [])
-        names = [m.get("name") for m in materials]
-        out: dict[str, dict] = {}
-        for m in materials:
-            name = m.get("name")
-            if name is None or names.count(name) != 1:
-                continue
-            params: dict[str, Any] = {}
-            bcf = m.get("pbrMetallicRoughness", {}).get("baseColorFactor")
-            if isinstance(bcf, list) and len(bcf) == 4:
-                params["base_color_factor"] = [float(x) for x in bcf]
-            if "scale" in m.get("normalTexture", {}):
-                params["normal_scale"] = float(m["normalTexture"]["scale"])
-            if "strength" in m.get("occlusionTexture", {}):
-                params["occlusion_strength"] = float(m["occlusionTexture"]["strength"])
-            strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {})
-            if "emissiveStrength" in strength:
-                params["emissive_strength"] = float(strength["emissiveStrength"])
-            out[name] = params
-        return out
-    except Exception:
-        return {}
