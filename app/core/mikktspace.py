@@ -42,7 +42,8 @@ def _normalize_rows(v: np.ndarray) -> np.ndarray:
 
 
 def _weld(positions, normals, uvs, faces) -> np.ndarray:
-    """Welded vertex index per corner (M, 3): equal position, normal and uv (bitwise, -0 as +0)."""
+    """Welded vertex index per corner (M, 3): equal position, normal and uv (bitwise, -0 as +0).
+    Corners of one input vertex are equal already, so the vertices are welded, not the corners."""
     key = np.concatenate([positions, normals, uvs], axis=1).astype(np.float32) + np.float32(0.0)
     _, inverse = np.unique(np.ascontiguousarray(key).view(np.dtype((np.void, key.dtype.itemsize * 8))),
                            return_inverse=True)
@@ -275,9 +276,26 @@ def split_vertices(faces: np.ndarray, corner_tangents: np.ndarray) -> tuple[np.n
     gather every other attribute with the first array.
     """
     faces = np.asarray(faces, np.int64).reshape(-1, 3)
-    tangents = np.asarray(corner_tangents, np.float32).reshape(-1, 4)
-    key = np.empty(len(tangents), np.dtype([("vertex", "<i8"), ("tangent", "V16")]))
-    key["vertex"] = faces.reshape(-1)
-    key["tangent"] = np.ascontiguousarray(tangents).view("V16").reshape(-1)
-    first, inverse = np.unique(key.view("V24"), return_index=True, return_inverse=True)[1:]
-    return faces.reshape(-1)[first], inverse.reshape(-1, 3).astype(np.int64), tangents[first]
+    tangents = np.ascontiguousarray(corner_tangents, np.float32).reshape(-1, 4)
+    corner_vertex = faces.reshape(-1)
+    count = int(corner_vertex.max()) + 1 if len(corner_vertex) else 0
+    # Each vertex keeps the tangent of its first corner; only corners that disagree with it (the
+    # other side of a mirrored seam) become new vertices, one per distinct (vertex, tangent).
+    first = np.full(count, -1, np.int64)
+    first[corner_vertex[::-1]] = np.arange(len(corner_vertex))[::-1]
+    used = first >= 0
+    vertex_tangent = np.zeros((count, 4), np.float32)
+    vertex_tangent[used] = tangents[first[used]]
+    differs = np.flatnonzero(np.any(tangents != vertex_tangent[corner_vertex], axis=1))
+    source = np.arange(count)
+    new_index = corner_vertex.copy()
+    out_tangents = vertex_tangent
+    if len(differs):
+        key = np.empty(len(differs), np.dtype([("vertex", "<i8"), ("tangent", "V16")]))
+        key["vertex"] = corner_vertex[differs]
+        key["tangent"] = tangents[differs].view("V16").reshape(-1)
+        pick, inverse = np.unique(key.view("V24"), return_index=True, return_inverse=True)[1:]
+        source = np.concatenate([source, corner_vertex[differs[pick]]])
+        out_tangents = np.concatenate([vertex_tangent, tangents[differs[pick]]])
+        new_index[differs] = count + inverse.reshape(-1)
+    return source, new_index.reshape(-1, 3), out_tangents
