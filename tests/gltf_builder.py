@@ -46,9 +46,12 @@ class Gltf:
             acc["bufferView"] = view
         elif not (sparse is not None and np.all(a == 0)):
             acc["bufferView"] = self._view(np.ascontiguousarray(a.astype(dtype)).tobytes())
-        if bounds:
-            acc["min"] = [float(x) for x in a.min(axis=0)]
-            acc["max"] = [float(x) for x in a.max(axis=0)]
+        if bounds:   # of the values after sparse substitution, as the specification requires
+            effective = a.astype(np.float64).copy()
+            if sparse is not None:
+                effective[np.asarray(sparse[0])] = np.asarray(sparse[1]).reshape(len(sparse[0]), -1)
+            acc["min"] = [float(x) for x in effective.min(axis=0)]
+            acc["max"] = [float(x) for x in effective.max(axis=0)]
         if sparse is not None:
             idx, values = sparse
             values = np.asarray(values).reshape(len(idx), -1)

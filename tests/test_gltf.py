@@ -116,8 +116,8 @@ def test_sparse_equals_dense(tmp_path):
     lifted = positions.copy()
     ids = np.array([2, 7, 12])
     lifted[ids, 2] += 0.5
-    for name, acc in (("sparse", lambda g: g.accessor(positions, sparse=(ids, lifted[ids]))),
-                      ("dense", lambda g: g.accessor(lifted))):
+    for name, acc in (("sparse", lambda g: g.accessor(positions, bounds=True, sparse=(ids, lifted[ids]))),
+                      ("dense", lambda g: g.accessor(lifted, bounds=True))):
         g = Gltf()
         mat = g.material(pbrMetallicRoughness={"baseColorFactor": [0.8, 0.5, 0.2, 1.0], "metallicFactor": 0.0})
         g.mesh([{"attributes": {"POSITION": acc(g)}, "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
