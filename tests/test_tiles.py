@@ -21,6 +21,7 @@ from alight.core.material import Material
 from alight.core.mesh import cube, sphere
 from alight.core.scene import Camera, Display, Light, Scene
 from alight.errors import AlightError
+from alight.exchange.meshes import load_mesh
 from alight.ibl.environment import load_environment
 from alight.render import renderer as renderer_module
 from alight.render.tiles import (
@@ -34,9 +35,10 @@ from alight.render.tiles import (
     side_limit,
     tile_matrix,
 )
-from tests.conftest import REPO
+from tests.conftest import REPO, SHARED_DATA
 from tests.gpu import renderer
 
+CASES = SHARED_DATA / "cases"
 LLVMPIPE = {"GL_MAX_TEXTURE_SIZE": 16384, "GL_MAX_RENDERBUFFER_SIZE": 16384, "GL_MAX_VIEWPORT_DIMS": (16384, 16384),
             "GL_MAX_FRAMEBUFFER_WIDTH": 16384, "GL_MAX_FRAMEBUFFER_HEIGHT": 16384}
 
@@ -155,6 +157,11 @@ SCENES = {   # name: (scene, anti-aliasing, size)
                       display=Display(background="color", background_color=(0.2, 0.3, 0.4))),
         "msaa", (90, 70)),
     "ball transparent": (lambda: Scene(mesh=sphere(), display=Display(background="transparent")), "msaa", (80, 80)),
+    # glTF alphaMode BLEND (drawn after the background, back to front) and MASK, over nothing
+    "blend file transparent": (
+        lambda: Scene(mesh=load_mesh(str(CASES / "gltf_alpha_blend.glb")), display=Display(background="transparent")),
+        "msaa", (80, 60)),
+    "mask file": (lambda: Scene(mesh=load_mesh(str(CASES / "gltf_alpha_mask.glb"))), "ssaa", (80, 60)),
 }
 
 
