@@ -231,3 +231,30 @@ def test_probe_tangents_match_the_built_in_sphere():
     part = sphere(32, 16).parts[0]
     inner = np.abs(part.normals[:, 1]) < 0.99
     np.testing.assert_allclose(probe_tangents(part.normals[inner].astype(np.float64)), part.tangents[inner, :3], atol=1e-5)
+
+
+def test_editor_script_edits_take_layer_fields():
+    """--script FIELD=VALUE reaches every layer field, with the ior rule and one-line errors."""
+    from alight.frontends.editor.state import EditorState
+
+    s = EditorState()
+    s.apply_edit("clearcoat=0.7")
+    s.apply_edit("sheen_color=0.5,0.2,0.1")
+    s.apply_edit("attenuation_distance=2.5")
+    s.apply_edit("ior=1.33")
+    m = s.material
+    assert (m.clearcoat, m.sheen_color, m.attenuation_distance, m.ior) == (0.7, (0.5, 0.2, 0.1), 2.5, 1.33)
+    assert m.specular_f0 == (f0_from_ior(1.33),) * 3 and m.layers() == {"clearcoat", "sheen"}
+    with pytest.raises(AlightError, match=r"^--script: field 'clearcoat': 2 is out of range \[0, 1\]$"):
+        s.apply_edit("clearcoat=2")
+    assert s.material == m
+
+
+def test_reference_refuses_a_mirror_coat(tmp_path):
+    """The coat's lobe must span texels as the base's must (docs/layer_clearcoat.md)."""
+    out = tmp_path / "r.exr"
+    proc = _cli("reference", "--view", "probe", "--size", "8", "--clearcoat", "1", "--clearcoat-roughness", "0.05",
+                "--out", out)
+    lines = [x for x in proc.stderr.splitlines() if x.strip()]
+    assert proc.returncode == 2 and len(lines) == 1 and not out.exists()
+    assert lines[0].startswith("alight: error: --clearcoat-roughness: clearcoat_roughness 0.05 < 0.1")
