@@ -34,6 +34,7 @@ from alight.ibl.bake import (
     bake_steps,
     roughness_to_grid_step,
 )
+from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.sun import MAX_SUNS
 
 GL_SRGB8_ALPHA8 = 0x8C43
@@ -164,13 +165,20 @@ class ForwardRenderer:
     """Owns a GL context's programs, uploaded meshes, bakes and targets.
 
     ``with ForwardRenderer() as r:`` releases everything on exit. Bakes are cached per environment
-    content and quality, so rendering many materials under one environment bakes once.
+    content and quality, in memory and in ``bake_cache`` (alight.ibl.bake_cache: on disk, shared
+    by every process; None keeps them in memory only), so rendering many materials under one
+    environment bakes once, and so does every later process. ``bakes_run`` counts the bakes
+    that ran, ``bakes_loaded`` those read from the disk cache.
     """
 
-    def __init__(self, ctx: moderngl.Context | None = None, shaders: ShaderLibrary | None = None):
+    def __init__(self, ctx: moderngl.Context | None = None, shaders: ShaderLibrary | None = None,
+                 bake_cache: BakeCache | None | str = "default"):
         self.ctx = ctx or create_headless_context()
         self.shaders = shaders or ShaderLibrary(self.ctx)
         self.luts = LutCache(self.ctx, self.shaders)
+        self.bake_cache = BakeCache() if bake_cache == "default" else bake_cache
+        self.bakes_run = 0
+        self.bakes_loaded = 0
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
         self._targets: _Targets | None = None
@@ -189,18 +197,38 @@ class ForwardRenderer:
         q = QUALITY[quality] if isinstance(quality, str) else quality
         key = (env.content_hash, q)
         if key not in self._bakes:
-            self._bakes[key] = bake_environment(self.ctx, self.shaders, env, q, self.luts)
+            maps = self._load_bake(env, q)
+            if maps is None:
+                maps = bake_environment(self.ctx, self.shaders, env, q, self.luts)
+                self._keep_bake(env, maps)
+            self._bakes[key] = maps
         return self._bakes[key]
 
     def bake_steps(self, env, quality: BakeQuality | str = "medium"):
         """``bake`` in steps (alight.ibl.bake.bake_steps): yields (fraction, label) between GPU passes
-        and returns the maps, cached as ``bake`` caches them (a cached bake yields nothing)."""
+        and returns the maps, cached as ``bake`` caches them (a cached bake yields nothing, one
+        on disk is loaded in the first step)."""
         q = QUALITY[quality] if isinstance(quality, str) else quality
         key = (env.content_hash, q)
         if key not in self._bakes:
-            maps = yield from bake_steps(self.ctx, self.shaders, env, q, self.luts)
+            maps = self._load_bake(env, q)
+            if maps is None:
+                maps = yield from bake_steps(self.ctx, self.shaders, env, q, self.luts)
+                self._keep_bake(env, maps)
             self._bakes[key] = maps
         return self._bakes[key]
+
+    def _load_bake(self, env, q: BakeQuality) -> IBLMaps | None:
+        if self.bake_cache is None:
+            return None
+        maps = load_bake(self.bake_cache, self.ctx, self.shaders, env, q, self.luts)
+        self.bakes_loaded += maps is not None
+        return maps
+
+    def _keep_bake(self, env, maps: IBLMaps) -> None:
+        self.bakes_run += 1
+        if self.bake_cache is not None:
+            save_bake(self.bake_cache, self.shaders, env, maps)
 
     def _gpu_mesh(self, mesh, program) -> list[_GpuPart]:
         entry = self._meshes.get(id(mesh))
@@ -269,6 +297,8 @@ class ForwardRenderer:
             self._targets.release()
             self._targets = None
         self.luts.release()
+        if self.bake_cache is not None:
+            self.bake_cache.close()
         self.shaders.reload()
 
     def __enter__(self) -> "ForwardRenderer":
