@@ -1,7 +1,14 @@
 """Draws a Scene into framebuffers with the forward PBR pass. Knows nothing of any UI.
 
-    background pass -> forward pass (mesh, or the probe view) -> [MSAA resolve | SSAA reduce]
-        -> linear radiance (EXR, tests) -> tone map pass -> sRGB (PNG, the editor)
+The passes of a frame, by anti-aliasing mode and what the caller reads back:
+
+    msaa:  forward pass (mesh, or the probe view) into the multisampled float target
+           -> resolve pass: mean of the samples, the background composited under them, written as
+              linear radiance and/or tone-mapped sRGB, whichever is read (render/resolve.frag)
+    none:  forward pass -> background pass (depth-tested to the uncovered pixels); written
+           tone mapped as drawn when only sRGB is read (draw_display, the editor's path), else
+           linear radiance [-> tone map pass, if sRGB is read too]
+    ssaa:  forward and background passes at 2x -> box reduction -> radiance [-> tone map pass]
 """
 
 from __future__ import annotations
@@ -53,6 +60,7 @@ SAMPLER_UNITS = {
     "u_irradiance": UNIT_IRRADIANCE, "u_prefiltered_radiance": UNIT_PREFILTERED,
     "u_prefiltered_radiance_mid": UNIT_PREFILTERED_MID, "u_brdf_lut": UNIT_LUT,
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
+    "u_scene": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
 }
 
@@ -134,7 +142,8 @@ class _Targets:
         self.draw_size = (width * scale, height * scale)
         ms = samples if aa == "msaa" else 0
         if aa == "msaa":
-            self.color = ctx.renderbuffer(self.draw_size, 4, samples=ms, dtype="f4")
+            # A texture, not a renderbuffer: render/resolve.frag reads its samples.
+            self.color = ctx.texture(self.draw_size, 4, samples=ms, dtype="f4")
         elif aa == "ssaa":
             self.color = ctx.texture(self.draw_size, 4, dtype="f4")
         else:
@@ -144,6 +153,7 @@ class _Targets:
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
         self._display_draw = None
+        self._both_fbo = None
 
     def display_draw(self) -> moderngl.Framebuffer:
         """The display image with the depth buffer, for ForwardRenderer.draw_display (no AA only)."""
@@ -151,8 +161,19 @@ class _Targets:
             self._display_draw = self.ctx.framebuffer([self.display], self.depth)
         return self._display_draw
 
+    def resolve_fbo(self, radiance: bool, display: bool) -> moderngl.Framebuffer:
+        """Where render/resolve.frag writes: the radiance, the display image, or both (in that
+        order: its RADIANCE_OUTPUT at location 0, DISPLAY_OUTPUT at 1)."""
+        if radiance and display:
+            if self._both_fbo is None:
+                self._both_fbo = self.ctx.framebuffer([self.radiance, self.display])
+            return self._both_fbo
+        return self.radiance_fbo if radiance else self.display_fbo
+
     def release(self) -> None:
         owned = [self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo, self.display]
+        if self._both_fbo is not None:
+            owned.insert(0, self._both_fbo)
         if self._display_draw is not None:
             owned.insert(0, self._display_draw)
         if self.color is not self.radiance:
@@ -323,8 +344,17 @@ class ForwardRenderer:
         if scene.view == "probe":
             aa = "none"  # the probe view's normals are exact per pixel centre: no blending
         targets = self._targets_for(width, height, aa, samples)
-        self.draw_hdr(scene, maps, targets)
-        self.tonemap(targets.radiance, scene.display, targets.display_fbo, opaque=scene.display.background != "transparent")
+        opaque = scene.display.background != "transparent"
+        # Only the images that are read are made (module docstring).
+        if aa == "msaa":
+            self._draw_scene(scene, maps, targets, targets.draw, background=False)
+            self._resolve(scene, maps, targets, read_linear, read_srgb)
+        elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe":
+            self.draw_display(scene, maps, targets)
+        else:
+            self.draw_hdr(scene, maps, targets)
+            if read_srgb:
+                self.tonemap(targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
         linear = srgb = None
         if read_linear:
             linear = np.frombuffer(targets.radiance_fbo.read(components=4, dtype="f4"), np.float32)
@@ -351,7 +381,7 @@ class ForwardRenderer:
         self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display)
 
     def _draw_scene(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, fbo: moderngl.Framebuffer,
-                    display_output: Display | None = None) -> None:
+                    display_output: Display | None = None, background: bool = True) -> None:
         ctx = self.ctx
         self._display_output = display_output
         width, height = targets.draw_size
@@ -371,9 +401,10 @@ class ForwardRenderer:
         elif scene.mesh is not None:
             self._draw_mesh(scene, maps, camera, view_projection)
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
-        self._draw_background(scene, maps, inverse_vp)
+        if background:
+            self._draw_background(scene, maps, inverse_vp)
         ctx.disable(moderngl.DEPTH_TEST)
-        if display_output is None:
+        if display_output is None and background:
             self._finish_radiance(targets)
         self._display_output = None
 
@@ -458,15 +489,21 @@ class ForwardRenderer:
             self._lights_bytes = data
         self._lights_ubo.bind_to_uniform_block(0)
 
-    def _draw_background(self, scene: Scene, maps: IBLMaps | None, inverse_vp: np.ndarray) -> None:
+    @staticmethod
+    def _background_mode(scene: Scene, maps: IBLMaps | None) -> int:
+        """common/background.glsl's BACKGROUND_MODE for the scene (3: none)."""
         mode = scene.display.background
         if mode == "transparent" or (mode in ("env", "blur") and maps is None):
-            return
-        prog = self._scene_program("render/background.vert", "render/background.frag",
-                                   {"BACKGROUND_MODE": {"env": 0, "blur": 1, "color": 2}[mode]})
-        if mode == "color":
+            return 3
+        return {"env": 0, "blur": 1, "color": 2}[mode]
+
+    @staticmethod
+    def _bind_background(prog: moderngl.Program, scene: Scene, maps: IBLMaps | None, inverse_vp: np.ndarray,
+                         mode: int) -> None:
+        """common/background.glsl's inputs."""
+        if mode == 2:
             prog["u_color"] = tuple(scene.display.background_color)
-        else:
+        elif mode in (0, 1):
             maps.environment.use(UNIT_ENVIRONMENT)
             maps.prefiltered_radiance.use(UNIT_PREFILTERED)
             # Grid A's mip for the blur roughness (half the grid step; see bake.grid_roughness).
@@ -475,6 +512,36 @@ class ForwardRenderer:
             _set(prog, "u_inverse_view_projection", inverse_vp.tobytes(), write=True)
             _set(prog, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
             _set(prog, "u_env_intensity", float(scene.env_intensity))
+
+    def _draw_background(self, scene: Scene, maps: IBLMaps | None, inverse_vp: np.ndarray) -> None:
+        mode = self._background_mode(scene, maps)
+        if mode == 3:
+            return
+        prog = self._scene_program("render/background.vert", "render/background.frag", {"BACKGROUND_MODE": mode})
+        self._bind_background(prog, scene, maps, inverse_vp, mode)
+        self._fullscreen(prog)
+
+    def _resolve(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, radiance: bool, display: bool) -> None:
+        """render/resolve.frag: the multisampled surfaces resolved, the background under them, into
+        the radiance and/or the display image (at least one is written, so a frame is complete)."""
+        radiance = radiance or not display
+        mode = self._background_mode(scene, maps)
+        defines = {"BACKGROUND_MODE": mode, "SCENE_SAMPLES": targets.samples}
+        if radiance:
+            defines["RADIANCE_OUTPUT"] = None
+        if display:
+            defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
+        prog = self.program("render/background.vert", "render/resolve.frag", defines)
+        camera = Camera() if scene.view == "probe" else self.camera_for(scene, targets.width / targets.height)
+        inverse_vp = np.linalg.inv(camera.view_projection(targets.width / targets.height)).astype(np.float32)
+        self._bind_background(prog, scene, maps, inverse_vp, mode)
+        targets.color.use(UNIT_RADIANCE)
+        _set(prog, "u_scene", UNIT_RADIANCE)
+        _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
+        _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
+        _set(prog, "u_opaque", scene.display.background != "transparent")
+        targets.resolve_fbo(radiance, display).use()
+        self.ctx.viewport = (0, 0, targets.width, targets.height)
         self._fullscreen(prog)
 
     def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:

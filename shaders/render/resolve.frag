@@ -1,0 +1,47 @@
+#version 450 core
+// The last pass of a multisampled frame, in one: the MSAA resolve (the mean of each pixel's
+// samples), the background composited under the surfaces, and the outputs the caller reads:
+// linear radiance (RADIANCE_OUTPUT) and the tone-mapped sRGB image (DISPLAY_OUTPUT, the maths
+// of render/tonemap.frag). It replaces a background pass that wrote every uncovered sample, the
+// resolve's float image and the tone map pass that read it back.
+#include "common/brdf.glsl"
+#include "common/background.glsl"
+#include "common/tonemapping.glsl"
+
+#ifndef SCENE_SAMPLES
+#define SCENE_SAMPLES 4
+#endif
+
+in vec3 v_ray;    // render/background.vert: world-space, not normalised
+
+uniform sampler2DMS u_scene;     // the surfaces' radiance; alpha 1 where one was drawn, 0 elsewhere
+uniform float u_exposure_scale;  // 2^EV
+uniform int u_tonemap;
+uniform bool u_opaque;           // false: keep the coverage as alpha (transparent background)
+
+#ifdef RADIANCE_OUTPUT
+layout(location = 0) out vec4 out_radiance;
+#endif
+#ifdef DISPLAY_OUTPUT
+layout(location = DISPLAY_OUTPUT) out vec4 out_display;
+#endif
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    // Shaded once per pixel, as the background pass shades it (at the pixel centre).
+    vec3 background = background_radiance(v_ray);
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < SCENE_SAMPLES; ++i) {
+        vec4 s = texelFetch(u_scene, p, i);
+        // Porter-Duff 'under': a sample's radiance is its surfaces' (alpha 1 where opaque), the
+        // background fills what they leave (all of an uncovered sample, cleared to alpha 0).
+        sum += vec4(s.rgb + (1.0 - s.a) * background, s.a);
+    }
+    vec4 hdr = sum / float(SCENE_SAMPLES);
+#ifdef RADIANCE_OUTPUT
+    out_radiance = hdr;
+#endif
+#ifdef DISPLAY_OUTPUT
+    out_display = vec4(linear_to_srgb(tonemap(hdr.rgb * u_exposure_scale, u_tonemap)), u_opaque ? 1.0 : hdr.a);
+#endif
+}
