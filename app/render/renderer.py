@@ -13,6 +13,7 @@ The passes of a frame, by anti-aliasing mode and what the caller reads back:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, replace
 
@@ -39,6 +40,7 @@ from alight.ibl.bake import (
     LutCache,
     bake_environment,
     bake_steps,
+    grid_roughness,
     roughness_to_grid_step,
 )
 from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
@@ -424,6 +426,27 @@ class ForwardRenderer:
             defines["MULTIPLE_SCATTERING"] = None
         return defines
 
+    # The maps that cannot change a roughness (MATERIAL_MAPS bits): any other map compiled in keeps
+    # the prefiltered lookup's path below the grid (ibl.glsl IBL_BELOW_GRID).
+    _ROUGHNESS_FREE_MAPS = {"base_color", "normal", "emissive", "occlusion", "metallic"}
+
+    def _below_grid_defines(self, scene: Scene, maps: IBLMaps | None, materials, map_mask: int = 0) -> dict:
+        """``{"IBL_BELOW_GRID": 0}`` when no roughness the pass can shade lies below the prefiltered
+        grid's first step: every ``*roughness`` field of the materials (the base layer's and any
+        other layer's) is at or above it and no compiled-in map can lower one. Else nothing: the
+        shader keeps the fade into the source cube (ibl.glsl)."""
+        if maps is None or not scene.ibl_enabled:
+            return {}
+        unsafe = {name for i, name in enumerate(MATERIAL_MAPS) if map_mask & (1 << i)} - self._ROUGHNESS_FREE_MAPS
+        if unsafe or map_mask >> len(MATERIAL_MAPS):
+            return {}
+        first_step = grid_roughness(0, maps.quality.prefiltered_levels)
+        for m in materials:
+            for f in dataclasses.fields(m):
+                if f.name.endswith("roughness") and float(getattr(m, f.name)) < first_step:
+                    return {}
+        return {"IBL_BELOW_GRID": 0}
+
     def _scene_program(self, vertex: str, fragment: str, defines: dict | None = None) -> moderngl.Program:
         """A scene pass's program: with DISPLAY_OUTPUT and the display's uniforms while
         ``draw_display`` runs (common/output_encoding.glsl)."""
@@ -545,7 +568,8 @@ class ForwardRenderer:
         self._fullscreen(prog)
 
     def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:
-        prog = self.program("render/fullscreen.vert", "render/probe.frag", self._ibl_defines(scene))
+        prog = self.program("render/fullscreen.vert", "render/probe.frag",
+                            {**self._ibl_defines(scene), **self._below_grid_defines(scene, maps, [scene.material])})
         m = scene.material
         prog["u_size"] = float(size)
         _set_material(prog, m)
@@ -557,6 +581,9 @@ class ForwardRenderer:
         # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
         defines = self._ibl_defines(scene)
         defines["MATERIAL_MAPS_MASK"] = self._map_mask(scene)
+        defines.update(self._below_grid_defines(scene, maps, [self._part_material(scene, part)[0]
+                                                              for part in scene.mesh.parts],
+                                                defines["MATERIAL_MAPS_MASK"]))
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
         prog = self._scene_program("render/pbr.vert", "render/pbr.frag", defines)
