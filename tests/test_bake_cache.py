@@ -327,3 +327,23 @@ def test_alight_cache_shows_and_clears(cache_dir):
     assert str(cache_dir / "bakes") in shown and "1 bake," in shown and "BRDF LUTs: 1 file" in shown
     assert "removed 1 bake and 1 BRDF LUT" in cli("cache", "clear")
     assert "0 bakes," in cli("cache", "show")
+
+
+def test_batch_workers_load_the_bake_another_process_made(cache_dir, tmp_path):
+    """alight batch's worker processes use the cache: after a first batch has baked the studio,
+    a second (forced, so every item renders again, in new worker processes) leaves the entry
+    untouched. A rebake would store a new entry: diskcache writes each value to a new file."""
+    spec = tmp_path / "spec.toml"
+    spec.write_text('size = [24, 24]\nquality = "low"\nmeshes = ["sphere"]\nenvironments = ["studio"]\n'
+                    'materials = ["gold", "copper"]\n')
+
+    def batch():
+        p = subprocess.run([sys.executable, "-m", "alight", "batch", str(spec), "--workers", "2", "--force"],
+                           cwd=REPO, env=dict(os.environ), capture_output=True, text=True, timeout=600)
+        assert p.returncode == 0, p.stderr
+
+    batch()
+    entry = _entry_file(cache_dir)
+    written = entry.stat().st_mtime_ns
+    batch()
+    assert _entry_file(cache_dir) == entry and entry.stat().st_mtime_ns == written
