@@ -56,13 +56,14 @@ UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONM
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 SRGB_MAPS = ("base_color", "emissive")
+UNIT_SCENE_DEPTH = 6 + len(MATERIAL_MAPS)   # render/resolve.frag's depth samples
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {
     "u_irradiance": UNIT_IRRADIANCE, "u_prefiltered_radiance": UNIT_PREFILTERED,
     "u_prefiltered_radiance_mid": UNIT_PREFILTERED_MID, "u_brdf_lut": UNIT_LUT,
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
-    "u_scene": UNIT_RADIANCE,
+    "u_scene": UNIT_RADIANCE, "u_scene_depth": UNIT_SCENE_DEPTH,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
 }
 
@@ -150,7 +151,14 @@ class _Targets:
             self.color = ctx.texture(self.draw_size, 4, dtype="f4")
         else:
             self.color = self.radiance
-        self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
+        if aa == "msaa":
+            # A texture too: the resolve tells covered samples by their depth, so the colour
+            # target is never cleared (a quarter of the clears' bytes; 59 -> 14 ms of CPU at 1080p).
+            self.depth = ctx.depth_texture(self.draw_size, samples=ms)
+            self.depth_only = ctx.framebuffer(depth_attachment=self.depth)
+        else:
+            self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
+            self.depth_only = None
         self.draw = ctx.framebuffer([self.color], self.depth)
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
@@ -174,6 +182,8 @@ class _Targets:
 
     def release(self) -> None:
         owned = [self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo, self.display]
+        if self.depth_only is not None:
+            owned.insert(0, self.depth_only)
         if self._both_fbo is not None:
             owned.insert(0, self._both_fbo)
         if self._display_draw is not None:
@@ -389,7 +399,11 @@ class ForwardRenderer:
         width, height = targets.draw_size
         fbo.use()
         ctx.viewport = (0, 0, width, height)
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        if background or targets.depth_only is None:
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        else:   # the resolve reads only the samples the depth says were drawn
+            targets.depth_only.clear(depth=1.0)
+            fbo.use()
         aspect = width / height
         # The probe's own camera is orthographic; its backdrop is drawn as the default camera sees it.
         camera = Camera() if scene.view == "probe" else self.camera_for(scene, aspect)
@@ -559,7 +573,9 @@ class ForwardRenderer:
         inverse_vp = np.linalg.inv(camera.view_projection(targets.width / targets.height)).astype(np.float32)
         self._bind_background(prog, scene, maps, inverse_vp, mode)
         targets.color.use(UNIT_RADIANCE)
+        targets.depth.use(UNIT_SCENE_DEPTH)
         _set(prog, "u_scene", UNIT_RADIANCE)
+        _set(prog, "u_scene_depth", UNIT_SCENE_DEPTH)
         _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
         _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
         _set(prog, "u_opaque", scene.display.background != "transparent")

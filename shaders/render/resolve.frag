@@ -14,7 +14,8 @@
 
 in vec3 v_ray;    // render/background.vert: world-space, not normalised
 
-uniform sampler2DMS u_scene;     // the surfaces' radiance; alpha 1 where one was drawn, 0 elsewhere
+uniform sampler2DMS u_scene;        // the surfaces' radiance and alpha where one was drawn; not cleared
+uniform sampler2DMS u_scene_depth;  // cleared to 1 (the far plane): below it, a surface was drawn
 uniform float u_exposure_scale;  // 2^EV
 uniform int u_tonemap;
 uniform bool u_opaque;           // false: keep the coverage as alpha (transparent background)
@@ -33,9 +34,11 @@ void main() {
     vec4 sum = vec4(0.0);
     for (int i = 0; i < SCENE_SAMPLES; ++i) {
         vec4 s = texelFetch(u_scene, p, i);
-        // Porter-Duff 'under': a sample's radiance is its surfaces' (alpha 1 where opaque), the
-        // background fills what they leave (all of an uncovered sample, cleared to alpha 0).
-        sum += vec4(s.rgb + (1.0 - s.a) * background, s.a);
+        bool covered = texelFetch(u_scene_depth, p, i).r < 1.0;
+        // Porter-Duff 'under': a covered sample's radiance is its surfaces' (alpha 1 where opaque)
+        // and the background fills what they leave; an uncovered sample is the background alone
+        // (its colour was never cleared: a select, so whatever it holds cannot leak in).
+        sum += covered ? vec4(s.rgb + (1.0 - s.a) * background, s.a) : vec4(background, 0.0);
     }
     vec4 hdr = sum / float(SCENE_SAMPLES);
 #ifdef RADIANCE_OUTPUT
