@@ -123,6 +123,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=4, help="alternated rounds (default: 4)")
     parser.add_argument("--frames", type=int, default=10, help="steady frames per process (default: 10)")
+    parser.add_argument("--parts", default="cold,steady", help="which measurements: cold, steady or both (default)")
     args = parser.parse_args()
     try:
         import pyvista  # noqa: F401
@@ -144,7 +145,8 @@ def main() -> int:
                   "--size", "1024", "--out", str(tmp / "alight.png")]
         vtk_cold = [py, "-c", VTK_SCRIPT, "cold", "1024", "1024", "0", str(tmp / "vtk.png"), str(ENV),
                     json.dumps(GOLD), str(ROUGHNESS)]
-        for i in range(args.rounds):
+        parts = set(args.parts.split(","))
+        for i in range(args.rounds if "cold" in parts else 0):
             # The BRDF LUT stays cached (it does not depend on the environment); the bake does not.
             shutil.rmtree(cache / "bakes", ignore_errors=True)
             for key, command, child_env in (("alight first", render, env), ("vtk", vtk_cold, None),
@@ -154,7 +156,7 @@ def main() -> int:
                 cold_cpu[key].append(cpu)
             print(f"round {i + 1}/{args.rounds}: cold alight {cold['alight first'][-1]:.2f} s, "
                   f"vtk {cold['vtk'][-1]:.2f} s, alight again {cold['alight second'][-1]:.2f} s", file=sys.stderr)
-        for i in range(args.rounds):
+        for i in range(args.rounds if "steady" in parts else 0):
             out = run([py, "-c", ALIGHT_STEADY, "1920", "1080", str(args.frames), str(ENV), str(ROUGHNESS)], env)[2]
             steady["alight"] += json.loads(out)["frames"]
             steady_cpu["alight"] += json.loads(out)["cpu"]
@@ -164,13 +166,17 @@ def main() -> int:
             steady_cpu["vtk"] += json.loads(out)["cpu"]
             print(f"round {i + 1}/{args.rounds}: steady alight {statistics.median(steady['alight']) * 1000:.0f} ms, "
                   f"vtk {statistics.median(steady['vtk']) * 1000:.0f} ms", file=sys.stderr)
-        for name in ("alight.png", "vtk.png"):
+        for name in ("alight.png", "vtk.png") if "cold" in parts else ():
             shutil.copy(tmp / name, Path(tempfile.gettempdir()) / f"bench_peers_{name}")
     with open("/proc/loadavg") as f:
         load_after = f.read().split()[:3]
 
     print(f"machine: {os.cpu_count()} cores, load average {'/'.join(load_before)} before, "
           f"{'/'.join(load_after)} after; {args.rounds} alternated rounds")
+    if "cold" not in parts:
+        cold = cold_cpu = {}
+    if "steady" not in parts:
+        steady = steady_cpu = {}
     print("cold process, 1024x1024, to PNG (wall; CPU of the process and its threads):")
     for k in cold:
         print(f"  {k:14s} wall {summary(cold[k])}\n  {'':14s} CPU  {summary(cold_cpu[k])}")
@@ -181,11 +187,13 @@ def main() -> int:
     print("ratios of medians, wall (CPU); below 1: alight faster:")
     for label, a, b in (("cold, empty bake cache / VTK", "alight first", "vtk"),
                         ("cold, bake cached / VTK", "alight second", "vtk"),
-                        ("cold, bake cached / empty cache", "alight second", "alight first")):
+                        ("cold, bake cached / empty cache", "alight second", "alight first")) if cold else ():
         print(f"  {label:34s} {m(cold[a]) / m(cold[b]):.2f} ({m(cold_cpu[a]) / m(cold_cpu[b]):.2f})")
-    print(f"  {'steady 1920x1080 frame / VTK':34s} {m(steady['alight']) / m(steady['vtk']):.2f} "
-          f"({m(steady_cpu['alight']) / m(steady_cpu['vtk']):.2f})")
-    print(f"images: {tempfile.gettempdir()}/bench_peers_alight.png, {tempfile.gettempdir()}/bench_peers_vtk.png")
+    if steady:
+        print(f"  {'steady 1920x1080 frame / VTK':34s} {m(steady['alight']) / m(steady['vtk']):.2f} "
+              f"({m(steady_cpu['alight']) / m(steady_cpu['vtk']):.2f})")
+    if "cold" in parts:
+        print(f"images: {tempfile.gettempdir()}/bench_peers_alight.png, {tempfile.gettempdir()}/bench_peers_vtk.png")
     return 0
 
 
