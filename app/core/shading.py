@@ -210,6 +210,22 @@ MIN_PUNCTUAL_ROUGHNESS = 0.045   # brdf.glsl
 MIN_N_DOT_V = 1e-4               # brdf.glsl
 
 
+def spot_attenuation(cos_angle, scale, offset):
+    """A spot's angular falloff (KHR_lights_punctual's recommended implementation): the square
+    of clamp(cos(angle off the axis) * scale + offset, 0, 1), scale = 1 / max(0.001, cos inner -
+    cos outer), offset = -cos outer * scale."""
+    t = np.clip(np.asarray(cos_angle, np.float64) * scale + offset, 0.0, 1.0)
+    return t * t
+
+
+def range_attenuation(distance_squared, range_):
+    """KHR_lights_punctual's range window: clamp(1 - (d / range)^4, 0, 1)^2 (1 without a range)."""
+    if range_ is None or range_ <= 0:
+        return np.ones_like(np.asarray(distance_squared, np.float64))
+    x = np.asarray(distance_squared, np.float64) / (range_ * range_)
+    return np.clip(1.0 - x * x, 0.0, 1.0) ** 2
+
+
 def punctual_light(n, v, l, base_color, metallic, roughness, specular_f0, radiance_in):
     """f(l, v) L_in (n.l) for one delta light, with k = (r+1)^2/8 (the lecture's punctual k)."""
     n, v, l = (np.asarray(x, dtype=np.float64) for x in (n, v, l))

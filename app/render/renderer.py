@@ -78,10 +78,27 @@ class Frame:
 
 
 class _GpuPart:
-    """A mesh part's buffers and textures, uploaded once."""
+    """A mesh part's buffers, uploaded once, and what its shader variant needs to know.
 
-    def __init__(self, ctx: moderngl.Context, program: moderngl.Program, part):
-        vertices = np.hstack([part.positions, part.normals, part.uvs, part.tangents]).astype(np.float32)
+    The vertex buffer holds position, normal, uv and tangent, then TEXCOORD_1 and COLOR_0 only
+    when the part has them (pbr.vert's HAS_UV1, HAS_VERTEX_COLOR). Textures come from the mesh's
+    shared set (one upload per image and sampler).
+    """
+
+    def __init__(self, ctx: moderngl.Context, part, textures: "_MeshTextures"):
+        columns = [part.positions, part.normals, part.uvs, part.tangents]
+        self.layout = ["3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent"]
+        self.has_uv1 = part.uvs1 is not None
+        self.has_colors = part.colors is not None
+        if self.has_uv1:
+            columns.append(part.uvs1)
+            self.layout[0] += " 2f"
+            self.layout.append("in_uv1")
+        if self.has_colors:
+            columns.append(part.colors)
+            self.layout[0] += " 4f"
+            self.layout.append("in_color")
+        vertices = np.hstack([np.asarray(c, np.float32) for c in columns])
         self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
         self.ctx = ctx
@@ -89,20 +106,21 @@ class _GpuPart:
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
         self.textures: dict[str, moderngl.Texture] = {}
+        self.infos: dict = {}
         self.closed = is_closed(part.positions, part.indices)
+        positions = np.asarray(part.positions, np.float64)
+        self.centre = (positions.min(axis=0) + positions.max(axis=0)) / 2.0 if len(positions) else np.zeros(3)
         fm = part.material
         if fm is not None:
-            for name in MATERIAL_MAPS:
-                image = getattr(fm, f"{name}_texture", None)
-                if image is not None:
-                    self.textures[name] = _upload_image(ctx, image, srgb=name in SRGB_MAPS)
+            for name, info in fm.textures().items():
+                self.infos[name] = info
+                self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
 
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
         if vao is None:
             vao = self._vaos[id(program)] = self.ctx.vertex_array(
-                program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent")],
-                self.ibo, index_element_size=4,
+                program, [(self.vbo, *self.layout)], self.ibo, index_element_size=4,
                 skip_errors=True)  # a debug view may not read every attribute
         return vao
 
@@ -111,12 +129,47 @@ class _GpuPart:
             vao.release()
         self.vbo.release()
         self.ibo.release()
-        for tex in self.textures.values():
+
+
+_MIN_FILTERS = {"nearest": moderngl.NEAREST, "linear": moderngl.LINEAR,
+                "nearest_mipmap_nearest": moderngl.NEAREST_MIPMAP_NEAREST,
+                "linear_mipmap_nearest": moderngl.LINEAR_MIPMAP_NEAREST,
+                "nearest_mipmap_linear": moderngl.NEAREST_MIPMAP_LINEAR,
+                "linear_mipmap_linear": moderngl.LINEAR_MIPMAP_LINEAR}
+
+
+class _MeshTextures:
+    """A mesh's textures, one per (image, colour space, sampler): parts sharing an image share
+    its upload. REPEAT and CLAMP_TO_EDGE are the texture's wrap state; MIRRORED_REPEAT is folded
+    in the shader (mesh_material.glsl), so its axis is clamped here."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._textures: dict[tuple, moderngl.Texture] = {}
+
+    def get(self, info, srgb: bool) -> moderngl.Texture:
+        sampler = info.sampler
+        key = (id(info.image), srgb, sampler)
+        tex = self._textures.get(key)
+        if tex is None:
+            tex = _upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps)
+            tex.filter = (_MIN_FILTERS.get(sampler.min_filter, moderngl.LINEAR_MIPMAP_LINEAR),
+                          moderngl.NEAREST if sampler.mag_filter == "nearest" else moderngl.LINEAR)
+            tex.repeat_x = sampler.wrap_s == "repeat"
+            tex.repeat_y = sampler.wrap_t == "repeat"
+            if not sampler.mipmaps or sampler.mag_filter == "nearest":
+                tex.anisotropy = 1.0
+            self._textures[key] = tex
+        return tex
+
+    def release(self) -> None:
+        for tex in self._textures.values():
             tex.release()
+        self._textures.clear()
 
 
-def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool) -> moderngl.Texture:
-    """An RGBA uint8 image (alight.core.mesh gives RGBA) as a mipmapped texture."""
+def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool, mipmaps: bool = True) -> moderngl.Texture:
+    """An RGBA uint8 image (alight.core.mesh gives RGBA) as a texture, mipmapped unless told not."""
     image = np.asarray(image, dtype=np.uint8)
     if image.shape[2] == 3:
         image = np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
@@ -124,9 +177,12 @@ def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool) -> moder
     data = np.ascontiguousarray(image[::-1, :, :4])
     h, w = data.shape[:2]
     tex = ctx.texture((w, h), 4, data.tobytes(), internal_format=GL_SRGB8_ALPHA8 if srgb else None)
-    tex.build_mipmaps()
-    tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-    tex.anisotropy = 8.0
+    if mipmaps:
+        tex.build_mipmaps()
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        tex.anisotropy = 8.0
+    else:
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
     return tex
 
 
@@ -213,9 +269,9 @@ class ForwardRenderer:
         self.bakes_run = 0
         self.bakes_loaded = 0
         self._bakes: dict[tuple, IBLMaps] = {}
-        self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
+        self._meshes: dict[int, tuple[object, list[_GpuPart], _MeshTextures]] = {}
         self._targets: _Targets | None = None
-        self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 32 + 16)
+        self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
         self._units_assigned: set[int] = set()
@@ -263,10 +319,13 @@ class ForwardRenderer:
         if self.bake_cache is not None:
             save_bake(self.bake_cache, self.shaders, env, maps)
 
-    def _gpu_mesh(self, mesh, program) -> list[_GpuPart]:
+    def _gpu_mesh(self, mesh, program=None) -> list[_GpuPart]:
         entry = self._meshes.get(id(mesh))
         if entry is None or entry[0] is not mesh:
-            entry = (mesh, [_GpuPart(self.ctx, program, part) for part in mesh.parts])
+            if entry is not None:
+                _release_mesh(entry)
+            textures = _MeshTextures(self.ctx)
+            entry = (mesh, [_GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
             self._meshes[id(mesh)] = entry
         return entry[1]
 
@@ -288,9 +347,8 @@ class ForwardRenderer:
             vao.release()
         self._fullscreen_vaos.clear()
         self._units_assigned.clear()
-        for _, parts in self._meshes.values():
-            for part in parts:
-                part.release()
+        for entry in self._meshes.values():
+            _release_mesh(entry)
         self._meshes.clear()
         old.reload()
 
@@ -322,9 +380,8 @@ class ForwardRenderer:
         for maps in self._bakes.values():
             maps.release()
         self._bakes.clear()
-        for _, parts in self._meshes.values():
-            for part in parts:
-                part.release()
+        for entry in self._meshes.values():
+            _release_mesh(entry)
         self._meshes.clear()
         if self._targets:
             self._targets.release()
@@ -358,7 +415,7 @@ class ForwardRenderer:
         targets = self._targets_for(width, height, aa, samples)
         opaque = scene.display.background != "transparent"
         # Only the images that are read are made (module docstring).
-        if aa == "msaa":
+        if aa == "msaa" and not self._has_blending_parts(scene):
             self._draw_scene(scene, maps, targets, targets.draw, background=False)
             self._resolve(scene, maps, targets, read_linear, read_srgb)
         elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe":
@@ -377,6 +434,14 @@ class ForwardRenderer:
             srgb = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8)
             srgb = srgb.reshape(height, width, 4)[::-1].copy()
         return Frame(linear, srgb)
+
+    @staticmethod
+    def _has_blending_parts(scene: Scene) -> bool:
+        """Whether a part blends (alphaMode BLEND): it is drawn over the background, so such a
+        frame keeps the background pass (the fused resolve composites the background last)."""
+        if scene.view == "probe" or scene.mesh is None or not scene.use_file_materials:
+            return False
+        return any(part.material is not None and part.material.alpha_mode == "BLEND" for part in scene.mesh.parts)
 
     def draw_hdr(self, scene: Scene, maps: IBLMaps | None, targets: _Targets) -> None:
         self._draw_scene(scene, maps, targets, targets.draw)
@@ -415,10 +480,14 @@ class ForwardRenderer:
         if scene.view == "probe":
             self._draw_probe(scene, maps, width)
         elif scene.mesh is not None:
-            self._draw_mesh(scene, maps, camera, view_projection)
+            self._draw_mesh(scene, maps, camera, view_projection, blend=False)
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         if background:
             self._draw_background(scene, maps, inverse_vp)
+            # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
+            # (The fused MSAA resolve, background=False, is used only for scenes with none.)
+            if scene.view != "probe" and scene.mesh is not None:
+                self._draw_mesh(scene, maps, camera, view_projection, blend=True)
         ctx.disable(moderngl.DEPTH_TEST)
         if display_output is None and background:
             self._finish_radiance(targets)
@@ -513,14 +582,29 @@ class ForwardRenderer:
         _set(program, "u_sun_prefilter_scale", scale.tobytes(), write=True)
 
     def _write_lights(self, scene: Scene) -> None:
+        """punctual.glsl's Lights block: vector and type, radiance, count, spot direction, and
+        the spot's cone scale and offset with the range (KHR_lights_punctual's recommended
+        falloff: scale = 1 / max(0.001, cos inner - cos outer), offset = -cos outer * scale)."""
         vectors = np.zeros((MAX_LIGHTS, 4), np.float32)
         radiance = np.zeros((MAX_LIGHTS, 4), np.float32)
+        spots = np.zeros((MAX_LIGHTS, 4), np.float32)
+        cones = np.zeros((MAX_LIGHTS, 4), np.float32)
         lights = scene.lights[:MAX_LIGHTS]
         for i, light in enumerate(lights):
             vectors[i, :3] = light.vector
-            vectors[i, 3] = 0.0 if light.kind == "point" else 1.0
+            vectors[i, 3] = {"point": 0.0, "directional": 1.0, "spot": 2.0}[light.kind]
             radiance[i, :3] = np.asarray(light.color, np.float32) * light.intensity
-        data = vectors.tobytes() + radiance.tobytes() + np.array([len(lights), 0, 0, 0], np.int32).tobytes()
+            if light.kind == "spot":
+                d = np.asarray(light.direction, np.float64)
+                spots[i, :3] = d / max(np.linalg.norm(d), 1e-30)
+                cos_inner = math.cos(math.radians(light.inner_cone_deg))
+                cos_outer = math.cos(math.radians(light.outer_cone_deg))
+                scale = 1.0 / max(0.001, cos_inner - cos_outer)
+                cones[i, :2] = (scale, -cos_outer * scale)
+            if light.range is not None and light.kind != "directional":
+                cones[i, 2] = light.range
+        data = (vectors.tobytes() + radiance.tobytes() + np.array([len(lights), 0, 0, 0], np.int32).tobytes()
+                + spots.tobytes() + cones.tobytes())
         if data != self._lights_bytes:  # unchanged lights cost no upload
             self._lights_ubo.write(data)
             self._lights_bytes = data
@@ -592,68 +676,168 @@ class ForwardRenderer:
         self._bind_ibl(prog, scene, maps)
         self._fullscreen(prog)
 
-    def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray) -> None:
-        ctx = self.ctx
-        # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
+    def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray,
+                   blend: bool = False) -> None:
+        """The parts that blend (``blend``) or the rest, each with its shader variant: the
+        scene's IBL model and debug view, plus only the features the part uses (_part_defines)."""
         defines = self._ibl_defines(scene)
-        defines["MATERIAL_MAPS_MASK"] = self._map_mask(scene)
-        defines.update(self._below_grid_defines(scene, maps, [self._part_material(scene, part)[0]
-                                                              for part in scene.mesh.parts],
-                                                defines["MATERIAL_MAPS_MASK"]))
+        defines.update(_light_defines(scene))
+        user_maps = self._user_maps_present(scene)
+        parts = list(zip(self._gpu_mesh(scene.mesh), scene.mesh.parts))
+        any_maps = 0
+        for gpu_part, part in parts:
+            any_maps |= self._part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
+        defines.update(self._below_grid_defines(scene, maps, [self._part_material(scene, part)[0] for _, part in parts],
+                                                any_maps))
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
-        prog = self._scene_program("render/pbr.vert", "render/pbr.frag", defines)
-        if scene.debug_view:
-            _set(prog, "u_debug_view", int(scene.debug_view))
-            _set(prog, "u_debug_mip", float(scene.debug_mip))
-        self._bind_ibl(prog, scene, maps)
-        self.draw_mesh_parts(scene, prog, camera, view_projection)
+        bound: set[int] = set()
 
-    def _map_mask(self, scene: Scene) -> int:
-        """mesh_material.glsl's MATERIAL_MAPS_MASK: a bit per map any part is drawn with."""
+        def program_for(part_defines: dict) -> moderngl.Program:
+            prog = self._scene_program("render/pbr.vert", "render/pbr.frag", {**defines, **part_defines})
+            if id(prog) not in bound:
+                bound.add(id(prog))
+                if scene.debug_view:
+                    _set(prog, "u_debug_view", int(scene.debug_view))
+                    _set(prog, "u_debug_mip", float(scene.debug_mip))
+                self._bind_ibl(prog, scene, maps)
+            return prog
+
+        self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=blend)
+
+    @staticmethod
+    def _user_maps_present(scene: Scene) -> set[str]:
         user = scene.texture_maps.paths() if scene.texture_maps is not None else {}
-        used = {name for name, path in user.items() if path in scene.texture_images}
-        for gpu_part, part in zip(self._gpu_mesh(scene.mesh, None), scene.mesh.parts):
-            if part.material is not None and scene.use_file_materials:
-                used.update(gpu_part.textures)
-        return sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in used)
+        return {name for name, path in user.items() if path in scene.texture_images}
 
-    def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program, camera: Camera,
-                        view_projection: np.ndarray) -> None:
-        """Draw every part of the scene's mesh with ``prog`` (pbr.vert's transforms, seen from
-        ``camera``): each part's material factors and maps bound, back faces culled where the
-        part is closed."""
+    @staticmethod
+    def _part_defines(scene: Scene, gpu_part: _GpuPart, part, user_maps: set[str]) -> dict:
+        """The shader variant a part needs (pbr.frag, mesh_material.glsl): the maps it reads, their
+        uv sets, transforms and mirrored axes, vertex colours, alpha mode and unlit. A part with
+        none of these compiles to the plain opaque shader."""
+        fm = part.material
+        file_material = fm is not None and scene.use_file_materials
+        defines: dict = {}
+        if file_material:
+            present = set(gpu_part.textures)
+            bits = {name: 1 << i for i, name in enumerate(MATERIAL_MAPS)}
+            masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
+            for name, info in gpu_part.infos.items():
+                bit = bits[name]
+                if info.tex_coord == 1 and gpu_part.has_uv1:
+                    masks["MAP_UV1_MASK"] |= bit
+                if info.transform is not None:
+                    masks["MAP_TRANSFORM_MASK"] |= bit
+                if info.sampler.wrap_s == "mirrored_repeat":
+                    masks["MAP_MIRROR_S_MASK"] |= bit
+                if info.sampler.wrap_t == "mirrored_repeat":
+                    masks["MAP_MIRROR_T_MASK"] |= bit
+            defines.update({k: v for k, v in masks.items() if v})
+            if masks["MAP_UV1_MASK"]:
+                defines["HAS_UV1"] = None
+            if fm.alpha_mode == "MASK":
+                defines["ALPHA_MODE"] = 1
+            elif fm.alpha_mode == "BLEND":
+                defines["ALPHA_MODE"] = 2
+            if fm.unlit:
+                defines["UNLIT"] = None
+        else:
+            present = set(user_maps)
+        if gpu_part.has_colors and scene.use_file_materials:
+            defines["HAS_VERTEX_COLOR"] = None
+        defines["MATERIAL_MAPS_MASK"] = sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in present)
+        return defines
+
+    def draw_mesh_parts(self, scene: Scene, prog, camera: Camera, view_projection: np.ndarray,
+                        blend: bool | None = None) -> None:
+        """Draw the scene's mesh parts (pbr.vert's transforms, seen from ``camera``), each with
+        its material's factors and maps bound.
+
+        ``prog``: one program for every part (the reference's G-buffer), or a function from a
+        part's defines (``_part_defines``) to its program. ``blend``: None draws every part;
+        False the parts that do not blend; True those that do (alphaMode BLEND), sorted back to
+        front by the distance of their centres, with blending on and depth writes off.
+        Culling follows the material (glTF doubleSided: false culls back faces); a part without
+        a glTF material is culled where it is closed, seen from both sides where it is open.
+        """
         ctx = self.ctx
-        _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
-        _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
-        _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
-        _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
+        user_maps = self._user_maps_present(scene)
         user = self._user_textures(scene)
         tiling = scene.texture_maps or TextureMaps()
-        for gpu_part, part in zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts):
-            material, maps_used = self._part_material(scene, part)
-            _set_material(prog, material)
-            fm = part.material if maps_used else None
-            _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
-            _set(prog, "u_occlusion_strength", float(getattr(fm, "occlusion_strength", 1.0)) if fm else 1.0)
-            # A file's maps use its own UVs as they are; the user's maps are tiled.
-            _set(prog, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
-            _set(prog, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
-            for name in MATERIAL_MAPS:
-                tex = gpu_part.textures.get(name) if maps_used else user.get(name)
-                _set(prog, f"u_has_{name}_map", tex is not None)
-                if tex is not None:
-                    tex.use(UNIT_MATERIAL[name])
-            # A closed mesh's back faces are hidden: culling them halves the triangles rasterised
-            # and stops back faces drawn first from being shaded and then overwritten (35% of
-            # the ball's cost on llvmpipe). Open meshes are seen from behind (the shader flips n).
-            if gpu_part.closed:
-                ctx.front_face = "ccw"
-                ctx.enable(moderngl.CULL_FACE)
-            else:
-                ctx.disable(moderngl.CULL_FACE)
-            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
-        ctx.disable(moderngl.CULL_FACE)
+        items = []
+        for gpu_part, part in zip(self._gpu_mesh(scene.mesh), scene.mesh.parts):
+            fm = part.material
+            blends = fm is not None and scene.use_file_materials and fm.alpha_mode == "BLEND"
+            if blend is None or blends == blend:
+                items.append((gpu_part, part))
+        if not items:
+            return
+        if blend:
+            eye = np.asarray(camera.position, np.float64)
+            items.sort(key=lambda item: -float(np.linalg.norm(item[0].centre - eye)))
+            ctx.enable(moderngl.BLEND)
+            # Straight alpha over what is behind; coverage accumulates in alpha (premultiplied).
+            ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+            ctx.depth_mask = False
+        prepared: set[int] = set()
+        try:
+            for gpu_part, part in items:
+                if callable(prog):
+                    program = prog(self._part_defines(scene, gpu_part, part, user_maps))
+                else:
+                    program = prog
+                if id(program) not in prepared:
+                    prepared.add(id(program))
+                    _set(program, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
+                    _set(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
+                    _set(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+                    _set(program, "u_camera_position", tuple(float(x) for x in camera.position))
+                material, maps_used = self._part_material(scene, part)
+                _set_material(program, material)
+                fm = part.material if maps_used else None
+                _set(program, "u_normal_scale", float(fm.normal_scale) if fm else 1.0)
+                _set(program, "u_occlusion_strength", float(fm.occlusion_strength) if fm else 1.0)
+                _set(program, "u_alpha", float(fm.alpha) if fm else 1.0)
+                _set(program, "u_alpha_cutoff", float(fm.alpha_cutoff) if fm else 0.5)
+                # A file's maps use its own UVs as they are; the user's maps are tiled.
+                _set(program, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
+                _set(program, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
+                if maps_used and any(info.transform is not None for info in gpu_part.infos.values()):
+                    transforms = np.tile(np.eye(3, dtype=np.float32), (len(MATERIAL_MAPS), 1, 1))
+                    for name, info in gpu_part.infos.items():
+                        if info.transform is not None:
+                            transforms[MATERIAL_MAPS.index(name)] = info.transform.gl_matrix()
+                    member = program.get("u_map_transform", None)
+                    if member is not None:
+                        # GLSL mat3 is column-major: upload the transposes. The compiler trims the
+                        # array after the last slot the variant reads.
+                        used = transforms.transpose(0, 2, 1)[:member.array_length]
+                        member.write(np.ascontiguousarray(used, dtype=np.float32).tobytes())
+                for name in MATERIAL_MAPS:
+                    tex = gpu_part.textures.get(name) if maps_used else user.get(name)
+                    _set(program, f"u_has_{name}_map", tex is not None)
+                    if tex is not None:
+                        tex.use(UNIT_MATERIAL[name])
+                if part.element.startswith("meshes["):
+                    # A glTF primitive: the file decides (the default material is single-sided).
+                    cull = not (part.material is not None and part.material.double_sided)
+                else:
+                    # A closed mesh's back faces are hidden: culling them halves the triangles
+                    # rasterised and stops back faces drawn first from being shaded and then
+                    # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
+                    # behind (the shader flips n).
+                    cull = gpu_part.closed
+                if cull:
+                    ctx.front_face = "ccw"
+                    ctx.enable(moderngl.CULL_FACE)
+                else:
+                    ctx.disable(moderngl.CULL_FACE)
+                gpu_part.vao_for(program).render(moderngl.TRIANGLES)
+        finally:
+            ctx.disable(moderngl.CULL_FACE)
+            if blend:
+                ctx.disable(moderngl.BLEND)
+                ctx.depth_mask = True
 
     @staticmethod
     def _part_material(scene: Scene, part) -> tuple[Material, bool]:
@@ -662,7 +846,7 @@ class ForwardRenderer:
         if fm is None or not scene.use_file_materials:
             return scene.material, False
         base = Material(base_color=tuple(fm.base_color), metallic=float(fm.metallic),
-                        roughness=float(fm.roughness), specular_f0=scene.material.specular_f0,
+                        roughness=float(fm.roughness), specular_f0=tuple(fm.specular_f0),
                         emissive=tuple(fm.emissive), name=part.name)
         if scene.material_overrides:
             base = replace(base, **scene.material_overrides)
@@ -695,6 +879,23 @@ class ForwardRenderer:
         if vao is None:
             vao = self._fullscreen_vaos[id(prog)] = self.ctx.vertex_array(prog, [])
         vao.render(moderngl.TRIANGLES, vertices=3)
+
+
+def _light_defines(scene: Scene) -> dict:
+    """punctual.glsl's PUNCTUAL_SPOT and PUNCTUAL_RANGE, only for scenes that have such lights."""
+    lights = scene.lights[:MAX_LIGHTS]
+    defines: dict = {}
+    if any(light.kind == "spot" for light in lights):
+        defines["PUNCTUAL_SPOT"] = None
+    if any(light.range is not None and light.kind != "directional" for light in lights):
+        defines["PUNCTUAL_RANGE"] = None
+    return defines
+
+
+def _release_mesh(entry) -> None:
+    for part in entry[1]:
+        part.release()
+    entry[2].release()
 
 
 def _rotation_cos_sin(deg: float) -> tuple[float, float]:

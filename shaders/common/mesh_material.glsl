@@ -1,12 +1,27 @@
 // The mesh pass's material inputs: varyings from render/pbr.vert, the material uniforms and
 // texture maps, the shading normal and the Surface at a fragment. Shared by render/pbr.frag
 // (forward shading) and render/gbuffer.frag (the reference's G-buffer).
+//
+// Every per-texture feature of glTF is a compile-time choice, a bit per map in a mask, so a
+// part pays only for what its maps use (llvmpipe runs both sides of a branch):
+//   MATERIAL_MAPS_MASK   the maps present;
+//   MAP_UV1_MASK         maps read with TEXCOORD_1 (needs HAS_UV1), the rest TEXCOORD_0;
+//   MAP_TRANSFORM_MASK   maps with KHR_texture_transform (u_map_transform[slot]);
+//   MAP_MIRROR_S_MASK,   maps whose sampler wraps by MIRRORED_REPEAT in s or t (REPEAT and
+//   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state).
+// HAS_VERTEX_COLOR: COLOR_0 multiplies the base colour and alpha (glTF 2.0 section 3.9.2).
 #include "common/surface.glsl"
 
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
+#ifdef HAS_UV1
+in vec2 v_uv1;
+#endif
+#ifdef HAS_VERTEX_COLOR
+in vec4 v_color;
+#endif
 
 uniform vec3 u_camera_position;
 uniform vec3 u_base_color;
@@ -16,6 +31,8 @@ uniform vec3 u_specular_f0;
 uniform vec3 u_emissive;
 uniform float u_normal_scale;
 uniform float u_occlusion_strength;
+uniform float u_alpha;          // baseColorFactor's alpha
+uniform float u_alpha_cutoff;   // MASK
 // The maps' coordinates: uv * u_uv_scale + u_uv_offset (the editor's tiling; identity for files).
 uniform vec2 u_uv_scale;
 uniform vec2 u_uv_offset;
@@ -44,6 +61,18 @@ uniform sampler2D u_roughness_map;
 #ifndef MATERIAL_MAPS_MASK
 #define MATERIAL_MAPS_MASK 127
 #endif
+#ifndef MAP_UV1_MASK
+#define MAP_UV1_MASK 0
+#endif
+#ifndef MAP_TRANSFORM_MASK
+#define MAP_TRANSFORM_MASK 0
+#endif
+#ifndef MAP_MIRROR_S_MASK
+#define MAP_MIRROR_S_MASK 0
+#endif
+#ifndef MAP_MIRROR_T_MASK
+#define MAP_MIRROR_T_MASK 0
+#endif
 const int MAP_BASE_COLOR = 1;
 const int MAP_METALLIC_ROUGHNESS = 2;
 const int MAP_NORMAL = 4;
@@ -51,6 +80,9 @@ const int MAP_EMISSIVE = 8;
 const int MAP_OCCLUSION = 16;
 const int MAP_METALLIC = 32;
 const int MAP_ROUGHNESS = 64;
+const int MAP_SLOTS = 7;
+// KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
+uniform mat3 u_map_transform[MAP_SLOTS];
 
 bool has_map(int bit, bool present) {
     return (MATERIAL_MAPS_MASK & bit) != 0 && present;
@@ -58,6 +90,35 @@ bool has_map(int bit, bool present) {
 
 vec2 material_uv() {
     return v_uv * u_uv_scale + u_uv_offset;
+}
+
+// The coordinates a map reads: its uv set, then its texture transform (glTF 2.0 textureInfo
+// texCoord; KHR_texture_transform).
+vec2 map_uv(int bit, int slot) {
+    vec2 uv = material_uv();
+#ifdef HAS_UV1
+    if ((MAP_UV1_MASK & bit) != 0) uv = v_uv1;
+#endif
+    if ((MAP_TRANSFORM_MASK & bit) != 0) uv = (u_map_transform[slot] * vec3(uv, 1.0)).xy;
+    return uv;
+}
+
+// MIRRORED_REPEAT (OpenGL 4.5 section 8.14.2): the triangle wave of period 2.
+float mirrored_repeat(float x) {
+    return 1.0 - abs(mod(x, 2.0) - 1.0);
+}
+
+// A map's texel at its coordinates. Mirrored axes are folded here and sampled with the
+// unfolded derivatives, so the mip level does not jump at the folds.
+vec4 sample_map(sampler2D map, int bit, int slot) {
+    vec2 uv = map_uv(bit, slot);
+    if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
+        vec2 folded = uv;
+        if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
+        if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
+        return textureGrad(map, folded, dFdx(uv), dFdy(uv));
+    }
+    return texture(map, uv);
 }
 
 vec3 shading_normal() {
@@ -72,7 +133,7 @@ vec3 shading_normal() {
         if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
         t = normalize(t);
         vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-        vec3 m = texture(u_normal_map, material_uv()).xyz * 2.0 - 1.0;
+        vec3 m = sample_map(u_normal_map, MAP_NORMAL, 2).xyz * 2.0 - 1.0;
         m.xy *= u_normal_scale;
         vec3 mapped = mat3(t, b, n) * m;
         n = dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
@@ -80,25 +141,37 @@ vec3 shading_normal() {
     return n;
 }
 
+// Base colour and alpha: factor x map x COLOR_0 (glTF 2.0 section 3.9.2).
+vec4 material_base_color() {
+    vec4 c = vec4(u_base_color, u_alpha);
+    if (has_map(MAP_BASE_COLOR, u_has_base_color_map)) c *= sample_map(u_base_color_map, MAP_BASE_COLOR, 0);
+#ifdef HAS_VERTEX_COLOR
+    c *= v_color;
+#endif
+    return c;
+}
+
+float material_alpha() {
+    return material_base_color().a;
+}
+
 Surface material_surface() {
     Surface s;
-    s.base_color = u_base_color;
+    s.base_color = material_base_color().rgb;
     s.metallic = u_metallic;
     s.roughness = u_roughness;
     s.specular_f0 = u_specular_f0;
     s.emissive = u_emissive;
     s.occlusion = 1.0;
-    vec2 uv = material_uv();
-    if (has_map(MAP_BASE_COLOR, u_has_base_color_map)) s.base_color *= texture(u_base_color_map, uv).rgb;
     // glTF's packing: G = roughness, B = metallic; a separate greyscale map takes precedence.
     vec2 metal_rough = vec2(1.0);
-    if (has_map(MAP_METALLIC_ROUGHNESS, u_has_metallic_roughness_map)) metal_rough = texture(u_metallic_roughness_map, uv).bg;
-    if (has_map(MAP_METALLIC, u_has_metallic_map)) metal_rough.x = texture(u_metallic_map, uv).r;
-    if (has_map(MAP_ROUGHNESS, u_has_roughness_map)) metal_rough.y = texture(u_roughness_map, uv).r;
+    if (has_map(MAP_METALLIC_ROUGHNESS, u_has_metallic_roughness_map)) metal_rough = sample_map(u_metallic_roughness_map, MAP_METALLIC_ROUGHNESS, 1).bg;
+    if (has_map(MAP_METALLIC, u_has_metallic_map)) metal_rough.x = sample_map(u_metallic_map, MAP_METALLIC, 5).r;
+    if (has_map(MAP_ROUGHNESS, u_has_roughness_map)) metal_rough.y = sample_map(u_roughness_map, MAP_ROUGHNESS, 6).r;
     s.metallic *= metal_rough.x;
     s.roughness *= metal_rough.y;
-    if (has_map(MAP_EMISSIVE, u_has_emissive_map)) s.emissive *= texture(u_emissive_map, uv).rgb;
-    if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, uv).r - 1.0);
+    if (has_map(MAP_EMISSIVE, u_has_emissive_map)) s.emissive *= sample_map(u_emissive_map, MAP_EMISSIVE, 3).rgb;
+    if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
     return s;
