@@ -105,3 +105,26 @@ def test_the_lookup_without_its_below_grid_fade_is_chosen_only_where_it_changes_
     assert r._below_grid_defines(scene, maps, [scene.material]) == {}
     assert r._below_grid_defines(scene, maps, [Material(roughness=0.8)], map_mask=2) == {}   # metallic-roughness map
     assert r._below_grid_defines(scene, maps, [Material(roughness=0.8)], map_mask=1) == {"IBL_BELOW_GRID": 0}
+
+
+def test_a_frame_with_blended_parts_keeps_the_background_pass_and_equals_it():
+    """A glTF BLEND part is drawn over the background (glTF 2.0 3.9.4), so an MSAA frame with one
+    takes the separate passes (background, blended parts, blit resolve), not the fused resolve:
+    the same pixels, and the background shows through the half-transparent ball."""
+    from dataclasses import replace
+
+    from alight.core.mesh import FileMaterial, Mesh
+
+    r = renderer()
+    maps = r.bake(load_environment("studio"), "low")
+    ball = sphere()
+    glass = FileMaterial(base_color=(0.9, 0.2, 0.1), metallic=0.0, roughness=0.4, alpha=0.5, alpha_mode="BLEND")
+    mesh = Mesh(parts=[replace(part, material=glass) for part in ball.parts], source="blend test")
+    scene = Scene(mesh=mesh, use_file_materials=True, lights=[Light("point", (2.0, 3.0, 4.0))])
+    assert r._has_blending_parts(scene)
+    linear, srgb = _separate_passes(r, scene, maps, "msaa")
+    frame = r.render(scene, maps, W, H, aa="msaa", read_linear=True, read_srgb=True)
+    np.testing.assert_array_equal(frame.linear, linear)
+    assert np.abs(frame.srgb.astype(int) - srgb).max() == 0
+    centre = linear[H // 2, W // 2]
+    assert 0.4 < centre[3] < 0.6        # half covered: the ball blends over the background
