@@ -45,6 +45,9 @@ void main() {
     out_radiance = hdr;
 #endif
 #ifdef DISPLAY_OUTPUT
-    out_display = vec4(linear_to_srgb(tonemap(hdr.rgb * u_exposure_scale, u_tonemap)), u_opaque ? 1.0 : hdr.a);
+    // As render/tonemap.frag: with a transparent background the radiance is premultiplied by
+    // coverage and a PNG's alpha is straight (PNG specification 12.8), so divide before the curve.
+    vec3 straight = u_opaque ? hdr.rgb : (hdr.a > 0.0 ? hdr.rgb / hdr.a : vec3(0.0));
+    out_display = vec4(linear_to_srgb(tonemap(straight * u_exposure_scale, u_tonemap)), u_opaque ? 1.0 : hdr.a);
 #endif
 }
