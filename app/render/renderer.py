@@ -4,7 +4,9 @@ The passes of a frame, by anti-aliasing mode and what the caller reads back:
 
     msaa:  forward pass (mesh, or the probe view) into the multisampled float target
            -> resolve pass: mean of the samples, the background composited under them, written as
-              linear radiance and/or tone-mapped sRGB, whichever is read (render/resolve.frag)
+              linear radiance and/or tone-mapped sRGB, whichever is read (render/resolve.frag);
+           with alphaMode BLEND parts (drawn over the background): forward pass -> background
+           pass -> blended parts -> blit resolve -> radiance [-> tone map pass]
     none:  forward pass -> background pass (depth-tested to the uncovered pixels); written
            tone mapped as drawn when only sRGB is read (draw_display, the editor's path), else
            linear radiance [-> tone map pass, if sRGB is read too]
