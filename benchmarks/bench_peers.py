@@ -1,7 +1,7 @@
 """alight against a peer renderer, pyvista/VTK, on the same scene; prints ratios. Not a test.
 
     .venv/bin/pip install -e '.[peers]'            # pyvista and VTK (an optional extra)
-    .venv/bin/python benchmarks/bench_peers.py      # ~5-10 minutes on 2 loaded cores
+    .venv/bin/python benchmarks/bench_peers.py      # about 20 minutes on 2 heavily loaded cores
     .venv/bin/python benchmarks/bench_peers.py --rounds 2 --frames 5   # shorter
 
 The scene: a UV sphere (128 x 64), royal_esplanade_1k.hdr as image-based light and background,
