@@ -161,9 +161,12 @@ def reflect(i, n):
 
 # --- tone mapping and output (tonemapping.glsl) -----------------------------------------
 
+TONEMAP_INPUT_MAX = 1.0e6   # tonemapping.glsl: exposed radiance is limited to this first
+
+
 def tonemap_aces_fitted(c):
     """Stephen Hill's fit of the ACES RRT+ODT (BakingLab, 2016), sRGB primaries in and out."""
-    c = np.asarray(c, dtype=np.float64)
+    c = np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX)
     m_in = np.array([[0.59719, 0.35458, 0.04823],
                      [0.07600, 0.90834, 0.01566],
                      [0.02840, 0.13383, 0.83777]])
@@ -178,7 +181,7 @@ def tonemap_aces_fitted(c):
 
 def tonemap_pbr_neutral(c):
     """Khronos PBR Neutral tone mapper (Khronos 3D Commerce, 2024)."""
-    c = np.asarray(c, dtype=np.float64).copy()
+    c = np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX)
     start, desat = 0.8 - 0.04, 0.15
     x = np.min(c, axis=-1, keepdims=True)
     offset = np.where(x < 0.08, x - 6.25 * x * x, 0.04)

@@ -441,7 +441,7 @@ def _render(args) -> int:
                   multiple_scattering=args.multiple_scattering, display=display)
     loaded = time.perf_counter()
 
-    from alight.exchange.output import write_image
+    from alight.exchange.output import image_rows_writer
     from alight.ibl.bake import quality_named
     from alight.render.renderer import ForwardRenderer
 
@@ -455,20 +455,22 @@ def _render(args) -> int:
         quality = quality_named(args.quality, args.irradiance)
     maps = renderer.bake(env, quality) if env is not None else None
     baked = time.perf_counter()
-    frame = renderer.render(scene, maps, width, height, aa=args.aa,
-                            read_linear=out.suffix.lower() == ".exr", read_srgb=out.suffix.lower() == ".png")
-    rendered = time.perf_counter()
-    if out.suffix.lower() == ".exr":
-        write_image(out, frame.linear, linear=True)
-    else:
-        pixels = frame.srgb if args.background == "transparent" else frame.srgb[:, :, :3]
-        write_image(out, pixels, linear=False)
+    # Strip by strip (an image too big for one framebuffer is drawn in tiles): each band of rows
+    # is written and dropped, so memory stays bounded at any --size.
+    exr = out.suffix.lower() == ".exr"
+    channels = 4 if exr or args.background == "transparent" else 3
+    writing = 0.0
+    with image_rows_writer(out, width, height, channels, linear=exr) as put:
+        for strip in renderer.render_strips(scene, maps, width, height, aa=args.aa, read_linear=exr, read_srgb=not exr):
+            t = time.perf_counter()
+            put(strip.frame.linear if exr else strip.frame.srgb[:, :, :channels])
+            writing += time.perf_counter() - t
     if args.verbose:
         from alight.core.gpu import describe
 
         done = time.perf_counter()
         print(f"{describe(renderer.ctx)}\nload {loaded - start:.3f}s  bake {baked - loaded:.3f}s "
-              f"render {rendered - baked:.3f}s  write {done - rendered:.3f}s", file=sys.stderr)
+              f"render {done - baked - writing:.3f}s  write {writing:.3f}s", file=sys.stderr)
         if maps is not None:
             print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
                   file=sys.stderr)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import moderngl
@@ -35,6 +36,7 @@ from alight.core.scene import (
 )
 from alight.core.shading import rotate_world_to_map
 from alight.core.texture_maps import TextureMaps
+from alight.errors import AlightError
 from alight.ibl.bake import (
     QUALITY,
     BakeQuality,
@@ -47,6 +49,16 @@ from alight.ibl.bake import (
 )
 from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.sun import MAX_SUNS
+from alight.render.tiles import (
+    TILE_BYTES,
+    Tile,
+    TilePlan,
+    framebuffer_bytes,
+    plan_tiles,
+    side_limit,
+    tile_matrix,
+    tile_origin,
+)
 
 GL_SRGB8_ALPHA8 = 0x8C43
 AA_MODES = ("none", "msaa", "ssaa")
@@ -77,6 +89,25 @@ class Frame:
 
     linear: np.ndarray
     srgb: np.ndarray
+
+
+@dataclass
+class Strip:
+    """Rows y0.. of an image (``ForwardRenderer.render_strips``), as a Frame of those rows."""
+
+    y0: int
+    frame: Frame
+
+
+@dataclass(frozen=True)
+class _View:
+    """The part of the image a pass draws: the whole image's size, and for a tile its
+    off-centre matrix (alight.render.tiles) and its bottom-left pixel in the image."""
+
+    width: int
+    height: int
+    matrix: np.ndarray | None = None
+    origin: tuple[int, int] = (0, 0)
 
 
 class _GpuPart:
@@ -194,6 +225,18 @@ class _Targets:
     def __init__(self, ctx: moderngl.Context, width: int, height: int, aa: str, samples: int):
         self.ctx = ctx
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
+        self._display_draw = None
+        self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
+        self.depth_only = self._both_fbo = None
+        self.color = None
+        try:
+            self._allocate()
+        except Exception:
+            self.release()
+            raise
+
+    def _allocate(self) -> None:
+        ctx, width, height, aa, samples = self.ctx, self.width, self.height, self.aa, self.samples
         # Linear radiance at the output size: drawn into directly without anti-aliasing, else the
         # MSAA resolve or the SSAA reduction lands here.
         self.radiance = ctx.texture((width, height), 4, dtype="f4")
@@ -216,12 +259,9 @@ class _Targets:
             self.depth_only = ctx.framebuffer(depth_attachment=self.depth)
         else:
             self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
-            self.depth_only = None
         self.draw = ctx.framebuffer([self.color], self.depth)
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
-        self._display_draw = None
-        self._both_fbo = None
 
     def display_draw(self) -> moderngl.Framebuffer:
         """The display image with the depth buffer, for ForwardRenderer.draw_display (no AA only)."""
@@ -239,17 +279,13 @@ class _Targets:
         return self.radiance_fbo if radiance else self.display_fbo
 
     def release(self) -> None:
-        owned = [self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo, self.display]
-        if self.depth_only is not None:
-            owned.insert(0, self.depth_only)
-        if self._both_fbo is not None:
-            owned.insert(0, self._both_fbo)
-        if self._display_draw is not None:
-            owned.insert(0, self._display_draw)
+        owned = [self._both_fbo, self.depth_only, self._display_draw, self.draw, self.depth, self.radiance_fbo,
+                 self.radiance, self.display_fbo, self.display]
         if self.color is not self.radiance:
             owned.append(self.color)
         for obj in owned:
-            obj.release()
+            if obj is not None:
+                obj.release()
 
 
 class ForwardRenderer:
@@ -410,32 +446,92 @@ class ForwardRenderer:
     # --- drawing -------------------------------------------------------------------------
 
     def render(self, scene: Scene, maps: IBLMaps | None, width: int, height: int,
-               aa: str = "msaa", samples: int = 4, read_linear: bool = True, read_srgb: bool = True) -> Frame:
-        """Draw ``scene`` lit by ``maps`` (None: no environment) and read the results back."""
+               aa: str = "msaa", samples: int = 4, read_linear: bool = True, read_srgb: bool = True,
+               tile: tuple[int, int] | None = None) -> Frame:
+        """Draw ``scene`` lit by ``maps`` (None: no environment) and read the results back.
+        An image one framebuffer cannot hold is drawn in tiles (``render_strips``) with the same
+        pixels; ``tile`` forces tiles of at most that size."""
+        linear = srgb = None
+        for strip in self.render_strips(scene, maps, width, height, aa, samples, read_linear, read_srgb, tile):
+            rows = (strip.frame.linear if read_linear else strip.frame.srgb)
+            if strip.y0 == 0 and rows is not None and len(rows) == height:
+                return strip.frame          # one pass: no copy
+            if read_linear:
+                if linear is None:
+                    linear = np.empty((height, width, 4), np.float32)
+                linear[strip.y0:strip.y0 + len(strip.frame.linear)] = strip.frame.linear
+            if read_srgb:
+                if srgb is None:
+                    srgb = np.empty((height, width, 4), np.uint8)
+                srgb[strip.y0:strip.y0 + len(strip.frame.srgb)] = strip.frame.srgb
+        return Frame(linear, srgb)
+
+    def render_strips(self, scene: Scene, maps: IBLMaps | None, width: int, height: int,
+                      aa: str = "msaa", samples: int = 4, read_linear: bool = True, read_srgb: bool = True,
+                      tile: tuple[int, int] | None = None) -> Iterator[Strip]:
+        """``render`` strip by strip, top first (alight.render.tiles): each Strip holds a band of
+        whole rows, drawn as one or more tiles, so a caller that writes and drops each one holds
+        one strip's pixels at a time. A size within the GL limits and TILE_BYTES is one strip."""
         if scene.view == "probe":
             aa = "none"  # the probe view's normals are exact per pixel centre: no blending
-        targets = self._targets_for(width, height, aa, samples)
+        if aa == "msaa":
+            samples = min(samples, self.ctx.max_samples)
+            if samples < 2:
+                aa = "none"   # this GL has no multisampled float framebuffers
+        plan, targets = self._tiled_targets(width, height, aa, samples, tile)
         opaque = scene.display.background != "transparent"
-        # Only the images that are read are made (module docstring).
-        if aa == "msaa" and not self._has_blending_parts(scene):
-            self._draw_scene(scene, maps, targets, targets.draw, background=False)
-            self._resolve(scene, maps, targets, read_linear, read_srgb)
-        elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe":
-            self.draw_display(scene, maps, targets)
-        else:
-            self.draw_hdr(scene, maps, targets)
-            if read_srgb:
-                self.tonemap(targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
-        linear = srgb = None
-        if read_linear:
-            linear = np.frombuffer(targets.radiance_fbo.read(components=4, dtype="f4"), np.float32)
-            linear = linear.reshape(height, width, 4)[::-1].copy()
-            if scene.view == "probe":
+        for tiles in plan.strips():
+            rows = tiles[0].height
+            linear = np.empty((rows, width, 4), np.float32) if read_linear and not plan.single else None
+            srgb = np.empty((rows, width, 4), np.uint8) if read_srgb and not plan.single else None
+            for t in tiles:
+                view = None if plan.single else _View(width, height, tile_matrix(plan, t), tile_origin(plan, t))
+                # Only the images that are read are made (module docstring).
+                if aa == "msaa" and not self._has_blending_parts(scene):
+                    self._draw_scene(scene, maps, targets, targets.draw, view=view, background=False)
+                    self._resolve(scene, maps, targets, read_linear, read_srgb)
+                elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe":
+                    self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display, view=view)
+                else:
+                    self._draw_scene(scene, maps, targets, targets.draw, view=view)
+                    if read_srgb:
+                        self.tonemap(targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
+                if read_linear:
+                    block = _read(targets.radiance_fbo, t, "f4", np.float32)
+                    if plan.single:
+                        linear = block.copy()
+                    else:
+                        linear[:, t.x:t.x + t.width] = block
+                if read_srgb:
+                    block = _read(targets.display_fbo, t, "f1", np.uint8)
+                    if plan.single:
+                        srgb = block.copy()
+                    else:
+                        srgb[:, t.x:t.x + t.width] = block
+            if linear is not None and scene.view == "probe":
                 linear[linear[:, :, 3] == 0.0] = 0.0  # CONVENTIONS.md: probe background radiance is 0
-        if read_srgb:
-            srgb = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8)
-            srgb = srgb.reshape(height, width, 4)[::-1].copy()
-        return Frame(linear, srgb)
+            yield Strip(tiles[0].y, Frame(linear, srgb))
+
+    def _tiled_targets(self, width: int, height: int, aa: str, samples: int,
+                       tile: tuple[int, int] | None) -> tuple[TilePlan, _Targets]:
+        """The tile plan for this size and the framebuffers of one tile. Where the GL refuses
+        them (out of memory, an incomplete framebuffer), tiles a quarter the size are tried."""
+        budget = TILE_BYTES
+        limits = {key: self.ctx.info.get(key) for key in (
+            "GL_MAX_TEXTURE_SIZE", "GL_MAX_RENDERBUFFER_SIZE", "GL_MAX_VIEWPORT_DIMS",
+            "GL_MAX_FRAMEBUFFER_WIDTH", "GL_MAX_FRAMEBUFFER_HEIGHT")}
+        while True:
+            plan = plan_tiles(width, height, side_limit(limits, aa), framebuffer_bytes(aa, samples), budget, tile=tile)
+            try:
+                return plan, self._targets_for(plan.tile_width, plan.tile_height, aa, samples)
+            except moderngl.Error as exc:
+                self._targets = None
+                if plan.tile_width * plan.tile_height <= 16 * 16:
+                    reason = " ".join(str(exc).split()) or type(exc).__name__
+                    raise AlightError(f"OpenGL: cannot make a {plan.tile_width}x{plan.tile_height} framebuffer "
+                                      f"({aa}) for a {width}x{height} image ({reason})") from None
+                budget = min(budget, plan.tile_width * plan.tile_height * framebuffer_bytes(aa, samples)) // 4
+                tile = None
 
     @staticmethod
     def _has_blending_parts(scene: Scene) -> bool:
@@ -460,7 +556,8 @@ class ForwardRenderer:
         self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display)
 
     def _draw_scene(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, fbo: moderngl.Framebuffer,
-                    display_output: Display | None = None, background: bool = True) -> None:
+                    display_output: Display | None = None, view: _View | None = None,
+                    background: bool = True) -> None:
         ctx = self.ctx
         self._display_output = display_output
         width, height = targets.draw_size
@@ -471,16 +568,21 @@ class ForwardRenderer:
         else:   # the resolve reads only the samples the depth says were drawn
             targets.depth_only.clear(depth=1.0)
             fbo.use()
-        aspect = width / height
+        scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
+        view = view or _View(targets.width, targets.height)
+        aspect = view.width / view.height
         # The probe's own camera is orthographic; its backdrop is drawn as the default camera sees it.
         camera = Camera() if scene.view == "probe" else self.camera_for(scene, aspect)
         view_projection = camera.view_projection(aspect)
+        if view.matrix is not None:     # a tile: the whole image's projection, off centre
+            view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
+        self._last_inverse_vp = inverse_vp    # the resolve's background rays (this frame or tile)
         self._write_lights(scene)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
         if scene.view == "probe":
-            self._draw_probe(scene, maps, width)
+            self._draw_probe(scene, maps, view.width * scale, (view.origin[0] * scale, view.origin[1] * scale))
         elif scene.mesh is not None:
             self._draw_mesh(scene, maps, camera, view_projection, blend=False)
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
@@ -655,9 +757,8 @@ class ForwardRenderer:
         if display:
             defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
         prog = self.program("render/background.vert", "render/resolve.frag", defines)
-        camera = Camera() if scene.view == "probe" else self.camera_for(scene, targets.width / targets.height)
-        inverse_vp = np.linalg.inv(camera.view_projection(targets.width / targets.height)).astype(np.float32)
-        self._bind_background(prog, scene, maps, inverse_vp, mode)
+        # The rays of the scene pass just drawn (for a tile, the whole image's projection off centre).
+        self._bind_background(prog, scene, maps, self._last_inverse_vp, mode)
         targets.color.use(UNIT_RADIANCE)
         targets.depth.use(UNIT_SCENE_DEPTH)
         _set(prog, "u_scene", UNIT_RADIANCE)
@@ -669,11 +770,12 @@ class ForwardRenderer:
         self.ctx.viewport = (0, 0, targets.width, targets.height)
         self._fullscreen(prog)
 
-    def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:
+    def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int, origin: tuple[int, int] = (0, 0)) -> None:
         prog = self.program("render/fullscreen.vert", "render/probe.frag",
                             {**self._ibl_defines(scene), **self._below_grid_defines(scene, maps, [scene.material])})
         m = scene.material
         prog["u_size"] = float(size)
+        _set(prog, "u_pixel_origin", tuple(float(x) for x in origin))
         _set_material(prog, m)
         self._bind_ibl(prog, scene, maps)
         self._fullscreen(prog)
@@ -898,6 +1000,12 @@ def _release_mesh(entry) -> None:
     for part in entry[1]:
         part.release()
     entry[2].release()
+
+
+def _read(fbo: moderngl.Framebuffer, tile: Tile, dtype: str, np_dtype) -> np.ndarray:
+    """The tile's pixels from the bottom-left of ``fbo``, rows top first (a view, not a copy)."""
+    data = fbo.read(viewport=(0, 0, tile.width, tile.height), components=4, dtype=dtype)
+    return np.frombuffer(data, np_dtype).reshape(tile.height, tile.width, 4)[::-1]
 
 
 def _rotation_cos_sin(deg: float) -> tuple[float, float]:
