@@ -30,7 +30,8 @@ def test_unknown_attribute_is_an_attribute_error():
         alight.no_such_thing  # noqa: B018
 
 
-def test_hundred_materials_under_one_environment_bake_once(monkeypatch):
+def test_hundred_materials_under_one_environment_bake_once(monkeypatch, tmp_path):
+    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path))   # an empty bake cache: the first render bakes
     calls = []
     real = alight.render.renderer.bake_environment
 
@@ -157,7 +158,8 @@ def test_other_renderers_in_the_process_are_not_disturbed():
     np.testing.assert_array_equal(before, after)
 
 
-def test_ibl_model_is_chosen_by_name_and_changes_the_image(shared_data):
+def test_ibl_model_is_chosen_by_name_and_changes_the_image(shared_data, monkeypatch, tmp_path):
+    monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path))   # an empty bake cache: the first render bakes
     with Renderer(48, quality="low") as r:
         r.set_environment(str(shared_data / "env" / "quarry_01_1k.hdr")).set_material("gold").set_view("probe")
         default = r.render(linear=True)

@@ -65,7 +65,9 @@ def test_white_furnace_ground_truth_never_exceeds_one(roughness, coat_roughness)
     # is a white metal's of the coat's roughness (a GGX lobe without Fresnel).
     coat_lobe = reflectance_ground_truth(env, n, (0, 0, 1), m.base_color, 1.0, coat_roughness, m.specular_f0)
     fc = cc.clearcoat_fresnel(n[:, 2])[:, None]
-    np.testing.assert_allclose(coated, (1.0 - fc) * bare + fc * coat_lobe, rtol=2e-5)
+    # rtol 2e-4: reflectance_ground_truth sums in float32 blocks (the BLAS's block order), which
+    # leaves up to ~1e-4 on the sharpest lobes over a 1024-wide map; the layered sum is float64.
+    np.testing.assert_allclose(coated, (1.0 - fc) * bare + fc * coat_lobe, rtol=2e-4)
 
 
 @pytest.mark.parametrize("model", ["alight", "lecture"])

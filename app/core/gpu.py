@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import ctypes
 import ctypes.util
+import functools
 import hashlib
 import re
 from dataclasses import dataclass, field
@@ -190,3 +192,65 @@ class ShaderLibrary:
         for prog in self._programs.values():
             prog.release()
         self._programs.clear()
+
+
+# ---- what moderngl does not expose: a cube's mip levels allocated and written directly ----
+# moderngl allocates only level 0 of a cube (build_mipmaps allocates the rest by filtering
+# level 0: on llvmpipe about 65 ms per float cube, thrown away when a pass then writes every
+# level) and writes only level 0. These call glTexImage2D on the cube's own GL name.
+GL_TEXTURE_CUBE_MAP = 0x8513
+GL_TEXTURE_CUBE_MAP_POSITIVE_X = 0x8515
+GL_TEXTURE_BASE_LEVEL = 0x813C
+GL_TEXTURE_MAX_LEVEL = 0x813D
+GL_RGBA32F = 0x8814
+GL_RGBA = 0x1908
+GL_FLOAT = 0x1406
+
+
+@functools.lru_cache(maxsize=1)
+def _gl():
+    """glTexImage2D and glTexParameteri of the current EGL context (core functions, so
+    eglGetProcAddress returns them on every EGL 1.5 driver, Mesa's and NVIDIA's)."""
+    egl = ctypes.CDLL(ctypes.util.find_library("EGL"))
+    egl.eglGetProcAddress.restype = ctypes.c_void_p
+    egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+
+    def function(name: str, *argtypes):
+        address = egl.eglGetProcAddress(name.encode())
+        if not address:
+            raise AlightError(f"OpenGL: {name} is missing from the driver")
+        return ctypes.CFUNCTYPE(None, *argtypes)(address)
+
+    u, i, p = ctypes.c_uint, ctypes.c_int, ctypes.c_void_p
+    return {"TexImage2D": function("glTexImage2D", u, i, i, i, i, i, u, u, p),
+            "TexParameteri": function("glTexParameteri", u, u, i)}
+
+
+def float_cube(ctx: moderngl.Context, size: int, levels: int, data=None) -> moderngl.TextureCube:
+    """An RGBA float32 cube with ``levels`` mip levels allocated (complete at that range).
+    ``data``: None (contents undefined: a pass writes every level), or per level a
+    (6, size >> level, size >> level, 4) float32 array in OpenGL's face order, row 0 first in
+    memory (as ``alight.ibl.bake.read_cube`` returns them)."""
+    import numpy as np
+
+    tex = ctx.texture_cube((size, size), 4, dtype="f4")
+    gl = _gl()
+    tex.use(ctx.default_texture_unit)     # binds it on moderngl's own scratch unit
+    for level in range(levels):
+        s = max(1, size >> level)
+        faces = None
+        if data is not None:
+            faces = np.ascontiguousarray(data[level], dtype=np.float32)
+            if faces.shape != (6, s, s, 4):
+                tex.release()
+                raise ValueError(f"level {level}: shape {faces.shape}, expected {(6, s, s, 4)}")
+        for face in range(6):
+            if faces is None and level == 0:
+                continue   # moderngl allocated level 0
+            pointer = faces[face].ctypes.data if faces is not None else None
+            gl["TexImage2D"](GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, level, GL_RGBA32F, s, s, 0, GL_RGBA, GL_FLOAT,
+                             pointer)
+    gl["TexParameteri"](GL_TEXTURE_CUBE_MAP, GL_TEXTURE_BASE_LEVEL, 0)
+    gl["TexParameteri"](GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, levels - 1)
+    tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR if levels > 1 else moderngl.LINEAR, moderngl.LINEAR)
+    return tex

@@ -63,7 +63,7 @@ class Renderer:
         self._features: dict[str, object] = {}
         self.aa: str = aa
         self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
-        self.bakes_done = 0    # how many bakes actually ran (cache misses), for callers that measure
+        self.bakes_done = 0    # how many bakes actually ran (misses of the memory and disk caches)
         self._mesh: Mesh | None = None
         self._env: Environment | None = _studio()
         self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
@@ -257,12 +257,12 @@ class Renderer:
         if self.quality == "auto":
             return self._frame_auto(w, h, linear, srgb)
         if self._env is not None and self.scene.ibl_enabled:
-            before = len(r._bakes)
+            before = r.bakes_run
             quality = self.quality if not isinstance(self.quality, str) else QUALITY.get(self.quality)
             if quality is None:
                 raise AlightError(f"quality: {self.quality!r} is not one of {', '.join(QUALITY)}")
             maps = r.bake(self._env, quality)
-            self.bakes_done += len(r._bakes) - before
+            self.bakes_done += r.bakes_run - before
         return r.render(self.scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
 
 
@@ -288,9 +288,9 @@ class Renderer:
         choice = self.last_auto_choice = choose_quality(scene_needs(scene), features, self.error_budget)
         maps = None
         if choice.quality is not None:
-            before = len(r._bakes)
+            before = r.bakes_run
             maps = r.bake(self._env, choice.quality)
-            self.bakes_done += len(r._bakes) - before
+            self.bakes_done += r.bakes_run - before
         return r.render(scene if on else replace(scene, ibl_enabled=False), maps, w, h, aa=self.aa,
                         read_linear=linear, read_srgb=srgb)
 

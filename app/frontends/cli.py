@@ -360,6 +360,13 @@ def build_parser() -> argparse.ArgumentParser:
     ch.add_argument("--out", default="alight-chart", metavar="DIR", help="output folder (default: alight-chart)")
     # --- end alight compare / alight chart ---------------------------------------------------
     sub.add_parser("presets", help="list the material presets (the lecture's F0 table)")
+    # --- alight cache (app/ibl/bake_cache.py) ------------------------------------------------
+    ca = sub.add_parser("cache", help="show or clear the bake cache (bakes reused across runs)",
+                        description="The bakes kept between runs (app/ibl/bake_cache.py) and the BRDF LUTs, in "
+                                    "ALIGHT_CACHE_DIR or the user's cache folder; the least recently used bakes "
+                                    "go first past the size limit (ALIGHT_BAKE_CACHE_MB).")
+    ca.add_argument("action", nargs="?", choices=("show", "clear"), default="show",
+                    help="show: where it is, entries and size (default); clear: remove every bake and LUT")
     _add_edit_parser(sub)
     return parser
 
@@ -383,6 +390,8 @@ def main(argv: list[str] | None = None) -> int:
             return _bake(args)
         if args.command == "presets":
             return _presets()
+        if args.command == "cache":  # alight cache
+            return _cache(args)
         if args.command == "export":  # alight export
             return _export(args)
         if args.command == "reference":  # alight reference
@@ -490,6 +499,28 @@ def _render(args) -> int:
             print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
                   file=sys.stderr)
     print(out)
+    return 0
+
+
+def _cache(args) -> int:
+    from alight.ibl.bake import LutCache
+    from alight.ibl.bake_cache import BakeCache
+
+    bakes = BakeCache()
+    luts = LutCache.files()
+    if args.action == "clear":
+        removed = bakes.clear()
+        for path in luts:
+            path.unlink(missing_ok=True)
+        print(f"removed {removed} bake{'s' * (removed != 1)} and {len(luts)} BRDF LUT{'s' * (len(luts) != 1)} "
+              f"from {bakes.directory.parent}")
+        return 0
+    count, size = bakes.stats()
+    lut_bytes = sum(p.stat().st_size for p in luts)
+    print(f"bake cache: {bakes.directory}")
+    print(f"  {count} bake{'s' * (count != 1)}, {size / 2**20:.1f} MiB of {bakes.size_limit / 2**20:.0f} MiB "
+          f"(past it, the least recently used go first; ALIGHT_BAKE_CACHE_MB sets it)")
+    print(f"  BRDF LUTs: {len(luts)} file{'s' * (len(luts) != 1)}, {lut_bytes / 2**20:.1f} MiB")
     return 0
 
 

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
-from alight.core.gpu import ShaderLibrary
+from alight.core.gpu import ShaderLibrary, float_cube
 from alight.core.shading import D_GGX, hammersley, importance_sample_ggx_tangent
 from alight.exchange.output import atomic_path
 from alight.ibl.sun import Sun, extract_suns
@@ -225,11 +225,8 @@ def upload_equirect(ctx: moderngl.Context, radiance: np.ndarray, mipmaps: bool =
 
 
 def _cube(ctx: moderngl.Context, size: int, levels: int) -> moderngl.TextureCube:
-    tex = ctx.texture_cube((size, size), 4, dtype="f4")
-    # build_mipmaps allocates levels 0..levels-1 and makes the texture complete at that range.
-    tex.build_mipmaps(0, levels - 1)
-    tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-    return tex
+    # Levels allocated, not filtered: every pass writes each level it owns.
+    return float_cube(ctx, size, levels)
 
 
 LUT_CHANNELS = 4   # brdf_lut.comp: A, B, t_A, t_B
@@ -254,6 +251,12 @@ class LutCache:
     def path_for(self, size: int, samples: int):
         digest = self.shaders.digest("ibl/brdf_lut.comp")[:16]
         return cache_dir() / f"brdf_lut-{size}-{samples}-{digest}.npy"
+
+    @staticmethod
+    def files() -> list:
+        """The LUT files in the cache folder (``alight cache`` shows and clears them)."""
+        folder = cache_dir()
+        return sorted(folder.glob("brdf_lut-*.npy")) if folder.is_dir() else []
 
     def get(self, size: int, samples: int) -> moderngl.Texture:
         return self._get(("brdf", size, samples), self.path_for(size, samples), size,

@@ -49,6 +49,15 @@ vec3 suns_prefiltered_step(vec3 d, int step) {
     return u_sun_prefilter_scale[step] * sum;
 }
 
+// IBL_BELOW_GRID 0 compiles out the fade into the source cube below grid A's first step: the
+// renderer sets it when no roughness the pass can shade (factors of every layer, maps) lies below
+// that step (app/render/renderer.py _below_grid_defines). llvmpipe runs both sides of a branch, so
+// the fade otherwise costs a trilinear cube fetch and a log2 at every pixel (11% of the editor's
+// scene pass).
+#ifndef IBL_BELOW_GRID
+#define IBL_BELOW_GRID 1
+#endif
+
 // The prefiltered radiance around world direction r for a roughness, blended between grid steps.
 // with_suns adds the compact sources (their power carries the intensity already) as the map
 // would hold them had they been baked in: the lecture's maps filter the whole environment.
@@ -71,6 +80,7 @@ vec3 prefiltered_radiance_at(vec3 r, float roughness, bool with_suns) {
     if (with_suns && u_sun_count > 0) {
         radiance += mix(suns_prefiltered_step(r, lo), suns_prefiltered_step(r, hi), t);
     }
+#if IBL_BELOW_GRID
     if (step < 0.0) {
         float r0 = exp2(-0.5 * u_prefiltered_max_mip);
         float texel_angle = 0.5 * PI / float(textureSize(u_environment, 0).x);
@@ -78,17 +88,19 @@ vec3 prefiltered_radiance_at(vec3 r, float roughness, bool with_suns) {
         float w = (roughness / r0) * (roughness / r0);
         radiance = mix(u_env_intensity * textureLod(u_environment, d, lod).rgb, radiance, w);
     }
+#endif
     return radiance;
 }
 
 // E/pi at normal n; with_suns adds the compact sources' P max(n.l, 0) / pi.
 vec3 irradiance_at(vec3 n, bool with_suns) {
-    vec3 e = u_env_intensity * texture(u_irradiance, rotate_world_to_map(n, u_env_rotation)).rgb;
+    // Explicit LOD 0 (the cube has one level): no screen derivatives to compute.
+    vec3 e = u_env_intensity * textureLod(u_irradiance, rotate_world_to_map(n, u_env_rotation), 0.0).rgb;
     return with_suns ? e + suns_irradiance_over_pi(n) : e;
 }
 
 vec4 brdf_lut_at(float n_dot_v, float roughness) {
-    return texture(u_brdf_lut, vec2(n_dot_v, roughness));
+    return textureLod(u_brdf_lut, vec2(n_dot_v, roughness), 0.0);   // one level: no derivatives
 }
 
 // ---- terms the improved models share -------------------------------------------------------

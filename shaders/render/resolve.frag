@@ -1,0 +1,53 @@
+#version 450 core
+// The last pass of a multisampled frame, in one: the MSAA resolve (the mean of each pixel's
+// samples), the background composited under the surfaces, and the outputs the caller reads:
+// linear radiance (RADIANCE_OUTPUT) and the tone-mapped sRGB image (DISPLAY_OUTPUT, the maths
+// of render/tonemap.frag). It replaces a background pass that wrote every uncovered sample, the
+// resolve's float image and the tone map pass that read it back.
+#include "common/brdf.glsl"
+#include "common/background.glsl"
+#include "common/tonemapping.glsl"
+
+#ifndef SCENE_SAMPLES
+#define SCENE_SAMPLES 4
+#endif
+
+in vec3 v_ray;    // render/background.vert: world-space, not normalised
+
+uniform sampler2DMS u_scene;        // the surfaces' radiance and alpha where one was drawn; not cleared
+uniform sampler2DMS u_scene_depth;  // cleared to 1 (the far plane): below it, a surface was drawn
+uniform float u_exposure_scale;  // 2^EV
+uniform int u_tonemap;
+uniform bool u_opaque;           // false: keep the coverage as alpha (transparent background)
+
+#ifdef RADIANCE_OUTPUT
+layout(location = 0) out vec4 out_radiance;
+#endif
+#ifdef DISPLAY_OUTPUT
+layout(location = DISPLAY_OUTPUT) out vec4 out_display;
+#endif
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    // Shaded once per pixel, as the background pass shades it (at the pixel centre).
+    vec3 background = background_radiance(v_ray);
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < SCENE_SAMPLES; ++i) {
+        vec4 s = texelFetch(u_scene, p, i);
+        bool covered = texelFetch(u_scene_depth, p, i).r < 1.0;
+        // Porter-Duff 'under': a covered sample's radiance is its surfaces' (alpha 1 where opaque)
+        // and the background fills what they leave; an uncovered sample is the background alone
+        // (its colour was never cleared: a select, so whatever it holds cannot leak in).
+        sum += covered ? vec4(s.rgb + (1.0 - s.a) * background, s.a) : vec4(background, 0.0);
+    }
+    vec4 hdr = sum / float(SCENE_SAMPLES);
+#ifdef RADIANCE_OUTPUT
+    out_radiance = hdr;
+#endif
+#ifdef DISPLAY_OUTPUT
+    // As render/tonemap.frag: with a transparent background the radiance is premultiplied by
+    // coverage and a PNG's alpha is straight (PNG specification 12.8), so divide before the curve.
+    vec3 straight = u_opaque ? hdr.rgb : (hdr.a > 0.0 ? hdr.rgb / hdr.a : vec3(0.0));
+    out_display = vec4(linear_to_srgb(tonemap(straight * u_exposure_scale, u_tonemap)), u_opaque ? 1.0 : hdr.a);
+#endif
+}

@@ -1,0 +1,127 @@
+"""The frame's pass structure (app/render/renderer.py): the fused MSAA resolve, the fused display
+path and the IBL lookup compiled without its below-grid fade give the pixels of the passes they
+replace. Each test builds the reference from the separate passes (background pass over every
+sample, the blit resolve, the tone map pass) in the same renderer, so the check can fail."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from alight.core.material import Material
+from alight.core.mesh import sphere
+from alight.core.scene import Display, Light, Scene
+from alight.exchange.presets import load_preset
+from alight.ibl.bake import grid_roughness
+from alight.ibl.environment import load_environment
+from tests.gpu import renderer
+
+W, H = 120, 90
+
+
+def _read(fbo, components, dtype, np_dtype):
+    return np.frombuffer(fbo.read(components=components, dtype=dtype), np_dtype).reshape(H, W, 4)[::-1]
+
+
+def _separate_passes(r, scene, maps, aa):
+    """The frame as the separate passes make it: surfaces, the background pass over every
+    sample, the resolve (a blit), the tone map pass."""
+    targets = r._targets_for(W, H, aa, 4)
+    r.draw_hdr(scene, maps, targets)
+    r.tonemap(targets.radiance, scene.display, targets.display_fbo,
+              opaque=scene.display.background != "transparent")
+    return (_read(targets.radiance_fbo, 4, "f4", np.float32).copy(),
+            _read(targets.display_fbo, 4, "f1", np.uint8).astype(int))
+
+
+@pytest.mark.parametrize("background", ["env", "blur", "color", "transparent"])
+def test_the_fused_msaa_resolve_equals_the_separate_passes(shared_data, background):
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "quarry_01_1k.hdr")), "low")
+    scene = Scene(mesh=sphere(), material=load_preset("gold"), lights=[Light("point", (2.0, 3.0, 4.0))],
+                  display=Display(background=background, exposure=0.5))
+    linear, srgb = _separate_passes(r, scene, maps, "msaa")
+    both = r.render(scene, maps, W, H, aa="msaa", read_linear=True, read_srgb=True)
+    only_linear = r.render(scene, maps, W, H, aa="msaa", read_linear=True, read_srgb=False).linear
+    only_srgb = r.render(scene, maps, W, H, aa="msaa", read_linear=False, read_srgb=True).srgb
+    assert srgb[:, :, :3].std() > 5.0                        # a real picture
+    edge = (linear[:, :, 3] > 0.0) & (linear[:, :, 3] < 1.0)
+    assert edge.sum() > 50                                   # anti-aliased silhouette pixels are compared too
+    for got in (both.linear, only_linear):
+        np.testing.assert_array_equal(got[:, :, 3], linear[:, :, 3])    # coverage
+        rel = np.abs(got[:, :, :3] - linear[:, :, :3]).sum() / np.abs(linear[:, :, :3]).sum()
+        assert rel < 1e-5, rel                               # float summation order only
+    for got in (both.srgb, only_srgb):
+        assert np.abs(got.astype(int) - srgb).max() <= 1
+
+
+def test_the_display_path_for_srgb_only_frames_equals_the_separate_passes():
+    r = renderer()
+    maps = r.bake(load_environment("studio"), "low")
+    scene = Scene(mesh=sphere(), material=load_preset("copper"), lights=[Light("point", (2.0, 3.0, 4.0))])
+    _, srgb = _separate_passes(r, scene, maps, "none")
+    fused = r.render(scene, maps, W, H, aa="none", read_linear=False, read_srgb=True).srgb
+    assert np.abs(fused.astype(int)[:, :, :3] - srgb[:, :, :3]).max() <= 1
+    assert (fused[:, :, 3] == 255).all()
+
+
+@pytest.mark.parametrize("view", ["camera", "probe"])
+def test_the_lookup_without_its_below_grid_fade_is_chosen_only_where_it_changes_nothing(shared_data, view):
+    """At or above grid A's first step (r0 = 0.25 at medium) the fade is compiled out and the
+    image equals the one with it compiled in; below r0 it is kept (the image differs from the
+    grid-only lookup)."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "medium")
+    r0 = grid_roughness(0, maps.quality.prefiltered_levels)
+    size = 64
+
+    def frame(roughness, force_fade: bool):
+        scene = Scene(mesh=None if view == "probe" else sphere(), view=view,
+                      material=Material(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=roughness))
+        real = r._below_grid_defines
+        if force_fade:
+            r._below_grid_defines = lambda *a, **k: {}
+        try:
+            chosen = real(scene, maps, [scene.material])
+            image = r.render(scene, maps, size, size, aa="none", read_srgb=False).linear
+        finally:
+            r._below_grid_defines = real
+        return chosen, image
+
+    chosen, without = frame(r0 + 0.05, False)
+    _, with_fade = frame(r0 + 0.05, True)
+    assert chosen == {"IBL_BELOW_GRID": 0}
+    np.testing.assert_array_equal(without, with_fade)
+    chosen, _ = frame(r0 * 0.5, False)
+    assert chosen == {}                                     # a roughness below the grid keeps the fade
+    # A layer's roughness counts too when the layer is on (clearcoat > 0); a layer that is off
+    # (glTF's default clearcoat_roughness 0, clearcoat 0) does not. So does a roughness map.
+    coated = Material(roughness=0.8, clearcoat=1.0, clearcoat_roughness=0.05)
+    scene = Scene(mesh=sphere(), material=coated)
+    assert r._below_grid_defines(scene, maps, [coated]) == {}
+    assert r._below_grid_defines(scene, maps, [Material(roughness=0.8, clearcoat_roughness=0.05)]) == {"IBL_BELOW_GRID": 0}
+    assert r._below_grid_defines(scene, maps, [Material(roughness=0.8)], map_mask=2) == {}   # metallic-roughness map
+    assert r._below_grid_defines(scene, maps, [Material(roughness=0.8)], map_mask=1) == {"IBL_BELOW_GRID": 0}
+
+
+def test_a_frame_with_blended_parts_keeps_the_background_pass_and_equals_it():
+    """A glTF BLEND part is drawn over the background (glTF 2.0 3.9.4), so an MSAA frame with one
+    takes the separate passes (background, blended parts, blit resolve), not the fused resolve:
+    the same pixels, and the background shows through the half-transparent ball."""
+    from dataclasses import replace
+
+    from alight.core.mesh import FileMaterial, Mesh
+
+    r = renderer()
+    maps = r.bake(load_environment("studio"), "low")
+    ball = sphere()
+    glass = FileMaterial(base_color=(0.9, 0.2, 0.1), metallic=0.0, roughness=0.4, alpha=0.5, alpha_mode="BLEND")
+    mesh = Mesh(parts=[replace(part, material=glass) for part in ball.parts], source="blend test")
+    scene = Scene(mesh=mesh, use_file_materials=True, lights=[Light("point", (2.0, 3.0, 4.0))])
+    assert r._has_blending_parts(scene)
+    linear, srgb = _separate_passes(r, scene, maps, "msaa")
+    frame = r.render(scene, maps, W, H, aa="msaa", read_linear=True, read_srgb=True)
+    np.testing.assert_array_equal(frame.linear, linear)
+    assert np.abs(frame.srgb.astype(int) - srgb).max() == 0
+    centre = linear[H // 2, W // 2]
+    assert 0.4 < centre[3] < 0.6        # half covered: the ball blends over the background
