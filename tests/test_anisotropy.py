@@ -1,0 +1,154 @@
+"""KHR_materials_anisotropy (docs/layer_anisotropy.md): the GLSL terms against their numpy twins,
+the exact BRDF's limits (strength 0 is CONVENTIONS.md's BRDF; a white metal never reflects more
+than it receives), and the exact answer on the GPU against numpy."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from alight.core import shading
+from alight.core.layers import anisotropy
+from alight.core.layers.stack import Pairs, layered_brdf_cos
+from alight.core.material import Material
+from tests.gpu import evaluate
+
+rng = np.random.default_rng(11)
+SHADER = "accuracy/evaluate_anisotropy.comp"
+DEFINES = {"HAS_ANISOTROPY": None}
+TERM_ALPHA, TERM_D, TERM_PROJECTED, TERM_PUNCTUAL, TERM_SPECULAR = range(5)
+
+
+def aniso(term, inputs, **uniforms):
+    return evaluate(term, inputs, uniforms, shader=SHADER, defines=DEFINES)
+
+
+def unit_xy(count):
+    """Directions in the upper hemisphere as their (x, y), z = sqrt(1 - x^2 - y^2) > 0.05."""
+    d = shading._normalize(rng.normal(size=(count, 3)))
+    d[:, 2] = np.abs(d[:, 2]) + 0.05
+    d = shading._normalize(d)
+    return d
+
+
+def test_alpha_d_and_projected_alpha_match_their_twins():
+    x = np.column_stack([rng.uniform(0, 1, 300), rng.uniform(0, 1, 300)])
+    at, ab = anisotropy.anisotropic_alpha(x[:, 0], x[:, 1])
+    np.testing.assert_allclose(aniso(TERM_ALPHA, x)[:, :2], np.column_stack([at, ab]), rtol=2e-6, atol=1e-7)
+    h = unit_xy(400)
+    alphas = np.column_stack([rng.uniform(0.05, 1, 400), rng.uniform(0.02, 1, 400)])
+    gpu = aniso(TERM_D, np.column_stack([h[:, :2], alphas]))[:, 0]
+    np.testing.assert_allclose(gpu, anisotropy.D_GGX_anisotropic(h[:, 0], h[:, 1], h[:, 2], alphas[:, 0], alphas[:, 1]),
+                               rtol=5e-4)
+    gpu = aniso(TERM_PROJECTED, np.column_stack([h[:, :2], alphas]))[:, 0]
+    np.testing.assert_allclose(gpu, anisotropy.projected_alpha(h[:, 0], h[:, 1], alphas[:, 0], alphas[:, 1]), rtol=2e-6)
+
+
+def test_the_anisotropic_d_is_normalised_and_isotropic_at_equal_alphas():
+    # int D(h) (n.h) dh = 1 over the hemisphere, for any pair of alphas (midpoint rule in theta, phi).
+    th = (np.arange(1500) + 0.5) * (np.pi / 2 / 1500)
+    ph = (np.arange(600) + 0.5) * (2 * np.pi / 600)
+    T, P = np.meshgrid(th, ph, indexing="ij")
+    h = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1)
+    dw = np.sin(T) * (np.pi / 2 / 1500) * (2 * np.pi / 600)
+    for at, ab in ((0.3, 0.3), (0.6, 0.1), (1.0, 0.25)):
+        D = anisotropy.D_GGX_anisotropic(h[..., 0], h[..., 1], h[..., 2], at, ab)
+        assert float(np.sum(D * h[..., 2] * dw)) == pytest.approx(1.0, abs=2e-3)
+    r = rng.uniform(0.1, 1, 50)
+    np.testing.assert_allclose(anisotropy.D_GGX_anisotropic(0.3, 0.4, np.sqrt(0.75), r * r, r * r),
+                               shading.D_GGX(np.sqrt(0.75), r), rtol=1e-12)
+
+
+def _pairs(v, l, rotation=0.0):
+    n = np.array([[0.0, 0.0, 1.0]])
+    return Pairs(n=n, v=v[None, :], l=l, t=np.array([[1.0, 0.0, 0.0]]), b=np.array([[0.0, 1.0, 0.0]]))
+
+
+@pytest.mark.parametrize("rotation", [0.0, 0.7])
+def test_punctual_and_exact_lobes_match_their_twins(rotation):
+    v = shading._normalize(np.array([0.5, -0.3, 0.8]))
+    l = unit_xy(300)
+    rough = rng.uniform(0.0, 1.0, 300)
+    strength = rng.uniform(0.0, 1.0, 300)
+    inputs = np.column_stack([l[:, :2], rough, strength])
+    base = np.array([0.8, 0.5, 0.2])
+    for metallic in (0.0, 1.0):
+        gpu = aniso(TERM_PUNCTUAL, inputs, u_view=tuple(v), u_base_color=tuple(base), u_metallic=metallic,
+                    u_anisotropy_rotation=rotation)[:, :3]
+        cpu = np.empty_like(gpu, dtype=np.float64)
+        for i in range(len(l)):
+            m = Material(base_color=tuple(base), metallic=metallic, roughness=float(rough[i]),
+                         anisotropy_strength=float(strength[i]), anisotropy_rotation=rotation)
+            p = _pairs(v, l[i:i + 1])
+            F = shading.F_Schlick(p.v_dot_h, np.asarray(m.f0()))
+            spec = anisotropy.anisotropic_specular(m, p, F, punctual=True)[0, 0]
+            kd = (1.0 - F[0, 0]) * (1.0 - metallic)
+            cpu[i] = (kd * base / np.pi + spec) * l[i, 2]
+        np.testing.assert_allclose(gpu, cpu, rtol=2e-3, atol=1e-5)
+    gpu = aniso(TERM_SPECULAR, inputs, u_view=tuple(v), u_spread=0.0, u_anisotropy_rotation=rotation)[:, :3]
+    keep = rough >= 0.05
+    cpu = np.array([anisotropy.anisotropic_specular(
+        Material(roughness=float(rough[i]), anisotropy_strength=float(strength[i]), anisotropy_rotation=rotation),
+        _pairs(v, l[i:i + 1]), np.ones((1, 1, 3)))[0, 0] for i in range(len(l))])
+    np.testing.assert_allclose(gpu[keep], cpu[keep], rtol=2e-3, atol=1e-5)
+
+
+def _sphere(n_theta=400, n_phi=800):
+    th = (np.arange(n_theta) + 0.5) * (np.pi / n_theta)
+    ph = (np.arange(n_phi) + 0.5) * (2 * np.pi / n_phi)
+    T, P = np.meshgrid(th, ph, indexing="ij")
+    l = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1).reshape(-1, 3)
+    return l, (np.sin(T) * (np.pi / n_theta) * (2 * np.pi / n_phi)).reshape(-1)
+
+
+def test_strength_zero_is_conventions_brdf_exactly():
+    l, _ = _sphere(60, 120)
+    v = shading._normalize(np.array([0.3, 0.2, 0.9]))
+    for r in (0.1, 0.4, 1.0):
+        iso = Material(base_color=(0.9, 0.6, 0.3), metallic=0.5, roughness=r)
+        # A strength of 1e-12 turns the layer on (Material.layers) with an isotropic lobe.
+        on = Material(base_color=(0.9, 0.6, 0.3), metallic=0.5, roughness=r, anisotropy_strength=1e-12,
+                      anisotropy_rotation=0.4)
+        assert "anisotropy" in on.layers() and "anisotropy" not in iso.layers()
+        np.testing.assert_allclose(layered_brdf_cos(on, _pairs(v, l)), layered_brdf_cos(iso, _pairs(v, l)),
+                                   rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("strength", [0.5, 1.0])
+def test_white_metal_furnace_never_exceeds_one(strength):
+    # The exact BRDF of a metal with F0 = 1 under radiance 1: its directional albedo, over views
+    # from normal to grazing and the view's azimuth against the direction.
+    l, dw = _sphere()
+    worst = 0.0
+    for r in (0.1, 0.3, 0.6, 1.0):
+        m = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=r, anisotropy_strength=strength)
+        for nv in (1.0, 0.7, 0.3, 0.05):
+            for azimuth in (0.0, 0.8, np.pi / 2):
+                s = np.sqrt(1 - nv * nv)
+                v = np.array([s * np.cos(azimuth), s * np.sin(azimuth), nv])
+                albedo = float(np.sum(layered_brdf_cos(m, _pairs(v, l))[0, :, 0] * dw))
+                worst = max(worst, albedo)
+    assert worst <= 1.0
+
+
+def test_anisotropic_ground_truth_sums_agree_with_the_pairwise_sum():
+    # The S1..S4 factorisation (ground_truth.anisotropic_ground_truth_terms) against the layered
+    # BRDF summed pair by pair (ground_truth.layered_ground_truth), and against the isotropic
+    # sums at strength 0, on a random 24x48 map.
+    from alight.accuracy import ground_truth as gt
+
+    radiance = rng.uniform(0.0, 2.0, (24, 48, 3))
+    normals = shading._normalize(rng.normal(size=(40, 3)) + np.array([0.0, 0.0, 2.0]))
+    view = (0.2, 0.1, 0.97)
+    tangents = shading._normalize(rng.normal(size=(40, 3)))
+    cases = [(0.3, 0.8, 0.5), (0.6, 1.0, -1.0), (0.45, 0.0, 0.0)]
+    terms = gt.anisotropic_ground_truth_terms(radiance, normals, view, tangents, cases, rotation_deg=30.0)
+    for (r, strength, rotation), term in zip(cases, terms):
+        m = Material(base_color=(0.7, 0.4, 0.2), metallic=0.3, roughness=r, anisotropy_strength=strength,
+                     anisotropy_rotation=rotation)
+        got = term.combine(m.base_color, m.metallic, m.specular_f0)
+        t = tangents - normals * np.sum(normals * tangents, -1, keepdims=True)
+        want = gt.layered_ground_truth(radiance, normals, view, m, t, rotation_deg=30.0) if strength else \
+            gt.reflectance_ground_truth(radiance, normals, view, m.base_color, m.metallic, r, m.specular_f0,
+                                        rotation_deg=30.0)
+        np.testing.assert_allclose(got, want, rtol=2e-5, atol=1e-7)
