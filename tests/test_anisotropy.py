@@ -152,3 +152,73 @@ def test_anisotropic_ground_truth_sums_agree_with_the_pairwise_sum():
             gt.reflectance_ground_truth(radiance, normals, view, m.base_color, m.metallic, r, m.specular_f0,
                                         rotation_deg=30.0)
         np.testing.assert_allclose(got, want, rtol=2e-5, atol=1e-7)
+
+
+# ---- image-based light ------------------------------------------------------------------------
+
+def test_energy_lut_matches_its_quadrature_and_is_one_at_strength_zero():
+    from alight.accuracy.converged import anisotropy_lut_converged
+    from tests.gpu import renderer
+
+    lut = renderer().anisotropy_lut
+    table = lut.table()                                # (2, strength, roughness, n.v, azimuth)
+    nx, ny, nz = lut.size
+    np.testing.assert_allclose(table[:, 0], 1.0, atol=1e-5)   # strength 0: exactly the round lobe's
+    for (i, j, k, az) in ((20, 5, nz - 1, 0), (10, 8, nz - 1, 3), (28, 4, nz // 2, 1), (6, 12, nz - 1, 2)):
+        n_dot_v, rough, strength = (i + 0.5) / nx, (j + 0.5) / ny, k / (nz - 1)
+        ra, rb = anisotropy_lut_converged(n_dot_v, rough, strength, np.radians(30.0 * az))
+        assert table[0, k, j, i, az] == pytest.approx(ra, rel=0.02), (n_dot_v, rough, strength, az)
+        assert table[1, k, j, i, az] == pytest.approx(rb, rel=0.05, abs=0.02), (n_dot_v, rough, strength, az)
+
+
+def _probe(r, maps, material, width, model="alight", **scene):
+    from alight.core.scene import Scene
+
+    return r.render(Scene(material=material, view="probe", ibl_model=model, **scene), maps, width, width,
+                    read_srgb=False).linear
+
+
+@pytest.mark.parametrize("rotation", [0.0, 1.2])
+def test_probe_within_bound_of_its_converged_twin(shared_data, rotation):
+    # The implementation's own error (bake, LUTs, grid blending) against the numpy twin of the
+    # same lookup with converged parts, on royal_esplanade reduced by 4: the bound of
+    # test_probe_accuracy.py for a metal (2%).
+    from alight.accuracy.converged import downsample_equirect, ibl_converged
+    from alight.ibl.environment import Environment, load_environment
+    from tests.gpu import renderer
+
+    width = 24
+    radiance = downsample_equirect(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")).radiance, 4)
+    env = Environment(np.ascontiguousarray(radiance, np.float32), "royal/4")
+    r = renderer()
+    maps = r.bake(env, "medium")
+    normals, inside = shading.probe_normals(width)
+    for rough, strength in ((0.35, 0.8), (0.6, 1.0)):
+        m = Material(base_color=(0.91, 0.92, 0.92), metallic=1.0, roughness=rough, anisotropy_strength=strength,
+                     anisotropy_rotation=rotation)
+        got = _probe(r, maps, m, width)[..., :3][inside]
+        ideal = ibl_converged("alight", radiance, normals[inside], (0.0, 0.0, 1.0), m.base_color, m.metallic, rough,
+                              m.specular_f0, anisotropy=(strength, rotation))
+        error = float(np.abs(got - ideal).sum() / np.abs(ideal).sum())
+        print(f"r={rough} strength={strength} rotation={rotation}: {100 * error:.2f}%")
+        assert error <= 0.02
+
+
+def test_white_furnace_stays_at_or_below_one():
+    # A white metal (F0 = 1) under radiance 1: the stretched lobe's energy (the LUT ratios times
+    # the round lobe's A + B) never exceeds 1; with multiple scattering it is 1.
+    from alight.ibl.environment import constant_environment
+    from tests.gpu import renderer
+
+    r = renderer()
+    maps = r.bake(constant_environment(1.0), "medium")
+    width = 32
+    _, inside = shading.probe_normals(width)
+    for rough in (0.2, 0.5, 1.0):
+        for strength in (0.5, 1.0):
+            m = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=rough, anisotropy_strength=strength,
+                         anisotropy_rotation=0.4)
+            single = _probe(r, maps, m, width)[..., :3][inside]
+            assert single.max() <= 1.0 + 2e-3, (rough, strength, float(single.max()))
+            multiple = _probe(r, maps, m, width, multiple_scattering=True)[..., :3][inside]
+            assert np.abs(multiple - 1.0).max() <= 5e-3, (rough, strength, float(np.abs(multiple - 1.0).max()))

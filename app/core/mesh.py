@@ -35,6 +35,9 @@ class FileMaterial:
     # The ior and the layers' factors the file gives (alight.core.material field names, e.g.
     # {"clearcoat": 1.0}; alight.exchange.gltf_material.layer_fields_from_gltf); empty: none.
     layers: dict = field(default_factory=dict)
+    # KHR_materials_anisotropy's anisotropyTexture (linear): RG the direction in tangent space
+    # (2x - 1), B a factor on the strength.
+    anisotropy_texture: np.ndarray | None = None
 
 
 @dataclass

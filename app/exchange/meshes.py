@@ -176,6 +176,7 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             occlusion_texture=_texture(mat.occlusionTexture, textures),
             occlusion_strength=float(extra.get("occlusion_strength", 1.0)),
             layers=dict(extra.get("layers", {})),
+            anisotropy_texture=extra.get("anisotropy_texture"),
         )
     if kind == "SimpleMaterial":
         if getattr(mat, "_name", None) is None:
@@ -227,11 +228,17 @@ def _gltf_material_params(path: Path) -> dict[str, dict]:
     """
     try:
         data = path.read_bytes()
+        binary = None
         if data[:4] == b"glTF":
             length, kind = struct.unpack("<II", data[12:20])
             if kind != 0x4E4F534A:  # 'JSON'
                 return {}
             doc = json.loads(data[20:20 + length])
+            rest = 20 + length
+            if len(data) >= rest + 8:
+                bin_length, bin_kind = struct.unpack("<II", data[rest:rest + 8])
+                if bin_kind == 0x004E4942:  # 'BIN\0'
+                    binary = data[rest + 8:rest + 8 + bin_length]
         else:
             doc = json.loads(data)
         materials = doc.get("materials", [])
@@ -253,9 +260,45 @@ def _gltf_material_params(path: Path) -> dict[str, dict]:
             if "emissiveStrength" in strength:
                 params["emissive_strength"] = float(strength["emissiveStrength"])
             params["layers"] = _layer_fields(m, str(path))
+            anisotropy = m.get("extensions", {}).get("KHR_materials_anisotropy", {}).get("anisotropyTexture")
+            if isinstance(anisotropy, dict) and "index" in anisotropy:
+                params["anisotropy_texture"] = _gltf_texture_image(doc, binary, path.parent, anisotropy["index"])
             out[name] = params
         return out
     except AlightError:
         raise
     except Exception:
         return {}
+
+
+def _gltf_texture_image(doc: dict, binary: bytes | None, folder: Path, index: int) -> np.ndarray | None:
+    """glTF texture ``index``'s image as (H, W, 4) uint8 RGBA (row 0 = top), decoded with Pillow
+    from its bufferView (a .glb's binary chunk or a buffer's file) or its own file; None when
+    the file does not resolve (trimesh, which reads the core textures, ignores extensions')."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    source = doc["textures"][int(index)]["source"]
+    image = doc["images"][int(source)]
+    if "bufferView" in image:
+        view = doc["bufferViews"][int(image["bufferView"])]
+        buffer = doc["buffers"][int(view.get("buffer", 0))]
+        uri = buffer.get("uri")
+        if uri is None:
+            blob = binary
+        elif uri.startswith("data:"):
+            blob = base64.b64decode(uri.split(",", 1)[1])
+        else:
+            blob = (folder / uri).read_bytes()
+        if blob is None:
+            return None
+        start = int(view.get("byteOffset", 0))
+        encoded = blob[start:start + int(view["byteLength"])]
+    elif str(image.get("uri", "")).startswith("data:"):
+        encoded = base64.b64decode(image["uri"].split(",", 1)[1])
+    else:
+        encoded = (folder / image["uri"]).read_bytes()
+    with Image.open(io.BytesIO(encoded)) as im:
+        return np.ascontiguousarray(np.asarray(im.convert("RGBA"), dtype=np.uint8))

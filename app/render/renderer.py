@@ -35,6 +35,7 @@ from alight.ibl.bake import (
     bake_steps,
     roughness_to_grid_step,
 )
+from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 
 GL_SRGB8_ALPHA8 = 0x8C43
@@ -44,7 +45,8 @@ MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
-MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness")
+MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
+                 "anisotropy")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 SRGB_MAPS = ("base_color", "emissive")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
@@ -55,6 +57,9 @@ SAMPLER_UNITS = {
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
 }
+# KHR_materials_anisotropy's energy ratios (alight.ibl.anisotropy_lut), bound where a program reads them.
+UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = 20, 21
+SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_ratio_b=UNIT_ANISOTROPY_RATIO_B)
 
 
 @dataclass
@@ -172,6 +177,7 @@ class ForwardRenderer:
         self.ctx = ctx or create_headless_context()
         self.shaders = shaders or ShaderLibrary(self.ctx)
         self.luts = LutCache(self.ctx, self.shaders)
+        self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
         self._targets: _Targets | None = None
@@ -270,6 +276,7 @@ class ForwardRenderer:
             self._targets.release()
             self._targets = None
         self.luts.release()
+        self.anisotropy_lut.release()
         self.shaders.reload()
 
     def __enter__(self) -> "ForwardRenderer":
@@ -390,6 +397,10 @@ class ForwardRenderer:
         maps.prefiltered_radiance.use(UNIT_PREFILTERED)
         maps.prefiltered_radiance_mid.use(UNIT_PREFILTERED_MID)
         maps.brdf_lut.use(UNIT_LUT)
+        if "u_anisotropy_ratio_a" in program:
+            ratio_a, ratio_b = self.anisotropy_lut.textures()
+            ratio_a.use(UNIT_ANISOTROPY_RATIO_A)
+            ratio_b.use(UNIT_ANISOTROPY_RATIO_B)
         _set(program, "u_prefiltered_max_mip", maps.prefiltered_max_mip)
         _set(program, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
         _set(program, "u_env_intensity", float(scene.env_intensity))

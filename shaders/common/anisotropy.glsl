@@ -2,48 +2,13 @@
 // (common/layers.glsl declares the hooks; docs/layer_anisotropy.md defines the BRDF exactly).
 // Numpy twin: app/core/layers/anisotropy.py (same names).
 #ifdef HAS_ANISOTROPY
+#include "common/anisotropic_ggx.glsl"
 
-// Quality choices, in one place: the image-based lookup's fetches along the stretched lobe
-// (ANISOTROPY_FETCHES, 1 to 8; docs/layer_anisotropy.md measures each count against the exact answer).
+// Quality choice, in one place: the image-based lookup's round fetches along the stretched lobe
+// (docs/layer_anisotropy.md: 6 fetches were up to 1.6x worse than 8 at strength 1, 16 no better).
 #ifndef ANISOTROPY_FETCHES
-#define ANISOTROPY_FETCHES 5
+#define ANISOTROPY_FETCHES 8
 #endif
-
-// ---- the BRDF's terms ------------------------------------------------------------------------
-
-// (alpha_t, alpha_b): alpha = r^2 along the direction grows to 1 with strength^2, across it
-// stays (KHR_materials_anisotropy, "Individual lighting contributions").
-vec2 anisotropic_alpha(float roughness, float strength) {
-    float alpha = roughness * roughness;
-    return vec2(mix(alpha, 1.0, strength * strength), alpha);
-}
-
-// Trowbridge-Reitz GGX with a roughness per tangent axis (Burley 2012, "Physically-Based Shading
-// at Disney", eq. 13; the extension's D), in the scaled-vector form that keeps float32 finite.
-float D_GGX_anisotropic(float t_dot_h, float b_dot_h, float n_dot_h, float alpha_t, float alpha_b) {
-    float a2 = alpha_t * alpha_b;
-    vec3 d = vec3(alpha_b * t_dot_h, alpha_t * b_dot_h, a2 * n_dot_h);
-    float w2 = a2 / dot(d, d);
-    return a2 * w2 * w2 / PI;
-}
-
-// The alpha a direction x sees: the lobe's alpha projected on x's azimuth (Heitz 2014,
-// "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs", sec. 5.3). Smith
-// masking of an anisotropic lobe is the isotropic masking at this alpha, so the base's
-// Schlick-GGX G (CONVENTIONS.md) carries over unchanged. At x = n the azimuth is undefined and
-// G1 = 1 whatever alpha: alpha_b is returned.
-float projected_alpha(float t_dot_x, float b_dot_x, float alpha_t, float alpha_b) {
-    float sin2 = t_dot_x * t_dot_x + b_dot_x * b_dot_x;
-    if (sin2 < 1e-12) return alpha_b;
-    return sqrt((t_dot_x * t_dot_x * alpha_t * alpha_t + b_dot_x * b_dot_x * alpha_b * alpha_b) / sin2);
-}
-
-// Schlick-GGX masking of one direction at its projected alpha: k = (sqrt(alpha) + 1)^2 / 8 for
-// punctual lights, alpha / 2 for the environment (brdf.glsl's k_direct, k_ibl).
-float G1_anisotropic(float n_dot_x, float projected, bool punctual) {
-    float r = sqrt(projected);
-    return G1_SchlickGGX(n_dot_x, punctual ? k_direct(r) : k_ibl(r));
-}
 
 // D G F / (4 n.l n.v) with the lobe stretched along s.anisotropy_direction. punctual: the
 // roughness floored at MIN_PUNCTUAL_ROUGHNESS and k_direct; otherwise CONVENTIONS.md's k_ibl,
@@ -70,8 +35,58 @@ vec3 anisotropic_specular(Surface s, vec3 n, vec3 v, vec3 l, vec3 F, bool punctu
 
 // ---- image-based light: the stretched lobe ---------------------------------------------------
 
+// ibl/anisotropy_lut.comp: the stretched lobe's A and B over the round lobe's, per (n.v,
+// roughness, strength), the view's azimuth from the direction at 0, 30, 60, 90 degrees in RGBA.
+uniform sampler3D u_anisotropy_ratio_a;
+uniform sampler3D u_anisotropy_ratio_b;
+
+// The factors on the BRDF LUT's (A, B) that make them the stretched lobe's energy: linear in
+// the view's azimuth between the table's four.
+vec2 anisotropic_energy_ratio(Surface s, vec3 n, vec3 v) {
+    vec3 size = vec3(textureSize(u_anisotropy_ratio_a, 0));
+    float strength = (s.anisotropy_strength * (size.z - 1.0) + 0.5) / size.z;
+    vec3 coord = vec3(max(dot(n, v), 0.0), s.roughness, strength);
+    vec4 a = texture(u_anisotropy_ratio_a, coord);
+    vec4 b = texture(u_anisotropy_ratio_b, coord);
+    float azimuth = atan(abs(dot(s.anisotropy_bitangent, v)), abs(dot(s.anisotropy_direction, v)));
+    float x = clamp(azimuth / radians(30.0), 0.0, 3.0);
+    vec4 w = max(1.0 - abs(vec4(x) - vec4(0.0, 1.0, 2.0, 3.0)), 0.0);
+    return vec2(dot(a, w), dot(b, w));
+}
+
+// The stretched lobe's prefiltered radiance, from ANISOTROPY_FETCHES round lookups. The lobe's
+// normals spread along the direction with alpha_t and across it with alpha_b; a round lookup
+// of the material's roughness (alpha_b) already holds the spread across, so the fetches' normals
+// h_k = normalize(n - x_k t) spread along t only, by what the round lobe leaves:
+// sqrt(alpha_t^2 - alpha_b^2), at the quantiles of GGX's slope marginal
+// (x = q / sqrt(1 - q^2) for q = 2 (k + 1/2) / K - 1, equal mass each). Each fetch is drawn
+// toward its own lobe's mean as the isotropic lookup is (specular_dominant_direction) and
+// weighted by what the BRDF gives that normal under uniform light, G1(n.l) v.h / n.h (the
+// energy itself comes from anisotropic_energy_ratio). At strength 0 every fetch is the
+// isotropic lookup at d. Measured against the exact answer (docs/layer_anisotropy.md): this
+// cuts the round lookup's error 2-5x; the Khronos sample viewer's bent normal is worse than
+// ignoring the stretch.
 vec3 anisotropic_prefiltered_radiance(Surface s, vec3 n, vec3 v, vec3 d, bool with_suns) {
-    return prefiltered_radiance_at(d, s.roughness, with_suns);
+    vec2 alpha = anisotropic_alpha(s.roughness, s.anisotropy_strength);
+    float spread = sqrt(max(alpha.x * alpha.x - alpha.y * alpha.y, 0.0));
+    if (spread < 1e-6) return prefiltered_radiance_at(d, s.roughness, with_suns);
+    vec3 t = s.anisotropy_direction;
+    vec3 b = s.anisotropy_bitangent;
+    vec3 f0 = surface_f0(s);
+    vec3 sum = vec3(0.0);
+    float total = 0.0;
+    for (int k = 0; k < ANISOTROPY_FETCHES; ++k) {
+        float q = (2.0 * float(k) + 1.0) / float(ANISOTROPY_FETCHES) - 1.0;
+        vec3 h = normalize(n - spread * q * inversesqrt(1.0 - q * q) * t);
+        float v_dot_h = max(dot(h, v), 0.0);
+        vec3 l = reflect(-v, h);
+        vec3 dk = specular_dominant_direction(h, l, f0, brdf_lut_at(v_dot_h, s.roughness));
+        float projected = projected_alpha(dot(t, dk), dot(b, dk), alpha.x, alpha.y);
+        float weight = G1_anisotropic(max(dot(n, dk), 0.0), projected, false) * v_dot_h / max(dot(n, h), 1e-4);
+        sum += weight * prefiltered_radiance_at(dk, s.roughness, with_suns);
+        total += weight;
+    }
+    return total > 0.0 ? sum / total : prefiltered_radiance_at(d, s.roughness, with_suns);
 }
 
 #endif

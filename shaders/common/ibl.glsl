@@ -188,6 +188,7 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
 #ifdef HAS_ANISOTROPY
+    lut.xy *= anisotropic_energy_ratio(s, n, v);
     vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, reflect(-v, n), true);
 #else
     vec3 prefiltered = prefiltered_radiance_at(reflect(-v, n), s.roughness, true);
@@ -206,6 +207,7 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
     vec3 r = reflect(-v, n);
     vec3 d = toward_lobe_mean ? specular_dominant_direction(n, r, f0, lut) : r;
 #ifdef HAS_ANISOTROPY
+    lut.xy *= anisotropic_energy_ratio(s, n, v);
     vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, d, with_suns);
 #else
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);

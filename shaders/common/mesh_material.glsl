@@ -38,12 +38,16 @@ uniform sampler2D u_emissive_map;
 uniform sampler2D u_occlusion_map;
 uniform sampler2D u_metallic_map;
 uniform sampler2D u_roughness_map;
+// KHR_materials_anisotropyTexture: RG the direction in the tangent frame (2x - 1), B a factor
+// on the strength (linear data).
+uniform bool u_has_anisotropy_map;
+uniform sampler2D u_anisotropy_map;
 
 // The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 127
+#define MATERIAL_MAPS_MASK 255
 #endif
 const int MAP_BASE_COLOR = 1;
 const int MAP_METALLIC_ROUGHNESS = 2;
@@ -52,6 +56,7 @@ const int MAP_EMISSIVE = 8;
 const int MAP_OCCLUSION = 16;
 const int MAP_METALLIC = 32;
 const int MAP_ROUGHNESS = 64;
+const int MAP_ANISOTROPY = 128;
 
 bool has_map(int bit, bool present) {
     return (MATERIAL_MAPS_MASK & bit) != 0 && present;
@@ -115,6 +120,20 @@ Surface material_surface(vec3 n) {
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
     mat3 frame = tangent_frame(n);
     apply_material_layers(s, n, frame[0], frame[1]);
+#endif
+#ifdef HAS_ANISOTROPY
+    if (has_map(MAP_ANISOTROPY, u_has_anisotropy_map)) {
+        // KHR_materials_anisotropy: the map's direction, turned by anisotropyRotation, in the
+        // tangent frame; its B scales the strength.
+        vec3 texel = texture(u_anisotropy_map, uv).rgb;
+        vec2 d = texel.rg * 2.0 - 1.0;
+        float c = cos(u_anisotropy_rotation);
+        float sn = sin(u_anisotropy_rotation);
+        vec3 direction = frame[0] * (c * d.x - sn * d.y) + frame[1] * (sn * d.x + c * d.y);
+        s.anisotropy_direction = dot(direction, direction) > 1e-12 ? normalize(direction) : frame[0];
+        s.anisotropy_bitangent = cross(n, s.anisotropy_direction);
+        s.anisotropy_strength *= texel.b;
+    }
 #endif
 #ifdef HAS_CLEARCOAT
     // KHR_materials_clearcoat: without a clearcoat normal map the coat is not normal-mapped,

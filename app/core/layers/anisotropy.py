@@ -77,3 +77,35 @@ def anisotropic_specular(m, p, F, punctual: bool = False, spread: float = 0.0) -
     g1l = G1_anisotropic(nl, projected_alpha(p.dot_l(direction, "aniso_t"), p.dot_l(bitangent, "aniso_b"), at, ab),
                          punctual)
     return (D * g1v * g1l / (4.0 * nl * nv))[..., None] * F
+
+
+def importance_sample_ggx_anisotropic(xi, alpha_t, alpha_b):
+    """Half vectors (..., 3) in tangent space (x along the direction, z = n) with pdf D(h) (n.h):
+    the unit GGX slope distribution scaled by (alpha_t, alpha_b) (Walter et al. 2007, sec. 5.2)."""
+    xi = np.asarray(xi, dtype=np.float64)
+    phi = 2.0 * PI * xi[..., 0]
+    radius = np.sqrt(xi[..., 1] / np.maximum(1.0 - xi[..., 1], 1e-12))
+    h = np.stack([radius * alpha_t * np.cos(phi), radius * alpha_b * np.sin(phi), np.ones_like(phi)], axis=-1)
+    return h / np.linalg.norm(h, axis=-1, keepdims=True)
+
+
+def fetch_normals(n, t, roughness, strength, fetches: int = 8):
+    """The stretched lookup's microfacet normals (P, K, 3) for normals n and directions t (P, 3):
+    h_k = normalize(n - x_k t), x_k = sqrt(alpha_t^2 - alpha_b^2) q / sqrt(1 - q^2) at the
+    quantiles q = (2k + 1)/K - 1 of GGX's slope marginal (anisotropy.glsl's
+    anisotropic_prefiltered_radiance)."""
+    at, ab = anisotropic_alpha(roughness, strength)
+    spread = np.sqrt(max(float(at * at - ab * ab), 0.0))
+    q = (2.0 * np.arange(fetches) + 1.0) / fetches - 1.0
+    x = spread * q / np.sqrt(1.0 - q * q)
+    h = np.asarray(n, np.float64)[:, None, :] - x[None, :, None] * np.asarray(t, np.float64)[:, None, :]
+    return h / np.linalg.norm(h, axis=-1, keepdims=True)
+
+
+def fetch_weights(n, dk, h, v, t, b, roughness, strength):
+    """Each fetch's weight (P, K): G1(n.d_k) at d_k's projected alpha times v.h_k / n.h_k."""
+    at, ab = anisotropic_alpha(roughness, strength)
+    n, v, t, b = (np.asarray(x, np.float64)[:, None, :] for x in (n, v, t, b))
+    projected = projected_alpha(np.sum(t * dk, -1), np.sum(b * dk, -1), at, ab)
+    masking = G1_anisotropic(np.maximum(np.sum(n * dk, -1), 0.0), projected, False)
+    return masking * np.maximum(np.sum(v * h, -1), 0.0) / np.maximum(np.sum(n * h, -1), 1e-4)
