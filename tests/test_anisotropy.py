@@ -222,3 +222,68 @@ def test_white_furnace_stays_at_or_below_one():
             assert single.max() <= 1.0 + 2e-3, (rough, strength, float(single.max()))
             multiple = _probe(r, maps, m, width, multiple_scattering=True)[..., :3][inside]
             assert np.abs(multiple - 1.0).max() <= 5e-3, (rough, strength, float(np.abs(multiple - 1.0).max()))
+
+
+def test_a_zero_strength_part_drawn_with_the_layer_compiled_in_changes_nothing(shared_data):
+    # A mesh whose parts mix an anisotropic material with a plain one compiles HAS_ANISOTROPY for
+    # both; the plain part then runs the layer's code at strength 0 (punctual lights, the compact
+    # sources and the environment). It must match the same part drawn without the layer within
+    # 0.2% (issue 11's zero-strength bound).
+    import dataclasses
+
+    from alight.core.mesh import FileMaterial, Mesh, sphere
+    from alight.core.scene import Camera, Light, Scene
+    from alight.ibl.environment import load_environment
+    from tests.gpu import renderer
+
+    def part(offset, layers):
+        p = sphere(64, 32).parts[0]
+        fm = FileMaterial(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.4, emissive=(0.0, 0.0, 0.0),
+                          alpha=1.0, base_color_texture=None, metallic_roughness_texture=None, normal_texture=None,
+                          normal_scale=1.0, emissive_texture=None, occlusion_texture=None, occlusion_strength=1.0,
+                          layers=layers)
+        return dataclasses.replace(p, positions=p.positions + np.float32(offset), material=fm, name=str(offset))
+
+    plain = part((1.2, 0.0, 0.0), {})
+    stretched = part((-1.2, 0.0, 0.0), {"anisotropy_strength": 0.9, "anisotropy_rotation": 0.5})
+    camera = Camera(position=(0.0, 0.0, 6.0), target=(0.0, 0.0, 0.0))
+    lights = [Light(vector=(2.0, 3.0, 4.0), intensity=30.0)]
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "quarry_01_1k.hdr")), "medium")   # a sun: suns_exact too
+
+    def draw(parts):
+        scene = Scene(mesh=Mesh(parts, "two"), camera=camera, lights=lights)
+        return r.render(scene, maps, 192, 96, aa="none").linear
+
+    both = draw([stretched, plain])
+    alone = draw([plain])
+    mask = (alone[..., 3] > 0) & (np.arange(192)[None, :] >= 96)   # the plain part's half of the image
+    assert mask.sum() > 1000
+    error = np.abs(both[mask, :3] - alone[mask, :3]).sum() / np.abs(alone[mask, :3]).sum()
+    assert error <= 0.002, error
+    # ... and the anisotropic part does change.
+    left = (both[..., 3] > 0) & (np.arange(192)[None, :] < 96)
+    assert np.abs(both[left, :3] - draw([dataclasses.replace(stretched, material=plain.material)])[left, :3]).mean() > 0.01
+
+
+def test_reference_on_the_gpu_matches_the_numpy_ground_truth(shared_data):
+    # alight reference (accuracy/reference.comp through the layer's anisotropic_specular) against
+    # anisotropic_ground_truth_terms, on a probe over royal_esplanade reduced by 8.
+    from alight.accuracy.converged import downsample_equirect
+    from alight.accuracy.ground_truth import anisotropic_ground_truth_terms, probe_points
+    from alight.accuracy.reference import ReferenceRenderer
+    from alight.core.scene import Scene
+    from alight.ibl.environment import load_environment
+    from tests.gpu import renderer
+
+    radiance = downsample_equirect(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")).radiance, 8)
+    m = Material(base_color=(0.9, 0.5, 0.2), metallic=0.6, roughness=0.45, anisotropy_strength=0.9,
+                 anisotropy_rotation=0.7)
+    width = 20
+    ref = ReferenceRenderer(renderer())
+    got = ref.render(Scene(material=m, view="probe"), radiance.astype(np.float32), width, width, env_level=0).linear
+    pts, inside = probe_points(width)
+    terms = anisotropic_ground_truth_terms(radiance, pts, (0.0, 0.0, 1.0), None,
+                                           [(m.roughness, m.anisotropy_strength, m.anisotropy_rotation)])[0]
+    want = terms.combine(m.base_color, m.metallic, m.specular_f0)
+    np.testing.assert_allclose(got[..., :3][inside], want, rtol=2e-4, atol=1e-6)
