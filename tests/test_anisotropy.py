@@ -219,8 +219,10 @@ def test_white_furnace_stays_at_or_below_one():
             m = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=rough, anisotropy_strength=strength,
                          anisotropy_rotation=0.4)
             single = _probe(r, maps, m, width)[..., :3][inside]
-            assert single.max() <= 1.0 + 2e-3, (rough, strength, float(single.max()))
             multiple = _probe(r, maps, m, width, multiple_scattering=True)[..., :3][inside]
+            print(f"r={rough} strength={strength}: single {single.min():.4f}-{single.max():.4f}, "
+                  f"multiple {multiple.min():.4f}-{multiple.max():.4f}")
+            assert single.max() <= 1.0 + 2e-3, (rough, strength, float(single.max()))
             assert np.abs(multiple - 1.0).max() <= 5e-3, (rough, strength, float(np.abs(multiple - 1.0).max()))
 
 
@@ -260,6 +262,7 @@ def test_a_zero_strength_part_drawn_with_the_layer_compiled_in_changes_nothing(s
     mask = (alone[..., 3] > 0) & (np.arange(192)[None, :] >= 96)   # the plain part's half of the image
     assert mask.sum() > 1000
     error = np.abs(both[mask, :3] - alone[mask, :3]).sum() / np.abs(alone[mask, :3]).sum()
+    print(f"zero-strength part: {100 * error:.4f}%")
     assert error <= 0.002, error
     # ... and the anisotropic part does change.
     left = (both[..., 3] > 0) & (np.arange(192)[None, :] < 96)

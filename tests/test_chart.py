@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from alight.accuracy.chart import (
+    LAYER_ROWS,
     NV_BINS,
     ErrorMap,
     Setting,
@@ -47,8 +48,9 @@ def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
     assert settings[0].factor == "baseline" and not _changed_fields(settings[0])
     for s in settings[1:]:
         changed = _changed_fields(s)
-        if s.factor in ("IBL model", "multiple scattering"):
+        if s.factor in ("IBL model", "multiple scattering", "layer"):
             assert not changed, (s.name, changed)
+            assert (s.factor == "layer") == bool(s.layer), s.name
         else:
             assert len(changed) == 1 and s.ibl_model == settings[0].ibl_model, (s.name, changed)
     qs = [s.quality for s in settings]
@@ -101,6 +103,16 @@ def test_reference_terms_combine_to_the_direct_reference():
             assert err < 1e-4, (mat.name, r, err)
     with pytest.raises(ValueError):
         terms.combine(load_preset("gold"), 0.5)
+    # A layer row's reference (the chart's anisotropy row): the same combination holds for the
+    # stretched lobe, which is linear in F0 and the base colour too.
+    layer = LAYER_ROWS["anisotropy"]
+    terms = reference_terms(ref, radiance, size, rs, layer)
+    for r in rs:
+        m = replace(load_preset("gold"), roughness=r, **dict(layer))
+        direct = ref.render_gbuffer(probe_gbuffer(size, m), Scene(view="probe", material=m), radiance, env_level=1).linear
+        combined = terms.combine(m, r)
+        err = np.abs(combined[..., :3] - direct[..., :3])[terms.inside].sum() / np.abs(direct[..., :3])[terms.inside].sum()
+        assert err < 1e-4, (r, err)
 
 
 def test_error_map_bins_by_nv_and_roughness():
@@ -159,7 +171,8 @@ def test_chart_quick_end_to_end(quick_chart):
     # The furnace: a constant environment of 1, a metal with F0 = 1: at r = 0 the mirror gives 1.
     with open(out / "furnace.csv", newline="") as f:
         furnace = list(csv.DictReader(f))
-    mirror = [float(r["mean"]) for r in furnace if float(r["roughness"]) == 0.0]
+    # (A layer's row is not a mirror at r = 0: anisotropy stretches it.)
+    mirror = [float(r["mean"]) for r in furnace if float(r["roughness"]) == 0.0 and not r["setting"].startswith("layer ")]
     assert mirror and all(abs(v - 1.0) < 0.01 for v in mirror)
     truth = [r for r in furnace if r["setting"] == "ground truth"]
     assert truth and all(0.0 < float(r["mean"]) <= 1.0 for r in truth)

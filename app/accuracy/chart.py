@@ -12,6 +12,9 @@ tractable), plus every IBL model of ``app/core/ibl_models.py`` and multiple scat
     MS             multiple-scattering compensation on, for every model: judged by the white
                    furnace only (a metal with F0 = 1 under constant radiance 1 should give 1),
                    never against the single-scattering ground truth
+    layer          a glTF layer of issue 11 (LAYER_ROWS) put on every preset at ``medium`` with
+                   the default model, against the ground truth of the layered material (its own
+                   reference, docs/layers.md)
 
 For each setting and environment: the bake time (the environment's passes, warm; the LUT is
 cached on disk and timed apart, cold), the frame time (a fixed scene: the material ball at
@@ -68,6 +71,11 @@ LEVEL1_FROM = 0.25
 LATEST_FILE = "latest_chart.txt"   # in alight.paths.cache_dir(): where the last chart's CSV is
 FRAME_REPEATS = 5
 REFERENCE_WEIGHT = 10.0   # a reference's time in settings' times (for the ETA)
+# The layers' rows (issue 11): the factors put on every preset, as (field, value) pairs of
+# alight.core.material.Material; each row has its own reference. Anisotropy: brushed_aluminium's.
+LAYER_ROWS: dict[str, tuple[tuple[str, float], ...]] = {
+    "anisotropy": (("anisotropy_strength", 0.8), ("anisotropy_rotation", 1.5707963)),
+}
 
 
 @dataclass(frozen=True)
@@ -79,6 +87,7 @@ class Setting:
     quality: BakeQuality
     ibl_model: str
     multiple_scattering: bool = False
+    layer: tuple[tuple[str, float], ...] = ()   # a layer's factors on every material (LAYER_ROWS)
 
     @property
     def bake_key(self) -> BakeQuality:
@@ -89,6 +98,10 @@ class Setting:
     @property
     def judged_by_truth(self) -> bool:
         return not self.multiple_scattering
+
+    def material(self, material):
+        """``material`` with this setting's layer factors on it."""
+        return replace(material, **dict(self.layer)) if self.layer else material
 
 
 def sweep(quick: bool = False) -> list[Setting]:
@@ -129,6 +142,8 @@ def sweep(quick: bool = False) -> list[Setting]:
         out.append(Setting(f"model {m}", "IBL model", base, m))
     for m in models:
         out.append(Setting(f"model {m} + MS", "multiple scattering", base, m, True))
+    for name, factors in LAYER_ROWS.items():
+        out.append(Setting(f"layer {name}", "layer", base, lead, layer=factors))
     return out
 
 
@@ -170,9 +185,11 @@ class ReferenceTerms:
         return out
 
 
-def reference_terms(ref_renderer, radiance: np.ndarray, size: int, roughness) -> ReferenceTerms:
-    """The three basis materials at every roughness, in one G-buffer per environment level."""
-    from alight.accuracy.reference import probe_gbuffer
+def reference_terms(ref_renderer, radiance: np.ndarray, size: int, roughness, layer=()) -> ReferenceTerms:
+    """The three basis materials at every roughness, in one G-buffer per environment level;
+    ``layer``: a layer's factors (Setting.layer) on all three (a layer that keeps the BRDF linear
+    in F0 and the base colour, as anisotropy does)."""
+    from alight.accuracy.reference import GBUFFER, probe_gbuffer
     from alight.core.material import Material
     from alight.core.scene import Scene
 
@@ -190,8 +207,7 @@ def reference_terms(ref_renderer, radiance: np.ndarray, size: int, roughness) ->
         if not idx:
             continue
         # Tiles: columns = basis materials, rows = roughness values of this level.
-        tiles = {name: np.zeros((len(idx) * size, 3 * size, 4), np.float32) for name in
-                 ("position", "normal", "view", "base_color", "specular_f0", "emissive")}
+        tiles = {name: np.zeros((len(idx) * size, 3 * size, 4), np.float32) for name in GBUFFER}
         for row, i in enumerate(idx):
             for col, mat in enumerate(basis):
                 g = probe_gbuffer(size, replace(mat, roughness=rs[i]))
@@ -199,7 +215,8 @@ def reference_terms(ref_renderer, radiance: np.ndarray, size: int, roughness) ->
                     tiles[name][row * size:(row + 1) * size, col * size:(col + 1) * size] = arr
                 if inside is None:
                     inside = g["position"][..., 3] > 0.5
-        res = ref_renderer.render_gbuffer(tiles, Scene(view="probe"), radiance, env_level=level)
+        layered = replace(Material(), **dict(layer)) if layer else Material()
+        res = ref_renderer.render_gbuffer(tiles, Scene(view="probe", material=layered), radiance, env_level=level)
         for row, i in enumerate(idx):
             levels[rs[i]] = res.env_level
             for col in range(3):
@@ -339,8 +356,8 @@ def frame_seconds_interleaved(renderer, items, mesh, size, repeats: int) -> list
     from alight.core.scene import Scene
 
     w, h = size
-    scenes = [Scene(mesh=mesh, material=Material(), ibl_model=s.ibl_model, multiple_scattering=s.multiple_scattering)
-              for s, _ in items]
+    scenes = [Scene(mesh=mesh, material=s.material(Material()), ibl_model=s.ibl_model,
+                    multiple_scattering=s.multiple_scattering) for s, _ in items]
     for scene, (_, maps) in zip(scenes, items):    # compile the programs, make the targets
         renderer.render(scene, maps, w, h, read_linear=False, read_srgb=False)
     renderer.ctx.finish()
@@ -359,7 +376,7 @@ def _furnace(renderer, setting: Setting, maps, size: int) -> list[tuple[float, f
 
     rows = []
     for r in FURNACE_ROUGHNESS:
-        m = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=r)
+        m = setting.material(Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=r))
         frame = renderer.render(_probe_scene(setting, m), maps, size, size, read_srgb=False)
         inside = frame.linear[..., 3] > 0
         v = frame.linear[..., :3][inside].mean(axis=1)
@@ -448,8 +465,9 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
     settings = config.settings
     results = [SettingResult(s) for s in settings]
     # Step weights, measured: a reference ~ 10 settings; the furnace and cold LUTs ~ 5.
-    progress = Progress([5.0] + ([REFERENCE_WEIGHT * len(config.roughness) / len(ROUGHNESS)] + [1.0] * len(settings))
-                        * len(envs), stream)
+    references = len(dict.fromkeys(s.layer for s in settings))
+    progress = Progress([5.0] + ([REFERENCE_WEIGHT * len(config.roughness) / len(ROUGHNESS)] * references
+                                 + [1.0] * len(settings)) * len(envs), stream)
     renderer = ForwardRenderer()
     ref_renderer = ReferenceRenderer(renderer)
     error_map = ErrorMap(config.roughness, config.size)
@@ -478,11 +496,15 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
 
         for e, env in enumerate(envs):
             env_name = Path(env.name).stem
-            terms = reference_terms(ref_renderer, env.radiance, size, config.roughness)
-            progress.step(f"{env_name}: reference ({terms.seconds:.1f} s)")
-            refs = {(p.name, r): terms.combine(replace(p, roughness=r), r)
-                    for p in presets for r in config.roughness}
-            ref_srgb = {k: tonemapped_srgb(v) for k, v in refs.items()}
+            refs, ref_srgb = {}, {}
+            for layer in dict.fromkeys(s.layer for s in settings):
+                terms = reference_terms(ref_renderer, env.radiance, size, config.roughness, layer)
+                progress.step(f"{env_name}: reference{' (' + layer[0][0] + ')' if layer else ''} ({terms.seconds:.1f} s)")
+                for p in presets:
+                    for r in config.roughness:
+                        layered = replace(p, roughness=r, **dict(layer))
+                        refs[(layer, p.name, r)] = terms.combine(layered, r)
+                        ref_srgb[(layer, p.name, r)] = tonemapped_srgb(refs[(layer, p.name, r)])
             bakes = {}
             frame_items = []
             for res in results:
@@ -499,13 +521,13 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                     for p in presets:
                         trow, rrow = [], []
                         for r in config.roughness:
-                            frame = renderer.render(_probe_scene(s, replace(p, roughness=r)), maps, size, size,
-                                                    read_srgb=False)
-                            ref = refs[(p.name, r)]
+                            frame = renderer.render(_probe_scene(s, s.material(replace(p, roughness=r))), maps, size,
+                                                    size, read_srgb=False)
+                            ref = refs[(s.layer, p.name, r)]
                             rel = relative_mae(frame.linear, ref, terms.inside)
                             cells.append((p.name, r, rel))
                             trow.append(tonemapped_srgb(frame.linear))
-                            rrow.append(ref_srgb[(p.name, r)])
+                            rrow.append(ref_srgb[(s.layer, p.name, r)])
                             if s.factor in ("baseline", "IBL model"):
                                 error_map.add(s.ibl_model, r, frame.linear, ref)
                         test_tiles.append(trow)

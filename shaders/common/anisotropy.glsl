@@ -4,10 +4,16 @@
 #ifdef HAS_ANISOTROPY
 #include "common/anisotropic_ggx.glsl"
 
-// Quality choice, in one place: the image-based lookup's round fetches along the stretched lobe
-// (docs/layer_anisotropy.md: 6 fetches were up to 1.6x worse than 8 at strength 1, 16 no better).
+// Quality choices, in one place: the image-based lookup's round fetches along the stretched lobe
+// (docs/layer_anisotropy.md: 6 fetches were up to 1.6x worse than 8 at strength 1, 16 no better),
+// and the lookup itself: 0 the stretched lobe (the default), 1 the round lobe at the material's
+// roughness, 2 the Khronos sample viewer's bent normal. 1 and 2 are kept to be measured against
+// (benchmarks/bench_anisotropy.py): both are 2-10x further from the exact answer.
 #ifndef ANISOTROPY_FETCHES
 #define ANISOTROPY_FETCHES 8
+#endif
+#ifndef ANISOTROPY_LOOKUP
+#define ANISOTROPY_LOOKUP 0
 #endif
 
 // D G F / (4 n.l n.v) with the lobe stretched along s.anisotropy_direction. punctual: the
@@ -67,6 +73,17 @@ vec2 anisotropic_energy_ratio(Surface s, vec3 n, vec3 v) {
 // cuts the round lookup's error 2-5x; the Khronos sample viewer's bent normal is worse than
 // ignoring the stretch.
 vec3 anisotropic_prefiltered_radiance(Surface s, vec3 n, vec3 v, vec3 d, bool with_suns) {
+#if ANISOTROPY_LOOKUP == 1
+    return prefiltered_radiance_at(d, s.roughness, with_suns);
+#elif ANISOTROPY_LOOKUP == 2
+    // The Khronos glTF sample viewer's (ibl.glsl, getIBLRadianceAnisotropy): n bent toward the
+    // plane of the direction and v by (1 - strength (1 - r))^4, the round lobe along its reflection.
+    vec3 anisotropic_normal = cross(cross(s.anisotropy_direction, v), s.anisotropy_direction);
+    float bend = 1.0 - s.anisotropy_strength * (1.0 - s.roughness);
+    bend *= bend;
+    vec3 bent = normalize(mix(anisotropic_normal, n, bend * bend));
+    return prefiltered_radiance_at(reflect(-v, bent), s.roughness, with_suns);
+#endif
     vec2 alpha = anisotropic_alpha(s.roughness, s.anisotropy_strength);
     float spread = sqrt(max(alpha.x * alpha.x - alpha.y * alpha.y, 0.0));
     if (spread < 1e-6) return prefiltered_radiance_at(d, s.roughness, with_suns);
