@@ -42,8 +42,14 @@ void main() {
     // The layers' factors are the scene material's (app/accuracy/reference.py), about the
     // G-buffer's frame.
     vec4 tw = texelFetch(u_g_tangent, p, 0);
-    vec3 t = normalize(tw.xyz - n * dot(n, tw.xyz));
+    vec3 t = tw.xyz - n * dot(n, tw.xyz);
+    t = dot(t, t) > 1e-12 ? normalize(t) : normalize(cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n));
     apply_material_layers(s, n, t, cross(n, t) * (tw.w < 0.0 ? -1.0 : 1.0));
+#endif
+#ifdef HAS_ANISOTROPY
+    // The G-buffer's tangent length: the anisotropy map's factor on the strength, 0 where the
+    // part has no anisotropy (render/gbuffer.frag); 1 in the probe's G-buffer.
+    s.anisotropy_strength *= min(length(tw.xyz), 1.0);
 #endif
     vec3 sum = u_first ? layered_emission(s, v) + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
     if (u_env_enabled && u_row_end > u_row_begin) {
