@@ -8,7 +8,7 @@
 // (docs/layer_anisotropy.md: 6 fetches were up to 1.6x worse than 8 at strength 1, 16 no better),
 // and the lookup itself: 0 the stretched lobe (the default), 1 the round lobe at the material's
 // roughness, 2 the Khronos sample viewer's bent normal. 1 and 2 are kept to be measured against
-// (benchmarks/bench_anisotropy.py): both are 2-10x further from the exact answer.
+// (benchmarks/bench_anisotropy.py): both are 4-6x (round) and 4-15x (bent) further from the exact answer for metals.
 #ifndef ANISOTROPY_FETCHES
 #define ANISOTROPY_FETCHES 8
 #endif
@@ -70,8 +70,8 @@ vec2 anisotropic_energy_ratio(Surface s, vec3 n, vec3 v) {
 // weighted by what the BRDF gives that normal under uniform light, G1(n.l) v.h / n.h (the
 // energy itself comes from anisotropic_energy_ratio). At strength 0 every fetch is the
 // isotropic lookup at d. Measured against the exact answer (docs/layer_anisotropy.md): this
-// cuts the round lookup's error 2-5x; the Khronos sample viewer's bent normal is worse than
-// ignoring the stretch.
+// cuts the round lookup's worst error 4-6x for metals; the Khronos sample viewer's bent normal
+// is worse than ignoring the stretch.
 vec3 anisotropic_prefiltered_radiance(Surface s, vec3 n, vec3 v, vec3 d, bool with_suns) {
 #if ANISOTROPY_LOOKUP == 1
     return prefiltered_radiance_at(d, s.roughness, with_suns);
