@@ -271,7 +271,8 @@ def test_a_zero_strength_part_drawn_with_the_layer_compiled_in_changes_nothing(s
 
 def test_reference_on_the_gpu_matches_the_numpy_ground_truth(shared_data):
     # alight reference (accuracy/reference.comp through the layer's anisotropic_specular) against
-    # anisotropic_ground_truth_terms, on a probe over royal_esplanade reduced by 8.
+    # anisotropic_ground_truth_terms, on a probe over royal_esplanade reduced by 8 and turned by
+    # 30 degrees (the stretch's direction goes into the map's frame with the normal).
     from alight.accuracy.converged import downsample_equirect
     from alight.accuracy.ground_truth import anisotropic_ground_truth_terms, probe_points
     from alight.accuracy.reference import ReferenceRenderer
@@ -284,10 +285,12 @@ def test_reference_on_the_gpu_matches_the_numpy_ground_truth(shared_data):
                  anisotropy_rotation=0.7)
     width = 20
     ref = ReferenceRenderer(renderer())
-    got = ref.render(Scene(material=m, view="probe"), radiance.astype(np.float32), width, width, env_level=0).linear
+    scene = Scene(material=m, view="probe", env_rotation_deg=30.0)
+    got = ref.render(scene, radiance.astype(np.float32), width, width, env_level=0).linear
     pts, inside = probe_points(width)
     terms = anisotropic_ground_truth_terms(radiance, pts, (0.0, 0.0, 1.0), None,
-                                           [(m.roughness, m.anisotropy_strength, m.anisotropy_rotation)])[0]
+                                           [(m.roughness, m.anisotropy_strength, m.anisotropy_rotation)],
+                                           rotation_deg=30.0)[0]
     want = terms.combine(m.base_color, m.metallic, m.specular_f0)
     np.testing.assert_allclose(got[..., :3][inside], want, rtol=2e-4, atol=1e-6)
 
