@@ -122,6 +122,18 @@ def prefiltered_converged(radiance, directions, roughness) -> np.ndarray:
     return out
 
 
+def prefiltered_converged_each(radiance, directions, roughness) -> np.ndarray:
+    """``prefiltered_converged`` with a roughness per direction (P,): the directions grouped by
+    roughness rounded to 1e-4 (the kernel changes by < 1e-4 relative within a group)."""
+    d = _unit_rows(directions)
+    rough = np.round(np.broadcast_to(np.asarray(roughness, np.float64), d.shape[:1]), 4)
+    out = np.empty((d.shape[0], 3))
+    for value in np.unique(rough):
+        sel = rough == value
+        out[sel] = prefiltered_converged(radiance, d[sel], float(min(value, 1.0)))
+    return out
+
+
 def sample_equirect_bilinear(radiance, directions) -> np.ndarray:
     """Bilinear lookup of an equirect map in unit directions (P, 3) -> (P, 3) float64.
 
@@ -397,7 +409,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         diffuse_weight = (1.0 - f0) * (1.0 - diffuse_fresnel(nv))[:, None]
         spec_weight = f0 * A + B
         direction = R
-        if model in ("dominant", "alight"):
+        if model in ("dominant", "alight", "stretched"):
             t_a, t_b = lobe_directions_converged(nv, r)
             weight_a = float(np.dot(f0, (0.2126, 0.7152, 0.0722))) * A[:, 0]
             t = (weight_a * t_a + B[:, 0] * t_b) / np.maximum(weight_a + B[:, 0], 1e-6)
@@ -417,6 +429,12 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         A, B = A * ratios[:, :1], B * ratios[:, 1:]
         spec_weight = f0 * A + B if model not in ("lecture", "lecture-schlick") else F * A + B
         prefiltered = anisotropic_prefiltered_converged(lighting, n, v, t_dir, f0, r, strength)
+    elif model == "stretched":
+        from alight.core.stretched_lobe import stretched_fetches
+
+        d_lo, d_hi, w_hi, fetch_r = stretched_fetches(n, v, direction, f0, A[:, 0], B[:, 0], r)
+        prefiltered = ((1.0 - w_hi)[:, None] * prefiltered_converged_each(lighting, d_lo, fetch_r)
+                       + w_hi[:, None] * prefiltered_converged_each(lighting, d_hi, fetch_r))
     else:
         prefiltered = prefiltered_converged(lighting, direction, r)
     albedo = base * (1.0 - m)

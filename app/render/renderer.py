@@ -60,6 +60,9 @@ SAMPLER_UNITS = {
 # KHR_materials_anisotropy's energy ratios (alight.ibl.anisotropy_lut), bound where a program reads them.
 UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = 20, 21
 SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_ratio_b=UNIT_ANISOTROPY_RATIO_B)
+# The `stretched` IBL model's lobe table (alight.core.stretched_lobe), bound where a program reads it.
+UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = 22, 23
+SAMPLER_UNITS.update(u_stretched_lobe_a=UNIT_STRETCHED_LOBE_A, u_stretched_lobe_b=UNIT_STRETCHED_LOBE_B)
 
 
 @dataclass
@@ -178,6 +181,7 @@ class ForwardRenderer:
         self.shaders = shaders or ShaderLibrary(self.ctx)
         self.luts = LutCache(self.ctx, self.shaders)
         self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
+        self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
         self._targets: _Targets | None = None
@@ -277,6 +281,10 @@ class ForwardRenderer:
             self._targets = None
         self.luts.release()
         self.anisotropy_lut.release()
+        if self._stretched_lobe is not None:
+            for tex in self._stretched_lobe:
+                tex.release()
+            self._stretched_lobe = None
         self.shaders.reload()
 
     def __enter__(self) -> "ForwardRenderer":
@@ -401,10 +409,29 @@ class ForwardRenderer:
             ratio_a, ratio_b = self.anisotropy_lut.textures()
             ratio_a.use(UNIT_ANISOTROPY_RATIO_A)
             ratio_b.use(UNIT_ANISOTROPY_RATIO_B)
+        if "u_stretched_lobe_a" in program:
+            lobe_a, lobe_b = self.stretched_lobe_textures()
+            lobe_a.use(UNIT_STRETCHED_LOBE_A)
+            lobe_b.use(UNIT_STRETCHED_LOBE_B)
         _set(program, "u_prefiltered_max_mip", maps.prefiltered_max_mip)
         _set(program, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
         _set(program, "u_env_intensity", float(scene.env_intensity))
         self._write_suns(program, scene, maps)
+
+    def stretched_lobe_textures(self) -> tuple[moderngl.Texture, moderngl.Texture]:
+        """The `stretched` model's lobe table (alight.core.stretched_lobe) as two RGBA32F textures,
+        linear filtering clamped at the edges (texel centres are the fitted cells)."""
+        if self._stretched_lobe is None:
+            from alight.core.stretched_lobe import lobe_table
+
+            textures = []
+            for part in lobe_table():
+                tex = self.ctx.texture((part.shape[1], part.shape[0]), 4, np.ascontiguousarray(part).tobytes(), dtype="f4")
+                tex.repeat_x = tex.repeat_y = False
+                tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+                textures.append(tex)
+            self._stretched_lobe = (textures[0], textures[1])
+        return self._stretched_lobe
 
     @staticmethod
     def _write_suns(program: moderngl.Program, scene: Scene, maps: IBLMaps) -> None:

@@ -5,10 +5,11 @@
 #include "common/anisotropic_ggx.glsl"
 
 // Quality choices, in one place: the image-based lookup's round fetches along the stretched lobe
-// (docs/layer_anisotropy.md: 6 fetches were up to 1.6x worse than 8 at strength 1, 16 no better),
-// and the lookup itself: 0 the stretched lobe (the default), 1 the round lobe at the material's
-// roughness, 2 the Khronos sample viewer's bent normal. 1 and 2 are kept to be measured against
-// (benchmarks/bench_anisotropy.py): both are 4-6x (round) and 4-15x (bent) further from the exact answer for metals.
+// (docs/layer_anisotropy.md, worst error over 12 cases on royal_esplanade: 6 fetches 23.8%,
+// 8: 21.3%, 16: 19.4%), and the lookup itself: 0 the stretched lobe (the default), 1 the round
+// lobe at the material's roughness, 2 the Khronos sample viewer's bent normal. 1 and 2 are kept
+// to be measured against (benchmarks/bench_anisotropy.py): for metals their worst error per map
+// is 4-6x (round) and 4-15x (bent) the stretched lobe's.
 #ifndef ANISOTROPY_FETCHES
 #define ANISOTROPY_FETCHES 8
 #endif
