@@ -198,7 +198,7 @@ def test_probe_within_bound_of_its_converged_twin(shared_data, rotation):
                      anisotropy_rotation=rotation)
         got = _probe(r, maps, m, width)[..., :3][inside]
         ideal = ibl_converged("alight", radiance, normals[inside], (0.0, 0.0, 1.0), m.base_color, m.metallic, rough,
-                              m.specular_f0, anisotropy=(strength, rotation))
+                              m.specular_f0, material=m)
         error = float(np.abs(got - ideal).sum() / np.abs(ideal).sum())
         print(f"r={rough} strength={strength} rotation={rotation}: {100 * error:.2f}%")
         assert error <= 0.02

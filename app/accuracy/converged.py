@@ -366,7 +366,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
-                  multiple_scattering: bool = False, anisotropy=None, tangents=None) -> np.ndarray:
+                  multiple_scattering: bool = False, material=None, tangents=None) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -376,10 +376,10 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     ``split_sum_converged``. Roughness must be >= MIN_PREFILTER_ROUGHNESS for the non-lecture
     models (the sun's mirror image below the grid is the source cube's business, not this twin's).
 
-    ``anisotropy``: (strength, rotation) of KHR_materials_anisotropy (anisotropy.glsl): the LUT's
-    A and B times the stretched lobe's ratios (``anisotropy_lut_converged``), the stretched
-    lookup (``anisotropic_prefiltered_converged``) and the compact sources through the stretched
-    lobe; ``tangents`` (P, 3) the tangent frame's t (default: the probe's).
+    With KHR_materials_anisotropy on ``material`` (anisotropy.glsl): the LUT's A and B times the
+    stretched lobe's ratios (``anisotropy_lut_converged``), the stretched lookup
+    (``anisotropic_prefiltered_converged``) and the compact sources through the stretched lobe;
+    ``tangents`` (P, 3) the tangent frame's t (default: the probe's).
     """
     from alight.core.ibl_models import IBL_MODELS, SUNS_AS_BAKED
     from alight.ibl.sun import extract_suns
@@ -415,15 +415,16 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
             t = (weight_a * t_a + B[:, 0] * t_b) / np.maximum(weight_a + B[:, 0], 1e-6)
             direction = _unit_rows(n + t[:, None] * (R - n))
     irradiance = irradiance_converged(lighting, n)
-    strength = float(anisotropy[0]) if anisotropy is not None else 0.0
+    from alight.core.layers.stack import probe_tangents
+
+    t0 = probe_tangents(n) if tangents is None else _unit_rows(tangents)
+    t0 = _unit_rows(t0 - n * np.sum(n * t0, -1, keepdims=True))
+    anisotropic = material is not None and "anisotropy" in material.layers()
+    strength = float(material.anisotropy_strength) if anisotropic else 0.0
     if strength > 0.0:
         from alight.core.layers.anisotropy import anisotropy_direction
-        from alight.core.layers.stack import probe_tangents
 
-        t0 = probe_tangents(n) if tangents is None else _unit_rows(tangents)
-        t0 = _unit_rows(t0 - n * np.sum(n * t0, -1, keepdims=True))
-        rotated = type("Rotation", (), {"anisotropy_rotation": float(anisotropy[1])})
-        t_dir, b_dir = anisotropy_direction(rotated, n, t0, np.cross(n, t0))
+        t_dir, b_dir = anisotropy_direction(material, n, t0, np.cross(n, t0))
         azimuth = np.arctan2(np.abs(np.sum(b_dir * v, -1)), np.abs(np.sum(t_dir * v, -1)))
         ratios = np.array([anisotropy_lut_converged(x, r, strength, a, 128, 128) for x, a in zip(nv, azimuth)])
         A, B = A * ratios[:, :1], B * ratios[:, 1:]
@@ -446,35 +447,52 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         out = spec_weight * prefiltered + (f_ms * e_ms + albedo * (1.0 - (spec_weight + f_ms * e_ms))) * irradiance
     else:
         out = diffuse_weight * albedo * irradiance + spec_weight * prefiltered
+    layered = material is not None and bool(material.layers())
+    if layered:
+        out = layered_ibl_converged(material, lighting, n, v, out)
     for sun in suns:
-        if strength > 0.0:
-            out = out + _sun_anisotropic(n, v, t0, sun, base, m, np.asarray(specular_f0, np.float64), r, anisotropy)
+        if layered:
+            from alight.core.layers.stack import Pairs, layered_brdf_cos
+
+            l = _unit_rows(sun.direction)
+            pairs = Pairs(n=n, v=v, l=l, t=t0, b=np.cross(n, t0), spread=sun.spread)
+            out = out + layered_brdf_cos(material, pairs)[:, 0, :] * np.asarray(sun.power)[None, :]
         else:
             out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
     return out
 
 
-def _sun_anisotropic(n, v, t, sun, base, metallic, specular_f0, roughness, anisotropy):
-    """ibl.glsl's sun_light through anisotropy.glsl's stretched lobe (the source's spread widens
-    both axes), times its power."""
-    from alight.core.layers.anisotropy import anisotropic_specular
-    from alight.core.layers.stack import Pairs
-    from alight.core.material import Material
-    from alight.core.shading import F_Schlick
+def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray:
+    """Numpy twin of common/layers.glsl's layered_ibl with converged maps: (P, 3). ``base`` is the
+    IBL model's result (P, 3); ``radiance`` the map the maps are baked from (without the compact
+    sources for the alight model). The sheen reads the numpy twin of its LUT
+    (alight.core.layers.sheen.sheen_lut_table), the clearcoat brdf_lut_converged."""
+    from alight.core.layers import clearcoat as cc
+    from alight.core.layers import sheen as sh
 
-    m = Material(base_color=tuple(base), metallic=metallic, roughness=roughness, specular_f0=tuple(specular_f0),
-                 anisotropy_strength=float(anisotropy[0]), anisotropy_rotation=float(anisotropy[1]))
-    out = np.zeros(n.shape)
-    l = np.asarray(sun.direction, np.float64)[None, :]
-    for i in range(n.shape[0]):
-        p = Pairs(n=n[i:i + 1], v=v[i:i + 1], l=l, t=t[i:i + 1], b=np.cross(n[i:i + 1], t[i:i + 1]))
-        nl = float(p.n_dot_l[0, 0])
-        if nl <= 0.0:
-            continue
-        F = F_Schlick(p.v_dot_h, np.asarray(m.f0()))
-        spec = anisotropic_specular(m, p, F, punctual=False, spread=float(sun.spread))[0, 0]
-        kd = (1.0 - F[0, 0]) * (1.0 - metallic)
-        out[i] = (kd * base / PI + spec) * nl * np.asarray(sun.power)
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    out = np.asarray(base, np.float64)
+    used = material.layers()
+    if "sheen" in used:
+        nv = np.clip(np.sum(n * v, axis=-1), 0.0, 1.0)
+        lut = sh.lut_bilinear(sh.sheen_lut_table(), nv, material.sheen_roughness)   # (P, 4)
+        toward_v = v - n * np.sum(n * v, axis=-1, keepdims=True)
+        length = np.linalg.norm(toward_v, axis=-1, keepdims=True)
+        t = np.where(length > 1e-6, toward_v / np.maximum(length, 1e-300), 0.0)
+        d = _unit_rows(n * np.sqrt(np.maximum(1.0 - lut[:, 1:2] ** 2, 0.0)) + t * lut[:, 1:2])
+        sheen = np.minimum(lut[:, :1], 1.0) * prefiltered_converged_each(radiance, d, lut[:, 2])
+        out = out * sh.sheen_scaling(material.sheen_color, lut[:, :1]) + sheen * np.asarray(material.sheen_color)
+    if "clearcoat" in used:
+        rc = float(material.clearcoat_roughness)
+        nv = np.maximum(np.sum(n * v, axis=-1), 0.0)
+        A, B = brdf_lut_converged(nv, rc)
+        t_a, t_b = lobe_directions_converged(nv, rc)
+        t = (A * t_a + B * t_b) / np.maximum(A + B, 1e-6)   # ibl.glsl's mix with F0 = 1
+        R = reflect(-v, n)
+        d = _unit_rows(n + t[:, None] * (R - n))
+        weight = material.clearcoat * cc.clearcoat_fresnel(nv)[:, None]
+        out = out * (1.0 - weight) + weight * (A + B)[:, None] * prefiltered_converged(radiance, d, rc)
     return out
 
 

@@ -65,6 +65,7 @@ LEVEL1_MAX_SUN_FRACTION = 0.10
 MAX_TEXELS_PER_DISPATCH = 1 << 15
 GBUFFER = ("position", "normal", "view", "base_color", "specular_f0", "emissive", "tangent")
 _UNIT_ENV = 7   # texture units 0-6: the G-buffer
+_UNIT_SHEEN_LUT = 8
 
 
 @dataclass
@@ -80,8 +81,16 @@ class ReferenceResult:
 
 def check_roughness(roughness: float, what: str = "roughness") -> None:
     if roughness < MIN_ROUGHNESS - 1e-9:
-        raise AlightError(f"--roughness: {what} {roughness:g} < {MIN_ROUGHNESS}: the GGX lobe is narrower than a "
+        option = "--" + what.replace("_", "-") if what != "roughness" else "--roughness"
+        raise AlightError(f"{option}: {what} {roughness:g} < {MIN_ROUGHNESS}: the GGX lobe is narrower than a "
                           f"few texels and the texel sum is no longer an integral (no reference below {MIN_ROUGHNESS})")
+
+
+def check_layer_roughness(material) -> None:
+    """The layers' own GGX lobes need the same: the coat's roughness (a coat below 0.1 is a
+    mirror; its sum would sample a delta). The sheen's Charlie lobe is wide at every roughness."""
+    if "clearcoat" in material.layers():
+        check_roughness(material.clearcoat_roughness, "clearcoat_roughness")
 
 
 def choose_env_level(radiance: np.ndarray, roughnesses) -> int:
@@ -158,7 +167,9 @@ class ReferenceRenderer:
         ctx.viewport = (0, 0, width, height)
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         camera = r.camera_for(scene, width / height)
-        prog = r.program("render/pbr.vert", "render/gbuffer.frag", r.layer_defines(scene))
+        def prog(defines: dict):   # each part's variant (uv sets, vertex colours, texture transforms)
+            return r.program("render/pbr.vert", "render/gbuffer.frag", defines)
+
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         r.draw_mesh_parts(scene, prog, camera, camera.view_projection(width / height))
@@ -209,6 +220,7 @@ class ReferenceRenderer:
         if use_env:
             for r in self.scene_roughnesses(scene):
                 check_roughness(r)
+            check_layer_roughness(self.layered_material(scene))
         ctx = self.ctx
         if scene.view == "probe":
             gtex = self._textures_from_arrays(probe_gbuffer(width, scene.material))
@@ -235,6 +247,7 @@ class ReferenceRenderer:
         if use_env:
             for r in roughnesses:
                 check_roughness(r)
+            check_layer_roughness(scene.material)
         return self._sum(self._textures_from_arrays(g), False, scene, radiance if use_env else None, width, height,
                          env_level, chunk_pairs, {}, roughnesses, scene.material)
 
@@ -261,8 +274,12 @@ class ReferenceRenderer:
         seconds["environment"] = t2 - t1
 
         accum = ctx.texture((width, height), 4, dtype="f4")
-        prog = self.renderer.shaders.compute("accuracy/reference.comp", layer_defines([material]))
+        defines = layer_defines([material])
+        prog = self.renderer.shaders.compute("accuracy/reference.comp", defines)
         _set_material(prog, material)   # the layers' factors (the G-buffer holds the base's)
+        if "HAS_SHEEN" in defines:
+            self.renderer.luts.sheen().use(_UNIT_SHEEN_LUT)
+            _set(prog, "u_sheen_lut", _UNIT_SHEEN_LUT)
         for unit, (name, tex) in enumerate(zip(GBUFFER, gtex)):
             tex.use(unit)
             _set(prog, f"u_g_{name}", unit)
