@@ -308,7 +308,7 @@ def test_compare_anisotropy_model_forward_and_reference_agree_under_a_point_ligh
     path = shared_data / "models" / "khronos" / "CompareAnisotropy" / "glTF-Binary" / "CompareAnisotropy.glb"
     mesh = load_mesh(str(path))
     textured = [p for p in mesh.parts if p.material is not None and p.material.anisotropy_texture is not None]
-    assert len(textured) == 1 and textured[0].material.anisotropy_texture.shape[2] == 4
+    assert len(textured) == 1 and textured[0].material.anisotropy_texture.image.shape[2] == 4
     assert sum(bool(p.material.layers) for p in mesh.parts) == 2
     scene = Scene(mesh=mesh, lights=[Light(vector=(1.0, 2.0, 4.0), intensity=40.0)], ibl_enabled=False)
     r = renderer()
