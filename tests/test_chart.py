@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from alight.accuracy.chart import (
+    LAYER_ROWS,
     NV_BINS,
     ErrorMap,
     Setting,
@@ -49,6 +50,7 @@ def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
         changed = _changed_fields(s)
         if s.factor in ("IBL model", "multiple scattering", "layer"):
             assert not changed, (s.name, changed)
+            assert (s.factor == "layer") == bool(s.layer), s.name
         else:
             assert len(changed) == 1 and s.ibl_model == settings[0].ibl_model, (s.name, changed)
     qs = [s.quality for s in settings]
@@ -107,6 +109,18 @@ def test_reference_terms_combine_to_the_direct_reference():
             assert err < 1e-4, (mat.name, r, err)
     with pytest.raises(ValueError):
         terms.combine(load_preset("gold"), 0.5)
+    # A layer row's reference (layer_reference): each roughness's tile of the one G-buffer equals
+    # a direct reference of the layered material alone (here brushed_aluminium's anisotropy).
+    from alight.accuracy.chart import layer_reference
+
+    aniso = load_preset("brushed_aluminium")
+    tiles = layer_reference(ref, radiance, size, aniso, rs)
+    assert sorted(tiles) == list(rs)
+    for r in rs:
+        m = replace(aniso, roughness=r)
+        direct = ref.render_gbuffer(probe_gbuffer(size, m), Scene(view="probe", material=m), radiance, env_level=1).linear
+        err = np.abs(tiles[r][..., :3] - direct[..., :3])[inside].sum() / np.abs(direct[..., :3])[inside].sum()
+        assert err < 1e-5, (r, err)
 
 
 def test_error_map_bins_by_nv_and_roughness():
@@ -159,19 +173,24 @@ def test_chart_quick_end_to_end(quick_chart):
         cases = list(csv.DictReader(f))
     judged = [r for r in rows if not r["multiple_scattering"]]
     # The base rows: the 3 presets without layers x 3 roughness values, one environment; each
-    # layer's row: its preset (car_paint, velvet) at the 3 roughness values.
+    # layer's row: its preset at the roughness values whose lobes the texel sum can integrate
+    # (alight.accuracy.reference's checks: a narrow anisotropic lobe has no case).
     layer_rows = [r for r in judged if r["factor"] == "layer"]
-    assert [r["setting"] for r in layer_rows] == ["layer clearcoat", "layer sheen"]
-    assert len(cases) == (len(judged) - 2) * 3 * 3 + 2 * 3
-    assert {c["preset"] for c in cases if c["setting"] == "layer clearcoat"} == {"car_paint"}
-    assert {c["preset"] for c in cases if c["setting"] == "layer sheen"} == {"velvet"}
+    assert [r["setting"] for r in layer_rows] == ["layer clearcoat", "layer sheen", "layer anisotropy"]
+    layer_preset = {"layer clearcoat": "car_paint", "layer sheen": "velvet", "layer anisotropy": "brushed_aluminium"}
+    per_layer = {name: [c for c in cases if c["setting"] == name] for name in layer_preset}
+    for name, preset in layer_preset.items():
+        assert {c["preset"] for c in per_layer[name]} == {preset}
+        assert 1 <= len(per_layer[name]) <= 3
+    assert len(cases) == (len(judged) - 3) * 3 * 3 + sum(len(v) for v in per_layer.values())
     # The baseline's summary is the mean of its cases.
     base = [float(c["rel_mae"]) for c in cases if c["setting"] == rows[0]["setting"]]
     assert rows[0]["rel_mae_mean"] == pytest.approx(np.mean(base), rel=1e-4)
     # The furnace: a constant environment of 1, a metal with F0 = 1: at r = 0 the mirror gives 1.
     with open(out / "furnace.csv", newline="") as f:
         furnace = list(csv.DictReader(f))
-    mirror = [float(r["mean"]) for r in furnace if float(r["roughness"]) == 0.0]
+    # (A layer's row is not a mirror at r = 0: anisotropy stretches it.)
+    mirror = [float(r["mean"]) for r in furnace if float(r["roughness"]) == 0.0 and not r["setting"].startswith("layer ")]
     assert mirror and all(abs(v - 1.0) < 0.01 for v in mirror)
     truth = [r for r in furnace if r["setting"] == "ground truth"]
     assert truth and all(0.0 < float(r["mean"]) <= 1.0 for r in truth)

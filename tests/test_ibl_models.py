@@ -88,3 +88,30 @@ def test_every_model_is_exact_for_a_white_furnace_up_to_its_weights(model):
     np.testing.assert_allclose(single, truth, rtol=2e-3, atol=2e-3)
     np.testing.assert_allclose(multi, 1.0, atol=1e-4)   # the texel sum of E/pi: 1 - 1.5e-5 at 256x128
     assert (truth < 0.999).any()    # single scattering loses energy: the compensation had work to do
+
+
+@pytest.mark.parametrize("env_name", ["newport_loft.hdr", "royal_esplanade_1k.hdr", "venice_sunset_1k.hdr"])
+def test_the_stretched_lobe_cuts_the_error_left_at_middle_roughness(shared_data, env_name):
+    """Maps without a strong sun, r = 0.4: what alight leaves is the lobe's shape (narrower across
+    the plane of incidence than the round prefiltered lobe, reaching further toward n). The
+    `stretched` model's two fetches, fitted in lobe space without any map
+    (tools/fit_stretched_lobe.py), cut it for a metal and a dielectric on each of these maps."""
+    radiance = reduced(shared_data, env_name)
+    for preset in ("gold", "water"):
+        e = errors(radiance, preset, 0.4, ["alight", "stretched"])
+        print(env_name, preset, {k: f"{100 * x:.1f}%" for k, x in e.items()})
+        assert e["stretched"] < 0.75 * e["alight"]
+
+
+def test_the_stretched_lobe_table_is_the_round_lookup_where_it_is_not_fitted():
+    """Rows below r = 0.2 (the lobe narrower than the fit's grid) and the n.v = 1 limit hold the
+    round lookup or close to it; every row's fetch roughness stays in (0, 1.3] of the material's."""
+    from alight.core.stretched_lobe import lobe_table
+
+    table = lobe_table()
+    assert table.shape == (2, 16, 8, 4)
+    rows_unfitted = [(i + 0.5) / 16 < 0.2 for i in range(16)]
+    np.testing.assert_array_equal(table[:, rows_unfitted], np.broadcast_to([0.0, 0.0, 0.0, 1.0], table[:, rows_unfitted].shape))
+    assert (table[..., 0] <= table[..., 1]).all()                   # canonical: a_lo <= a_hi
+    assert ((table[..., 2] >= 0) & (table[..., 2] <= 1)).all()
+    assert ((table[..., 3] > 0) & (table[..., 3] <= 1.3 + 1e-6)).all()

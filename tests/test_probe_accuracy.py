@@ -84,13 +84,14 @@ MODEL_CASES = [(e, r) for e in ENVIRONMENTS for r in (0.3, 0.5, 1.0)]
 
 @pytest.mark.parametrize("env_name,roughness", MODEL_CASES)
 @pytest.mark.parametrize("name", list(MATERIALS))
-def test_default_model_within_bound_of_its_converged_twin(shared_data, env_name, name, roughness):
-    """The default model (alight) against alight.accuracy.converged.ibl_converged, its numpy twin with
+@pytest.mark.parametrize("model", ["alight", "stretched"])
+def test_default_model_within_bound_of_its_converged_twin(shared_data, env_name, name, roughness, model):
+    """The default model (alight), and `stretched` (its two fitted fetches, app/core/stretched_lobe.py),
+    against alight.accuracy.converged.ibl_converged, its numpy twin with
     converged maps: the same bounds as the lecture's. This checks the shader's lobe directions,
     diffuse weight and exact compact sources, not only the bake. The twin sums over the map
     reduced by 2 (alight.accuracy.converged.downsample_equirect: <= 0.06% at r >= 0.25) to keep it fast.
     Measured: royal 0.5% (dielectric), 0.7-1.4% (metal); quarry 0.2-0.5%, 0.6-1.5%."""
-    model = "alight"
     env = load_environment(str(shared_data / "env" / env_name))
     n, inside = shading.probe_normals(WIDTH)
     m = Material(base_color=MATERIALS[name].base_color, metallic=MATERIALS[name].metallic, roughness=roughness)

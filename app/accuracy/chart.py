@@ -65,18 +65,22 @@ FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
 # of its texels), from this roughness up.
 FURNACE_TRUTH_WIDTH = 256
 FURNACE_TRUTH_FROM = 0.25
-QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet")   # the last two: the layers' rows
+QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet", "brushed_aluminium")   # the last three: the layers' rows
 # Layers with a row of their own (issue 11), the material of their white furnace (radiance 1:
 # what the layer reflects and transmits must not exceed 1, and at roughness 0 it is exactly 1)
 # and the preset drawn for their frame time.
-LAYER_ROWS = ("clearcoat", "sheen")
+LAYER_ROWS = ("clearcoat", "sheen", "anisotropy")
 LAYER_FURNACE = {
     # A white metal under a full coat, or under a white sheen: at most 1 (docs/layer_clearcoat.md,
     # docs/layer_sheen.md).
     "clearcoat": dict(base_color=(1.0, 1.0, 1.0), metallic=1.0, clearcoat=1.0, clearcoat_roughness=0.3),
     "sheen": dict(base_color=(1.0, 1.0, 1.0), metallic=1.0, sheen_color=(1.0, 1.0, 1.0), sheen_roughness=0.5),
+    # A white metal with brushed_aluminium's anisotropy: exactly 1 would need multiple scattering,
+    # so at most 1 (docs/layer_anisotropy.md).
+    "anisotropy": dict(base_color=(1.0, 1.0, 1.0), metallic=1.0, anisotropy_strength=0.8,
+                       anisotropy_rotation=1.5707963),
 }
-LAYER_FRAME_PRESET = {"clearcoat": "car_paint", "sheen": "velvet"}
+LAYER_FRAME_PRESET = {"clearcoat": "car_paint", "sheen": "velvet", "anisotropy": "brushed_aluminium"}
 # Environments left out of the summary columns (still in chart_cases.csv): spot1Lux's truth is
 # near zero over most of the ball, where a relative error means little (issue 4).
 SUMMARY_EXCLUDED = ("spot1Lux",)

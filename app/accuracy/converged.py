@@ -122,6 +122,18 @@ def prefiltered_converged(radiance, directions, roughness) -> np.ndarray:
     return out
 
 
+def prefiltered_converged_each(radiance, directions, roughness) -> np.ndarray:
+    """``prefiltered_converged`` with a roughness per direction (P,): the directions grouped by
+    roughness rounded to 1e-4 (the kernel changes by < 1e-4 relative within a group)."""
+    d = _unit_rows(directions)
+    rough = np.round(np.broadcast_to(np.asarray(roughness, np.float64), d.shape[:1]), 4)
+    out = np.empty((d.shape[0], 3))
+    for value in np.unique(rough):
+        sel = rough == value
+        out[sel] = prefiltered_converged(radiance, d[sel], float(min(value, 1.0)))
+    return out
+
+
 def sample_equirect_bilinear(radiance, directions) -> np.ndarray:
     """Bilinear lookup of an equirect map in unit directions (P, 3) -> (P, 3) float64.
 
@@ -240,6 +252,77 @@ def lobe_directions_converged(n_dot_v, roughness, n_u: int = 512, n_phi: int = 1
     return out[0].reshape(shape), out[1].reshape(shape)
 
 
+def anisotropy_lut_converged(n_dot_v, roughness, strength, azimuth, n_u: int = 256, n_phi: int = 256):
+    """Numpy twin of ibl/anisotropy_lut.comp at one view: the stretched lobe's (A, B) over the
+    round lobe's, (ratio_A, ratio_B), by a midpoint rule over the slope distribution's inverse
+    CDF (u, phi) instead of Hammersley points. ``azimuth``: the view's angle (radians) from the
+    stretch direction in the tangent plane. Scalars in, floats out.
+    """
+    from alight.core.layers.anisotropy import anisotropic_alpha, projected_alpha
+
+    nv = float(np.clip(n_dot_v, 1e-4, 1.0))
+    sg = (np.arange(n_u) + 0.5) / n_u
+    u = 1.0 - (1.0 - sg) ** 2          # dense near u = 1 (grazing h), as _lut_quadrature
+    wu = 2.0 * (1.0 - sg) / n_u
+    phi = (np.arange(n_phi) + 0.5) * (2.0 * PI / n_phi)
+    sin_v = np.sqrt(1.0 - nv * nv)
+    v = np.array([sin_v * np.cos(azimuth), sin_v * np.sin(azimuth), nv])
+
+    def energy(alpha_t, alpha_b):
+        radius = np.sqrt(u / (1.0 - u))[:, None]
+        h = np.stack(np.broadcast_arrays(radius * alpha_t * np.cos(phi)[None, :],
+                                         radius * alpha_b * np.sin(phi)[None, :], np.ones((n_u, n_phi))), -1)
+        h /= np.linalg.norm(h, axis=-1, keepdims=True)
+        vh = h @ v
+        l = 2.0 * vh[..., None] * h - v
+        ok = (l[..., 2] > 0.0) & (vh > 0.0)
+        kv = projected_alpha(v[0], v[1], alpha_t, alpha_b) / 2.0
+        kl = projected_alpha(l[..., 0], l[..., 1], alpha_t, alpha_b) / 2.0
+        nl = np.where(ok, l[..., 2], 1.0)
+        g = (nv / (nv * (1.0 - kv) + kv)) * (nl / (nl * (1.0 - kl) + kl))
+        g_vis = np.where(ok, g * np.clip(vh, 0.0, 1.0) / (h[..., 2] * nv), 0.0)
+        fc = (1.0 - np.clip(vh, 0.0, 1.0)) ** 5
+        return wu @ np.mean((1.0 - fc) * g_vis, axis=1), wu @ np.mean(fc * g_vis, axis=1)
+
+    at, ab = anisotropic_alpha(float(roughness), float(strength))
+    sa, sb = energy(float(at), float(ab))
+    ra, rb = energy(float(ab), float(ab))
+    return (sa / ra if ra > 0.0 else 1.0), (sb / rb if rb > 0.0 else 1.0)
+
+
+def anisotropic_prefiltered_converged(radiance, normals, view, tangents, f0, roughness, strength,
+                                      fetches: int = 8) -> np.ndarray:
+    """Numpy twin of anisotropy.glsl's anisotropic_prefiltered_radiance with converged parts: the
+    ``fetches`` round lookups (``prefiltered_converged`` at the material's roughness) along the
+    stretch, each drawn toward its lobe's mean (the LUT's t_A, t_B by quadrature) and weighted
+    by G1(n.l) v.h / n.h. ``tangents``: the stretch direction at each point (P, 3), already
+    rotated; (P, 3) float64.
+    """
+    from alight.core.layers.anisotropy import fetch_normals, fetch_weights
+
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    t = _unit_rows(tangents)
+    b = np.cross(n, t)
+    r = float(roughness)
+    h = fetch_normals(n, t, r, strength, fetches)                                # (P, K, 3)
+    vh = np.clip(np.sum(v[:, None, :] * h, -1), 0.0, 1.0)
+    l = 2.0 * np.sum(v[:, None, :] * h, -1)[..., None] * h - v[:, None, :]
+    # The LUT's (A, B, t_A, t_B) at (v.h, r), from quadratures on a fine n.v grid.
+    grid = np.linspace(0.0, 1.0, 129)
+    A, B = brdf_lut_converged(grid, np.full_like(grid, r), 256, 64)
+    ta, tb = lobe_directions_converged(grid, np.full_like(grid, r), 256, 64)
+    a_k, b_k, ta_k, tb_k = (np.interp(vh, grid, x) for x in (A, B, ta, tb))
+    weight_a = float(np.dot(np.asarray(f0, np.float64), (0.2126, 0.7152, 0.0722))) * a_k
+    mix_t = (weight_a * ta_k + b_k * tb_k) / np.maximum(weight_a + b_k, 1e-6)
+    dk = h + mix_t[..., None] * (l - h)
+    dk /= np.linalg.norm(dk, axis=-1, keepdims=True)
+    w = fetch_weights(n, dk, h, v, t, b, r, strength)                           # (P, K)
+    values = prefiltered_converged(radiance, dk.reshape(-1, 3), r).reshape(dk.shape)
+    total = np.sum(w, axis=1, keepdims=True)
+    return np.sum(w[..., None] * values, axis=1) / np.maximum(total, 1e-30)
+
+
 # ibl.glsl's diffuse_fresnel: a quartic in 1 - n.v fitted to diffuse_fresnel_converged.
 DIFFUSE_FRESNEL_COEFFS = (8.233601e-05, 0.002021979, 0.009310647, 0.007795988, 0.0089526)
 
@@ -283,7 +366,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
-                  multiple_scattering: bool = False, material=None) -> np.ndarray:
+                  multiple_scattering: bool = False, material=None, tangents=None) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -292,6 +375,11 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     the whole map), ``alight`` shades them as delta lights through the exact BRDF. ``lecture`` is
     ``split_sum_converged``. Roughness must be >= MIN_PREFILTER_ROUGHNESS for the non-lecture
     models (the sun's mirror image below the grid is the source cube's business, not this twin's).
+
+    With KHR_materials_anisotropy on ``material`` (anisotropy.glsl): the LUT's A and B times the
+    stretched lobe's ratios (``anisotropy_lut_converged``), the stretched lookup
+    (``anisotropic_prefiltered_converged``) and the compact sources through the stretched lobe;
+    ``tangents`` (P, 3) the tangent frame's t (default: the probe's).
     """
     from alight.core.ibl_models import IBL_MODELS, SUNS_AS_BAKED
     from alight.ibl.sun import extract_suns
@@ -321,13 +409,35 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         diffuse_weight = (1.0 - f0) * (1.0 - diffuse_fresnel(nv))[:, None]
         spec_weight = f0 * A + B
         direction = R
-        if model in ("dominant", "alight"):
+        if model in ("dominant", "alight", "stretched"):
             t_a, t_b = lobe_directions_converged(nv, r)
             weight_a = float(np.dot(f0, (0.2126, 0.7152, 0.0722))) * A[:, 0]
             t = (weight_a * t_a + B[:, 0] * t_b) / np.maximum(weight_a + B[:, 0], 1e-6)
             direction = _unit_rows(n + t[:, None] * (R - n))
     irradiance = irradiance_converged(lighting, n)
-    prefiltered = prefiltered_converged(lighting, direction, r)
+    from alight.core.layers.stack import probe_tangents
+
+    t0 = probe_tangents(n) if tangents is None else _unit_rows(tangents)
+    t0 = _unit_rows(t0 - n * np.sum(n * t0, -1, keepdims=True))
+    anisotropic = material is not None and "anisotropy" in material.layers()
+    strength = float(material.anisotropy_strength) if anisotropic else 0.0
+    if strength > 0.0:
+        from alight.core.layers.anisotropy import anisotropy_direction
+
+        t_dir, b_dir = anisotropy_direction(material, n, t0, np.cross(n, t0))
+        azimuth = np.arctan2(np.abs(np.sum(b_dir * v, -1)), np.abs(np.sum(t_dir * v, -1)))
+        ratios = np.array([anisotropy_lut_converged(x, r, strength, a, 128, 128) for x, a in zip(nv, azimuth)])
+        A, B = A * ratios[:, :1], B * ratios[:, 1:]
+        spec_weight = f0 * A + B if model not in ("lecture", "lecture-schlick") else F * A + B
+        prefiltered = anisotropic_prefiltered_converged(lighting, n, v, t_dir, f0, r, strength)
+    elif model == "stretched":
+        from alight.core.stretched_lobe import stretched_fetches
+
+        d_lo, d_hi, w_hi, fetch_r = stretched_fetches(n, v, direction, f0, A[:, 0], B[:, 0], r)
+        prefiltered = ((1.0 - w_hi)[:, None] * prefiltered_converged_each(lighting, d_lo, fetch_r)
+                       + w_hi[:, None] * prefiltered_converged_each(lighting, d_hi, fetch_r))
+    else:
+        prefiltered = prefiltered_converged(lighting, direction, r)
     albedo = base * (1.0 - m)
     if multiple_scattering:
         e_ss = A + B
@@ -342,23 +452,13 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         out = layered_ibl_converged(material, lighting, n, v, out)
     for sun in suns:
         if layered:
-            from alight.core.layers.stack import Pairs, layered_brdf_cos, probe_tangents
+            from alight.core.layers.stack import Pairs, layered_brdf_cos
 
             l = _unit_rows(sun.direction)
-            pairs = Pairs(n=n, v=v, l=l, t=probe_tangents(n), b=np.cross(n, probe_tangents(n)), spread=sun.spread)
+            pairs = Pairs(n=n, v=v, l=l, t=t0, b=np.cross(n, t0), spread=sun.spread)
             out = out + layered_brdf_cos(material, pairs)[:, 0, :] * np.asarray(sun.power)[None, :]
         else:
             out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
-    return out
-
-
-def _prefiltered_per_point(radiance, directions, roughness) -> np.ndarray:
-    """prefiltered_converged with a roughness per direction (one texel sum per distinct value)."""
-    out = np.empty((directions.shape[0], 3))
-    roughness = np.asarray(roughness, np.float64)
-    for value in np.unique(roughness):
-        sel = roughness == value
-        out[sel] = prefiltered_converged(radiance, directions[sel], float(value))
     return out
 
 
@@ -381,7 +481,7 @@ def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray
         length = np.linalg.norm(toward_v, axis=-1, keepdims=True)
         t = np.where(length > 1e-6, toward_v / np.maximum(length, 1e-300), 0.0)
         d = _unit_rows(n * np.sqrt(np.maximum(1.0 - lut[:, 1:2] ** 2, 0.0)) + t * lut[:, 1:2])
-        sheen = np.minimum(lut[:, :1], 1.0) * _prefiltered_per_point(radiance, d, lut[:, 2])
+        sheen = np.minimum(lut[:, :1], 1.0) * prefiltered_converged_each(radiance, d, lut[:, 2])
         out = out * sh.sheen_scaling(material.sheen_color, lut[:, :1]) + sheen * np.asarray(material.sheen_color)
     if "clearcoat" in used:
         rc = float(material.clearcoat_roughness)

@@ -18,6 +18,8 @@ IBL_MODELS: dict[str, str] = {
     "dominant": "karis, fetched at the specular lobe's mean direction (from the BRDF LUT) instead of R",
     "alight": "dominant for the environment without its compact sources, and those sources (the sun) "
               "through the exact BRDF",
+    "stretched": "alight, with the lobe's shape from two round fetches fitted to the real lobe in lobe "
+                 "space (app/core/stretched_lobe.json) instead of one at its mean direction",
 }
 
 DEFAULT_IBL_MODEL = "alight"

@@ -86,7 +86,10 @@ TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
 # clearcoat_roughness G multiply their factors (linear); clearcoat_normal is the coat's own
 # tangent-space normal map (scaled by clearcoat_normal_scale); sheen_color RGB (sRGB) and
 # sheen_roughness A multiply theirs.
-LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness")
+# anisotropy (KHR_materials_anisotropy's anisotropyTexture, linear): RG a direction in the tangent
+# frame (2x - 1), B a factor on anisotropy_strength.
+LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness",
+                       "anisotropy")
 
 
 @dataclass
@@ -125,6 +128,7 @@ class FileMaterial:
     clearcoat_normal_scale: float = 1.0
     sheen_color_texture: TextureInfo | None = None
     sheen_roughness_texture: TextureInfo | None = None
+    anisotropy_texture: TextureInfo | None = None
 
     def __post_init__(self) -> None:
         for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:

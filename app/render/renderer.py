@@ -49,6 +49,7 @@ from alight.ibl.bake import (
     roughness_to_grid_step,
 )
 from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
+from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.render.tiles import (
     TILE_BYTES,
@@ -69,7 +70,7 @@ MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
-                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness")
+                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
 UNIT_SCENE_DEPTH = UNIT_SHEEN_LUT + 1      # render/resolve.frag's depth samples
@@ -84,6 +85,12 @@ SAMPLER_UNITS = {
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
     "u_sheen_lut": UNIT_SHEEN_LUT,
 }
+# KHR_materials_anisotropy's energy ratios (alight.ibl.anisotropy_lut), bound where a program reads them.
+UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = 20, 21
+SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_ratio_b=UNIT_ANISOTROPY_RATIO_B)
+# The `stretched` IBL model's lobe table (alight.core.stretched_lobe), bound where a program reads it.
+UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = 22, 23
+SAMPLER_UNITS.update(u_stretched_lobe_a=UNIT_STRETCHED_LOBE_A, u_stretched_lobe_b=UNIT_STRETCHED_LOBE_B)
 
 
 @dataclass
@@ -310,6 +317,8 @@ class ForwardRenderer:
         self.bake_cache = BakeCache() if bake_cache == "default" else bake_cache
         self.bakes_run = 0
         self.bakes_loaded = 0
+        self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
+        self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart], _MeshTextures]] = {}
         self._targets: _Targets | None = None
@@ -431,6 +440,11 @@ class ForwardRenderer:
         self.luts.release()
         if self.bake_cache is not None:
             self.bake_cache.close()
+        self.anisotropy_lut.release()
+        if self._stretched_lobe is not None:
+            for tex in self._stretched_lobe:
+                tex.release()
+            self._stretched_lobe = None
         self.shaders.reload()
 
     def __enter__(self) -> "ForwardRenderer":
@@ -667,10 +681,33 @@ class ForwardRenderer:
         maps.prefiltered_radiance.use(UNIT_PREFILTERED)
         maps.prefiltered_radiance_mid.use(UNIT_PREFILTERED_MID)
         maps.brdf_lut.use(UNIT_LUT)
+        if "u_anisotropy_ratio_a" in program:
+            ratio_a, ratio_b = self.anisotropy_lut.textures()
+            ratio_a.use(UNIT_ANISOTROPY_RATIO_A)
+            ratio_b.use(UNIT_ANISOTROPY_RATIO_B)
+        if "u_stretched_lobe_a" in program:
+            lobe_a, lobe_b = self.stretched_lobe_textures()
+            lobe_a.use(UNIT_STRETCHED_LOBE_A)
+            lobe_b.use(UNIT_STRETCHED_LOBE_B)
         _set(program, "u_prefiltered_max_mip", maps.prefiltered_max_mip)
         _set(program, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
         _set(program, "u_env_intensity", float(scene.env_intensity))
         self._write_suns(program, scene, maps)
+
+    def stretched_lobe_textures(self) -> tuple[moderngl.Texture, moderngl.Texture]:
+        """The `stretched` model's lobe table (alight.core.stretched_lobe) as two RGBA32F textures,
+        linear filtering clamped at the edges (texel centres are the fitted cells)."""
+        if self._stretched_lobe is None:
+            from alight.core.stretched_lobe import lobe_table
+
+            textures = []
+            for part in lobe_table():
+                tex = self.ctx.texture((part.shape[1], part.shape[0]), 4, np.ascontiguousarray(part).tobytes(), dtype="f4")
+                tex.repeat_x = tex.repeat_y = False
+                tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+                textures.append(tex)
+            self._stretched_lobe = (textures[0], textures[1])
+        return self._stretched_lobe
 
     @staticmethod
     def _write_suns(program: moderngl.Program, scene: Scene, maps: IBLMaps) -> None:

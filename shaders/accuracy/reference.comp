@@ -50,10 +50,17 @@ void main() {
     // The layers' factors are the scene material's (app/accuracy/reference.py), about the
     // G-buffer's frame.
     vec4 tw = texelFetch(u_g_tangent, p, 0);
-    vec3 t = normalize(tw.xyz - n * dot(n, tw.xyz));
+    vec3 t = tw.xyz - n * dot(n, tw.xyz);
+    t = dot(t, t) > 1e-12 ? normalize(t) : normalize(cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n));
     vec3 b = cross(n, t) * (tw.w < 0.0 ? -1.0 : 1.0);
     apply_material_layers(s, n, t, b);
     apply_material_layers(s_map, n_map, rotate_world_to_map(t, u_env_rotation), rotate_world_to_map(b, u_env_rotation));
+#endif
+#ifdef HAS_ANISOTROPY
+    // The G-buffer's tangent length: the anisotropy map's factor on the strength, 0 where the
+    // part has no anisotropy (render/gbuffer.frag); 1 in the probe's G-buffer.
+    s.anisotropy_strength *= min(length(tw.xyz), 1.0);
+    s_map.anisotropy_strength = s.anisotropy_strength;
 #endif
     vec3 sum = u_first ? layered_emission(s, v) + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
     if (u_env_enabled && u_row_end > u_row_begin) {

@@ -6,6 +6,12 @@
 
 #include "common/suns.glsl"
 
+// The model: IBL_MODEL is the position of its name in app/core/ibl_models.py's IBL_MODELS, set by
+// app/render/renderer.py (ibl_model below), so only the chosen model is compiled.
+#ifndef IBL_MODEL
+#define IBL_MODEL 4
+#endif
+
 uniform samplerCube u_irradiance;            // E/pi: the cosine-weighted mean radiance
 uniform samplerCube u_environment;           // source radiance with box mips: the mirror (r = 0)
 uniform samplerCube u_prefiltered_radiance;  // grid A: mip m holds alpha = 2^(m - max_mip)
@@ -122,6 +128,35 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
     return normalize(mix(n, r, t));
 }
 
+#if IBL_MODEL == 5
+// ---- the stretched lobe (model `stretched`) -------------------------------------------------
+
+// app/core/stretched_lobe.json over (n.v, roughness) at texel centres, for the lobe's F0-scaled
+// part (a) and its bias part (b): (a_lo, a_hi, w_hi, beta), two round fetches at signed angles
+// from the lobe's mean direction in the plane of incidence (toward the horizon positive), the
+// second weighted w_hi, both at roughness r sqrt(beta). tools/fit_stretched_lobe.py fits them in
+// lobe space (no environment map): the real lobe is narrower across the plane of incidence than
+// the round one the prefiltered map holds, and reaches further toward n.
+uniform sampler2D u_stretched_lobe_a;
+uniform sampler2D u_stretched_lobe_b;
+
+// The prefiltered radiance for the real lobe around its mean direction d: the two fitted
+// fetches, the parts' fits mixed by their weights as specular_dominant_direction mixes t_A, t_B.
+vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float roughness, vec3 d, bool with_suns) {
+    vec2 coord = vec2(max(dot(n, v), 0.0), roughness);
+    float weight_a = dot(f0, vec3(0.2126, 0.7152, 0.0722)) * lut.x;
+    vec4 fit = (weight_a * texture(u_stretched_lobe_a, coord) + lut.y * texture(u_stretched_lobe_b, coord))
+               / max(weight_a + lut.y, 1e-6);
+    vec3 toward_horizon = d * dot(n, d) - n;
+    toward_horizon = dot(toward_horizon, toward_horizon) > 1e-10 ? normalize(toward_horizon) : vec3(0.0);
+    float fetch_roughness = roughness * sqrt(fit.w);
+    vec3 d_lo = cos(fit.x) * d + sin(fit.x) * toward_horizon;
+    vec3 d_hi = cos(fit.y) * d + sin(fit.y) * toward_horizon;
+    return mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
+               prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
+}
+#endif
+
 // A compact source as the ground truth sees it: the Cook-Torrance BRDF with the IBL k and the
 // Fresnel per direction, per unit power (f n.l; sun_layered adds the layers and the power P).
 // The source is not a point: its RMS angular radius
@@ -200,6 +235,7 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
 #ifdef HAS_ANISOTROPY
+    lut.xy *= anisotropic_energy_ratio(s, n, v);
     vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, reflect(-v, n), true);
 #else
     vec3 prefiltered = prefiltered_radiance_at(reflect(-v, n), s.roughness, true);
@@ -218,7 +254,10 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
     vec3 r = reflect(-v, n);
     vec3 d = toward_lobe_mean ? specular_dominant_direction(n, r, f0, lut) : r;
 #ifdef HAS_ANISOTROPY
+    lut.xy *= anisotropic_energy_ratio(s, n, v);
     vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, d, with_suns);
+#elif IBL_MODEL == 5
+    vec3 prefiltered = stretched_prefiltered_radiance(n, v, f0, lut, s.roughness, d, with_suns);
 #else
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
 #endif
@@ -255,11 +294,14 @@ vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
     return (layered_ibl(s, n, v, karis_split_sum(s, n, v, true, false), false) + suns) * s.occlusion;
 }
 
+// alight's model with the lobe's shape from two round fetches fitted to the real lobe in lobe
+// space (stretched_prefiltered_radiance) instead of one at its mean direction.
+vec3 ibl_stretched(Surface s, vec3 n, vec3 v) {
+    return ibl_alight(s, n, v);
+}
+
 // The model the forward pass uses: IBL_MODEL is the position of its name in app/core/ibl_models.py's
 // IBL_MODELS, set by app/render/renderer.py, so only the chosen model is compiled.
-#ifndef IBL_MODEL
-#define IBL_MODEL 4
-#endif
 vec3 ibl_model(Surface s, vec3 n, vec3 v) {
 #if IBL_MODEL == 0
     return ibl_lecture(s, n, v);
@@ -269,7 +311,9 @@ vec3 ibl_model(Surface s, vec3 n, vec3 v) {
     return ibl_karis(s, n, v);
 #elif IBL_MODEL == 3
     return ibl_dominant(s, n, v);
-#else
+#elif IBL_MODEL == 4
     return ibl_alight(s, n, v);
+#else
+    return ibl_stretched(s, n, v);
 #endif
 }

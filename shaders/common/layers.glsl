@@ -42,6 +42,8 @@ vec3 sheen_ibl(Surface s, vec3 n, vec3 v, bool with_suns);
 vec3 anisotropic_specular(Surface s, vec3 n, vec3 v, vec3 l, vec3 F, bool punctual, float spread);
 // The prefiltered environment for the stretched lobe (replaces the isotropic lookup along d).
 vec3 anisotropic_prefiltered_radiance(Surface s, vec3 n, vec3 v, vec3 d, bool with_suns);
+// The factors on the BRDF LUT's (A, B) that give the stretched lobe's energy.
+vec2 anisotropic_energy_ratio(Surface s, vec3 n, vec3 v);
 #endif
 
 #ifdef HAS_TRANSMISSION

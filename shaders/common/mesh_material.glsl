@@ -71,12 +71,16 @@ uniform bool u_has_sheen_roughness_map;       // A multiplies sheen_roughness
 uniform sampler2D u_sheen_color_map;
 uniform sampler2D u_sheen_roughness_map;
 #endif
+#ifdef HAS_ANISOTROPY
+uniform bool u_has_anisotropy_map;            // KHR_materials_anisotropy: RG a direction (2x - 1), B x strength
+uniform sampler2D u_anisotropy_map;
+#endif
 
 // The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 4095
+#define MATERIAL_MAPS_MASK 8191
 #endif
 #ifndef MAP_UV1_MASK
 #define MAP_UV1_MASK 0
@@ -102,7 +106,8 @@ const int MAP_CLEARCOAT_ROUGHNESS = 256;
 const int MAP_CLEARCOAT_NORMAL = 512;
 const int MAP_SHEEN_COLOR = 1024;
 const int MAP_SHEEN_ROUGHNESS = 2048;
-const int MAP_SLOTS = 12;
+const int MAP_ANISOTROPY = 4096;
+const int MAP_SLOTS = 13;
 // KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
 uniform mat3 u_map_transform[MAP_SLOTS];
 
@@ -209,6 +214,20 @@ Surface material_surface(vec3 n) {
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
     mat3 frame = tangent_frame(n);
     apply_material_layers(s, n, frame[0], frame[1]);
+#endif
+#ifdef HAS_ANISOTROPY
+    if (has_map(MAP_ANISOTROPY, u_has_anisotropy_map)) {
+        // KHR_materials_anisotropy: the map's direction, turned by anisotropyRotation, in the
+        // tangent frame; its B scales the strength.
+        vec3 texel = sample_map(u_anisotropy_map, MAP_ANISOTROPY, 12).rgb;
+        vec2 d = texel.rg * 2.0 - 1.0;
+        float c = cos(u_anisotropy_rotation);
+        float sn = sin(u_anisotropy_rotation);
+        vec3 direction = frame[0] * (c * d.x - sn * d.y) + frame[1] * (sn * d.x + c * d.y);
+        s.anisotropy_direction = dot(direction, direction) > 1e-12 ? normalize(direction) : frame[0];
+        s.anisotropy_bitangent = cross(n, s.anisotropy_direction);
+        s.anisotropy_strength *= texel.b;
+    }
 #endif
 #ifdef HAS_CLEARCOAT
     // KHR_materials_clearcoat: without a clearcoat normal map the coat is not normal-mapped,

@@ -22,4 +22,22 @@ void main() {
     out_specular_f0 = vec4(s.specular_f0, 1.0);
     out_emissive = vec4(s.emissive, 1.0);
     out_tangent = vec4(tangent_frame(n)[0], v_tangent.w < 0.0 ? -1.0 : 1.0);
+#ifdef HAS_ANISOTROPY
+    // KHR_materials_anisotropy: the direction before the material's rotation (the reference
+    // rotates it), its length the factor on the strength: the map's B, 0 on a part without the
+    // layer (accuracy/reference.comp).
+    float factor = s.anisotropy_strength > 0.0 ? 1.0 : 0.0;
+    if (has_map(MAP_ANISOTROPY, u_has_anisotropy_map)) {
+        vec3 texel = sample_map(u_anisotropy_map, MAP_ANISOTROPY, 12).rgb;
+        mat3 frame = tangent_frame(n);
+        vec3 direction = frame * vec3(texel.rg * 2.0 - 1.0, 0.0);
+        if (dot(direction, direction) > 1e-12) out_tangent.xyz = normalize(direction);
+        factor *= texel.b;
+    }
+    out_tangent.xyz *= factor;
+#else
+    // A part drawn without the layer: length 0, so the reference (which applies a scene's one set
+    // of layer factors at every pixel) leaves it isotropic; no other layer reads the tangent.
+    out_tangent.xyz = vec3(0.0);
+#endif
 }

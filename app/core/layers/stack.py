@@ -105,7 +105,7 @@ def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
     if "transmission" in m.layers():
         kd = kd * (1.0 - m.transmission)
     if "anisotropy" in m.layers():
-        specular_cos = anisotropy.anisotropic_specular(m, p, F) * nl_c[..., None]
+        specular_cos = anisotropy.anisotropic_specular(m, p, F, spread=p.spread) * nl_c[..., None]
     else:
         r = m.roughness
         lobe = r

@@ -1,0 +1,65 @@
+"""The `stretched` IBL model's lobe table (``app/core/stretched_lobe.json``, written by
+``tools/fit_stretched_lobe.py``) and the numpy twin of its lookup (``shaders/common/ibl.glsl``:
+``stretched_prefiltered_radiance``).
+
+The table: for the specular lobe's F0-scaled part (A) and its bias part (B), per (n.v,
+roughness) texel centre (8 x 16), two round prefiltered fetches fitted to the real lobe in lobe
+space: (a_lo, a_hi, w_hi, beta) = their signed angles (radians, toward the horizon positive) from
+the lobe's mean direction in the plane of incidence, the second one's weight, and the fetches'
+alpha over the material's. Rows below r = 0.2 are the round lookup (0, 0, 0, 1).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from pathlib import Path
+
+import numpy as np
+
+TABLE_PATH = Path(__file__).with_name("stretched_lobe.json")
+
+
+@functools.lru_cache(maxsize=1)
+def lobe_table() -> np.ndarray:
+    """(2, n_roughness, n_n_dot_v, 4) float32: parts A and B, rows roughness, columns n.v."""
+    doc = json.loads(TABLE_PATH.read_text())
+    table = np.asarray([doc["A"], doc["B"]], dtype=np.float32)
+    if table.ndim != 4 or table.shape[0] != 2 or table.shape[3] != 4 or not np.isfinite(table).all():
+        raise ValueError(f"{TABLE_PATH}: not a (2, R, N, 4) table of finite numbers")
+    return table
+
+
+def sample_table(part: np.ndarray, n_dot_v, roughness) -> np.ndarray:
+    """Bilinear lookup of one part (R, N, 4) at texel-centre coordinates, clamped at the edges
+    (GL_LINEAR with CLAMP_TO_EDGE, as the shader's texture()): (P, 4)."""
+    rows, cols = part.shape[:2]
+    x = np.clip(np.asarray(n_dot_v, np.float64) * cols - 0.5, 0.0, cols - 1.0)
+    y = np.clip(np.asarray(roughness, np.float64) * rows - 0.5, 0.0, rows - 1.0)
+    x0 = np.minimum(np.floor(x).astype(int), cols - 2) if cols > 1 else np.zeros_like(x, int)
+    y0 = np.minimum(np.floor(y).astype(int), rows - 2) if rows > 1 else np.zeros_like(y, int)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    x1, y1 = np.minimum(x0 + 1, cols - 1), np.minimum(y0 + 1, rows - 1)
+    p = part.astype(np.float64)
+    top = p[y0, x0] * (1 - fx) + p[y0, x1] * fx
+    bottom = p[y1, x0] * (1 - fx) + p[y1, x1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def stretched_fetches(n, v, d, f0, lut_a, lut_b, roughness):
+    """The two fetches of ``stretched_prefiltered_radiance`` for points with normals ``n``, views
+    ``v``, mean directions ``d`` (P, 3) and the BRDF LUT's A, B (P,): (d_lo, d_hi (P, 3), w_hi
+    (P,), fetch roughness (P,))."""
+    table = lobe_table()
+    n, v, d = (np.asarray(x, np.float64) for x in (n, v, d))
+    n_dot_v = np.maximum(np.sum(n * v, -1), 0.0)
+    weight_a = float(np.dot(np.asarray(f0, np.float64), (0.2126, 0.7152, 0.0722))) * np.asarray(lut_a)
+    b = np.asarray(lut_b)
+    fit = (weight_a[:, None] * sample_table(table[0], n_dot_v, roughness)
+           + b[:, None] * sample_table(table[1], n_dot_v, roughness)) / np.maximum(weight_a + b, 1e-6)[:, None]
+    toward = d * np.sum(n * d, -1, keepdims=True) - n
+    length = np.linalg.norm(toward, axis=-1, keepdims=True)
+    toward = np.where(length * length > 1e-10, toward / np.maximum(length, 1e-300), 0.0)
+    d_lo = np.cos(fit[:, :1]) * d + np.sin(fit[:, :1]) * toward
+    d_hi = np.cos(fit[:, 1:2]) * d + np.sin(fit[:, 1:2]) * toward
+    return d_lo, d_hi, fit[:, 2], float(roughness) * np.sqrt(fit[:, 3])
