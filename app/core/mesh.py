@@ -178,6 +178,10 @@ class Mesh:
     cameras: list = field(default_factory=list)
     lights: list = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    # The built-in UV sphere's (radius, segments), centred at the origin, its part's geometry as
+    # ``sphere`` made it: a renderer may draw it with fewer segments where its size on screen
+    # allows (alight.core.sphere_lod), never more. None for every other mesh: drawn as given.
+    lod_sphere: tuple[float, int] | None = None
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space min and max corners over all parts."""
@@ -303,7 +307,7 @@ def sphere(segments: int = 128, rings: int = 64, radius: float = 1.0) -> Mesh:
         tangents.reshape(-1, 4),
         np.concatenate([upper, lower]),
     )
-    return Mesh([part], "sphere")
+    return Mesh([part], "sphere", lod_sphere=(float(radius), int(segments)) if rings * 2 == segments else None)
 
 
 # (normal, tangent = +u direction); bitangent (+v) = cross(normal, tangent), so w = +1.

@@ -27,7 +27,7 @@ from alight.core.gpu import ShaderLibrary, create_headless_context
 from alight.core.ibl_models import SUNS_AS_BAKED, ibl_model_index
 from alight.core.layers import layer_defines
 from alight.core.material import LAYERS, Material, with_overrides
-from alight.core.mesh import is_closed
+from alight.core.mesh import is_closed, sphere
 from alight.core.scene import (
     TONEMAPS,
     Camera,
@@ -36,6 +36,7 @@ from alight.core.scene import (
     frame_camera,
 )
 from alight.core.shading import rotate_world_to_map
+from alight.core.sphere_lod import MAX_SILHOUETTE_ERROR_PX, SPHERE_LOD_SEGMENTS, projected_radius_px, sphere_segments
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.ibl.bake import (
@@ -321,6 +322,12 @@ class ForwardRenderer:
         self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart], _MeshTextures]] = {}
+        # The built-in sphere's coarser levels (alight.core.sphere_lod), by the mesh's id and segments.
+        self._sphere_lods: dict[tuple[int, int], tuple[object, list[_GpuPart], _MeshTextures]] = {}
+        self.last_sphere_segments: int | None = None   # the level the last mesh pass drew (tests, benchmarks)
+        # How far the built-in sphere's outline may fall inside the true one, in output pixels
+        # (alight.core.sphere_lod); 0 draws the sphere's own tessellation.
+        self.sphere_max_error_px = MAX_SILHOUETTE_ERROR_PX
         self._targets: _Targets | None = None
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
@@ -380,6 +387,41 @@ class ForwardRenderer:
             self._meshes[id(mesh)] = entry
         return entry[1]
 
+    def _drawn_parts(self, mesh, camera: Camera, image_size: tuple[int, int]) -> tuple[list[_GpuPart], float | None]:
+        """The GPU parts a pass draws for ``mesh``, and the radius of the true sphere they stand
+        for where ``mesh`` is the built-in sphere (else None).
+
+        The built-in sphere (``Mesh.lod_sphere``) seen by a perspective camera from outside is
+        drawn at the coarsest level whose outline stays within ``sphere_max_error_px`` at
+        ``image_size`` (the whole image's pixels; alight.core.sphere_lod), never finer than its
+        own, and its fragments are shaded on the true sphere (mesh_material.glsl SPHERE_SURFACE),
+        so the level moves the outline only. Every pass of a frame, every tile, picks the same."""
+        own = self._gpu_mesh(mesh)
+        self.last_sphere_segments = None
+        if mesh.lod_sphere is None or len(mesh.parts) != 1 or camera.ortho_half_height is not None:
+            return own, None
+        radius, segments = mesh.lod_sphere
+        vp = camera.view_projection(image_size[0] / image_size[1])
+        radius_px = projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size)
+        if not math.isfinite(radius_px):    # the eye at or inside the sphere: drawn as given
+            return own, None
+        n = sphere_segments(radius_px, self.sphere_max_error_px,
+                            levels=tuple(x for x in SPHERE_LOD_SEGMENTS if x < segments) + (segments,))
+        self.last_sphere_segments = n
+        if n == segments:
+            return own, radius
+        for old in [k for k, e in self._sphere_lods.items() if e[0] is not mesh]:   # another mesh's levels
+            _release_mesh(self._sphere_lods.pop(old))
+        key = (id(mesh), n)
+        entry = self._sphere_lods.get(key)
+        if entry is None:
+            part = mesh.parts[0]
+            lod = dataclasses.replace(sphere(n, n // 2, radius).parts[0], material=part.material, name=part.name,
+                                      element=part.element)
+            textures = _MeshTextures(self.ctx)
+            entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, lod, textures)], textures)
+        return entry[1], radius
+
     def _targets_for(self, width: int, height: int, aa: str, samples: int) -> _Targets:
         t = self._targets
         if t is None or (t.width, t.height, t.aa, t.samples) != (width, height, aa, samples):
@@ -398,9 +440,10 @@ class ForwardRenderer:
             vao.release()
         self._fullscreen_vaos.clear()
         self._units_assigned.clear()
-        for entry in self._meshes.values():
+        for entry in [*self._meshes.values(), *self._sphere_lods.values()]:
             _release_mesh(entry)
         self._meshes.clear()
+        self._sphere_lods.clear()
         old.reload()
 
     def _user_textures(self, scene: Scene) -> dict[str, moderngl.Texture]:
@@ -431,9 +474,10 @@ class ForwardRenderer:
         for maps in self._bakes.values():
             maps.release()
         self._bakes.clear()
-        for entry in self._meshes.values():
+        for entry in [*self._meshes.values(), *self._sphere_lods.values()]:
             _release_mesh(entry)
         self._meshes.clear()
+        self._sphere_lods.clear()
         if self._targets:
             self._targets.release()
             self._targets = None
@@ -602,14 +646,14 @@ class ForwardRenderer:
         if scene.view == "probe":
             self._draw_probe(scene, maps, view.width * scale, (view.origin[0] * scale, view.origin[1] * scale))
         elif scene.mesh is not None:
-            self._draw_mesh(scene, maps, camera, view_projection, blend=False)
+            self._draw_mesh(scene, maps, camera, view_projection, blend=False, image_size=(view.width, view.height))
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         if background:
             self._draw_background(scene, maps, inverse_vp)
             # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
             # (The fused MSAA resolve, background=False, is used only for scenes with none.)
             if scene.view != "probe" and scene.mesh is not None:
-                self._draw_mesh(scene, maps, camera, view_projection, blend=True)
+                self._draw_mesh(scene, maps, camera, view_projection, blend=True, image_size=(view.width, view.height))
         ctx.disable(moderngl.DEPTH_TEST)
         if display_output is None and background:
             self._finish_radiance(targets)
@@ -827,7 +871,7 @@ class ForwardRenderer:
         self._fullscreen(prog)
 
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray,
-                   blend: bool = False) -> None:
+                   blend: bool = False, image_size: tuple[int, int] | None = None) -> None:
         """The parts that blend (``blend``) or the rest, each with its shader variant: the
         scene's IBL model and debug view, plus only the features the part uses (_part_defines)."""
         defines = self._ibl_defines(scene)
@@ -855,7 +899,7 @@ class ForwardRenderer:
             self._bind_layer_luts(all_defines)
             return prog
 
-        self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=blend)
+        self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=blend, image_size=image_size)
 
     def _bind_layer_luts(self, defines: dict) -> None:
         """The tables a compiled-in layer reads (the sheen LUT), baked on first use."""
@@ -915,7 +959,7 @@ class ForwardRenderer:
         return defines
 
     def draw_mesh_parts(self, scene: Scene, prog, camera: Camera, view_projection: np.ndarray,
-                        blend: bool | None = None) -> None:
+                        blend: bool | None = None, image_size: tuple[int, int] | None = None) -> None:
         """Draw the scene's mesh parts (pbr.vert's transforms, seen from ``camera``), each with
         its material's factors and maps bound.
 
@@ -925,13 +969,17 @@ class ForwardRenderer:
         front by the distance of their centres, with blending on and depth writes off.
         Culling follows the material (glTF doubleSided: false culls back faces); a part without
         a glTF material is culled where it is closed, seen from both sides where it is open.
+        ``image_size``: the whole image's (width, height) in pixels (default: the viewport's),
+        which picks the built-in sphere's level (``_drawn_parts``).
         """
         ctx = self.ctx
         user_maps = self._user_maps_present(scene)
         user = self._user_textures(scene)
         tiling = scene.texture_maps or TextureMaps()
         items = []
-        for gpu_part, part in zip(self._gpu_mesh(scene.mesh), scene.mesh.parts):
+        size = image_size or tuple(ctx.viewport[2:])
+        drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
+        for gpu_part, part in zip(drawn, scene.mesh.parts):
             fm = part.material
             blends = fm is not None and scene.use_file_materials and fm.alpha_mode == "BLEND"
             if blend is None or blends == blend:
@@ -949,7 +997,10 @@ class ForwardRenderer:
         try:
             for gpu_part, part in items:
                 if callable(prog):
-                    program = prog(self._part_defines(scene, gpu_part, part, user_maps))
+                    part_defines = self._part_defines(scene, gpu_part, part, user_maps)
+                    if sphere_radius is not None:
+                        part_defines["SPHERE_SURFACE"] = None
+                    program = prog(part_defines)
                 else:
                     program = prog
                 if id(program) not in prepared:
@@ -958,6 +1009,7 @@ class ForwardRenderer:
                     _set(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
                     _set(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
                     _set(program, "u_camera_position", tuple(float(x) for x in camera.position))
+                    _set(program, "u_sphere_radius", float(sphere_radius or 0.0))
                 material, maps_used = self._part_material(scene, part)
                 _set_material(program, material)
                 fm = part.material if maps_used else None

@@ -10,6 +10,8 @@
 //   MAP_MIRROR_S_MASK,   maps whose sampler wraps by MIRRORED_REPEAT in s or t (REPEAT and
 //   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state).
 // HAS_VERTEX_COLOR: COLOR_0 multiplies the base colour and alpha (glTF 2.0 section 3.9.2).
+// SPHERE_SURFACE: the part is the built-in sphere drawn at a coarser level (alight.core.sphere_lod):
+// the surface point is where the view ray meets the true sphere, and the normal is the sphere's.
 #include "common/surface.glsl"
 #include "common/material_layers.glsl"
 
@@ -111,6 +113,29 @@ const int MAP_SLOTS = 13;
 // KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
 uniform mat3 u_map_transform[MAP_SLOTS];
 
+#ifdef SPHERE_SURFACE
+uniform float u_sphere_radius;   // centred at the origin; the camera is outside it (perspective)
+
+// The view ray's first hit on the sphere |x| = r (ray-sphere intersection). The flat facets lie
+// inside the sphere, so the hit is a step s back along the ray from the facet point p:
+// |p - s d|^2 = r^2. Solved about p, not the eye, so that nothing cancels at grazing angles.
+vec3 sphere_surface_point(vec3 eye, vec3 facet_point, float r) {
+    vec3 d = normalize(facet_point - eye);
+    float pd = dot(facet_point, d);
+    float s = pd + sqrt(max(pd * pd + (r * r - dot(facet_point, facet_point)), 0.0));
+    return facet_point - s * d;
+}
+#endif
+
+// The shaded point: the interpolated position, or on the built-in sphere the true surface's.
+vec3 surface_position() {
+#ifdef SPHERE_SURFACE
+    return sphere_surface_point(u_camera_position, v_position, u_sphere_radius);
+#else
+    return v_position;
+#endif
+}
+
 bool has_map(int bit, bool present) {
     return (MATERIAL_MAPS_MASK & bit) != 0 && present;
 }
@@ -151,7 +176,11 @@ vec4 sample_map(sampler2D map, int bit, int slot) {
 // The interpolated normal, or the face normal from screen derivatives where it is zero (bad
 // meshes), facing the viewer's side.
 vec3 geometric_normal() {
+#ifdef SPHERE_SURFACE
+    vec3 n = surface_position();
+#else
     vec3 n = v_normal;
+#endif
     vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
     n = dot(n, n) > 1e-12 ? normalize(n) : face;
     return gl_FrontFacing ? n : -n;

@@ -15,9 +15,9 @@ layout(location = 6) out vec4 out_tangent;      // the tangent frame's t, its ha
 void main() {
     vec3 n = shading_normal();
     Surface s = material_surface(n);
-    out_position = vec4(v_position, 1.0);
+    out_position = vec4(surface_position(), 1.0);
     out_normal = vec4(n, s.roughness);
-    out_view = vec4(normalize(u_camera_position - v_position), s.metallic);
+    out_view = vec4(normalize(u_camera_position - surface_position()), s.metallic);
     out_base_color = vec4(s.base_color, 1.0);
     out_specular_f0 = vec4(s.specular_f0, 1.0);
     out_emissive = vec4(s.emissive, 1.0);

@@ -24,11 +24,11 @@ void main() {
     out_radiance = encode_output(material_base_color().rgb, alpha);
 #else
     vec3 n = shading_normal();
-    vec3 v = normalize(u_camera_position - v_position);
+    vec3 v = normalize(u_camera_position - surface_position());
 #ifdef DEBUG_VIEW
-    out_radiance = encode_output(debug_view(material_surface(n), n, v, v_position), alpha);
+    out_radiance = encode_output(debug_view(material_surface(n), n, v, surface_position()), alpha);
 #else
-    out_radiance = encode_output(shade(material_surface(n), n, v, v_position), alpha);
+    out_radiance = encode_output(shade(material_surface(n), n, v, surface_position()), alpha);
 #endif
 #endif
 }

@@ -1,0 +1,75 @@
+"""How finely to tessellate the built-in UV sphere for the size it has on screen.
+
+The built-in ball's shading normal is the sphere's own (``alight.core.mesh.sphere``: the vertex
+normals are the unit positions, so the interpolated, renormalised normal points from the centre
+through the facet point), so a coarser tessellation moves the picture only where the flat
+facets part from the true sphere: at the silhouette, and in where a pixel's ray meets the facet
+instead of the sphere. On a software rasteriser (llvmpipe) the ball's cost grows with its
+triangle count at editor sizes (small triangles pay for whole 4x4 blocks), so the renderer draws
+the coarsest level of SPHERE_LOD_SEGMENTS whose facets stay within MAX_SILHOUETTE_ERROR_PX of the
+sphere's outline. A GPU pays nothing for it either way.
+
+The error model: a UV sphere of ``n`` segments and ``n / 2`` rings steps 2 pi / n in longitude
+and latitude; its flat triangles part furthest from the sphere at the middle of a quad's
+diagonal, half a diagonal (about sqrt(2) pi / n of arc) from its corners, so the outline moves
+in by at most ``R (1 - cos(sqrt(2) pi / n))`` (the sagitta of that arc; R the sphere's radius).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# The levels the renderer keeps (segments; rings are half). 128 is the built-in ball's own, and
+# the finest: a larger picture is drawn as before, never with more triangles than today.
+SPHERE_LOD_SEGMENTS = (16, 20, 24, 28, 32, 40, 48, 56, 64, 80, 96, 112, 128)
+# The quality choice: how far (in output pixels) the facets may fall inside the true outline.
+MAX_SILHOUETTE_ERROR_PX = 0.5
+
+
+def silhouette_error(segments: int, radius_px: float) -> float:
+    """The farthest the outline of a ``segments`` x ``segments / 2`` UV sphere of ``radius_px``
+    pixels lies inside the true sphere's, in pixels (the module docstring's model)."""
+    return float(radius_px) * (1.0 - math.cos(math.sqrt(2.0) * math.pi / segments))
+
+
+def sphere_segments(radius_px: float, max_error_px: float = MAX_SILHOUETTE_ERROR_PX,
+                    levels: tuple[int, ...] = SPHERE_LOD_SEGMENTS) -> int:
+    """The fewest segments among ``levels`` whose silhouette error is at most ``max_error_px``
+    for a sphere ``radius_px`` pixels across (its projected radius); the finest level when none
+    is. A radius that is not finite or not positive gets the finest level."""
+    if not (math.isfinite(radius_px) and radius_px > 0.0):
+        return levels[-1]
+    for n in levels:
+        if silhouette_error(n, radius_px) <= max_error_px:
+            return n
+    return levels[-1]
+
+
+def projected_radius_px(view_projection: np.ndarray, centre, radius: float, image_size: tuple[int, int]) -> float:
+    """The radius, in pixels of the whole image, of a sphere's outline on screen (its largest
+    semi-axis where it is off the axis).
+
+    ``view_projection``: the camera's (4, 4) matrix in pyrr's row-vector layout (``clip = (p, 1)
+    @ VP``, alight.core.scene.Camera.view_projection), perspective or orthographic, not a tile's;
+    ``image_size``: (width, height) in pixels. Perspective: a sphere of angular radius a seen
+    on the axis is ``f tan(a)`` across, ``tan(a) = r / sqrt(d^2 - r^2)``; off the axis at angle t
+    its outline stretches radially by about ``1 / cos^2(t)``. Where the sphere reaches the eye,
+    infinity (the caller draws the finest level).
+    """
+    vp = np.asarray(view_projection, np.float64)
+    c = np.append(np.asarray(centre, np.float64), 1.0) @ vp
+    r = float(radius)
+    # Pixels per unit of tan(angle) (perspective) or per world unit (orthographic), in x and y.
+    gx, gy = float(np.linalg.norm(vp[:3, 0])), float(np.linalg.norm(vp[:3, 1]))
+    fx, fy = gx * image_size[0] / 2.0, gy * image_size[1] / 2.0
+    w_gradient = float(np.linalg.norm(vp[:3, 3]))      # 1 for a perspective camera, 0 orthographic
+    if w_gradient == 0.0:
+        return r * max(fx, fy) / float(c[3])
+    d = float(c[3]) / w_gradient           # the centre's depth along the view axis
+    if d <= r * 1.0000001:
+        return math.inf
+    tan_x, tan_y = float(c[0]) / float(c[3]) / gx * w_gradient, float(c[1]) / float(c[3]) / gy * w_gradient
+    off_axis = 1.0 + tan_x * tan_x + tan_y * tan_y
+    return r / math.sqrt(d * d - r * r) * max(fx, fy) / w_gradient * off_axis
