@@ -41,7 +41,7 @@ def _setup(level: str):
     from alight.ibl.environment import load_environment
     from alight.render.renderer import ForwardRenderer
 
-    r = ForwardRenderer(bake_cache=None)
+    r = ForwardRenderer()   # the bake from the disk cache: callgrind would spend minutes re-baking
     maps = r.bake(load_environment(str(ENV)), "low")
     mesh = sphere()
     if level == "before":

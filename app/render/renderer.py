@@ -74,7 +74,7 @@ MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
                  "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
-UNIT_SCENE_DEPTH = UNIT_SHEEN_LUT + 1      # render/resolve.frag's depth samples
+UNIT_SCENE_DEPTH = UNIT_SHEEN_LUT + 1      # free (the resolve read depth samples here); kept so later units keep theirs
 SRGB_MAPS = ("base_color", "emissive", "sheen_color")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
@@ -82,7 +82,7 @@ SAMPLER_UNITS = {
     "u_irradiance": UNIT_IRRADIANCE, "u_prefiltered_radiance": UNIT_PREFILTERED,
     "u_prefiltered_radiance_mid": UNIT_PREFILTERED_MID, "u_brdf_lut": UNIT_LUT,
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
-    "u_scene": UNIT_RADIANCE, "u_scene_depth": UNIT_SCENE_DEPTH,
+    "u_scene": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
     "u_sheen_lut": UNIT_SHEEN_LUT,
 }
@@ -239,7 +239,7 @@ class _Targets:
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
         self._display_draw = None
         self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
-        self.depth_only = self._both_fbo = None
+        self._both_fbo = None
         self.color = None
         try:
             self._allocate()
@@ -264,13 +264,7 @@ class _Targets:
             self.color = ctx.texture(self.draw_size, 4, dtype="f4")
         else:
             self.color = self.radiance
-        if aa == "msaa":
-            # A texture too: the resolve tells covered samples by their depth, so the colour
-            # target is never cleared (a quarter of the clears' bytes; 59 -> 14 ms of CPU at 1080p).
-            self.depth = ctx.depth_texture(self.draw_size, samples=ms)
-            self.depth_only = ctx.framebuffer(depth_attachment=self.depth)
-        else:
-            self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
+        self.depth = ctx.depth_renderbuffer(self.draw_size, samples=ms)
         self.draw = ctx.framebuffer([self.color], self.depth)
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
@@ -291,7 +285,7 @@ class _Targets:
         return self.radiance_fbo if radiance else self.display_fbo
 
     def release(self) -> None:
-        owned = [self._both_fbo, self.depth_only, self._display_draw, self.draw, self.depth, self.radiance_fbo,
+        owned = [self._both_fbo, self._display_draw, self.draw, self.depth, self.radiance_fbo,
                  self.radiance, self.display_fbo, self.display]
         if self.color is not self.radiance:
             owned.append(self.color)
@@ -625,11 +619,8 @@ class ForwardRenderer:
         width, height = targets.draw_size
         fbo.use()
         ctx.viewport = (0, 0, width, height)
-        if background or targets.depth_only is None:
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        else:   # the resolve reads only the samples the depth says were drawn
-            targets.depth_only.clear(depth=1.0)
-            fbo.use()
+        # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag).
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
         view = view or _View(targets.width, targets.height)
         aspect = view.width / view.height
@@ -848,9 +839,7 @@ class ForwardRenderer:
         # The rays of the scene pass just drawn (for a tile, the whole image's projection off centre).
         self._bind_background(prog, scene, maps, self._last_inverse_vp, mode)
         targets.color.use(UNIT_RADIANCE)
-        targets.depth.use(UNIT_SCENE_DEPTH)
         _set(prog, "u_scene", UNIT_RADIANCE)
-        _set(prog, "u_scene_depth", UNIT_SCENE_DEPTH)
         _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
         _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
         _set(prog, "u_opaque", scene.display.background != "transparent")

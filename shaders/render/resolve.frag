@@ -14,8 +14,7 @@
 
 in vec3 v_ray;    // render/background.vert: world-space, not normalised
 
-uniform sampler2DMS u_scene;        // the surfaces' radiance and alpha where one was drawn; not cleared
-uniform sampler2DMS u_scene_depth;  // cleared to 1 (the far plane): below it, a surface was drawn
+uniform sampler2DMS u_scene;   // the surfaces' radiance and alpha (coverage); cleared to 0 where none was drawn
 uniform float u_exposure_scale;  // 2^EV
 uniform int u_tonemap;
 uniform bool u_opaque;           // false: keep the coverage as alpha (transparent background)
@@ -32,15 +31,12 @@ void main() {
     // Shaded once per pixel, as the background pass shades it (at the pixel centre).
     vec3 background = background_radiance(v_ray);
     vec4 sum = vec4(0.0);
-    for (int i = 0; i < SCENE_SAMPLES; ++i) {
-        vec4 s = texelFetch(u_scene, p, i);
-        bool covered = texelFetch(u_scene_depth, p, i).r < 1.0;
-        // Porter-Duff 'under': a covered sample's radiance is its surfaces' (alpha 1 where opaque)
-        // and the background fills what they leave; an uncovered sample is the background alone
-        // (its colour was never cleared: a select, so whatever it holds cannot leak in).
-        sum += covered ? vec4(s.rgb + (1.0 - s.a) * background, s.a) : vec4(background, 0.0);
-    }
-    vec4 hdr = sum / float(SCENE_SAMPLES);
+    for (int i = 0; i < SCENE_SAMPLES; ++i) sum += texelFetch(u_scene, p, i);
+    // Porter-Duff 'under', summed over the samples: each sample's radiance is its surfaces' (alpha
+    // 1 where opaque) and the background fills what they leave; an uncovered sample, cleared to
+    // (0, 0, 0, 0), is the background alone. Linear, so the mean of the samples composites once.
+    vec4 mean = sum / float(SCENE_SAMPLES);
+    vec4 hdr = vec4(mean.rgb + (1.0 - mean.a) * background, mean.a);
 #ifdef RADIANCE_OUTPUT
     out_radiance = hdr;
 #endif
