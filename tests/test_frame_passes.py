@@ -125,3 +125,28 @@ def test_a_frame_with_blended_parts_keeps_the_background_pass_and_equals_it():
     assert np.abs(frame.srgb.astype(int) - srgb).max() == 0
     centre = linear[H // 2, W // 2]
     assert 0.4 < centre[3] < 0.6        # half covered: the ball blends over the background
+
+
+def test_srgb_only_msaa_frames_in_half_floats_keep_the_pixels_and_clamp_what_half_cannot_hold():
+    """An sRGB-only MSAA frame draws into half floats (renderer.HALF_FLOAT_MIN_EXPOSURE): the
+    same 8-bit pixels as the float frame within 1 LSB, also where the radiance passes half's
+    largest value (a light of 1e9: its highlight clamps to 65504 and still saturates, never inf
+    or NaN); an exposure below the limit keeps the float target. (llvmpipe's conversion to half
+    saturates by itself, so here the shader's clamp, HALF_FLOAT_OUTPUT, is not what is tested:
+    it is there for a GL that rounds to +inf.)"""
+    from alight.render.renderer import HALF_FLOAT_MAX, HALF_FLOAT_MIN_EXPOSURE
+
+    r = renderer()
+    maps = r.bake(load_environment("studio"), "low")
+    scene = Scene(mesh=sphere(), material=Material(base_color=(0.9, 0.9, 0.9), metallic=1.0, roughness=0.2),
+                  lights=[Light("point", (2.0, 3.0, 4.0), intensity=1e9)], display=Display(exposure=-5.0))
+    full = r.render(scene, maps, W, H, aa="msaa", read_linear=True, read_srgb=True)
+    assert not r._targets.half
+    assert full.linear[:, :, :3].max() > 10 * HALF_FLOAT_MAX        # the highlight is out of half's range
+    half = r.render(scene, maps, W, H, aa="msaa", read_linear=False, read_srgb=True).srgb
+    assert r._targets.half
+    assert np.abs(half.astype(int) - full.srgb).max() <= 1
+    assert (half[full.srgb[:, :, :3].max(axis=2) == 255].max(axis=1) == 255).all()   # saturated stays saturated
+    scene.display.exposure = HALF_FLOAT_MIN_EXPOSURE - 1.0
+    r.render(scene, maps, W, H, aa="msaa", read_linear=False, read_srgb=True)
+    assert not r._targets.half

@@ -67,6 +67,11 @@ GL_SRGB8_ALPHA8 = 0x8C43
 AA_MODES = ("none", "msaa", "ssaa")
 MAX_LIGHTS = 16   # punctual.glsl's MAX_LIGHTS
 MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2 levels - 1)
+# A multisampled frame read as sRGB only is drawn into half floats (half the bytes written,
+# cleared and resolved) where the tone map saturates before the clamp to half's largest value
+# could show: 65504 / 4 (one sample of four) at 2^-6 is 256, white in every tone map.
+HALF_FLOAT_MAX = 65504.0
+HALF_FLOAT_MIN_EXPOSURE = -6.0
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
@@ -234,9 +239,10 @@ def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool, mipmaps:
 class _Targets:
     """Framebuffers for one output size and anti-aliasing mode, kept between frames."""
 
-    def __init__(self, ctx: moderngl.Context, width: int, height: int, aa: str, samples: int):
+    def __init__(self, ctx: moderngl.Context, width: int, height: int, aa: str, samples: int, half: bool = False):
         self.ctx = ctx
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
+        self.half = half and aa == "msaa"     # the MSAA colour in half floats (HALF_FLOAT_MIN_EXPOSURE)
         self._display_draw = None
         self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
         self._both_fbo = None
@@ -259,7 +265,7 @@ class _Targets:
         ms = samples if aa == "msaa" else 0
         if aa == "msaa":
             # A texture, not a renderbuffer: render/resolve.frag reads its samples.
-            self.color = ctx.texture(self.draw_size, 4, samples=ms, dtype="f4")
+            self.color = ctx.texture(self.draw_size, 4, samples=ms, dtype="f2" if self.half else "f4")
         elif aa == "ssaa":
             self.color = ctx.texture(self.draw_size, 4, dtype="f4")
         else:
@@ -328,6 +334,7 @@ class ForwardRenderer:
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
         self._units_assigned: set[int] = set()
         self._display_output: Display | None = None   # set while draw_display runs
+        self._half_output = False     # set while a scene pass draws into half floats (_Targets.half)
         # User-loaded texture maps (Scene.texture_maps): (path, sRGB) -> (image, texture),
         # uploaded once per decoded image.
         self._map_textures: dict[tuple[str, bool], tuple[np.ndarray, moderngl.Texture]] = {}
@@ -416,12 +423,13 @@ class ForwardRenderer:
             entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, lod, textures)], textures)
         return entry[1], radius
 
-    def _targets_for(self, width: int, height: int, aa: str, samples: int) -> _Targets:
+    def _targets_for(self, width: int, height: int, aa: str, samples: int, half: bool = False) -> _Targets:
         t = self._targets
-        if t is None or (t.width, t.height, t.aa, t.samples) != (width, height, aa, samples):
+        half = half and aa == "msaa"
+        if t is None or (t.width, t.height, t.aa, t.samples, t.half) != (width, height, aa, samples, half):
             if t is not None:
                 t.release()
-            self._targets = _Targets(self.ctx, width, height, aa, samples)
+            self._targets = _Targets(self.ctx, width, height, aa, samples, half)
         return self._targets
 
     def use_shaders(self, shaders: ShaderLibrary) -> None:
@@ -534,7 +542,10 @@ class ForwardRenderer:
             samples = min(samples, self.ctx.max_samples)
             if samples < 2:
                 aa = "none"   # this GL has no multisampled float framebuffers
-        plan, targets = self._tiled_targets(width, height, aa, samples, tile)
+        # Half floats only where the fused resolve reads them and nothing but sRGB is read.
+        half = (aa == "msaa" and read_srgb and not read_linear and not self._has_blending_parts(scene)
+                and scene.display.exposure >= HALF_FLOAT_MIN_EXPOSURE)
+        plan, targets = self._tiled_targets(width, height, aa, samples, tile, half)
         opaque = scene.display.background != "transparent"
         for tiles in plan.strips():
             rows = tiles[0].height
@@ -569,7 +580,7 @@ class ForwardRenderer:
             yield Strip(tiles[0].y, Frame(linear, srgb))
 
     def _tiled_targets(self, width: int, height: int, aa: str, samples: int,
-                       tile: tuple[int, int] | None) -> tuple[TilePlan, _Targets]:
+                       tile: tuple[int, int] | None, half: bool = False) -> tuple[TilePlan, _Targets]:
         """The tile plan for this size and the framebuffers of one tile. Where the GL refuses
         them (out of memory, an incomplete framebuffer), tiles a quarter the size are tried."""
         budget = TILE_BYTES
@@ -579,7 +590,7 @@ class ForwardRenderer:
         while True:
             plan = plan_tiles(width, height, side_limit(limits, aa), framebuffer_bytes(aa, samples), budget, tile=tile)
             try:
-                return plan, self._targets_for(plan.tile_width, plan.tile_height, aa, samples)
+                return plan, self._targets_for(plan.tile_width, plan.tile_height, aa, samples, half)
             except moderngl.Error as exc:
                 self._targets = None
                 if plan.tile_width * plan.tile_height <= 16 * 16:
@@ -616,6 +627,7 @@ class ForwardRenderer:
                     background: bool = True) -> None:
         ctx = self.ctx
         self._display_output = display_output
+        self._half_output = targets.half and fbo is targets.draw
         width, height = targets.draw_size
         fbo.use()
         ctx.viewport = (0, 0, width, height)
@@ -649,6 +661,7 @@ class ForwardRenderer:
         if display_output is None and background:
             self._finish_radiance(targets)
         self._display_output = None
+        self._half_output = False
 
     def camera_for(self, scene: Scene, aspect: float) -> Camera:
         if scene.camera is not None:
@@ -695,6 +708,8 @@ class ForwardRenderer:
         ``draw_display`` runs (common/output_encoding.glsl)."""
         display = self._display_output
         if display is None:
+            if self._half_output:
+                defines = {**(defines or {}), "HALF_FLOAT_OUTPUT": None}
             return self.program(vertex, fragment, defines)
         prog = self.program(vertex, fragment, {**(defines or {}), "DISPLAY_OUTPUT": None})
         _set(prog, "u_exposure_scale", float(2.0 ** display.exposure))
