@@ -374,3 +374,90 @@ def downsample_equirect(radiance, factor: int) -> np.ndarray:
     r >= 0.25 when downsampling). At factor 4: irradiance 5.8e-4 / 4e-5, r = 0.5: 3.3e-4 / 8e-5.
     """
     return box_reduce(radiance, int(factor))
+
+
+# --- transmission (docs/transmission.md) --------------------------------------------------
+
+def prefilter_kernel_mean_cosine(roughness, n_u: int = 4096):
+    """The mean cosine between l and the lookup direction d of the prefiltered map's kernel at a
+    roughness, D(h) max(d.l, 0) over l with h = normalize(l + d) (the lecture's prefilter, N = V =
+    R = d): E[(n.l)^2] / E[n.l] over h drawn with pdf D(h)(n.h), n.l = 2 (n.h)^2 - 1, only
+    n.l > 0. 1 at roughness 0, falling with roughness; a midpoint rule over the GGX inverse CDF
+    (twin of transmission_lut.comp's prefilter_kernel_mean_cosine)."""
+    r = np.atleast_1d(np.asarray(roughness, dtype=np.float64))
+    u = (np.arange(n_u) + 0.5) / n_u
+    out = np.empty(r.shape)
+    for i, rr in enumerate(r.reshape(-1)):
+        a2 = rr ** 4
+        nh2 = (1.0 - u) / (1.0 + (a2 - 1.0) * u)
+        nl = np.maximum(2.0 * nh2 - 1.0, 0.0)
+        out.reshape(-1)[i] = float(np.sum(nl * nl) / max(np.sum(nl), 1e-30)) if a2 > 0 else 1.0
+    return out.reshape(np.shape(roughness))
+
+
+def roughness_for_mean_cosine(mean_cosine, steps: int = 40):
+    """The prefiltered roughness whose kernel has this mean cosine (bisection on
+    ``prefilter_kernel_mean_cosine``), clamped to [0, 1]."""
+    c = np.atleast_1d(np.asarray(mean_cosine, dtype=np.float64)).reshape(-1)
+    lo = np.zeros_like(c)
+    hi = np.ones_like(c)
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        wider = prefilter_kernel_mean_cosine(mid, 1024) < c   # mid's kernel is wider than wanted
+        hi = np.where(wider, mid, hi)
+        lo = np.where(wider, lo, mid)
+    return (0.5 * (lo + hi)).reshape(np.shape(mean_cosine))
+
+
+def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: int = 64):
+    """Numpy twin of ``ibl/transmission_lut.comp``: the refracted lobe of KHR_materials_volume's
+    BTDF (v outside, index 1; l inside, index ``ior``) at one (n.v, roughness, ior) each, as
+    three numbers the forward pass reads (docs/transmission.md, "Real-time"):
+
+    - E: the integral of btdf (1 - Fc(v.h)) |n.l| over l (transmitted = (1 - m) t c T (1 - F0) E L
+      under a constant environment L). Drawing h with pdf D(h)(n.h) and l = refract(-v, h, 1/ior),
+      the weight is (1 - Fc) G(n.v, |n.l|) (v.h) / ((n.h)(n.v)): the same as the BRDF LUT's;
+    - sin_mean: the sine of the lobe's mean direction's angle from -n, leaning toward -v's
+      tangential part (0 at n.v = 1);
+    - roughness: the prefiltered roughness whose kernel has the same mean cosine about its axis
+      (``roughness_for_mean_cosine``), so one prefiltered fetch along the mean direction stands
+      for the lobe.
+
+    Midpoint grid over (u, phi in [0, 2 pi)) as ``brdf_lut_converged``; n.v >= 1e-4, ior >= 1.
+    Returns (E, sin_mean, roughness), each of the broadcast shape.
+    """
+    from alight.core.btdf import refract
+
+    nv, r, eta = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (n_dot_v, roughness, ior)))
+    shape = nv.shape
+    nv = np.clip(nv.reshape(-1), 1e-4, 1.0)
+    r = np.clip(r.reshape(-1), 0.0, 1.0)
+    eta = np.maximum(eta.reshape(-1), 1.0)
+    sg = (np.arange(n_u) + 0.5) / n_u
+    u = 1.0 - (1.0 - sg) ** 2
+    wu = 2.0 * (1.0 - sg) / n_u
+    phi = (np.arange(n_phi) + 0.5) * (2.0 * PI / n_phi)
+    energy = np.empty(nv.shape[0])
+    sin_mean = np.empty(nv.shape[0])
+    cosines = np.empty(nv.shape[0])
+    for i in range(nv.shape[0]):
+        a2 = r[i] ** 4
+        cos_t = np.sqrt((1.0 - u) / (1.0 + (a2 - 1.0) * u))
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+        h = np.stack([sin_t[:, None] * np.cos(phi)[None, :], sin_t[:, None] * np.sin(phi)[None, :],
+                      np.broadcast_to(cos_t[:, None], (n_u, n_phi))], axis=-1)
+        v = np.array([np.sqrt(1.0 - nv[i] ** 2), 0.0, nv[i]])
+        vh = h @ v
+        l = refract(np.broadcast_to(-v, h.shape), h, np.full(h.shape[:2], 1.0 / eta[i]))
+        nl = l[..., 2]
+        ok = (nl < 0.0) & (vh > 0.0)
+        g = G_Smith(nv[i], np.where(ok, -nl, 1.0), k_ibl(r[i]))
+        w = np.where(ok, (1.0 - (1.0 - np.clip(vh, 0.0, 1.0)) ** 5) * g * vh / (h[..., 2] * nv[i]), 0.0)
+        w = w * wu[:, None] / n_phi
+        energy[i] = float(w.sum())
+        mx, mz = float(np.sum(w * l[..., 0])), float(np.sum(w * l[..., 2]))
+        length = np.hypot(mx, mz)
+        sin_mean[i] = -mx / length if length > 0 else 0.0
+        cosines[i] = length / energy[i] if energy[i] > 0 else 1.0
+    rough = roughness_for_mean_cosine(cosines)
+    return energy.reshape(shape), sin_mean.reshape(shape), rough.reshape(shape)
