@@ -21,20 +21,25 @@ TERMS = {name: i for i, name in enumerate([
     "BEER_LAMBERT", "TRANSMITTED_LIGHT"])}
 
 
-def evaluate(term: str, inputs: np.ndarray, uniforms: dict | None = None) -> np.ndarray:
-    """Run shaders/accuracy/evaluate_terms.comp on rows of up to 4 inputs; returns (N, 4) outputs."""
+def evaluate(term: str | int, inputs: np.ndarray, uniforms: dict | None = None,
+             shader: str = "accuracy/evaluate_terms.comp", defines: dict | None = None) -> np.ndarray:
+    """Run an evaluator compute shader on rows of up to 4 inputs; returns (N, 4) outputs.
+
+    ``shader`` and ``defines`` pick another evaluator with the same interface (u_inputs,
+    u_outputs, u_count, u_term: each layer has its own, shaders/accuracy/evaluate_<layer>.comp);
+    ``term`` is then its index there."""
     r = renderer()
     ctx = r.ctx
     rows = np.zeros((len(inputs), 4), np.float32)
     inputs = np.asarray(inputs, np.float32).reshape(len(inputs), -1)
     rows[:, : inputs.shape[1]] = inputs
-    prog = r.shaders.compute("accuracy/evaluate_terms.comp")
+    prog = r.shaders.compute(shader, defines)
     src = ctx.buffer(rows.tobytes())
     dst = ctx.buffer(reserve=rows.nbytes)
     src.bind_to_storage_buffer(0)
     dst.bind_to_storage_buffer(1)
     prog["u_count"] = len(rows)
-    prog["u_term"] = TERMS[term]
+    prog["u_term"] = TERMS[term] if isinstance(term, str) else int(term)
     for name, value in (uniforms or {}).items():
         if name in prog:
             prog[name] = value

@@ -11,12 +11,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from alight.core.material import Material
+from alight.core.material import LAYER_FIELDS, Material
 from alight.errors import AlightError
 from alight.exchange.gltf_material import (
+    EXT_ANISOTROPY,
+    EXT_CLEARCOAT,
     EXT_EMISSIVE,
     EXT_IOR,
+    EXT_SHEEN,
     EXT_SPECULAR,
+    EXT_TRANSMISSION,
+    EXT_VOLUME,
     export_material_gltf,
     export_mesh_glb,
     import_material,
@@ -27,7 +32,7 @@ from alight.exchange.presets import list_presets, load_preset
 
 REPO = Path(__file__).resolve().parents[1]
 VALIDATOR_PACKAGE = REPO / "tools" / "node" / "node_modules" / "gltf-validator"
-FIELDS = ("base_color", "metallic", "roughness", "specular_f0", "emissive")
+FIELDS = ("base_color", "metallic", "roughness", "specular_f0", "emissive", "ior", *LAYER_FIELDS)
 
 
 @pytest.fixture(scope="session")
@@ -52,6 +57,9 @@ def validate():
 def assert_same(a: Material, b: Material, tol: float = 1e-6) -> None:
     for f in FIELDS:
         x, y = np.atleast_1d(getattr(a, f)), np.atleast_1d(getattr(b, f))
+        if np.isinf(x).any() or np.isinf(y).any():
+            assert np.array_equal(x, y), (f, getattr(a, f), getattr(b, f))
+            continue
         assert np.abs(x - y).max() <= tol, (f, getattr(a, f), getattr(b, f))
     assert a.name == b.name
 
@@ -70,6 +78,35 @@ def edge_materials() -> list[Material]:
         out.append(Material(base_color=tuple(rng.random(3)), metallic=float(rng.random()),
                             roughness=float(rng.random()), specular_f0=tuple(rng.random(3) * 0.3),
                             emissive=tuple(rng.random(3) * 5 * (i % 2)), name=f"random{i}"))
+    return out + layered_materials()
+
+
+def layered_materials() -> list[Material]:
+    """Each layer alone, every layer at once, an ior apart from the specular colour, and random
+    layered materials (issue 11's extensions)."""
+    rng = np.random.default_rng(11)
+    out = [
+        Material(clearcoat=1.0, clearcoat_roughness=0.03, name="clearcoat"),
+        Material(sheen_color=(0.9, 0.2, 0.4), sheen_roughness=0.5, name="sheen"),
+        Material(metallic=1.0, anisotropy_strength=0.8, anisotropy_rotation=-2.5, name="anisotropy"),
+        Material(transmission=1.0, ior=1.33, roughness=0.0, name="transmission"),
+        Material(transmission=0.9, thickness=0.5, attenuation_color=(0.8, 0.3, 0.1), attenuation_distance=0.2,
+                 ior=1.76, name="volume"),
+        Material(transmission=0.5, thickness=1.5, name="volume_without_attenuation"),
+        Material(ior=2.4, specular_f0=(0.1, 0.12, 0.14), name="ior_with_specular_colour"),
+        Material(ior=1.0, specular_f0=(0.0, 0.0, 0.0), transmission=1.0, name="ior_1"),
+        Material(ior=1.2, clearcoat=0.3, clearcoat_roughness=0.4, sheen_color=(0.5, 0.5, 0.5),
+                 sheen_roughness=1.0, anisotropy_strength=0.2, anisotropy_rotation=0.3, transmission=0.6,
+                 thickness=0.01, attenuation_color=(0.0, 1.0, 0.5), attenuation_distance=30.0, name="every_layer"),
+    ]
+    for i in range(8):
+        out.append(Material(base_color=tuple(rng.random(3)), metallic=float(rng.random()), roughness=float(rng.random()),
+                            ior=float(1.0 + 2.0 * rng.random()), transmission=float(rng.random()),
+                            thickness=float(rng.random() * 3), attenuation_color=tuple(rng.random(3)),
+                            attenuation_distance=float(0.01 + rng.random() * 10), clearcoat=float(rng.random()),
+                            clearcoat_roughness=float(rng.random()), sheen_color=tuple(rng.random(3)),
+                            sheen_roughness=float(rng.random()), anisotropy_strength=float(rng.random()),
+                            anisotropy_rotation=float((rng.random() - 0.5) * 20), name=f"random_layers{i}"))
     return out
 
 
@@ -239,3 +276,58 @@ def test_editor_state_exports_the_edited_material(validate, tmp_path):
     with pytest.raises(AlightError):
         state.export_gltf(str(tmp_path / "no_such_folder" / "x.gltf"))
     assert not (tmp_path / "no_such_folder").exists()
+
+
+def test_every_layer_is_written_as_its_extension(tmp_path):
+    doc = read_gltf_json(export_material_gltf(layered_materials()[8], tmp_path / "m.gltf"))
+    ext = doc["materials"][0]["extensions"]
+    assert set(doc["extensionsUsed"]) == {EXT_IOR, EXT_TRANSMISSION, EXT_VOLUME, EXT_CLEARCOAT, EXT_SHEEN, EXT_ANISOTROPY}
+    assert ext[EXT_TRANSMISSION] == {"transmissionFactor": 0.6}
+    assert ext[EXT_VOLUME] == {"thicknessFactor": 0.01, "attenuationDistance": 30.0, "attenuationColor": [0.0, 1.0, 0.5]}
+    assert ext[EXT_CLEARCOAT] == {"clearcoatFactor": 0.3, "clearcoatRoughnessFactor": 0.4}
+    assert ext[EXT_SHEEN] == {"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessFactor": 1.0}
+    assert ext[EXT_ANISOTROPY] == {"anisotropyStrength": 0.2, "anisotropyRotation": 0.3}
+    assert ext[EXT_IOR] == {"ior": 1.2}
+    # A layer at its defaults writes nothing.
+    doc = read_gltf_json(export_material_gltf(Material(clearcoat_roughness=0.5), tmp_path / "n.gltf"))
+    assert doc["materials"][0]["extensions"] == {EXT_CLEARCOAT: {"clearcoatRoughnessFactor": 0.5}}
+
+
+def test_import_reads_the_layer_extensions_with_their_defaults(tmp_path):
+    gm = {"extensions": {EXT_TRANSMISSION: {}, EXT_VOLUME: {"thicknessFactor": 2},
+                         EXT_CLEARCOAT: {"clearcoatFactor": 1}, EXT_SHEEN: {"sheenRoughnessFactor": 0.5},
+                         EXT_ANISOTROPY: {"anisotropyStrength": 0.5}, EXT_IOR: {"ior": 0}}}
+    p = tmp_path / "x.gltf"
+    p.write_text(json.dumps({"asset": {"version": "2.0"}, "materials": [gm]}))
+    m = import_material(p)
+    assert (m.transmission, m.thickness, m.attenuation_distance, m.attenuation_color) == (0.0, 2.0, float("inf"), (1.0,) * 3)
+    assert (m.clearcoat, m.clearcoat_roughness, m.sheen_color, m.sheen_roughness) == (1.0, 0.0, (0.0,) * 3, 0.5)
+    assert (m.anisotropy_strength, m.anisotropy_rotation, m.ior) == (0.5, 0.0, 1.5)   # legacy ior 0: glTF's 1.5
+
+
+@pytest.mark.parametrize("ext, body, problem", [
+    (EXT_CLEARCOAT, {"clearcoatFactor": 2.0}, "clearcoat"),
+    (EXT_SHEEN, {"sheenColorFactor": [1, 1]}, "sheenColorFactor"),
+    (EXT_VOLUME, {"attenuationDistance": -1}, "attenuation_distance"),
+    (EXT_TRANSMISSION, [], EXT_TRANSMISSION),
+])
+def test_bad_layer_extensions_are_one_line_errors(tmp_path, ext, body, problem):
+    p = tmp_path / "x.gltf"
+    p.write_text(json.dumps({"asset": {"version": "2.0"}, "materials": [{"extensions": {ext: body}}]}))
+    with pytest.raises(AlightError) as e:
+        import_material(p)
+    assert str(e.value).startswith(str(p)) and problem in str(e.value) and "\n" not in str(e.value)
+
+
+def test_ior_1_with_reflectance_is_refused_on_export(tmp_path):
+    with pytest.raises(AlightError, match="glTF cannot hold both"):
+        export_material_gltf(Material(ior=1.0, specular_f0=(0.04,) * 3), tmp_path / "m.gltf")
+    assert not (tmp_path / "m.gltf").exists()
+
+
+def test_mesh_files_bring_their_layers(shared_data):
+    """ClearCoatTest's coated spheres carry KHR_materials_clearcoat into the mesh's parts."""
+    mesh = load_mesh(str(shared_data / "models" / "khronos" / "ClearCoatTest" / "glTF-Binary" / "ClearCoatTest.glb"))
+    coated = [p for p in mesh.parts if p.material is not None and p.material.layers.get("clearcoat")]
+    assert coated, [p.name for p in mesh.parts]
+    assert {p.material.layers["clearcoat"] for p in coated} == {1.0}

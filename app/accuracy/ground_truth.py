@@ -333,6 +333,42 @@ def reflectance_ground_truth(radiance, normals, views, base_color, metallic, rou
     return terms.combine(base_color, metallic, specular_f0, emissive)
 
 
+# Pairs per chunk of the layered sum: each (p, T, 3) float64 temporary is at most 2**21 * 3 * 8 B
+# = 48 MiB, and a layer holds a few at once.
+_LAYERED_CHUNK_PAIRS = 1 << 21
+
+
+def layered_ground_truth(radiance, normals, views, material, tangents=None, rotation_deg: float = 0.0,
+                         intensity: float = 1.0) -> np.ndarray:
+    """The exact answer L_o(n, v) (P, 3) float64 for a material with layers (docs/layers.md):
+    emission through the coat plus the sum over the texels of the whole layered BRDF
+    (``alight.core.layers.stack.layered_brdf_cos``) times W = L dOmega.
+
+    Without the S1..S4 factorisation (layers are not linear in one F0), so every pair is
+    evaluated: about 10x the cost of ``reflectance_ground_truth`` per point. ``tangents``
+    (P, 3): the anisotropy's frame (default: the probe's, ``probe_tangents``). The base
+    roughness and the layers' roughness must be >= MIN_ROUGHNESS where their lobes are narrow
+    (each layer module says which).
+    """
+    from alight.core.layers.stack import Pairs, layered_brdf_cos, layered_emission, probe_tangents
+
+    _check_roughness(material.roughness)
+    dirs, wt = _texels(radiance, rotation_deg, intensity)
+    dirs64, wt64 = dirs.astype(np.float64), wt.astype(np.float64)
+    n = _unit_rows(normals)
+    v = _unit_rows(views, n.shape[0])
+    t = probe_tangents(n) if tangents is None else _unit_rows(tangents, n.shape[0])
+    b = np.cross(n, t)
+    out = np.zeros((n.shape[0], 3))
+    step = max(1, _LAYERED_CHUNK_PAIRS // max(dirs.shape[0], 1))
+    for a in range(0, n.shape[0], step):
+        sl = slice(a, min(n.shape[0], a + step))
+        pairs = Pairs(n=n[sl], v=v[sl], l=dirs64, t=t[sl], b=b[sl])
+        f = layered_brdf_cos(material, pairs)                       # (p, T, 3)
+        out[sl] = layered_emission(material, pairs) + np.einsum("ptc,tc->pc", f, wt64)
+    return out
+
+
 def probe_points(width: int):
     """Normals (N, 3) of the probe pixels inside the disk and the (W, W) inside mask."""
     normals, inside = probe_normals(int(width))
@@ -350,6 +386,12 @@ def probe_ground_truth(radiance, width: int, material, rotation_deg: float = 0.0
     pts, inside = probe_points(width)
     r = material.roughness if roughness is None else roughness
     out = np.zeros(inside.shape + (3,))
+    if getattr(material, "layers", None) and material.layers():
+        import dataclasses
+
+        m = material if roughness is None else dataclasses.replace(material, roughness=float(roughness))
+        out[inside] = layered_ground_truth(radiance, pts, (0.0, 0.0, 1.0), m, None, rotation_deg, intensity)
+        return out
     out[inside] = reflectance_ground_truth(radiance, pts, (0.0, 0.0, 1.0), material.base_color, material.metallic,
                                            r, material.specular_f0, material.emissive, rotation_deg, intensity)
     return out

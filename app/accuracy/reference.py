@@ -45,9 +45,12 @@ import moderngl
 import numpy as np
 
 from alight.accuracy.ground_truth import MIN_ROUGHNESS
+from alight.core.layers import layer_defines
+from alight.core.layers.stack import probe_tangents
+from alight.core.material import LAYER_FIELDS
 from alight.core.shading import probe_normals
 from alight.errors import AlightError
-from alight.render.renderer import ForwardRenderer, _rotation_cos_sin, _set
+from alight.render.renderer import ForwardRenderer, _rotation_cos_sin, _set, _set_material
 
 # Pixel-texel pairs per dispatch at most (a 256^2 probe on a 1024x512 map: ~26 dispatches).
 CHUNK_PAIRS = 1 << 28
@@ -60,8 +63,8 @@ LEVEL1_MAX_SUN_FRACTION = 0.10
 # across the outer loop: a 512x256 map in one dispatch summed only its upper half. Measured:
 # constant radiance 1 gave 0.496 instead of 0.99998 at 512x256, 0.012 at 1024x512.
 MAX_TEXELS_PER_DISPATCH = 1 << 15
-GBUFFER = ("position", "normal", "view", "base_color", "specular_f0", "emissive")
-_UNIT_ENV = 6   # texture units 0-5: the G-buffer
+GBUFFER = ("position", "normal", "view", "base_color", "specular_f0", "emissive", "tangent")
+_UNIT_ENV = 7   # texture units 0-6: the G-buffer
 
 
 @dataclass
@@ -117,6 +120,8 @@ def probe_gbuffer(size: int, material) -> dict[str, np.ndarray]:
     g["base_color"][..., :3] = material.base_color
     g["specular_f0"][..., :3] = material.specular_f0
     g["emissive"][..., :3] = material.emissive
+    g["tangent"][..., :3] = probe_tangents(normals)
+    g["tangent"][..., 3] = 1.0
     for name in GBUFFER[1:]:
         g[name][~inside] = 0.0
     return g
@@ -163,6 +168,20 @@ class ReferenceRenderer:
         depth.release()
         return texs
 
+    def layered_material(self, scene):
+        """The material whose layer factors the reference applies at every pixel (the G-buffer
+        carries the base model only): the scene's, or the one all the mesh's parts share. Parts
+        with different layer factors are refused (one line) rather than summed wrongly."""
+        if scene.view == "probe" or scene.mesh is None:
+            return scene.material
+        materials = [self.renderer._part_material(scene, part)[0] for part in scene.mesh.parts]
+        distinct = {tuple(getattr(m, f) for f in ("ior", *LAYER_FIELDS)) for m in materials if m.layers()}
+        if len(distinct) > 1:
+            raise AlightError(f"{scene.mesh.source}: parts with different layer factors (clearcoat, sheen, ...): "
+                              "the reference takes one set per scene")
+        layered = [m for m in materials if m.layers()]
+        return layered[0] if layered else scene.material
+
     def scene_roughnesses(self, scene) -> list[float]:
         """The roughness factors the scene's surfaces use (textures not included)."""
         if scene.view == "probe" or scene.mesh is None:
@@ -202,7 +221,7 @@ class ReferenceRenderer:
             flip = False
         seconds["gbuffer"] = time.perf_counter() - t0
         return self._sum(gtex, flip, scene, radiance if use_env else None, width, height, env_level, chunk_pairs,
-                         seconds, self.scene_roughnesses(scene))
+                         seconds, self.scene_roughnesses(scene), self.layered_material(scene))
 
     def render_gbuffer(self, g: dict[str, np.ndarray], scene, radiance: np.ndarray | None,
                        env_level: int | None = None, chunk_pairs: int = CHUNK_PAIRS) -> ReferenceResult:
@@ -217,10 +236,10 @@ class ReferenceRenderer:
             for r in roughnesses:
                 check_roughness(r)
         return self._sum(self._textures_from_arrays(g), False, scene, radiance if use_env else None, width, height,
-                         env_level, chunk_pairs, {}, roughnesses)
+                         env_level, chunk_pairs, {}, roughnesses, scene.material)
 
     def _sum(self, gtex, flip: bool, scene, radiance, width: int, height: int, env_level, chunk_pairs: int,
-             seconds: dict[str, float], roughnesses) -> ReferenceResult:
+             seconds: dict[str, float], roughnesses, material) -> ReferenceResult:
         ctx = self.ctx
         use_env = radiance is not None
         t1 = time.perf_counter()
@@ -242,7 +261,8 @@ class ReferenceRenderer:
         seconds["environment"] = t2 - t1
 
         accum = ctx.texture((width, height), 4, dtype="f4")
-        prog = self.renderer.shaders.compute("accuracy/reference.comp")
+        prog = self.renderer.shaders.compute("accuracy/reference.comp", layer_defines([material]))
+        _set_material(prog, material)   # the layers' factors (the G-buffer holds the base's)
         for unit, (name, tex) in enumerate(zip(GBUFFER, gtex)):
             tex.use(unit)
             _set(prog, f"u_g_{name}", unit)

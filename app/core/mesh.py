@@ -11,7 +11,7 @@ while texture arrays keep PIL's order (row 0 = top row), so a texel is found at
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -32,6 +32,9 @@ class FileMaterial:
     emissive_texture: np.ndarray | None  # sRGB
     occlusion_texture: np.ndarray | None  # R = occlusion
     occlusion_strength: float
+    # The ior and the layers' factors the file gives (alight.core.material field names, e.g.
+    # {"clearcoat": 1.0}; alight.exchange.gltf_material.layer_fields_from_gltf); empty: none.
+    layers: dict = field(default_factory=dict)
 
 
 @dataclass

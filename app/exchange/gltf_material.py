@@ -7,12 +7,32 @@ KHR_materials_emissive_strength):
     base_color  = baseColorFactor.rgb          (alpha is dropped: the model is opaque)
     metallic    = metallicFactor, roughness = roughnessFactor
     emissive    = emissiveFactor * emissiveStrength
+    ior         = ior
     specular_f0 = min(((ior - 1) / (ior + 1))^2 * specularColorFactor, 1) * specularFactor
 
-Export inverts the last line exactly: a grey F0 other than 0.04 becomes an ior
-(ior = (1 + sqrt(F0)) / (1 - sqrt(F0))), and a coloured F0 the ior of its largest channel
-with specularColorFactor = F0 / max(F0) <= 1, so engines that know the extensions shade the
-same dielectric reflectance. Textures are not carried (the material model has none).
+Export inverts the last lines exactly: the material's ior goes out as KHR_materials_ior
+(when not 1.5), and a specular_f0 other than the ior's F0 as specularColorFactor = F0 / F0(ior)
+(KHR_materials_specular allows factors above 1; the formula's min(..., 1) then clamps), so
+engines that know the extensions shade the same dielectric reflectance. The ior rule of
+alight.core.material makes a grey F0 other than 0.04 an ior of its own: water's 0.02 is ior
+1.33, written as such.
+
+The layers (issue 11; docs/layers.md) are the extensions' factors, one to one:
+
+    transmission          = KHR_materials_transmission.transmissionFactor
+    thickness             = KHR_materials_volume.thicknessFactor
+    attenuation_color     = KHR_materials_volume.attenuationColor
+    attenuation_distance  = KHR_materials_volume.attenuationDistance (absent: +inf)
+    clearcoat             = KHR_materials_clearcoat.clearcoatFactor
+    clearcoat_roughness   = KHR_materials_clearcoat.clearcoatRoughnessFactor
+    sheen_color           = KHR_materials_sheen.sheenColorFactor
+    sheen_roughness       = KHR_materials_sheen.sheenRoughnessFactor
+    anisotropy_strength   = KHR_materials_anisotropy.anisotropyStrength
+    anisotropy_rotation   = KHR_materials_anisotropy.anisotropyRotation
+
+An extension is written only when one of its fields differs from its default (the layer is
+on). Textures are not carried here: the material model has none (a mesh file's maps are read
+by alight.exchange.meshes).
 """
 
 from __future__ import annotations
@@ -26,17 +46,32 @@ from typing import Any
 
 import numpy as np
 
-from alight.core.material import Material, validate_material
+from alight.core.material import DEFAULT_IOR, Material, f0_from_ior, validate_material
 from alight.errors import AlightError
 from alight.exchange.output import atomic_path
 
 EXT_IOR = "KHR_materials_ior"
 EXT_SPECULAR = "KHR_materials_specular"
 EXT_EMISSIVE = "KHR_materials_emissive_strength"
+EXT_TRANSMISSION = "KHR_materials_transmission"
+EXT_VOLUME = "KHR_materials_volume"
+EXT_CLEARCOAT = "KHR_materials_clearcoat"
+EXT_SHEEN = "KHR_materials_sheen"
+EXT_ANISOTROPY = "KHR_materials_anisotropy"
 DEFAULT_F0 = 0.04  # ((1.5 - 1) / (1.5 + 1))^2, glTF's default dielectric
-# Above this F0 the ior would grow without bound (F0 = 1 needs ior = inf); there the default
-# ior 1.5 with specularColorFactor = F0 / 0.04 (allowed above 1, clamped by the formula) is used.
-_MAX_IOR_F0 = 0.9
+# Each layer extension's factors: (glTF name, Material field, glTF default, components).
+LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
+    EXT_TRANSMISSION: (("transmissionFactor", "transmission", 0.0, 1),),
+    EXT_VOLUME: (("thicknessFactor", "thickness", 0.0, 1),
+                 ("attenuationDistance", "attenuation_distance", math.inf, 1),
+                 ("attenuationColor", "attenuation_color", (1.0, 1.0, 1.0), 3)),
+    EXT_CLEARCOAT: (("clearcoatFactor", "clearcoat", 0.0, 1),
+                    ("clearcoatRoughnessFactor", "clearcoat_roughness", 0.0, 1)),
+    EXT_SHEEN: (("sheenColorFactor", "sheen_color", (0.0, 0.0, 0.0), 3),
+                ("sheenRoughnessFactor", "sheen_roughness", 0.0, 1)),
+    EXT_ANISOTROPY: (("anisotropyStrength", "anisotropy_strength", 0.0, 1),
+                     ("anisotropyRotation", "anisotropy_rotation", 0.0, 1)),
+}
 GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 
 
@@ -90,6 +125,32 @@ def dielectric_f0(ior: float, specular_factor: float = 1.0,
     return tuple(min(base * c, 1.0) * specular_factor for c in specular_color)  # type: ignore[return-value]
 
 
+def layer_fields_from_gltf(gm: dict, source: str) -> dict[str, Any]:
+    """The Material fields a glTF material's layer extensions and KHR_materials_ior give
+    (only those the file has; the rest keep their defaults), unvalidated."""
+    ext = gm.get("extensions") or {}
+    if not isinstance(ext, dict):
+        raise _fail(source, "material: extensions must be an object")
+    out: dict[str, Any] = {}
+    for name, params in LAYER_EXTENSIONS.items():
+        e = ext.get(name)
+        if e is None:
+            continue
+        if not isinstance(e, dict):
+            raise _fail(source, f"material: {name} must be an object")
+        for key, field, default, count in params:
+            if key in e:
+                if count == 1:
+                    out[field] = _number(e[key], default, source, f"{name}.{key}")
+                else:
+                    out[field] = tuple(_numbers(e[key], count, list(default), source, f"{name}.{key}"))
+    ior = (ext.get(EXT_IOR) or {}).get("ior")
+    if ior is not None:
+        ior = _number(ior, DEFAULT_IOR, source, f"{EXT_IOR}.ior")
+        out["ior"] = DEFAULT_IOR if ior == 0.0 else ior   # the extension's legacy 'ior 0': no ior
+    return out
+
+
 def material_from_gltf(gm: dict, source: str, name: str = "material") -> Material:
     """One glTF material object (a dict from the JSON's ``materials``) as a Material."""
     if not isinstance(gm, dict):
@@ -111,10 +172,12 @@ def material_from_gltf(gm: dict, source: str, name: str = "material") -> Materia
         ior = 1.5  # the extension's legacy 'ior 0' means no ior; F0 then stays the default
     if ior < 1.0:
         raise _fail(source, f"ior: {ior:g} is below 1")
+    layers = layer_fields_from_gltf(gm, source)
+    layers["ior"] = ior
     m = Material(base_color=tuple(base[:3]), metallic=metallic, roughness=roughness,  # type: ignore[arg-type]
                  specular_f0=dielectric_f0(ior, spec_factor, tuple(spec_color)),  # type: ignore[arg-type]
                  emissive=tuple(e * strength for e in emissive),  # type: ignore[arg-type]
-                 name=str(gm.get("name") or name))
+                 name=str(gm.get("name") or name), **layers)
     return validate_material(m, source)
 
 
@@ -150,18 +213,21 @@ def material_to_gltf(m: Material) -> tuple[dict, list[str]]:
         gm["emissiveFactor"] = [e / scale for e in m.emissive]
         if scale != 1.0:
             ext[EXT_EMISSIVE] = {"emissiveStrength": scale}
-    f0 = m.specular_f0
-    f0_max = max(f0)
-    if f0 != (DEFAULT_F0,) * 3:
-        if f0_max == 0.0:
-            ext[EXT_IOR] = {"ior": 1.0}  # ior 1 reflects nothing
-        elif f0_max <= _MAX_IOR_F0:
-            s = math.sqrt(f0_max)
-            ext[EXT_IOR] = {"ior": (1.0 + s) / (1.0 - s)}
-            if min(f0) != f0_max:
-                ext[EXT_SPECULAR] = {"specularColorFactor": [c / f0_max for c in f0]}
-        else:
-            ext[EXT_SPECULAR] = {"specularColorFactor": [c / DEFAULT_F0 for c in f0]}
+    ior = m.ior
+    f0_ior = f0_from_ior(ior)
+    if f0_ior == 0.0 and max(m.specular_f0) > 0.0:
+        # glTF's F0 is ((ior - 1)/(ior + 1))^2 times a factor: ior 1 reflects nothing whatever
+        # the factor, so this pair has no glTF form. Refused rather than written differently.
+        raise _fail(m.name, f"ior {ior:g} with specular_f0 {max(m.specular_f0):g}: glTF cannot hold both "
+                            "(ior 1 reflects nothing there); give one and let the other follow")
+    if ior != DEFAULT_IOR:
+        ext[EXT_IOR] = {"ior": ior}
+    if any(abs(c - f0_ior) > 1e-12 for c in m.specular_f0) and f0_ior > 0.0:
+        ext[EXT_SPECULAR] = {"specularColorFactor": [c / f0_ior for c in m.specular_f0]}
+    for name, params in LAYER_EXTENSIONS.items():
+        values = {key: getattr(m, field) for key, field, default, _ in params if getattr(m, field) != default}
+        if values:
+            ext[name] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in values.items()}
     if ext:
         gm["extensions"] = ext
     return gm, sorted(ext)

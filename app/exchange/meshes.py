@@ -175,6 +175,7 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             emissive_texture=_texture(mat.emissiveTexture, textures),
             occlusion_texture=_texture(mat.occlusionTexture, textures),
             occlusion_strength=float(extra.get("occlusion_strength", 1.0)),
+            layers=dict(extra.get("layers", {})),
         )
     if kind == "SimpleMaterial":
         if getattr(mat, "_name", None) is None:
@@ -197,6 +198,23 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             occlusion_strength=1.0,
         )
     return None
+
+
+def _layer_fields(gm: dict, source: str) -> dict[str, Any]:
+    """The ior and layer factors of one glTF material (alight.exchange.gltf_material), checked
+    against the model's ranges; a bad value is a one-line error naming the file."""
+    from alight.core.material import LAYER_FIELDS, Material, validate_material
+    from alight.exchange.gltf_material import EXT_IOR, EXT_SPECULAR, layer_fields_from_gltf, material_from_gltf
+
+    fields = layer_fields_from_gltf(gm, source)
+    ext = gm.get("extensions") or {}
+    if EXT_IOR in ext or EXT_SPECULAR in ext:   # the file's dielectric: ior and F0 together
+        m = material_from_gltf({"extensions": {k: ext[k] for k in (EXT_IOR, EXT_SPECULAR) if k in ext}}, source)
+        fields["ior"], fields["specular_f0"] = m.ior, m.specular_f0
+    if fields:
+        m = validate_material(Material(**fields), f"{source}: material '{gm.get('name')}'")
+        fields = {f: getattr(m, f) for f in fields if f in LAYER_FIELDS or f in ("ior", "specular_f0")}
+    return fields
 
 
 def _gltf_material_params(path: Path) -> dict[str, dict]:
@@ -234,7 +252,10 @@ def _gltf_material_params(path: Path) -> dict[str, dict]:
             strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {})
             if "emissiveStrength" in strength:
                 params["emissive_strength"] = float(strength["emissiveStrength"])
+            params["layers"] = _layer_fields(m, str(path))
             out[name] = params
         return out
+    except AlightError:
+        raise
     except Exception:
         return {}

@@ -14,7 +14,8 @@ import numpy as np
 
 from alight.core.gpu import ShaderLibrary, create_headless_context
 from alight.core.ibl_models import SUNS_AS_BAKED, ibl_model_index
-from alight.core.material import Material
+from alight.core.layers import layer_defines
+from alight.core.material import Material, with_overrides
 from alight.core.mesh import is_closed
 from alight.core.scene import (
     TONEMAPS,
@@ -448,7 +449,8 @@ class ForwardRenderer:
         self._fullscreen(prog)
 
     def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:
-        prog = self.program("render/fullscreen.vert", "render/probe.frag", self._ibl_defines(scene))
+        defines = {**self._ibl_defines(scene), **layer_defines([scene.material])}
+        prog = self.program("render/fullscreen.vert", "render/probe.frag", defines)
         m = scene.material
         prog["u_size"] = float(size)
         _set_material(prog, m)
@@ -460,6 +462,7 @@ class ForwardRenderer:
         # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
         defines = self._ibl_defines(scene)
         defines["MATERIAL_MAPS_MASK"] = self._map_mask(scene)
+        defines.update(self.layer_defines(scene))
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
         prog = self._scene_program("render/pbr.vert", "render/pbr.frag", defines)
@@ -468,6 +471,13 @@ class ForwardRenderer:
             _set(prog, "u_debug_mip", float(scene.debug_mip))
         self._bind_ibl(prog, scene, maps)
         self.draw_mesh_parts(scene, prog, camera, view_projection)
+
+    def layer_defines(self, scene: Scene) -> dict:
+        """The HAS_* defines of the layers any part of the scene's mesh is drawn with
+        (alight.core.layers): a scene without layers compiles none."""
+        if scene.mesh is None:
+            return layer_defines([scene.material])
+        return layer_defines(self._part_material(scene, part)[0] for part in scene.mesh.parts)
 
     def _map_mask(self, scene: Scene) -> int:
         """mesh_material.glsl's MATERIAL_MAPS_MASK: a bit per map any part is drawn with."""
@@ -523,9 +533,12 @@ class ForwardRenderer:
             return scene.material, False
         base = Material(base_color=tuple(fm.base_color), metallic=float(fm.metallic),
                         roughness=float(fm.roughness), specular_f0=scene.material.specular_f0,
-                        emissive=tuple(fm.emissive), name=part.name)
+                        ior=scene.material.ior, emissive=tuple(fm.emissive), name=part.name)
+        layers = getattr(fm, "layers", None)
+        if layers:   # the file's own layer fields and ior (alight.exchange.gltf_material)
+            base = replace(base, **layers)
         if scene.material_overrides:
-            base = replace(base, **scene.material_overrides)
+            base = with_overrides(base, **scene.material_overrides)
         return base, True
 
     def _finish_radiance(self, targets: _Targets) -> None:
@@ -579,3 +592,15 @@ def _set_material(prog: moderngl.Program, m: Material) -> None:
     _set(prog, "u_roughness", float(m.roughness))
     _set(prog, "u_specular_f0", tuple(float(x) for x in m.specular_f0))
     _set(prog, "u_emissive", tuple(float(x) for x in m.emissive))
+    # The layers' factors (common/material_layers.glsl); a layer not compiled in has no uniform.
+    _set(prog, "u_clearcoat", float(m.clearcoat))
+    _set(prog, "u_clearcoat_roughness", float(m.clearcoat_roughness))
+    _set(prog, "u_sheen_color", tuple(float(x) for x in m.sheen_color))
+    _set(prog, "u_sheen_roughness", float(m.sheen_roughness))
+    _set(prog, "u_anisotropy_strength", float(m.anisotropy_strength))
+    _set(prog, "u_anisotropy_rotation", float(m.anisotropy_rotation))
+    _set(prog, "u_transmission", float(m.transmission))
+    _set(prog, "u_ior", float(m.ior))
+    _set(prog, "u_thickness", float(m.thickness))
+    _set(prog, "u_attenuation_color", tuple(float(x) for x in m.attenuation_color))
+    _set(prog, "u_attenuation_distance", float(min(m.attenuation_distance, 3.0e38)))

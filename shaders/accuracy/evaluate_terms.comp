@@ -73,7 +73,7 @@ void main() {
         case TERM_CUBE_TEXEL_DIRECTION: o.xyz = cube_texel_direction(ivec3(a.xyz), int(a.w)); break;
         case TERM_PUNCTUAL: {
             // One light straight along n; a = (n.l, roughness, metallic, base grey).
-            Surface s = Surface(vec3(a.w), a.z, a.y, vec3(0.04), vec3(0.0), 1.0);
+            Surface s = surface_base(vec3(a.w), a.z, a.y, vec3(0.04), vec3(0.0), 1.0);
             vec3 n = vec3(0.0, 0.0, 1.0);
             vec3 l = vec3(sqrt(max(0.0, 1.0 - a.x * a.x)), 0.0, a.x);
             o.xyz = punctual_light(s, n, n, l, vec3(1.0));

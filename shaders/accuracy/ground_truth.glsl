@@ -1,27 +1,41 @@
 // CONVENTIONS.md's ground truth for image-based lighting as a finite sum over the texels of an
 // equirect map (numpy twin: app/accuracy/ground_truth.py):
 //     L_o(n, v) = emissive + sum_t f(l_t, v) L(l_t) max(n.l_t, 0) dOmega_t
-// with k = r^2/2 (the IBL k) and F (so kd) per direction at v.h. Nothing is sampled.
-#include "common/brdf.glsl"
-#include "common/equirect.glsl"
-#include "common/surface.glsl"
+// with k = r^2/2 (the IBL k) and F (so kd) per direction at v.h. Nothing is sampled. A
+// material's layers (docs/layers.md) enter through the same functions as in shading, with
+// CONVENTIONS.md's exact choices (punctual = false, spread 0; common/layers.glsl).
+#include "common/shading.glsl"
 
 // f(l, v) max(n.l, 0) of CONVENTIONS.md, built from brdf.glsl's terms. n_dot_v is already
 // clamped to MIN_N_DOT_V (as app/accuracy/ground_truth.py does); h is the geometric half vector, with
 // |l + v| floored at 1e-7 (l = -v).
 vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l) {
+#ifdef HAS_TRANSMISSION
+    vec3 f = transmission_light(s, n, v, l, false);
+#else
+    vec3 f = vec3(0.0);
+#endif
     float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0) return vec3(0.0);
-    vec3 lv = l + v;
-    vec3 h = lv / max(length(lv), 1e-7);
-    float n_dot_h = dot(n, h);
-    float v_dot_h = clamp(dot(v, h), 0.0, 1.0);
-    vec3 F = F_Schlick(v_dot_h, f0);
-    vec3 kd = (1.0 - F) * (1.0 - s.metallic);
-    float D = D_GGX(n_dot_h, s.roughness);
-    float G = G_Smith(n_dot_v, n_dot_l, k_ibl(s.roughness));
-    vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
-    return (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+    if (n_dot_l > 0.0) {
+        vec3 lv = l + v;
+        vec3 h = lv / max(length(lv), 1e-7);
+        float n_dot_h = dot(n, h);
+        float v_dot_h = clamp(dot(v, h), 0.0, 1.0);
+        vec3 F = F_Schlick(v_dot_h, f0);
+        vec3 kd = (1.0 - F) * (1.0 - s.metallic);
+#ifdef HAS_TRANSMISSION
+        kd *= 1.0 - s.transmission;
+#endif
+#ifdef HAS_ANISOTROPY
+        vec3 specular = anisotropic_specular(s, n, v, l, F, false, 0.0);
+#else
+        float D = D_GGX(n_dot_h, s.roughness);
+        float G = G_Smith(n_dot_v, n_dot_l, k_ibl(s.roughness));
+        vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
+#endif
+        f += (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+    }
+    return layered_light(s, n, v, l, f, false, 0.0);
 }
 
 // (sin phi, cos phi) of each column's centre, phi = (u - 0.5) 2 pi, filled by app/accuracy/reference.py

@@ -5,7 +5,7 @@
 // punctual_light, k = (r+1)^2/8, no occlusion). Pixels the G-buffer marks empty stay 0.
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "accuracy/ground_truth.glsl"
-#include "common/punctual.glsl"
+#include "common/material_layers.glsl"
 
 uniform sampler2D u_g_position;     // xyz world position, w coverage (0 or 1)
 uniform sampler2D u_g_normal;       // xyz n, w roughness
@@ -13,6 +13,7 @@ uniform sampler2D u_g_view;         // xyz v, w metallic
 uniform sampler2D u_g_base_color;
 uniform sampler2D u_g_specular_f0;
 uniform sampler2D u_g_emissive;
+uniform sampler2D u_g_tangent;      // xyz the tangent t of the layers' frame (b = cross(n, t) * w)
 uniform sampler2D u_env;            // the (possibly downsampled) equirect, level 0
 layout(rgba32f, binding = 0) uniform image2D u_accum;
 
@@ -21,8 +22,7 @@ uniform bool u_first;
 uniform bool u_env_enabled;
 uniform int u_row_begin;
 uniform int u_row_end;
-uniform vec2 u_env_rotation;        // (cos(-deg), sin(-deg)): world -> map
-uniform float u_env_intensity;
+// u_env_rotation ((cos(-deg), sin(-deg)): world -> map) and u_env_intensity: common/ibl.glsl's.
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -34,11 +34,18 @@ void main() {
     }
     vec4 nr = texelFetch(u_g_normal, p, 0);
     vec4 vm = texelFetch(u_g_view, p, 0);
-    Surface s = Surface(texelFetch(u_g_base_color, p, 0).rgb, vm.w, nr.w,
-                        texelFetch(u_g_specular_f0, p, 0).rgb, texelFetch(u_g_emissive, p, 0).rgb, 1.0);
+    Surface s = surface_base(texelFetch(u_g_base_color, p, 0).rgb, vm.w, nr.w,
+                             texelFetch(u_g_specular_f0, p, 0).rgb, texelFetch(u_g_emissive, p, 0).rgb, 1.0);
     vec3 n = normalize(nr.xyz);
     vec3 v = normalize(vm.xyz);
-    vec3 sum = u_first ? s.emissive + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
+    // The layers' factors are the scene material's (app/accuracy/reference.py), about the
+    // G-buffer's frame.
+    vec4 tw = texelFetch(u_g_tangent, p, 0);
+    vec3 t = normalize(tw.xyz - n * dot(n, tw.xyz));
+    apply_material_layers(s, n, t, cross(n, t) * (tw.w < 0.0 ? -1.0 : 1.0));
+#endif
+    vec3 sum = u_first ? layered_emission(s, v) + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
     if (u_env_enabled && u_row_end > u_row_begin) {
         vec3 n_map = rotate_world_to_map(n, u_env_rotation);
         vec3 v_map = rotate_world_to_map(v, u_env_rotation);

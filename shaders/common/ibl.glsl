@@ -111,29 +111,48 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
 }
 
 // A compact source as the ground truth sees it: the Cook-Torrance BRDF with the IBL k and the
-// Fresnel per direction, times its power P. The source is not a point: its RMS angular radius
+// Fresnel per direction, per unit power (f n.l; sun_layered adds the layers and the power P).
+// The source is not a point: its RMS angular radius
 // widens the normal distribution to alpha' = sqrt(alpha^2 + spread^2) (D stays normalised), so a
 // mirror shows a spot of the source's size and power (after Karis 2013's sphere lights; it
 // matters only where alpha is near the source's size, e.g. royal_esplanade's 2-degree lamps).
-vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
+vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, float spread) {
     float n_dot_l = dot(n, l);
     if (n_dot_l <= 0.0) return vec3(0.0);
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
     float n_dot_h = max(dot(n, h), 0.0);
     vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s));
+#ifdef HAS_ANISOTROPY
+    vec3 specular = anisotropic_specular(s, n, v, l, F, false, spread);
+#else
     float alpha = s.roughness * s.roughness;
     float widened = max(sqrt(sqrt(alpha * alpha + spread * spread)), MIN_PUNCTUAL_ROUGHNESS);
     float D = D_GGX(n_dot_h, widened);
     float G = G_Smith(n_dot_v, n_dot_l, k_ibl(max(s.roughness, MIN_PUNCTUAL_ROUGHNESS)));
-    vec3 diffuse = (1.0 - F) * (1.0 - s.metallic) * Fd_Lambert(s.base_color);
-    return (diffuse + D * G * F / (4.0 * n_dot_l * n_dot_v)) * power * n_dot_l;
+    vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
+#endif
+    vec3 kd = (1.0 - F) * (1.0 - s.metallic);
+#ifdef HAS_TRANSMISSION
+    kd *= 1.0 - s.transmission;
+#endif
+    return (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+}
+
+// A compact source through the base and its layers (common/layers.glsl).
+vec3 sun_layered(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
+#ifdef HAS_TRANSMISSION
+    vec3 transmitted = transmission_light(s, n, v, l, false);
+#else
+    vec3 transmitted = vec3(0.0);
+#endif
+    return layered_light(s, n, v, l, transmitted + sun_light(s, n, v, l, spread), false, spread) * power;
 }
 
 vec3 suns_exact(Surface s, vec3 n, vec3 v) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < u_sun_count; ++i) {
-        sum += sun_light(s, n, v, u_sun_direction[i], u_sun_power[i], u_sun_spread[i]);
+        sum += sun_layered(s, n, v, u_sun_direction[i], u_sun_power[i], u_sun_spread[i]);
     }
     return sum;
 }
@@ -145,6 +164,9 @@ vec3 suns_exact(Surface s, vec3 n, vec3 v) {
 vec3 ibl_combine(Surface s, vec3 f0, vec3 diffuse_weight, vec3 spec_weight, vec4 lut,
                  vec3 irradiance, vec3 prefiltered) {
     vec3 albedo = s.base_color * (1.0 - s.metallic);
+#ifdef HAS_TRANSMISSION
+    albedo *= 1.0 - s.transmission;   // the rest of the diffuse lobe is transmitted (transmission.glsl)
+#endif
 #ifdef MULTIPLE_SCATTERING
     float e_ss = lut.x + lut.y;
     float e_ms = 1.0 - e_ss;
@@ -165,8 +187,12 @@ vec3 ibl_combine(Surface s, vec3 f0, vec3 diffuse_weight, vec3 spec_weight, vec4
 vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
-    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true),
-                       prefiltered_radiance_at(reflect(-v, n), s.roughness, true));
+#ifdef HAS_ANISOTROPY
+    vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, reflect(-v, n), true);
+#else
+    vec3 prefiltered = prefiltered_radiance_at(reflect(-v, n), s.roughness, true);
+#endif
+    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true), prefiltered);
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
@@ -179,37 +205,42 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
     vec3 r = reflect(-v, n);
     vec3 d = toward_lobe_mean ? specular_dominant_direction(n, r, f0, lut) : r;
+#ifdef HAS_ANISOTROPY
+    vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, d, with_suns);
+#else
+    vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
+#endif
     return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
-                       irradiance_at(n, with_suns), prefiltered_radiance_at(d, s.roughness, with_suns));
+                       irradiance_at(n, with_suns), prefiltered);
 }
 
 // The lecture's cook_torrance_IBL: kd and F from the roughness-aware Fresnel at n.v.
 vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
     vec3 F = F_SchlickRoughness(max(dot(n, v), 0.0), surface_f0(s), s.roughness);
-    return lecture_split_sum(s, n, v, F) * s.occlusion;
+    return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * s.occlusion;
 }
 
 // The lecture with plain Schlick at n.v for kd and F (the diffuse weight ignores roughness).
 vec3 ibl_lecture_schlick(Surface s, vec3 n, vec3 v) {
     vec3 F = F_Schlick(max(dot(n, v), 0.0), surface_f0(s));
-    return lecture_split_sum(s, n, v, F) * s.occlusion;
+    return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * s.occlusion;
 }
 
 vec3 ibl_karis(Surface s, vec3 n, vec3 v) {
-    return karis_split_sum(s, n, v, false, true) * s.occlusion;
+    return layered_ibl(s, n, v, karis_split_sum(s, n, v, false, true), true) * s.occlusion;
 }
 
 // Karis' split fetched at the lobe's mean direction instead of R.
 vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
-    return karis_split_sum(s, n, v, true, true) * s.occlusion;
+    return layered_ibl(s, n, v, karis_split_sum(s, n, v, true, true), true) * s.occlusion;
 }
 
 // alight's model: ibl_dominant for the environment without its compact sources, and those
-// sources through the exact BRDF at every roughness (below the prefiltered grid too, where
-// app/render/renderer.py binds the source cube without them).
+// sources through the exact BRDF and its layers at every roughness (below the prefiltered grid
+// too, where app/render/renderer.py binds the source cube without them).
 vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
     vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v) : vec3(0.0);
-    return (karis_split_sum(s, n, v, true, false) + suns) * s.occlusion;
+    return (layered_ibl(s, n, v, karis_split_sum(s, n, v, true, false), false) + suns) * s.occlusion;
 }
 
 // The model the forward pass uses: IBL_MODEL is the position of its name in app/core/ibl_models.py's

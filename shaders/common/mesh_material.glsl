@@ -2,6 +2,7 @@
 // texture maps, the shading normal and the Surface at a fragment. Shared by render/pbr.frag
 // (forward shading) and render/gbuffer.frag (the reference's G-buffer).
 #include "common/surface.glsl"
+#include "common/material_layers.glsl"
 
 in vec3 v_position;
 in vec3 v_normal;
@@ -60,35 +61,45 @@ vec2 material_uv() {
     return v_uv * u_uv_scale + u_uv_offset;
 }
 
-vec3 shading_normal() {
-    // Zero-length normals (bad meshes) fall back to the face normal from screen derivatives.
+// The interpolated normal, or the face normal from screen derivatives where it is zero (bad
+// meshes), facing the viewer's side.
+vec3 geometric_normal() {
     vec3 n = v_normal;
     vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
     n = dot(n, n) > 1e-12 ? normalize(n) : face;
-    if (!gl_FrontFacing) n = -n;
+    return gl_FrontFacing ? n : -n;
+}
+
+// An orthonormal tangent frame about n from the mesh's tangent (Gram-Schmidt); a tangent
+// parallel to n (a broken file) gets any perpendicular instead. b carries the mesh's handedness.
+mat3 tangent_frame(vec3 n) {
+    vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
+    if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
+    t = normalize(t);
+    vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+    return mat3(t, b, n);
+}
+
+// A tangent-space normal map's value in world space about n (glTF: xy scaled by scale).
+vec3 normal_from_map(sampler2D map, float scale, vec3 n) {
+    vec3 m = texture(map, material_uv()).xyz * 2.0 - 1.0;
+    m.xy *= scale;
+    vec3 mapped = tangent_frame(n) * m;
+    return dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
+}
+
+vec3 shading_normal() {
+    vec3 n = geometric_normal();
     if (has_map(MAP_NORMAL, u_has_normal_map)) {
-        // Gram-Schmidt; a tangent parallel to n (a broken file) gets any perpendicular instead.
-        vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
-        if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
-        t = normalize(t);
-        vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-        vec3 m = texture(u_normal_map, material_uv()).xyz * 2.0 - 1.0;
-        m.xy *= u_normal_scale;
-        vec3 mapped = mat3(t, b, n) * m;
-        n = dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
+        n = normal_from_map(u_normal_map, u_normal_scale, n);
     }
     return n;
 }
 
-Surface material_surface() {
-    Surface s;
-    s.base_color = u_base_color;
-    s.metallic = u_metallic;
-    s.roughness = u_roughness;
-    s.specular_f0 = u_specular_f0;
-    s.emissive = u_emissive;
-    s.occlusion = 1.0;
+// The material at this fragment; n is shading_normal() (the layers' directions are built about it).
+Surface material_surface(vec3 n) {
     vec2 uv = material_uv();
+    Surface s = surface_base(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
     if (has_map(MAP_BASE_COLOR, u_has_base_color_map)) s.base_color *= texture(u_base_color_map, uv).rgb;
     // glTF's packing: G = roughness, B = metallic; a separate greyscale map takes precedence.
     vec2 metal_rough = vec2(1.0);
@@ -101,5 +112,14 @@ Surface material_surface() {
     if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, uv).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
+    mat3 frame = tangent_frame(n);
+    apply_material_layers(s, n, frame[0], frame[1]);
+#endif
+#ifdef HAS_CLEARCOAT
+    // KHR_materials_clearcoat: without a clearcoat normal map the coat is not normal-mapped,
+    // even where the base is.
+    s.clearcoat_normal = geometric_normal();
+#endif
     return s;
 }

@@ -12,10 +12,16 @@ layout(std140, binding = 0) uniform Lights {
     ivec4 u_light_count;
 };
 
-// f(l, v) L_in (n.l) for one light, with the lecture's punctual k = (r+1)^2/8.
-vec3 punctual_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 radiance_in) {
+// The base's f(l, v) (n.l) for one light, with the lecture's punctual k = (r+1)^2/8; with
+// HAS_TRANSMISSION also the transmitted part, for light from either side (common/layers.glsl).
+vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
+#ifdef HAS_TRANSMISSION
+    vec3 transmitted = transmission_light(s, n, v, l, true);
+#else
+    vec3 transmitted = vec3(0.0);
+#endif
     float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0) return vec3(0.0);
+    if (n_dot_l <= 0.0) return transmitted;
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
     float n_dot_h = max(dot(n, h), 0.0);
@@ -23,10 +29,22 @@ vec3 punctual_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 radiance_in) {
     float roughness = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
     vec3 F = F_Schlick(v_dot_h, surface_f0(s));
     vec3 kd = (1.0 - F) * (1.0 - s.metallic);
+#ifdef HAS_TRANSMISSION
+    kd *= 1.0 - s.transmission;
+#endif
+#ifdef HAS_ANISOTROPY
+    vec3 specular = anisotropic_specular(s, n, v, l, F, true, 0.0);
+#else
     float D = D_GGX(n_dot_h, roughness);
     float G = G_Smith(n_dot_v, n_dot_l, k_direct(roughness));
     vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
-    return (kd * Fd_Lambert(s.base_color) + specular) * radiance_in * n_dot_l;
+#endif
+    return transmitted + (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+}
+
+// f(l, v) L_in (n.l) for one light: the base with the layers over it (common/layers.glsl).
+vec3 punctual_light(Surface s, vec3 n, vec3 v, vec3 l, vec3 radiance_in) {
+    return layered_light(s, n, v, l, punctual_base(s, n, v, l), true, 0.0) * radiance_in;
 }
 
 vec3 punctual_lights(Surface s, vec3 n, vec3 v, vec3 position) {

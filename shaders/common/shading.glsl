@@ -2,13 +2,19 @@
 #include "common/brdf.glsl"
 #include "common/equirect.glsl"
 #include "common/surface.glsl"
+#include "common/layers.glsl"
 #include "common/ibl.glsl"
 #include "common/punctual.glsl"
+// The layers' definitions (each under its HAS_* define), after the lookups they use.
+#include "common/clearcoat.glsl"
+#include "common/sheen.glsl"
+#include "common/anisotropy.glsl"
+#include "common/transmission.glsl"
 
 uniform bool u_ibl_enabled;
 
 vec3 shade(Surface s, vec3 n, vec3 v, vec3 position) {
-    vec3 radiance = s.emissive;
+    vec3 radiance = layered_emission(s, v);
     if (u_ibl_enabled) {
         radiance += ibl_model(s, n, v);
     }

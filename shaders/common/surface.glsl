@@ -1,4 +1,7 @@
-// The material model of CONVENTIONS.md at one shading point.
+// The material model of CONVENTIONS.md at one shading point, with the glTF layers of issue 11
+// (docs/layers.md). A layer's fields exist only when its HAS_* define is set
+// (app/core/layers/__init__.py: layer_defines), so a material without layers compiles to the
+// base model alone and pays nothing for them.
 
 struct Surface {
     vec3 base_color;   // linear albedo; F0 of metals
@@ -7,9 +10,69 @@ struct Surface {
     vec3 specular_f0;  // F0 of the dielectric part
     vec3 emissive;     // linear radiance added on top
     float occlusion;   // ambient occlusion, scales image-based light only
+#ifdef HAS_CLEARCOAT
+    float clearcoat;            // KHR_materials_clearcoat: the coat's weight
+    float clearcoat_roughness;  // perceptual; alpha = clearcoat_roughness^2
+    vec3 clearcoat_normal;      // world space: n, unless the coat has its own normal map
+#endif
+#ifdef HAS_SHEEN
+    vec3 sheen_color;           // KHR_materials_sheen, linear
+    float sheen_roughness;      // perceptual; the Charlie distribution's alpha = sheen_roughness^2
+#endif
+#ifdef HAS_ANISOTROPY
+    float anisotropy_strength;  // KHR_materials_anisotropy
+    vec3 anisotropy_direction;  // world-space unit tangent along which the lobe stretches
+    vec3 anisotropy_bitangent;  // cross(n, anisotropy_direction)
+#endif
+#ifdef HAS_TRANSMISSION
+    float transmission;         // KHR_materials_transmission
+    float ior;                  // KHR_materials_ior: the refraction's index
+#endif
+#ifdef HAS_VOLUME
+    float thickness;            // KHR_materials_volume, in world units at this point
+    vec3 attenuation_color;
+    float attenuation_distance; // +inf (a huge number) for none
+#endif
 };
 
 // F0 = mix(specular_f0, base_color, metallic).
 vec3 surface_f0(Surface s) {
     return mix(s.specular_f0, s.base_color, s.metallic);
+}
+
+// A Surface with the base model's fields; every compiled-in layer starts off (glTF's defaults).
+// The layers' own values come from common/material_layers.glsl (uniforms and maps).
+Surface surface_base(vec3 base_color, float metallic, float roughness, vec3 specular_f0, vec3 emissive,
+                     float occlusion) {
+    Surface s;
+    s.base_color = base_color;
+    s.metallic = metallic;
+    s.roughness = roughness;
+    s.specular_f0 = specular_f0;
+    s.emissive = emissive;
+    s.occlusion = occlusion;
+#ifdef HAS_CLEARCOAT
+    s.clearcoat = 0.0;
+    s.clearcoat_roughness = 0.0;
+    s.clearcoat_normal = vec3(0.0, 0.0, 1.0);
+#endif
+#ifdef HAS_SHEEN
+    s.sheen_color = vec3(0.0);
+    s.sheen_roughness = 0.0;
+#endif
+#ifdef HAS_ANISOTROPY
+    s.anisotropy_strength = 0.0;
+    s.anisotropy_direction = vec3(1.0, 0.0, 0.0);
+    s.anisotropy_bitangent = vec3(0.0, 1.0, 0.0);
+#endif
+#ifdef HAS_TRANSMISSION
+    s.transmission = 0.0;
+    s.ior = 1.5;
+#endif
+#ifdef HAS_VOLUME
+    s.thickness = 0.0;
+    s.attenuation_color = vec3(1.0);
+    s.attenuation_distance = 3.0e38;
+#endif
+    return s;
 }

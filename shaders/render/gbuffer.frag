@@ -10,13 +10,16 @@ layout(location = 2) out vec4 out_view;         // v (surface -> eye), metallic
 layout(location = 3) out vec4 out_base_color;   // base colour, 1
 layout(location = 4) out vec4 out_specular_f0;  // specular F0 of the dielectric part, 1
 layout(location = 5) out vec4 out_emissive;     // emissive, 1
+layout(location = 6) out vec4 out_tangent;      // the tangent frame's t, its handedness (the layers')
 
 void main() {
-    Surface s = material_surface();
+    vec3 n = shading_normal();
+    Surface s = material_surface(n);
     out_position = vec4(v_position, 1.0);
-    out_normal = vec4(shading_normal(), s.roughness);
+    out_normal = vec4(n, s.roughness);
     out_view = vec4(normalize(u_camera_position - v_position), s.metallic);
     out_base_color = vec4(s.base_color, 1.0);
     out_specular_f0 = vec4(s.specular_f0, 1.0);
     out_emissive = vec4(s.emissive, 1.0);
+    out_tangent = vec4(tangent_frame(n)[0], v_tangent.w < 0.0 ? -1.0 : 1.0);
 }

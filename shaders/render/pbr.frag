@@ -11,8 +11,8 @@ void main() {
     vec3 n = shading_normal();
     vec3 v = normalize(u_camera_position - v_position);
 #ifdef DEBUG_VIEW
-    out_radiance = encode_output(debug_view(material_surface(), n, v, v_position), 1.0);
+    out_radiance = encode_output(debug_view(material_surface(n), n, v, v_position), 1.0);
 #else
-    out_radiance = encode_output(shade(material_surface(), n, v, v_position), 1.0);
+    out_radiance = encode_output(shade(material_surface(n), n, v, v_position), 1.0);
 #endif
 }

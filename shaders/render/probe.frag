@@ -2,6 +2,7 @@
 // The probe view of CONVENTIONS.md: a unit sphere, orthographic, filling a square image, with
 // the exact normal n = (x, y, sqrt(1 - x^2 - y^2)) per pixel and v = (0, 0, 1).
 #include "common/shading.glsl"
+#include "common/material_layers.glsl"
 
 uniform float u_size;
 uniform vec3 u_base_color;
@@ -19,7 +20,12 @@ void main() {
     float r2 = dot(xy, xy);
     if (r2 >= 1.0) discard;
     vec3 n = vec3(xy, sqrt(1.0 - r2));
-    Surface s = Surface(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
+    Surface s = surface_base(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
+    vec3 t, b;
+    probe_tangent_frame(n, t, b);
+    apply_material_layers(s, n, t, b);
+#endif
     out_radiance = vec4(shade(s, n, vec3(0.0, 0.0, 1.0), n), 1.0);
     gl_FragDepth = 0.0;  // in front of the background, which is drawn after on the far plane
 }

@@ -10,7 +10,7 @@ import numpy as np
 
 from alight.accuracy.auto_quality import DEFAULT_ERROR_BUDGET
 from alight.core.ibl_models import IBL_MODELS
-from alight.core.material import validate_material
+from alight.core.material import validate_material, with_overrides
 from alight.core.scene import BACKGROUNDS, TONEMAPS, Light
 from alight.core.shading import linear_to_srgb, srgb_to_linear
 from alight.core.texture_maps import MAP_SLOTS, SLOT_LABELS
@@ -26,6 +26,15 @@ AA_CHOICES = ("none", "msaa")
 
 def _srgb(c) -> list[float]:
     return [float(x) for x in np.clip(linear_to_srgb(np.asarray(c, np.float64)), 0.0, 1.0)]
+
+
+def _edited(m, **fields):
+    """An edit of specular F0 or ior with the rule applied (alight.core.material.with_overrides);
+    a value out of range keeps the material as it was (the caller validates and reports)."""
+    try:
+        return with_overrides(m, "panel", **fields)
+    except AlightError:
+        return dataclasses.replace(m, **fields)
 
 
 def _linear(c) -> tuple[float, float, float]:
@@ -50,6 +59,7 @@ class Panel:
         self.map_path = ""
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
+        self._sections_for = None      # the loaded material the layer sections were opened for
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -124,15 +134,23 @@ class Panel:
         changed, v = imgui.slider_float("roughness", m.roughness, 0.0, 1.0)
         if changed:
             m = dataclasses.replace(m, roughness=v)
+        # specular F0 and ior are one interface (alight.core.material's rule): editing one sets the other.
         changed, v = imgui.drag_float3("specular F0", list(m.specular_f0), 0.002, 0.0, 1.0)
         if changed:
-            m = dataclasses.replace(m, specular_f0=tuple(min(max(x, 0.0), 1.0) for x in v))
+            m = _edited(m, specular_f0=tuple(min(max(x, 0.0), 1.0) for x in v))
+        changed, v = imgui.drag_float("ior", m.ior, 0.005, 1.0, 4.0)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("index of refraction (KHR_materials_ior): F0 = ((ior-1)/(ior+1))^2 times the "
+                              "specular colour; specular F0 and ior follow each other")
+        if changed:
+            m = _edited(m, ior=max(v, 1.0))
         changed, v = imgui.drag_float3("emissive", list(m.emissive), 0.01, 0.0, 100.0)
         if changed:
             m = dataclasses.replace(m, emissive=tuple(max(x, 0.0) for x in v))
         changed, name = imgui.input_text("name", m.name)
         if changed and name.strip() and name.isprintable():
             m = dataclasses.replace(m, name=name)
+        m = self._layers(s, m)
         if m != s.material:
             try:
                 s.material = validate_material(m, "panel")
@@ -171,6 +189,92 @@ class Panel:
                 s.error, s.message = "", f"exported {self.gltf_path}"
             except AlightError as exc:
                 s.fail(exc)
+
+    def _layers(self, s, m):
+        """A collapsible section per layer (issue 11), open where the material uses the layer:
+        the open state follows the material whenever another one is loaded (a preset, a file,
+        revert), and the artist's clicks otherwise."""
+        from imgui_bundle import imgui
+
+        reset = s.saved_material is not self._sections_for
+        self._sections_for = s.saved_material
+        used = m.layers()
+        for title, layer, draw in (("Clearcoat", "clearcoat", self._clearcoat), ("Sheen", "sheen", self._sheen),
+                                   ("Anisotropy", "anisotropy", self._anisotropy),
+                                   ("Transmission", "transmission", self._transmission),
+                                   ("Volume", "volume", self._volume)):
+            if reset:
+                imgui.set_next_item_open(layer in used, imgui.Cond_.always)
+            if imgui.tree_node_ex(f"{title}{' (on)' if layer in used else ''}###layer_{layer}"):
+                m = draw(m)
+                imgui.tree_pop()
+        return m
+
+    @staticmethod
+    def _clearcoat(m):
+        from imgui_bundle import imgui
+
+        changed, v = imgui.slider_float("clearcoat", m.clearcoat, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, clearcoat=v)
+        changed, v = imgui.slider_float("clearcoat roughness", m.clearcoat_roughness, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, clearcoat_roughness=v)
+        return m
+
+    @staticmethod
+    def _sheen(m):
+        from imgui_bundle import imgui
+
+        changed, col = imgui.color_edit3("sheen colour (sRGB)", _srgb(m.sheen_color))
+        if changed:
+            m = dataclasses.replace(m, sheen_color=_linear(col))
+        changed, v = imgui.slider_float("sheen roughness", m.sheen_roughness, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, sheen_roughness=v)
+        return m
+
+    @staticmethod
+    def _anisotropy(m):
+        from imgui_bundle import imgui
+
+        changed, v = imgui.slider_float("anisotropy strength", m.anisotropy_strength, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, anisotropy_strength=v)
+        changed, v = imgui.slider_angle("anisotropy rotation", m.anisotropy_rotation, -180.0, 180.0)
+        if changed:
+            m = dataclasses.replace(m, anisotropy_rotation=v)
+        return m
+
+    @staticmethod
+    def _transmission(m):
+        from imgui_bundle import imgui
+
+        changed, v = imgui.slider_float("transmission", m.transmission, 0.0, 1.0)
+        if changed:
+            m = dataclasses.replace(m, transmission=v)
+        return m
+
+    @staticmethod
+    def _volume(m):
+        from imgui_bundle import imgui
+
+        imgui.text_disabled("acts through transmission; thickness 0 is thin-walled")
+        changed, v = imgui.drag_float("thickness", m.thickness, 0.005, 0.0, 100.0)
+        if changed:
+            m = dataclasses.replace(m, thickness=max(v, 0.0))
+        changed, col = imgui.color_edit3("attenuation colour (sRGB)", _srgb(m.attenuation_color))
+        if changed:
+            m = dataclasses.replace(m, attenuation_color=_linear(col))
+        finite = m.attenuation_distance != float("inf")
+        changed, finite_now = imgui.checkbox("attenuate", finite)
+        if changed:
+            m = dataclasses.replace(m, attenuation_distance=1.0 if finite_now else float("inf"))
+        if finite_now and not changed:
+            changed, v = imgui.drag_float("attenuation distance", m.attenuation_distance, 0.01, 1e-3, 1e4)
+            if changed:
+                m = dataclasses.replace(m, attenuation_distance=max(v, 1e-3))
+        return m
 
     def _browse(self, label: str, suffixes: tuple[str, ...], on_pick) -> None:
         """A button opening the file browser (file_browser.py: native dialog or built-in)."""

@@ -83,8 +83,11 @@ def _imgui_ini():
 
 
 def _no_scene_options(args) -> bool:
-    return (args.mesh, args.env, args.preset, args.base_color, args.metallic, args.roughness,
-            args.specular_f0, args.emissive) == ("sphere", "studio", None, None, None, None, None, None)
+    from alight.core.material import LAYER_FIELDS
+
+    material_flags = (args.preset, args.base_color, args.metallic, args.roughness, args.specular_f0,
+                      args.emissive, args.ior, *(getattr(args, f) for f in LAYER_FIELDS))
+    return (args.mesh, args.env) == ("sphere", "studio") and all(x is None for x in material_flags)
 
 
 def _benchmark(win, frames: int) -> int:

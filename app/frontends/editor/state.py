@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
-from alight.core.material import Material, validate_material
+from alight.core.material import LAYER_FIELDS, Material, validate_material, with_overrides
 from alight.core.scene import TONEMAPS, Display, Light, Scene
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
@@ -29,6 +29,8 @@ DEBUG_VIEWS = ("shaded", "base colour", "normal", "roughness", "metallic", "F0",
                "specular only (IBL)", "irradiance", "prefiltered radiance at mip", "BRDF LUT", "D (first light)",
                "G (first light)", "F (first light)")
 DATA_VIEWS = {1, 2, 3, 4, 5, 6, 11, 12, 13, 14}
+VECTOR_LAYER_FIELDS = ("sheen_color", "attenuation_color")
+SCALAR_LAYER_FIELDS = tuple(f for f in LAYER_FIELDS if f not in VECTOR_LAYER_FIELDS)
 
 
 def default_lights() -> list[Light]:
@@ -178,8 +180,8 @@ class EditorState:
     # --- scripted edits (``alight edit --script``; the tests drive the editor with these) ------
 
     def apply_edit(self, edit: str) -> None:
-        """``field=value``: roughness / metallic (numbers), base_color / emissive / specular_f0
-        (R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
+        """``field=value``: roughness / metallic / ior and the layers' numbers (clearcoat, ...),
+        base_color / emissive / specular_f0 / sheen_color / attenuation_color (R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
         env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), quality;
         map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
         uv_offset (U,V)."""
@@ -190,11 +192,10 @@ class EditorState:
         if not sep:
             raise AlightError(f"--script: '{edit}' is not FIELD=VALUE")
         try:
-            if key in ("roughness", "metallic"):
-                self.material = validate_material(dataclasses.replace(self.material, **{key: float(value)}), "--script")
-            elif key in ("base_color", "emissive", "specular_f0"):
-                self.material = validate_material(
-                    dataclasses.replace(self.material, **{key: parse_color(value, "--script")}), "--script")
+            if key in ("roughness", "metallic", "ior", *SCALAR_LAYER_FIELDS):
+                self.material = with_overrides(self.material, "--script", **{key: _finite(value, edit)})
+            elif key in ("base_color", "emissive", "specular_f0", *VECTOR_LAYER_FIELDS):
+                self.material = with_overrides(self.material, "--script", **{key: parse_color(value, "--script")})
             elif key == "preset":
                 self.load_material(value)
             elif key == "open":
