@@ -283,7 +283,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
-                  multiple_scattering: bool = False) -> np.ndarray:
+                  multiple_scattering: bool = False, diffuse_scale: float = 1.0) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -292,6 +292,8 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     the whole map), ``alight`` shades them as delta lights through the exact BRDF. ``lecture`` is
     ``split_sum_converged``. Roughness must be >= MIN_PREFILTER_ROUGHNESS for the non-lecture
     models (the sun's mirror image below the grid is the source cube's business, not this twin's).
+    ``diffuse_scale`` scales the diffuse lobe (1 - transmission: the rest is transmitted,
+    ``transmission_ibl_converged``).
     """
     from alight.core.ibl_models import IBL_MODELS, SUNS_AS_BAKED
     from alight.ibl.sun import extract_suns
@@ -328,7 +330,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
             direction = _unit_rows(n + t[:, None] * (R - n))
     irradiance = irradiance_converged(lighting, n)
     prefiltered = prefiltered_converged(lighting, direction, r)
-    albedo = base * (1.0 - m)
+    albedo = base * (1.0 - m) * float(diffuse_scale)
     if multiple_scattering:
         e_ss = A + B
         e_ms = 1.0 - e_ss
@@ -338,11 +340,11 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     else:
         out = diffuse_weight * albedo * irradiance + spec_weight * prefiltered
     for sun in suns:
-        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
+        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread, diffuse_scale)
     return out
 
 
-def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0):
+def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0, diffuse_scale=1.0):
     """ibl.glsl's sun_light: the exact BRDF (IBL k, F at v.h) times the power P, D widened to
     alpha' = sqrt(alpha^2 + spread^2) for the source's size."""
     l = np.asarray(l, dtype=np.float64)
@@ -359,7 +361,7 @@ def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0):
     G = G_Smith(nv, np.where(nl > 0, nl, 1.0), k)
     F = f0 + (1.0 - f0) * ((1.0 - vh) ** 5)[:, None]
     spec = (D * G / (4.0 * np.where(nl > 0, nl, 1.0) * nv))[:, None] * F
-    diffuse = (1.0 - F) * (1.0 - metallic) * base / PI
+    diffuse = (1.0 - F) * (1.0 - metallic) * base / PI * diffuse_scale
     return np.where((nl > 0)[:, None], (diffuse + spec) * nlc[:, None] * np.asarray(power)[None, :], 0.0)
 
 
@@ -461,3 +463,106 @@ def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: i
         cosines[i] = length / energy[i] if energy[i] > 0 else 1.0
     rough = roughness_for_mean_cosine(cosines)
     return energy.reshape(shape), sin_mean.reshape(shape), rough.reshape(shape)
+
+
+def transmitted_lobe_converged(material, normals, view, n_table: int = 129):
+    """Where the forward pass's transmitted lobe points, its prefiltered roughness and its energy
+    (common/transmission.glsl: thin_walled_lobe, refracted_lobe) with converged tables: (P, 3)
+    directions, (P,) roughness, (P,) energy. Thin-walled: the BRDF LUT's A and t_A (mirrored
+    through the surface), roughness the material's. Refracting: ``transmission_lut_converged``
+    on ``n_table`` values of n.v, interpolated linearly (the lobe changes slowly in n.v)."""
+    from alight.core.btdf import mirror_through_surface
+
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    r = float(material.roughness)
+    nv = np.clip(np.sum(n * v, axis=-1), 0.0, 1.0)
+    if "volume" not in material.layers():
+        A, _ = brdf_lut_converged(nv, r)
+        t_a, _ = lobe_directions_converged(nv, r)
+        R = reflect(-v, n)
+        mean = _unit_rows(n + t_a[:, None] * (R - n))
+        return mirror_through_surface(mean, n), np.full(nv.shape, r), A
+    grid = np.linspace(1e-4, 1.0, n_table)
+    energy, sin_mean, rough = transmission_lut_converged(grid, r, float(material.ior))
+    e = np.interp(nv, grid, energy)
+    s = np.clip(np.interp(nv, grid, sin_mean), 0.0, 1.0)
+    rr = np.interp(nv, grid, rough)
+    nvc = np.maximum(nv, 1e-4)
+    tangential = v - nvc[:, None] * n
+    length = np.linalg.norm(tangential, axis=-1, keepdims=True)
+    side = np.where(length > 1e-6, -tangential / np.maximum(length, 1e-300), 0.0)
+    direction = -n * np.sqrt(1.0 - s * s)[:, None] + side * s[:, None]
+    return direction, rr, e
+
+
+def prefiltered_converged_varying(radiance, directions, roughness, steps: int = 12) -> np.ndarray:
+    """``prefiltered_converged`` where each direction has its own roughness: evaluated at
+    ``steps`` roughness values spanning theirs and interpolated linearly in alpha = r^2 between
+    the two nearest (the forward pass blends its grid steps the same way)."""
+    d = _unit_rows(directions)
+    r = np.clip(np.asarray(roughness, dtype=np.float64), MIN_PREFILTER_ROUGHNESS, 1.0)
+    lo, hi = float(r.min()), float(r.max())
+    if hi - lo < 1e-6:
+        return prefiltered_converged(radiance, d, lo)
+    knots = np.sqrt(np.linspace(lo * lo, hi * hi, steps))
+    out = np.zeros((d.shape[0], 3))
+    a = r * r
+    ka = knots * knots
+    idx = np.clip(np.searchsorted(ka, a) - 1, 0, steps - 2)
+    t = ((a - ka[idx]) / (ka[idx + 1] - ka[idx]))[:, None]
+    for j in range(steps - 1):
+        sel = idx == j
+        if sel.any():
+            out[sel] = (1.0 - t[sel]) * prefiltered_converged(radiance, d[sel], knots[j]) \
+                + t[sel] * prefiltered_converged(radiance, d[sel], knots[j + 1])
+    return out
+
+
+def transmission_ibl_converged(model: str, radiance, normals, view, material) -> np.ndarray:
+    """The transmitted part of the forward pass's image-based light with converged parts (P, 3):
+    the twin of transmission.glsl's transmission_ibl, weight base (1 - F0) E L_prefiltered along
+    the lobe, plus, for the models that shade the compact sources exactly (``alight``), those
+    sources through the BTDF (ibl.glsl's sun_layered: the lobe widened by the source's spread).
+    Add ``ibl_converged(..., diffuse_scale=1 - transmission)`` for the whole IBL."""
+    from alight.core.btdf import beer_lambert
+    from alight.core.ibl_models import SUNS_AS_BAKED
+    from alight.ibl.sun import extract_suns
+
+    m = material
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    rad = np.asarray(radiance, dtype=np.float32)
+    suns = []
+    if model in SUNS_AS_BAKED:
+        lighting = rad
+    else:
+        lighting, suns = extract_suns(rad)
+    direction, rough, energy = transmitted_lobe_converged(m, n, v)
+    weight = (1.0 - m.metallic) * m.transmission * np.asarray(m.base_color) * (1.0 - np.asarray(m.f0()))
+    if "volume" in m.layers():
+        weight = weight * beer_lambert(m.attenuation_color, m.attenuation_distance, m.thickness)
+    out = weight * energy[:, None] * prefiltered_converged_varying(lighting, direction, rough)
+    for sun in suns:
+        out = out + _sun_transmitted(m, n, v, sun)
+    return out
+
+
+def _sun_transmitted(m, n, v, sun) -> np.ndarray:
+    """transmission.glsl's transmission_light for a compact source (exact k, the lobe widened by
+    its spread) times its power P: (P, 3)."""
+    import dataclasses
+
+    from alight.core.layers.stack import Pairs
+    from alight.core.layers.transmission import thin_walled, transmission_light
+    from alight.core.shading import MIN_PUNCTUAL_ROUGHNESS
+
+    alpha = m.roughness ** 2
+    scale = 1.0 if thin_walled(m) else 2.0 / max(1.0 - 1.0 / m.ior, 1e-3)
+    widened = min(np.sqrt(np.sqrt(alpha * alpha + (sun.spread * scale) ** 2)), 1.0)
+    roughness = max(widened, MIN_PUNCTUAL_ROUGHNESS) if sun.spread > 0 else m.roughness
+    # D takes the widened roughness, k the material's (as the shader does).
+    p = Pairs(n=n, v=v, l=np.asarray(sun.direction, np.float64)[None, :])
+    widened_material = dataclasses.replace(m, roughness=roughness)
+    f = transmission_light(widened_material, p, k_roughness=m.roughness)[:, 0, :]
+    return f * np.asarray(sun.power)[None, :]

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from alight.core.shading import MIN_N_DOT_V, D_GGX, F_Schlick, G_Smith, _dot, _normalize, k_direct, k_ibl  # noqa: F401 (k_*: re-exported for the twins)
+from alight.core.shading import MIN_N_DOT_V, D_GGX, G_Smith, _dot, _normalize
 
 # Shared with btdf.glsl: |v + ior l| floor (l = -v at ior 1, where refraction bends nothing).
 MIN_HALF_LENGTH = 1e-7
@@ -97,28 +97,16 @@ def refract(i, n, eta):
     return np.where((k >= 0.0)[..., None], out, 0.0)
 
 
-def transmission_btdf(n, v, l, roughness, k, ior, thickness):
-    """The BTDF (without Fresnel and tint) at unit n, v, l: the thin-walled one where
-    ``thickness`` <= 0, else the refracting one at ``ior``; zero unless n.l < 0. Returns
-    (btdf, v_dot_h), v.h at the BTDF's own half vector, for the Fresnel term."""
+def transmission_btdf(n, v, l, roughness, k, ior, thin):
+    """The BTDF (without Fresnel and tint) at unit n, v, l: the thin-walled one where ``thin``,
+    else the refracting one at ``ior``; zero unless n.l < 0. Returns (btdf, v_dot_h), v.h at the
+    BTDF's own half vector (clamped to [0, 1]), for the Fresnel term."""
     n, v, l = (np.asarray(x, dtype=np.float64) for x in (n, v, l))
     n_dot_v = np.maximum(_dot(n, v), MIN_N_DOT_V)
     n_dot_l = _dot(n, l)
-    thin = np.asarray(thickness, dtype=np.float64) <= 0.0
+    thin = np.asarray(thin, dtype=bool)
     h = np.where(thin[..., None], half_vector_thin(n, v, l), half_vector_refraction(v, l, ior))
     n_dot_h, v_dot_h, l_dot_h = _dot(n, h), _dot(v, h), _dot(l, h)
     value = np.where(thin, btdf_thin(n_dot_v, n_dot_l, n_dot_h, roughness, k),
                      btdf_refraction(n_dot_v, n_dot_l, n_dot_h, v_dot_h, l_dot_h, roughness, ior, k))
     return np.where(n_dot_l < 0.0, value, 0.0), np.clip(v_dot_h, 0.0, 1.0)
-
-
-def transmitted_light(factor, ior, thickness, attenuation, base_color, metallic, f0, n, v, l, roughness, k,
-                      radiance_in):
-    """(1 - metallic) t T base (1 - F) btdf |n.l| L_in for light from behind (n.l < 0): the
-    transmitted part of glTF's dielectric BSDF (RGB, broadcast over leading dimensions)."""
-    btdf, v_dot_h = transmission_btdf(n, v, l, roughness, k, ior, thickness)
-    F = F_Schlick(v_dot_h, f0)
-    n_dot_l = np.abs(_dot(np.asarray(n, dtype=np.float64), np.asarray(l, dtype=np.float64)))
-    weight = (1.0 - np.asarray(metallic, dtype=np.float64)) * np.asarray(factor, dtype=np.float64)
-    return weight[..., None] * np.asarray(attenuation) * np.asarray(base_color) * (1.0 - F) \
-        * (btdf * n_dot_l)[..., None] * np.asarray(radiance_in)

@@ -1,7 +1,14 @@
 """Draws a Scene into framebuffers with the forward PBR pass. Knows nothing of any UI.
 
-    background pass -> forward pass (mesh, or the probe view) -> [MSAA resolve | SSAA reduce]
+    forward pass (mesh, or the probe view) -> background pass -> [MSAA resolve | SSAA reduce]
         -> linear radiance (EXR, tests) -> tone map pass -> sRGB (PNG, the editor)
+
+A mesh with transmissive parts (KHR_materials_transmission) is drawn in passes, in this order:
+
+    opaque parts -> copy (what is behind: radiance and coverage, mipmapped) -> transmissive
+        parts (reading the copy, common/transmission.glsl) -> background -> [blended parts]
+
+so that what the glass shows is the opaque scene behind it, as the Khronos Sample Viewer does.
 """
 
 from __future__ import annotations
@@ -36,6 +43,7 @@ from alight.ibl.bake import (
     roughness_to_grid_step,
 )
 from alight.ibl.sun import MAX_SUNS
+from alight.ibl.transmission_lut import TransmissionLut
 
 GL_SRGB8_ALPHA8 = 0x8C43
 AA_MODES = ("none", "msaa", "ssaa")
@@ -46,6 +54,8 @@ MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
+UNIT_TRANSMISSION_LUT = 6 + len(MATERIAL_MAPS)   # ibl/transmission_lut.comp's table (HAS_VOLUME)
+UNIT_SCENE_BEHIND = UNIT_TRANSMISSION_LUT + 1      # the opaque parts' copy (TRANSMISSION_SCENE)
 SRGB_MAPS = ("base_color", "emissive")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
@@ -54,6 +64,7 @@ SAMPLER_UNITS = {
     "u_prefiltered_radiance_mid": UNIT_PREFILTERED_MID, "u_brdf_lut": UNIT_LUT,
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
+    "u_transmission_lut": UNIT_TRANSMISSION_LUT, "u_scene_behind": UNIT_SCENE_BEHIND,
 }
 
 
@@ -144,6 +155,20 @@ class _Targets:
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
         self._display_draw = None
+        self._behind: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+
+    def behind(self) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
+        """What transmissive parts see behind them: the opaque parts' radiance with alpha =
+        coverage (premultiplied: uncovered pixels are 0), at the draw size, mipmapped so that a
+        rough surface reads it blurred (common/transmission.glsl: scene_behind). Half floats:
+        a blurred view through glass needs no more than 11 bits."""
+        if self._behind is None:
+            tex = self.ctx.texture(self.draw_size, 4, dtype="f2")
+            tex.build_mipmaps()
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            self._behind = (tex, self.ctx.framebuffer([tex]))
+        return self._behind
 
     def display_draw(self) -> moderngl.Framebuffer:
         """The display image with the depth buffer, for ForwardRenderer.draw_display (no AA only)."""
@@ -157,6 +182,8 @@ class _Targets:
             owned.insert(0, self._display_draw)
         if self.color is not self.radiance:
             owned.append(self.color)
+        if self._behind is not None:
+            owned.extend(self._behind[::-1])
         for obj in owned:
             obj.release()
 
@@ -172,6 +199,7 @@ class ForwardRenderer:
         self.ctx = ctx or create_headless_context()
         self.shaders = shaders or ShaderLibrary(self.ctx)
         self.luts = LutCache(self.ctx, self.shaders)
+        self._transmission_lut: TransmissionLut | None = None
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
         self._targets: _Targets | None = None
@@ -270,7 +298,15 @@ class ForwardRenderer:
             self._targets.release()
             self._targets = None
         self.luts.release()
+        if self._transmission_lut is not None:
+            self._transmission_lut.release()
         self.shaders.reload()
+
+    def transmission_lut(self) -> moderngl.Texture:
+        """The transmission LUT (alight.ibl.transmission_lut), baked or read on first use."""
+        if self._transmission_lut is None:
+            self._transmission_lut = TransmissionLut(self.ctx, self.shaders)
+        return self._transmission_lut.texture()
 
     def __enter__(self) -> "ForwardRenderer":
         return self
@@ -315,7 +351,8 @@ class ForwardRenderer:
         the scene's programs tone map as they write (common/output_encoding.glsl), so neither the
         float image nor the tone map pass is needed (the editor's view). Without anti-aliasing
         only: a resolve must average radiance, not display values."""
-        if targets.aa != "none" or scene.view == "probe":
+        if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
+            # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
             self.draw_hdr(scene, maps, targets)
             self.tonemap(targets.radiance, scene.display, targets.display_fbo)
             return
@@ -340,7 +377,7 @@ class ForwardRenderer:
         if scene.view == "probe":
             self._draw_probe(scene, maps, width)
         elif scene.mesh is not None:
-            self._draw_mesh(scene, maps, camera, view_projection)
+            self._draw_mesh(scene, maps, camera, view_projection, targets, fbo)
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         self._draw_background(scene, maps, inverse_vp)
         ctx.disable(moderngl.DEPTH_TEST)
@@ -390,6 +427,8 @@ class ForwardRenderer:
         maps.prefiltered_radiance.use(UNIT_PREFILTERED)
         maps.prefiltered_radiance_mid.use(UNIT_PREFILTERED_MID)
         maps.brdf_lut.use(UNIT_LUT)
+        if "u_transmission_lut" in program:
+            self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
         _set(program, "u_prefiltered_max_mip", maps.prefiltered_max_mip)
         _set(program, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
         _set(program, "u_env_intensity", float(scene.env_intensity))
@@ -457,12 +496,44 @@ class ForwardRenderer:
         self._bind_ibl(prog, scene, maps)
         self._fullscreen(prog)
 
-    def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray) -> None:
-        ctx = self.ctx
+    def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray,
+                   targets: _Targets, fbo: moderngl.Framebuffer) -> None:
+        """The mesh's parts: opaque ones, then (where any part transmits) a copy of what they
+        left in ``fbo`` and the transmissive parts reading it (the module docstring's order).
+        Each pass compiles only its own parts' layers."""
+        transmissive = self.transmissive_parts(scene)
+        opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
+        if opaque:
+            prog = self._mesh_program(scene, maps, opaque)
+            self.draw_mesh_parts(scene, prog, camera, view_projection, opaque)
+        if not transmissive:
+            return
+        behind, behind_fbo = targets.behind()
+        self.ctx.copy_framebuffer(behind_fbo, fbo)   # the MSAA resolve too, where there is one
+        behind.build_mipmaps()
+        fbo.use()
+        prog = self._mesh_program(scene, maps, transmissive, {"TRANSMISSION_SCENE": None})
+        behind.use(UNIT_SCENE_BEHIND)
+        if not (scene.ibl_enabled and maps is not None):
+            # The thin-walled lobe's energy is the BRDF LUT's A, which _bind_ibl bound only with
+            # an environment; the transmission LUT likewise.
+            q = QUALITY["medium"]
+            self.luts.get(q.lut_size, q.lut_samples).use(UNIT_LUT)
+            if "u_transmission_lut" in prog:
+                self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
+        _set(prog, "u_behind_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+        half_fov = math.radians(camera.fov_y_deg) / 2.0
+        _set(prog, "u_behind_pixels_per_radian", float(targets.draw_size[1] / 2.0 / math.tan(half_fov)))
+        self.draw_mesh_parts(scene, prog, camera, view_projection, transmissive)
+
+    def _mesh_program(self, scene: Scene, maps: IBLMaps | None, parts: list[int],
+                      extra_defines: dict | None = None) -> moderngl.Program:
+        """pbr.frag compiled for ``parts``: the scene's IBL model and maps, those parts' layers."""
         # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
         defines = self._ibl_defines(scene)
         defines["MATERIAL_MAPS_MASK"] = self._map_mask(scene)
-        defines.update(self.layer_defines(scene))
+        defines.update(self.layer_defines(scene, parts))
+        defines.update(extra_defines or {})
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
         prog = self._scene_program("render/pbr.vert", "render/pbr.frag", defines)
@@ -470,14 +541,22 @@ class ForwardRenderer:
             _set(prog, "u_debug_view", int(scene.debug_view))
             _set(prog, "u_debug_mip", float(scene.debug_mip))
         self._bind_ibl(prog, scene, maps)
-        self.draw_mesh_parts(scene, prog, camera, view_projection)
+        return prog
 
-    def layer_defines(self, scene: Scene) -> dict:
-        """The HAS_* defines of the layers any part of the scene's mesh is drawn with
-        (alight.core.layers): a scene without layers compiles none."""
+    def layer_defines(self, scene: Scene, parts: list[int] | None = None) -> dict:
+        """The HAS_* defines of the layers any part of the scene's mesh (or those of ``parts``,
+        indices) is drawn with (alight.core.layers): a scene without layers compiles none."""
         if scene.mesh is None:
             return layer_defines([scene.material])
-        return layer_defines(self._part_material(scene, part)[0] for part in scene.mesh.parts)
+        chosen = range(len(scene.mesh.parts)) if parts is None else parts
+        return layer_defines(self._part_material(scene, scene.mesh.parts[i])[0] for i in chosen)
+
+    def transmissive_parts(self, scene: Scene) -> list[int]:
+        """Indices of the mesh's parts whose material transmits (KHR_materials_transmission)."""
+        if scene.view == "probe" or scene.mesh is None:
+            return []
+        return [i for i, part in enumerate(scene.mesh.parts)
+                if "transmission" in self._part_material(scene, part)[0].layers()]
 
     def _map_mask(self, scene: Scene) -> int:
         """mesh_material.glsl's MATERIAL_MAPS_MASK: a bit per map any part is drawn with."""
@@ -489,10 +568,10 @@ class ForwardRenderer:
         return sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in used)
 
     def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program, camera: Camera,
-                        view_projection: np.ndarray) -> None:
-        """Draw every part of the scene's mesh with ``prog`` (pbr.vert's transforms, seen from
-        ``camera``): each part's material factors and maps bound, back faces culled where the
-        part is closed."""
+                        view_projection: np.ndarray, parts: list[int] | None = None) -> None:
+        """Draw every part of the scene's mesh (or those of ``parts``, indices) with ``prog``
+        (pbr.vert's transforms, seen from ``camera``): each part's material factors and maps
+        bound, back faces culled where the part is closed."""
         ctx = self.ctx
         _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
         _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
@@ -500,7 +579,10 @@ class ForwardRenderer:
         _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
         user = self._user_textures(scene)
         tiling = scene.texture_maps or TextureMaps()
-        for gpu_part, part in zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts):
+        chosen = None if parts is None else set(parts)
+        for index, (gpu_part, part) in enumerate(zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts)):
+            if chosen is not None and index not in chosen:
+                continue
             material, maps_used = self._part_material(scene, part)
             _set_material(prog, material)
             fm = part.material if maps_used else None

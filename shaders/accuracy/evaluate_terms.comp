@@ -5,14 +5,12 @@
 #include "common/sampling.glsl"
 #include "common/cubemap.glsl"
 #include "common/tonemapping.glsl"
-#include "common/btdf.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Inputs { vec4 u_inputs[]; };
 layout(std430, binding = 1) writeonly buffer Outputs { vec4 u_outputs[]; };
 uniform int u_count;
 uniform int u_term;
-uniform vec4 u_params;   // per-term constants (the transmission terms)
 
 const int TERM_D_GGX = 0;
 const int TERM_G1 = 1;
@@ -31,19 +29,6 @@ const int TERM_K = 13;
 const int TERM_GRID_STEP = 14;
 const int TERM_CUBE_TEXEL_DIRECTION = 15;
 const int TERM_PUNCTUAL = 16;
-const int TERM_BTDF_THIN = 17;
-const int TERM_BTDF_REFRACTION = 18;
-const int TERM_BEER_LAMBERT = 19;
-const int TERM_TRANSMITTED_LIGHT = 20;
-
-// Unit v and l around n = +Z: v in the xz plane at n.v, l at n.l (< 0: behind) and azimuth phi.
-vec3 view_at(float n_dot_v) {
-    return vec3(sqrt(max(0.0, 1.0 - n_dot_v * n_dot_v)), 0.0, n_dot_v);
-}
-vec3 light_at(float n_dot_l, float phi) {
-    float s = sqrt(max(0.0, 1.0 - n_dot_l * n_dot_l));
-    return vec3(s * cos(phi), s * sin(phi), n_dot_l);
-}
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -77,25 +62,6 @@ void main() {
             vec3 n = vec3(0.0, 0.0, 1.0);
             vec3 l = vec3(sqrt(max(0.0, 1.0 - a.x * a.x)), 0.0, a.x);
             o.xyz = punctual_light(s, n, n, l, vec3(1.0));
-            break;
-        }
-        case TERM_BTDF_THIN: o.xy = vec2(btdf_thin(a.x, a.y, a.z, a.w, k_ibl(a.w)), btdf_thin(a.x, a.y, a.z, a.w, k_direct(a.w))); break;
-        case TERM_BTDF_REFRACTION: {
-            // a = (n.v, n.l, roughness, ior), l on the far side from v (azimuth pi).
-            vec3 n = vec3(0.0, 0.0, 1.0);
-            vec3 v = view_at(a.x);
-            vec3 l = light_at(a.y, PI);
-            vec3 h = half_vector_refraction(v, l, a.w);
-            o.xy = vec2(btdf_refraction(a.x, a.y, dot(n, h), dot(v, h), dot(l, h), a.z, a.w, k_ibl(a.z)), dot(v, h));
-            break;
-        }
-        case TERM_BEER_LAMBERT: o.xyz = beer_lambert(a.xyz, u_params.x, a.w); break;
-        case TERM_TRANSMITTED_LIGHT: {
-            // a = (n.l, n.v, roughness, phi); u_params = (ior, thickness, metallic, factor).
-            TransmissionLayer t = TransmissionLayer(u_params.w, u_params.x, u_params.y, vec3(1.0, 0.8, 0.5));
-            vec3 n = vec3(0.0, 0.0, 1.0);
-            o.xyz = transmitted_light(t, vec3(0.9, 0.6, 0.3), u_params.z, vec3(0.04), n, view_at(a.y),
-                                      light_at(a.x, a.w), a.z, k_direct(a.z), vec3(1.0));
             break;
         }
     }

@@ -8,14 +8,6 @@
 // |v + ior l| floor: at ior 1 the straight-through direction has no refraction half vector.
 const float MIN_HALF_LENGTH = 1e-7;
 
-// A transmissive layer at one shading point (the material's fields, textures applied).
-struct TransmissionLayer {
-    float factor;        // glTF transmissionFactor: the share of the non-reflected light transmitted
-    float ior;           // index of refraction of the volume (>= 1)
-    float thickness;     // 0: thin-walled; else the path length through the volume (world units)
-    vec3 attenuation;    // Beer-Lambert transmittance over that path (beer_lambert)
-};
-
 // A direction behind the surface mirrored to the front (KHR_materials_transmission's thin wall).
 vec3 mirror_through_surface(vec3 l, vec3 n) {
     return l - 2.0 * dot(n, l) * n;
@@ -57,29 +49,15 @@ vec3 beer_lambert(vec3 attenuation_color, float attenuation_distance, float dist
     return ratio > 0.0 ? pow(attenuation_color, vec3(ratio)) : vec3(1.0);
 }
 
-// The BTDF for the layer (thin-walled when its thickness is 0) at unit n, v, l, without Fresnel
-// and tint; v_dot_h returns the half vector's v.h for the Fresnel term.
-float transmission_btdf(TransmissionLayer t, vec3 n, vec3 v, vec3 l, float roughness, float k,
+// The BTDF at unit n, v, l without Fresnel and tint: thin-walled, or refracting at `ior`;
+// zero unless l is behind the surface. v_dot_h returns its half vector's v.h for the Fresnel.
+float transmission_btdf(vec3 n, vec3 v, vec3 l, float roughness, float k, float ior, bool thin,
                         out float v_dot_h) {
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     float n_dot_l = dot(n, l);
-    if (t.thickness <= 0.0) {
-        vec3 h = half_vector_thin(n, v, l);
-        v_dot_h = clamp(dot(v, h), 0.0, 1.0);
-        return n_dot_l < 0.0 ? btdf_thin(n_dot_v, n_dot_l, dot(n, h), roughness, k) : 0.0;
-    }
-    vec3 h = half_vector_refraction(v, l, t.ior);
+    vec3 h = thin ? half_vector_thin(n, v, l) : half_vector_refraction(v, l, ior);
     v_dot_h = clamp(dot(v, h), 0.0, 1.0);
-    return n_dot_l < 0.0 ? btdf_refraction(n_dot_v, n_dot_l, dot(n, h), dot(v, h), dot(l, h), roughness, t.ior, k) : 0.0;
-}
-
-// (1 - metallic) t T base (1 - F) btdf |n.l| L_in for light arriving from behind (n.l < 0):
-// the transmitted part of glTF's dielectric_brdf, tinted by the base colour and the volume.
-vec3 transmitted_light(TransmissionLayer t, vec3 base_color, float metallic, vec3 f0, vec3 n, vec3 v,
-                       vec3 l, float roughness, float k, vec3 radiance_in) {
-    float v_dot_h;
-    float btdf = transmission_btdf(t, n, v, l, roughness, k, v_dot_h);
-    vec3 F = F_Schlick(v_dot_h, f0);
-    return (1.0 - metallic) * t.factor * t.attenuation * base_color * (1.0 - F)
-         * btdf * abs(dot(n, l)) * radiance_in;
+    if (n_dot_l >= 0.0) return 0.0;
+    return thin ? btdf_thin(n_dot_v, n_dot_l, dot(n, h), roughness, k)
+                : btdf_refraction(n_dot_v, n_dot_l, dot(n, h), dot(v, h), dot(l, h), roughness, ior, k);
 }
