@@ -23,7 +23,7 @@ from alight.paths import cache_dir
 # texel. The lobe changes slowly along each axis (app/accuracy/converged.py's twin agrees with
 # the table to TABLE_TOLERANCE, tests/test_transmission.py).
 SIZE = (32, 32, 16)
-SAMPLES = 1024
+SAMPLES = 4096
 CHANNELS = 4
 IOR_AXIS_MAX = 0.75   # common/transmission_lut.glsl: z = (1 - 1/ior) / IOR_AXIS_MAX
 
