@@ -419,14 +419,17 @@ def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: i
     - E: the integral of btdf (1 - Fc(v.h)) |n.l| over l (transmitted = (1 - m) t c T (1 - F0) E L
       under a constant environment L). Drawing h with pdf D(h)(n.h) and l = refract(-v, h, 1/ior),
       the weight is (1 - Fc) G(n.v, |n.l|) (v.h) / ((n.h)(n.v)): the same as the BRDF LUT's;
-    - sin_mean: the sine of the lobe's mean direction's angle from -n, leaning toward -v's
-      tangential part (0 at n.v = 1);
+    - bend: the sine of the lobe's mean direction's angle from -n (leaning toward -v's
+      tangential part) over the sine of v's angle from n: 1/ior for a smooth surface (Snell),
+      more where roughness leans the lobe toward grazing. A ratio rather than the sine itself,
+      so that it goes to 0 with the view's sine at n.v = 1, where the tangential direction is
+      undefined (the table's last texel centre is n.v = 0.984, not 1);
     - roughness: the prefiltered roughness whose kernel has the same mean cosine about its axis
       (``roughness_for_mean_cosine``), so one prefiltered fetch along the mean direction stands
       for the lobe.
 
     Midpoint grid over (u, phi in [0, 2 pi)) as ``brdf_lut_converged``; n.v >= 1e-4, ior >= 1.
-    Returns (E, sin_mean, roughness), each of the broadcast shape.
+    Returns (E, bend, roughness), each of the broadcast shape.
     """
     from alight.core.btdf import refract
 
@@ -440,7 +443,7 @@ def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: i
     wu = 2.0 * (1.0 - sg) / n_u
     phi = (np.arange(n_phi) + 0.5) * (2.0 * PI / n_phi)
     energy = np.empty(nv.shape[0])
-    sin_mean = np.empty(nv.shape[0])
+    bend = np.empty(nv.shape[0])
     cosines = np.empty(nv.shape[0])
     for i in range(nv.shape[0]):
         a2 = r[i] ** 4
@@ -459,10 +462,11 @@ def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: i
         energy[i] = float(w.sum())
         mx, mz = float(np.sum(w * l[..., 0])), float(np.sum(w * l[..., 2]))
         length = np.hypot(mx, mz)
-        sin_mean[i] = -mx / length if length > 0 else 0.0
+        sin_v = np.sqrt(max(1.0 - nv[i] ** 2, 0.0))
+        bend[i] = -mx / length / sin_v if length > 0 and sin_v > 0 else 1.0 / eta[i]
         cosines[i] = length / energy[i] if energy[i] > 0 else 1.0
     rough = roughness_for_mean_cosine(cosines)
-    return energy.reshape(shape), sin_mean.reshape(shape), rough.reshape(shape)
+    return energy.reshape(shape), bend.reshape(shape), rough.reshape(shape)
 
 
 def transmitted_lobe_converged(material, normals, view, n_table: int = 129):
@@ -484,9 +488,9 @@ def transmitted_lobe_converged(material, normals, view, n_table: int = 129):
         mean = _unit_rows(n + t_a[:, None] * (R - n))
         return mirror_through_surface(mean, n), np.full(nv.shape, r), A
     grid = np.linspace(1e-4, 1.0, n_table)
-    energy, sin_mean, rough = transmission_lut_converged(grid, r, float(material.ior))
+    energy, bend, rough = transmission_lut_converged(grid, r, float(material.ior))
     e = np.interp(nv, grid, energy)
-    s = np.clip(np.interp(nv, grid, sin_mean), 0.0, 1.0)
+    s = np.clip(np.interp(nv, grid, bend) * np.sqrt(1.0 - np.minimum(nv, 1.0) ** 2), 0.0, 1.0)
     rr = np.interp(nv, grid, rough)
     nvc = np.maximum(nv, 1e-4)
     tangential = v - nvc[:, None] * n

@@ -2,8 +2,8 @@
 (n.v, roughness, ior), baked once by ``shaders/ibl/transmission_lut.comp`` and kept in the user's
 cache directory like the BRDF LUT (docs/transmission.md, "Real-time").
 
-Channels: E (the lobe's energy), sin_mean (its mean direction), roughness (the prefiltered
-roughness with the same mean cosine). The numpy twin is
+Channels: E (the lobe's energy), bend (its mean direction: the sine of its angle from -n over
+the view's sine), roughness (the prefiltered roughness with the same mean cosine). The numpy twin is
 ``alight.accuracy.converged.transmission_lut_converged``. Thin-walled transmission needs no table
 of its own: its lobe is the reflection lobe mirrored through the surface (the BRDF LUT's A).
 """

@@ -8,7 +8,7 @@
 #ifdef HAS_TRANSMISSION
 
 #ifdef HAS_VOLUME
-uniform sampler3D u_transmission_lut;   // ibl/transmission_lut.comp: E, sin_mean, roughness
+uniform sampler3D u_transmission_lut;   // ibl/transmission_lut.comp: E, bend, roughness
 #endif
 
 // Without HAS_VOLUME every transmissive surface is thin-walled (KHR_materials_volume absent or
@@ -88,15 +88,15 @@ TransmittedLobe thin_walled_lobe(Surface s, vec3 n, vec3 v) {
 }
 
 #ifdef HAS_VOLUME
-// Refracting: the transmission LUT's energy, mean direction (its angle from -n, leaning toward
-// -v's tangential part) and the prefiltered roughness of the same mean cosine.
+// Refracting: the transmission LUT's energy, mean direction (the sine of its angle from -n,
+// leaning toward -v's tangential part, is bend times the view's sine) and the prefiltered
+// roughness of the same mean cosine.
 TransmittedLobe refracted_lobe(Surface s, vec3 n, vec3 v) {
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec4 lut = texture(u_transmission_lut, vec3(n_dot_v, s.roughness, lut_axis_of_ior(s.ior)));
-    vec3 tangential = v - n * dot(n, v);
-    float length_t = length(tangential);
-    vec3 side = length_t > 1e-6 ? -tangential / length_t : vec3(0.0);
-    float sin_mean = clamp(lut.y, 0.0, 1.0);
+    vec3 tangential = v - n * dot(n, v);   // length: the view's sine
+    float sin_mean = clamp(lut.y * length(tangential), 0.0, 1.0);
+    vec3 side = -tangential / max(length(tangential), 1e-8);
     vec3 direction = -n * sqrt(1.0 - sin_mean * sin_mean) + side * sin_mean;
     return TransmittedLobe(direction, lut.z, lut.x);
 }

@@ -2,7 +2,9 @@
 // The refracted lobe of KHR_materials_volume's BTDF over n.v (x), roughness (y) and the ior
 // (z = (1 - 1/ior) / IOR_AXIS_MAX, common/transmission_lut.glsl), at texel centres, k = r^2/2 (docs/transmission.md, "Real-time"):
 //   R: E, the lobe's energy: the integral of btdf (1 - Fc(v.h)) |n.l| over l;
-//   G: the sine of its mean direction's angle from -n, leaning toward -v's tangential part;
+//   G: bend, the sine of its mean direction's angle from -n (leaning toward -v's tangential
+//      part) over the view's sine: 1/ior for a smooth surface; a ratio so that it vanishes
+//      with the view's sine at n.v = 1 (the last texel centre is n.v = 0.984, not 1);
 //   B: the prefiltered roughness whose kernel has the lobe's mean cosine about that direction,
 //      so that one prefiltered fetch along the mean stands for the whole lobe;
 //   A: 0.
@@ -66,9 +68,10 @@ vec4 integrate_btdf(float n_dot_v, float roughness, float ior) {
         }
     }
     float length_mean = length(mean);
-    float sin_mean = length_mean > 0.0 ? -mean.x / length_mean : 0.0;
+    float sin_v = sqrt(max(1.0 - n_dot_v * n_dot_v, 0.0));
+    float bend = length_mean > 0.0 && sin_v > 0.0 ? -mean.x / length_mean / sin_v : 1.0 / ior;
     float mean_cosine = energy > 0.0 ? length_mean / energy : 1.0;
-    return vec4(energy / float(u_samples), sin_mean, roughness_for_mean_cosine(mean_cosine), 0.0);
+    return vec4(energy / float(u_samples), bend, roughness_for_mean_cosine(mean_cosine), 0.0);
 }
 
 void main() {
