@@ -47,7 +47,7 @@ def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
     assert settings[0].factor == "baseline" and not _changed_fields(settings[0])
     for s in settings[1:]:
         changed = _changed_fields(s)
-        if s.factor in ("IBL model", "multiple scattering"):
+        if s.factor in ("IBL model", "multiple scattering", "layer"):
             assert not changed, (s.name, changed)
         else:
             assert len(changed) == 1 and s.ibl_model == settings[0].ibl_model, (s.name, changed)
@@ -66,6 +66,12 @@ def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
     assert judged == set(IBL_MODELS) == furnace_only
     quick = sweep(quick=True)
     assert len(quick) < len(settings) and {s.ibl_model for s in quick} == set(IBL_MODELS)
+    # a row per layer of issue 11, at medium with the default model, in both sweeps
+    from alight.accuracy.chart import LAYER_ROWS
+
+    for sw in (settings, quick):
+        assert [s.layer for s in sw if s.factor == "layer"] == list(LAYER_ROWS)
+        assert all(s.ibl_model == settings[0].ibl_model for s in sw if s.layer)
 
 
 def test_pareto_frontier():
@@ -152,7 +158,14 @@ def test_chart_quick_end_to_end(quick_chart):
     with open(out / "chart_cases.csv", newline="") as f:
         cases = list(csv.DictReader(f))
     judged = [r for r in rows if not r["multiple_scattering"]]
-    assert len(cases) == len(judged) * 3 * 3          # 3 presets x 3 roughness values, one environment
+    # The base rows: the 2 presets without layers x 3 roughness values, one environment; the
+    # transmission row: water at r = 0.5 and 1 (at 0.25 its refracted lobe is too narrow for the
+    # texel sum, alight.accuracy.ground_truth.check_transmission_lobe).
+    layer_rows = [r for r in judged if r["factor"] == "layer"]
+    assert [r["setting"] for r in layer_rows] == ["layer transmission"]
+    assert len(cases) == (len(judged) - 1) * 2 * 3 + 2
+    assert {(c["preset"], float(c["roughness"])) for c in cases if c["setting"] == "layer transmission"} == \
+        {("water", 0.5), ("water", 1.0)}
     # The baseline's summary is the mean of its cases.
     base = [float(c["rel_mae"]) for c in cases if c["setting"] == rows[0]["setting"]]
     assert rows[0]["rel_mae_mean"] == pytest.approx(np.mean(base), rel=1e-4)

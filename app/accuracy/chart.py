@@ -9,9 +9,15 @@ tractable), plus every IBL model of ``app/core/ibl_models.py`` and multiple scat
     FIS            filtered importance sampling off
     LUT            BRDF LUT size; BRDF LUT sample count
     IBL model      every entry of IBL_MODELS
+    layer          one row per layer of issue 11 (``LAYER_ROWS``): the error of the presets
+                   that use the layer against the layer's exact answer, the layer's own white
+                   furnace (``LAYER_FURNACE``) and the ball's frame time with the layer on
     MS             multiple-scattering compensation on, for every model: judged by the white
                    furnace only (a metal with F0 = 1 under constant radiance 1 should give 1),
                    never against the single-scattering ground truth
+
+The other rows are judged over the presets without layers (the BRDF's own error); a preset with
+a layer counts in that layer's row only.
 
 For each setting and environment: the bake time (the environment's passes, warm; the LUT is
 cached on disk and timed apart, cold), the frame time (a fixed scene: the material ball at
@@ -21,7 +27,9 @@ radiance and FLIP on the tone-mapped images (``alight.accuracy.metrics``).
 
 The reference is computed once per environment, for three basis materials, all roughness
 values in one G-buffer; every preset follows exactly from them because the BRDF is linear in F0
-and in the base colour (see ``ReferenceTerms``). Roughness below 0.25 is summed over the full map;
+and in the base colour (see ``ReferenceTerms``). A preset with a layer has its own reference (one
+G-buffer of its roughness values per level), without the roughness values where the layer's
+lobe is too narrow for a texel sum (``alight.accuracy.ground_truth.check_transmission_lobe``). Roughness below 0.25 is summed over the full map;
 from 0.25 up over the map box-reduced by 2 (``alight.accuracy.reference``'s level 1: <= 0.02% change on
 royal_esplanade, ~1% on quarry_01's compact sun, small beside the split sum's 5-30%).
 
@@ -58,6 +66,12 @@ FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
 FURNACE_TRUTH_WIDTH = 256
 FURNACE_TRUTH_FROM = 0.25
 QUICK_PRESETS = ("gold", "plastic_high", "water")
+# Layers with a row of their own (issue 11), the material of their white furnace (radiance 1:
+# what the layer reflects and transmits must not exceed 1, and at roughness 0 it is exactly 1)
+# and the preset drawn for their frame time.
+LAYER_ROWS = ("transmission",)
+LAYER_FURNACE = {"transmission": dict(base_color=(1.0, 1.0, 1.0), transmission=1.0, ior=1.0)}
+LAYER_FRAME_PRESET = {"transmission": "water"}
 # Environments left out of the summary columns (still in chart_cases.csv): spot1Lux's truth is
 # near zero over most of the ball, where a relative error means little (issue 4).
 SUMMARY_EXCLUDED = ("spot1Lux",)
@@ -79,6 +93,7 @@ class Setting:
     quality: BakeQuality
     ibl_model: str
     multiple_scattering: bool = False
+    layer: str = ""        # a layer row (LAYER_ROWS): judged over the presets with that layer
 
     @property
     def bake_key(self) -> BakeQuality:
@@ -127,6 +142,8 @@ def sweep(quick: bool = False) -> list[Setting]:
             add(f"LUT {n} samples", "LUT samples", lut_samples=n)
     for m in models[1:]:
         out.append(Setting(f"model {m}", "IBL model", base, m))
+    for layer in LAYER_ROWS:
+        out.append(Setting(f"layer {layer}", "layer", base, lead, layer=layer))
     for m in models:
         out.append(Setting(f"model {m} + MS", "multiple scattering", base, m, True))
     return out
@@ -170,9 +187,38 @@ class ReferenceTerms:
         return out
 
 
+def layer_reference(ref_renderer, radiance: np.ndarray, size: int, material, roughness) -> dict:
+    """The reference of one material with layers at each roughness its layers allow, (S, S, 4)
+    linear RGBA by roughness: one G-buffer of those roughness values per environment level (the
+    layers' factors are the scene material's, alight.accuracy.reference)."""
+    from alight.accuracy.ground_truth import check_transmission_lobe
+    from alight.accuracy.reference import GBUFFER, probe_gbuffer
+    from alight.core.scene import Scene
+
+    allowed = []
+    for r in roughness:
+        if "volume" in material.layers():
+            try:
+                check_transmission_lobe(r, material.ior)
+            except ValueError:
+                continue
+        allowed.append(float(r))
+    out = {}
+    for level in (0, 1):
+        rs = [r for r in allowed if (r >= LEVEL1_FROM) == bool(level)]
+        if not rs:
+            continue
+        tiles = {name: np.concatenate([probe_gbuffer(size, replace(material, roughness=r))[name] for r in rs], axis=0)
+                 for name in GBUFFER}
+        res = ref_renderer.render_gbuffer(tiles, Scene(view="probe", material=material), radiance, env_level=level)
+        for row, r in enumerate(rs):
+            out[r] = res.linear[row * size:(row + 1) * size].copy()
+    return out
+
+
 def reference_terms(ref_renderer, radiance: np.ndarray, size: int, roughness) -> ReferenceTerms:
     """The three basis materials at every roughness, in one G-buffer per environment level."""
-    from alight.accuracy.reference import probe_gbuffer
+    from alight.accuracy.reference import GBUFFER, probe_gbuffer
     from alight.core.material import Material
     from alight.core.scene import Scene
 
@@ -190,8 +236,7 @@ def reference_terms(ref_renderer, radiance: np.ndarray, size: int, roughness) ->
         if not idx:
             continue
         # Tiles: columns = basis materials, rows = roughness values of this level.
-        tiles = {name: np.zeros((len(idx) * size, 3 * size, 4), np.float32) for name in
-                 ("position", "normal", "view", "base_color", "specular_f0", "emissive")}
+        tiles = {name: np.zeros((len(idx) * size, 3 * size, 4), np.float32) for name in GBUFFER}
         for row, i in enumerate(idx):
             for col, mat in enumerate(basis):
                 g = probe_gbuffer(size, replace(mat, roughness=rs[i]))
@@ -330,17 +375,25 @@ def _probe_scene(setting: Setting, material):
                  multiple_scattering=setting.multiple_scattering)
 
 
+def frame_material(setting: Setting):
+    """The material ball's material for a setting's frame time: the default material, or for a
+    layer row the preset that shows the layer (LAYER_FRAME_PRESET)."""
+    from alight.core.material import Material
+    from alight.exchange.presets import load_preset
+
+    return load_preset(LAYER_FRAME_PRESET[setting.layer]) if setting.layer else Material()
+
+
 def frame_seconds_interleaved(renderer, items, mesh, size, repeats: int) -> list[float]:
-    """Median seconds of a frame of the material ball (default material, camera view, the
+    """Median seconds of a frame of the material ball (``frame_material``, camera view, the
     environment behind it; render + finish, no read-back) for each (setting, maps) of ``items``.
     The repeats go round the settings in turn, so a burst of load from other work on the machine
     falls on all of them alike rather than on one."""
-    from alight.core.material import Material
     from alight.core.scene import Scene
 
     w, h = size
-    scenes = [Scene(mesh=mesh, material=Material(), ibl_model=s.ibl_model, multiple_scattering=s.multiple_scattering)
-              for s, _ in items]
+    scenes = [Scene(mesh=mesh, material=frame_material(s), ibl_model=s.ibl_model,
+                    multiple_scattering=s.multiple_scattering) for s, _ in items]
     for scene, (_, maps) in zip(scenes, items):    # compile the programs, make the targets
         renderer.render(scene, maps, w, h, read_linear=False, read_srgb=False)
     renderer.ctx.finish()
@@ -359,7 +412,10 @@ def _furnace(renderer, setting: Setting, maps, size: int) -> list[tuple[float, f
 
     rows = []
     for r in FURNACE_ROUGHNESS:
-        m = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=r)
+        if setting.layer:
+            m = Material(roughness=r, **LAYER_FURNACE[setting.layer])
+        else:
+            m = Material(base_color=(1.0, 1.0, 1.0), metallic=1.0, roughness=r)
         frame = renderer.render(_probe_scene(setting, m), maps, size, size, read_srgb=False)
         inside = frame.linear[..., 3] > 0
         v = frame.linear[..., :3][inside].mean(axis=1)
@@ -435,6 +491,8 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
     if out_dir.exists() and not out_dir.is_dir():
         raise AlightError(f"{out_dir}: exists and is not a folder")
     presets = [load_preset(p) for p in config.presets]
+    base_presets = [p for p in presets if not p.layers()]
+    layered = {layer: [p for p in presets if layer in p.layers()] for layer in LAYER_ROWS}
     envs = []
     for spec in config.envs:
         envs.append(load_environment(spec))
@@ -481,7 +539,11 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
             terms = reference_terms(ref_renderer, env.radiance, size, config.roughness)
             progress.step(f"{env_name}: reference ({terms.seconds:.1f} s)")
             refs = {(p.name, r): terms.combine(replace(p, roughness=r), r)
-                    for p in presets for r in config.roughness}
+                    for p in base_presets for r in config.roughness}
+            for layer, ps in layered.items():
+                for p in ps:
+                    for r, image in layer_reference(ref_renderer, env.radiance, size, p, config.roughness).items():
+                        refs[(p.name, r)] = image
             ref_srgb = {k: tonemapped_srgb(v) for k, v in refs.items()}
             bakes = {}
             frame_items = []
@@ -494,14 +556,20 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                 maps = _with_lut(renderer, maps, s.quality)
                 if e == 0:
                     frame_items.append((res, maps))
-                if s.judged_by_truth:
+                if s.judged_by_truth and (layered[s.layer] if s.layer else base_presets):
                     test_tiles, ref_tiles, cells = [], [], []
-                    for p in presets:
+                    for p in (layered[s.layer] if s.layer else base_presets):
                         trow, rrow = [], []
                         for r in config.roughness:
+                            ref = refs.get((p.name, r))
+                            if ref is None:   # a layer's lobe too narrow for the texel sum: no case
+                                blank = np.zeros((size, size, 3), np.float32)
+                                trow.append(blank)
+                                rrow.append(blank)
+                                cells.append(None)
+                                continue
                             frame = renderer.render(_probe_scene(s, replace(p, roughness=r)), maps, size, size,
                                                     read_srgb=False)
-                            ref = refs[(p.name, r)]
                             rel = relative_mae(frame.linear, ref, terms.inside)
                             cells.append((p.name, r, rel))
                             trow.append(tonemapped_srgb(frame.linear))
@@ -512,7 +580,10 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                         ref_tiles.append(rrow)
                     _, flip_map = flip(_mosaic(test_tiles, pad), _mosaic(ref_tiles, pad))
                     cell = size + 2 * pad
-                    for k, (pname, r, rel) in enumerate(cells):
+                    for k, cell_case in enumerate(cells):
+                        if cell_case is None:
+                            continue
+                        pname, r, rel = cell_case
                         i, j = divmod(k, len(config.roughness))
                         tile = flip_map[i * cell + pad:i * cell + pad + size, j * cell + pad:j * cell + pad + size]
                         res.cases.append((env_name, pname, r, rel, float(tile[terms.inside].mean())))
