@@ -293,3 +293,19 @@ def test_attenuation_renders_as_the_equivalent_tinted_base_colour(tmp_path, shar
     covered = images[0][..., 3] > 0
     assert covered.sum() > 400
     assert relative(images[0][..., :3][covered], images[1][..., :3][covered]) <= 0.01
+
+
+def test_reference_refuses_a_refracted_lobe_too_narrow_to_sum(tmp_path):
+    """alight reference on water at roughness 0.2: its refracted lobe (alpha 0.005) is narrower
+    than the reflected lobe at 0.1, so the texel sum is refused: one line, status 2, no file."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "water.exr"
+    proc = subprocess.run([sys.executable, "-m", "alight", "reference", "--view", "probe", "--preset", "water",
+                           "--roughness", "0.2", "--size", "8", "--out", str(out)], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("alight: error: --roughness:") and "narrower" in lines[0]
+    assert not out.exists()

@@ -84,6 +84,21 @@ def check_roughness(roughness: float, what: str = "roughness") -> None:
                           f"few texels and the texel sum is no longer an integral (no reference below {MIN_ROUGHNESS})")
 
 
+def check_layer_lobes(material, roughnesses) -> None:
+    """A refracting volume's lobe is narrower than the reflected one (about (ior - 1) / (2 ior) of
+    its alpha): refused, one line, where it is narrower than the reflected lobe at MIN_ROUGHNESS
+    (alight.accuracy.ground_truth.check_transmission_lobe; docs/layer_transmission.md)."""
+    from alight.accuracy.ground_truth import check_transmission_lobe
+
+    if "volume" not in material.layers():
+        return
+    for r in roughnesses:
+        try:
+            check_transmission_lobe(r, material.ior)
+        except ValueError as exc:
+            raise AlightError(f"--roughness: {exc} (no reference there)") from None
+
+
 def choose_env_level(radiance: np.ndarray, roughnesses) -> int:
     """Level 1 (factor 2) when every roughness is >= 0.25, the map is >= 1024 wide and no
     compact bright source holds >= ``LEVEL1_MAX_SUN_FRACTION`` of its power; else 0."""
@@ -209,6 +224,7 @@ class ReferenceRenderer:
         if use_env:
             for r in self.scene_roughnesses(scene):
                 check_roughness(r)
+            check_layer_lobes(self.layered_material(scene), self.scene_roughnesses(scene))
         ctx = self.ctx
         if scene.view == "probe":
             gtex = self._textures_from_arrays(probe_gbuffer(width, scene.material))
@@ -235,6 +251,7 @@ class ReferenceRenderer:
         if use_env:
             for r in roughnesses:
                 check_roughness(r)
+            check_layer_lobes(scene.material, roughnesses)
         return self._sum(self._textures_from_arrays(g), False, scene, radiance if use_env else None, width, height,
                          env_level, chunk_pairs, {}, roughnesses, scene.material)
 
