@@ -283,7 +283,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
-                  multiple_scattering: bool = False, diffuse_scale: float = 1.0) -> np.ndarray:
+                  multiple_scattering: bool = False, material=None, diffuse_scale: float = 1.0) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -292,8 +292,11 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     the whole map), ``alight`` shades them as delta lights through the exact BRDF. ``lecture`` is
     ``split_sum_converged``. Roughness must be >= MIN_PREFILTER_ROUGHNESS for the non-lecture
     models (the sun's mirror image below the grid is the source cube's business, not this twin's).
-    ``diffuse_scale`` scales the diffuse lobe (1 - transmission: the rest is transmitted,
-    ``transmission_ibl_converged``).
+    ``material`` (an alight.core.material.Material): its layers over the result, as
+    common/layers.glsl's layered_ibl (``layered_ibl_converged``: the transmitted environment, the
+    sheen, the coat; the diffuse lobe scaled by 1 - transmission), and the compact sources through
+    the whole layered BRDF. Without it, ``diffuse_scale`` scales the diffuse lobe alone (the
+    reflected part of a transmissive material, without what it transmits).
     """
     from alight.core.ibl_models import IBL_MODELS, SUNS_AS_BAKED
     from alight.ibl.sun import extract_suns
@@ -330,6 +333,8 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
             direction = _unit_rows(n + t[:, None] * (R - n))
     irradiance = irradiance_converged(lighting, n)
     prefiltered = prefiltered_converged(lighting, direction, r)
+    if material is not None and "transmission" in material.layers():
+        diffuse_scale = 1.0 - material.transmission
     albedo = base * (1.0 - m) * float(diffuse_scale)
     if multiple_scattering:
         e_ss = A + B
@@ -339,8 +344,64 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         out = spec_weight * prefiltered + (f_ms * e_ms + albedo * (1.0 - (spec_weight + f_ms * e_ms))) * irradiance
     else:
         out = diffuse_weight * albedo * irradiance + spec_weight * prefiltered
+    layered = material is not None and bool(material.layers())
+    if layered:
+        out = layered_ibl_converged(material, lighting, n, v, out)
     for sun in suns:
-        out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread, diffuse_scale)
+        if layered:
+            from alight.core.layers.stack import Pairs, layered_brdf_cos, probe_tangents
+
+            l = _unit_rows(sun.direction)
+            pairs = Pairs(n=n, v=v, l=l, t=probe_tangents(n), b=np.cross(n, probe_tangents(n)), spread=sun.spread)
+            out = out + layered_brdf_cos(material, pairs)[:, 0, :] * np.asarray(sun.power)[None, :]
+        else:
+            out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread, diffuse_scale)
+    return out
+
+
+def _prefiltered_per_point(radiance, directions, roughness) -> np.ndarray:
+    """prefiltered_converged with a roughness per direction (one texel sum per distinct value)."""
+    out = np.empty((directions.shape[0], 3))
+    roughness = np.asarray(roughness, np.float64)
+    for value in np.unique(roughness):
+        sel = roughness == value
+        out[sel] = prefiltered_converged(radiance, directions[sel], float(value))
+    return out
+
+
+def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray:
+    """Numpy twin of common/layers.glsl's layered_ibl with converged maps: (P, 3). ``base`` is the
+    IBL model's result (P, 3); ``radiance`` the map the maps are baked from (without the compact
+    sources for the alight model). The sheen reads the numpy twin of its LUT
+    (alight.core.layers.sheen.sheen_lut_table), the clearcoat brdf_lut_converged."""
+    from alight.core.layers import clearcoat as cc
+    from alight.core.layers import sheen as sh
+
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    out = np.asarray(base, np.float64)
+    used = material.layers()
+    if "transmission" in used:
+        out = out + transmission_environment_converged(material, radiance, n, v)
+    if "sheen" in used:
+        nv = np.clip(np.sum(n * v, axis=-1), 0.0, 1.0)
+        lut = sh.lut_bilinear(sh.sheen_lut_table(), nv, material.sheen_roughness)   # (P, 4)
+        toward_v = v - n * np.sum(n * v, axis=-1, keepdims=True)
+        length = np.linalg.norm(toward_v, axis=-1, keepdims=True)
+        t = np.where(length > 1e-6, toward_v / np.maximum(length, 1e-300), 0.0)
+        d = _unit_rows(n * np.sqrt(np.maximum(1.0 - lut[:, 1:2] ** 2, 0.0)) + t * lut[:, 1:2])
+        sheen = np.minimum(lut[:, :1], 1.0) * _prefiltered_per_point(radiance, d, lut[:, 2])
+        out = out * sh.sheen_scaling(material.sheen_color, lut[:, :1]) + sheen * np.asarray(material.sheen_color)
+    if "clearcoat" in used:
+        rc = float(material.clearcoat_roughness)
+        nv = np.maximum(np.sum(n * v, axis=-1), 0.0)
+        A, B = brdf_lut_converged(nv, rc)
+        t_a, t_b = lobe_directions_converged(nv, rc)
+        t = (A * t_a + B * t_b) / np.maximum(A + B, 1e-6)   # ibl.glsl's mix with F0 = 1
+        R = reflect(-v, n)
+        d = _unit_rows(n + t[:, None] * (R - n))
+        weight = material.clearcoat * cc.clearcoat_fresnel(nv)[:, None]
+        out = out * (1.0 - weight) + weight * (A + B)[:, None] * prefiltered_converged(radiance, d, rc)
     return out
 
 
@@ -523,50 +584,18 @@ def prefiltered_converged_varying(radiance, directions, roughness, steps: int = 
     return out
 
 
-def transmission_ibl_converged(model: str, radiance, normals, view, material) -> np.ndarray:
-    """The transmitted part of the forward pass's image-based light with converged parts (P, 3):
-    the twin of transmission.glsl's transmission_ibl, weight base (1 - F0) E L_prefiltered along
-    the lobe, plus, for the models that shade the compact sources exactly (``alight``), those
-    sources through the BTDF (ibl.glsl's sun_layered: the lobe widened by the source's spread).
-    Add ``ibl_converged(..., diffuse_scale=1 - transmission)`` for the whole IBL."""
+def transmission_environment_converged(material, radiance, normals, view) -> np.ndarray:
+    """The transmitted environment with converged parts (P, 3): the twin of transmission.glsl's
+    transmission_ibl, weight base (1 - F0) E L_prefiltered along the lobe (``radiance``: the map
+    the maps are baked from, without the compact sources for the alight model; those go through
+    the BTDF with the rest of the layered BRDF, ``ibl_converged``)."""
     from alight.core.btdf import beer_lambert
-    from alight.core.ibl_models import SUNS_AS_BAKED
-    from alight.ibl.sun import extract_suns
 
     m = material
     n = _unit_rows(normals)
     v = np.broadcast_to(_unit_rows(view), n.shape)
-    rad = np.asarray(radiance, dtype=np.float32)
-    suns = []
-    if model in SUNS_AS_BAKED:
-        lighting = rad
-    else:
-        lighting, suns = extract_suns(rad)
     direction, rough, energy = transmitted_lobe_converged(m, n, v)
     weight = (1.0 - m.metallic) * m.transmission * np.asarray(m.base_color) * (1.0 - np.asarray(m.f0()))
     if "volume" in m.layers():
         weight = weight * beer_lambert(m.attenuation_color, m.attenuation_distance, m.thickness)
-    out = weight * energy[:, None] * prefiltered_converged_varying(lighting, direction, rough)
-    for sun in suns:
-        out = out + _sun_transmitted(m, n, v, sun)
-    return out
-
-
-def _sun_transmitted(m, n, v, sun) -> np.ndarray:
-    """transmission.glsl's transmission_light for a compact source (exact k, the lobe widened by
-    its spread) times its power P: (P, 3)."""
-    import dataclasses
-
-    from alight.core.layers.stack import Pairs
-    from alight.core.layers.transmission import thin_walled, transmission_light
-    from alight.core.shading import MIN_PUNCTUAL_ROUGHNESS
-
-    alpha = m.roughness ** 2
-    scale = 1.0 if thin_walled(m) else 2.0 / max(1.0 - 1.0 / m.ior, 1e-3)
-    widened = min(np.sqrt(np.sqrt(alpha * alpha + (sun.spread * scale) ** 2)), 1.0)
-    roughness = max(widened, MIN_PUNCTUAL_ROUGHNESS) if sun.spread > 0 else m.roughness
-    # D takes the widened roughness, k the material's (as the shader does).
-    p = Pairs(n=n, v=v, l=np.asarray(sun.direction, np.float64)[None, :])
-    widened_material = dataclasses.replace(m, roughness=roughness)
-    f = transmission_light(widened_material, p, k_roughness=m.roughness)[:, 0, :]
-    return f * np.asarray(sun.power)[None, :]
+    return weight * energy[:, None] * prefiltered_converged_varying(np.asarray(radiance, np.float32), direction, rough)

@@ -353,6 +353,11 @@ def layered_ground_truth(radiance, normals, views, material, tangents=None, rota
     from alight.core.layers.stack import Pairs, layered_brdf_cos, layered_emission, probe_tangents
 
     _check_roughness(material.roughness)
+    if "clearcoat" in material.layers():
+        try:
+            _check_roughness(material.clearcoat_roughness)
+        except ValueError as e:
+            raise ValueError(f"clearcoat_roughness: {e}") from None
     dirs, wt = _texels(radiance, rotation_deg, intensity)
     dirs64, wt64 = dirs.astype(np.float64), wt.astype(np.float64)
     n = _unit_rows(normals)

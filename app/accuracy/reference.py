@@ -65,6 +65,7 @@ LEVEL1_MAX_SUN_FRACTION = 0.10
 MAX_TEXELS_PER_DISPATCH = 1 << 15
 GBUFFER = ("position", "normal", "view", "base_color", "specular_f0", "emissive", "tangent")
 _UNIT_ENV = 7   # texture units 0-6: the G-buffer
+_UNIT_SHEEN_LUT = 8
 
 
 @dataclass
@@ -80,7 +81,8 @@ class ReferenceResult:
 
 def check_roughness(roughness: float, what: str = "roughness") -> None:
     if roughness < MIN_ROUGHNESS - 1e-9:
-        raise AlightError(f"--roughness: {what} {roughness:g} < {MIN_ROUGHNESS}: the GGX lobe is narrower than a "
+        option = "--" + what.replace("_", "-") if what != "roughness" else "--roughness"
+        raise AlightError(f"{option}: {what} {roughness:g} < {MIN_ROUGHNESS}: the GGX lobe is narrower than a "
                           f"few texels and the texel sum is no longer an integral (no reference below {MIN_ROUGHNESS})")
 
 
@@ -97,6 +99,13 @@ def check_layer_lobes(material, roughnesses) -> None:
             check_transmission_lobe(r, material.ior)
         except ValueError as exc:
             raise AlightError(f"--roughness: {exc} (no reference there)") from None
+
+
+def check_layer_roughness(material) -> None:
+    """The layers' own GGX lobes need the same: the coat's roughness (a coat below 0.1 is a
+    mirror; its sum would sample a delta). The sheen's Charlie lobe is wide at every roughness."""
+    if "clearcoat" in material.layers():
+        check_roughness(material.clearcoat_roughness, "clearcoat_roughness")
 
 
 def choose_env_level(radiance: np.ndarray, roughnesses) -> int:
@@ -224,6 +233,7 @@ class ReferenceRenderer:
         if use_env:
             for r in self.scene_roughnesses(scene):
                 check_roughness(r)
+            check_layer_roughness(self.layered_material(scene))
             check_layer_lobes(self.layered_material(scene), self.scene_roughnesses(scene))
         ctx = self.ctx
         if scene.view == "probe":
@@ -251,6 +261,7 @@ class ReferenceRenderer:
         if use_env:
             for r in roughnesses:
                 check_roughness(r)
+            check_layer_roughness(scene.material)
             check_layer_lobes(scene.material, roughnesses)
         return self._sum(self._textures_from_arrays(g), False, scene, radiance if use_env else None, width, height,
                          env_level, chunk_pairs, {}, roughnesses, scene.material)
@@ -278,8 +289,12 @@ class ReferenceRenderer:
         seconds["environment"] = t2 - t1
 
         accum = ctx.texture((width, height), 4, dtype="f4")
-        prog = self.renderer.shaders.compute("accuracy/reference.comp", layer_defines([material]))
+        defines = layer_defines([material])
+        prog = self.renderer.shaders.compute("accuracy/reference.comp", defines)
         _set_material(prog, material)   # the layers' factors (the G-buffer holds the base's)
+        if "HAS_SHEEN" in defines:
+            self.renderer.luts.sheen().use(_UNIT_SHEEN_LUT)
+            _set(prog, "u_sheen_lut", _UNIT_SHEEN_LUT)
         for unit, (name, tex) in enumerate(zip(GBUFFER, gtex)):
             tex.use(unit)
             _set(prog, f"u_g_{name}", unit)

@@ -35,6 +35,16 @@ class FileMaterial:
     # The ior and the layers' factors the file gives (alight.core.material field names, e.g.
     # {"clearcoat": 1.0}; alight.exchange.gltf_material.layer_fields_from_gltf); empty: none.
     layers: dict = field(default_factory=dict)
+    # The layers' textures (KHR_materials_clearcoat, KHR_materials_sheen), (H, W, 4) uint8 RGBA:
+    # clearcoat R and clearcoat_roughness G multiply their factors (linear); clearcoat_normal is a
+    # tangent-space normal map for the coat alone (scaled by clearcoat_normal_scale); sheen_color
+    # RGB (sRGB) and sheen_roughness A multiply theirs.
+    clearcoat_texture: np.ndarray | None = None
+    clearcoat_roughness_texture: np.ndarray | None = None
+    clearcoat_normal_texture: np.ndarray | None = None
+    clearcoat_normal_scale: float = 1.0
+    sheen_color_texture: np.ndarray | None = None
+    sheen_roughness_texture: np.ndarray | None = None
 
 
 @dataclass

@@ -176,6 +176,7 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             occlusion_texture=_texture(mat.occlusionTexture, textures),
             occlusion_strength=float(extra.get("occlusion_strength", 1.0)),
             layers=dict(extra.get("layers", {})),
+            **extra.get("layer_textures", {}),
         )
     if kind == "SimpleMaterial":
         if getattr(mat, "_name", None) is None:
@@ -227,11 +228,17 @@ def _gltf_material_params(path: Path) -> dict[str, dict]:
     """
     try:
         data = path.read_bytes()
+        binary = None
         if data[:4] == b"glTF":
             length, kind = struct.unpack("<II", data[12:20])
             if kind != 0x4E4F534A:  # 'JSON'
                 return {}
             doc = json.loads(data[20:20 + length])
+            rest = 20 + length
+            if len(data) >= rest + 8:
+                bin_length, bin_kind = struct.unpack("<II", data[rest:rest + 8])
+                if bin_kind == 0x004E4942:  # 'BIN\0'
+                    binary = data[rest + 8:rest + 8 + bin_length]
         else:
             doc = json.loads(data)
         materials = doc.get("materials", [])
@@ -253,9 +260,67 @@ def _gltf_material_params(path: Path) -> dict[str, dict]:
             if "emissiveStrength" in strength:
                 params["emissive_strength"] = float(strength["emissiveStrength"])
             params["layers"] = _layer_fields(m, str(path))
+            params["layer_textures"] = _layer_textures(doc, binary, path.parent, m)
             out[name] = params
         return out
     except AlightError:
         raise
     except Exception:
         return {}
+
+
+# The layers' textures alight draws (FileMaterial fields): (extension, textureInfo key).
+LAYER_TEXTURES = {
+    "clearcoat_texture": ("KHR_materials_clearcoat", "clearcoatTexture"),
+    "clearcoat_roughness_texture": ("KHR_materials_clearcoat", "clearcoatRoughnessTexture"),
+    "clearcoat_normal_texture": ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
+    "sheen_color_texture": ("KHR_materials_sheen", "sheenColorTexture"),
+    "sheen_roughness_texture": ("KHR_materials_sheen", "sheenRoughnessTexture"),
+}
+
+
+def _layer_textures(doc: dict, binary: bytes | None, folder: Path, gm: dict) -> dict[str, Any]:
+    """FileMaterial fields for the layer textures a glTF material names (images decoded), and
+    the coat normal map's scale. They are read with TEXCOORD_0, as the core maps are here."""
+    out: dict[str, Any] = {}
+    ext = gm.get("extensions") or {}
+    for slot, (name, key) in LAYER_TEXTURES.items():
+        info = (ext.get(name) or {}).get(key)
+        if isinstance(info, dict) and "index" in info:
+            image = _gltf_texture_image(doc, binary, folder, info["index"])
+            if image is not None:
+                out[slot] = image
+                if slot == "clearcoat_normal_texture":
+                    out["clearcoat_normal_scale"] = float(info.get("scale", 1.0))
+    return out
+
+
+def _gltf_texture_image(doc: dict, binary: bytes | None, folder: Path, index: int) -> np.ndarray | None:
+    """glTF texture ``index``'s image as (H, W, 4) uint8 RGBA (row 0 = top), decoded with Pillow
+    from its bufferView (a .glb's binary chunk or a buffer's file) or its own file; None when it
+    does not resolve (trimesh reads the core textures, not the extensions')."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    image = doc["images"][int(doc["textures"][int(index)]["source"])]
+    if "bufferView" in image:
+        view = doc["bufferViews"][int(image["bufferView"])]
+        uri = doc["buffers"][int(view.get("buffer", 0))].get("uri")
+        if uri is None:
+            blob = binary
+        elif uri.startswith("data:"):
+            blob = base64.b64decode(uri.split(",", 1)[1])
+        else:
+            blob = (folder / uri).read_bytes()
+        if blob is None:
+            return None
+        start = int(view.get("byteOffset", 0))
+        encoded = blob[start:start + int(view["byteLength"])]
+    elif str(image.get("uri", "")).startswith("data:"):
+        encoded = base64.b64decode(image["uri"].split(",", 1)[1])
+    else:
+        encoded = (folder / image["uri"]).read_bytes()
+    with Image.open(io.BytesIO(encoded)) as im:
+        return np.ascontiguousarray(np.asarray(im.convert("RGBA"), dtype=np.uint8))

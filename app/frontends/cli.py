@@ -580,13 +580,14 @@ def _reference(args) -> int:
             raise AlightError(f"--env-level: {level} is out of range [0, 8]")
     material, overrides = build_material(args)
 
-    from alight.accuracy.reference import check_roughness
+    from alight.accuracy.reference import check_layer_roughness, check_roughness
     from alight.core.scene import Scene, parse_light
     from alight.exchange.meshes import load_mesh
     from alight.ibl.environment import load_environment
 
     if not args.no_ibl:
         check_roughness(material.roughness)   # before any file is read
+        check_layer_roughness(material)
     lights = [parse_light(spec) for spec in args.light]
     mesh = load_mesh(args.mesh) if args.view == "camera" else None
     env = None if args.no_ibl else load_environment(args.env)

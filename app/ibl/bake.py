@@ -248,7 +248,7 @@ class LutCache:
     def __init__(self, ctx: moderngl.Context, shaders: ShaderLibrary):
         self.ctx = ctx
         self.shaders = shaders
-        self._textures: dict[tuple[int, int], moderngl.Texture] = {}
+        self._textures: dict[tuple, moderngl.Texture] = {}
         self.last_source = ""   # 'memory', 'disk' or 'baked'
 
     def path_for(self, size: int, samples: int):
@@ -256,11 +256,25 @@ class LutCache:
         return cache_dir() / f"brdf_lut-{size}-{samples}-{digest}.npy"
 
     def get(self, size: int, samples: int) -> moderngl.Texture:
-        key = (size, samples)
+        return self._get(("brdf", size, samples), self.path_for(size, samples), size,
+                         lambda: self._bake(size, samples))
+
+    def sheen(self, size: int | None = None, steps: int | None = None) -> moderngl.Texture:
+        """The sheen LUT (ibl/sheen_lut.comp: E, the lobe's mean direction and width over n.v and
+        sheen roughness; numpy twin alight.core.layers.sheen.sheen_lut_table), cached like the
+        BRDF LUT. Baked only when a material with sheen is drawn."""
+        from alight.core.layers.sheen import _QUADRATURE, SHEEN_LUT_SIZE
+
+        size = size or SHEEN_LUT_SIZE
+        steps = steps or _QUADRATURE
+        digest = self.shaders.digest("ibl/sheen_lut.comp")[:16]
+        path = cache_dir() / f"sheen_lut-{size}-{steps}-{digest}.npy"
+        return self._get(("sheen", size, steps), path, size, lambda: self._bake_sheen(size, steps))
+
+    def _get(self, key: tuple, path, size: int, bake) -> moderngl.Texture:
         if key in self._textures:
             self.last_source = "memory"
             return self._textures[key]
-        path = self.path_for(size, samples)
         table = None
         try:
             loaded = np.load(path, allow_pickle=False)
@@ -273,7 +287,7 @@ class LutCache:
             tex = self._upload(table)
         else:
             self.last_source = "baked"
-            tex = self._bake(size, samples)
+            tex = bake()
             table = read_lut(tex)
             try:
                 os.makedirs(path.parent, exist_ok=True)
@@ -290,6 +304,16 @@ class LutCache:
         tex = self.ctx.texture((size, size), LUT_CHANNELS, table.tobytes(), dtype="f4")
         tex.repeat_x = tex.repeat_y = False
         tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        return tex
+
+    def _bake_sheen(self, size: int, steps: int) -> moderngl.Texture:
+        tex = self._upload(np.zeros((size, size, LUT_CHANNELS), np.float32))
+        prog = self.shaders.compute("ibl/sheen_lut.comp")
+        prog["u_size"] = size
+        prog["u_steps"] = steps
+        tex.bind_to_image(0, read=False, write=True)
+        prog.run(_groups(size), _groups(size), 1)
+        self.ctx.memory_barrier()
         return tex
 
     def _bake(self, size: int, samples: int) -> moderngl.Texture:

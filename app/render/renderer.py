@@ -52,11 +52,13 @@ MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
-MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness")
+MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
+                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
-UNIT_TRANSMISSION_LUT = 6 + len(MATERIAL_MAPS)   # ibl/transmission_lut.comp's table (HAS_VOLUME)
+UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
+UNIT_TRANSMISSION_LUT = UNIT_SHEEN_LUT + 1          # ibl/transmission_lut.comp's table (HAS_VOLUME)
 UNIT_SCENE_BEHIND = UNIT_TRANSMISSION_LUT + 1      # the opaque parts' copy (TRANSMISSION_SCENE)
-SRGB_MAPS = ("base_color", "emissive")
+SRGB_MAPS = ("base_color", "emissive", "sheen_color")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {
@@ -64,7 +66,7 @@ SAMPLER_UNITS = {
     "u_prefiltered_radiance_mid": UNIT_PREFILTERED_MID, "u_brdf_lut": UNIT_LUT,
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
-    "u_transmission_lut": UNIT_TRANSMISSION_LUT, "u_scene_behind": UNIT_SCENE_BEHIND,
+    "u_sheen_lut": UNIT_SHEEN_LUT, "u_transmission_lut": UNIT_TRANSMISSION_LUT, "u_scene_behind": UNIT_SCENE_BEHIND,
 }
 
 
@@ -427,8 +429,6 @@ class ForwardRenderer:
         maps.prefiltered_radiance.use(UNIT_PREFILTERED)
         maps.prefiltered_radiance_mid.use(UNIT_PREFILTERED_MID)
         maps.brdf_lut.use(UNIT_LUT)
-        if "u_transmission_lut" in program:
-            self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
         _set(program, "u_prefiltered_max_mip", maps.prefiltered_max_mip)
         _set(program, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
         _set(program, "u_env_intensity", float(scene.env_intensity))
@@ -493,6 +493,7 @@ class ForwardRenderer:
         m = scene.material
         prog["u_size"] = float(size)
         _set_material(prog, m)
+        self._bind_layer_luts(defines)
         self._bind_ibl(prog, scene, maps)
         self._fullscreen(prog)
 
@@ -516,11 +517,9 @@ class ForwardRenderer:
         behind.use(UNIT_SCENE_BEHIND)
         if not (scene.ibl_enabled and maps is not None):
             # The thin-walled lobe's energy is the BRDF LUT's A, which _bind_ibl bound only with
-            # an environment; the transmission LUT likewise.
+            # an environment.
             q = QUALITY["medium"]
             self.luts.get(q.lut_size, q.lut_samples).use(UNIT_LUT)
-            if "u_transmission_lut" in prog:
-                self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
         _set(prog, "u_behind_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
         half_fov = math.radians(camera.fov_y_deg) / 2.0
         _set(prog, "u_behind_pixels_per_radian", float(targets.draw_size[1] / 2.0 / math.tan(half_fov)))
@@ -541,7 +540,16 @@ class ForwardRenderer:
             _set(prog, "u_debug_view", int(scene.debug_view))
             _set(prog, "u_debug_mip", float(scene.debug_mip))
         self._bind_ibl(prog, scene, maps)
+        self._bind_layer_luts(defines)
         return prog
+
+    def _bind_layer_luts(self, defines: dict) -> None:
+        """The tables a compiled-in layer reads (the sheen LUT, the transmission LUT), baked on
+        first use."""
+        if "HAS_SHEEN" in defines:
+            self.luts.sheen().use(UNIT_SHEEN_LUT)
+        if "HAS_VOLUME" in defines:
+            self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
 
     def layer_defines(self, scene: Scene, parts: list[int] | None = None) -> dict:
         """The HAS_* defines of the layers any part of the scene's mesh (or those of ``parts``,
@@ -587,6 +595,7 @@ class ForwardRenderer:
             _set_material(prog, material)
             fm = part.material if maps_used else None
             _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
+            _set(prog, "u_clearcoat_normal_scale", float(getattr(fm, "clearcoat_normal_scale", 1.0)) if fm else 1.0)
             _set(prog, "u_occlusion_strength", float(getattr(fm, "occlusion_strength", 1.0)) if fm else 1.0)
             # A file's maps use its own UVs as they are; the user's maps are tiled.
             _set(prog, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))

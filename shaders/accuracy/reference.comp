@@ -38,18 +38,23 @@ void main() {
                              texelFetch(u_g_specular_f0, p, 0).rgb, texelFetch(u_g_emissive, p, 0).rgb, 1.0);
     vec3 n = normalize(nr.xyz);
     vec3 v = normalize(vm.xyz);
+    vec3 n_map = rotate_world_to_map(n, u_env_rotation);
+    vec3 v_map = rotate_world_to_map(v, u_env_rotation);
+    // The environment is summed in the map's frame: a copy of the surface with its layers'
+    // directions (coat normal, tangent frame) in that frame too.
+    Surface s_map = s;
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
     // The layers' factors are the scene material's (app/accuracy/reference.py), about the
     // G-buffer's frame.
     vec4 tw = texelFetch(u_g_tangent, p, 0);
     vec3 t = normalize(tw.xyz - n * dot(n, tw.xyz));
-    apply_material_layers(s, n, t, cross(n, t) * (tw.w < 0.0 ? -1.0 : 1.0));
+    vec3 b = cross(n, t) * (tw.w < 0.0 ? -1.0 : 1.0);
+    apply_material_layers(s, n, t, b);
+    apply_material_layers(s_map, n_map, rotate_world_to_map(t, u_env_rotation), rotate_world_to_map(b, u_env_rotation));
 #endif
     vec3 sum = u_first ? layered_emission(s, v) + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
     if (u_env_enabled && u_row_end > u_row_begin) {
-        vec3 n_map = rotate_world_to_map(n, u_env_rotation);
-        vec3 v_map = rotate_world_to_map(v, u_env_rotation);
-        sum += u_env_intensity * ground_truth_rows(u_env, 0, u_row_begin, u_row_end, s, n_map, v_map);
+        sum += u_env_intensity * ground_truth_rows(u_env, 0, u_row_begin, u_row_end, s_map, n_map, v_map);
     }
     imageStore(u_accum, p, vec4(sum, 1.0));
 }

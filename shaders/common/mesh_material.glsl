@@ -39,11 +39,28 @@ uniform sampler2D u_occlusion_map;
 uniform sampler2D u_metallic_map;
 uniform sampler2D u_roughness_map;
 
+// The layers' maps (glTF: KHR_materials_clearcoat, KHR_materials_sheen), declared with their layer.
+#ifdef HAS_CLEARCOAT
+uniform bool u_has_clearcoat_map;             // R multiplies clearcoat
+uniform bool u_has_clearcoat_roughness_map;   // G multiplies clearcoat_roughness
+uniform bool u_has_clearcoat_normal_map;      // the coat's own tangent-space normal map
+uniform float u_clearcoat_normal_scale;
+uniform sampler2D u_clearcoat_map;
+uniform sampler2D u_clearcoat_roughness_map;
+uniform sampler2D u_clearcoat_normal_map;
+#endif
+#ifdef HAS_SHEEN
+uniform bool u_has_sheen_color_map;           // RGB (sRGB) multiplies sheen_color
+uniform bool u_has_sheen_roughness_map;       // A multiplies sheen_roughness
+uniform sampler2D u_sheen_color_map;
+uniform sampler2D u_sheen_roughness_map;
+#endif
+
 // The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 127
+#define MATERIAL_MAPS_MASK 4095
 #endif
 const int MAP_BASE_COLOR = 1;
 const int MAP_METALLIC_ROUGHNESS = 2;
@@ -52,6 +69,11 @@ const int MAP_EMISSIVE = 8;
 const int MAP_OCCLUSION = 16;
 const int MAP_METALLIC = 32;
 const int MAP_ROUGHNESS = 64;
+const int MAP_CLEARCOAT = 128;
+const int MAP_CLEARCOAT_ROUGHNESS = 256;
+const int MAP_CLEARCOAT_NORMAL = 512;
+const int MAP_SHEEN_COLOR = 1024;
+const int MAP_SHEEN_ROUGHNESS = 2048;
 
 bool has_map(int bit, bool present) {
     return (MATERIAL_MAPS_MASK & bit) != 0 && present;
@@ -120,6 +142,17 @@ Surface material_surface(vec3 n) {
     // KHR_materials_clearcoat: without a clearcoat normal map the coat is not normal-mapped,
     // even where the base is.
     s.clearcoat_normal = geometric_normal();
+    if (has_map(MAP_CLEARCOAT, u_has_clearcoat_map)) s.clearcoat *= texture(u_clearcoat_map, uv).r;
+    if (has_map(MAP_CLEARCOAT_ROUGHNESS, u_has_clearcoat_roughness_map)) {
+        s.clearcoat_roughness *= texture(u_clearcoat_roughness_map, uv).g;
+    }
+    if (has_map(MAP_CLEARCOAT_NORMAL, u_has_clearcoat_normal_map)) {
+        s.clearcoat_normal = normal_from_map(u_clearcoat_normal_map, u_clearcoat_normal_scale, s.clearcoat_normal);
+    }
+#endif
+#ifdef HAS_SHEEN
+    if (has_map(MAP_SHEEN_COLOR, u_has_sheen_color_map)) s.sheen_color *= texture(u_sheen_color_map, uv).rgb;
+    if (has_map(MAP_SHEEN_ROUGHNESS, u_has_sheen_roughness_map)) s.sheen_roughness *= texture(u_sheen_roughness_map, uv).a;
 #endif
     return s;
 }

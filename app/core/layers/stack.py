@@ -19,7 +19,7 @@ import numpy as np
 
 from alight.core.layers import anisotropy, clearcoat, sheen, transmission
 from alight.core.material import Material
-from alight.core.shading import PI, D_GGX, F_Schlick, G1_SchlickGGX, k_ibl
+from alight.core.shading import MIN_PUNCTUAL_ROUGHNESS, PI, D_GGX, F_Schlick, G1_SchlickGGX, k_ibl
 
 MIN_N_DOT_V = 1e-4   # brdf.glsl
 
@@ -27,7 +27,7 @@ MIN_N_DOT_V = 1e-4   # brdf.glsl
 @dataclass
 class Pairs:
     """P points x T directions. ``n``, ``v`` (P, 3) unit; ``l`` (T, 3) unit; the tangent
-    frame ``t``, ``b`` (P, 3) (anisotropy; the probe's is ``probe_tangent_frame``) and the
+    frame ``t``, ``b`` (P, 3) (anisotropy; the probe's is ``probe_tangents``) and the
     coat's normal ``n_c`` (P, 3) where a layer needs them (n_c defaults to n)."""
 
     n: np.ndarray
@@ -36,6 +36,9 @@ class Pairs:
     t: np.ndarray | None = None
     b: np.ndarray | None = None
     n_c: np.ndarray | None = None
+    # A compact source's RMS angular radius (ibl.glsl: sun_layered): widens the GGX lobes to
+    # alpha' = sqrt(alpha^2 + spread^2), floored at MIN_PUNCTUAL_ROUGHNESS; 0 for the exact sum.
+    spread: float = 0.0
     _cache: dict = field(default_factory=dict, repr=False)
 
     def _get(self, key, make):
@@ -104,9 +107,15 @@ def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
     if "anisotropy" in m.layers():
         specular_cos = anisotropy.anisotropic_specular(m, p, F) * nl_c[..., None]
     else:
-        k = k_ibl(m.roughness)
+        r = m.roughness
+        lobe = r
+        if p.spread > 0.0:   # a compact source (ibl.glsl: sun_light)
+            r = max(r, MIN_PUNCTUAL_ROUGHNESS)
+            lobe = max(float(np.sqrt(np.sqrt(m.roughness ** 4 + p.spread ** 2))), MIN_PUNCTUAL_ROUGHNESS)
+        k = k_ibl(r)
         # D G / (4 n.l n.v) n.l = D G1(n.l) G1(n.v) / (4 n.v)
-        dg = D_GGX(p.n_dot_h, m.roughness) * G1_SchlickGGX(nl_c, k) * G1_SchlickGGX(p.n_dot_v, k)
+        dg = D_GGX(np.maximum(p.n_dot_h, 0.0) if p.spread > 0.0 else p.n_dot_h, lobe) \
+            * G1_SchlickGGX(nl_c, k) * G1_SchlickGGX(p.n_dot_v, k)
         specular_cos = (dg / (4.0 * p.n_dot_v))[..., None] * F
     f = kd * (np.asarray(m.base_color) / PI) * nl_c[..., None] + specular_cos
     f = np.where(lit[..., None], f, 0.0)

@@ -27,13 +27,25 @@ def transmission_weight(m) -> np.ndarray:
     return weight
 
 
-def transmission_light(m, p, punctual: bool = False, k_roughness: float | None = None) -> np.ndarray:
+def widened_transmission_roughness(m, spread: float) -> float:
+    """transmission.glsl's widened_transmission_roughness: the lobe's alpha widened for a source
+    of RMS angular radius ``spread``, 2 / (1 - 1/ior) times more for the narrower refracted lobe."""
+    scale = 1.0 if thin_walled(m) else 2.0 / max(1.0 - 1.0 / m.ior, 1e-3)
+    alpha = m.roughness ** 2
+    return min(float(np.sqrt(np.sqrt(alpha * alpha + (spread * scale) ** 2))), 1.0)
+
+
+def transmission_light(m, p, punctual: bool = False) -> np.ndarray:
     """The transmitted part of the base times |n.l| for every pair, (P, T, 3): for l behind the
     surface (n.l < 0) (1 - m) t T base (1 - F(v.h)) btdf |n.l|, 0 in front. ``punctual``: the
-    punctual lights' k = (r+1)^2/8 and roughness floor; else the exact k = r^2/2.
-    ``k_roughness``: the roughness k is computed from, where D's is widened (a compact source)."""
+    punctual lights' k = (r+1)^2/8 and roughness floor; else the exact k = r^2/2. A compact
+    source (``p.spread`` > 0) widens D's lobe (``widened_transmission_roughness``); k keeps the
+    material's roughness, as ibl.glsl's sun_light does."""
     roughness = max(m.roughness, MIN_PUNCTUAL_ROUGHNESS) if punctual else m.roughness
-    k = k_direct(roughness) if punctual else k_ibl(roughness if k_roughness is None else k_roughness)
+    k = k_direct(roughness) if punctual else k_ibl(roughness)
+    spread = float(getattr(p, "spread", 0.0))
+    if spread > 0.0:
+        roughness = max(widened_transmission_roughness(m, spread), MIN_PUNCTUAL_ROUGHNESS)
     nl = p.n_dot_l                      # (P, T)
     nv = p.n_dot_v                      # (P, 1), clamped
     nv_raw = p.n_dot_v_raw
