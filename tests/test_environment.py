@@ -246,7 +246,7 @@ def test_channels(tmp_path):
 
     with pytest.raises(AlightError) as ei:
         load_environment(str(_write(tmp_path / "two.exr", np.ones((16, 32, 2), np.float32))))
-    _one_line_error(ei, "two.exr", "2-channel")
+    _one_line_error(ei, "two.exr", "channels R, G: need R, G and B, or Y (grey)")
 
 
 def test_tiled_exr(tmp_path):

@@ -106,6 +106,13 @@ def test_punctual_light():
     assert np.isfinite(gpu).all()
 
 
+def test_spot_and_range_attenuation():
+    x = np.column_stack([rng.uniform(0.5, 1, 300), rng.uniform(1, 20, 300), rng.uniform(-19, 0, 300), rng.uniform(0, 1.5, 300)])
+    gpu = evaluate("SPOT_RANGE", x)
+    close(gpu[:, 0], shading.spot_attenuation(x[:, 0], x[:, 1], x[:, 2]), rtol=1e-4, atol=1e-6)
+    close(gpu[:, 1], shading.range_attenuation(x[:, 3], 1.0), rtol=1e-4, atol=1e-6)
+
+
 # --- the transmission BTDF and layer (common/btdf.glsl and transmission.glsl against
 # app/core/btdf.py and app/core/layers/transmission.py) -------------------------------------
 

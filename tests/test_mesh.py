@@ -184,15 +184,16 @@ def test_damaged_helmet_material(shared_data):
     (part,) = mesh.parts
     m = part.material
     assert isinstance(m, FileMaterial)
-    for tex in (m.base_color_texture, m.metallic_roughness_texture, m.normal_texture,
-                m.emissive_texture, m.occlusion_texture):
+    for info in (m.base_color_texture, m.metallic_roughness_texture, m.normal_texture,
+                 m.emissive_texture, m.occlusion_texture):
+        tex = info.image
         assert tex is not None and tex.dtype == np.uint8 and tex.shape == (2048, 2048, 4)
     # glTF defaults (no factors in the file) and its emissiveFactor [1, 1, 1].
     assert (m.metallic, m.roughness, m.alpha) == (1.0, 1.0, 1.0)
     assert m.base_color == (1.0, 1.0, 1.0) and m.emissive == (1.0, 1.0, 1.0)
     assert m.normal_scale == 1.0 and m.occlusion_strength == 1.0
     # Normal map texels point mostly out of the surface (blue channel high).
-    assert m.normal_texture[..., 2].mean() > 200
+    assert m.normal_texture.image[..., 2].mean() > 200
     # Its uvs are stored with v_gltf in [1, 2] (REPEAT wrap); trimesh's flip makes them [-1, 0].
     assert part.uvs[:, 1].max() <= 0.0 and part.uvs[:, 1].min() >= -1.0
     # DamagedHelmet has mirrored uv islands: both handedness signs occur.
@@ -220,7 +221,7 @@ def test_uv_convention_duck(shared_data):
     the flip.
     """
     (part,) = load_mesh(str(shared_data / "models/Duck.glb")).parts
-    tex = part.material.base_color_texture
+    tex = part.material.base_color_texture.image
     assert tex.shape == (512, 512, 4)
     h, w = tex.shape[:2]
 
@@ -240,7 +241,7 @@ def test_uv_convention_duck(shared_data):
 
 def test_box_textured_material(shared_data):
     (part,) = load_mesh(str(shared_data / "models/BoxTextured.glb")).parts
-    assert part.material.base_color_texture.shape == (256, 256, 4)
+    assert part.material.base_color_texture.image.shape == (256, 256, 4)
     assert part.material.metallic == 0.0
 
 

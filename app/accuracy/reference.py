@@ -182,7 +182,9 @@ class ReferenceRenderer:
         ctx.viewport = (0, 0, width, height)
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         camera = r.camera_for(scene, width / height)
-        prog = r.program("render/pbr.vert", "render/gbuffer.frag")
+        def prog(defines: dict):   # each part's variant (uv sets, vertex colours, texture transforms)
+            return r.program("render/pbr.vert", "render/gbuffer.frag", defines)
+
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         r.draw_mesh_parts(scene, prog, camera, camera.view_projection(width / height))

@@ -11,45 +11,145 @@ while texture arrays keep PIL's order (row 0 = top row), so a texel is found at
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 BUILTIN_MESHES = ("sphere", "cube", "plane")
+WRAP_MODES = ("repeat", "clamp_to_edge", "mirrored_repeat")   # glTF 2.0 sampler.wrapS/T (10497, 33071, 33648)
+ALPHA_MODES = ("OPAQUE", "MASK", "BLEND")                      # glTF 2.0 material.alphaMode
+
+
+@dataclass(frozen=True)
+class Sampler:
+    """How a texture is sampled (glTF 2.0 section 3.8.4, "Samplers").
+
+    ``wrap_s``/``wrap_t``: one of WRAP_MODES. ``mag_filter``: 'nearest' or 'linear';
+    ``min_filter``: 'nearest', 'linear' or '<nearest|linear>_mipmap_<nearest|linear>'. glTF
+    leaves undefined filters to the implementation: alight uses trilinear filtering then.
+    """
+
+    wrap_s: str = "repeat"
+    wrap_t: str = "repeat"
+    mag_filter: str = "linear"
+    min_filter: str = "linear_mipmap_linear"
+
+    @property
+    def mipmaps(self) -> bool:
+        return "mipmap" in self.min_filter
+
+
+@dataclass(frozen=True)
+class TextureTransform:
+    """KHR_texture_transform: ``uv' = T(offset) R(rotation) S(scale) uv`` in glTF's texture
+    space (u right, v down, origin at the image's top left); ``rotation`` in radians, as the
+    extension's specification defines the matrix."""
+
+    offset: tuple[float, float] = (0.0, 0.0)
+    rotation: float = 0.0
+    scale: tuple[float, float] = (1.0, 1.0)
+
+    def matrix(self) -> np.ndarray:
+        """(3, 3) float64, acting on glTF uvs as column vectors (u, v, 1)."""
+        c, s = math.cos(self.rotation), math.sin(self.rotation)
+        t = np.array([[1.0, 0.0, self.offset[0]], [0.0, 1.0, self.offset[1]], [0.0, 0.0, 1.0]])
+        # The extension's GLSL mat3(c, -s, 0, s, c, 0, 0, 0, 1) is column-major: these are its rows
+        # (checked against TextureTransformTest's rotation markers).
+        r = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+        sc = np.diag([self.scale[0], self.scale[1], 1.0])
+        return t @ r @ sc
+
+    def gl_matrix(self) -> np.ndarray:
+        """The same map on alight's uvs (OpenGL: v_gl = 1 - v_gltf): F M F with F the flip."""
+        flip = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 1.0], [0.0, 0.0, 1.0]])
+        return flip @ self.matrix() @ flip
+
+
+@dataclass
+class TextureInfo:
+    """One texture slot of a material (glTF 2.0 textureInfo): the decoded image, which uv set it
+    reads (``tex_coord``: 0 = TEXCOORD_0, 1 = TEXCOORD_1), KHR_texture_transform and the sampler.
+
+    ``image``: (H, W, 4) uint8 RGBA, row 0 = the image's top row (grey spread to RGB, alpha 255
+    where the file has none); sRGB or linear as the slot says, never converted here.
+    """
+
+    image: np.ndarray
+    tex_coord: int = 0
+    transform: TextureTransform | None = None
+    sampler: Sampler = field(default_factory=Sampler)
+
+
+TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion")
+# The layers' textures (KHR_materials_clearcoat, KHR_materials_sheen): clearcoat R and
+# clearcoat_roughness G multiply their factors (linear); clearcoat_normal is the coat's own
+# tangent-space normal map (scaled by clearcoat_normal_scale); sheen_color RGB (sRGB) and
+# sheen_roughness A multiply theirs.
+LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness")
+
+
 @dataclass
 class FileMaterial:
-    """A glTF/OBJ material as the file gives it (metal-roughness model)."""
+    """A glTF/OBJ material as the file gives it (glTF 2.0 metal-roughness, section 3.9).
 
-    base_color: tuple[float, float, float]  # linear factor
-    metallic: float
-    roughness: float
-    emissive: tuple[float, float, float]  # linear, times KHR_materials_emissive_strength
-    alpha: float
-    base_color_texture: np.ndarray | None  # (H, W, 4) uint8, sRGB, row 0 = top
-    metallic_roughness_texture: np.ndarray | None  # linear; G = roughness, B = metallic
-    normal_texture: np.ndarray | None  # tangent-space normal map
-    normal_scale: float
-    emissive_texture: np.ndarray | None  # sRGB
-    occlusion_texture: np.ndarray | None  # R = occlusion
-    occlusion_strength: float
+    Factors are linear. A ``*_texture`` is a TextureInfo (an (H, W, 4) uint8 array is accepted
+    and wrapped with TEXCOORD_0 and the default sampler). ``specular_f0`` is the dielectric F0
+    that KHR_materials_ior and KHR_materials_specular give (0.04 without them).
+    """
+
+    base_color: tuple[float, float, float] = (1.0, 1.0, 1.0)  # linear factor
+    metallic: float = 1.0
+    roughness: float = 1.0
+    emissive: tuple[float, float, float] = (0.0, 0.0, 0.0)  # linear, times KHR_materials_emissive_strength
+    alpha: float = 1.0                                       # baseColorFactor's alpha
+    base_color_texture: TextureInfo | None = None            # sRGB; A = alpha
+    metallic_roughness_texture: TextureInfo | None = None    # linear; G = roughness, B = metallic
+    normal_texture: TextureInfo | None = None                # tangent-space normal map
+    normal_scale: float = 1.0
+    emissive_texture: TextureInfo | None = None              # sRGB
+    occlusion_texture: TextureInfo | None = None             # R = occlusion
+    occlusion_strength: float = 1.0
+    alpha_mode: str = "OPAQUE"                               # ALPHA_MODES
+    alpha_cutoff: float = 0.5                                # MASK only
+    double_sided: bool = False
+    unlit: bool = False                                      # KHR_materials_unlit
+    specular_f0: tuple[float, float, float] = (0.04, 0.04, 0.04)
+    name: str = ""
     # The ior and the layers' factors the file gives (alight.core.material field names, e.g.
     # {"clearcoat": 1.0}; alight.exchange.gltf_material.layer_fields_from_gltf); empty: none.
     layers: dict = field(default_factory=dict)
-    # The layers' textures (KHR_materials_clearcoat, KHR_materials_sheen), (H, W, 4) uint8 RGBA:
-    # clearcoat R and clearcoat_roughness G multiply their factors (linear); clearcoat_normal is a
-    # tangent-space normal map for the coat alone (scaled by clearcoat_normal_scale); sheen_color
-    # RGB (sRGB) and sheen_roughness A multiply theirs.
-    clearcoat_texture: np.ndarray | None = None
-    clearcoat_roughness_texture: np.ndarray | None = None
-    clearcoat_normal_texture: np.ndarray | None = None
+    clearcoat_texture: TextureInfo | None = None
+    clearcoat_roughness_texture: TextureInfo | None = None
+    clearcoat_normal_texture: TextureInfo | None = None
     clearcoat_normal_scale: float = 1.0
-    sheen_color_texture: np.ndarray | None = None
-    sheen_roughness_texture: np.ndarray | None = None
+    sheen_color_texture: TextureInfo | None = None
+    sheen_roughness_texture: TextureInfo | None = None
+
+    def __post_init__(self) -> None:
+        for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:
+            value = getattr(self, f"{slot}_texture")
+            if isinstance(value, np.ndarray):
+                setattr(self, f"{slot}_texture", TextureInfo(value))
+
+    def textures(self) -> dict[str, TextureInfo]:
+        """The slots that have a texture, by slot name (TEXTURE_SLOTS, then LAYER_TEXTURE_SLOTS)."""
+        out = {}
+        for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:
+            info = getattr(self, f"{slot}_texture")
+            if info is not None:
+                out[slot] = info
+        return out
 
 
 @dataclass
 class MeshPart:
-    """One geometry with one material, in world space."""
+    """One glTF primitive (or OBJ/PLY group) with one material, in world space.
+
+    ``uvs`` and ``uvs1`` follow OpenGL (v = 0 bottom, i.e. 1 - v of glTF); ``colors`` is COLOR_0
+    (or PLY/OBJ vertex colours) as linear RGBA that multiplies the base colour and alpha.
+    ``element`` names where it came from in the file (``meshes[2].primitives[0]``).
+    """
 
     name: str
     positions: np.ndarray  # (N, 3) float32
@@ -58,12 +158,22 @@ class MeshPart:
     tangents: np.ndarray  # (N, 4) float32, bitangent = w * cross(n, t)
     indices: np.ndarray  # (M, 3) uint32, counter-clockwise front faces
     material: FileMaterial | None
+    uvs1: np.ndarray | None = None  # (N, 2) float32, TEXCOORD_1
+    colors: np.ndarray | None = None  # (N, 4) float32, linear RGBA
+    element: str = ""
 
 
 @dataclass
 class Mesh:
+    """Parts in world space, and what else the file brought: its cameras (``alight.core.scene.Camera``,
+    in the file's order), its punctual lights (``alight.core.scene.Light``) and one-line warnings
+    about what alight renders without."""
+
     parts: list[MeshPart]
     source: str  # 'sphere' / 'cube' / 'plane' or the file path
+    cameras: list = field(default_factory=list)
+    lights: list = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space min and max corners over all parts."""

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 VIEWS = ("camera", "probe")
 TONEMAPS = ("none", "aces", "neutral")
 BACKGROUNDS = ("env", "blur", "color", "transparent")
-LIGHT_KINDS = ("point", "directional")
+LIGHT_KINDS = ("point", "directional", "spot")
 
 
 @dataclass
@@ -31,6 +31,8 @@ class Camera:
     fov_y_deg: float = 35.0
     near: float = 0.05
     far: float = 100.0
+    # glTF orthographic cameras: the view's half height (ymag); None: perspective (fov_y_deg).
+    ortho_half_height: float | None = None
 
     def view_matrix(self) -> np.ndarray:
         """pyrr's row-vector layout: upload as is for GLSL's column-vector ``M * v``."""
@@ -38,6 +40,10 @@ class Camera:
                                             np.array(self.up), dtype=np.float32)
 
     def projection_matrix(self, aspect: float) -> np.ndarray:
+        if self.ortho_half_height is not None:
+            h = self.ortho_half_height
+            return pyrr.matrix44.create_orthogonal_projection(-h * aspect, h * aspect, -h, h, self.near, self.far,
+                                                              dtype=np.float32)
         return pyrr.matrix44.create_perspective_projection(self.fov_y_deg, aspect, self.near, self.far,
                                                            dtype=np.float32)
 
@@ -60,12 +66,41 @@ def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float =
                   near=max(distance - radius * 1.5, distance * 1e-3), far=distance + radius * 4.0)
 
 
+def orbit_camera(center, radius: float, aspect: float, orbit_deg: float = 0.0, elevation_deg: float = 0.0,
+                 distance: float | None = None, fov_y_deg: float = 35.0, target=None) -> Camera:
+    """A camera looking at ``target`` (default: ``center``) from a direction turned ``orbit_deg``
+    about +Y from +Z (right-handed) and raised by ``elevation_deg``, at ``distance`` (default:
+    the distance that frames a sphere of ``radius``, frame_camera's), with a vertical field of
+    view of ``fov_y_deg`` degrees. The near and far planes enclose the sphere."""
+    a, e = math.radians(orbit_deg), math.radians(elevation_deg)
+    direction = np.array([math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e)])
+    look_at = np.asarray(center if target is None else target, dtype=np.float64)
+    framed = frame_camera(look_at, max(radius, 1e-6), fov_y_deg, aspect, direction)
+    if distance is None:
+        return framed
+    position = look_at + direction * distance
+    reach = float(np.linalg.norm(position - np.asarray(center, np.float64))) + max(radius, 1e-6)
+    near = max(reach - 2.5 * max(radius, 1e-6), reach * 1e-4)
+    up = (0.0, 1.0, 0.0) if abs(math.cos(e)) > 1e-6 else (0.0, 0.0, -math.copysign(1.0, math.sin(e)))
+    return Camera(tuple(position), tuple(look_at), up, fov_y_deg, near=near, far=reach + max(radius, 1e-6) * 2.0)
+
+
 @dataclass
 class Light:
-    kind: str = "point"                                   # 'point' or 'directional'
+    """A punctual light (KHR_lights_punctual's three kinds). ``vector`` is the position (point,
+    spot) or the direction light travels (directional); ``direction`` the direction a spot
+    points. A spot's intensity falls off between ``inner_cone_deg`` and ``outer_cone_deg`` from
+    its axis (the extension's recommended falloff); ``range`` (point, spot) windows the inverse
+    square law to 0 at that distance, as the extension recommends (None: no cutoff)."""
+
+    kind: str = "point"                                   # LIGHT_KINDS
     vector: tuple[float, float, float] = (2.0, 3.0, 4.0)  # position, or the direction light travels
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
-    intensity: float = 10.0                               # point: radiant intensity; directional: irradiance
+    intensity: float = 10.0                               # point, spot: intensity (/d^2); directional: irradiance
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)   # spot only
+    inner_cone_deg: float = 0.0                           # spot only
+    outer_cone_deg: float = 45.0                          # spot only
+    range: float | None = None
 
 
 def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
@@ -79,21 +114,37 @@ def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
 
 
 def parse_light(spec: str) -> Light:
-    """``point:pos=X,Y,Z[:color=R,G,B][:intensity=I]`` or ``directional:dir=X,Y,Z[:...]``."""
+    """``point:pos=X,Y,Z[:color=R,G,B][:intensity=I][:range=R]``, ``directional:dir=X,Y,Z[:...]``
+    or ``spot:pos=X,Y,Z:dir=X,Y,Z[:inner=DEG][:outer=DEG][:...]`` (cone half-angles, default 0
+    and 45 degrees, as KHR_lights_punctual's defaults)."""
     fields = spec.split(":")
-    kind = {"point": "point", "dir": "directional", "directional": "directional", "sun": "directional"}.get(fields[0])
+    kind = {"point": "point", "dir": "directional", "directional": "directional", "sun": "directional",
+            "spot": "spot"}.get(fields[0])
     if kind is None:
-        raise AlightError(f"--light: '{spec}': the kind must be point or directional")
-    light = Light(kind=kind, vector=(0.0, 0.0, 0.0) if kind == "point" else (0.0, -1.0, 0.0),
-                  intensity=10.0 if kind == "point" else 3.0)
+        raise AlightError(f"--light: '{spec}': the kind must be point, directional or spot")
+    light = Light(kind=kind, vector=(0.0, -1.0, 0.0) if kind == "directional" else (0.0, 0.0, 0.0),
+                  intensity=3.0 if kind == "directional" else 10.0)
     for item in fields[1:]:
         key, _, value = item.partition("=")
-        if key in ("pos", "position") and kind == "point":
+        if key in ("pos", "position") and kind != "directional":
             light.vector = _floats(value, 3, key)
-        elif key in ("dir", "direction") and kind == "directional":
-            light.vector = _floats(value, 3, key)
-            if np.linalg.norm(light.vector) == 0.0:
+        elif key in ("dir", "direction") and kind != "point":
+            direction = _floats(value, 3, key)
+            if np.linalg.norm(direction) == 0.0:
                 raise AlightError(f"--light: '{spec}': the direction is zero")
+            if kind == "spot":
+                light.direction = direction
+            else:
+                light.vector = direction
+        elif key in ("inner", "outer") and kind == "spot":
+            (angle,) = _floats(value, 1, key)
+            if not 0.0 <= angle <= 90.0:
+                raise AlightError(f"--light: '{spec}': {key} must be from 0 to 90 degrees")
+            setattr(light, f"{key}_cone_deg", angle)
+        elif key == "range" and kind != "directional":
+            (light.range,) = _floats(value, 1, key)
+            if light.range <= 0:
+                raise AlightError(f"--light: '{spec}': range must be > 0")
         elif key in ("color", "colour"):
             light.color = _floats(value, 3, key)
             if min(light.color) < 0:
@@ -103,8 +154,10 @@ def parse_light(spec: str) -> Light:
             if light.intensity < 0:
                 raise AlightError(f"--light: '{spec}': intensity must be >= 0")
         else:
-            raise AlightError(f"--light: '{spec}': unknown field '{key}' "
-                              f"(point takes pos=, directional takes dir=; both take color= and intensity=)")
+            raise AlightError(f"--light: '{spec}': unknown field '{key}' (point takes pos=, directional "
+                              f"dir=, spot pos=, dir=, inner=, outer=; all take color= and intensity=)")
+    if kind == "spot" and light.inner_cone_deg >= light.outer_cone_deg:
+        raise AlightError(f"--light: '{spec}': inner must be below outer")
     return light
 
 

@@ -161,9 +161,12 @@ def reflect(i, n):
 
 # --- tone mapping and output (tonemapping.glsl) -----------------------------------------
 
+TONEMAP_INPUT_MAX = 1.0e6   # tonemapping.glsl: exposed radiance is limited to this first
+
+
 def tonemap_aces_fitted(c):
     """Stephen Hill's fit of the ACES RRT+ODT (BakingLab, 2016), sRGB primaries in and out."""
-    c = np.asarray(c, dtype=np.float64)
+    c = np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX)
     m_in = np.array([[0.59719, 0.35458, 0.04823],
                      [0.07600, 0.90834, 0.01566],
                      [0.02840, 0.13383, 0.83777]])
@@ -178,7 +181,7 @@ def tonemap_aces_fitted(c):
 
 def tonemap_pbr_neutral(c):
     """Khronos PBR Neutral tone mapper (Khronos 3D Commerce, 2024)."""
-    c = np.asarray(c, dtype=np.float64).copy()
+    c = np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX)
     start, desat = 0.8 - 0.04, 0.15
     x = np.min(c, axis=-1, keepdims=True)
     offset = np.where(x < 0.08, x - 6.25 * x * x, 0.04)
@@ -208,6 +211,22 @@ def srgb_to_linear(c):
 
 MIN_PUNCTUAL_ROUGHNESS = 0.045   # brdf.glsl
 MIN_N_DOT_V = 1e-4               # brdf.glsl
+
+
+def spot_attenuation(cos_angle, scale, offset):
+    """A spot's angular falloff (KHR_lights_punctual's recommended implementation): the square
+    of clamp(cos(angle off the axis) * scale + offset, 0, 1), scale = 1 / max(0.001, cos inner -
+    cos outer), offset = -cos outer * scale."""
+    t = np.clip(np.asarray(cos_angle, np.float64) * scale + offset, 0.0, 1.0)
+    return t * t
+
+
+def range_attenuation(distance_squared, range_):
+    """KHR_lights_punctual's range window: clamp(1 - (d / range)^4, 0, 1)^2 (1 without a range)."""
+    if range_ is None or range_ <= 0:
+        return np.ones_like(np.asarray(distance_squared, np.float64))
+    x = np.asarray(distance_squared, np.float64) / (range_ * range_)
+    return np.clip(1.0 - x * x, 0.0, 1.0) ** 2
 
 
 def punctual_light(n, v, l, base_color, metallic, roughness, specular_f0, radiance_in):

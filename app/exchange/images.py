@@ -84,3 +84,40 @@ def _read(path: str) -> np.ndarray:
 
 def _one_line(text) -> str:
     return " ".join(str(text or "").split())
+
+
+def decode_texture(data: bytes, where: str) -> np.ndarray:
+    """Encoded image bytes (PNG, JPEG, WebP, ...; a glTF image) as (H, W, 4) uint8 RGBA, row 0 =
+    top, decoded with Pillow (which reads from memory, as GLB and data: images need).
+
+    The stored values are kept: PNG gAMA and iCCP chunks and JPEG ICC profiles are ignored, as
+    glTF 2.0 (section 3.8.2) requires; 16-bit channels are rounded to 8 bits (Pillow reduces
+    16-bit colour PNGs itself and keeps 16-bit grey, which is rescaled here); grey is spread to
+    RGB; a missing alpha is 255. ``where`` names the file and element in a failure's one line.
+    """
+    import io
+
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(io.BytesIO(data)) as img:
+            img.load()
+            w, h = img.size
+            if max(w, h) > MAX_MAP_SIZE:
+                raise AlightError(f"{where}: {w}x{h} is larger than {MAX_MAP_SIZE} pixels a side")
+            if img.mode in ("I;16", "I;16B", "I;16L", "I"):
+                wide = np.asarray(img, dtype=np.uint32 if img.mode == "I" else np.uint16).astype(np.float64)
+                peak = 65535.0
+                grey = np.clip(np.rint(wide * (255.0 / peak)), 0, 255).astype(np.uint8)
+                return np.ascontiguousarray(np.dstack([grey, grey, grey, np.full_like(grey, 255)]))
+            if img.mode == "F":
+                grey = np.clip(np.rint(np.asarray(img, np.float64) * 255.0), 0, 255).astype(np.uint8)
+                return np.ascontiguousarray(np.dstack([grey, grey, grey, np.full_like(grey, 255)]))
+            rgba = img if img.mode == "RGBA" else img.convert("RGBA")
+            return np.ascontiguousarray(np.asarray(rgba, dtype=np.uint8))
+    except AlightError:
+        raise
+    except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as exc:
+        raise AlightError(f"{where}: cannot decode the image ({_one_line(exc) or type(exc).__name__})") from None
+    except MemoryError:
+        raise AlightError(f"{where}: not enough memory to decode the image") from None

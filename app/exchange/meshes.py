@@ -1,4 +1,7 @@
-"""Mesh files (.obj .gltf .glb .ply .stl) read with trimesh into ``alight.core.mesh.Mesh``.
+"""Mesh files into ``alight.core.mesh.Mesh``: glTF/GLB by ``alight.exchange.gltf``; OBJ, PLY and
+STL by trimesh, with what trimesh leaves out added here: vertex colours (PLY ``red green blue
+[alpha]``, OBJ ``v x y z r g b``; sRGB-encoded, decoded to linear) and MTL ``map_Kd`` statements
+with options (``alight.exchange.mtl``: ``-o``/``-s`` become the map's texture transform).
 
 trimesh is imported lazily inside the loader so that start-up and the built-in meshes never pay
 for it. Every problem with a file becomes a one-line :class:`AlightError` naming the file.
@@ -6,8 +9,6 @@ for it. Every problem with a file becomes a one-line :class:`AlightError` naming
 
 from __future__ import annotations
 
-import json
-import struct
 from pathlib import Path
 from typing import Any, Callable
 
@@ -52,6 +53,10 @@ def load_mesh(spec: str) -> Mesh:
         )
     if not path.is_file():
         raise AlightError(f"{spec}: no such file")
+    if ext in (".gltf", ".glb"):
+        from alight.exchange.gltf import load_gltf
+
+        return load_gltf(path, spec)
 
     import trimesh  # lazily: importing trimesh costs start-up time the built-ins do not need
 
@@ -60,8 +65,10 @@ def load_mesh(spec: str) -> Mesh:
     except Exception as exc:  # trimesh raises anything from ValueError to KeyError on bad files
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     try:
-        extras = _gltf_material_params(path) if ext in (".gltf", ".glb") else {}
+        extras: dict[str, dict] = {}
         textures: dict[int, np.ndarray] = {}
+        if ext == ".obj":
+            _attach_diffuse_maps(spec, path, extras, textures)
         parts = []
         for node in scene.graph.nodes_geometry:
             transform, geom_name = scene.graph[node]
@@ -124,6 +131,15 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
     else:
         uvs = np.zeros((len(positions), 2))
 
+    colors = None
+    if getattr(geom.visual, "kind", None) == "vertex":
+        from alight.core.shading import srgb_to_linear
+
+        rgba = np.asarray(geom.visual.vertex_colors, dtype=np.float64)
+        if rgba.shape == (len(positions), 4):
+            rgba = np.clip(np.nan_to_num(rgba / 255.0 if rgba.max(initial=0.0) > 1.0 else rgba), 0.0, 1.0)
+            colors = np.concatenate([srgb_to_linear(rgba[:, :3]), rgba[:, 3:]], axis=1)
+
     return MeshPart(
         name=name,
         positions=np.ascontiguousarray(positions, dtype=np.float32),
@@ -132,6 +148,7 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
         tangents=compute_tangents(positions, normals, uvs, faces),
         indices=np.ascontiguousarray(faces, dtype=np.uint32),
         material=_file_material(getattr(geom.visual, "material", None), textures, extras),
+        colors=None if colors is None else np.ascontiguousarray(colors, dtype=np.float32),
     )
 
 
@@ -156,33 +173,12 @@ def _factor(value: Any, default: tuple[float, ...]) -> np.ndarray:
 def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, dict]) -> FileMaterial | None:
     """The file's material in our terms; None for vertex colours or trimesh's placeholder."""
     kind = type(mat).__name__
-    if kind == "PBRMaterial":
-        extra = extras.get(mat.name, {}) if mat.name is not None else {}
-        base = _factor(mat.baseColorFactor, (1.0, 1.0, 1.0, 1.0))
-        if "base_color_factor" in extra:  # exact linear factor rather than trimesh's uint8
-            base = np.asarray(extra["base_color_factor"], dtype=np.float64)
-        emissive = _factor(mat.emissiveFactor, (0.0, 0.0, 0.0))[:3] * extra.get("emissive_strength", 1.0)
-        return FileMaterial(
-            base_color=tuple(float(x) for x in base[:3]),
-            metallic=float(1.0 if mat.metallicFactor is None else mat.metallicFactor),
-            roughness=float(1.0 if mat.roughnessFactor is None else mat.roughnessFactor),
-            emissive=tuple(float(x) for x in emissive),
-            alpha=float(base[3]) if len(base) > 3 else 1.0,
-            base_color_texture=_texture(mat.baseColorTexture, textures),
-            metallic_roughness_texture=_texture(mat.metallicRoughnessTexture, textures),
-            normal_texture=_texture(mat.normalTexture, textures),
-            normal_scale=float(extra.get("normal_scale", 1.0)),
-            emissive_texture=_texture(mat.emissiveTexture, textures),
-            occlusion_texture=_texture(mat.occlusionTexture, textures),
-            occlusion_strength=float(extra.get("occlusion_strength", 1.0)),
-            layers=dict(extra.get("layers", {})),
-            **extra.get("layer_textures", {}),
-        )
     if kind == "SimpleMaterial":
         if getattr(mat, "_name", None) is None:
             # trimesh's placeholder (a grey 2x2 image) for an OBJ with uvs but no usable .mtl
             return None
         diffuse = _factor(mat.diffuse, (1.0, 1.0, 1.0, 1.0))
+        own_map = extras.get("map_Kd", {}).get(mat.name)
         return FileMaterial(
             # MTL Kd is display-referred in practice; (x/255)**2.2 approximates the sRGB decode.
             base_color=tuple(float(x) ** 2.2 for x in diffuse[:3]),
@@ -190,7 +186,7 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
             roughness=0.5,
             emissive=(0.0, 0.0, 0.0),
             alpha=float(diffuse[3]) if len(diffuse) > 3 else 1.0,
-            base_color_texture=_texture(mat.image, textures),
+            base_color_texture=own_map if own_map is not None else _texture(mat.image, textures),
             metallic_roughness_texture=None,
             normal_texture=None,
             normal_scale=1.0,
@@ -201,126 +197,27 @@ def _file_material(mat: Any, textures: dict[int, np.ndarray], extras: dict[str, 
     return None
 
 
-def _layer_fields(gm: dict, source: str) -> dict[str, Any]:
-    """The ior and layer factors of one glTF material (alight.exchange.gltf_material), checked
-    against the model's ranges; a bad value is a one-line error naming the file."""
-    from alight.core.material import LAYER_FIELDS, Material, validate_material
-    from alight.exchange.gltf_material import EXT_IOR, EXT_SPECULAR, layer_fields_from_gltf, material_from_gltf
+def _attach_diffuse_maps(spec: str, path: Path, extras: dict, cache: dict) -> None:
+    """The OBJ's MTL map_Kd statements, read by alight.exchange.mtl (options applied), as
+    TextureInfos by material name in ``extras['map_Kd']``; a map that does not read is an error."""
+    from alight.core.mesh import TextureInfo, TextureTransform
+    from alight.exchange.images import decode_texture
+    from alight.exchange.mtl import diffuse_maps
 
-    fields = layer_fields_from_gltf(gm, source)
-    ext = gm.get("extensions") or {}
-    if EXT_IOR in ext or EXT_SPECULAR in ext:   # the file's dielectric: ior and F0 together
-        m = material_from_gltf({"extensions": {k: ext[k] for k in (EXT_IOR, EXT_SPECULAR) if k in ext}}, source)
-        fields["ior"], fields["specular_f0"] = m.ior, m.specular_f0
-    if fields:
-        m = validate_material(Material(**fields), f"{source}: material '{gm.get('name')}'")
-        fields = {f: getattr(m, f) for f in fields if f in LAYER_FIELDS or f in ("ior", "specular_f0")}
-    return fields
-
-
-def _gltf_material_params(path: Path) -> dict[str, dict]:
-    """Material values trimesh drops, read from the glTF JSON, keyed by (unique) material name.
-
-    trimesh keeps neither normalTexture.scale, occlusionTexture.strength nor
-    KHR_materials_emissive_strength, and it quantises baseColorFactor to uint8. Materials are
-    matched to trimesh's by name, so nameless or duplicate-named ones keep the defaults.
-    Any problem here just means defaults: trimesh has already validated the file.
-    """
-    try:
-        data = path.read_bytes()
-        binary = None
-        if data[:4] == b"glTF":
-            length, kind = struct.unpack("<II", data[12:20])
-            if kind != 0x4E4F534A:  # 'JSON'
-                return {}
-            doc = json.loads(data[20:20 + length])
-            rest = 20 + length
-            if len(data) >= rest + 8:
-                bin_length, bin_kind = struct.unpack("<II", data[rest:rest + 8])
-                if bin_kind == 0x004E4942:  # 'BIN\0'
-                    binary = data[rest + 8:rest + 8 + bin_length]
-        else:
-            doc = json.loads(data)
-        materials = doc.get("materials", [])
-        names = [m.get("name") for m in materials]
-        out: dict[str, dict] = {}
-        for m in materials:
-            name = m.get("name")
-            if name is None or names.count(name) != 1:
-                continue
-            params: dict[str, Any] = {}
-            bcf = m.get("pbrMetallicRoughness", {}).get("baseColorFactor")
-            if isinstance(bcf, list) and len(bcf) == 4:
-                params["base_color_factor"] = [float(x) for x in bcf]
-            if "scale" in m.get("normalTexture", {}):
-                params["normal_scale"] = float(m["normalTexture"]["scale"])
-            if "strength" in m.get("occlusionTexture", {}):
-                params["occlusion_strength"] = float(m["occlusionTexture"]["strength"])
-            strength = m.get("extensions", {}).get("KHR_materials_emissive_strength", {})
-            if "emissiveStrength" in strength:
-                params["emissive_strength"] = float(strength["emissiveStrength"])
-            params["layers"] = _layer_fields(m, str(path))
-            params["layer_textures"] = _layer_textures(doc, binary, path.parent, m)
-            out[name] = params
-        return out
-    except AlightError:
-        raise
-    except Exception:
-        return {}
-
-
-# The layers' textures alight draws (FileMaterial fields): (extension, textureInfo key).
-LAYER_TEXTURES = {
-    "clearcoat_texture": ("KHR_materials_clearcoat", "clearcoatTexture"),
-    "clearcoat_roughness_texture": ("KHR_materials_clearcoat", "clearcoatRoughnessTexture"),
-    "clearcoat_normal_texture": ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
-    "sheen_color_texture": ("KHR_materials_sheen", "sheenColorTexture"),
-    "sheen_roughness_texture": ("KHR_materials_sheen", "sheenRoughnessTexture"),
-}
-
-
-def _layer_textures(doc: dict, binary: bytes | None, folder: Path, gm: dict) -> dict[str, Any]:
-    """FileMaterial fields for the layer textures a glTF material names (images decoded), and
-    the coat normal map's scale. They are read with TEXCOORD_0, as the core maps are here."""
-    out: dict[str, Any] = {}
-    ext = gm.get("extensions") or {}
-    for slot, (name, key) in LAYER_TEXTURES.items():
-        info = (ext.get(name) or {}).get(key)
-        if isinstance(info, dict) and "index" in info:
-            image = _gltf_texture_image(doc, binary, folder, info["index"])
-            if image is not None:
-                out[slot] = image
-                if slot == "clearcoat_normal_texture":
-                    out["clearcoat_normal_scale"] = float(info.get("scale", 1.0))
-    return out
-
-
-def _gltf_texture_image(doc: dict, binary: bytes | None, folder: Path, index: int) -> np.ndarray | None:
-    """glTF texture ``index``'s image as (H, W, 4) uint8 RGBA (row 0 = top), decoded with Pillow
-    from its bufferView (a .glb's binary chunk or a buffer's file) or its own file; None when it
-    does not resolve (trimesh reads the core textures, not the extensions')."""
-    import base64
-    import io
-
-    from PIL import Image
-
-    image = doc["images"][int(doc["textures"][int(index)]["source"])]
-    if "bufferView" in image:
-        view = doc["bufferViews"][int(image["bufferView"])]
-        uri = doc["buffers"][int(view.get("buffer", 0))].get("uri")
-        if uri is None:
-            blob = binary
-        elif uri.startswith("data:"):
-            blob = base64.b64decode(uri.split(",", 1)[1])
-        else:
-            blob = (folder / uri).read_bytes()
-        if blob is None:
-            return None
-        start = int(view.get("byteOffset", 0))
-        encoded = blob[start:start + int(view["byteLength"])]
-    elif str(image.get("uri", "")).startswith("data:"):
-        encoded = base64.b64decode(image["uri"].split(",", 1)[1])
-    else:
-        encoded = (folder / image["uri"]).read_bytes()
-    with Image.open(io.BytesIO(encoded)) as im:
-        return np.ascontiguousarray(np.asarray(im.convert("RGBA"), dtype=np.uint8))
+    out = {}
+    for name, diffuse in diffuse_maps(path).items():
+        key = str(diffuse.path)
+        if key not in cache:
+            try:
+                data = diffuse.path.read_bytes()
+            except OSError as e:
+                raise AlightError(f"{spec}: material {name}: map_Kd '{diffuse.path.name}' cannot be read "
+                                  f"({e.strerror or e})") from None
+            cache[key] = decode_texture(data, f"{spec}: material {name}: map_Kd '{diffuse.path.name}'")
+        transform = None
+        if diffuse.offset != (0.0, 0.0) or diffuse.scale != (1.0, 1.0):
+            (ou, ov), (su, sv) = diffuse.offset, diffuse.scale
+            # uv' = s uv + o on OpenGL uvs is, in glTF's v-down space, scale s and offset (ou, 1 - sv - ov).
+            transform = TextureTransform(offset=(ou, 1.0 - sv - ov), scale=(su, sv))
+        out[name] = TextureInfo(cache[key], transform=transform)
+    extras["map_Kd"] = out

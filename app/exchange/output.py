@@ -64,15 +64,29 @@ def write_image(path: str | os.PathLike, pixels, linear: bool) -> None:
     Rows are top first.
     """
     import numpy as np
+
+    pixels = np.asarray(pixels)
+    h, w, c = pixels.shape
+    with image_rows_writer(path, w, h, c, linear) as put:
+        put(pixels)
+
+
+@contextlib.contextmanager
+def image_rows_writer(path: str | os.PathLike, width: int, height: int, channels: int, linear: bool):
+    """Write an image band by band, top first, so a huge one never sits in memory whole:
+    ``with image_rows_writer(...) as put: put(rows)`` for bands of (n, width, channels) pixels
+    that together make ``height`` rows. Atomic: the file appears, whole, only when the block ends
+    without an exception (a temporary file beside it, renamed; OpenImageIO's scanline writes).
+    ``linear``: float32 for .exr (zip-compressed); else uint8 for .png. Any write failure is an
+    AlightError of one line naming the file."""
+    import numpy as np
     import OpenImageIO as oiio
 
     from alight.errors import AlightError
 
     p = Path(path)
-    pixels = np.ascontiguousarray(pixels)
-    h, w, c = pixels.shape
     fmt = oiio.FLOAT if linear else oiio.UINT8
-    spec = oiio.ImageSpec(w, h, c, fmt)
+    spec = oiio.ImageSpec(width, height, channels, fmt)
     if linear:
         spec.attribute("compression", "zip")
     try:
@@ -80,10 +94,23 @@ def write_image(path: str | os.PathLike, pixels, linear: bool) -> None:
             out = oiio.ImageOutput.create(str(tmp))
             if out is None or not out.open(str(tmp), spec):
                 raise OSError(" ".join((oiio.geterror() or "cannot open for writing").split()))
-            ok = out.write_image(pixels)
-            error = out.geterror()
-            out.close()
-            if not ok:
-                raise OSError(" ".join(error.split()) or "write failed")
+            written = 0
+
+            def put(rows) -> None:
+                nonlocal written
+                rows = np.ascontiguousarray(rows, dtype=np.float32 if linear else np.uint8)
+                if rows.shape[1:] != (width, channels) or written + len(rows) > height:
+                    raise ValueError(f"rows of shape {rows.shape} do not continue a {width}x{height}x{channels} "
+                                     f"image at row {written}")
+                if not out.write_scanlines(written, written + len(rows), 0, rows):
+                    raise OSError(" ".join(out.geterror().split()) or "write failed")
+                written += len(rows)
+
+            try:
+                yield put
+                if written != height:
+                    raise ValueError(f"{written} of {height} rows were written")
+            finally:
+                out.close()
     except OSError as exc:
         raise AlightError(f"{p}: cannot write ({exc.strerror or exc})") from None

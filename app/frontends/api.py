@@ -33,7 +33,6 @@ from alight.core.scene import (
     Display,
     Light,
     Scene,
-    frame_camera,
     parse_light,
 )
 from alight.errors import AlightError
@@ -166,18 +165,25 @@ class Renderer:
         return self
 
     def set_camera(self, camera: Camera | None = None, *, orbit_deg: float | None = None,
-                   elevation_deg: float = 0.0) -> "Renderer":
-        """A Camera, None (frame the mesh from +Z), or ``orbit_deg``: frame the mesh from a direction
-        turned that many degrees about +Y from +Z (right-handed), raised by ``elevation_deg``."""
+                   elevation_deg: float = 0.0, distance: float | None = None, fov_deg: float = 35.0,
+                   target=None) -> "Renderer":
+        """A Camera, None (frame the mesh from +Z), or ``orbit_deg``: look at ``target`` (default:
+        the mesh's centre) from a direction turned that many degrees about +Y from +Z
+        (right-handed), raised by ``elevation_deg``, at ``distance`` (default: framing the mesh),
+        with a vertical field of view of ``fov_deg``. A mesh file's own cameras are
+        ``r.mesh.cameras`` (glTF)."""
         if orbit_deg is not None:
-            import math
+            from alight.core.scene import orbit_camera
 
-            a, e = math.radians(orbit_deg), math.radians(elevation_deg)
-            direction = (math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e))
             centre, radius = self._mesh.bounding_sphere() if self._mesh is not None else ((0, 0, 0), 1.0)
-            camera = frame_camera(centre, max(radius, 1e-6), aspect=self.width / self.height, direction=direction)
+            camera = orbit_camera(centre, radius, self.width / self.height, orbit_deg, elevation_deg,
+                                  distance, fov_deg, target)
         self.scene.camera = camera
         return self
+
+    @property
+    def mesh(self) -> Mesh | None:
+        return self._mesh
 
     def set_view(self, view: Literal["camera", "probe"]) -> "Renderer":
         if view not in ("camera", "probe"):

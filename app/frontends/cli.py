@@ -60,13 +60,76 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
                    help="multiply the environment's radiance by X (default: 1)")
     g.add_argument("--no-ibl", action="store_true", help="no environment light (punctual lights and emission only)")
     g.add_argument("--light", action="append", default=[], metavar="SPEC",
-                   help="add a light: point:pos=X,Y,Z[:color=R,G,B][:intensity=I] or "
-                        "directional:dir=X,Y,Z[:color=R,G,B][:intensity=I]; repeat for more "
-                        "(point intensity is W/sr-like, divided by distance squared; directional is irradiance)")
+                   help="add a light: point:pos=X,Y,Z, directional:dir=X,Y,Z or "
+                        "spot:pos=X,Y,Z:dir=X,Y,Z[:inner=DEG][:outer=DEG], each [:color=R,G,B][:intensity=I] "
+                        "(point and spot also [:range=R]); repeat for more (point and spot intensity is "
+                        "W/sr-like, divided by distance squared; directional is irradiance). Without --light, "
+                        "a glTF file's KHR_lights_punctual lights are used")
+    g.add_argument("--no-file-lights", action="store_true", help="ignore the lights a glTF file brings")
     g.add_argument("--view", choices=("camera", "probe"), default="camera",
                    help="camera: the mesh framed by a camera on +Z; probe: CONVENTIONS.md's analysis view "
                         "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)")
     _add_material_options(p)
+
+
+def _add_camera_options(p: argparse.ArgumentParser) -> None:
+    c = p.add_argument_group("camera (default: the mesh framed from +Z)")
+    c.add_argument("--camera", default="auto", metavar="auto|gltf[:N]",
+                   help="auto: frame the mesh (with the flags below); gltf[:N]: the glTF file's camera N "
+                        "(default 0), placed by its node (default: auto)")
+    c.add_argument("--orbit", type=_number("--orbit"), default=0.0, metavar="DEG",
+                   help="turn the camera about +Y from +Z by DEG degrees, right-handed (default: 0)")
+    c.add_argument("--elevation", type=_number("--elevation", -90.0, 90.0), default=0.0, metavar="DEG",
+                   help="raise the camera by DEG degrees (default: 0)")
+    c.add_argument("--distance", type=_number("--distance", 1e-6), default=None, metavar="X",
+                   help="the camera's distance from the target (default: what frames the mesh)")
+    c.add_argument("--fov", type=_number("--fov", 1.0, 179.0), default=None, metavar="DEG",
+                   help="vertical field of view in degrees (default: 35, or the glTF camera's)")
+    c.add_argument("--target", metavar="X,Y,Z", help="the point looked at (default: the mesh's bounding-box centre)")
+
+
+def _camera(args, mesh, aspect: float):
+    """The Camera --camera and the camera flags ask for (None: the renderer frames the mesh)."""
+    from dataclasses import replace
+
+    from alight.core.scene import orbit_camera
+
+    spec = args.camera
+    flags = {"--orbit": args.orbit != 0.0, "--elevation": args.elevation != 0.0,
+             "--distance": args.distance is not None, "--target": args.target is not None}
+    if spec == "auto":
+        if not any(flags.values()) and args.fov is None:
+            return None
+        target = None
+        if args.target is not None:
+            try:
+                target = tuple(float(x) for x in args.target.split(","))
+            except ValueError:
+                target = ()
+            if len(target) != 3 or not all(math.isfinite(x) for x in target):
+                raise AlightError(f"--target: '{args.target}' is not three comma-separated numbers")
+        if mesh is None:
+            raise AlightError("--orbit/--elevation/--distance/--fov/--target: only with --view camera")
+        centre, radius = mesh.bounding_sphere()
+        return orbit_camera(centre, radius, aspect, args.orbit, args.elevation, args.distance,
+                            35.0 if args.fov is None else args.fov, target)
+    kind, _, index = spec.partition(":")
+    if kind != "gltf":
+        raise AlightError(f"--camera: '{spec}' is not auto, gltf or gltf:N")
+    used = [name for name, on in flags.items() if on]
+    if used:
+        raise AlightError(f"{used[0]}: not with --camera {spec} (the file's camera is placed by its node)")
+    try:
+        n = int(index) if index else 0
+    except ValueError:
+        raise AlightError(f"--camera: '{spec}': N must be a whole number") from None
+    cameras = getattr(mesh, "cameras", []) if mesh is not None else []
+    if not cameras:
+        raise AlightError(f"--camera: {args.mesh}: the file has no camera")
+    if not 0 <= n < len(cameras):
+        raise AlightError(f"--camera: {args.mesh}: camera {n} does not exist (the file has {len(cameras)})")
+    camera = cameras[n]
+    return camera if args.fov is None else replace(camera, fov_y_deg=args.fov)
 
 
 def _add_material_options(p: argparse.ArgumentParser) -> None:
@@ -193,6 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Render a material headless. With only --out: the default material ball "
                                    "in the built-in studio.")
     _add_scene_options(r)
+    _add_camera_options(r)
     _add_bake_options(r, auto=True)
     d = r.add_argument_group("image")
     d.add_argument("--size", type=_size, default=(1024, 1024), metavar="W|WxH", help="image size (default: 1024)")
@@ -372,6 +436,11 @@ def _render(args) -> int:
 
     lights = [parse_light(spec) for spec in args.light]
     mesh = load_mesh(args.mesh) if args.view == "camera" else None
+    if mesh is not None:
+        _warn(mesh.warnings)
+        if not args.light and not args.no_file_lights:
+            lights = list(mesh.lights)
+    camera = _camera(args, mesh, width / height)
     env = None if args.no_ibl else load_environment(args.env)
     if env is not None:
         _warn(env.warnings)
@@ -381,13 +450,13 @@ def _render(args) -> int:
 
         display.background_color = parse_color(args.background_color, "--background-color")
     scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
-                  material_overrides=overrides, lights=lights, view=args.view,
+                  material_overrides=overrides, lights=lights, camera=camera, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, ibl_model=args.ibl,
                   multiple_scattering=args.multiple_scattering, display=display)
     loaded = time.perf_counter()
 
-    from alight.exchange.output import write_image
+    from alight.exchange.output import image_rows_writer
     from alight.ibl.bake import quality_named
     from alight.render.renderer import ForwardRenderer
 
@@ -401,20 +470,22 @@ def _render(args) -> int:
         quality = quality_named(args.quality, args.irradiance)
     maps = renderer.bake(env, quality) if env is not None else None
     baked = time.perf_counter()
-    frame = renderer.render(scene, maps, width, height, aa=args.aa,
-                            read_linear=out.suffix.lower() == ".exr", read_srgb=out.suffix.lower() == ".png")
-    rendered = time.perf_counter()
-    if out.suffix.lower() == ".exr":
-        write_image(out, frame.linear, linear=True)
-    else:
-        pixels = frame.srgb if args.background == "transparent" else frame.srgb[:, :, :3]
-        write_image(out, pixels, linear=False)
+    # Strip by strip (an image too big for one framebuffer is drawn in tiles): each band of rows
+    # is written and dropped, so memory stays bounded at any --size.
+    exr = out.suffix.lower() == ".exr"
+    channels = 4 if exr or args.background == "transparent" else 3
+    writing = 0.0
+    with image_rows_writer(out, width, height, channels, linear=exr) as put:
+        for strip in renderer.render_strips(scene, maps, width, height, aa=args.aa, read_linear=exr, read_srgb=not exr):
+            t = time.perf_counter()
+            put(strip.frame.linear if exr else strip.frame.srgb[:, :, :channels])
+            writing += time.perf_counter() - t
     if args.verbose:
         from alight.core.gpu import describe
 
         done = time.perf_counter()
         print(f"{describe(renderer.ctx)}\nload {loaded - start:.3f}s  bake {baked - loaded:.3f}s "
-              f"render {rendered - baked:.3f}s  write {done - rendered:.3f}s", file=sys.stderr)
+              f"render {done - baked - writing:.3f}s  write {writing:.3f}s", file=sys.stderr)
         if maps is not None:
             print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
                   file=sys.stderr)

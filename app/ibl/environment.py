@@ -1,11 +1,12 @@
 """Environment maps: loading, validation and repair of equirectangular files, and the built-in studio.
 
 Every environment is an (H, W, 3) float32, C-contiguous array of linear scene-referred RGB
-radiance with W == 2*H, finite and >= 0, row 0 at the top (+Y); the mapping between texels and
-directions is CONVENTIONS.md's (see ``alight.core.shading.direction_to_equirect_uv``).
+radiance with W == 2*H, in [0, RADIANCE_MAX] (1e10), row 0 at the top (+Y); the mapping between
+texels and directions is CONVENTIONS.md's (see ``alight.core.shading.direction_to_equirect_uv``).
 
-Files are read by ``alight.exchange.environment_files`` (in strips, repaired, box-reduced when
-wider than ``max_width``); every problem with a file becomes one :class:`AlightError` line
+Files are read by ``alight.exchange.environment_files`` (oriented as the file says, the display
+window as the picture, the first part with R, G, B; in strips, repaired, box-reduced when wider
+than ``max_width``); every problem with a file becomes one :class:`AlightError` line
 naming the file first, every repair one warning line.
 """
 
@@ -20,7 +21,7 @@ import numpy as np
 
 from alight.core.shading import texel_directions
 from alight.errors import AlightError
-from alight.exchange.environment_files import read_equirect
+from alight.exchange.environment_files import RADIANCE_MAX, Repairs, read_equirect, repair_radiance
 
 MAX_WIDTH = 4096
 
@@ -29,21 +30,19 @@ MAX_WIDTH = 4096
 class Environment:
     """An equirectangular environment ready to bake (see the module docstring for the invariants)."""
 
-    radiance: np.ndarray  # (H, W, 3) float32, linear RGB, W == 2*H, finite, >= 0, C-contiguous
+    radiance: np.ndarray  # (H, W, 3) float32, linear RGB, W == 2*H, in [0, RADIANCE_MAX], C-contiguous
     name: str  # 'studio', 'constant', or the file path
     warnings: list[str] = field(default_factory=list)  # repairs made, one line each
     _hash: str | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         # The loader repairs files; an array handed in directly (the Python API takes one) gets
-        # the same repair here, on a copy, so NaN never reaches the bake's mips.
+        # the same repair here, on a copy, so NaN or 1e30 never reaches the bake's mips.
         rad = np.asarray(self.radiance)
-        if rad.size and not (np.isfinite(rad).all() and rad.min() >= 0.0):
-            broken = ~np.all(np.isfinite(rad) & (rad >= 0.0), axis=-1)
-            rad = np.array(rad, dtype=np.float32, order="C")
-            rad[broken] = 0.0
-            self.radiance = rad
-            self.warnings = [*self.warnings, f"{self.name}: {int(broken.sum())} NaN/Inf/negative texels set to 0"]
+        if rad.size and not (np.isfinite(rad).all() and 0.0 <= rad.min() and rad.max() <= RADIANCE_MAX):
+            repairs = Repairs()
+            self.radiance = repair_radiance(np.array(rad, dtype=np.float32, order="C"), repairs)
+            self.warnings = [*self.warnings, *repairs.lines(self.name)]
 
     @property
     def content_hash(self) -> str:
@@ -72,9 +71,11 @@ def load_environment(spec: str, max_width: int = MAX_WIDTH) -> Environment:
     """'studio' (the built-in studio) or the path of an equirect file OpenImageIO can read.
 
     Raises AlightError (one line: file then problem) for a missing, unreadable, corrupt,
-    truncated or empty file, a map that is not 2:1, or a 2-channel image. 1 channel is
-    replicated to RGB, channels beyond the third (alpha) are dropped. NaN/Inf/negative texels
-    are set to 0 and maps wider than ``max_width`` are box-reduced, each with a warning line.
+    truncated or empty file, a picture that is not 2:1, or one without R, G, B or Y channels.
+    Y (grey) is replicated to RGB; alpha and other channels are dropped; the file's orientation
+    and display window are applied. NaN/Inf/negative texels are set to 0, texels above
+    RADIANCE_MAX clamped to it, maps wider than ``max_width`` box-reduced, and the part taken
+    from a multi-part file named: each a warning line.
     """
     if str(spec) == "studio":
         return studio_environment()

@@ -14,6 +14,7 @@ so that what the glass shows is the opaque scene behind it, as the Khronos Sampl
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import moderngl
@@ -33,6 +34,7 @@ from alight.core.scene import (
 )
 from alight.core.shading import rotate_world_to_map
 from alight.core.texture_maps import TextureMaps
+from alight.errors import AlightError
 from alight.ibl.bake import (
     QUALITY,
     BakeQuality,
@@ -44,6 +46,16 @@ from alight.ibl.bake import (
 )
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
+from alight.render.tiles import (
+    TILE_BYTES,
+    Tile,
+    TilePlan,
+    framebuffer_bytes,
+    plan_tiles,
+    side_limit,
+    tile_matrix,
+    tile_origin,
+)
 
 GL_SRGB8_ALPHA8 = 0x8C43
 AA_MODES = ("none", "msaa", "ssaa")
@@ -79,11 +91,47 @@ class Frame:
     srgb: np.ndarray
 
 
-class _GpuPart:
-    """A mesh part's buffers and textures, uploaded once."""
+@dataclass
+class Strip:
+    """Rows y0.. of an image (``ForwardRenderer.render_strips``), as a Frame of those rows."""
 
-    def __init__(self, ctx: moderngl.Context, program: moderngl.Program, part):
-        vertices = np.hstack([part.positions, part.normals, part.uvs, part.tangents]).astype(np.float32)
+    y0: int
+    frame: Frame
+
+
+@dataclass(frozen=True)
+class _View:
+    """The part of the image a pass draws: the whole image's size, and for a tile its
+    off-centre matrix (alight.render.tiles) and its bottom-left pixel in the image."""
+
+    width: int
+    height: int
+    matrix: np.ndarray | None = None
+    origin: tuple[int, int] = (0, 0)
+
+
+class _GpuPart:
+    """A mesh part's buffers, uploaded once, and what its shader variant needs to know.
+
+    The vertex buffer holds position, normal, uv and tangent, then TEXCOORD_1 and COLOR_0 only
+    when the part has them (pbr.vert's HAS_UV1, HAS_VERTEX_COLOR). Textures come from the mesh's
+    shared set (one upload per image and sampler).
+    """
+
+    def __init__(self, ctx: moderngl.Context, part, textures: "_MeshTextures"):
+        columns = [part.positions, part.normals, part.uvs, part.tangents]
+        self.layout = ["3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent"]
+        self.has_uv1 = part.uvs1 is not None
+        self.has_colors = part.colors is not None
+        if self.has_uv1:
+            columns.append(part.uvs1)
+            self.layout[0] += " 2f"
+            self.layout.append("in_uv1")
+        if self.has_colors:
+            columns.append(part.colors)
+            self.layout[0] += " 4f"
+            self.layout.append("in_color")
+        vertices = np.hstack([np.asarray(c, np.float32) for c in columns])
         self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
         self.ctx = ctx
@@ -91,20 +139,21 @@ class _GpuPart:
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
         self.textures: dict[str, moderngl.Texture] = {}
+        self.infos: dict = {}
         self.closed = is_closed(part.positions, part.indices)
+        positions = np.asarray(part.positions, np.float64)
+        self.centre = (positions.min(axis=0) + positions.max(axis=0)) / 2.0 if len(positions) else np.zeros(3)
         fm = part.material
         if fm is not None:
-            for name in MATERIAL_MAPS:
-                image = getattr(fm, f"{name}_texture", None)
-                if image is not None:
-                    self.textures[name] = _upload_image(ctx, image, srgb=name in SRGB_MAPS)
+            for name, info in fm.textures().items():
+                self.infos[name] = info
+                self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
 
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
         if vao is None:
             vao = self._vaos[id(program)] = self.ctx.vertex_array(
-                program, [(self.vbo, "3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent")],
-                self.ibo, index_element_size=4,
+                program, [(self.vbo, *self.layout)], self.ibo, index_element_size=4,
                 skip_errors=True)  # a debug view may not read every attribute
         return vao
 
@@ -113,12 +162,47 @@ class _GpuPart:
             vao.release()
         self.vbo.release()
         self.ibo.release()
-        for tex in self.textures.values():
+
+
+_MIN_FILTERS = {"nearest": moderngl.NEAREST, "linear": moderngl.LINEAR,
+                "nearest_mipmap_nearest": moderngl.NEAREST_MIPMAP_NEAREST,
+                "linear_mipmap_nearest": moderngl.LINEAR_MIPMAP_NEAREST,
+                "nearest_mipmap_linear": moderngl.NEAREST_MIPMAP_LINEAR,
+                "linear_mipmap_linear": moderngl.LINEAR_MIPMAP_LINEAR}
+
+
+class _MeshTextures:
+    """A mesh's textures, one per (image, colour space, sampler): parts sharing an image share
+    its upload. REPEAT and CLAMP_TO_EDGE are the texture's wrap state; MIRRORED_REPEAT is folded
+    in the shader (mesh_material.glsl), so its axis is clamped here."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._textures: dict[tuple, moderngl.Texture] = {}
+
+    def get(self, info, srgb: bool) -> moderngl.Texture:
+        sampler = info.sampler
+        key = (id(info.image), srgb, sampler)
+        tex = self._textures.get(key)
+        if tex is None:
+            tex = _upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps)
+            tex.filter = (_MIN_FILTERS.get(sampler.min_filter, moderngl.LINEAR_MIPMAP_LINEAR),
+                          moderngl.NEAREST if sampler.mag_filter == "nearest" else moderngl.LINEAR)
+            tex.repeat_x = sampler.wrap_s == "repeat"
+            tex.repeat_y = sampler.wrap_t == "repeat"
+            if not sampler.mipmaps or sampler.mag_filter == "nearest":
+                tex.anisotropy = 1.0
+            self._textures[key] = tex
+        return tex
+
+    def release(self) -> None:
+        for tex in self._textures.values():
             tex.release()
+        self._textures.clear()
 
 
-def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool) -> moderngl.Texture:
-    """An RGBA uint8 image (alight.core.mesh gives RGBA) as a mipmapped texture."""
+def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool, mipmaps: bool = True) -> moderngl.Texture:
+    """An RGBA uint8 image (alight.core.mesh gives RGBA) as a texture, mipmapped unless told not."""
     image = np.asarray(image, dtype=np.uint8)
     if image.shape[2] == 3:
         image = np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
@@ -126,9 +210,12 @@ def _upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool) -> moder
     data = np.ascontiguousarray(image[::-1, :, :4])
     h, w = data.shape[:2]
     tex = ctx.texture((w, h), 4, data.tobytes(), internal_format=GL_SRGB8_ALPHA8 if srgb else None)
-    tex.build_mipmaps()
-    tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-    tex.anisotropy = 8.0
+    if mipmaps:
+        tex.build_mipmaps()
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        tex.anisotropy = 8.0
+    else:
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
     return tex
 
 
@@ -138,6 +225,18 @@ class _Targets:
     def __init__(self, ctx: moderngl.Context, width: int, height: int, aa: str, samples: int):
         self.ctx = ctx
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
+        self._display_draw = None
+        self._behind: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+        self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
+        self.color = None
+        try:
+            self._allocate()
+        except Exception:
+            self.release()
+            raise
+
+    def _allocate(self) -> None:
+        ctx, width, height, aa, samples = self.ctx, self.width, self.height, self.aa, self.samples
         # Linear radiance at the output size: drawn into directly without anti-aliasing, else the
         # MSAA resolve or the SSAA reduction lands here.
         self.radiance = ctx.texture((width, height), 4, dtype="f4")
@@ -156,8 +255,6 @@ class _Targets:
         self.draw = ctx.framebuffer([self.color], self.depth)
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
-        self._display_draw = None
-        self._behind: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
 
     def behind(self) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
         """What transmissive parts see behind them: the opaque parts' radiance with alpha =
@@ -179,15 +276,15 @@ class _Targets:
         return self._display_draw
 
     def release(self) -> None:
-        owned = [self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo, self.display]
-        if self._display_draw is not None:
-            owned.insert(0, self._display_draw)
+        owned = [self._display_draw, self.draw, self.depth, self.radiance_fbo, self.radiance, self.display_fbo,
+                 self.display]
         if self.color is not self.radiance:
             owned.append(self.color)
         if self._behind is not None:
             owned.extend(self._behind[::-1])
         for obj in owned:
-            obj.release()
+            if obj is not None:
+                obj.release()
 
 
 class ForwardRenderer:
@@ -203,9 +300,9 @@ class ForwardRenderer:
         self.luts = LutCache(self.ctx, self.shaders)
         self._transmission_lut: TransmissionLut | None = None
         self._bakes: dict[tuple, IBLMaps] = {}
-        self._meshes: dict[int, tuple[object, list[_GpuPart]]] = {}
+        self._meshes: dict[int, tuple[object, list[_GpuPart], _MeshTextures]] = {}
         self._targets: _Targets | None = None
-        self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 32 + 16)
+        self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
         self._units_assigned: set[int] = set()
@@ -233,10 +330,13 @@ class ForwardRenderer:
             self._bakes[key] = maps
         return self._bakes[key]
 
-    def _gpu_mesh(self, mesh, program) -> list[_GpuPart]:
+    def _gpu_mesh(self, mesh, program=None) -> list[_GpuPart]:
         entry = self._meshes.get(id(mesh))
         if entry is None or entry[0] is not mesh:
-            entry = (mesh, [_GpuPart(self.ctx, program, part) for part in mesh.parts])
+            if entry is not None:
+                _release_mesh(entry)
+            textures = _MeshTextures(self.ctx)
+            entry = (mesh, [_GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
             self._meshes[id(mesh)] = entry
         return entry[1]
 
@@ -258,9 +358,8 @@ class ForwardRenderer:
             vao.release()
         self._fullscreen_vaos.clear()
         self._units_assigned.clear()
-        for _, parts in self._meshes.values():
-            for part in parts:
-                part.release()
+        for entry in self._meshes.values():
+            _release_mesh(entry)
         self._meshes.clear()
         old.reload()
 
@@ -292,9 +391,8 @@ class ForwardRenderer:
         for maps in self._bakes.values():
             maps.release()
         self._bakes.clear()
-        for _, parts in self._meshes.values():
-            for part in parts:
-                part.release()
+        for entry in self._meshes.values():
+            _release_mesh(entry)
         self._meshes.clear()
         if self._targets:
             self._targets.release()
@@ -327,23 +425,84 @@ class ForwardRenderer:
     # --- drawing -------------------------------------------------------------------------
 
     def render(self, scene: Scene, maps: IBLMaps | None, width: int, height: int,
-               aa: str = "msaa", samples: int = 4, read_linear: bool = True, read_srgb: bool = True) -> Frame:
-        """Draw ``scene`` lit by ``maps`` (None: no environment) and read the results back."""
+               aa: str = "msaa", samples: int = 4, read_linear: bool = True, read_srgb: bool = True,
+               tile: tuple[int, int] | None = None) -> Frame:
+        """Draw ``scene`` lit by ``maps`` (None: no environment) and read the results back.
+        An image one framebuffer cannot hold is drawn in tiles (``render_strips``) with the same
+        pixels; ``tile`` forces tiles of at most that size."""
+        linear = srgb = None
+        for strip in self.render_strips(scene, maps, width, height, aa, samples, read_linear, read_srgb, tile):
+            rows = (strip.frame.linear if read_linear else strip.frame.srgb)
+            if strip.y0 == 0 and rows is not None and len(rows) == height:
+                return strip.frame          # one pass: no copy
+            if read_linear:
+                if linear is None:
+                    linear = np.empty((height, width, 4), np.float32)
+                linear[strip.y0:strip.y0 + len(strip.frame.linear)] = strip.frame.linear
+            if read_srgb:
+                if srgb is None:
+                    srgb = np.empty((height, width, 4), np.uint8)
+                srgb[strip.y0:strip.y0 + len(strip.frame.srgb)] = strip.frame.srgb
+        return Frame(linear, srgb)
+
+    def render_strips(self, scene: Scene, maps: IBLMaps | None, width: int, height: int,
+                      aa: str = "msaa", samples: int = 4, read_linear: bool = True, read_srgb: bool = True,
+                      tile: tuple[int, int] | None = None) -> Iterator[Strip]:
+        """``render`` strip by strip, top first (alight.render.tiles): each Strip holds a band of
+        whole rows, drawn as one or more tiles, so a caller that writes and drops each one holds
+        one strip's pixels at a time. A size within the GL limits and TILE_BYTES is one strip."""
         if scene.view == "probe":
             aa = "none"  # the probe view's normals are exact per pixel centre: no blending
-        targets = self._targets_for(width, height, aa, samples)
-        self.draw_hdr(scene, maps, targets)
-        self.tonemap(targets.radiance, scene.display, targets.display_fbo, opaque=scene.display.background != "transparent")
-        linear = srgb = None
-        if read_linear:
-            linear = np.frombuffer(targets.radiance_fbo.read(components=4, dtype="f4"), np.float32)
-            linear = linear.reshape(height, width, 4)[::-1].copy()
-            if scene.view == "probe":
+        if aa == "msaa":
+            samples = min(samples, self.ctx.max_samples)
+            if samples < 2:
+                aa = "none"   # this GL has no multisampled float framebuffers
+        plan, targets = self._tiled_targets(width, height, aa, samples, tile)
+        opaque = scene.display.background != "transparent"
+        for tiles in plan.strips():
+            rows = tiles[0].height
+            linear = np.empty((rows, width, 4), np.float32) if read_linear and not plan.single else None
+            srgb = np.empty((rows, width, 4), np.uint8) if read_srgb and not plan.single else None
+            for t in tiles:
+                view = None if plan.single else _View(width, height, tile_matrix(plan, t), tile_origin(plan, t))
+                self._draw_scene(scene, maps, targets, targets.draw, view=view)
+                self.tonemap(targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
+                if read_linear:
+                    block = _read(targets.radiance_fbo, t, "f4", np.float32)
+                    if plan.single:
+                        linear = block.copy()
+                    else:
+                        linear[:, t.x:t.x + t.width] = block
+                if read_srgb:
+                    block = _read(targets.display_fbo, t, "f1", np.uint8)
+                    if plan.single:
+                        srgb = block.copy()
+                    else:
+                        srgb[:, t.x:t.x + t.width] = block
+            if linear is not None and scene.view == "probe":
                 linear[linear[:, :, 3] == 0.0] = 0.0  # CONVENTIONS.md: probe background radiance is 0
-        if read_srgb:
-            srgb = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8)
-            srgb = srgb.reshape(height, width, 4)[::-1].copy()
-        return Frame(linear, srgb)
+            yield Strip(tiles[0].y, Frame(linear, srgb))
+
+    def _tiled_targets(self, width: int, height: int, aa: str, samples: int,
+                       tile: tuple[int, int] | None) -> tuple[TilePlan, _Targets]:
+        """The tile plan for this size and the framebuffers of one tile. Where the GL refuses
+        them (out of memory, an incomplete framebuffer), tiles a quarter the size are tried."""
+        budget = TILE_BYTES
+        limits = {key: self.ctx.info.get(key) for key in (
+            "GL_MAX_TEXTURE_SIZE", "GL_MAX_RENDERBUFFER_SIZE", "GL_MAX_VIEWPORT_DIMS",
+            "GL_MAX_FRAMEBUFFER_WIDTH", "GL_MAX_FRAMEBUFFER_HEIGHT")}
+        while True:
+            plan = plan_tiles(width, height, side_limit(limits, aa), framebuffer_bytes(aa, samples), budget, tile=tile)
+            try:
+                return plan, self._targets_for(plan.tile_width, plan.tile_height, aa, samples)
+            except moderngl.Error as exc:
+                self._targets = None
+                if plan.tile_width * plan.tile_height <= 16 * 16:
+                    reason = " ".join(str(exc).split()) or type(exc).__name__
+                    raise AlightError(f"OpenGL: cannot make a {plan.tile_width}x{plan.tile_height} framebuffer "
+                                      f"({aa}) for a {width}x{height} image ({reason})") from None
+                budget = min(budget, plan.tile_width * plan.tile_height * framebuffer_bytes(aa, samples)) // 4
+                tile = None
 
     def draw_hdr(self, scene: Scene, maps: IBLMaps | None, targets: _Targets) -> None:
         self._draw_scene(scene, maps, targets, targets.draw)
@@ -361,27 +520,35 @@ class ForwardRenderer:
         self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display)
 
     def _draw_scene(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, fbo: moderngl.Framebuffer,
-                    display_output: Display | None = None) -> None:
+                    display_output: Display | None = None, view: _View | None = None) -> None:
         ctx = self.ctx
         self._display_output = display_output
         width, height = targets.draw_size
         fbo.use()
         ctx.viewport = (0, 0, width, height)
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        aspect = width / height
+        scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
+        view = view or _View(targets.width, targets.height)
+        aspect = view.width / view.height
         # The probe's own camera is orthographic; its backdrop is drawn as the default camera sees it.
         camera = Camera() if scene.view == "probe" else self.camera_for(scene, aspect)
         view_projection = camera.view_projection(aspect)
+        if view.matrix is not None:     # a tile: the whole image's projection, off centre
+            view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
         self._write_lights(scene)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
         if scene.view == "probe":
-            self._draw_probe(scene, maps, width)
+            self._draw_probe(scene, maps, view.width * scale, (view.origin[0] * scale, view.origin[1] * scale))
         elif scene.mesh is not None:
-            self._draw_mesh(scene, maps, camera, view_projection, targets, fbo)
+            self._draw_mesh(scene, maps, camera, view_projection, blend=False, targets=targets, fbo=fbo,
+                            pixels_per_radian=view.height * scale / 2.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0))
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         self._draw_background(scene, maps, inverse_vp)
+        # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
+        if scene.view != "probe" and scene.mesh is not None:
+            self._draw_mesh(scene, maps, camera, view_projection, blend=True)
         ctx.disable(moderngl.DEPTH_TEST)
         if display_output is None:
             self._finish_radiance(targets)
@@ -455,14 +622,29 @@ class ForwardRenderer:
         _set(program, "u_sun_prefilter_scale", scale.tobytes(), write=True)
 
     def _write_lights(self, scene: Scene) -> None:
+        """punctual.glsl's Lights block: vector and type, radiance, count, spot direction, and
+        the spot's cone scale and offset with the range (KHR_lights_punctual's recommended
+        falloff: scale = 1 / max(0.001, cos inner - cos outer), offset = -cos outer * scale)."""
         vectors = np.zeros((MAX_LIGHTS, 4), np.float32)
         radiance = np.zeros((MAX_LIGHTS, 4), np.float32)
+        spots = np.zeros((MAX_LIGHTS, 4), np.float32)
+        cones = np.zeros((MAX_LIGHTS, 4), np.float32)
         lights = scene.lights[:MAX_LIGHTS]
         for i, light in enumerate(lights):
             vectors[i, :3] = light.vector
-            vectors[i, 3] = 0.0 if light.kind == "point" else 1.0
+            vectors[i, 3] = {"point": 0.0, "directional": 1.0, "spot": 2.0}[light.kind]
             radiance[i, :3] = np.asarray(light.color, np.float32) * light.intensity
-        data = vectors.tobytes() + radiance.tobytes() + np.array([len(lights), 0, 0, 0], np.int32).tobytes()
+            if light.kind == "spot":
+                d = np.asarray(light.direction, np.float64)
+                spots[i, :3] = d / max(np.linalg.norm(d), 1e-30)
+                cos_inner = math.cos(math.radians(light.inner_cone_deg))
+                cos_outer = math.cos(math.radians(light.outer_cone_deg))
+                scale = 1.0 / max(0.001, cos_inner - cos_outer)
+                cones[i, :2] = (scale, -cos_outer * scale)
+            if light.range is not None and light.kind != "directional":
+                cones[i, 2] = light.range
+        data = (vectors.tobytes() + radiance.tobytes() + np.array([len(lights), 0, 0, 0], np.int32).tobytes()
+                + spots.tobytes() + cones.tobytes())
         if data != self._lights_bytes:  # unchanged lights cost no upload
             self._lights_ubo.write(data)
             self._lights_bytes = data
@@ -487,61 +669,71 @@ class ForwardRenderer:
             _set(prog, "u_env_intensity", float(scene.env_intensity))
         self._fullscreen(prog)
 
-    def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int) -> None:
+    def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int, origin: tuple[int, int] = (0, 0)) -> None:
         defines = {**self._ibl_defines(scene), **layer_defines([scene.material])}
         prog = self.program("render/fullscreen.vert", "render/probe.frag", defines)
         m = scene.material
         prog["u_size"] = float(size)
+        _set(prog, "u_pixel_origin", tuple(float(x) for x in origin))
         _set_material(prog, m)
         self._bind_layer_luts(defines)
         self._bind_ibl(prog, scene, maps)
         self._fullscreen(prog)
 
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray,
-                   targets: _Targets, fbo: moderngl.Framebuffer) -> None:
-        """The mesh's parts: opaque ones, then (where any part transmits) a copy of what they
-        left in ``fbo`` and the transmissive parts reading it (the module docstring's order).
-        Each pass compiles only its own parts' layers."""
+                   blend: bool = False, targets: _Targets | None = None, fbo: moderngl.Framebuffer | None = None,
+                   pixels_per_radian: float = 1.0) -> None:
+        """The parts that blend (``blend``) or the rest, each with its shader variant: the
+        scene's IBL model and debug view, plus only the features the part uses (_part_defines).
+        The rest is drawn as the module docstring says: the opaque parts, then, where any part
+        transmits, a copy of what they left in ``fbo`` and the transmissive parts reading it
+        (TRANSMISSION_SCENE; ``pixels_per_radian``: the image's rows per radian at its centre,
+        for the copy's blur)."""
+        defines = self._ibl_defines(scene)
+        defines.update(_light_defines(scene))
+        if scene.debug_view:
+            defines["DEBUG_VIEW"] = None
+        bound: set[int] = set()
+
+        def program_for(part_defines: dict) -> moderngl.Program:
+            all_defines = {**defines, **part_defines}
+            prog = self._scene_program("render/pbr.vert", "render/pbr.frag", all_defines)
+            if id(prog) not in bound:
+                bound.add(id(prog))
+                if scene.debug_view:
+                    _set(prog, "u_debug_view", int(scene.debug_view))
+                    _set(prog, "u_debug_mip", float(scene.debug_mip))
+                self._bind_ibl(prog, scene, maps)
+            self._bind_layer_luts(all_defines)
+            return prog
+
+        if blend:
+            self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=True)
+            return
         transmissive = self.transmissive_parts(scene)
         opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
         if opaque:
-            prog = self._mesh_program(scene, maps, opaque)
-            self.draw_mesh_parts(scene, prog, camera, view_projection, opaque)
+            self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=False, parts=opaque)
         if not transmissive:
             return
         behind, behind_fbo = targets.behind()
         self.ctx.copy_framebuffer(behind_fbo, fbo)   # the MSAA resolve too, where there is one
         behind.build_mipmaps()
         fbo.use()
-        prog = self._mesh_program(scene, maps, transmissive, {"TRANSMISSION_SCENE": None})
         behind.use(UNIT_SCENE_BEHIND)
         if not (scene.ibl_enabled and maps is not None):
-            # The thin-walled lobe's energy is the BRDF LUT's A, which _bind_ibl bound only with
+            # The thin-walled lobe's energy is the BRDF LUT's A, which _bind_ibl binds only with
             # an environment.
             q = QUALITY["medium"]
             self.luts.get(q.lut_size, q.lut_samples).use(UNIT_LUT)
-        _set(prog, "u_behind_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
-        half_fov = math.radians(camera.fov_y_deg) / 2.0
-        _set(prog, "u_behind_pixels_per_radian", float(targets.draw_size[1] / 2.0 / math.tan(half_fov)))
-        self.draw_mesh_parts(scene, prog, camera, view_projection, transmissive)
 
-    def _mesh_program(self, scene: Scene, maps: IBLMaps | None, parts: list[int],
-                      extra_defines: dict | None = None) -> moderngl.Program:
-        """pbr.frag compiled for ``parts``: the scene's IBL model and maps, those parts' layers."""
-        # A debug view (the editor's) is a separate compile, so the normal path pays nothing.
-        defines = self._ibl_defines(scene)
-        defines["MATERIAL_MAPS_MASK"] = self._map_mask(scene)
-        defines.update(self.layer_defines(scene, parts))
-        defines.update(extra_defines or {})
-        if scene.debug_view:
-            defines["DEBUG_VIEW"] = None
-        prog = self._scene_program("render/pbr.vert", "render/pbr.frag", defines)
-        if scene.debug_view:
-            _set(prog, "u_debug_view", int(scene.debug_view))
-            _set(prog, "u_debug_mip", float(scene.debug_mip))
-        self._bind_ibl(prog, scene, maps)
-        self._bind_layer_luts(defines)
-        return prog
+        def transmissive_program(part_defines: dict) -> moderngl.Program:
+            prog = program_for({**part_defines, "TRANSMISSION_SCENE": None})
+            _set(prog, "u_behind_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+            _set(prog, "u_behind_pixels_per_radian", float(pixels_per_radian))
+            return prog
+
+        self.draw_mesh_parts(scene, transmissive_program, camera, view_projection, blend=False, parts=transmissive)
 
     def _bind_layer_luts(self, defines: dict) -> None:
         """The tables a compiled-in layer reads (the sheen LUT, the transmission LUT), baked on
@@ -563,58 +755,150 @@ class ForwardRenderer:
         """Indices of the mesh's parts whose material transmits (KHR_materials_transmission)."""
         if scene.view == "probe" or scene.mesh is None:
             return []
+        # A part that blends (alphaMode BLEND) is drawn in the blended pass, over the background,
+        # and transmits the environment only.
         return [i for i, part in enumerate(scene.mesh.parts)
-                if "transmission" in self._part_material(scene, part)[0].layers()]
+                if "transmission" in self._part_material(scene, part)[0].layers()
+                and not (part.material is not None and scene.use_file_materials and part.material.alpha_mode == "BLEND")]
 
-    def _map_mask(self, scene: Scene) -> int:
-        """mesh_material.glsl's MATERIAL_MAPS_MASK: a bit per map any part is drawn with."""
+    @staticmethod
+    def _user_maps_present(scene: Scene) -> set[str]:
         user = scene.texture_maps.paths() if scene.texture_maps is not None else {}
-        used = {name for name, path in user.items() if path in scene.texture_images}
-        for gpu_part, part in zip(self._gpu_mesh(scene.mesh, None), scene.mesh.parts):
-            if part.material is not None and scene.use_file_materials:
-                used.update(gpu_part.textures)
-        return sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in used)
+        return {name for name, path in user.items() if path in scene.texture_images}
 
-    def draw_mesh_parts(self, scene: Scene, prog: moderngl.Program, camera: Camera,
-                        view_projection: np.ndarray, parts: list[int] | None = None) -> None:
-        """Draw every part of the scene's mesh (or those of ``parts``, indices) with ``prog``
-        (pbr.vert's transforms, seen from ``camera``): each part's material factors and maps
-        bound, back faces culled where the part is closed."""
+    @staticmethod
+    def _part_defines(scene: Scene, gpu_part: _GpuPart, part, user_maps: set[str]) -> dict:
+        """The shader variant a part needs (pbr.frag, mesh_material.glsl): the maps it reads, their
+        uv sets, transforms and mirrored axes, vertex colours, alpha mode, unlit and the layers
+        its material uses. A part with none of these compiles to the plain opaque shader."""
+        fm = part.material
+        file_material = fm is not None and scene.use_file_materials
+        defines: dict = {}
+        if file_material:
+            present = set(gpu_part.textures)
+            bits = {name: 1 << i for i, name in enumerate(MATERIAL_MAPS)}
+            masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
+            for name, info in gpu_part.infos.items():
+                bit = bits[name]
+                if info.tex_coord == 1 and gpu_part.has_uv1:
+                    masks["MAP_UV1_MASK"] |= bit
+                if info.transform is not None:
+                    masks["MAP_TRANSFORM_MASK"] |= bit
+                if info.sampler.wrap_s == "mirrored_repeat":
+                    masks["MAP_MIRROR_S_MASK"] |= bit
+                if info.sampler.wrap_t == "mirrored_repeat":
+                    masks["MAP_MIRROR_T_MASK"] |= bit
+            defines.update({k: v for k, v in masks.items() if v})
+            if masks["MAP_UV1_MASK"]:
+                defines["HAS_UV1"] = None
+            if fm.alpha_mode == "MASK":
+                defines["ALPHA_MODE"] = 1
+            elif fm.alpha_mode == "BLEND":
+                defines["ALPHA_MODE"] = 2
+            if fm.unlit:
+                defines["UNLIT"] = None
+        else:
+            present = set(user_maps)
+        if gpu_part.has_colors and scene.use_file_materials:
+            defines["HAS_VERTEX_COLOR"] = None
+        defines["MATERIAL_MAPS_MASK"] = sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in present)
+        # The layers this part's material uses, and only those (alight.core.layers).
+        defines.update(layer_defines([ForwardRenderer._part_material(scene, part)[0]]))
+        return defines
+
+    def draw_mesh_parts(self, scene: Scene, prog, camera: Camera, view_projection: np.ndarray,
+                        blend: bool | None = None, parts: list[int] | None = None) -> None:
+        """Draw the scene's mesh parts (pbr.vert's transforms, seen from ``camera``), each with
+        its material's factors and maps bound.
+
+        ``prog``: one program for every part (the reference's G-buffer), or a function from a
+        part's defines (``_part_defines``) to its program. ``blend``: None draws every part;
+        False the parts that do not blend; True those that do (alphaMode BLEND), sorted back to
+        front by the distance of their centres, with blending on and depth writes off. ``parts``:
+        only these (indices into the mesh's parts), within what ``blend`` selects.
+        Culling follows the material (glTF doubleSided: false culls back faces); a part without
+        a glTF material is culled where it is closed, seen from both sides where it is open.
+        """
         ctx = self.ctx
-        _set(prog, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
-        _set(prog, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
-        _set(prog, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
-        _set(prog, "u_camera_position", tuple(float(x) for x in camera.position))
+        user_maps = self._user_maps_present(scene)
         user = self._user_textures(scene)
         tiling = scene.texture_maps or TextureMaps()
+        items = []
         chosen = None if parts is None else set(parts)
-        for index, (gpu_part, part) in enumerate(zip(self._gpu_mesh(scene.mesh, prog), scene.mesh.parts)):
-            if chosen is not None and index not in chosen:
-                continue
-            material, maps_used = self._part_material(scene, part)
-            _set_material(prog, material)
-            fm = part.material if maps_used else None
-            _set(prog, "u_normal_scale", float(getattr(fm, "normal_scale", 1.0)) if fm else 1.0)
-            _set(prog, "u_clearcoat_normal_scale", float(getattr(fm, "clearcoat_normal_scale", 1.0)) if fm else 1.0)
-            _set(prog, "u_occlusion_strength", float(getattr(fm, "occlusion_strength", 1.0)) if fm else 1.0)
-            # A file's maps use its own UVs as they are; the user's maps are tiled.
-            _set(prog, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
-            _set(prog, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
-            for name in MATERIAL_MAPS:
-                tex = gpu_part.textures.get(name) if maps_used else user.get(name)
-                _set(prog, f"u_has_{name}_map", tex is not None)
-                if tex is not None:
-                    tex.use(UNIT_MATERIAL[name])
-            # A closed mesh's back faces are hidden: culling them halves the triangles rasterised
-            # and stops back faces drawn first from being shaded and then overwritten (35% of
-            # the ball's cost on llvmpipe). Open meshes are seen from behind (the shader flips n).
-            if gpu_part.closed:
-                ctx.front_face = "ccw"
-                ctx.enable(moderngl.CULL_FACE)
-            else:
-                ctx.disable(moderngl.CULL_FACE)
-            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
-        ctx.disable(moderngl.CULL_FACE)
+        for index, (gpu_part, part) in enumerate(zip(self._gpu_mesh(scene.mesh), scene.mesh.parts)):
+            fm = part.material
+            blends = fm is not None and scene.use_file_materials and fm.alpha_mode == "BLEND"
+            if (blend is None or blends == blend) and (chosen is None or index in chosen):
+                items.append((gpu_part, part))
+        if not items:
+            return
+        if blend:
+            eye = np.asarray(camera.position, np.float64)
+            items.sort(key=lambda item: -float(np.linalg.norm(item[0].centre - eye)))
+            ctx.enable(moderngl.BLEND)
+            # Straight alpha over what is behind; coverage accumulates in alpha (premultiplied).
+            ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+            ctx.depth_mask = False
+        prepared: set[int] = set()
+        try:
+            for gpu_part, part in items:
+                if callable(prog):
+                    program = prog(self._part_defines(scene, gpu_part, part, user_maps))
+                else:
+                    program = prog
+                if id(program) not in prepared:
+                    prepared.add(id(program))
+                    _set(program, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
+                    _set(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
+                    _set(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+                    _set(program, "u_camera_position", tuple(float(x) for x in camera.position))
+                material, maps_used = self._part_material(scene, part)
+                _set_material(program, material)
+                fm = part.material if maps_used else None
+                _set(program, "u_normal_scale", float(fm.normal_scale) if fm else 1.0)
+                _set(program, "u_clearcoat_normal_scale", float(fm.clearcoat_normal_scale) if fm else 1.0)
+                _set(program, "u_occlusion_strength", float(fm.occlusion_strength) if fm else 1.0)
+                _set(program, "u_alpha", float(fm.alpha) if fm else 1.0)
+                _set(program, "u_alpha_cutoff", float(fm.alpha_cutoff) if fm else 0.5)
+                # A file's maps use its own UVs as they are; the user's maps are tiled.
+                _set(program, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
+                _set(program, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
+                if maps_used and any(info.transform is not None for info in gpu_part.infos.values()):
+                    transforms = np.tile(np.eye(3, dtype=np.float32), (len(MATERIAL_MAPS), 1, 1))
+                    for name, info in gpu_part.infos.items():
+                        if info.transform is not None:
+                            transforms[MATERIAL_MAPS.index(name)] = info.transform.gl_matrix()
+                    member = program.get("u_map_transform", None)
+                    if member is not None:
+                        # GLSL mat3 is column-major: upload the transposes. The compiler trims the
+                        # array after the last slot the variant reads.
+                        used = transforms.transpose(0, 2, 1)[:member.array_length]
+                        member.write(np.ascontiguousarray(used, dtype=np.float32).tobytes())
+                for name in MATERIAL_MAPS:
+                    tex = gpu_part.textures.get(name) if maps_used else user.get(name)
+                    _set(program, f"u_has_{name}_map", tex is not None)
+                    if tex is not None:
+                        tex.use(UNIT_MATERIAL[name])
+                if part.element.startswith("meshes["):
+                    # A glTF primitive: the file decides (the default material is single-sided).
+                    cull = not (part.material is not None and part.material.double_sided)
+                else:
+                    # A closed mesh's back faces are hidden: culling them halves the triangles
+                    # rasterised and stops back faces drawn first from being shaded and then
+                    # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
+                    # behind (the shader flips n).
+                    cull = gpu_part.closed
+                if cull:
+                    ctx.front_face = "ccw"
+                    ctx.enable(moderngl.CULL_FACE)
+                else:
+                    ctx.disable(moderngl.CULL_FACE)
+                gpu_part.vao_for(program).render(moderngl.TRIANGLES)
+        finally:
+            ctx.disable(moderngl.CULL_FACE)
+            if blend:
+                ctx.disable(moderngl.BLEND)
+                ctx.depth_mask = True
 
     @staticmethod
     def _part_material(scene: Scene, part) -> tuple[Material, bool]:
@@ -623,10 +907,10 @@ class ForwardRenderer:
         if fm is None or not scene.use_file_materials:
             return scene.material, False
         base = Material(base_color=tuple(fm.base_color), metallic=float(fm.metallic),
-                        roughness=float(fm.roughness), specular_f0=scene.material.specular_f0,
-                        ior=scene.material.ior, emissive=tuple(fm.emissive), name=part.name)
-        layers = getattr(fm, "layers", None)
-        if layers:   # the file's own layer fields and ior (alight.exchange.gltf_material)
+                        roughness=float(fm.roughness), specular_f0=tuple(fm.specular_f0),
+                        ior=fm.layers.get("ior"), emissive=tuple(fm.emissive), name=part.name)
+        layers = {k: v for k, v in fm.layers.items() if k != "ior"}
+        if layers:   # the file's own layer factors (alight.exchange.gltf_material)
             base = replace(base, **layers)
         if scene.material_overrides:
             base = with_overrides(base, **scene.material_overrides)
@@ -659,6 +943,29 @@ class ForwardRenderer:
         if vao is None:
             vao = self._fullscreen_vaos[id(prog)] = self.ctx.vertex_array(prog, [])
         vao.render(moderngl.TRIANGLES, vertices=3)
+
+
+def _light_defines(scene: Scene) -> dict:
+    """punctual.glsl's PUNCTUAL_SPOT and PUNCTUAL_RANGE, only for scenes that have such lights."""
+    lights = scene.lights[:MAX_LIGHTS]
+    defines: dict = {}
+    if any(light.kind == "spot" for light in lights):
+        defines["PUNCTUAL_SPOT"] = None
+    if any(light.range is not None and light.kind != "directional" for light in lights):
+        defines["PUNCTUAL_RANGE"] = None
+    return defines
+
+
+def _release_mesh(entry) -> None:
+    for part in entry[1]:
+        part.release()
+    entry[2].release()
+
+
+def _read(fbo: moderngl.Framebuffer, tile: Tile, dtype: str, np_dtype) -> np.ndarray:
+    """The tile's pixels from the bottom-left of ``fbo``, rows top first (a view, not a copy)."""
+    data = fbo.read(viewport=(0, 0, tile.width, tile.height), components=4, dtype=dtype)
+    return np.frombuffer(data, np_dtype).reshape(tile.height, tile.width, 4)[::-1]
 
 
 def _rotation_cos_sin(deg: float) -> tuple[float, float]:

@@ -29,6 +29,7 @@ const int TERM_K = 13;
 const int TERM_GRID_STEP = 14;
 const int TERM_CUBE_TEXEL_DIRECTION = 15;
 const int TERM_PUNCTUAL = 16;
+const int TERM_SPOT_RANGE = 17;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -62,6 +63,13 @@ void main() {
             vec3 n = vec3(0.0, 0.0, 1.0);
             vec3 l = vec3(sqrt(max(0.0, 1.0 - a.x * a.x)), 0.0, a.x);
             o.xyz = punctual_light(s, n, n, l, vec3(1.0));
+            break;
+        }
+        case TERM_SPOT_RANGE: {
+            // a = (cos of the angle off the spot's axis, cone scale, cone offset, d^2 / range^2).
+            vec3 l = -vec3(sqrt(max(0.0, 1.0 - a.x * a.x)), 0.0, a.x);   // toward the light
+            o.x = spot_attenuation(vec3(0.0, 0.0, 1.0), l, a.yz);
+            o.y = range_attenuation(a.w, 1.0);
             break;
         }
     }

@@ -4,6 +4,9 @@
 // first one (u_first) starts it from emission plus the punctual lights (punctual.glsl's
 // punctual_light, k = (r+1)^2/8, no occlusion). Pixels the G-buffer marks empty stay 0.
 layout(local_size_x = 8, local_size_y = 8) in;
+// Every light kind alight has: the reference is measured, not raced.
+#define PUNCTUAL_SPOT
+#define PUNCTUAL_RANGE
 #include "accuracy/ground_truth.glsl"
 #include "common/material_layers.glsl"
 

@@ -1,6 +1,15 @@
 // The mesh pass's material inputs: varyings from render/pbr.vert, the material uniforms and
 // texture maps, the shading normal and the Surface at a fragment. Shared by render/pbr.frag
 // (forward shading) and render/gbuffer.frag (the reference's G-buffer).
+//
+// Every per-texture feature of glTF is a compile-time choice, a bit per map in a mask, so a
+// part pays only for what its maps use (llvmpipe runs both sides of a branch):
+//   MATERIAL_MAPS_MASK   the maps present;
+//   MAP_UV1_MASK         maps read with TEXCOORD_1 (needs HAS_UV1), the rest TEXCOORD_0;
+//   MAP_TRANSFORM_MASK   maps with KHR_texture_transform (u_map_transform[slot]);
+//   MAP_MIRROR_S_MASK,   maps whose sampler wraps by MIRRORED_REPEAT in s or t (REPEAT and
+//   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state).
+// HAS_VERTEX_COLOR: COLOR_0 multiplies the base colour and alpha (glTF 2.0 section 3.9.2).
 #include "common/surface.glsl"
 #include "common/material_layers.glsl"
 
@@ -8,6 +17,12 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
+#ifdef HAS_UV1
+in vec2 v_uv1;
+#endif
+#ifdef HAS_VERTEX_COLOR
+in vec4 v_color;
+#endif
 
 uniform vec3 u_camera_position;
 uniform vec3 u_base_color;
@@ -17,6 +32,8 @@ uniform vec3 u_specular_f0;
 uniform vec3 u_emissive;
 uniform float u_normal_scale;
 uniform float u_occlusion_strength;
+uniform float u_alpha;          // baseColorFactor's alpha
+uniform float u_alpha_cutoff;   // MASK
 // The maps' coordinates: uv * u_uv_scale + u_uv_offset (the editor's tiling; identity for files).
 uniform vec2 u_uv_scale;
 uniform vec2 u_uv_offset;
@@ -38,7 +55,6 @@ uniform sampler2D u_emissive_map;
 uniform sampler2D u_occlusion_map;
 uniform sampler2D u_metallic_map;
 uniform sampler2D u_roughness_map;
-
 // The layers' maps (glTF: KHR_materials_clearcoat, KHR_materials_sheen), declared with their layer.
 #ifdef HAS_CLEARCOAT
 uniform bool u_has_clearcoat_map;             // R multiplies clearcoat
@@ -62,6 +78,18 @@ uniform sampler2D u_sheen_roughness_map;
 #ifndef MATERIAL_MAPS_MASK
 #define MATERIAL_MAPS_MASK 4095
 #endif
+#ifndef MAP_UV1_MASK
+#define MAP_UV1_MASK 0
+#endif
+#ifndef MAP_TRANSFORM_MASK
+#define MAP_TRANSFORM_MASK 0
+#endif
+#ifndef MAP_MIRROR_S_MASK
+#define MAP_MIRROR_S_MASK 0
+#endif
+#ifndef MAP_MIRROR_T_MASK
+#define MAP_MIRROR_T_MASK 0
+#endif
 const int MAP_BASE_COLOR = 1;
 const int MAP_METALLIC_ROUGHNESS = 2;
 const int MAP_NORMAL = 4;
@@ -74,6 +102,9 @@ const int MAP_CLEARCOAT_ROUGHNESS = 256;
 const int MAP_CLEARCOAT_NORMAL = 512;
 const int MAP_SHEEN_COLOR = 1024;
 const int MAP_SHEEN_ROUGHNESS = 2048;
+const int MAP_SLOTS = 12;
+// KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
+uniform mat3 u_map_transform[MAP_SLOTS];
 
 bool has_map(int bit, bool present) {
     return (MATERIAL_MAPS_MASK & bit) != 0 && present;
@@ -81,6 +112,35 @@ bool has_map(int bit, bool present) {
 
 vec2 material_uv() {
     return v_uv * u_uv_scale + u_uv_offset;
+}
+
+// The coordinates a map reads: its uv set, then its texture transform (glTF 2.0 textureInfo
+// texCoord; KHR_texture_transform).
+vec2 map_uv(int bit, int slot) {
+    vec2 uv = material_uv();
+#ifdef HAS_UV1
+    if ((MAP_UV1_MASK & bit) != 0) uv = v_uv1;
+#endif
+    if ((MAP_TRANSFORM_MASK & bit) != 0) uv = (u_map_transform[slot] * vec3(uv, 1.0)).xy;
+    return uv;
+}
+
+// MIRRORED_REPEAT (OpenGL 4.5 section 8.14.2): the triangle wave of period 2.
+float mirrored_repeat(float x) {
+    return 1.0 - abs(mod(x, 2.0) - 1.0);
+}
+
+// A map's texel at its coordinates. Mirrored axes are folded here and sampled with the
+// unfolded derivatives, so the mip level does not jump at the folds.
+vec4 sample_map(sampler2D map, int bit, int slot) {
+    vec2 uv = map_uv(bit, slot);
+    if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
+        vec2 folded = uv;
+        if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
+        if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
+        return textureGrad(map, folded, dFdx(uv), dFdy(uv));
+    }
+    return texture(map, uv);
 }
 
 // The interpolated normal, or the face normal from screen derivatives where it is zero (bad
@@ -103,8 +163,8 @@ mat3 tangent_frame(vec3 n) {
 }
 
 // A tangent-space normal map's value in world space about n (glTF: xy scaled by scale).
-vec3 normal_from_map(sampler2D map, float scale, vec3 n) {
-    vec3 m = texture(map, material_uv()).xyz * 2.0 - 1.0;
+vec3 normal_from_map(sampler2D map, int bit, int slot, float scale, vec3 n) {
+    vec3 m = sample_map(map, bit, slot).xyz * 2.0 - 1.0;
     m.xy *= scale;
     vec3 mapped = tangent_frame(n) * m;
     return dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
@@ -113,25 +173,37 @@ vec3 normal_from_map(sampler2D map, float scale, vec3 n) {
 vec3 shading_normal() {
     vec3 n = geometric_normal();
     if (has_map(MAP_NORMAL, u_has_normal_map)) {
-        n = normal_from_map(u_normal_map, u_normal_scale, n);
+        n = normal_from_map(u_normal_map, MAP_NORMAL, 2, u_normal_scale, n);
     }
     return n;
 }
 
+// Base colour and alpha: factor x map x COLOR_0 (glTF 2.0 section 3.9.2).
+vec4 material_base_color() {
+    vec4 c = vec4(u_base_color, u_alpha);
+    if (has_map(MAP_BASE_COLOR, u_has_base_color_map)) c *= sample_map(u_base_color_map, MAP_BASE_COLOR, 0);
+#ifdef HAS_VERTEX_COLOR
+    c *= v_color;
+#endif
+    return c;
+}
+
+float material_alpha() {
+    return material_base_color().a;
+}
+
 // The material at this fragment; n is shading_normal() (the layers' directions are built about it).
 Surface material_surface(vec3 n) {
-    vec2 uv = material_uv();
-    Surface s = surface_base(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
-    if (has_map(MAP_BASE_COLOR, u_has_base_color_map)) s.base_color *= texture(u_base_color_map, uv).rgb;
+    Surface s = surface_base(material_base_color().rgb, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
     // glTF's packing: G = roughness, B = metallic; a separate greyscale map takes precedence.
     vec2 metal_rough = vec2(1.0);
-    if (has_map(MAP_METALLIC_ROUGHNESS, u_has_metallic_roughness_map)) metal_rough = texture(u_metallic_roughness_map, uv).bg;
-    if (has_map(MAP_METALLIC, u_has_metallic_map)) metal_rough.x = texture(u_metallic_map, uv).r;
-    if (has_map(MAP_ROUGHNESS, u_has_roughness_map)) metal_rough.y = texture(u_roughness_map, uv).r;
+    if (has_map(MAP_METALLIC_ROUGHNESS, u_has_metallic_roughness_map)) metal_rough = sample_map(u_metallic_roughness_map, MAP_METALLIC_ROUGHNESS, 1).bg;
+    if (has_map(MAP_METALLIC, u_has_metallic_map)) metal_rough.x = sample_map(u_metallic_map, MAP_METALLIC, 5).r;
+    if (has_map(MAP_ROUGHNESS, u_has_roughness_map)) metal_rough.y = sample_map(u_roughness_map, MAP_ROUGHNESS, 6).r;
     s.metallic *= metal_rough.x;
     s.roughness *= metal_rough.y;
-    if (has_map(MAP_EMISSIVE, u_has_emissive_map)) s.emissive *= texture(u_emissive_map, uv).rgb;
-    if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (texture(u_occlusion_map, uv).r - 1.0);
+    if (has_map(MAP_EMISSIVE, u_has_emissive_map)) s.emissive *= sample_map(u_emissive_map, MAP_EMISSIVE, 3).rgb;
+    if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
@@ -142,17 +214,20 @@ Surface material_surface(vec3 n) {
     // KHR_materials_clearcoat: without a clearcoat normal map the coat is not normal-mapped,
     // even where the base is.
     s.clearcoat_normal = geometric_normal();
-    if (has_map(MAP_CLEARCOAT, u_has_clearcoat_map)) s.clearcoat *= texture(u_clearcoat_map, uv).r;
+    if (has_map(MAP_CLEARCOAT, u_has_clearcoat_map)) s.clearcoat *= sample_map(u_clearcoat_map, MAP_CLEARCOAT, 7).r;
     if (has_map(MAP_CLEARCOAT_ROUGHNESS, u_has_clearcoat_roughness_map)) {
-        s.clearcoat_roughness *= texture(u_clearcoat_roughness_map, uv).g;
+        s.clearcoat_roughness *= sample_map(u_clearcoat_roughness_map, MAP_CLEARCOAT_ROUGHNESS, 8).g;
     }
     if (has_map(MAP_CLEARCOAT_NORMAL, u_has_clearcoat_normal_map)) {
-        s.clearcoat_normal = normal_from_map(u_clearcoat_normal_map, u_clearcoat_normal_scale, s.clearcoat_normal);
+        s.clearcoat_normal = normal_from_map(u_clearcoat_normal_map, MAP_CLEARCOAT_NORMAL, 9, u_clearcoat_normal_scale,
+                                             s.clearcoat_normal);
     }
 #endif
 #ifdef HAS_SHEEN
-    if (has_map(MAP_SHEEN_COLOR, u_has_sheen_color_map)) s.sheen_color *= texture(u_sheen_color_map, uv).rgb;
-    if (has_map(MAP_SHEEN_ROUGHNESS, u_has_sheen_roughness_map)) s.sheen_roughness *= texture(u_sheen_roughness_map, uv).a;
+    if (has_map(MAP_SHEEN_COLOR, u_has_sheen_color_map)) s.sheen_color *= sample_map(u_sheen_color_map, MAP_SHEEN_COLOR, 10).rgb;
+    if (has_map(MAP_SHEEN_ROUGHNESS, u_has_sheen_roughness_map)) {
+        s.sheen_roughness *= sample_map(u_sheen_roughness_map, MAP_SHEEN_ROUGHNESS, 11).a;
+    }
 #endif
     return s;
 }

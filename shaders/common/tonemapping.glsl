@@ -4,8 +4,14 @@ const int TONEMAP_NONE = 0;
 const int TONEMAP_ACES = 1;
 const int TONEMAP_NEUTRAL = 2;
 
+// Exposed radiance is limited to this before a curve: both curves are white (to 1/255) far
+// below it, so no pixel changes, and the ACES fit's v*v stays finite in float32 (a 1e30 texel,
+// or 1e10 at +32 EV, made it inf/inf = NaN: a black PNG).
+const float TONEMAP_INPUT_MAX = 1.0e6;
+
 // Stephen Hill's fit of the ACES RRT+ODT (BakingLab 2016), sRGB primaries in and out.
 vec3 tonemap_aces_fitted(vec3 c) {
+    c = min(c, vec3(TONEMAP_INPUT_MAX));
     const mat3 m_in = mat3(0.59719, 0.07600, 0.02840,
                            0.35458, 0.90834, 0.13383,
                            0.04823, 0.01566, 0.83777);
@@ -20,6 +26,7 @@ vec3 tonemap_aces_fitted(vec3 c) {
 
 // Khronos PBR Neutral (Khronos 3D Commerce 2024): keeps base colours true up to 0.8.
 vec3 tonemap_pbr_neutral(vec3 c) {
+    c = min(c, vec3(TONEMAP_INPUT_MAX));
     const float start = 0.8 - 0.04;
     const float desaturation = 0.15;
     float x = min(c.r, min(c.g, c.b));

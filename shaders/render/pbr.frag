@@ -1,5 +1,8 @@
 #version 450 core
 // Forward PBR pass: a mesh with the metal-roughness material (factors times glTF textures).
+// ALPHA_MODE (glTF 2.0 material.alphaMode): unset or 0 OPAQUE (alpha ignored, written as 1),
+// 1 MASK (fragments below the cutoff discarded), 2 BLEND (alpha written; the renderer blends).
+// UNLIT (KHR_materials_unlit): the base colour is the radiance.
 #include "common/shading.glsl"
 #include "common/mesh_material.glsl"
 #include "common/debug_views.glsl"
@@ -8,11 +11,24 @@
 layout(location = 0) out vec4 out_radiance;
 
 void main() {
+#if defined(ALPHA_MODE) && ALPHA_MODE != 0
+    float alpha = material_alpha();
+#if ALPHA_MODE == 1
+    if (alpha < u_alpha_cutoff) discard;
+    alpha = 1.0;
+#endif
+#else
+    const float alpha = 1.0;
+#endif
+#ifdef UNLIT
+    out_radiance = encode_output(material_base_color().rgb, alpha);
+#else
     vec3 n = shading_normal();
     vec3 v = normalize(u_camera_position - v_position);
 #ifdef DEBUG_VIEW
-    out_radiance = encode_output(debug_view(material_surface(n), n, v, v_position), 1.0);
+    out_radiance = encode_output(debug_view(material_surface(n), n, v, v_position), alpha);
 #else
-    out_radiance = encode_output(shade(material_surface(n), n, v, v_position), 1.0);
+    out_radiance = encode_output(shade(material_surface(n), n, v, v_position), alpha);
+#endif
 #endif
 }

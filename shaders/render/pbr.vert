@@ -1,10 +1,19 @@
 #version 450 core
-// Forward PBR pass: world-space position, normal and tangent for the fragment shader.
+// Forward PBR pass: world-space position, normal and tangent for the fragment shader; the
+// second uv set (HAS_UV1) and vertex colours (HAS_VERTEX_COLOR) only for parts that have them.
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) in vec4 in_tangent;
+#ifdef HAS_UV1
+layout(location = 4) in vec2 in_uv1;
+out vec2 v_uv1;
+#endif
+#ifdef HAS_VERTEX_COLOR
+layout(location = 5) in vec4 in_color;
+out vec4 v_color;
+#endif
 
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
@@ -21,5 +30,11 @@ void main() {
     v_normal = u_normal_matrix * in_normal;
     v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
     v_uv = in_uv;
+#ifdef HAS_UV1
+    v_uv1 = in_uv1;
+#endif
+#ifdef HAS_VERTEX_COLOR
+    v_color = in_color;
+#endif
     gl_Position = u_view_projection * world;
 }

@@ -5,6 +5,7 @@
 #include "common/material_layers.glsl"
 
 uniform float u_size;
+uniform vec2 u_pixel_origin;   // a tile's bottom-left pixel in the image (alight.render.tiles); else 0
 uniform vec3 u_base_color;
 uniform float u_metallic;
 uniform float u_roughness;
@@ -15,8 +16,9 @@ layout(location = 0) out vec4 out_radiance;
 
 void main() {
     // GL's window origin is the bottom-left; the written file's row 0 is the top, so
-    // y = 1 - 2 (row + 0.5) / W becomes 2 gl_FragCoord.y / W - 1.
-    vec2 xy = 2.0 * gl_FragCoord.xy / u_size - 1.0;
+    // y = 1 - 2 (row + 0.5) / W becomes 2 gl_FragCoord.y / W - 1. Adding a tile's whole-pixel
+    // origin is exact: every pixel gets the same xy as in one pass over the image.
+    vec2 xy = 2.0 * (gl_FragCoord.xy + u_pixel_origin) / u_size - 1.0;
     float r2 = dot(xy, xy);
     if (r2 >= 1.0) discard;
     vec3 n = vec3(xy, sqrt(1.0 - r2));

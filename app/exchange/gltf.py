@@ -1,0 +1,680 @@
+"""glTF 2.0 (.gltf, .glb) into ``alight.core.mesh.Mesh``: the standard library's json parses the
+document, numpy decodes the accessors (``alight.exchange.gltf_accessors``), Pillow the images,
+and ``alight.core.mikktspace`` makes the tangents a file leaves out. (pygltflib was measured and
+left out: its dataclasses-json parse of MetalRoughSpheresNoTextures' 625 objects took about 2 s
+where json.loads takes milliseconds, and it decodes no accessor; see README, "What alight reads".)
+
+What the specification's MUSTs ask of a viewer is done here (section numbers of glTF 2.0):
+the default scene's node hierarchy with TRS or matrix transforms (3.5), a mirroring transform
+reversing the winding (3.7.4), primitive modes TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN
+(3.7.2.1; points and lines are skipped with one warning), flat normals where NORMAL is missing
+(supplied tangents then ignored), MikkTSpace tangents where TANGENT is missing under a normal
+map, COLOR_0, TEXCOORD_0/1, every material slot's texCoord, samplers, alphaMode and
+alphaCutoff, doubleSided, cameras (3.10) and the extensions in ``SUPPORTED``. An extension in
+``extensionsRequired`` that alight does not support refuses the file; one that is only used is
+rendered without, with one warning line per extension.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import struct
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from alight.core.mesh import (
+    FileMaterial,
+    Mesh,
+    MeshPart,
+    Sampler,
+    TextureInfo,
+    TextureTransform,
+    _normalize,
+)
+from alight.core.scene import Camera, Light
+from alight.errors import AlightError
+from alight.exchange.gltf_accessors import Accessors, fail, read_uri
+
+# Extensions alight renders as their specifications say (KHR_materials_specular: its factors;
+# its two textures are warned about where a file uses them).
+SUPPORTED = {
+    "KHR_texture_transform", "KHR_materials_unlit", "KHR_materials_emissive_strength", "KHR_materials_ior",
+    "KHR_materials_specular", "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_texture_webp",
+    "KHR_draco_mesh_compression",
+    "KHR_materials_clearcoat", "KHR_materials_sheen",
+}
+# The layers' textures alight draws (issue 11): FileMaterial slot -> (extension, textureInfo key).
+LAYER_TEXTURES = {
+    "clearcoat": ("KHR_materials_clearcoat", "clearcoatTexture"),
+    "clearcoat_roughness": ("KHR_materials_clearcoat", "clearcoatRoughnessTexture"),
+    "clearcoat_normal": ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
+    "sheen_color": ("KHR_materials_sheen", "sheenColorTexture"),
+    "sheen_roughness": ("KHR_materials_sheen", "sheenRoughnessTexture"),
+}
+# Compression a file cannot be read without: refused in one line when no library decodes it.
+COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_texture_basisu"}
+
+_WRAP = {10497: "repeat", 33071: "clamp_to_edge", 33648: "mirrored_repeat"}
+_MAG = {9728: "nearest", 9729: "linear"}
+_MIN = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest", 9985: "linear_mipmap_nearest",
+        9986: "nearest_mipmap_linear", 9987: "linear_mipmap_linear"}
+_SRGB_SLOTS = ("base_color", "emissive")
+_MODE_NAMES = {0: "POINTS", 1: "LINES", 2: "LINE_LOOP", 3: "LINE_STRIP"}
+
+
+def _draco_available() -> bool:
+    try:
+        import DracoPy  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+@dataclass
+class _Local:
+    """One primitive decoded in its mesh's own space (shared by every node that instances it)."""
+
+    positions: np.ndarray
+    normals: np.ndarray
+    uvs: np.ndarray
+    uvs1: np.ndarray | None
+    colors: np.ndarray | None
+    tangents: np.ndarray
+    indices: np.ndarray
+    material: FileMaterial | None
+
+
+class _Json(dict):
+    """A JSON object whose glTF properties read as attributes (``node.mesh``; None when absent).
+    ``sparse.values`` is the one name a dict method shadows: read it as ``sparse["values"]``."""
+
+    def __getattr__(self, name: str):
+        return self.get(name)
+
+
+def read_document(path: Path, spec: str) -> tuple[_Json, bytes | None]:
+    """The JSON document of a .gltf or .glb (section 4, "GLB File Format Specification") and the
+    GLB binary chunk (None for .gltf)."""
+    data = path.read_bytes()
+    blob = None
+    if data[:4] == b"glTF":
+        if len(data) < 20:
+            raise AlightError(f"{spec}: cannot read the file (truncated GLB header)")
+        version, total = struct.unpack_from("<II", data, 4)
+        if version != 2:
+            raise AlightError(f"{spec}: GLB container version {version}: only 2 is supported")
+        if total > len(data):
+            raise AlightError(f"{spec}: cannot read the file (truncated: the GLB header says {total} bytes, "
+                              f"the file has {len(data)})")
+        chunks, offset = {}, 12
+        while offset + 8 <= total:
+            length, kind = struct.unpack_from("<II", data, offset)
+            if offset + 8 + length > total:
+                raise AlightError(f"{spec}: cannot read the file (a GLB chunk runs past the end)")
+            chunks.setdefault(kind, data[offset + 8:offset + 8 + length])
+            offset += 8 + length + (-length % 4 if kind != 0x4E4F534A else 0)
+        if 0x4E4F534A not in chunks:
+            raise AlightError(f"{spec}: cannot read the file (no JSON chunk in the GLB)")
+        text, blob = chunks[0x4E4F534A], chunks.get(0x004E4942)
+    else:
+        text = data
+    try:
+        doc = json.loads(text.decode("utf-8-sig"), object_hook=_Json)
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise AlightError(f"{spec}: cannot read the file (not valid glTF JSON: {_one_line(exc)})") from None
+    if not isinstance(doc, _Json) or not isinstance(doc.asset, dict):
+        raise AlightError(f"{spec}: cannot read the file (not a glTF document: no 'asset')")
+    return doc, blob
+
+
+class _Reader:
+    def __init__(self, path: Path, spec: str):
+        self.source = spec
+        doc, blob = read_document(path, spec)
+        version = str(doc.asset.get("version") or "")
+        if not version.startswith("2."):
+            raise AlightError(f"{spec}: asset.version {version or '(none)'}: only glTF 2.x is supported")
+        self.doc = doc
+        self.acc = Accessors(doc, spec, path.parent, blob)
+        self.base = path.parent
+        self.warnings: list[str] = []
+        self._warned: set[str] = set()
+        self._images: dict[int, np.ndarray] = {}
+        self._materials: dict[int, FileMaterial] = {}
+        self._locals: dict[tuple[int, int], _Local | None] = {}
+        self._check_extensions()
+
+    # --- messages ------------------------------------------------------------------------
+
+    def warn(self, key: str, line: str) -> None:
+        if key not in self._warned:
+            self._warned.add(key)
+            self.warnings.append(f"{self.source}: {line}")
+
+    def _check_extensions(self) -> None:
+        used = list(self.doc.extensionsUsed or [])
+        required = list(self.doc.extensionsRequired or [])
+        supported = set(SUPPORTED)
+        if not _draco_available():
+            supported.discard("KHR_draco_mesh_compression")
+        for name in required:
+            if name not in supported:
+                why = ("no library that decodes it installs here" if name in COMPRESSION
+                       else "alight does not support it")
+                raise fail(self.source, "extensionsRequired", f"{name} is required and {why}")
+        for name in used:
+            if name not in supported:
+                self.warn(f"ext:{name}", f"extensionsUsed: {name} is not supported; rendered without it")
+
+    # --- images, textures, materials ------------------------------------------------------
+
+    def _image_bytes(self, index: int) -> bytes:
+        images = self.doc.images or []
+        where = f"images[{index}]"
+        if not 0 <= index < len(images):
+            raise fail(self.source, where, "does not exist")
+        image = images[index]
+        if image.uri is not None:
+            return read_uri(self.source, self.base, image.uri, where)
+        if image.bufferView is not None:
+            data, start, length, _ = self.acc.view_bytes(image.bufferView)
+            return data[start:start + length]
+        raise fail(self.source, where, "has neither uri nor bufferView")
+
+    def _decode_images(self, indices: list[int]) -> None:
+        """Decode the images materials use, two at a time (Pillow releases the GIL while decoding)."""
+        from alight.exchange.images import decode_texture
+
+        todo = [i for i in dict.fromkeys(indices) if i not in self._images]
+        if not todo:
+            return
+        blobs = [self._image_bytes(i) for i in todo]
+        wheres = [f"{self.source}: images[{i}]" for i in todo]
+        if len(todo) == 1:
+            self._images[todo[0]] = decode_texture(blobs[0], wheres[0])
+            return
+        with ThreadPoolExecutor(max_workers=min(len(todo), os.cpu_count() or 2)) as pool:
+            for i, image in zip(todo, pool.map(decode_texture, blobs, wheres)):
+                self._images[i] = image
+
+    def _texture_source(self, index: int, element: str) -> int:
+        textures = self.doc.textures or []
+        if not 0 <= index < len(textures):
+            raise fail(self.source, element, f"textures[{index}] does not exist")
+        tex = textures[index]
+        ext = tex.extensions or {}
+        if "KHR_texture_basisu" in ext and tex.source is None:
+            raise fail(self.source, f"textures[{index}]", "KHR_texture_basisu: no library that decodes it installs here")
+        source = tex.source
+        webp = ext.get("EXT_texture_webp")
+        if isinstance(webp, dict) and webp.get("source") is not None:
+            source = webp["source"]
+        if source is None:
+            raise fail(self.source, f"textures[{index}]", "has no image source alight can decode")
+        return int(source)
+
+    def _sampler(self, texture_index: int) -> Sampler:
+        tex = self.doc.textures[texture_index]
+        if tex.sampler is None:
+            return Sampler()
+        samplers = self.doc.samplers or []
+        if not 0 <= tex.sampler < len(samplers):
+            raise fail(self.source, f"textures[{texture_index}]", f"samplers[{tex.sampler}] does not exist")
+        s = samplers[tex.sampler]
+        where = f"samplers[{tex.sampler}]"
+        for name, value, table in (("wrapS", s.wrapS, _WRAP), ("wrapT", s.wrapT, _WRAP)):
+            if value is not None and value not in table:
+                raise fail(self.source, where, f"{name} {value} is not a glTF wrap mode")
+        return Sampler(wrap_s=_WRAP.get(s.wrapS if s.wrapS is not None else 10497, "repeat"),
+                       wrap_t=_WRAP.get(s.wrapT if s.wrapT is not None else 10497, "repeat"),
+                       mag_filter=_MAG.get(s.magFilter, "linear"),
+                       min_filter=_MIN.get(s.minFilter, "linear_mipmap_linear"))
+
+    def _texture_info(self, info, element: str) -> tuple[TextureInfo, int] | None:
+        """A material's textureInfo: (TextureInfo without its image yet, image index)."""
+        if info is None or info.index is None:
+            return None
+        tex_coord = int(info.texCoord or 0)
+        transform = None
+        ext = (info.extensions or {}).get("KHR_texture_transform")
+        if isinstance(ext, dict):
+            try:
+                offset = tuple(float(x) for x in ext.get("offset", (0.0, 0.0)))
+                scale = tuple(float(x) for x in ext.get("scale", (1.0, 1.0)))
+                rotation = float(ext.get("rotation", 0.0))
+            except (TypeError, ValueError):
+                raise fail(self.source, f"{element}.extensions.KHR_texture_transform", "bad offset, rotation or scale") from None
+            if len(offset) != 2 or len(scale) != 2 or not all(map(math.isfinite, (*offset, *scale, rotation))):
+                raise fail(self.source, f"{element}.extensions.KHR_texture_transform", "bad offset, rotation or scale")
+            transform = TextureTransform(offset, rotation, scale)  # type: ignore[arg-type]
+            if ext.get("texCoord") is not None:
+                tex_coord = int(ext["texCoord"])
+        if tex_coord not in (0, 1):
+            self.warn(f"texcoord:{tex_coord}", f"{element}: texCoord {tex_coord}: only TEXCOORD_0 and TEXCOORD_1 "
+                                               f"are read; the texture is left out")
+            return None
+        image_index = self._texture_source(int(info.index), element)
+        return TextureInfo(image=None, tex_coord=tex_coord, transform=transform,  # type: ignore[arg-type]
+                           sampler=self._sampler(int(info.index))), image_index
+
+    def material(self, index: int) -> FileMaterial:
+        fm = self._materials.get(index)
+        if fm is not None:
+            return fm
+        from alight.exchange.gltf_material import layer_fields_from_gltf, material_from_gltf
+
+        materials = self.doc.materials or []
+        where = f"materials[{index}]"
+        if not 0 <= index < len(materials):
+            raise fail(self.source, where, "does not exist")
+        m = materials[index]
+        pbr = m.pbrMetallicRoughness
+        ext = m.extensions or {}
+        raw = {
+            "name": m.name,
+            "pbrMetallicRoughness": {} if pbr is None else {
+                k: v for k, v in (("baseColorFactor", pbr.baseColorFactor), ("metallicFactor", pbr.metallicFactor),
+                                  ("roughnessFactor", pbr.roughnessFactor)) if v is not None},
+            "emissiveFactor": m.emissiveFactor,
+            "extensions": ext,
+        }
+        try:
+            factors = material_from_gltf(raw, self.source, name=f"material{index}")
+        except AlightError as e:
+            message = str(e)
+            prefix = f"{self.source}: "
+            raise AlightError(f"{self.source}: {where}: {message[len(prefix):] if message.startswith(prefix) else message}") from None
+        base = list(pbr.baseColorFactor) if pbr is not None and pbr.baseColorFactor else [1.0, 1.0, 1.0, 1.0]
+        alpha_mode = m.alphaMode or "OPAQUE"
+        if alpha_mode not in ("OPAQUE", "MASK", "BLEND"):
+            raise fail(self.source, where, f"alphaMode {alpha_mode!r} is not OPAQUE, MASK or BLEND")
+        slots = {
+            "base_color": pbr.baseColorTexture if pbr is not None else None,
+            "metallic_roughness": pbr.metallicRoughnessTexture if pbr is not None else None,
+            "normal": m.normalTexture, "emissive": m.emissiveTexture, "occlusion": m.occlusionTexture,
+        }
+        infos = {}
+        for slot, (name, key) in LAYER_TEXTURES.items():
+            layer_info = (ext.get(name) or {}).get(key) if isinstance(ext.get(name), dict) else None
+            if isinstance(layer_info, dict):
+                slots[slot] = SimpleNamespace(index=layer_info.get("index"), texCoord=layer_info.get("texCoord"),
+                                              extensions=layer_info.get("extensions"))
+        for slot, info in slots.items():
+            got = self._texture_info(info, f"{where}.{_json_slot(slot)}")
+            if got is not None:
+                infos[slot] = got
+        spec = ext.get("KHR_materials_specular")
+        if isinstance(spec, dict) and (spec.get("specularTexture") or spec.get("specularColorTexture")):
+            self.warn("specular-textures", f"{where}: KHR_materials_specular textures are not applied "
+                                           f"(its factors are)")
+        self._decode_images([image_index for _, image_index in infos.values()])
+        textures = {}
+        for slot, (info, image_index) in infos.items():
+            info.image = self._images[image_index]
+            textures[f"{slot}_texture"] = info
+        fm = FileMaterial(
+            base_color=tuple(float(x) for x in factors.base_color),  # type: ignore[arg-type]
+            metallic=float(factors.metallic), roughness=float(factors.roughness),
+            emissive=tuple(float(x) for x in factors.emissive),  # type: ignore[arg-type]
+            alpha=float(base[3]) if len(base) > 3 else 1.0,
+            normal_scale=float(m.normalTexture.scale if m.normalTexture is not None and m.normalTexture.scale is not None else 1.0),
+            occlusion_strength=float(m.occlusionTexture.strength if m.occlusionTexture is not None
+                                     and m.occlusionTexture.strength is not None else 1.0),
+            alpha_mode=alpha_mode,
+            alpha_cutoff=float(0.5 if m.alphaCutoff is None else m.alphaCutoff),
+            double_sided=bool(m.doubleSided),
+            unlit="KHR_materials_unlit" in ext,
+            specular_f0=tuple(float(x) for x in factors.specular_f0),  # type: ignore[arg-type]
+            name=m.name or f"material{index}",
+            layers=layer_fields_from_gltf(raw, self.source),
+            clearcoat_normal_scale=float((ext.get("KHR_materials_clearcoat") or {}).get("clearcoatNormalTexture", {})
+                                         .get("scale", 1.0)) if isinstance(ext.get("KHR_materials_clearcoat"), dict) else 1.0,
+            **textures,
+        )
+        self._materials[index] = fm
+        return fm
+
+    # --- geometry --------------------------------------------------------------------------
+
+    def primitive(self, mesh_index: int, prim_index: int) -> _Local | None:
+        key = (mesh_index, prim_index)
+        if key not in self._locals:
+            self._locals[key] = self._decode_primitive(mesh_index, prim_index)
+        return self._locals[key]
+
+    def _decode_primitive(self, mesh_index: int, prim_index: int) -> _Local | None:
+        element = f"meshes[{mesh_index}].primitives[{prim_index}]"
+        prim = self.doc.meshes[mesh_index].primitives[prim_index]
+        mode = 4 if prim.mode is None else int(prim.mode)
+        if mode in _MODE_NAMES:
+            self.warn(f"mode:{mode}", f"{element}: mode {_MODE_NAMES[mode]}: points and lines are not drawn")
+            return None
+        if mode not in (4, 5, 6):
+            raise fail(self.source, element, f"mode {mode} is not a glTF primitive mode")
+        attrs = prim.attributes
+        ext = prim.extensions or {}
+        draco = ext.get("KHR_draco_mesh_compression")
+        if "EXT_meshopt_compression" in (self.doc.extensionsRequired or []):
+            raise fail(self.source, element, "EXT_meshopt_compression: no library that decodes it installs here")
+        if isinstance(draco, dict) and _draco_available():
+            arrays, indices = self._draco(draco, element)
+        else:
+            if getattr(attrs, "POSITION", None) is None:
+                raise fail(self.source, element, "has no POSITION attribute")
+            arrays = {}
+            for name in ("POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0"):
+                index = getattr(attrs, name, None)
+                if index is not None:
+                    arrays[name] = self.acc.read(index, f"{element}: {name}")
+            count = len(arrays["POSITION"])
+            for name, array in arrays.items():
+                if len(array) != count:
+                    raise fail(self.source, f"{element}: {name}", f"has {len(array)} elements, POSITION has {count}")
+            indices = (self.acc.indices(prim.indices, element, count) if prim.indices is not None
+                       else np.arange(count, dtype=np.int64))
+        faces = _triangles(indices, mode)
+        positions = arrays["POSITION"][:, :3].astype(np.float64)
+        if not np.isfinite(positions).all():
+            raise fail(self.source, f"{element}: POSITION", "contains NaN or Inf")
+        faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])]
+        if len(faces) == 0:
+            return None
+        material = self.material(int(prim.material)) if prim.material is not None else None
+
+        def attribute(name: str, width: int) -> np.ndarray | None:
+            a = arrays.get(name)
+            if a is None:
+                return None
+            if a.shape[1] < width:
+                raise fail(self.source, f"{element}: {name}", f"has {a.shape[1]} components, {width} needed")
+            return np.nan_to_num(a[:, :width].astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+
+        normals = attribute("NORMAL", 3)
+        tangents = attribute("TANGENT", 4)
+        uv0, uv1 = attribute("TEXCOORD_0", 2), attribute("TEXCOORD_1", 2)
+        colors = arrays.get("COLOR_0")
+        if colors is not None:
+            colors = np.nan_to_num(colors.astype(np.float64))
+            if colors.shape[1] == 3:
+                colors = np.concatenate([colors, np.ones((len(colors), 1))], axis=1)
+            elif colors.shape[1] != 4:
+                raise fail(self.source, f"{element}: COLOR_0", "must be VEC3 or VEC4")
+        # glTF uvs have v down from the image's top; alight's are OpenGL's (v up from the bottom).
+        for uv in (uv0, uv1):
+            if uv is not None:
+                uv[:, 1] = 1.0 - uv[:, 1]
+        if normals is None:
+            # Section 3.7.2.1: flat normals, and supplied tangents are then ignored.
+            corner = faces.reshape(-1)
+            positions, faces = positions[corner], np.arange(len(corner), dtype=np.int64).reshape(-1, 3)
+            uv0 = uv0[corner] if uv0 is not None else None
+            uv1 = uv1[corner] if uv1 is not None else None
+            colors = colors[corner] if colors is not None else None
+            p = positions[faces]
+            face_n, ok = _normalize(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
+            face_n[~ok] = (0.0, 1.0, 0.0)
+            normals = np.repeat(face_n, 3, axis=0)
+            tangents = None
+        else:
+            normals, ok = _normalize(normals)
+            if not ok.all():
+                from alight.core.mesh import smooth_normals
+
+                computed, computed_ok = _normalize(smooth_normals(positions, faces))
+                normals[~ok] = np.where(computed_ok[~ok, None], computed[~ok], (0.0, 1.0, 0.0))
+        uvs = uv0 if uv0 is not None else np.zeros((len(positions), 2))
+        if uv1 is None and material is not None and any(i.tex_coord == 1 for i in material.textures().values()):
+            self.warn(f"uv1:{element}", f"{element}: a texture reads texCoord 1 but there is no TEXCOORD_1; "
+                                        f"TEXCOORD_0 is used")
+        normal_info = material.normal_texture if material is not None else None
+        if tangents is not None:
+            t_xyz, t_ok = _normalize(tangents[:, :3])
+            tangents = np.concatenate([t_xyz, np.where(tangents[:, 3:4] < 0, -1.0, 1.0)], axis=1)
+            if not t_ok.all():
+                tangents = None   # a broken TANGENT: regenerate rather than shade garbage
+        if tangents is None and normal_info is not None:
+            from alight.core.mikktspace import generate_tangents, split_vertices
+
+            tangent_uv = uv1 if (normal_info.tex_coord == 1 and uv1 is not None) else uvs
+            corner_t = generate_tangents(positions, normals, tangent_uv, faces)
+            source, faces, tangents = split_vertices(faces, corner_t)
+            positions, normals, uvs = positions[source], normals[source], uvs[source]
+            uv1 = uv1[source] if uv1 is not None else None
+            colors = colors[source] if colors is not None else None
+        if tangents is None and uv0 is None:
+            tangents = _any_tangents(normals)   # no uvs: no map can be placed on it
+        elif tangents is None:
+            from alight.core.mesh import compute_tangents
+
+            tangents = compute_tangents(positions, normals, uvs, faces)   # for maps the user loads
+        return _Local(positions=positions, normals=normals, uvs=uvs, uvs1=uv1, colors=colors,
+                      tangents=np.asarray(tangents, np.float64), indices=faces, material=material)
+
+    def _draco(self, draco: dict, element: str) -> tuple[dict, np.ndarray]:
+        """KHR_draco_mesh_compression decoded with DracoPy (Google's Draco library)."""
+        import DracoPy
+
+        data, start, length, _ = self.acc.view_bytes(draco.get("bufferView"))
+        try:
+            mesh = DracoPy.decode(data[start:start + length])
+        except Exception as exc:
+            raise fail(self.source, f"{element}: KHR_draco_mesh_compression", f"cannot decode ({_one_line(exc)})") from None
+        arrays = {"POSITION": np.asarray(mesh.points, np.float32).reshape(-1, 3)}
+        ids = draco.get("attributes", {})
+        by_id = {}
+        for attr in getattr(mesh, "attributes", []) or []:
+            uid = attr.get("unique_id") if isinstance(attr, dict) else None
+            if uid is not None:
+                by_id[int(uid)] = np.asarray(attr["data"], np.float32).reshape(len(arrays["POSITION"]), -1)
+        for name in ("NORMAL", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0", "TANGENT"):
+            if name in ids and int(ids[name]) in by_id:
+                arrays[name] = by_id[int(ids[name])]
+        if "NORMAL" in ids and "NORMAL" not in arrays and getattr(mesh, "normals", None) is not None:
+            arrays["NORMAL"] = np.asarray(mesh.normals, np.float32).reshape(-1, 3)
+        if "TEXCOORD_0" in ids and "TEXCOORD_0" not in arrays and getattr(mesh, "tex_coord", None) is not None:
+            arrays["TEXCOORD_0"] = np.asarray(mesh.tex_coord, np.float32).reshape(-1, 2)
+        faces = np.asarray(mesh.faces, np.int64).reshape(-1)
+        return arrays, faces
+
+    # --- the scene --------------------------------------------------------------------------
+
+    def load(self) -> Mesh:
+        doc = self.doc
+        nodes = doc.nodes or []
+        scenes = doc.scenes or []
+        if scenes:
+            scene_index = doc.scene if doc.scene is not None else 0
+            if not 0 <= scene_index < len(scenes):
+                raise fail(self.source, "scene", f"scenes[{scene_index}] does not exist")
+            roots = list(scenes[scene_index].nodes or [])
+        else:
+            children = {c for n in nodes for c in (n.children or [])}
+            roots = [i for i in range(len(nodes)) if i not in children]
+        parts: list[MeshPart] = []
+        cameras: list[tuple[int, np.ndarray]] = []
+        lights: list[Light] = []
+        light_defs = ((doc.extensions or {}).get("KHR_lights_punctual") or {}).get("lights") or []
+        visited: set[int] = set()
+        stack = [(int(r), np.eye(4)) for r in reversed(roots)]
+        while stack:
+            index, parent = stack.pop()
+            if not 0 <= index < len(nodes):
+                raise fail(self.source, f"nodes[{index}]", "does not exist")
+            if index in visited:
+                raise fail(self.source, f"nodes[{index}]", "is reached twice (the node hierarchy must be a forest)")
+            visited.add(index)
+            node = nodes[index]
+            world = parent @ _local_matrix(node, self.source, index)
+            if node.mesh is not None:
+                parts.extend(self._place(int(node.mesh), world, node.name or f"node{index}"))
+            if node.camera is not None:
+                cameras.append((int(node.camera), world))
+            light_ref = (node.extensions or {}).get("KHR_lights_punctual")
+            if isinstance(light_ref, dict) and light_ref.get("light") is not None:
+                lights.append(self._light(int(light_ref["light"]), light_defs, world))
+            for child in reversed(node.children or []):
+                stack.append((int(child), world))
+        if not parts:
+            raise AlightError(f"{self.source}: no triangles in the file")
+        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings)
+        mesh.cameras = [self._camera(i, world, mesh) for i, world in cameras]
+        return mesh
+
+    def _place(self, mesh_index: int, world: np.ndarray, name: str) -> list[MeshPart]:
+        meshes = self.doc.meshes or []
+        if not 0 <= mesh_index < len(meshes):
+            raise fail(self.source, f"meshes[{mesh_index}]", "does not exist")
+        if not np.isfinite(world).all():
+            raise fail(self.source, f"meshes[{mesh_index}]", "its node transform contains NaN or Inf")
+        out = []
+        for p in range(len(meshes[mesh_index].primitives or [])):
+            local = self.primitive(mesh_index, p)
+            if local is None:
+                continue
+            m, t = world[:3, :3], world[:3, 3]
+            # Normals take the cofactor matrix (det * inverse transpose) times sign(det); a
+            # mirroring transform also reverses the winding (section 3.7.4) and the bitangent.
+            cof = np.stack([np.cross(m[1], m[2]), np.cross(m[2], m[0]), np.cross(m[0], m[1])])
+            det = float(np.dot(m[0], cof[0]))
+            faces = local.indices
+            if det < 0:
+                faces, cof = faces[:, ::-1], -cof
+            normals, ok = _normalize(local.normals @ cof.T)
+            normals[~ok] = (0.0, 1.0, 0.0)
+            t_xyz, t_ok = _normalize(local.tangents[:, :3] @ m.T)
+            t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
+            t_xyz, t_ok = _normalize(t_xyz)
+            if not t_ok.all():
+                axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+                fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
+                t_xyz[~t_ok] = fallback[~t_ok]
+            w = local.tangents[:, 3:4] * (1.0 if det >= 0 else -1.0)
+            out.append(MeshPart(
+                name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
+                positions=np.ascontiguousarray(local.positions @ m.T + t, dtype=np.float32),
+                normals=np.ascontiguousarray(normals, dtype=np.float32),
+                uvs=np.ascontiguousarray(local.uvs, dtype=np.float32),
+                tangents=np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32),
+                indices=np.ascontiguousarray(faces, dtype=np.uint32),
+                material=local.material,
+                uvs1=None if local.uvs1 is None else np.ascontiguousarray(local.uvs1, dtype=np.float32),
+                colors=None if local.colors is None else np.ascontiguousarray(local.colors, dtype=np.float32),
+                element=f"meshes[{mesh_index}].primitives[{p}]",
+            ))
+        return out
+
+    def _camera(self, index: int, world: np.ndarray, mesh: Mesh) -> Camera:
+        cams = self.doc.cameras or []
+        where = f"cameras[{index}]"
+        if not 0 <= index < len(cams):
+            raise fail(self.source, where, "does not exist")
+        cam = cams[index]
+        position = world[:3, 3]
+        forward, _ = _normalize(-world[:3, 2])
+        up, _ = _normalize(world[:3, 1])
+        centre, radius = mesh.bounding_sphere()
+        reach = float(np.linalg.norm(position - centre)) + 2.0 * radius
+        if cam.type == "orthographic" and cam.orthographic is not None:
+            o = cam.orthographic
+            near, far = float(o.znear or 0.0), float(o.zfar or reach)
+            return Camera(tuple(position), tuple(position + forward), tuple(up), 35.0, near=near,
+                          far=max(far, near + 1e-6), ortho_half_height=abs(float(o.ymag or 1.0)))
+        p = cam.perspective
+        if p is None or p.yfov is None or not p.yfov > 0:
+            raise fail(self.source, where, "perspective.yfov is missing or not positive")
+        near = float(p.znear) if p.znear else 0.01
+        far = float(p.zfar) if p.zfar else max(reach, near * 10.0)
+        return Camera(tuple(position), tuple(position + forward), tuple(up), math.degrees(float(p.yfov)),
+                      near=near, far=far)
+
+    def _light(self, index: int, defs: list, world: np.ndarray) -> Light:
+        where = f"extensions.KHR_lights_punctual.lights[{index}]"
+        if not 0 <= index < len(defs) or not isinstance(defs[index], dict):
+            raise fail(self.source, where, "does not exist")
+        d = defs[index]
+        kind = d.get("type")
+        if kind not in ("point", "directional", "spot"):
+            raise fail(self.source, where, f"type {kind!r} is not point, directional or spot")
+        color = tuple(float(x) for x in d.get("color", (1.0, 1.0, 1.0)))
+        intensity = float(d.get("intensity", 1.0))
+        direction, _ = _normalize(-world[:3, 2])
+        position = world[:3, 3]
+        light = Light(kind=kind, vector=tuple(direction) if kind == "directional" else tuple(position),
+                      color=color, intensity=intensity, direction=tuple(direction))  # type: ignore[arg-type]
+        if d.get("range") is not None and kind != "directional":
+            light.range = float(d["range"])
+        if kind == "spot":
+            spot = d.get("spot") or {}
+            light.inner_cone_deg = math.degrees(float(spot.get("innerConeAngle", 0.0)))
+            light.outer_cone_deg = math.degrees(float(spot.get("outerConeAngle", math.pi / 4)))
+        return light
+
+
+def _any_tangents(normals: np.ndarray) -> np.ndarray:
+    """(N, 4) unit tangents orthogonal to the normals, w = 1 (a part without uvs)."""
+    axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    t, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
+    return np.concatenate([t, np.ones((len(t), 1))], axis=1)
+
+
+def _json_slot(slot: str) -> str:
+    if slot in LAYER_TEXTURES:
+        return "extensions.{}.{}".format(*LAYER_TEXTURES[slot])
+    return {"base_color": "pbrMetallicRoughness.baseColorTexture",
+            "metallic_roughness": "pbrMetallicRoughness.metallicRoughnessTexture",
+            "normal": "normalTexture", "emissive": "emissiveTexture", "occlusion": "occlusionTexture"}[slot]
+
+
+def _triangles(indices: np.ndarray, mode: int) -> np.ndarray:
+    """Triangles (M, 3) of a primitive's index list (section 3.7.2.1's topology table)."""
+    n = len(indices)
+    if mode == 4:
+        return indices[: n - n % 3].reshape(-1, 3)
+    if n < 3:
+        return np.zeros((0, 3), np.int64)
+    i = np.arange(n - 2)
+    if mode == 5:   # TRIANGLE_STRIP: p_i = {v_i, v_{i+(1+i%2)}, v_{i+(2-i%2)}}
+        return np.stack([indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]], axis=1)
+    # TRIANGLE_FAN: p_i = {v_{i+1}, v_{i+2}, v_0}
+    return np.stack([indices[i + 1], indices[i + 2], np.full_like(i, indices[0])], axis=1)
+
+
+def _local_matrix(node, source: str, index: int) -> np.ndarray:
+    """A node's local transform (section 3.5.3): its column-major matrix, or T * R * S."""
+    if node.matrix is not None:
+        m = np.asarray(node.matrix, np.float64)
+        if m.shape != (16,):
+            raise fail(source, f"nodes[{index}].matrix", "must have 16 numbers")
+        return m.reshape(4, 4).T
+    t = np.asarray(node.translation if node.translation is not None else (0.0, 0.0, 0.0), np.float64)
+    q = np.asarray(node.rotation if node.rotation is not None else (0.0, 0.0, 0.0, 1.0), np.float64)
+    s = np.asarray(node.scale if node.scale is not None else (1.0, 1.0, 1.0), np.float64)
+    if t.shape != (3,) or q.shape != (4,) or s.shape != (3,):
+        raise fail(source, f"nodes[{index}]", "translation, rotation or scale has the wrong length")
+    norm = np.linalg.norm(q)
+    x, y, z, w = q / norm if norm > 0 else (0.0, 0.0, 0.0, 1.0)
+    r = np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+    out = np.eye(4)
+    out[:3, :3] = r * s[None, :]
+    out[:3, 3] = t
+    return out
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 160 else text[:157] + "..."
+
+
+def load_gltf(path: Path, spec: str) -> Mesh:
+    """A .gltf/.glb file as world-space parts with its cameras, lights and warnings."""
+    return _Reader(path, spec).load()
