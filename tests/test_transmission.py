@@ -308,3 +308,53 @@ def test_reference_refuses_a_refracted_lobe_too_narrow_to_sum(tmp_path):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("alight: error: --roughness:") and "narrower" in lines[0]
     assert not out.exists()
+
+
+# --- the layer's textures, by equivalence -------------------------------------------------------
+
+def _draw_file_material(shared_data, **fields):
+    import dataclasses as dc
+
+    from alight.core.mesh import FileMaterial
+
+    material = FileMaterial(**{**dict(base_color=(0.9, 0.85, 0.8), metallic=0.0, roughness=0.35), **fields})
+    mesh = sphere(64, 32)
+    mesh = dc.replace(mesh, parts=[dc.replace(mesh.parts[0], material=material)])
+    scene = Scene(mesh=mesh, material=Material(), use_file_materials=True,
+                  lights=[Light("point", (2.0, 3.0, 4.0), (1.0, 1.0, 1.0), 20.0)])
+    return renderer().render(scene, maps_for(load_environment(str(shared_data / "env" / "venice_sunset_1k.hdr"))),
+                             96, 96, aa="none").linear
+
+
+def test_transmission_and_thickness_textures_equal_their_factors(shared_data):
+    """transmissionTexture R and thicknessTexture G multiply their factors (the extensions):
+    constant maps render as the product of the factors, within 1% (relMAE, linear); without the
+    maps the image differs (> 5%), so the maps are read."""
+    texture = np.full((8, 8, 4), 255, np.uint8)
+    texture[..., 0] = 153   # R: transmission 0.6
+    texture[..., 1] = 102   # G: thickness 0.4 of the factor
+    layers = {"transmission": 1.0, "thickness": 1.5, "ior": 1.5, "attenuation_color": (0.5, 0.7, 0.9),
+              "attenuation_distance": 0.5}
+    with_maps = _draw_file_material(shared_data, layers=layers, transmission_texture=texture, thickness_texture=texture)
+    factors = _draw_file_material(shared_data, layers={**layers, "transmission": 153 / 255, "thickness": 1.5 * 102 / 255})
+    covered = factors[..., 3] > 0
+    assert relative(with_maps[..., :3][covered], factors[..., :3][covered]) <= 0.01
+    bare = _draw_file_material(shared_data, layers=layers)
+    assert relative(bare[..., :3][covered], factors[..., :3][covered]) > 0.05
+
+
+def test_the_compare_models_bring_their_transmission_and_volume(shared_data):
+    """CompareVolume's thicknessTexture and CompareIor's transmissionTexture reach their parts,
+    and neither extension is warned about any more."""
+    from alight.exchange.meshes import load_mesh
+
+    root = shared_data / "models" / "khronos"
+    volume = load_mesh(str(root / "CompareVolume" / "glTF-Binary" / "CompareVolume.glb"))
+    ior = load_mesh(str(root / "CompareIor" / "glTF-Binary" / "CompareIor.glb"))
+    for mesh in (volume, ior):
+        assert not any("KHR_materials_transmission" in w or "KHR_materials_volume" in w for w in mesh.warnings)
+    thick = [p.material for p in volume.parts if p.material is not None and p.material.layers.get("thickness")]
+    assert thick and all(m.thickness_texture is not None for m in thick)
+    assert thick[0].layers["attenuation_color"] == pytest.approx((0.15, 1.0, 0.5))
+    transmissive = [p.material for p in ior.parts if p.material is not None and p.material.layers.get("transmission")]
+    assert len(transmissive) == 2 and all(m.transmission_texture is not None for m in transmissive)

@@ -85,8 +85,10 @@ TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
 # The layers' textures (KHR_materials_clearcoat, KHR_materials_sheen): clearcoat R and
 # clearcoat_roughness G multiply their factors (linear); clearcoat_normal is the coat's own
 # tangent-space normal map (scaled by clearcoat_normal_scale); sheen_color RGB (sRGB) and
-# sheen_roughness A multiply theirs.
-LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness")
+# sheen_roughness A multiply theirs. KHR_materials_transmission's R multiplies transmission and
+# KHR_materials_volume's thickness G multiplies thickness (linear).
+LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness",
+                       "transmission", "thickness")
 
 
 @dataclass
@@ -125,6 +127,8 @@ class FileMaterial:
     clearcoat_normal_scale: float = 1.0
     sheen_color_texture: TextureInfo | None = None
     sheen_roughness_texture: TextureInfo | None = None
+    transmission_texture: TextureInfo | None = None
+    thickness_texture: TextureInfo | None = None
 
     def __post_init__(self) -> None:
         for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:

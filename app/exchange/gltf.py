@@ -47,7 +47,7 @@ SUPPORTED = {
     "KHR_texture_transform", "KHR_materials_unlit", "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_specular", "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_texture_webp",
     "KHR_draco_mesh_compression",
-    "KHR_materials_clearcoat", "KHR_materials_sheen",
+    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_transmission", "KHR_materials_volume",
 }
 # The layers' textures alight draws (issue 11): FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
@@ -56,6 +56,8 @@ LAYER_TEXTURES = {
     "clearcoat_normal": ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
     "sheen_color": ("KHR_materials_sheen", "sheenColorTexture"),
     "sheen_roughness": ("KHR_materials_sheen", "sheenRoughnessTexture"),
+    "transmission": ("KHR_materials_transmission", "transmissionTexture"),
+    "thickness": ("KHR_materials_volume", "thicknessTexture"),
 }
 # Compression a file cannot be read without: refused in one line when no library decodes it.
 COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_texture_basisu"}

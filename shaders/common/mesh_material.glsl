@@ -71,12 +71,20 @@ uniform bool u_has_sheen_roughness_map;       // A multiplies sheen_roughness
 uniform sampler2D u_sheen_color_map;
 uniform sampler2D u_sheen_roughness_map;
 #endif
+#ifdef HAS_TRANSMISSION
+uniform bool u_has_transmission_map;          // R multiplies transmission
+uniform sampler2D u_transmission_map;
+#endif
+#ifdef HAS_VOLUME
+uniform bool u_has_thickness_map;             // G multiplies thickness
+uniform sampler2D u_thickness_map;
+#endif
 
 // The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 4095
+#define MATERIAL_MAPS_MASK 16383
 #endif
 #ifndef MAP_UV1_MASK
 #define MAP_UV1_MASK 0
@@ -102,7 +110,9 @@ const int MAP_CLEARCOAT_ROUGHNESS = 256;
 const int MAP_CLEARCOAT_NORMAL = 512;
 const int MAP_SHEEN_COLOR = 1024;
 const int MAP_SHEEN_ROUGHNESS = 2048;
-const int MAP_SLOTS = 12;
+const int MAP_TRANSMISSION = 4096;
+const int MAP_THICKNESS = 8192;
+const int MAP_SLOTS = 14;
 // KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
 uniform mat3 u_map_transform[MAP_SLOTS];
 
@@ -228,6 +238,12 @@ Surface material_surface(vec3 n) {
     if (has_map(MAP_SHEEN_ROUGHNESS, u_has_sheen_roughness_map)) {
         s.sheen_roughness *= sample_map(u_sheen_roughness_map, MAP_SHEEN_ROUGHNESS, 11).a;
     }
+#endif
+#ifdef HAS_TRANSMISSION
+    if (has_map(MAP_TRANSMISSION, u_has_transmission_map)) s.transmission *= sample_map(u_transmission_map, MAP_TRANSMISSION, 12).r;
+#endif
+#ifdef HAS_VOLUME
+    if (has_map(MAP_THICKNESS, u_has_thickness_map)) s.thickness *= sample_map(u_thickness_map, MAP_THICKNESS, 13).g;
 #endif
     return s;
 }
