@@ -7,7 +7,7 @@ Tolerances: GLSL runs in float32, the twins in float64, so agreement is to float
 import numpy as np
 import pytest
 
-from alight.core import shading
+from alight.core import btdf, shading
 from alight.ibl.bake import roughness_to_grid_step
 from tests.gpu import evaluate
 
@@ -111,3 +111,75 @@ def test_spot_and_range_attenuation():
     gpu = evaluate("SPOT_RANGE", x)
     close(gpu[:, 0], shading.spot_attenuation(x[:, 0], x[:, 1], x[:, 2]), rtol=1e-4, atol=1e-6)
     close(gpu[:, 1], shading.range_attenuation(x[:, 3], 1.0), rtol=1e-4, atol=1e-6)
+
+
+# --- the transmission BTDF and layer (common/btdf.glsl and transmission.glsl against
+# app/core/btdf.py and app/core/layers/transmission.py) -------------------------------------
+
+TRANSMISSION_TERMS = {"BTDF_THIN": 0, "BTDF_REFRACTION": 1, "BEER_LAMBERT": 2, "TRANSMISSION_LIGHT": 3}
+
+
+def evaluate_transmission(term, inputs, uniforms=None):
+    return evaluate(TRANSMISSION_TERMS[term], inputs, uniforms, shader="accuracy/evaluate_transmission.comp",
+                    defines={"HAS_TRANSMISSION": None, "HAS_VOLUME": None})
+
+
+def _view_at(n_dot_v):
+    return np.column_stack([np.sqrt(1 - n_dot_v ** 2), np.zeros_like(n_dot_v), n_dot_v])
+
+
+def _light_at(n_dot_l, phi):
+    s = np.sqrt(1 - n_dot_l ** 2)
+    return np.column_stack([s * np.cos(phi), s * np.sin(phi), n_dot_l])
+
+
+def test_btdf_thin():
+    x = np.column_stack([rng.uniform(0.01, 1, 400), -rng.uniform(0.01, 1, 400), rng.uniform(0, 1, 400),
+                         rng.uniform(0.1, 1, 400)])
+    gpu = evaluate_transmission("BTDF_THIN", x)
+    for column, k in ((0, shading.k_ibl), (1, shading.k_direct)):
+        close(gpu[:, column], btdf.btdf_thin(x[:, 0], x[:, 1], x[:, 2], x[:, 3], k(x[:, 3])), rtol=3e-4, atol=1e-6)
+
+
+def test_btdf_refraction_and_its_half_vector():
+    x = np.column_stack([rng.uniform(0.05, 1, 500), -rng.uniform(0.05, 1, 500), rng.uniform(0.2, 1, 500),
+                         rng.uniform(1.05, 2.6, 500)])
+    gpu = evaluate_transmission("BTDF_REFRACTION", x)
+    n = np.array([0.0, 0.0, 1.0])
+    value, v_dot_h = btdf.transmission_btdf(n, _view_at(x[:, 0]), _light_at(x[:, 1], np.pi), x[:, 2],
+                                            shading.k_ibl(x[:, 2]), x[:, 3], False)
+    close(gpu[:, 0], value, rtol=2e-3, atol=1e-5)
+    close(np.clip(gpu[:, 1], 0, 1), v_dot_h, atol=1e-5)
+    assert (value > 0).sum() > 300   # most of the cases are real refractions, not the zero branch
+
+
+def test_beer_lambert():
+    x = np.column_stack([rng.uniform(0, 1, (200, 3)), rng.uniform(0, 3, 200)])
+    x[:10, 3] = 0.0
+    for distance in (0.5, 2.0, 3.0e38):
+        gpu = evaluate_transmission("BEER_LAMBERT", x, {"u_params": (distance, 0.0, 0.0, 0.0)})[:, :3]
+        close(gpu, btdf.beer_lambert(x[:, :3], distance, x[:, 3:4]), rtol=1e-4, atol=1e-6)
+    assert np.all(btdf.beer_lambert(x[:, :3], np.inf, x[:, 3:4]) == 1.0)
+    np.testing.assert_allclose(btdf.beer_lambert([0.25, 0.5, 1.0], 2.0, 4.0), [0.0625, 0.25, 1.0])
+
+
+@pytest.mark.parametrize("ior,thickness", [(1.5, 0.0), (1.5, 1.0), (2.4, 0.3), (1.33, 2.0)])
+@pytest.mark.parametrize("punctual", [False, True])
+def test_transmission_light(ior, thickness, punctual):
+    from alight.core.layers.stack import Pairs
+    from alight.core.layers.transmission import transmission_light
+    from alight.core.material import Material
+
+    x = np.column_stack([-rng.uniform(0.02, 1, 300), rng.uniform(0.02, 1, 300), rng.uniform(0.05, 1, 300),
+                         rng.uniform(0, 2 * np.pi, 300)])
+    x[:20, 0] *= -1   # some lights in front: no transmitted light there
+    params = (ior, thickness, 0.25, float(punctual))
+    gpu = evaluate_transmission("TRANSMISSION_LIGHT", x, {"u_params": params})[:, :3]
+    cpu = np.empty_like(gpu, dtype=np.float64)
+    for i, (nl, nv, r, phi) in enumerate(x):
+        m = Material(base_color=(0.9, 0.6, 0.3), metallic=0.25, roughness=r, specular_f0=(0.05, 0.04, 0.03), ior=ior,
+                     transmission=0.8, thickness=thickness, attenuation_color=(1.0, 0.8, 0.5), attenuation_distance=0.7)
+        p = Pairs(n=np.array([[0.0, 0.0, 1.0]]), v=_view_at(np.array([nv])), l=_light_at(np.array([nl]), np.array([phi])))
+        cpu[i] = transmission_light(m, p, punctual)[0, 0]
+    close(gpu, cpu, rtol=2e-3, atol=2e-5)
+    assert np.isfinite(gpu).all() and (gpu >= 0).all() and np.all(gpu[:20] == 0)

@@ -4,14 +4,14 @@ from pathlib import Path
 
 import numpy as np
 
-from alight.core.material import load_preset
+from alight.exchange.presets import load_preset
 from alight.core.mesh import sphere
 from alight.core.scene import Scene
 from alight.exchange.output import write_image
 from alight.ibl.environment import studio_environment
 from alight.render.renderer import ForwardRenderer
 
-PRESETS = ["gold", "copper", "silver", "iron", "plastic_glass_low", "plastic_high", "water"]
+PRESETS = ["gold", "copper", "silver", "iron", "plastic_high", "plastic_glass_low", "water", "glass_high_ruby", "diamond"]
 SIZE = 256
 
 with ForwardRenderer() as renderer:

@@ -29,7 +29,8 @@ The reference is computed once per environment, for three basis materials, all r
 values in one G-buffer; every preset follows exactly from them because the BRDF is linear in F0
 and in the base colour (see ``ReferenceTerms``). A preset with a layer has its own reference (one
 G-buffer of its roughness values per level), without the roughness values where the layer's
-lobe is too narrow for a texel sum (``alight.accuracy.reference``'s checks). Roughness below 0.25 is summed over the full map;
+lobe is too narrow for a texel sum (``alight.accuracy.reference``'s checks,
+``alight.accuracy.ground_truth.check_transmission_lobe``). Roughness below 0.25 is summed over the full map;
 from 0.25 up over the map box-reduced by 2 (``alight.accuracy.reference``'s level 1: <= 0.02% change on
 royal_esplanade, ~1% on quarry_01's compact sun, small beside the split sum's 5-30%).
 
@@ -65,11 +66,11 @@ FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
 # of its texels), from this roughness up.
 FURNACE_TRUTH_WIDTH = 256
 FURNACE_TRUTH_FROM = 0.25
-QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet", "brushed_aluminium")   # the last three: the layers' rows
+QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet", "brushed_aluminium")   # the last four: the layers' rows
 # Layers with a row of their own (issue 11), the material of their white furnace (radiance 1:
 # what the layer reflects and transmits must not exceed 1, and at roughness 0 it is exactly 1)
 # and the preset drawn for their frame time.
-LAYER_ROWS = ("clearcoat", "sheen", "anisotropy")
+LAYER_ROWS = ("clearcoat", "sheen", "anisotropy", "transmission")
 LAYER_FURNACE = {
     # A white metal under a full coat, or under a white sheen: at most 1 (docs/layer_clearcoat.md,
     # docs/layer_sheen.md).
@@ -79,8 +80,11 @@ LAYER_FURNACE = {
     # so at most 1 (docs/layer_anisotropy.md).
     "anisotropy": dict(base_color=(1.0, 1.0, 1.0), metallic=1.0, anisotropy_strength=0.8,
                        anisotropy_rotation=1.5707963),
+    # A thin white wall of ior 1 that transmits everything (docs/layer_transmission.md).
+    "transmission": dict(base_color=(1.0, 1.0, 1.0), transmission=1.0, ior=1.0),
 }
-LAYER_FRAME_PRESET = {"clearcoat": "car_paint", "sheen": "velvet", "anisotropy": "brushed_aluminium"}
+LAYER_FRAME_PRESET = {"clearcoat": "car_paint", "sheen": "velvet", "anisotropy": "brushed_aluminium",
+                      "transmission": "water"}
 # Environments left out of the summary columns (still in chart_cases.csv): spot1Lux's truth is
 # near zero over most of the ball, where a relative error means little (issue 4).
 SUMMARY_EXCLUDED = ("spot1Lux",)
@@ -200,6 +204,7 @@ def layer_reference(ref_renderer, radiance: np.ndarray, size: int, material, rou
     """The reference of one material with layers at each roughness its layers allow, (S, S, 4)
     linear RGBA by roughness: one G-buffer of those roughness values per environment level (the
     layers' factors are the scene material's, alight.accuracy.reference)."""
+    from alight.accuracy.ground_truth import check_transmission_lobe
     from alight.accuracy.reference import GBUFFER, check_layer_roughness, check_roughness, probe_gbuffer
     from alight.core.scene import Scene
     from alight.errors import AlightError
@@ -209,7 +214,9 @@ def layer_reference(ref_renderer, radiance: np.ndarray, size: int, material, rou
         try:   # a lobe the texel sum cannot integrate has no reference, and so no case
             check_roughness(r)
             check_layer_roughness(replace(material, roughness=r))
-        except AlightError:
+            if "volume" in material.layers():
+                check_transmission_lobe(r, material.ior)
+        except (AlightError, ValueError):
             continue
         allowed.append(float(r))
     out = {}

@@ -366,7 +366,8 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
-                  multiple_scattering: bool = False, material=None, tangents=None) -> np.ndarray:
+                  multiple_scattering: bool = False, material=None, tangents=None,
+                  diffuse_scale: float = 1.0) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -380,6 +381,12 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     stretched lobe's ratios (``anisotropy_lut_converged``), the stretched lookup
     (``anisotropic_prefiltered_converged``) and the compact sources through the stretched lobe;
     ``tangents`` (P, 3) the tangent frame's t (default: the probe's).
+
+    ``material`` (an alight.core.material.Material): its layers over the result, as
+    common/layers.glsl's layered_ibl (``layered_ibl_converged``: the transmitted environment, the
+    sheen, the coat; the diffuse lobe scaled by 1 - transmission), and the compact sources through
+    the whole layered BRDF. Without it, ``diffuse_scale`` scales the diffuse lobe alone (the
+    reflected part of a transmissive material, without what it transmits).
     """
     from alight.core.ibl_models import IBL_MODELS, SUNS_AS_BAKED
     from alight.ibl.sun import extract_suns
@@ -438,7 +445,9 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
                        + w_hi[:, None] * prefiltered_converged_each(lighting, d_hi, fetch_r))
     else:
         prefiltered = prefiltered_converged(lighting, direction, r)
-    albedo = base * (1.0 - m)
+    if material is not None and "transmission" in material.layers():
+        diffuse_scale = 1.0 - material.transmission
+    albedo = base * (1.0 - m) * float(diffuse_scale)
     if multiple_scattering:
         e_ss = A + B
         e_ms = 1.0 - e_ss
@@ -458,7 +467,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
             pairs = Pairs(n=n, v=v, l=l, t=t0, b=np.cross(n, t0), spread=sun.spread)
             out = out + layered_brdf_cos(material, pairs)[:, 0, :] * np.asarray(sun.power)[None, :]
         else:
-            out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread)
+            out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread, diffuse_scale)
     return out
 
 
@@ -474,6 +483,8 @@ def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray
     v = np.broadcast_to(_unit_rows(view), n.shape)
     out = np.asarray(base, np.float64)
     used = material.layers()
+    if "transmission" in used:
+        out = out + transmission_environment_converged(material, radiance, n, v)
     if "sheen" in used:
         nv = np.clip(np.sum(n * v, axis=-1), 0.0, 1.0)
         lut = sh.lut_bilinear(sh.sheen_lut_table(), nv, material.sheen_roughness)   # (P, 4)
@@ -496,7 +507,7 @@ def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray
     return out
 
 
-def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0):
+def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0, diffuse_scale=1.0):
     """ibl.glsl's sun_light: the exact BRDF (IBL k, F at v.h) times the power P, D widened to
     alpha' = sqrt(alpha^2 + spread^2) for the source's size."""
     l = np.asarray(l, dtype=np.float64)
@@ -513,7 +524,7 @@ def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0):
     G = G_Smith(nv, np.where(nl > 0, nl, 1.0), k)
     F = f0 + (1.0 - f0) * ((1.0 - vh) ** 5)[:, None]
     spec = (D * G / (4.0 * np.where(nl > 0, nl, 1.0) * nv))[:, None] * F
-    diffuse = (1.0 - F) * (1.0 - metallic) * base / PI
+    diffuse = (1.0 - F) * (1.0 - metallic) * base / PI * diffuse_scale
     return np.where((nl > 0)[:, None], (diffuse + spec) * nlc[:, None] * np.asarray(power)[None, :], 0.0)
 
 
@@ -528,3 +539,165 @@ def downsample_equirect(radiance, factor: int) -> np.ndarray:
     r >= 0.25 when downsampling). At factor 4: irradiance 5.8e-4 / 4e-5, r = 0.5: 3.3e-4 / 8e-5.
     """
     return box_reduce(radiance, int(factor))
+
+
+# --- transmission (docs/transmission.md) --------------------------------------------------
+
+def prefilter_kernel_mean_cosine(roughness, n_u: int = 4096):
+    """The mean cosine between l and the lookup direction d of the prefiltered map's kernel at a
+    roughness, D(h) max(d.l, 0) over l with h = normalize(l + d) (the lecture's prefilter, N = V =
+    R = d): E[(n.l)^2] / E[n.l] over h drawn with pdf D(h)(n.h), n.l = 2 (n.h)^2 - 1, only
+    n.l > 0. 1 at roughness 0, falling with roughness; a midpoint rule over the GGX inverse CDF
+    (twin of transmission_lut.comp's prefilter_kernel_mean_cosine)."""
+    r = np.atleast_1d(np.asarray(roughness, dtype=np.float64))
+    u = (np.arange(n_u) + 0.5) / n_u
+    out = np.empty(r.shape)
+    for i, rr in enumerate(r.reshape(-1)):
+        a2 = rr ** 4
+        nh2 = (1.0 - u) / (1.0 + (a2 - 1.0) * u)
+        nl = np.maximum(2.0 * nh2 - 1.0, 0.0)
+        out.reshape(-1)[i] = float(np.sum(nl * nl) / max(np.sum(nl), 1e-30)) if a2 > 0 else 1.0
+    return out.reshape(np.shape(roughness))
+
+
+def roughness_for_mean_cosine(mean_cosine, steps: int = 40):
+    """The prefiltered roughness whose kernel has this mean cosine (bisection on
+    ``prefilter_kernel_mean_cosine``), clamped to [0, 1]."""
+    c = np.atleast_1d(np.asarray(mean_cosine, dtype=np.float64)).reshape(-1)
+    lo = np.zeros_like(c)
+    hi = np.ones_like(c)
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        wider = prefilter_kernel_mean_cosine(mid, 1024) < c   # mid's kernel is wider than wanted
+        hi = np.where(wider, mid, hi)
+        lo = np.where(wider, lo, mid)
+    return (0.5 * (lo + hi)).reshape(np.shape(mean_cosine))
+
+
+def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: int = 64):
+    """Numpy twin of ``ibl/transmission_lut.comp``: the refracted lobe of KHR_materials_volume's
+    BTDF (v outside, index 1; l inside, index ``ior``) at one (n.v, roughness, ior) each, as
+    three numbers the forward pass reads (docs/transmission.md, "Real-time"):
+
+    - E: the integral of btdf (1 - Fc(v.h)) |n.l| over l (transmitted = (1 - m) t c T (1 - F0) E L
+      under a constant environment L). Drawing h with pdf D(h)(n.h) and l = refract(-v, h, 1/ior),
+      the weight is (1 - Fc) G(n.v, |n.l|) (v.h) / ((n.h)(n.v)): the same as the BRDF LUT's;
+    - bend: the sine of the lobe's mean direction's angle from -n (leaning toward -v's
+      tangential part) over the sine of v's angle from n: 1/ior for a smooth surface (Snell),
+      more where roughness leans the lobe toward grazing. A ratio rather than the sine itself,
+      so that it goes to 0 with the view's sine at n.v = 1, where the tangential direction is
+      undefined (the table's last texel centre is n.v = 0.984, not 1);
+    - roughness: the prefiltered roughness whose kernel has the same mean cosine about its axis
+      (``roughness_for_mean_cosine``), so one prefiltered fetch along the mean direction stands
+      for the lobe.
+
+    Midpoint grid over (u, phi in [0, 2 pi)) as ``brdf_lut_converged``; n.v >= 1e-4, ior >= 1.
+    Returns (E, bend, roughness), each of the broadcast shape.
+    """
+    from alight.core.btdf import refract
+
+    nv, r, eta = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (n_dot_v, roughness, ior)))
+    shape = nv.shape
+    nv = np.clip(nv.reshape(-1), 1e-4, 1.0)
+    r = np.clip(r.reshape(-1), 0.0, 1.0)
+    eta = np.maximum(eta.reshape(-1), 1.0)
+    sg = (np.arange(n_u) + 0.5) / n_u
+    u = 1.0 - (1.0 - sg) ** 2
+    wu = 2.0 * (1.0 - sg) / n_u
+    phi = (np.arange(n_phi) + 0.5) * (2.0 * PI / n_phi)
+    energy = np.empty(nv.shape[0])
+    bend = np.empty(nv.shape[0])
+    cosines = np.empty(nv.shape[0])
+    for i in range(nv.shape[0]):
+        a2 = r[i] ** 4
+        cos_t = np.sqrt((1.0 - u) / (1.0 + (a2 - 1.0) * u))
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+        h = np.stack([sin_t[:, None] * np.cos(phi)[None, :], sin_t[:, None] * np.sin(phi)[None, :],
+                      np.broadcast_to(cos_t[:, None], (n_u, n_phi))], axis=-1)
+        v = np.array([np.sqrt(1.0 - nv[i] ** 2), 0.0, nv[i]])
+        vh = h @ v
+        l = refract(np.broadcast_to(-v, h.shape), h, np.full(h.shape[:2], 1.0 / eta[i]))
+        nl = l[..., 2]
+        ok = (nl < 0.0) & (vh > 0.0)
+        g = G_Smith(nv[i], np.where(ok, -nl, 1.0), k_ibl(r[i]))
+        w = np.where(ok, (1.0 - (1.0 - np.clip(vh, 0.0, 1.0)) ** 5) * g * vh / (h[..., 2] * nv[i]), 0.0)
+        w = w * wu[:, None] / n_phi
+        energy[i] = float(w.sum())
+        mx, mz = float(np.sum(w * l[..., 0])), float(np.sum(w * l[..., 2]))
+        length = np.hypot(mx, mz)
+        sin_v = np.sqrt(max(1.0 - nv[i] ** 2, 0.0))
+        bend[i] = -mx / length / sin_v if length > 0 and sin_v > 0 else 1.0 / eta[i]
+        cosines[i] = length / energy[i] if energy[i] > 0 else 1.0
+    rough = roughness_for_mean_cosine(cosines)
+    return energy.reshape(shape), bend.reshape(shape), rough.reshape(shape)
+
+
+def transmitted_lobe_converged(material, normals, view, n_table: int = 129):
+    """Where the forward pass's transmitted lobe points, its prefiltered roughness and its energy
+    (common/transmission.glsl: thin_walled_lobe, refracted_lobe) with converged tables: (P, 3)
+    directions, (P,) roughness, (P,) energy. Thin-walled: the BRDF LUT's A and t_A (mirrored
+    through the surface), roughness the material's. Refracting: ``transmission_lut_converged``
+    on ``n_table`` values of n.v, interpolated linearly (the lobe changes slowly in n.v)."""
+    from alight.core.btdf import mirror_through_surface
+
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    r = float(material.roughness)
+    nv = np.clip(np.sum(n * v, axis=-1), 0.0, 1.0)
+    if "volume" not in material.layers():
+        A, _ = brdf_lut_converged(nv, r)
+        t_a, _ = lobe_directions_converged(nv, r)
+        R = reflect(-v, n)
+        mean = _unit_rows(n + t_a[:, None] * (R - n))
+        return mirror_through_surface(mean, n), np.full(nv.shape, r), A
+    grid = np.linspace(1e-4, 1.0, n_table)
+    energy, bend, rough = transmission_lut_converged(grid, r, float(material.ior))
+    e = np.interp(nv, grid, energy)
+    s = np.clip(np.interp(nv, grid, bend) * np.sqrt(1.0 - np.minimum(nv, 1.0) ** 2), 0.0, 1.0)
+    rr = np.interp(nv, grid, rough)
+    nvc = np.maximum(nv, 1e-4)
+    tangential = v - nvc[:, None] * n
+    length = np.linalg.norm(tangential, axis=-1, keepdims=True)
+    side = np.where(length > 1e-6, -tangential / np.maximum(length, 1e-300), 0.0)
+    direction = -n * np.sqrt(1.0 - s * s)[:, None] + side * s[:, None]
+    return direction, rr, e
+
+
+def prefiltered_converged_varying(radiance, directions, roughness, steps: int = 12) -> np.ndarray:
+    """``prefiltered_converged`` where each direction has its own roughness: evaluated at
+    ``steps`` roughness values spanning theirs and interpolated linearly in alpha = r^2 between
+    the two nearest (the forward pass blends its grid steps the same way)."""
+    d = _unit_rows(directions)
+    r = np.clip(np.asarray(roughness, dtype=np.float64), MIN_PREFILTER_ROUGHNESS, 1.0)
+    lo, hi = float(r.min()), float(r.max())
+    if hi - lo < 1e-6:
+        return prefiltered_converged(radiance, d, lo)
+    knots = np.sqrt(np.linspace(lo * lo, hi * hi, steps))
+    out = np.zeros((d.shape[0], 3))
+    a = r * r
+    ka = knots * knots
+    idx = np.clip(np.searchsorted(ka, a) - 1, 0, steps - 2)
+    t = ((a - ka[idx]) / (ka[idx + 1] - ka[idx]))[:, None]
+    for j in range(steps - 1):
+        sel = idx == j
+        if sel.any():
+            out[sel] = (1.0 - t[sel]) * prefiltered_converged(radiance, d[sel], knots[j]) \
+                + t[sel] * prefiltered_converged(radiance, d[sel], knots[j + 1])
+    return out
+
+
+def transmission_environment_converged(material, radiance, normals, view) -> np.ndarray:
+    """The transmitted environment with converged parts (P, 3): the twin of transmission.glsl's
+    transmission_ibl, weight base (1 - F0) E L_prefiltered along the lobe (``radiance``: the map
+    the maps are baked from, without the compact sources for the alight model; those go through
+    the BTDF with the rest of the layered BRDF, ``ibl_converged``)."""
+    from alight.core.btdf import beer_lambert
+
+    m = material
+    n = _unit_rows(normals)
+    v = np.broadcast_to(_unit_rows(view), n.shape)
+    direction, rough, energy = transmitted_lobe_converged(m, n, v)
+    weight = (1.0 - m.metallic) * m.transmission * np.asarray(m.base_color) * (1.0 - np.asarray(m.f0()))
+    if "volume" in m.layers():
+        weight = weight * beer_lambert(m.attenuation_color, m.attenuation_distance, m.thickness)
+    return weight * energy[:, None] * prefiltered_converged_varying(np.asarray(radiance, np.float32), direction, rough)

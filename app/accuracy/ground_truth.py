@@ -207,6 +207,118 @@ def ground_truth_terms(radiance, normals, views, roughness, rotation_deg: float 
     return GroundTruthTerms(rs, s1, s2, s3, s4)
 
 
+def transmission_terms(radiance, normals, views, roughness, ior: float = 1.5, thin: bool = True,
+                       rotation_deg: float = 0.0, intensity: float = 1.0) -> np.ndarray:
+    """The transmitted light's texel sum S_T (docs/transmission.md) for each point: (R, P, 3).
+
+        S_T = sum over texels with n.l < 0 of btdf(l, v) (1 - Fc(v.h)) |n.l| W
+
+    with the thin-walled BTDF (``thin``) or the refracting one at index ``ior`` (v outside, index
+    1), k = r^2/2, Fc = (1 - v.h)^5 at the BTDF's own half vector (``alight.core.btdf``). Since
+    1 - F = (1 - F0)(1 - Fc), the transmitted radiance is (1 - m) t c T (1 - F0) S_T: see
+    :func:`transmission_combine`. Same chunking, guards and roughness limits as
+    :func:`ground_truth_terms`; the refracting lobe is narrower than the reflected one by about
+    (ior - 1) / (2 ior), so ``check_transmission_lobe`` refuses lobes under a texel's scale.
+    """
+    rs = tuple(_check_roughness(r) for r in np.atleast_1d(np.asarray(roughness, dtype=np.float64)))
+    eta = float(ior)
+    if not thin:
+        for r in rs:
+            check_transmission_lobe(r, eta)
+    dirs, wt = _texels(radiance, rotation_deg, intensity)
+    n = _unit_rows(normals)
+    p = n.shape[0]
+    v = _unit_rows(views, p)
+    nv_raw_all = np.sum(n * v, axis=-1)
+    nv_all = np.maximum(nv_raw_all, MIN_N_DOT_V)
+    t = dirs.shape[0]
+    out = np.zeros((len(rs), p, 3))
+    step = max(1, _CHUNK_ELEMS // max(t, 1))
+    n32, v32 = n.astype(np.float32), v.astype(np.float32)
+    one = np.float32(1.0)
+    for a in range(0, p, step):
+        sl = slice(a, min(p, a + step))
+        nl = n32[sl] @ dirs.T                       # (p, T)
+        lv = v32[sl] @ dirs.T
+        nv = nv_all[sl].astype(np.float32)[:, None]
+        nv_raw = nv_raw_all[sl].astype(np.float32)[:, None]
+        behind = nl < 0.0
+        anl = np.where(behind, -nl, np.float32(0.0))   # |n.l| behind the surface, else 0
+        if thin:
+            # l' = l - 2 (n.l) n: n.l' = -n.l, v.l' = v.l - 2 (n.l)(n.v); h = normalize(v + l')
+            vlm = lv - np.float32(2.0) * nl * nv_raw
+            length = np.sqrt(np.maximum(np.float32(2.0) * (one + vlm), np.float32(0.0)))
+            vh = np.sqrt(np.maximum(np.float32(0.5) * (one + vlm), np.float32(0.0)))
+            nh = (-nl + nv_raw) / np.maximum(length, np.float32(1e-7))
+            del vlm, length
+            lh = None
+        else:
+            # h = -(v + eta l)/|v + eta l|: n.h, v.h, l.h from n.l and v.l
+            e = np.float32(eta)
+            length = np.sqrt(np.maximum(one + e * e + np.float32(2.0) * e * lv, np.float32(0.0)))
+            inv = one / np.maximum(length, np.float32(1e-7))
+            nh = -(nv_raw + e * nl) * inv
+            vh = -(one + e * lv) * inv
+            lh = -(lv + e) * inv
+            del length, inv
+        ok = behind & (nh > 0.0) & (vh > 0.0)
+        if lh is not None:
+            ok &= lh < 0.0
+        fresnel = one - np.clip(one - vh, 0.0, 1.0) ** 5   # 1 - Fc
+        nh2 = nh * nh
+        for i, r in enumerate(rs):
+            a2 = np.float32(r ** 4)
+            k = np.float32(r * r / 2.0)
+            den = nh2 * (a2 - one) + one
+            np.square(den, out=den)
+            # G1(|n.l|) |n.l| ... over (n.v): G1(n.v)/n.v = 1/(n.v (1 - k) + k)
+            g1l = anl / (anl * (one - k) + k)
+            view = (a2 / np.float32(PI)) / (nv * (one - k) + k)
+            if thin:
+                # D G / (4 |n.l| n.v) |n.l| = D G1(|n.l|) G1(n.v) / (4 n.v)
+                value = g1l / den * (view / np.float32(4.0))
+            else:
+                # |l.h| |v.h| / (|n.l| n.v) eta^2 D G / (v.h + eta l.h)^2 |n.l|, where
+                # (v.h + eta l.h)^2 = |v + eta l|^2 = 1 + eta^2 + 2 eta v.l
+                len2 = one + np.float32(eta * eta) + np.float32(2.0 * eta) * lv
+                value = (np.abs(lh) * vh) * np.float32(eta * eta) * g1l / den * view / np.maximum(len2, np.float32(1e-12))
+            value = np.where(ok, value * fresnel, np.float32(0.0))
+            out[i, sl] += value @ wt
+            del value, den, g1l
+        del nl, lv, behind, anl, nh, vh, lh, ok, fresnel, nh2
+    return out
+
+
+def check_transmission_lobe(roughness: float, ior: float) -> None:
+    """The refracting lobe spans about alpha (ior - 1) / (2 ior) of the reflected lobe's alpha (at
+    normal incidence, a facet tilted by theta bends the refracted ray by theta (1 - 1/ior), the
+    reflected one by 2 theta): refuse lobes narrower than the reflected lobe at MIN_ROUGHNESS,
+    where the texel sum stops being an integral (ValueError)."""
+    r = float(roughness)
+    eta = float(ior)
+    if not np.isfinite(eta) or eta < 1.0:
+        raise ValueError(f"ior must be >= 1 for a refracting volume, got {ior!r}")
+    effective = r * r * (eta - 1.0) / (2.0 * eta)
+    if effective < MIN_ROUGHNESS ** 2 * (1.0 - 1e-9):
+        raise ValueError(f"roughness {r:g} at ior {eta:g}: the refracted lobe (alpha {effective:.2g}) is narrower than "
+                         f"the reflected lobe at roughness {MIN_ROUGHNESS} and the texel sum is no longer an integral")
+
+
+def transmission_combine(reflection: np.ndarray | tuple, s_t: np.ndarray, base_color, metallic, specular_f0,
+                         transmission: float, attenuation=(1.0, 1.0, 1.0)) -> np.ndarray:
+    """L_o with transmission (docs/transmission.md): the reflected part with its diffuse scaled by
+    (1 - transmission), plus (1 - m) t c T (1 - F0) S_T. ``reflection`` is ``GroundTruthTerms.combine
+    (..., parts=True)``'s (diffuse, specular); ``s_t`` one roughness's (P, 3) of
+    :func:`transmission_terms`; ``attenuation`` the Beer-Lambert transmittance T (RGB)."""
+    diffuse, specular = reflection
+    base = np.asarray(base_color, dtype=np.float64)
+    m = float(metallic)
+    t = float(transmission)
+    f0 = f0_of(base, m, np.asarray(specular_f0, dtype=np.float64))
+    transmitted = (1.0 - m) * t * base * np.asarray(attenuation, dtype=np.float64) * (1.0 - f0) * s_t
+    return (1.0 - t) * diffuse + specular + transmitted
+
+
 def reflectance_ground_truth(radiance, normals, views, base_color, metallic, roughness, specular_f0,
                              emissive=(0.0, 0.0, 0.0), rotation_deg: float = 0.0,
                              intensity: float = 1.0) -> np.ndarray:

@@ -86,6 +86,21 @@ def check_roughness(roughness: float, what: str = "roughness") -> None:
                           f"few texels and the texel sum is no longer an integral (no reference below {MIN_ROUGHNESS})")
 
 
+def check_layer_lobes(material, roughnesses) -> None:
+    """A refracting volume's lobe is narrower than the reflected one (about (ior - 1) / (2 ior) of
+    its alpha): refused, one line, where it is narrower than the reflected lobe at MIN_ROUGHNESS
+    (alight.accuracy.ground_truth.check_transmission_lobe; docs/layer_transmission.md)."""
+    from alight.accuracy.ground_truth import check_transmission_lobe
+
+    if "volume" not in material.layers():
+        return
+    for r in roughnesses:
+        try:
+            check_transmission_lobe(r, material.ior)
+        except ValueError as exc:
+            raise AlightError(f"--roughness: {exc} (no reference there)") from None
+
+
 def check_layer_roughness(material) -> None:
     """The layers' own GGX lobes need the same: the coat's roughness (a coat below 0.1 is a
     mirror; its sum would sample a delta). The sheen's Charlie lobe is wide at every roughness."""
@@ -221,6 +236,7 @@ class ReferenceRenderer:
             for r in self.scene_roughnesses(scene):
                 check_roughness(r)
             check_layer_roughness(self.layered_material(scene))
+            check_layer_lobes(self.layered_material(scene), self.scene_roughnesses(scene))
         ctx = self.ctx
         if scene.view == "probe":
             gtex = self._textures_from_arrays(probe_gbuffer(width, scene.material))
@@ -248,6 +264,7 @@ class ReferenceRenderer:
             for r in roughnesses:
                 check_roughness(r)
             check_layer_roughness(scene.material)
+            check_layer_lobes(scene.material, roughnesses)
         return self._sum(self._textures_from_arrays(g), False, scene, radiance if use_env else None, width, height,
                          env_level, chunk_pairs, {}, roughnesses, scene.material)
 

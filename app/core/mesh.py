@@ -87,9 +87,10 @@ TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
 # tangent-space normal map (scaled by clearcoat_normal_scale); sheen_color RGB (sRGB) and
 # sheen_roughness A multiply theirs.
 # anisotropy (KHR_materials_anisotropy's anisotropyTexture, linear): RG a direction in the tangent
-# frame (2x - 1), B a factor on anisotropy_strength.
+# frame (2x - 1), B a factor on anisotropy_strength. KHR_materials_transmission's R multiplies
+# transmission and KHR_materials_volume's thickness G multiplies thickness (linear).
 LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness",
-                       "anisotropy")
+                       "anisotropy", "transmission", "thickness")
 
 
 @dataclass
@@ -129,6 +130,8 @@ class FileMaterial:
     sheen_color_texture: TextureInfo | None = None
     sheen_roughness_texture: TextureInfo | None = None
     anisotropy_texture: TextureInfo | None = None
+    transmission_texture: TextureInfo | None = None
+    thickness_texture: TextureInfo | None = None
 
     def __post_init__(self) -> None:
         for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:

@@ -47,7 +47,8 @@ SUPPORTED = {
     "KHR_texture_transform", "KHR_materials_unlit", "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_specular", "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_texture_webp",
     "KHR_draco_mesh_compression",
-    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy",
+    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_transmission",
+    "KHR_materials_volume",
 }
 # The layers' textures alight draws (issue 11): FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
@@ -57,6 +58,8 @@ LAYER_TEXTURES = {
     "sheen_color": ("KHR_materials_sheen", "sheenColorTexture"),
     "sheen_roughness": ("KHR_materials_sheen", "sheenRoughnessTexture"),
     "anisotropy": ("KHR_materials_anisotropy", "anisotropyTexture"),
+    "transmission": ("KHR_materials_transmission", "transmissionTexture"),
+    "thickness": ("KHR_materials_volume", "thicknessTexture"),
 }
 # Compression a file cannot be read without: refused in one line when no library decodes it.
 COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_texture_basisu"}

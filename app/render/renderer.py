@@ -11,6 +11,14 @@ The passes of a frame, by anti-aliasing mode and what the caller reads back:
            tone mapped as drawn when only sRGB is read (draw_display, the editor's path), else
            linear radiance [-> tone map pass, if sRGB is read too]
     ssaa:  forward and background passes at 2x -> box reduction -> radiance [-> tone map pass]
+
+A mesh with transmissive parts (KHR_materials_transmission) has a forward pass in three steps:
+
+    opaque parts -> copy (what is behind: radiance and coverage, mipmapped) -> transmissive
+        parts (reading the copy, common/transmission.glsl)
+
+so that what the glass shows is the opaque scene behind it, as the Khronos Sample Viewer does
+(the colour target is then cleared, so that the copy's alpha is the opaque parts' coverage).
 """
 
 from __future__ import annotations
@@ -52,6 +60,7 @@ from alight.ibl.bake import (
 from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
+from alight.ibl.transmission_lut import TransmissionLut
 from alight.render.tiles import (
     TILE_BYTES,
     Tile,
@@ -76,10 +85,13 @@ HALF_FLOAT_MIN_EXPOSURE = -6.0
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
-                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy")
+                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy",
+                 "transmission", "thickness")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
-UNIT_SCENE_DEPTH = UNIT_SHEEN_LUT + 1      # free (the resolve read depth samples here); kept so later units keep theirs
+UNIT_TRANSMISSION_LUT = UNIT_SHEEN_LUT + 1          # ibl/transmission_lut.comp's table (HAS_VOLUME)
+UNIT_SCENE_BEHIND = UNIT_TRANSMISSION_LUT + 1      # the opaque parts' copy (TRANSMISSION_SCENE)
+UNIT_SCENE_DEPTH = UNIT_SCENE_BEHIND + 1           # free (the resolve read depth samples here); kept so later units keep theirs
 SRGB_MAPS = ("base_color", "emissive", "sheen_color")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
@@ -89,13 +101,13 @@ SAMPLER_UNITS = {
     "u_environment": UNIT_ENVIRONMENT, "u_radiance": UNIT_RADIANCE, "u_radiance_source": UNIT_RADIANCE,
     "u_scene": UNIT_RADIANCE,
     **{f"u_{name}_map": unit for name, unit in UNIT_MATERIAL.items()},
-    "u_sheen_lut": UNIT_SHEEN_LUT,
+    "u_sheen_lut": UNIT_SHEEN_LUT, "u_transmission_lut": UNIT_TRANSMISSION_LUT, "u_scene_behind": UNIT_SCENE_BEHIND,
 }
 # KHR_materials_anisotropy's energy ratios (alight.ibl.anisotropy_lut), bound where a program reads them.
-UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = 20, 21
+UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = UNIT_SCENE_DEPTH + 1, UNIT_SCENE_DEPTH + 2
 SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_ratio_b=UNIT_ANISOTROPY_RATIO_B)
 # The `stretched` IBL model's lobe table (alight.core.stretched_lobe), bound where a program reads it.
-UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = 22, 23
+UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_DEPTH + 3, UNIT_SCENE_DEPTH + 4
 SAMPLER_UNITS.update(u_stretched_lobe_a=UNIT_STRETCHED_LOBE_A, u_stretched_lobe_b=UNIT_STRETCHED_LOBE_B)
 
 
@@ -244,6 +256,7 @@ class _Targets:
         self.width, self.height, self.aa, self.samples = width, height, aa, samples
         self.half = half and aa == "msaa"     # the MSAA colour in half floats (HALF_FLOAT_MIN_EXPOSURE)
         self._display_draw = None
+        self._behind: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
         self._both_fbo = None
         self.color = None
@@ -275,6 +288,19 @@ class _Targets:
         self.display = ctx.texture((width, height), 4, dtype="f1")
         self.display_fbo = ctx.framebuffer([self.display])
 
+    def behind(self) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
+        """What transmissive parts see behind them: the opaque parts' radiance with alpha =
+        coverage (premultiplied: uncovered pixels are 0), at the draw size, mipmapped so that a
+        rough surface reads it blurred (common/transmission.glsl: scene_behind). Half floats:
+        a blurred view through glass needs no more than 11 bits."""
+        if self._behind is None:
+            tex = self.ctx.texture(self.draw_size, 4, dtype="f2")
+            tex.build_mipmaps()
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            self._behind = (tex, self.ctx.framebuffer([tex]))
+        return self._behind
+
     def display_draw(self) -> moderngl.Framebuffer:
         """The display image with the depth buffer, for ForwardRenderer.draw_display (no AA only)."""
         if self._display_draw is None:
@@ -295,6 +321,8 @@ class _Targets:
                  self.radiance, self.display_fbo, self.display]
         if self.color is not self.radiance:
             owned.append(self.color)
+        if self._behind is not None:
+            owned.extend(self._behind[::-1])
         for obj in owned:
             if obj is not None:
                 obj.release()
@@ -320,6 +348,7 @@ class ForwardRenderer:
         self.bakes_loaded = 0
         self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
         self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
+        self._transmission_lut: TransmissionLut | None = None
         self._bakes: dict[tuple, IBLMaps] = {}
         self._meshes: dict[int, tuple[object, list[_GpuPart], _MeshTextures]] = {}
         # The built-in sphere's coarser levels (alight.core.sphere_lod), by the mesh's id and segments.
@@ -491,7 +520,15 @@ class ForwardRenderer:
             for tex in self._stretched_lobe:
                 tex.release()
             self._stretched_lobe = None
+        if self._transmission_lut is not None:
+            self._transmission_lut.release()
         self.shaders.reload()
+
+    def transmission_lut(self) -> moderngl.Texture:
+        """The transmission LUT (alight.ibl.transmission_lut), baked or read on first use."""
+        if self._transmission_lut is None:
+            self._transmission_lut = TransmissionLut(self.ctx, self.shaders)
+        return self._transmission_lut.texture()
 
     def __enter__(self) -> "ForwardRenderer":
         return self
@@ -543,8 +580,9 @@ class ForwardRenderer:
             if samples < 2:
                 aa = "none"   # this GL has no multisampled float framebuffers
         # Half floats only where the fused resolve reads them and nothing but sRGB is read.
+        # (Not with transmissive parts: their copy of the opaque parts keeps floats.)
         half = (aa == "msaa" and read_srgb and not read_linear and not self._has_blending_parts(scene)
-                and scene.display.exposure >= HALF_FLOAT_MIN_EXPOSURE)
+                and not self.transmissive_parts(scene) and scene.display.exposure >= HALF_FLOAT_MIN_EXPOSURE)
         plan, targets = self._tiled_targets(width, height, aa, samples, tile, half)
         opaque = scene.display.background != "transparent"
         for tiles in plan.strips():
@@ -616,7 +654,8 @@ class ForwardRenderer:
         the scene's programs tone map as they write (common/output_encoding.glsl), so neither the
         float image nor the tone map pass is needed (the editor's view). Without anti-aliasing
         only: a resolve must average radiance, not display values."""
-        if targets.aa != "none" or scene.view == "probe":
+        if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
+            # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
             self.draw_hdr(scene, maps, targets)
             self.tonemap(targets.radiance, scene.display, targets.display_fbo)
             return
@@ -631,7 +670,8 @@ class ForwardRenderer:
         width, height = targets.draw_size
         fbo.use()
         ctx.viewport = (0, 0, width, height)
-        # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag).
+        # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag),
+        # and transmissive parts read the opaque parts' coverage from it.
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
         view = view or _View(targets.width, targets.height)
@@ -649,7 +689,9 @@ class ForwardRenderer:
         if scene.view == "probe":
             self._draw_probe(scene, maps, view.width * scale, (view.origin[0] * scale, view.origin[1] * scale))
         elif scene.mesh is not None:
-            self._draw_mesh(scene, maps, camera, view_projection, blend=False, image_size=(view.width, view.height))
+            self._draw_mesh(scene, maps, camera, view_projection, blend=False, targets=targets, fbo=fbo,
+                            pixels_per_radian=view.height * scale / 2.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0),
+                            image_size=(view.width, view.height))
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         if background:
             self._draw_background(scene, maps, inverse_vp)
@@ -685,18 +727,24 @@ class ForwardRenderer:
 
     def _below_grid_defines(self, scene: Scene, maps: IBLMaps | None, materials, map_mask: int = 0) -> dict:
         """``{"IBL_BELOW_GRID": 0}`` when no roughness the pass can shade lies below the prefiltered
-        grid's first step: every ``*roughness`` field of the materials (the base layer's and any
-        other layer's) is at or above it and no compiled-in map can lower one. Else nothing: the
-        shader keeps the fade into the source cube (ibl.glsl)."""
+        grid's first step: the materials' roughness (and their coat's) is at or above it, no
+        compiled-in map can lower one, and no layer or IBL model reads the maps at a roughness of
+        its own. Else nothing: the shader keeps the fade into the source cube (ibl.glsl)."""
         if maps is None or not scene.ibl_enabled:
             return {}
         unsafe = {name for i, name in enumerate(MATERIAL_MAPS) if map_mask & (1 << i)} - self._ROUGHNESS_FREE_MAPS
         if unsafe or map_mask >> len(MATERIAL_MAPS):
             return {}
         first_step = grid_roughness(0, maps.quality.prefiltered_levels)
+        if scene.ibl_model == "stretched":
+            return {}   # its fetches' roughness is the material's times a fitted factor below 1
         for m in materials:
-            # the base layer's roughness, and those of the layers the material uses (a layer that is
-            # off is compiled out, and its roughness field keeps glTF's default 0)
+            if m.layers() - {"clearcoat"}:
+                # sheen, anisotropy and transmission read the prefiltered maps at a roughness of
+                # their own (a LUT's or the stretched lobe's), which may lie below the grid
+                return {}
+            # the base layer's roughness, and the coat's when the coat is on (a layer that is off
+            # is compiled out, and its roughness field keeps glTF's default 0)
             used = {"roughness"} | {f for layer in m.layers() for f in LAYERS[layer]}
             for f in dataclasses.fields(m):
                 if f.name in used and f.name.endswith("roughness") and float(getattr(m, f.name)) < first_step:
@@ -875,9 +923,14 @@ class ForwardRenderer:
         self._fullscreen(prog)
 
     def _draw_mesh(self, scene: Scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray,
-                   blend: bool = False, image_size: tuple[int, int] | None = None) -> None:
+                   blend: bool = False, targets: _Targets | None = None, fbo: moderngl.Framebuffer | None = None,
+                   pixels_per_radian: float = 1.0, image_size: tuple[int, int] | None = None) -> None:
         """The parts that blend (``blend``) or the rest, each with its shader variant: the
-        scene's IBL model and debug view, plus only the features the part uses (_part_defines)."""
+        scene's IBL model and debug view, plus only the features the part uses (_part_defines).
+        The rest is drawn as the module docstring says: the opaque parts, then, where any part
+        transmits, a copy of what they left in ``fbo`` and the transmissive parts reading it
+        (TRANSMISSION_SCENE; ``pixels_per_radian``: the image's rows per radian at its centre,
+        for the copy's blur)."""
         defines = self._ibl_defines(scene)
         defines.update(_light_defines(scene))
         user_maps = self._user_maps_present(scene)
@@ -903,19 +956,61 @@ class ForwardRenderer:
             self._bind_layer_luts(all_defines)
             return prog
 
-        self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=blend, image_size=image_size)
+        if blend:
+            self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=True, image_size=image_size)
+            return
+        transmissive = self.transmissive_parts(scene)
+        opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
+        if opaque:
+            self.draw_mesh_parts(scene, program_for, camera, view_projection, blend=False, parts=opaque,
+                                 image_size=image_size)
+        if not transmissive:
+            return
+        behind, behind_fbo = targets.behind()
+        self.ctx.copy_framebuffer(behind_fbo, fbo)   # the MSAA resolve too, where there is one
+        behind.build_mipmaps()
+        fbo.use()
+        behind.use(UNIT_SCENE_BEHIND)
+        if not (scene.ibl_enabled and maps is not None):
+            # The thin-walled lobe's energy is the BRDF LUT's A, which _bind_ibl binds only with
+            # an environment.
+            q = QUALITY["medium"]
+            self.luts.get(q.lut_size, q.lut_samples).use(UNIT_LUT)
+
+        def transmissive_program(part_defines: dict) -> moderngl.Program:
+            prog = program_for({**part_defines, "TRANSMISSION_SCENE": None})
+            _set(prog, "u_behind_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+            _set(prog, "u_behind_pixels_per_radian", float(pixels_per_radian))
+            return prog
+
+        self.draw_mesh_parts(scene, transmissive_program, camera, view_projection, blend=False, parts=transmissive,
+                             image_size=image_size)
 
     def _bind_layer_luts(self, defines: dict) -> None:
-        """The tables a compiled-in layer reads (the sheen LUT), baked on first use."""
+        """The tables a compiled-in layer reads (the sheen LUT, the transmission LUT), baked on
+        first use."""
         if "HAS_SHEEN" in defines:
             self.luts.sheen().use(UNIT_SHEEN_LUT)
+        if "HAS_VOLUME" in defines:
+            self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
 
-    def layer_defines(self, scene: Scene) -> dict:
-        """The HAS_* defines of the layers any part of the scene's mesh is drawn with
-        (alight.core.layers): a scene without layers compiles none."""
+    def layer_defines(self, scene: Scene, parts: list[int] | None = None) -> dict:
+        """The HAS_* defines of the layers any part of the scene's mesh (or those of ``parts``,
+        indices) is drawn with (alight.core.layers): a scene without layers compiles none."""
         if scene.mesh is None:
             return layer_defines([scene.material])
-        return layer_defines(self._part_material(scene, part)[0] for part in scene.mesh.parts)
+        chosen = range(len(scene.mesh.parts)) if parts is None else parts
+        return layer_defines(self._part_material(scene, scene.mesh.parts[i])[0] for i in chosen)
+
+    def transmissive_parts(self, scene: Scene) -> list[int]:
+        """Indices of the mesh's parts whose material transmits (KHR_materials_transmission)."""
+        if scene.view == "probe" or scene.mesh is None:
+            return []
+        # A part that blends (alphaMode BLEND) is drawn in the blended pass, over the background,
+        # and transmits the environment only.
+        return [i for i, part in enumerate(scene.mesh.parts)
+                if "transmission" in self._part_material(scene, part)[0].layers()
+                and not (part.material is not None and scene.use_file_materials and part.material.alpha_mode == "BLEND")]
 
     @staticmethod
     def _user_maps_present(scene: Scene) -> set[str]:
@@ -963,14 +1058,16 @@ class ForwardRenderer:
         return defines
 
     def draw_mesh_parts(self, scene: Scene, prog, camera: Camera, view_projection: np.ndarray,
-                        blend: bool | None = None, image_size: tuple[int, int] | None = None) -> None:
+                        blend: bool | None = None, parts: list[int] | None = None,
+                        image_size: tuple[int, int] | None = None) -> None:
         """Draw the scene's mesh parts (pbr.vert's transforms, seen from ``camera``), each with
         its material's factors and maps bound.
 
         ``prog``: one program for every part (the reference's G-buffer), or a function from a
         part's defines (``_part_defines``) to its program. ``blend``: None draws every part;
         False the parts that do not blend; True those that do (alphaMode BLEND), sorted back to
-        front by the distance of their centres, with blending on and depth writes off.
+        front by the distance of their centres, with blending on and depth writes off. ``parts``:
+        only these (indices into the mesh's parts), within what ``blend`` selects.
         Culling follows the material (glTF doubleSided: false culls back faces); a part without
         a glTF material is culled where it is closed, seen from both sides where it is open.
         ``image_size``: the whole image's (width, height) in pixels (default: the viewport's),
@@ -983,10 +1080,11 @@ class ForwardRenderer:
         items = []
         size = image_size or tuple(ctx.viewport[2:])
         drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
-        for gpu_part, part in zip(drawn, scene.mesh.parts):
+        chosen = None if parts is None else set(parts)
+        for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
             fm = part.material
             blends = fm is not None and scene.use_file_materials and fm.alpha_mode == "BLEND"
-            if blend is None or blends == blend:
+            if (blend is None or blends == blend) and (chosen is None or index in chosen):
                 items.append((gpu_part, part))
         if not items:
             return

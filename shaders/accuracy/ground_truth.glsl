@@ -11,7 +11,7 @@
 // |l + v| floored at 1e-7 (l = -v).
 vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l) {
 #ifdef HAS_TRANSMISSION
-    vec3 f = transmission_light(s, n, v, l, false);
+    vec3 f = transmission_light(s, n, v, l, false, 0.0);
 #else
     vec3 f = vec3(0.0);
 #endif

@@ -189,7 +189,7 @@ vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, float spread) {
 // A compact source through the base and its layers (common/layers.glsl).
 vec3 sun_layered(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
 #ifdef HAS_TRANSMISSION
-    vec3 transmitted = transmission_light(s, n, v, l, false);
+    vec3 transmitted = transmission_light(s, n, v, l, false, spread);
 #else
     vec3 transmitted = vec3(0.0);
 #endif

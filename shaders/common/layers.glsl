@@ -50,7 +50,7 @@ vec2 anisotropic_energy_ratio(Surface s, vec3 n, vec3 v);
 // The transmitted part of the base for one direction l (either side of the surface), times
 // |n.l|, with every weight included (transmission, 1 - metallic, the Fresnel and, with
 // HAS_VOLUME, the attenuation). The base's diffuse lobe is scaled by 1 - transmission.
-vec3 transmission_light(Surface s, vec3 n, vec3 v, vec3 l, bool punctual);
+vec3 transmission_light(Surface s, vec3 n, vec3 v, vec3 l, bool punctual, float spread);
 // The transmitted environment (or scene behind), with the same weights.
 vec3 transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns);
 #endif

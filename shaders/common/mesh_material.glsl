@@ -77,12 +77,20 @@ uniform sampler2D u_sheen_roughness_map;
 uniform bool u_has_anisotropy_map;            // KHR_materials_anisotropy: RG a direction (2x - 1), B x strength
 uniform sampler2D u_anisotropy_map;
 #endif
+#ifdef HAS_TRANSMISSION
+uniform bool u_has_transmission_map;          // R multiplies transmission
+uniform sampler2D u_transmission_map;
+#endif
+#ifdef HAS_VOLUME
+uniform bool u_has_thickness_map;             // G multiplies thickness
+uniform sampler2D u_thickness_map;
+#endif
 
 // The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 8191
+#define MATERIAL_MAPS_MASK 32767
 #endif
 #ifndef MAP_UV1_MASK
 #define MAP_UV1_MASK 0
@@ -109,7 +117,9 @@ const int MAP_CLEARCOAT_NORMAL = 512;
 const int MAP_SHEEN_COLOR = 1024;
 const int MAP_SHEEN_ROUGHNESS = 2048;
 const int MAP_ANISOTROPY = 4096;
-const int MAP_SLOTS = 13;
+const int MAP_TRANSMISSION = 8192;
+const int MAP_THICKNESS = 16384;
+const int MAP_SLOTS = 15;
 // KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
 uniform mat3 u_map_transform[MAP_SLOTS];
 
@@ -276,6 +286,12 @@ Surface material_surface(vec3 n) {
     if (has_map(MAP_SHEEN_ROUGHNESS, u_has_sheen_roughness_map)) {
         s.sheen_roughness *= sample_map(u_sheen_roughness_map, MAP_SHEEN_ROUGHNESS, 11).a;
     }
+#endif
+#ifdef HAS_TRANSMISSION
+    if (has_map(MAP_TRANSMISSION, u_has_transmission_map)) s.transmission *= sample_map(u_transmission_map, MAP_TRANSMISSION, 13).r;
+#endif
+#ifdef HAS_VOLUME
+    if (has_map(MAP_THICKNESS, u_has_thickness_map)) s.thickness *= sample_map(u_thickness_map, MAP_THICKNESS, 14).g;
 #endif
     return s;
 }

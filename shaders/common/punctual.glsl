@@ -24,7 +24,7 @@ layout(std140, binding = 0) uniform Lights {
 // HAS_TRANSMISSION also the transmitted part, for light from either side (common/layers.glsl).
 vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
 #ifdef HAS_TRANSMISSION
-    vec3 transmitted = transmission_light(s, n, v, l, true);
+    vec3 transmitted = transmission_light(s, n, v, l, true, 0.0);
 #else
     vec3 transmitted = vec3(0.0);
 #endif

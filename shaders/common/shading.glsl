@@ -18,6 +18,11 @@ vec3 shade(Surface s, vec3 n, vec3 v, vec3 position) {
     if (u_ibl_enabled) {
         radiance += ibl_model(s, n, v);
     }
+#ifdef TRANSMISSION_SCENE
+    else {
+        radiance += transmission_scene_only(s, n, v);
+    }
+#endif
     radiance += punctual_lights(s, n, v, position);
     return radiance;
 }
