@@ -208,18 +208,18 @@ def test_framebuffers_the_gl_refuses_give_smaller_tiles(maps, monkeypatch):
     real = renderer_module.ForwardRenderer._targets_for
     asked = []
 
-    def refuse_big(self, width, height, aa, samples):
+    def refuse_big(self, width, height, aa, samples, half=False):
         asked.append((width, height))
         if width * height > 1000:
             raise moderngl.Error("the framebuffer is not complete")
-        return real(self, width, height, aa, samples)
+        return real(self, width, height, aa, samples, half)
 
     monkeypatch.setattr(renderer_module.ForwardRenderer, "_targets_for", refuse_big)
     tiled = r.render(scene, maps, 96, 64)
     assert asked[0] == (96, 64) and asked[-1][0] * asked[-1][1] <= 1000
     _compare(one.linear, tiled.linear, 0.01)
 
-    def refuse_all(self, width, height, aa, samples):
+    def refuse_all(self, width, height, aa, samples, half=False):
         raise moderngl.Error("GL_OUT_OF_MEMORY\ntoo big")
 
     monkeypatch.setattr(renderer_module.ForwardRenderer, "_targets_for", refuse_all)

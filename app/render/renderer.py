@@ -171,7 +171,9 @@ class _GpuPart:
         self.infos: dict = {}
         self.closed = is_closed(part.positions, part.indices)
         positions = np.asarray(part.positions, np.float64)
-        self.centre = (positions.min(axis=0) + positions.max(axis=0)) / 2.0 if len(positions) else np.zeros(3)
+        self.lo = positions.min(axis=0) if len(positions) else np.zeros(3)    # bounding box corners
+        self.hi = positions.max(axis=0) if len(positions) else np.zeros(3)
+        self.centre = (self.lo + self.hi) / 2.0
         fm = part.material
         if fm is not None:
             for name, info in fm.textures().items():
@@ -683,6 +685,7 @@ class ForwardRenderer:
             view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
         self._last_inverse_vp = inverse_vp    # the resolve's background rays (this frame or tile)
+        self._last_surface_rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
         self._write_lights(scene)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
@@ -704,6 +707,29 @@ class ForwardRenderer:
             self._finish_radiance(targets)
         self._display_output = None
         self._half_output = False
+
+    def _surface_rect(self, scene: Scene, view_projection: np.ndarray,
+                      size: tuple[int, int]) -> tuple[int, int, int, int] | None:
+        """(x, y, width, height) in pixels of ``size`` holding every pixel the mesh can cover:
+        the projected corners of its parts' bounding boxes, a pixel wider each way. None: the
+        whole image (the probe view, or a box reaching behind the eye)."""
+        if scene.view == "probe":
+            return None
+        if scene.mesh is None:
+            return (0, 0, 0, 0)
+        parts = self._gpu_mesh(scene.mesh)
+        if not parts:
+            return (0, 0, 0, 0)
+        lo = np.min([p.lo for p in parts], axis=0)
+        hi = np.max([p.hi for p in parts], axis=0)
+        corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        clip = corners @ np.asarray(view_projection, np.float64)
+        if (clip[:, 3] <= 1e-6).any():
+            return None
+        pixels = (clip[:, :2] / clip[:, 3:] * 0.5 + 0.5) * np.array(size, np.float64)
+        x0, y0 = np.clip(np.floor(pixels.min(axis=0)) - 1, 0, size).astype(int)
+        x1, y1 = np.clip(np.ceil(pixels.max(axis=0)) + 1, 0, size).astype(int)
+        return (int(x0), int(y0), int(max(x1 - x0, 0)), int(max(y1 - y0, 0)))
 
     def camera_for(self, scene: Scene, aspect: float) -> Camera:
         if scene.camera is not None:
@@ -898,17 +924,35 @@ class ForwardRenderer:
             defines["RADIANCE_OUTPUT"] = None
         if display:
             defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
-        prog = self.program("render/background.vert", "render/resolve.frag", defines)
-        # The rays of the scene pass just drawn (for a tile, the whole image's projection off centre).
-        self._bind_background(prog, scene, maps, self._last_inverse_vp, mode)
-        targets.color.use(UNIT_RADIANCE)
-        _set(prog, "u_scene", UNIT_RADIANCE)
-        _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
-        _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
-        _set(prog, "u_opaque", scene.display.background != "transparent")
+        w, h = targets.width, targets.height
+        rect = self._last_surface_rect
+        if rect is None or rect == (0, 0, w, h):
+            passes = [(defines, None)]
+        else:
+            # Outside the mesh's rectangle no sample was drawn: the background alone, without
+            # reading the samples (NO_SURFACES), in up to four strips around it; then the
+            # resolve inside it. Every pixel is written once.
+            x, y, rw, rh = rect
+            strips = [(0, 0, w, y), (0, y + rh, w, h - y - rh), (0, y, x, rh), (x + rw, y, w - x - rw, rh)]
+            passes = [({**defines, "NO_SURFACES": None}, strip) for strip in strips if strip[2] > 0 and strip[3] > 0]
+            if rw > 0 and rh > 0:
+                passes.append((defines, rect))
         targets.resolve_fbo(radiance, display).use()
-        self.ctx.viewport = (0, 0, targets.width, targets.height)
-        self._fullscreen(prog)
+        self.ctx.viewport = (0, 0, w, h)
+        try:
+            for pass_defines, scissor in passes:
+                prog = self.program("render/background.vert", "render/resolve.frag", pass_defines)
+                # The rays of the scene pass just drawn (for a tile, the whole image's projection off centre).
+                self._bind_background(prog, scene, maps, self._last_inverse_vp, mode)
+                targets.color.use(UNIT_RADIANCE)
+                _set(prog, "u_scene", UNIT_RADIANCE)
+                _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
+                _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
+                _set(prog, "u_opaque", scene.display.background != "transparent")
+                self.ctx.scissor = scissor
+                self._fullscreen(prog)
+        finally:
+            self.ctx.scissor = None
 
     def _draw_probe(self, scene: Scene, maps: IBLMaps | None, size: int, origin: tuple[int, int] = (0, 0)) -> None:
         defines = {**self._ibl_defines(scene), **self._below_grid_defines(scene, maps, [scene.material]),

@@ -31,7 +31,9 @@ void main() {
     // Shaded once per pixel, as the background pass shades it (at the pixel centre).
     vec3 background = background_radiance(v_ray);
     vec4 sum = vec4(0.0);
+#ifndef NO_SURFACES   // (outside the mesh's screen rectangle no sample was drawn: renderer.py _resolve)
     for (int i = 0; i < SCENE_SAMPLES; ++i) sum += texelFetch(u_scene, p, i);
+#endif
     // Porter-Duff 'under', summed over the samples: each sample's radiance is its surfaces' (alpha
     // 1 where opaque) and the background fills what they leave; an uncovered sample, cleared to
     // (0, 0, 0, 0), is the background alone. Linear, so the mean of the samples composites once.
