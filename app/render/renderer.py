@@ -2,9 +2,11 @@
 
 The passes of a frame, by anti-aliasing mode and what the caller reads back:
 
-    msaa:  forward pass (mesh, or the probe view) into the multisampled float target
+    msaa:  forward pass (mesh, or the probe view) into the multisampled float target (cleared:
+           alpha is coverage; half floats when only sRGB is read, HALF_FLOAT_MIN_EXPOSURE)
            -> resolve pass: mean of the samples, the background composited under them, written as
-              linear radiance and/or tone-mapped sRGB, whichever is read (render/resolve.frag);
+              linear radiance and/or tone-mapped sRGB, whichever is read (render/resolve.frag;
+              outside the mesh's screen rectangle the background alone, without the samples);
            with alphaMode BLEND parts (drawn over the background): forward pass -> background
            pass -> blended parts -> blit resolve -> radiance [-> tone map pass]
     none:  forward pass -> background pass (depth-tested to the uncovered pixels); written
