@@ -24,10 +24,11 @@ from alight.core.sphere_lod import (
     projected_radius_px,
     silhouette_error,
     sphere_segments,
+    sphere_surface_point,
 )
 from alight.exchange.presets import load_preset
 from alight.ibl.environment import load_environment
-from tests.gpu import renderer
+from tests.gpu import evaluate, renderer
 
 
 @pytest.mark.parametrize("segments", [16, 48, 128])
@@ -163,3 +164,23 @@ def test_orthographic_and_inside_views_draw_the_mesh_as_given(shared_data):
         frame = r.render(scene, maps, 64, 64, aa="none")
         assert r.last_sphere_segments is None
         assert np.isfinite(frame.linear).all()
+
+
+def test_the_shaded_point_is_the_rays_hit_on_the_true_sphere_and_the_glsl_matches_its_twin():
+    """Facet points of a coarse ball (grazing ones near its outline included) seen from the
+    default camera's distance: the twin's point lies on the sphere, on the ray, before the facet;
+    common/sphere_surface.glsl gives the same point."""
+    rng = np.random.default_rng(3)
+    part = sphere(16, 8).parts[0]
+    tri = part.positions[part.indices].astype(np.float64)
+    w = rng.dirichlet(np.ones(3), size=len(tri))
+    points = np.einsum("tv,tvc->tc", w, tri)
+    eye = np.array([0.0, 0.0, 4.323162])
+    hit = sphere_surface_point(eye, points, 1.0)
+    np.testing.assert_allclose(np.linalg.norm(hit, axis=1), 1.0, atol=1e-9)
+    ray = (points - eye) / np.linalg.norm(points - eye, axis=1, keepdims=True)
+    along = hit - eye
+    np.testing.assert_allclose(np.cross(along, ray), 0.0, atol=1e-9)               # on the ray
+    assert (np.sum(along * ray, axis=1) <= np.linalg.norm(points - eye, axis=1) + 1e-12).all()   # not beyond
+    glsl = evaluate("SPHERE_SURFACE", np.hstack([points, np.full((len(points), 1), eye[2])]))[:, :3]
+    np.testing.assert_allclose(glsl, hit, atol=2e-5)

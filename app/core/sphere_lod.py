@@ -73,3 +73,17 @@ def projected_radius_px(view_projection: np.ndarray, centre, radius: float, imag
     tan_x, tan_y = float(c[0]) / float(c[3]) / gx * w_gradient, float(c[1]) / float(c[3]) / gy * w_gradient
     off_axis = 1.0 + tan_x * tan_x + tan_y * tan_y
     return r / math.sqrt(d * d - r * r) * max(fx, fy) / w_gradient * off_axis
+
+
+def sphere_surface_point(eye, facet_point, radius: float) -> np.ndarray:
+    """The view ray's first hit on the sphere ``|x| = radius`` centred at the origin, for rays
+    from ``eye`` (3,) through ``facet_point`` (N, 3) or (3,) lying inside the sphere: the shaded
+    point of the built-in ball (GLSL twin: common/sphere_surface.glsl). Solved about the facet
+    point p, ``|p - s d|^2 = r^2`` for the step s back toward the eye, so that nothing cancels at
+    grazing angles. float64."""
+    p = np.asarray(facet_point, np.float64)
+    d = p - np.asarray(eye, np.float64)
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    pd = np.sum(p * d, axis=-1, keepdims=True)
+    s = pd + np.sqrt(np.maximum(pd * pd + (radius * radius - np.sum(p * p, axis=-1, keepdims=True)), 0.0))
+    return p - s * d

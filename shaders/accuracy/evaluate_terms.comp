@@ -5,6 +5,7 @@
 #include "common/sampling.glsl"
 #include "common/cubemap.glsl"
 #include "common/tonemapping.glsl"
+#include "common/sphere_surface.glsl"
 
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Inputs { vec4 u_inputs[]; };
@@ -30,6 +31,7 @@ const int TERM_GRID_STEP = 14;
 const int TERM_CUBE_TEXEL_DIRECTION = 15;
 const int TERM_PUNCTUAL = 16;
 const int TERM_SPOT_RANGE = 17;
+const int TERM_SPHERE_SURFACE = 18;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -72,6 +74,8 @@ void main() {
             o.y = range_attenuation(a.w, 1.0);
             break;
         }
+        // a = (facet point, the eye's distance on +z); the unit sphere.
+        case TERM_SPHERE_SURFACE: o.xyz = sphere_surface_point(vec3(0.0, 0.0, a.w), a.xyz, 1.0); break;
     }
     u_outputs[i] = o;
 }

@@ -124,17 +124,9 @@ const int MAP_SLOTS = 15;
 uniform mat3 u_map_transform[MAP_SLOTS];
 
 #ifdef SPHERE_SURFACE
+#include "common/sphere_surface.glsl"
 uniform float u_sphere_radius;   // centred at the origin; the camera is outside it (perspective)
 
-// The view ray's first hit on the sphere |x| = r (ray-sphere intersection). The flat facets lie
-// inside the sphere, so the hit is a step s back along the ray from the facet point p:
-// |p - s d|^2 = r^2. Solved about p, not the eye, so that nothing cancels at grazing angles.
-vec3 sphere_surface_point(vec3 eye, vec3 facet_point, float r) {
-    vec3 d = normalize(facet_point - eye);
-    float pd = dot(facet_point, d);
-    float s = pd + sqrt(max(pd * pd + (r * r - dot(facet_point, facet_point)), 0.0));
-    return facet_point - s * d;
-}
 #endif
 
 // The shaded point: the interpolated position, or on the built-in sphere the true surface's.
