@@ -162,6 +162,12 @@ vec4 sample_map(sampler2D map, int bit, int slot) {
 // meshes), facing the viewer's side.
 vec3 geometric_normal() {
     vec3 n = v_normal;
+    // With MSAA the pixel centre of an edge pixel may lie off the triangle, where the
+    // interpolated normal is extrapolated past the silhouette and faces away from the eye (a
+    // mirror-like ball then sparkles along its rim): there, read it at the covered samples'
+    // centroid instead. Covered centres are left as they are (GLSL 4.50 section 8.13.2).
+    vec3 eye = u_camera_position - v_position;
+    if (dot(n, eye) * (gl_FrontFacing ? 1.0 : -1.0) < 0.0) n = interpolateAtCentroid(v_normal);
     vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
     n = dot(n, n) > 1e-12 ? normalize(n) : face;
     return gl_FrontFacing ? n : -n;
