@@ -183,7 +183,8 @@ class Renderer:
 
             centre, radius = self._mesh.bounding_sphere() if self._mesh is not None else ((0, 0, 0), 1.0)
             camera = orbit_camera(centre, radius, self.width / self.height, orbit_deg, elevation_deg,
-                                  distance, fov_deg, target)
+                                  distance, fov_deg, target,
+                                  corners=self._mesh.corners() if self._mesh is not None else None)
         self.scene.camera = camera
         return self
 
