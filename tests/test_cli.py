@@ -417,3 +417,28 @@ def test_render_help_documents_every_option():
     for option in HELP_OPTIONS:
         # The option itself, not a longer one it is a prefix or suffix of (--env vs --env-rotation, --ibl vs --no-ibl).
         assert re.search(rf"(?<![\w-]){re.escape(option)}(?![\w-])", text), f"{option} not in render --help"
+
+
+def test_sigterm_during_a_write_leaves_nothing_behind(tmp_path):
+    """`kill` (SIGTERM) while a tiled image is being written: the temporary file beside the
+    output is removed, as on Ctrl-C, and the exit status says so (128 + 15)."""
+    import signal
+    import time
+
+    out = tmp_path / "huge.png"
+    proc = subprocess.Popen([sys.executable, "-m", "alight", "render", "--size", "8192", "--aa", "none",
+                             "--quality", "low", "--out", str(out)], cwd=REPO, env=dict(os.environ),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300
+        while not list(tmp_path.glob(".huge.*")) and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert list(tmp_path.glob(".huge.*")), "the render never started writing"
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 128 + 15, err
+    assert err.strip().splitlines()[-1] == "alight: terminated"
+    assert list(tmp_path.iterdir()) == []

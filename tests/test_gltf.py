@@ -546,3 +546,45 @@ def test_draco_equals_plain(tmp_path):
     g.use("KHR_draco_mesh_compression", required=True)
     g.save(tmp_path / "draco.glb")
     assert_equivalent(render(tmp_path / "draco.glb"), render(tmp_path / "plain.glb"))
+
+
+def _specular_plane(path, specular: dict, textures: dict | None = None) -> Path:
+    """A grey dielectric plane with KHR_materials_specular ``specular`` and constant textures
+    (``textures``: specularTexture / specularColorTexture -> an RGBA texel)."""
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(4)
+    ext = dict(specular)
+    for key, texel in (textures or {}).items():
+        ext[key] = {"index": g.image(np.tile(np.asarray(texel, np.uint8), (8, 8, 1)))}
+    mat = g.material(pbrMetallicRoughness={"baseColorFactor": [0.2, 0.2, 0.2, 1.0], "metallicFactor": 0.0,
+                                           "roughnessFactor": 0.3},
+                     extensions={"KHR_materials_specular": ext})
+    g.use("KHR_materials_specular")
+    attributes = {"POSITION": g.accessor(positions, bounds=True), "NORMAL": g.accessor(normals),
+                  "TEXCOORD_0": g.accessor(uvs)}
+    g.mesh([{"attributes": attributes, "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
+    return g.save(path)
+
+
+@pytest.mark.parametrize("color_factor", [1.0, 30.0], ids=["white", "f0_above_1"])
+def test_specular_textures_equal_their_factors(tmp_path, color_factor):
+    """KHR_materials_specular's specularTexture (A) and specularColorTexture (RGB, sRGB) multiply
+    specularFactor and specularColorFactor before the extension's min(..., 1): constant textures
+    render as the products of the factors (color_factor 30: F0 1.2 before the texel, so the min
+    must come after it)."""
+    from alight.core.shading import srgb_to_linear
+
+    texel_a, texel_rgb = 153, (255, 128, 64)
+    with_maps = _specular_plane(tmp_path / "maps.glb",
+                                {"specularFactor": 0.9, "specularColorFactor": [color_factor] * 3},
+                                {"specularTexture": (255, 0, 255, texel_a), "specularColorTexture": (*texel_rgb, 255)})
+    colour = [color_factor * float(srgb_to_linear(c / 255.0)) for c in texel_rgb]
+    factors = _specular_plane(tmp_path / "factors.glb",
+                              {"specularFactor": 0.9 * texel_a / 255.0, "specularColorFactor": colour})
+    a, b = render(with_maps), render(factors)
+    assert_equivalent(a, b)
+    # and the textures do something: without them the plane differs
+    plain = render(_specular_plane(tmp_path / "plain.glb", {"specularFactor": 0.9,
+                                                            "specularColorFactor": [color_factor] * 3}))
+    covered = b[..., 3] > 0
+    assert relative_mae(plain[..., :3], b[..., :3], covered) > 0.02

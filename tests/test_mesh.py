@@ -446,3 +446,16 @@ def test_import_does_not_import_trimesh():
     code = "import sys, alight.exchange.meshes as m; m.sphere(); m.load_mesh('cube'); print('trimesh' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_obj_with_a_missing_mtllib_says_so_once(tmp_path):
+    from alight.exchange.meshes import load_mesh
+
+    obj = "mtllib gone.mtl\nmtllib here.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"
+    (tmp_path / "tri.obj").write_text(obj)
+    (tmp_path / "here.mtl").write_text("newmtl red\nKd 1 0 0\n")
+    mesh = load_mesh(str(tmp_path / "tri.obj"))
+    assert [w for w in mesh.warnings if "mtllib" in w] == [
+        f"{tmp_path / 'tri.obj'}: mtllib 'gone.mtl' not found; its materials are drawn with the default material"]
+    (tmp_path / "gone.mtl").write_text("newmtl blue\nKd 0 0 1\n")
+    assert load_mesh(str(tmp_path / "tri.obj")).warnings == []

@@ -48,3 +48,25 @@ def test_unwritable_folder_is_a_one_line_error(tmp_path):
     with pytest.raises(AlightError) as info:
         write_image(tmp_path / "missing" / "x.png", np.zeros((2, 2, 3), np.uint8), linear=False)
     assert "\n" not in str(info.value) and "x.png" in str(info.value)
+
+
+def test_png_keeps_straight_alpha_as_given(tmp_path):
+    """The display image's alpha is straight (PNG specification 12.8): the file holds the bytes
+    given, not colour divided by alpha (OpenImageIO's default for PNG), and reading a texture map
+    back gives them unpremultiplied."""
+    import OpenImageIO as oiio
+
+    from alight.exchange.images import load_map_image
+
+    px = np.zeros((2, 3, 4), np.uint8)
+    px[..., :3] = (200, 120, 40)
+    px[..., 3] = [[0, 64, 128], [191, 255, 1]]
+    path = tmp_path / "straight.png"
+    write_image(path, px, linear=False)
+    config = oiio.ImageSpec()
+    config.attribute("oiio:UnassociatedAlpha", 1)
+    inp = oiio.ImageInput.open(str(path), config)
+    stored = np.asarray(inp.read_image(0, 0, 0, 4, oiio.UINT8)).reshape(2, 3, 4)
+    inp.close()
+    np.testing.assert_array_equal(stored, px)
+    np.testing.assert_array_equal(load_map_image(str(path)), px)

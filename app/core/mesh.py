@@ -91,6 +91,9 @@ TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
 # transmission and KHR_materials_volume's thickness G multiplies thickness (linear).
 LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness",
                        "anisotropy", "transmission", "thickness")
+# KHR_materials_specular's textures: specular A multiplies specularFactor, specular_color RGB
+# (sRGB) multiplies specularColorFactor, before the extension's min(..., 1) (FileMaterial).
+SPECULAR_TEXTURE_SLOTS = ("specular", "specular_color")
 
 
 @dataclass
@@ -132,17 +135,24 @@ class FileMaterial:
     anisotropy_texture: TextureInfo | None = None
     transmission_texture: TextureInfo | None = None
     thickness_texture: TextureInfo | None = None
+    # KHR_materials_specular with textures: specular_f0 per texel is
+    # min(specular_color_f0 * specular_color, 1) * specular_factor * specular (the textures'
+    # values), where specular_color_f0 = F0(ior) * specularColorFactor, not clamped.
+    specular_texture: TextureInfo | None = None
+    specular_color_texture: TextureInfo | None = None
+    specular_factor: float = 1.0
+    specular_color_f0: tuple[float, float, float] = (0.04, 0.04, 0.04)
 
     def __post_init__(self) -> None:
-        for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:
+        for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS + SPECULAR_TEXTURE_SLOTS:
             value = getattr(self, f"{slot}_texture")
             if isinstance(value, np.ndarray):
                 setattr(self, f"{slot}_texture", TextureInfo(value))
 
     def textures(self) -> dict[str, TextureInfo]:
-        """The slots that have a texture, by slot name (TEXTURE_SLOTS, then LAYER_TEXTURE_SLOTS)."""
+        """The slots that have a texture, by slot name (TEXTURE_SLOTS, LAYER_TEXTURE_SLOTS, SPECULAR_TEXTURE_SLOTS)."""
         out = {}
-        for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS:
+        for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS + SPECULAR_TEXTURE_SLOTS:
             info = getattr(self, f"{slot}_texture")
             if info is not None:
                 out[slot] = info

@@ -41,8 +41,7 @@ from alight.core.scene import Camera, Light
 from alight.errors import AlightError
 from alight.exchange.gltf_accessors import Accessors, fail, read_uri
 
-# Extensions alight renders as their specifications say (KHR_materials_specular: its factors;
-# its two textures are warned about where a file uses them).
+# Extensions alight renders as their specifications say.
 SUPPORTED = {
     "KHR_texture_transform", "KHR_materials_unlit", "KHR_materials_emissive_strength", "KHR_materials_ior",
     "KHR_materials_specular", "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_texture_webp",
@@ -60,6 +59,8 @@ LAYER_TEXTURES = {
     "anisotropy": ("KHR_materials_anisotropy", "anisotropyTexture"),
     "transmission": ("KHR_materials_transmission", "transmissionTexture"),
     "thickness": ("KHR_materials_volume", "thicknessTexture"),
+    "specular": ("KHR_materials_specular", "specularTexture"),
+    "specular_color": ("KHR_materials_specular", "specularColorTexture"),
 }
 # Compression a file cannot be read without: refused in one line when no library decodes it.
 COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_texture_basisu"}
@@ -313,10 +314,15 @@ class _Reader:
             got = self._texture_info(info, f"{where}.{_json_slot(slot)}")
             if got is not None:
                 infos[slot] = got
-        spec = ext.get("KHR_materials_specular")
-        if isinstance(spec, dict) and (spec.get("specularTexture") or spec.get("specularColorTexture")):
-            self.warn("specular-textures", f"{where}: KHR_materials_specular textures are not applied "
-                                           f"(its factors are)")
+        specular = {}
+        if "specular" in infos or "specular_color" in infos:
+            # the texels multiply the factors before the extension's min(..., 1) (FileMaterial)
+            spec = ext.get("KHR_materials_specular") or {}
+            ior = float(factors.ior) if factors.ior is not None else 1.5
+            f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+            color = spec.get("specularColorFactor") or [1.0, 1.0, 1.0]
+            specular = dict(specular_factor=float(spec.get("specularFactor", 1.0)),
+                            specular_color_f0=tuple(f0 * float(c) for c in color))
         self._decode_images([image_index for _, image_index in infos.values()])
         textures = {}
         for slot, (info, image_index) in infos.items():
@@ -339,6 +345,7 @@ class _Reader:
             layers=layer_fields_from_gltf(raw, self.source),
             clearcoat_normal_scale=float((ext.get("KHR_materials_clearcoat") or {}).get("clearcoatNormalTexture", {})
                                          .get("scale", 1.0)) if isinstance(ext.get("KHR_materials_clearcoat"), dict) else 1.0,
+            **specular,
             **textures,
         )
         self._materials[index] = fm

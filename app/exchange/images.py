@@ -56,7 +56,11 @@ def load_map_image(path: str) -> np.ndarray:
 def _read(path: str) -> np.ndarray:
     import OpenImageIO as oiio
 
-    inp = oiio.ImageInput.open(path)
+    # The stored values, alpha straight as PNG keeps it (PNG specification 12.8): OpenImageIO
+    # would otherwise premultiply colour by alpha as it reads.
+    config = oiio.ImageSpec()
+    config.attribute("oiio:UnassociatedAlpha", 1)
+    inp = oiio.ImageInput.open(path, config)
     if inp is None:
         raise AlightError(f"{path}: cannot read texture map ({_one_line(oiio.geterror()) or 'unknown format'})")
     try:

@@ -67,8 +67,13 @@ def load_mesh(spec: str) -> Mesh:
     try:
         extras: dict[str, dict] = {}
         textures: dict[int, np.ndarray] = {}
+        warnings: list[str] = []
         if ext == ".obj":
+            from alight.exchange.mtl import missing_libraries
+
             _attach_diffuse_maps(spec, path, extras, textures)
+            warnings += [f"{spec}: mtllib '{name}' not found; its materials are drawn with the default material"
+                         for name in missing_libraries(path)]
         parts = []
         for node in scene.graph.nodes_geometry:
             transform, geom_name = scene.graph[node]
@@ -84,7 +89,7 @@ def load_mesh(spec: str) -> Mesh:
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     if not parts:
         raise AlightError(f"{spec}: no triangles in the file")
-    return Mesh(parts, str(spec))
+    return Mesh(parts, str(spec), warnings=warnings)
 
 
 def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,

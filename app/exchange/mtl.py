@@ -72,6 +72,12 @@ def _libraries(obj_path: Path) -> list[Path]:
     return out
 
 
+def missing_libraries(obj_path: Path) -> list[str]:
+    """The names of the MTL files an OBJ's ``mtllib`` statements give that are not there (their
+    materials are then drawn with the default material: worth one warning line)."""
+    return list(dict.fromkeys(lib.name for lib in _libraries(obj_path) if not lib.is_file()))
+
+
 def diffuse_maps(obj_path: Path) -> dict[str, DiffuseMap]:
     """map_Kd of every material in the OBJ's MTL files, by material name."""
     maps: dict[str, DiffuseMap] = {}

@@ -89,6 +89,10 @@ def image_rows_writer(path: str | os.PathLike, width: int, height: int, channels
     spec = oiio.ImageSpec(width, height, channels, fmt)
     if linear:
         spec.attribute("compression", "zip")
+    else:
+        # The display image's alpha is straight (render/tonemap.frag): written as given.
+        # OpenImageIO takes pixels as premultiplied by default and divides them by alpha for PNG.
+        spec.attribute("oiio:UnassociatedAlpha", 1)
     try:
         with atomic_path(p) as tmp:
             out = oiio.ImageOutput.create(str(tmp))

@@ -381,6 +381,7 @@ def main(argv: list[str] | None = None) -> int:
             parser.print_help()
             return 0
         args = parser.parse_args(["edit"])   # with a display, plain 'alight' opens the editor
+    previous = _catch_termination()
     try:
         if args.command == "edit":
             return _edit(args)
@@ -414,10 +415,45 @@ def main(argv: list[str] | None = None) -> int:
     except AlightError as exc:
         print(f"alight: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("alight: terminated", file=sys.stderr)
+        return 128 + 15
     except KeyboardInterrupt:
         print("alight: interrupted", file=sys.stderr)
         return 130
+    finally:
+        _restore_termination(previous)
     return 0
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (a job scheduler's or `kill`'s), raised where the process is, so that what is
+    being written is removed as on Ctrl-C (alight.exchange.output.atomic_path) before it exits."""
+
+
+def _on_terminate(signum, frame):
+    raise Terminated()
+
+
+def _catch_termination():
+    """SIGTERM as ``Terminated`` in the main thread; returns the handler it replaces (None
+    where signals cannot be set: another thread, an embedding host)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    try:
+        return signal.signal(signal.SIGTERM, _on_terminate)
+    except (ValueError, OSError):
+        return None
+
+
+def _restore_termination(previous) -> None:
+    if previous is not None:
+        import signal
+
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _warn(lines) -> None:

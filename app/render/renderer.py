@@ -80,13 +80,13 @@ MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
                  "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy",
-                 "transmission", "thickness")
+                 "transmission", "thickness", "specular", "specular_color")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
 UNIT_TRANSMISSION_LUT = UNIT_SHEEN_LUT + 1          # ibl/transmission_lut.comp's table (HAS_VOLUME)
 UNIT_SCENE_BEHIND = UNIT_TRANSMISSION_LUT + 1      # the opaque parts' copy (TRANSMISSION_SCENE)
 UNIT_SCENE_DEPTH = UNIT_SCENE_BEHIND + 1           # render/resolve.frag's depth samples
-SRGB_MAPS = ("base_color", "emissive", "sheen_color")
+SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {
@@ -673,7 +673,7 @@ class ForwardRenderer:
 
     # The maps that cannot change a roughness (MATERIAL_MAPS bits): any other map compiled in keeps
     # the prefiltered lookup's path below the grid (ibl.glsl IBL_BELOW_GRID).
-    _ROUGHNESS_FREE_MAPS = {"base_color", "normal", "emissive", "occlusion", "metallic"}
+    _ROUGHNESS_FREE_MAPS = {"base_color", "normal", "emissive", "occlusion", "metallic", "specular", "specular_color"}
 
     def _below_grid_defines(self, scene: Scene, maps: IBLMaps | None, materials, map_mask: int = 0) -> dict:
         """``{"IBL_BELOW_GRID": 0}`` when no roughness the pass can shade lies below the prefiltered
@@ -1059,6 +1059,9 @@ class ForwardRenderer:
                 _set(program, "u_occlusion_strength", float(fm.occlusion_strength) if fm else 1.0)
                 _set(program, "u_alpha", float(fm.alpha) if fm else 1.0)
                 _set(program, "u_alpha_cutoff", float(fm.alpha_cutoff) if fm else 0.5)
+                _set(program, "u_specular_factor", float(fm.specular_factor) if fm else 1.0)
+                _set(program, "u_specular_color_f0", tuple(float(x) for x in fm.specular_color_f0) if fm
+                     else tuple(float(x) for x in material.specular_f0))
                 # A file's maps use its own UVs as they are; the user's maps are tiled.
                 _set(program, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
                 _set(program, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))

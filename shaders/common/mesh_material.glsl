@@ -88,7 +88,7 @@ uniform sampler2D u_thickness_map;
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 32767
+#define MATERIAL_MAPS_MASK 131071
 #endif
 #ifndef MAP_UV1_MASK
 #define MAP_UV1_MASK 0
@@ -117,7 +117,19 @@ const int MAP_SHEEN_ROUGHNESS = 2048;
 const int MAP_ANISOTROPY = 4096;
 const int MAP_TRANSMISSION = 8192;
 const int MAP_THICKNESS = 16384;
-const int MAP_SLOTS = 15;
+const int MAP_SPECULAR = 32768;
+const int MAP_SPECULAR_COLOR = 65536;
+const int MAP_SLOTS = 17;
+// KHR_materials_specular's textures, compiled in only where a part has one (the mask's bits 15, 16).
+#if (MATERIAL_MAPS_MASK & 98304) != 0
+#define HAS_SPECULAR_MAPS
+uniform bool u_has_specular_map;              // A multiplies specularFactor
+uniform bool u_has_specular_color_map;        // RGB (sRGB) multiplies specularColorFactor
+uniform sampler2D u_specular_map;
+uniform sampler2D u_specular_color_map;
+uniform float u_specular_factor;
+uniform vec3 u_specular_color_f0;             // F0(ior) * specularColorFactor, before the min(., 1)
+#endif
 // KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
 uniform mat3 u_map_transform[MAP_SLOTS];
 
@@ -162,6 +174,12 @@ vec4 sample_map(sampler2D map, int bit, int slot) {
 // meshes), facing the viewer's side.
 vec3 geometric_normal() {
     vec3 n = v_normal;
+    // With MSAA the pixel centre of an edge pixel may lie off the triangle, where the
+    // interpolated normal is extrapolated past the silhouette and faces away from the eye (a
+    // mirror-like ball then sparkles along its rim): there, read it at the covered samples'
+    // centroid instead. Covered centres are left as they are (GLSL 4.50 section 8.13.2).
+    vec3 eye = u_camera_position - v_position;
+    if (dot(n, eye) * (gl_FrontFacing ? 1.0 : -1.0) < 0.0) n = interpolateAtCentroid(v_normal);
     vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
     n = dot(n, n) > 1e-12 ? normalize(n) : face;
     return gl_FrontFacing ? n : -n;
@@ -218,6 +236,18 @@ Surface material_surface(vec3 n) {
     s.metallic *= metal_rough.x;
     s.roughness *= metal_rough.y;
     if (has_map(MAP_EMISSIVE, u_has_emissive_map)) s.emissive *= sample_map(u_emissive_map, MAP_EMISSIVE, 3).rgb;
+#ifdef HAS_SPECULAR_MAPS
+    if (has_map(MAP_SPECULAR, u_has_specular_map) || has_map(MAP_SPECULAR_COLOR, u_has_specular_color_map)) {
+        // KHR_materials_specular: dielectric F0 = min(F0(ior) * specularColor, 1) * specular.
+        vec3 color = u_specular_color_f0;
+        float factor = u_specular_factor;
+        if (has_map(MAP_SPECULAR_COLOR, u_has_specular_color_map)) {
+            color *= sample_map(u_specular_color_map, MAP_SPECULAR_COLOR, 16).rgb;
+        }
+        if (has_map(MAP_SPECULAR, u_has_specular_map)) factor *= sample_map(u_specular_map, MAP_SPECULAR, 15).a;
+        s.specular_f0 = min(color, vec3(1.0)) * factor;
+    }
+#endif
     if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
