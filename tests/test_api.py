@@ -168,3 +168,18 @@ def test_ibl_model_is_chosen_by_name_and_changes_the_image(shared_data, monkeypa
         assert np.abs(default - lecture).max() > 0.05
         with pytest.raises(AlightError, match="ibl model"):
             r.set_ibl_model("nonsense")
+
+
+def test_file_warnings_reach_the_api_user_once(tmp_path, capfd):
+    """What a mesh file is drawn without is said on stderr through the API too, once."""
+    import alight
+
+    (tmp_path / "tri2.obj").write_text("mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    r = alight.Renderer(16)
+    r.set_mesh(tmp_path / "tri2.obj")
+    r.set_mesh(tmp_path / "tri2.obj")
+    err = capfd.readouterr().err.splitlines()
+    assert [line for line in err if "nowhere.mtl" in line] == [
+        f"alight: warning: {tmp_path / 'tri2.obj'}: mtllib 'nowhere.mtl' not found; its materials are drawn "
+        "with the default material"]
+    r.close()

@@ -347,3 +347,23 @@ def test_batch_workers_load_the_bake_another_process_made(cache_dir, tmp_path):
     written = entry.stat().st_mtime_ns
     batch()
     assert _entry_file(cache_dir) == entry and entry.stat().st_mtime_ns == written
+
+
+def test_lut_tables_round_trip_and_refuse_what_they_are_not(tmp_path):
+    """The LUTs' .npy files (alight.ibl.table_files): a table comes back as stored; a truncated
+    file, another shape or a non-finite value reads as absent (the LUT is baked again)."""
+    from alight.ibl.table_files import load_table, save_table
+
+    table = np.arange(24, dtype=np.float32).reshape(2, 3, 4)
+    path = tmp_path / "sub" / "lut.npy"
+    save_table(path, table)
+    np.testing.assert_array_equal(load_table(path, (2, 3, 4)), table)
+    assert load_table(path, (3, 2, 4)) is None
+    path.write_bytes(path.read_bytes()[:-8])
+    assert load_table(path, (2, 3, 4)) is None
+    bad = table.copy()
+    bad[0, 0, 0] = np.nan
+    save_table(path, bad)
+    assert load_table(path, (2, 3, 4)) is None
+    assert load_table(tmp_path / "none.npy", (2, 3, 4)) is None
+    assert [p.name for p in path.parent.iterdir()] == ["lut.npy"]     # no temporary left

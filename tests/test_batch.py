@@ -177,3 +177,14 @@ def test_ray_executor_on_a_local_two_worker_cluster(folder):
     for name, data in ray_images.items():
         with Image.open(folder / "inline" / name) as im:
             assert im.tobytes() == data, name
+
+
+def test_file_warnings_are_printed_once_per_batch(folder):
+    """What a mesh file is drawn without (here an OBJ's missing mtllib) is said once, however
+    many items and workers read the file."""
+    (folder / "tri.obj").write_text("mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    spec = write_spec(folder, SPEC.replace('"duck.glb"]', '"tri.obj"]'))
+    log = io.StringIO()
+    assert main(str(spec), executor="local", workers=2, log=log) == 0
+    lines = [line for line in log.getvalue().splitlines() if line.startswith("alight: warning:")]
+    assert len(lines) == 1 and "mtllib 'gone.mtl' not found" in lines[0], lines

@@ -172,3 +172,15 @@ def choice_seconds_of_medium(choice) -> float:
     from alight.accuracy.auto_quality import load_table, predicted_seconds
 
     return predicted_seconds(load_table(), "medium", 1.0, False)
+
+
+def test_a_dropped_file_says_what_it_is_drawn_without(tmp_path, capfd):
+    """Opening (dropping) a mesh file with warnings says them on stderr and counts them in the
+    panel's message, not only for the file given at start."""
+    from alight.frontends.editor.state import EditorState
+
+    (tmp_path / "tri3.obj").write_text("mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    state = EditorState()
+    assert state.open_file(str(tmp_path / "tri3.obj"))
+    assert state.message == "opened tri3.obj (1 warning on stderr)"
+    assert "mtllib 'absent.mtl' not found" in capfd.readouterr().err

@@ -459,3 +459,32 @@ def test_obj_with_a_missing_mtllib_says_so_once(tmp_path):
         f"{tmp_path / 'tri.obj'}: mtllib 'gone.mtl' not found; its materials are drawn with the default material"]
     (tmp_path / "gone.mtl").write_text("newmtl blue\nKd 0 0 1\n")
     assert load_mesh(str(tmp_path / "tri.obj")).warnings == []
+
+
+def test_framing_fits_a_long_object_in_a_wide_image():
+    """fit_distance: the bounding box's corners, where nearer than the sphere fit, all project
+    inside both fields of view with the margin; a ball keeps the sphere fit."""
+    import math
+
+    from alight.core.mesh import sphere
+    from alight.core.scene import frame_camera, orbit_camera
+
+    lo, hi = np.array([-4.0, -0.5, -0.3]), np.array([4.0, 0.5, 0.3])
+    pick = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=bool)
+    corners = np.where(pick, hi, lo)
+    radius = float(np.linalg.norm(hi))
+    for aspect, orbit in ((2.5, 0.0), (2.5, 30.0), (0.75, 0.0)):
+        sphere_fit = orbit_camera((0, 0, 0), radius, aspect, orbit, 10.0)
+        box_fit = orbit_camera((0, 0, 0), radius, aspect, orbit, 10.0, corners=corners)
+        d_sphere = np.linalg.norm(sphere_fit.position)
+        d_box = np.linalg.norm(box_fit.position)
+        assert d_box < d_sphere
+        vp = box_fit.view_projection(aspect).astype(np.float64)
+        clip = np.c_[corners, np.ones(8)] @ vp
+        ndc = clip[:, :2] / clip[:, 3:4]
+        assert np.abs(ndc).max() <= 1.0 / 1.3 + 1e-6       # inside, with the margin to spare
+        assert np.abs(ndc).max() >= 1.0 / 1.3 - 1e-6       # and no further than needed
+    ball = sphere()
+    cam = frame_camera(*ball.bounding_sphere(), aspect=1.0, corners=ball.corners())
+    plain = frame_camera(*ball.bounding_sphere(), aspect=1.0)
+    assert cam.position == plain.position and math.isclose(cam.far, plain.far)

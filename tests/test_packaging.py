@@ -67,7 +67,8 @@ def test_wheel_holds_alight_and_nothing_named_app(wheel):
     shipped = {n.removeprefix("alight/shaders/") for n in names if n.startswith("alight/shaders/")}
     in_repo = {p.relative_to(REPO / "shaders").as_posix() for p in (REPO / "shaders").rglob("*") if p.is_file()}
     assert in_repo and in_repo <= shipped, f"shaders missing from the wheel: {sorted(in_repo - shipped)}"
-    assert len([n for n in names if n.startswith("alight/presets/") and n.endswith(".json")]) == 10
+    presets = {n.removeprefix("alight/presets/") for n in names if n.startswith("alight/presets/") and n.endswith(".json")}
+    assert presets == {p.name for p in (REPO / "presets").glob("*.json")} and len(presets) >= 10
     assert "alight/accuracy/auto_quality_table.json" in names
     entry_points = zipfile.ZipFile(wheel).read(next(n for n in names if n.endswith("entry_points.txt"))).decode()
     assert "alight = alight.frontends.cli:main" in entry_points

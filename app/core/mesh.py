@@ -197,6 +197,12 @@ class Mesh:
         allp = np.concatenate([p.positions for p in self.parts]).astype(np.float64)
         return allp.min(axis=0), allp.max(axis=0)
 
+    def corners(self) -> np.ndarray:
+        """The bounding box's 8 world-space corners (8, 3) (camera framing)."""
+        lo, hi = self.bounds()
+        pick = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=bool)
+        return np.where(pick, hi, lo)
+
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre of the bounding box and the distance to the farthest vertex (camera framing)."""
         lo, hi = self.bounds()

@@ -51,15 +51,40 @@ class Camera:
         return pyrr.matrix44.multiply(self.view_matrix(), self.projection_matrix(aspect))
 
 
-def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float = 1.0,
-                 direction=(0.0, 0.0, 1.0), margin: float = 1.3) -> Camera:
-    """A camera on ``direction`` from ``center`` (default +Z, CONVENTIONS.md) that fits a sphere
-    of ``radius`` in the narrower of the two fields of view."""
+def fit_distance(center, radius: float, fov_y_deg: float, aspect: float, direction, corners=None,
+                 margin: float = 1.3) -> float:
+    """How far along ``direction`` from ``center`` a camera (up +Y) must stand to see the object
+    with ``margin`` to spare: the sphere of ``radius`` in the narrower field of view, or, nearer
+    where that is enough, every corner of its bounding box (``corners`` (8, 3)) in both fields
+    of view. A long or flat object (a row of test tiles, a car) then fills a wide image instead of
+    the sphere's square."""
     half = math.radians(fov_y_deg) / 2.0
-    half_narrow = min(half, math.atan(math.tan(half) * aspect))
-    distance = margin * radius / math.sin(half_narrow)
+    tan_y = math.tan(half)
+    tan_x = tan_y * aspect
+    distance = margin * radius / math.sin(min(half, math.atan(tan_x)))
+    if corners is None:
+        return distance
+    d = np.asarray(direction, np.float64)
+    d = d / np.linalg.norm(d)
+    right = np.cross(-d, (0.0, 1.0, 0.0))
+    if np.linalg.norm(right) < 1e-9:      # looking straight up or down: any right will do
+        right = np.array([1.0, 0.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, -d)
+    o = np.asarray(corners, np.float64) - np.asarray(center, np.float64)
+    # corner at depth D - o.d in front of the camera: |o.right| <= (D - o.d) tan_x / margin
+    need = o @ d + margin * np.maximum(np.abs(o @ right) / tan_x, np.abs(o @ up) / tan_y)
+    return min(distance, float(need.max()))
+
+
+def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float = 1.0,
+                 direction=(0.0, 0.0, 1.0), margin: float = 1.3, corners=None) -> Camera:
+    """A camera on ``direction`` from ``center`` (default +Z, CONVENTIONS.md) that fits a sphere
+    of ``radius`` in the narrower of the two fields of view, or the bounding box's ``corners``
+    (8, 3) where they need less distance (``fit_distance``)."""
     d = np.asarray(direction, dtype=np.float64)
     d = d / np.linalg.norm(d)
+    distance = fit_distance(center, radius, fov_y_deg, aspect, d, corners, margin)
     c = np.asarray(center, dtype=np.float64)
     position = c + d * distance
     return Camera(tuple(position), tuple(c), (0.0, 1.0, 0.0), fov_y_deg,
@@ -67,15 +92,16 @@ def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float =
 
 
 def orbit_camera(center, radius: float, aspect: float, orbit_deg: float = 0.0, elevation_deg: float = 0.0,
-                 distance: float | None = None, fov_y_deg: float = 35.0, target=None) -> Camera:
+                 distance: float | None = None, fov_y_deg: float = 35.0, target=None, corners=None) -> Camera:
     """A camera looking at ``target`` (default: ``center``) from a direction turned ``orbit_deg``
     about +Y from +Z (right-handed) and raised by ``elevation_deg``, at ``distance`` (default:
     the distance that frames a sphere of ``radius``, frame_camera's), with a vertical field of
-    view of ``fov_y_deg`` degrees. The near and far planes enclose the sphere."""
+    view of ``fov_y_deg`` degrees; ``corners``: the bounding box's (frame_camera). The near and
+    far planes enclose the sphere."""
     a, e = math.radians(orbit_deg), math.radians(elevation_deg)
     direction = np.array([math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e)])
     look_at = np.asarray(center if target is None else target, dtype=np.float64)
-    framed = frame_camera(look_at, max(radius, 1e-6), fov_y_deg, aspect, direction)
+    framed = frame_camera(look_at, max(radius, 1e-6), fov_y_deg, aspect, direction, corners=corners)
     if distance is None:
         return framed
     position = look_at + direction * distance

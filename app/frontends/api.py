@@ -35,7 +35,7 @@ from alight.core.scene import (
     Scene,
     parse_light,
 )
-from alight.errors import AlightError
+from alight.errors import AlightError, warn
 from alight.exchange.meshes import load_mesh
 from alight.exchange.presets import load_preset
 from alight.ibl.environment import Environment, load_environment
@@ -104,8 +104,12 @@ class Renderer:
     # --- scene state ---------------------------------------------------------------------
 
     def set_mesh(self, mesh: str | os.PathLike | Mesh) -> "Renderer":
-        """'sphere', 'cube', 'plane', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh."""
+        """'sphere', 'cube', 'plane', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
+        What the file is drawn without is said on stderr, one ``alight: warning:`` line each, once
+        per process (alight.errors.warn)."""
         self._mesh = mesh if isinstance(mesh, Mesh) else load_mesh(os.fspath(mesh))
+        for line in self._mesh.warnings:
+            warn(line)
         self.scene.mesh = self._mesh
         return self
 
@@ -118,6 +122,8 @@ class Renderer:
             self._env = _studio()
         else:
             self._env = load_environment(os.fspath(env))
+        for line in self._env.warnings if self._env is not None else ():
+            warn(line)     # what was repaired or clamped (alight.errors.warn: once per process)
         self.scene.ibl_enabled = self._env is not None
         if rotation_deg is not None:
             self.scene.env_rotation_deg = float(rotation_deg)
@@ -177,7 +183,8 @@ class Renderer:
 
             centre, radius = self._mesh.bounding_sphere() if self._mesh is not None else ((0, 0, 0), 1.0)
             camera = orbit_camera(centre, radius, self.width / self.height, orbit_deg, elevation_deg,
-                                  distance, fov_deg, target)
+                                  distance, fov_deg, target,
+                                  corners=self._mesh.corners() if self._mesh is not None else None)
         self.scene.camera = camera
         return self
 

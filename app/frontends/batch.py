@@ -283,7 +283,12 @@ def run(plan_: Plan, executor: str = "local", workers: int | None = None, force:
         print(f"alight batch: {len(result.skipped)} up to date, {len(todo)} to render", file=log)
     plan_.out_dir.mkdir(parents=True, exist_ok=True)
     progress = _Progress(len(todo), log)
-    for name, error, _ in _execute(todo, executor, workers):
+    warned: set[str] = set()
+    for name, error, _, warnings in _execute(todo, executor, workers):
+        for line in warnings:     # each once, whichever worker met it first
+            if line not in warned:
+                warned.add(line)
+                print(f"alight: warning: {line}", file=log)
         if error is None:
             result.rendered.append(name)
         else:

@@ -21,20 +21,23 @@ MATERIAL_FIELDS = {"base_color", "metallic", "roughness", "specular_f0", "emissi
 _WORKER: dict[str, Any] = {}
 
 
-def render_item(item) -> tuple[str, str | None, float]:
+def render_item(item) -> tuple[str, str | None, float, list[str]]:
     """Render one item in this process (its renderer and caches live as long as the process).
-    Returns (name, error or None, seconds); never raises, so one bad item cannot stop a batch."""
+    Returns (name, error or None, seconds, warnings): the warning lines of the mesh and
+    environment files this process read for the item (what the picture is drawn without; the
+    batch prints each once). Never raises, so one bad item cannot stop a batch."""
     start = time.perf_counter()
+    warnings: list[str] = []
     try:
-        _render(item)
-        return item.name, None, time.perf_counter() - start
+        _render(item, warnings)
+        return item.name, None, time.perf_counter() - start, warnings
     except AlightError as e:
-        return item.name, " ".join(str(e).split()), time.perf_counter() - start
+        return item.name, " ".join(str(e).split()), time.perf_counter() - start, warnings
     except Exception as e:  # a bug or a driver failure: still one line, and the batch goes on
-        return item.name, f"{type(e).__name__}: {' '.join(str(e).split())}", time.perf_counter() - start
+        return item.name, f"{type(e).__name__}: {' '.join(str(e).split())}", time.perf_counter() - start, warnings
 
 
-def _render(item) -> None:
+def _render(item, warnings: list[str]) -> None:
     from alight.exchange.meshes import load_mesh
     from alight.frontends.api import Renderer
     from alight.ibl.environment import load_environment
@@ -48,6 +51,7 @@ def _render(item) -> None:
         meshes[item.mesh] = load_mesh(item.mesh)
     if item.environment not in envs:
         envs[item.environment] = load_environment(item.environment)
+    warnings.extend([*meshes[item.mesh].warnings, *envs[item.environment].warnings])
     r.quality, r.aa = item.quality, item.aa
     r.width, r.height = item.size
     r.set_mesh(meshes[item.mesh]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)

@@ -112,7 +112,7 @@ def _camera(args, mesh, aspect: float):
             raise AlightError("--orbit/--elevation/--distance/--fov/--target: only with --view camera")
         centre, radius = mesh.bounding_sphere()
         return orbit_camera(centre, radius, aspect, args.orbit, args.elevation, args.distance,
-                            35.0 if args.fov is None else args.fov, target)
+                            35.0 if args.fov is None else args.fov, target, corners=mesh.corners())
     kind, _, index = spec.partition(":")
     if kind != "gltf":
         raise AlightError(f"--camera: '{spec}' is not auto, gltf or gltf:N")

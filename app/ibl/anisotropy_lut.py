@@ -11,13 +11,12 @@ when a scene draws an anisotropic material.
 
 from __future__ import annotations
 
-import os
 
 import moderngl
 import numpy as np
 
 from alight.core.gpu import ShaderLibrary
-from alight.exchange.output import atomic_path
+from alight.ibl.table_files import load_table, save_table
 from alight.paths import cache_dir
 
 # (n.v, roughness, strength) texels and Hammersley samples per lobe and azimuth. Strength
@@ -50,23 +49,11 @@ class AnisotropyLut:
             return self._textures
         path = self.path()
         shape = (2, self.size[2], self.size[1], self.size[0], 4)
-        table = None
-        try:
-            loaded = np.load(path, allow_pickle=False)
-            if loaded.shape == shape and loaded.dtype == np.float32 and np.isfinite(loaded).all():
-                table = loaded
-        except (OSError, ValueError):
-            table = None
+        table = load_table(path, shape)
         if table is None:
             self.last_source = "baked"
             table = self._bake()
-            try:
-                os.makedirs(path.parent, exist_ok=True)
-                with atomic_path(path) as tmp:
-                    with open(tmp, "wb") as f:
-                        np.save(f, table)
-            except OSError:
-                pass  # an unwritable cache only costs a re-bake next time
+            save_table(path, table)
         else:
             self.last_source = "disk"
         self._textures = (self._upload(table[0]), self._upload(table[1]))

@@ -12,7 +12,6 @@ Every quality choice is in ``QUALITY`` below.
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
@@ -22,8 +21,8 @@ import numpy as np
 
 from alight.core.gpu import ShaderLibrary, float_cube
 from alight.core.shading import D_GGX, hammersley, importance_sample_ggx_tangent
-from alight.exchange.output import atomic_path
 from alight.ibl.sun import Sun, extract_suns
+from alight.ibl.table_files import load_table, save_table
 from alight.paths import cache_dir
 
 if TYPE_CHECKING:
@@ -278,27 +277,14 @@ class LutCache:
         if key in self._textures:
             self.last_source = "memory"
             return self._textures[key]
-        table = None
-        try:
-            loaded = np.load(path, allow_pickle=False)
-            if loaded.shape == (size, size, LUT_CHANNELS) and loaded.dtype == np.float32 and np.isfinite(loaded).all():
-                table = loaded
-        except (OSError, ValueError):
-            table = None
+        table = load_table(path, (size, size, LUT_CHANNELS))
         if table is not None:
             self.last_source = "disk"
             tex = self._upload(table)
         else:
             self.last_source = "baked"
             tex = bake()
-            table = read_lut(tex)
-            try:
-                os.makedirs(path.parent, exist_ok=True)
-                with atomic_path(path) as tmp:
-                    with open(tmp, "wb") as f:
-                        np.save(f, table)
-            except OSError:
-                pass  # an unwritable cache only costs a re-bake next time
+            save_table(path, read_lut(tex))
         self._textures[key] = tex
         return tex
 

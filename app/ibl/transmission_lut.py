@@ -10,13 +10,12 @@ of its own: its lobe is the reflection lobe mirrored through the surface (the BR
 
 from __future__ import annotations
 
-import os
 
 import moderngl
 import numpy as np
 
 from alight.core.gpu import ShaderLibrary
-from alight.exchange.output import atomic_path
+from alight.ibl.table_files import load_table, save_table
 from alight.paths import cache_dir
 
 # Quality choices in one place: texels over n.v, roughness and the ior axis, and samples per
@@ -71,26 +70,14 @@ class TransmissionLut:
             return self._texture
         path = self.path()
         shape = (SIZE[2], SIZE[1], SIZE[0], CHANNELS)
-        table = None
-        try:
-            loaded = np.load(path, allow_pickle=False)
-            if loaded.shape == shape and loaded.dtype == np.float32 and np.isfinite(loaded).all():
-                table = loaded
-        except (OSError, ValueError):
-            table = None
+        table = load_table(path, shape)
         if table is not None:
             self.last_source = "disk"
             self._texture = self._upload(table)
         else:
             self.last_source = "baked"
             self._texture = self._bake()
-            try:
-                os.makedirs(path.parent, exist_ok=True)
-                with atomic_path(path) as tmp:
-                    with open(tmp, "wb") as f:
-                        np.save(f, read_table(self._texture))
-            except OSError:
-                pass   # an unwritable cache only costs a bake next time
+            save_table(path, read_table(self._texture))
         return self._texture
 
     def _upload(self, table: np.ndarray) -> moderngl.Texture:

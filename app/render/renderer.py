@@ -661,7 +661,7 @@ class ForwardRenderer:
         if scene.mesh is None:
             return Camera()
         center, radius = scene.mesh.bounding_sphere()
-        return frame_camera(center, max(radius, 1e-6), aspect=aspect)
+        return frame_camera(center, max(radius, 1e-6), aspect=aspect, corners=scene.mesh.corners())
 
     @staticmethod
     def _ibl_defines(scene: Scene) -> dict:

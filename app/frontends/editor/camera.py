@@ -47,10 +47,13 @@ class OrbitCamera:
     def zoom(self, wheel: float) -> None:
         self.distance = max(self.radius * 0.05, self.distance * 0.9 ** wheel)
 
-    def frame(self, center, radius: float, aspect: float, margin: float = 1.3) -> None:
-        """Fit a sphere in the narrower field of view (as alight.core.scene.frame_camera does)."""
-        half = math.radians(self.fov_y_deg) / 2.0
-        half_narrow = min(half, math.atan(math.tan(half) * aspect))
+    def frame(self, center, radius: float, aspect: float, margin: float = 1.3, corners=None) -> None:
+        """Fit a sphere in the narrower field of view, or the bounding box's ``corners`` where
+        they need less distance, from the current direction (alight.core.scene.fit_distance, as
+        frame_camera does)."""
+        from alight.core.scene import fit_distance
+
         self.radius = max(float(radius), 1e-6)
-        self.distance = margin * self.radius / math.sin(half_narrow)
+        direction = self._offset() / max(np.linalg.norm(self._offset()), 1e-12)
+        self.distance = fit_distance(center, self.radius, self.fov_y_deg, aspect, direction, corners, margin)
         self.target = tuple(float(x) for x in center)

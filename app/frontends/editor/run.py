@@ -20,8 +20,6 @@ def build_state(args) -> EditorState:
     state.material = state.saved_material = material
     state.load_mesh(args.mesh)
     state.load_env(args.env)
-    for line in [*getattr(state.mesh, "warnings", []), *state.env.warnings]:
-        print(f"alight: warning: {line}", file=sys.stderr)
     if args.no_ibl:
         state.ibl_enabled = False
     # As in 'alight render': a mesh file without --preset shows its own materials and maps.

@@ -65,6 +65,7 @@ class EditorState:
     debug_mip: float = 0.0
     error: str = ""          # the last error, shown in the panel until the next success
     message: str = ""        # the last success ("saved gold.json")
+    warnings: int = 0        # warning lines of the last mesh or environment file opened
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
     mesh: object = None
     env: object = None
@@ -100,12 +101,23 @@ class EditorState:
 
         mesh = load_mesh(spec)
         self.mesh, self.mesh_spec = mesh, spec
+        self._say(mesh.warnings)
 
     def load_env(self, spec: str) -> None:
         from alight.ibl.environment import load_environment
 
         env = load_environment(spec)
         self.env, self.env_spec = env, spec
+        self._say(env.warnings)
+
+    def _say(self, warnings) -> None:
+        """What a file is drawn without: on stderr (once per process, alight.errors.warn) and
+        counted in the panel's message, whenever the file is opened (at start or dropped)."""
+        from alight.errors import warn
+
+        for line in warnings:
+            warn(line)
+        self.warnings = len(warnings)
 
     def set_map(self, slot: str, path: str) -> None:
         """Fill a texture slot from an image file (read now: a bad file raises, nothing changes)."""
@@ -169,6 +181,8 @@ class EditorState:
             self.fail(exc)
             return False
         self.error, self.message = "", f"opened {os.path.basename(path)}"
+        if self.warnings and (suffix in ENV_SUFFIXES or suffix in MESH_EXTENSIONS):
+            self.message += f" ({self.warnings} warning{'s' if self.warnings > 1 else ''} on stderr)"
         return True
 
     def fail(self, exc: Exception) -> None:

@@ -140,7 +140,7 @@ class EditorWindow:
         if self.state.mesh is not None:
             center, radius = self.state.mesh.bounding_sphere()
             w, h = self.view_area()
-            self.orbit.frame(center, radius, w / max(h, 1))
+            self.orbit.frame(center, radius, w / max(h, 1), corners=self.state.mesh.corners())
         self._framed_mesh = self.state.mesh
 
     @property
