@@ -21,10 +21,12 @@ from __future__ import annotations
 import argparse
 import csv
 import statistics
+import sys
 import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))   # `benchmarks.bench_render` when run as a script, as the others do
 
 import numpy as np
 
@@ -151,6 +153,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeats", type=int, default=15)
+    ap.add_argument("--presets", nargs="+", metavar="NAME", help="only these presets (every shared map still)")
+    ap.add_argument("--no-frames", action="store_true", help="errors only: skip the frame-time loop")
     args = ap.parse_args(argv)
     from alight.exchange.presets import list_presets, load_preset
 
@@ -163,16 +167,18 @@ def main(argv=None):
         envs = [e for e in envs if e[0].startswith(("royal", "quarry"))]
         presets = ["gold", "copper", "plastic_high"]
         roughnesses = (0.3, 1.0)
+    if args.presets:
+        presets = args.presets
     section("IBL models vs the ground truth (probe 32x32, medium bake, truth over the map reduced by 2)")
     rows = errors(envs, presets, roughnesses)
-    suffix = "_quick" if args.quick else ""
+    suffix = "_quick" if args.quick else ("_" + "_".join(args.presets) if args.presets else "")
     RESULTS.mkdir(exist_ok=True)
     with open(RESULTS / f"ibl_models{suffix}.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
     section("Frame time per model")
-    frames = frame_times(5 if args.quick else args.repeats)
+    frames = {} if args.no_frames else frame_times(5 if args.quick else args.repeats)
     report(rows, frames, RESULTS / f"ibl_models{suffix}.md")
 
 

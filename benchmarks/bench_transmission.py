@@ -121,6 +121,9 @@ def errors(envs, roughnesses):
                 rows.append(dict(environment=label, material=name, roughness=rough,
                                  alight=float(np.abs(got - truth).sum()) / den,
                                  sample_viewer=float(np.abs(sv - truth).sum()) / den))
+                # as it goes: a long run on a loaded machine still leaves its finished cases
+                print(f"  {label:28s} {name:18s} r={rough:<4g} alight {100 * rows[-1]['alight']:6.2f}%  "
+                      f"sample viewer's {100 * rows[-1]['sample_viewer']:6.2f}%", flush=True)
         maps.release()
         print(f"  {label}: {time.perf_counter() - t0:.1f} s", flush=True)
     r.release()
