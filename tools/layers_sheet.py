@@ -1,9 +1,9 @@
-"""Renders docs/layers.png, the material layers' contact sheet (issue 11): every preset on the
+"""Renders docs/layers.jpg, the material layers' contact sheet (issue 11): every preset on the
 material ball, ClearCoatTest beside Khronos' reference screenshot, and the Khronos Compare*
 models of the material extensions (each pair: without the feature on the left, with it on the
 right), all under royal_esplanade_1k.
 
-    .venv/bin/python tools/layers_sheet.py [--out docs/layers.png] [--keep DIR]
+    .venv/bin/python tools/layers_sheet.py [--out docs/layers.jpg] [--keep DIR]
 
 Needs ../shared/data beside the checkout. Everything is drawn by alight's public Renderer at
 `medium` with the files' own materials; what alight printed as a warning (an extension it does
@@ -27,7 +27,7 @@ DATA = REPO.parent / "shared" / "data"
 KHRONOS = DATA / "models" / "khronos"
 ENV = DATA / "env" / "royal_esplanade_1k.hdr"
 # The Compare* models of material extensions (the others, base colour to normal, are core glTF:
-# docs/khronos.png shows them).
+# docs/khronos.jpg shows them).
 COMPARE = ["CompareAnisotropy", "CompareSheen", "CompareTransmission", "CompareVolume", "CompareIor",
            "CompareSpecular", "CompareIridescence", "CompareDispersion"]
 BG = (24, 24, 24)
@@ -145,7 +145,9 @@ def main(argv=None) -> int:
                    heading("Khronos Compare* models of the material extensions (no reference screenshots)", width),
                    compare], False, gap=8)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    sheet.save(args.out)
+    # JPEG at quality 92 without chroma subsampling: the renders' gradients stay smooth (a 256-colour
+    # PNG banded them) and the sheet stays under the repository's 1 MiB a file (a PNG was 1.3-1.7 MB)
+    sheet.convert("RGB").save(args.out, quality=92, optimize=True, subsampling=0)
     print(args.out)
     return 0
 
