@@ -92,7 +92,7 @@ def warnings_of(mesh) -> list[str]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(REPO / "docs" / "layers.png"))
+    ap.add_argument("--out", default=str(REPO / "docs" / "layers.jpg"))
     ap.add_argument("--ball", type=int, default=200, help="size of a preset's tile (default 200)")
     ap.add_argument("--keep", metavar="DIR", help="also write each render as DIR/NAME.png")
     args = ap.parse_args(argv)
