@@ -57,6 +57,14 @@ def front_view(mesh, fov_deg: float = 35.0) -> dict:
     return dict(orbit_deg=0.0, elevation_deg=0.0, distance=float(distance), fov_deg=fov_deg, target=tuple(centre))
 
 
+def save_sheet(sheet: Image.Image, out) -> None:
+    """A contact sheet as JPEG at quality 92 without chroma subsampling: the renders' gradients
+    stay smooth (a 256-colour PNG banded them) and the sheet stays under the repository's 1 MiB a
+    file (a PNG was 1.3-1.7 MB)."""
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    sheet.convert("RGB").save(out, quality=92, optimize=True, subsampling=0)
+
+
 def fit(image: Image.Image, size: int) -> Image.Image:
     image = image.convert("RGB")
     image.thumbnail((size, size))
@@ -121,10 +129,7 @@ def main(argv=None) -> int:
         else:
             draw.rectangle([x + size + 8, y + label_h, x + 2 * size + 8, y + label_h + size], outline="grey")
             draw.text((x + size + 16, y + label_h + size // 2), "no reference screenshot", fill="grey")
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    # JPEG at quality 92 without chroma subsampling: the renders' gradients stay smooth (a 256-colour
-    # PNG banded them) and the sheet stays under the repository's 1 MiB a file (a PNG was 1.3-1.7 MB)
-    sheet.convert("RGB").save(args.out, quality=92, optimize=True, subsampling=0)
+    save_sheet(sheet, args.out)
     print(args.out)
     return 0
 

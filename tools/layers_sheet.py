@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
+from khronos_sheet import save_sheet   # tools/ is on sys.path when this runs as a script
+
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
 KHRONOS = DATA / "models" / "khronos"
@@ -144,10 +146,7 @@ def main(argv=None) -> int:
                    heading("KHR_materials_clearcoat: ClearCoatTest", width), cct,
                    heading("Khronos Compare* models of the material extensions (no reference screenshots)", width),
                    compare], False, gap=8)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    # JPEG at quality 92 without chroma subsampling: the renders' gradients stay smooth (a 256-colour
-    # PNG banded them) and the sheet stays under the repository's 1 MiB a file (a PNG was 1.3-1.7 MB)
-    sheet.convert("RGB").save(args.out, quality=92, optimize=True, subsampling=0)
+    save_sheet(sheet, args.out)
     print(args.out)
     return 0
 

@@ -296,20 +296,18 @@ class LutCache:
         return tex
 
     def _bake_sheen(self, size: int, steps: int) -> moderngl.Texture:
-        tex = self._upload(np.zeros((size, size, LUT_CHANNELS), np.float32))
-        prog = self.shaders.compute("ibl/sheen_lut.comp")
-        prog["u_size"] = size
-        prog["u_steps"] = steps
-        tex.bind_to_image(0, read=False, write=True)
-        prog.run(_groups(size), _groups(size), 1)
-        self.ctx.memory_barrier()
-        return tex
+        return self._run("ibl/sheen_lut.comp", size, u_steps=steps)
 
     def _bake(self, size: int, samples: int) -> moderngl.Texture:
+        return self._run("ibl/brdf_lut.comp", size, u_samples=samples)
+
+    def _run(self, shader: str, size: int, **uniforms) -> moderngl.Texture:
+        """A size x size LUT written by one compute pass (``shader``, ``u_size`` and ``uniforms``)."""
         tex = self._upload(np.zeros((size, size, LUT_CHANNELS), np.float32))
-        prog = self.shaders.compute("ibl/brdf_lut.comp")
+        prog = self.shaders.compute(shader)
         prog["u_size"] = size
-        prog["u_samples"] = samples
+        for name, value in uniforms.items():
+            prog[name] = value
         tex.bind_to_image(0, read=False, write=True)
         prog.run(_groups(size), _groups(size), 1)
         self.ctx.memory_barrier()
