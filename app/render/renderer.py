@@ -93,7 +93,6 @@ UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
 UNIT_TRANSMISSION_LUT = UNIT_SHEEN_LUT + 1          # ibl/transmission_lut.comp's table (HAS_VOLUME)
 UNIT_SCENE_BEHIND = UNIT_TRANSMISSION_LUT + 1      # the opaque parts' copy (TRANSMISSION_SCENE)
-UNIT_SCENE_DEPTH = UNIT_SCENE_BEHIND + 1           # free (the resolve read depth samples here); kept so later units keep theirs
 SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color")
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
@@ -106,10 +105,10 @@ SAMPLER_UNITS = {
     "u_sheen_lut": UNIT_SHEEN_LUT, "u_transmission_lut": UNIT_TRANSMISSION_LUT, "u_scene_behind": UNIT_SCENE_BEHIND,
 }
 # KHR_materials_anisotropy's energy ratios (alight.ibl.anisotropy_lut), bound where a program reads them.
-UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = UNIT_SCENE_DEPTH + 1, UNIT_SCENE_DEPTH + 2
+UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = UNIT_SCENE_BEHIND + 1, UNIT_SCENE_BEHIND + 2
 SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_ratio_b=UNIT_ANISOTROPY_RATIO_B)
 # The `stretched` IBL model's lobe table (alight.core.stretched_lobe), bound where a program reads it.
-UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_DEPTH + 3, UNIT_SCENE_DEPTH + 4
+UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_BEHIND + 3, UNIT_SCENE_BEHIND + 4
 SAMPLER_UNITS.update(u_stretched_lobe_a=UNIT_STRETCHED_LOBE_A, u_stretched_lobe_b=UNIT_STRETCHED_LOBE_B)
 
 
