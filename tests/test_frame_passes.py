@@ -21,6 +21,16 @@ from tests.gpu import renderer
 W, H = 120, 90
 
 
+@pytest.fixture(autouse=True)
+def tessellated_ball():
+    """The separate passes draw into the multisampled target, which the built-in sphere's impostor
+    never does (its own equivalence is tests/test_sphere_lod.py's): compare like with like."""
+    r = renderer()
+    r.sphere_impostor = False
+    yield
+    r.sphere_impostor = True
+
+
 def _read(fbo, components, dtype, np_dtype):
     return np.frombuffer(fbo.read(components=components, dtype=dtype), np_dtype).reshape(H, W, 4)[::-1]
 

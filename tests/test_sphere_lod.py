@@ -24,6 +24,7 @@ from alight.core.sphere_lod import (
     projected_radius_px,
     silhouette_error,
     sphere_segments,
+    ray_meets_sphere,
     sphere_surface_point,
 )
 from alight.exchange.presets import load_preset
@@ -91,13 +92,16 @@ def test_the_projected_radius_is_the_outlines_within_a_few_percent_and_never_bel
     assert projected_radius_px(inside.view_projection(1.0), (0.0, 0.0, 0.0), 1.0, (64, 64)) == math.inf
 
 
-def _ball(r, maps, mesh, size, aa="msaa", max_error=MAX_SILHOUETTE_ERROR_PX):
-    scene = Scene(mesh=mesh, material=dataclasses.replace(load_preset("gold"), roughness=0.3))
-    r.sphere_max_error_px = max_error
-    frame = r.render(scene, maps, *size, aa=aa)
-    segments = r.last_sphere_segments
-    r.sphere_max_error_px = MAX_SILHOUETTE_ERROR_PX
-    return frame, segments
+def _ball(r, maps, mesh, size, aa="msaa", max_error=MAX_SILHOUETTE_ERROR_PX, impostor=False, **scene_fields):
+    """The gold ball, tessellated (the level for ``max_error``) or as the impostor."""
+    scene = Scene(mesh=mesh, material=dataclasses.replace(load_preset("gold"), roughness=0.3), **scene_fields)
+    r.sphere_max_error_px, r.sphere_impostor = max_error, impostor
+    try:
+        frame = r.render(scene, maps, *size, aa=aa)
+    finally:
+        r.sphere_max_error_px, r.sphere_impostor = MAX_SILHOUETTE_ERROR_PX, True
+    assert r.last_sphere_impostor == ({"msaa": 4, "none": 1, "ssaa": 1}[aa] if impostor else None)
+    return frame, r.last_sphere_segments
 
 
 def _inside(*alphas, shrink=2):
@@ -184,3 +188,112 @@ def test_the_shaded_point_is_the_rays_hit_on_the_true_sphere_and_the_glsl_matche
     assert (np.sum(along * ray, axis=1) <= np.linalg.norm(points - eye, axis=1) + 1e-12).all()   # not beyond
     glsl = evaluate("SPHERE_SURFACE", np.hstack([points, np.full((len(points), 1), eye[2])]))[:, :3]
     np.testing.assert_allclose(glsl, hit, atol=2e-5)
+
+
+# ---- the impostor (ForwardRenderer._sphere_impostor) -------------------------------------------
+
+STANDARD_4X = np.array([(-0.125, -0.375), (0.375, -0.125), (-0.375, 0.125), (0.125, 0.375)])
+
+
+def _coverage(camera: Camera, size, offsets, radius=1.0) -> np.ndarray:
+    """The fraction of each pixel's sample rays (``offsets`` from its centre, in pixels) that
+    meet the sphere, by the numpy twin; (H, W), row 0 at the top."""
+    w, h = size
+    inverse = np.linalg.inv(camera.view_projection(w / h).astype(np.float64))
+    y, x = np.mgrid[0:h, 0:w]
+    eye = np.asarray(camera.position, np.float64)
+    hits = np.zeros((h, w))
+    for ox, oy in offsets:
+        ndc = np.stack([(x + 0.5 + ox) / w * 2 - 1, (y + 0.5 + oy) / h * 2 - 1, np.ones_like(x, float),
+                        np.ones_like(x, float)], axis=-1).reshape(-1, 4)
+        far = ndc @ inverse
+        hits += ray_meets_sphere(eye, far[:, :3] / far[:, 3:] - eye, radius).reshape(h, w)
+    return (hits / len(offsets))[::-1]
+
+
+@pytest.mark.parametrize("size,aa", [((96, 96), "msaa"), ((320, 240), "none"), ((200, 150), "ssaa"),
+                                     ((256, 160), "msaa")])
+def test_the_impostor_is_the_finest_ball_inside_and_the_true_sphere_at_the_outline(shared_data, size, aa):
+    """Against the finest tessellated ball (256 x 128, shaded on the true sphere): the same
+    pixels inside the outline; over the whole picture within the levels' bound. Its coverage is
+    the true sphere's at the samples, by the numpy twin (ray_meets_sphere)."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    impostor, _ = _ball(r, maps, sphere(), size, aa, impostor=True)
+    finest, n = _ball(r, maps, sphere(256, 128), size, aa, max_error=0.0)
+    assert n == 256
+    assert impostor.srgb[:, :, :3].std() > 5.0                     # a real picture
+    assert _rel(impostor.linear, finest.linear) < 0.01
+    inside = _inside(impostor.linear[..., 3], finest.linear[..., 3])
+    assert inside.sum() > 0.2 * size[0] * size[1]
+    assert _rel(impostor.linear, finest.linear, inside) < 1e-5
+    if aa == "ssaa":
+        return    # (its alpha is the mean of 2x2 sub-pixels: the msaa and none cases test the coverage)
+    camera = r.camera_for(Scene(mesh=sphere()), size[0] / size[1])
+    want = _coverage(camera, size, STANDARD_4X if aa == "msaa" else [(0.0, 0.0)])
+    got = impostor.linear[..., 3]
+    # Rays within float rounding of the tangent may go either way.
+    assert (got != want).sum() <= max(2, 0.02 * ((want > 0) & (want < 1)).sum()), (got != want).sum()
+    assert np.abs(got - want).max() <= 1.0 / len(STANDARD_4X) if aa == "msaa" else True
+
+
+def test_the_impostors_outline_is_nearer_the_true_one_than_the_tessellated_balls(shared_data):
+    """Coverage against the sphere's exact area per pixel (16 x 16 sample rays): the impostor's
+    4 samples of the true sphere err less than 4 samples of the level drawn, whose facets fall
+    inside the outline by up to half a pixel."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    size = (200, 150)
+    camera = r.camera_for(Scene(mesh=sphere()), size[0] / size[1])
+    grid = (np.arange(16) + 0.5) / 16 - 0.5
+    exact = _coverage(camera, size, [(gx, gy) for gx in grid for gy in grid])
+    impostor, _ = _ball(r, maps, sphere(), size, impostor=True)
+    level, n = _ball(r, maps, sphere(), size)
+    assert n < 128
+    edge = (exact > 0) & (exact < 1)
+    err_impostor = float(np.abs(impostor.linear[..., 3] - exact)[edge].mean())
+    err_level = float(np.abs(level.linear[..., 3] - exact)[edge].mean())
+    bias_impostor = float((impostor.linear[..., 3] - exact)[edge].mean())
+    bias_level = float((level.linear[..., 3] - exact)[edge].mean())
+    assert err_impostor < err_level, (err_impostor, err_level)
+    assert abs(bias_impostor) < abs(bias_level), (bias_impostor, bias_level)
+
+
+def test_tiles_draw_the_impostor_as_the_whole_image(shared_data):
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    scene = Scene(mesh=sphere(), material=Material(base_color=(0.8, 0.8, 0.8), metallic=0.0, roughness=0.5))
+    whole = r.render(scene, maps, 160, 120, aa="msaa", read_linear=True, read_srgb=False)
+    assert r.last_sphere_impostor == 4
+    tiled = r.render(scene, maps, 160, 120, aa="msaa", read_linear=True, read_srgb=False, tile=(64, 64))
+    assert r.last_sphere_impostor == 4
+    np.testing.assert_array_equal(tiled.linear[..., 3], whole.linear[..., 3])
+    assert _rel(tiled.linear, whole.linear) < 1e-5
+
+
+def test_the_impostor_is_not_used_where_the_shading_needs_more_than_the_ray(shared_data):
+    """Texture maps (their uvs), anisotropy (its tangents), transmission, a debug view, an
+    orthographic camera, an eye near the sphere: the tessellated ball."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    base = Scene(mesh=sphere(), material=Material())
+    r.render(base, maps, 64, 64, aa="msaa")
+    assert r.last_sphere_impostor == 4
+    r.render(base, maps, 64, 64, aa="none")
+    assert r.last_sphere_impostor == 1
+    checker = np.zeros((8, 8, 4), np.float32)
+    checker[::2, ::2] = 1.0
+    from alight.core.texture_maps import TextureMaps
+    cases = [
+        dataclasses.replace(base, texture_maps=TextureMaps(base_color="checker.png"),
+                            texture_images={"checker.png": checker}),
+        dataclasses.replace(base, material=Material(anisotropy_strength=0.5)),
+        dataclasses.replace(base, material=Material(transmission=1.0)),
+        dataclasses.replace(base, debug_view=1),
+        dataclasses.replace(base, camera=Camera(ortho_half_height=1.5)),
+        dataclasses.replace(base, camera=Camera(position=(0.0, 0.0, 1.1), near=0.01)),
+    ]
+    for scene in cases:
+        frame = r.render(scene, maps, 64, 64, aa="msaa")
+        assert r.last_sphere_impostor is None, scene
+        assert np.isfinite(frame.linear).all()

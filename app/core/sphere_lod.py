@@ -77,13 +77,43 @@ def projected_radius_px(view_projection: np.ndarray, centre, radius: float, imag
 
 def sphere_surface_point(eye, facet_point, radius: float) -> np.ndarray:
     """The view ray's first hit on the sphere ``|x| = radius`` centred at the origin, for rays
-    from ``eye`` (3,) through ``facet_point`` (N, 3) or (3,) lying inside the sphere: the shaded
-    point of the built-in ball (GLSL twin: common/sphere_surface.glsl). Solved about the facet
-    point p, ``|p - s d|^2 = r^2`` for the step s back toward the eye, so that nothing cancels at
-    grazing angles. float64."""
+    from ``eye`` (3,) through ``facet_point`` (N, 3) or (3,), a point of the drawn mesh (a facet
+    inside the sphere, or the impostor's proxy outside it): the shaded point of the built-in ball
+    (GLSL twin: common/sphere_surface.glsl). Solved about the facet point p, ``|p - s d|^2 = r^2``
+    for the step s back toward the eye (the larger root), so that nothing cancels at grazing
+    angles. A ray that misses gets its point closest to the centre. float64."""
     p = np.asarray(facet_point, np.float64)
     d = p - np.asarray(eye, np.float64)
     d = d / np.linalg.norm(d, axis=-1, keepdims=True)
     pd = np.sum(p * d, axis=-1, keepdims=True)
     s = pd + np.sqrt(np.maximum(pd * pd + (radius * radius - np.sum(p * p, axis=-1, keepdims=True)), 0.0))
     return p - s * d
+
+
+# The impostor's proxy (alight.render.renderer ForwardRenderer._sphere_impostor): the 16-segment
+# level, scaled to hold the true outline with this many output pixels to spare. A pixel whose
+# samples (at most 0.53 px from its centre in the standard 4x pattern) meet the sphere then has
+# its centre inside the proxy.
+IMPOSTOR_PROXY_SEGMENTS = 16
+IMPOSTOR_MARGIN_PX = 2.0
+
+
+def impostor_proxy_scale(radius_px: float, segments: int = IMPOSTOR_PROXY_SEGMENTS,
+                         margin_px: float = IMPOSTOR_MARGIN_PX) -> float | None:
+    """The factor on the sphere's radius that makes a ``segments`` UV sphere's facets lie outside
+    the true sphere by ``margin_px`` pixels of its outline (``radius_px``: its projected radius,
+    ``projected_radius_px``): the facets lie within ``R cos(sqrt(2) pi / n)`` of the centre
+    (the module docstring's model). None where the radius is not finite and positive."""
+    if not (math.isfinite(radius_px) and radius_px > 0.0):
+        return None
+    return (1.0 + margin_px / radius_px) / math.cos(math.sqrt(2.0) * math.pi / segments)
+
+
+def ray_meets_sphere(eye, directions, radius: float) -> np.ndarray:
+    """Whether rays from ``eye`` (3,), outside the sphere ``|x| = radius`` centred at the origin,
+    along ``directions`` (N, 3) of any length meet it in front of the eye: the impostor's coverage
+    test (GLSL twin: common/sphere_surface.glsl ray_meets_sphere). Returns (N,) bool."""
+    e = np.asarray(eye, np.float64)
+    d = np.asarray(directions, np.float64)
+    b = d @ e
+    return (b < 0.0) & (b * b >= np.sum(d * d, axis=-1) * (e @ e - radius * radius))

@@ -46,7 +46,13 @@ from alight.core.scene import (
     frame_camera,
 )
 from alight.core.shading import rotate_world_to_map
-from alight.core.sphere_lod import MAX_SILHOUETTE_ERROR_PX, SPHERE_LOD_SEGMENTS, projected_radius_px, sphere_segments
+from alight.core.sphere_lod import (
+    MAX_SILHOUETTE_ERROR_PX,
+    SPHERE_LOD_SEGMENTS,
+    impostor_proxy_scale,
+    projected_radius_px,
+    sphere_segments,
+)
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.ibl.bake import (
@@ -262,6 +268,7 @@ class _Targets:
         self._behind: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
         self._both_fbo = None
+        self._single: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.color = None
         try:
             self._allocate()
@@ -304,6 +311,16 @@ class _Targets:
             self._behind = (tex, self.ctx.framebuffer([tex]))
         return self._behind
 
+    def single(self) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
+        """A single-sample colour target at the draw size, in the multisampled one's format, where
+        the built-in sphere's impostor writes its coverage-weighted radiance for the fused resolve
+        (ForwardRenderer._sphere_impostor). No depth: the proxy is convex, its back faces culled."""
+        if self._single is None:
+            tex = self.ctx.texture(self.draw_size, 4, dtype="f2" if self.half else "f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._single = (tex, self.ctx.framebuffer([tex]))
+        return self._single
+
     def display_draw(self) -> moderngl.Framebuffer:
         """The display image with the depth buffer, for ForwardRenderer.draw_display (no AA only)."""
         if self._display_draw is None:
@@ -326,6 +343,8 @@ class _Targets:
             owned.append(self.color)
         if self._behind is not None:
             owned.extend(self._behind[::-1])
+        if self._single is not None:
+            owned.extend(self._single[::-1])
         for obj in owned:
             if obj is not None:
                 obj.release()
@@ -360,6 +379,12 @@ class ForwardRenderer:
         # How far the built-in sphere's outline may fall inside the true one, in output pixels
         # (alight.core.sphere_lod); 0 draws the sphere's own tessellation.
         self.sphere_max_error_px = MAX_SILHOUETTE_ERROR_PX
+        # The built-in sphere drawn as an impostor where it can be (_sphere_impostor); False draws
+        # its tessellation in every pass (the tests compare the two).
+        self.sphere_impostor = True
+        self.last_sphere_impostor: int | None = None   # the last mesh pass's coverage samples, or None
+        self._impostor_samples = 1    # set by _draw_scene: 1, 4 (the fused resolve's stand-in), 0 (none)
+        self._scene_single = False    # the last scene pass drew into _Targets.single (for _resolve)
         self._targets: _Targets | None = None
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
@@ -454,6 +479,50 @@ class ForwardRenderer:
             textures = _MeshTextures(self.ctx)
             entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, lod, textures)], textures)
         return entry[1], radius
+
+    def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int]) -> float | None:
+        """The scale of the impostor's proxy where the built-in sphere is drawn as one, else None.
+
+        The proxy is the 16-segment ball scaled so that its facets hold the true sphere's outline
+        with 2 px to spare (alight.core.sphere_lod.impostor_proxy_scale); each of its pixels
+        tests its sample rays against the true sphere (mesh_material.glsl SPHERE_IMPOSTOR) and is
+        shaded as the tessellated ball's are (SPHERE_SURFACE: on the true sphere, at the pixel
+        centre), so only the outline's coverage changes: it is the true sphere's. Used where the
+        shading depends on the view ray alone: a perspective camera well outside the proxy, and
+        a part without texture maps (their uvs would come from the proxy), anisotropy (its
+        tangents), transmission, blending, masks, vertex colours or a debug view."""
+        mesh = scene.mesh
+        if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
+                or len(mesh.parts) != 1 or camera.ortho_half_height is not None or scene.debug_view):
+            return None
+        radius = mesh.lod_sphere[0]
+        distance = float(np.linalg.norm(np.asarray(camera.position, np.float64)))
+        vp = camera.view_projection(image_size[0] / image_size[1])
+        scale = impostor_proxy_scale(projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size))
+        # The proxy whole between the clipping planes, the eye well outside it.
+        if (scale is None or distance <= 1.1 * scale * radius or distance - scale * radius <= 1.01 * camera.near
+                or distance + scale * radius >= 0.99 * camera.far):
+            return None
+        part = mesh.parts[0]
+        defines = self._part_defines(scene, self._gpu_mesh(mesh)[0], part, self._user_maps_present(scene))
+        if (defines["MATERIAL_MAPS_MASK"] or any(k in defines for k in (
+                "ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_ANISOTROPY", "HAS_TRANSMISSION"))):
+            return None
+        return scale
+
+    def _impostor_proxy(self, mesh) -> _GpuPart:
+        """The built-in sphere's impostor proxy: its 16-segment level (drawn scaled)."""
+        for old in [k for k, e in self._sphere_lods.items() if e[0] is not mesh]:   # another mesh's
+            _release_mesh(self._sphere_lods.pop(old))
+        key = (id(mesh), "proxy")
+        entry = self._sphere_lods.get(key)
+        if entry is None:
+            radius, part = mesh.lod_sphere[0], mesh.parts[0]
+            proxy = dataclasses.replace(sphere(16, 8, radius).parts[0], material=part.material, name=part.name,
+                                        element=part.element)
+            textures = _MeshTextures(self.ctx)
+            entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, proxy, textures)], textures)
+        return entry[1][0]
 
     def _targets_for(self, width: int, height: int, aa: str, samples: int, half: bool = False) -> _Targets:
         t = self._targets
@@ -671,22 +740,40 @@ class ForwardRenderer:
         self._display_output = display_output
         self._half_output = targets.half and fbo is targets.draw
         width, height = targets.draw_size
-        fbo.use()
-        ctx.viewport = (0, 0, width, height)
-        # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag),
-        # and transmissive parts read the opaque parts' coverage from it.
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
         view = view or _View(targets.width, targets.height)
         aspect = view.width / view.height
         # The probe's own camera is orthographic; its backdrop is drawn as the default camera sees it.
         camera = Camera() if scene.view == "probe" else self.camera_for(scene, aspect)
+        # The built-in sphere as an impostor (_sphere_impostor): with one coverage sample a pixel
+        # into a single-sample target, with 4 into the fused resolve's single-sample stand-in for
+        # the multisampled one (its mean already taken); never into a multisampled target.
+        impostor = self._sphere_impostor(scene, camera, (view.width, view.height)) is not None
+        self._scene_single = impostor and fbo is targets.draw and targets.aa == "msaa" and not background
+        if self._scene_single:
+            fbo = targets.single()[1]
+        self._impostor_samples = 4 if self._scene_single else (1 if targets.aa != "msaa" else 0)
+        fbo.use()
+        ctx.viewport = (0, 0, width, height)
         view_projection = camera.view_projection(aspect)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
             view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
         self._last_inverse_vp = inverse_vp    # the resolve's background rays (this frame or tile)
-        self._last_surface_rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
+        self._last_surface_rect = rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
+        # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag),
+        # and transmissive parts read the opaque parts' coverage from it. For the fused resolve
+        # (background=False) only the mesh's rectangle: no surface is drawn and no sample read
+        # outside it (_resolve), and a 4x target's full clear was 66 ms of a 1920x1080 frame's
+        # CPU time here. Not with transmissive parts: they read the opaque copy anywhere.
+        if not background and scale == 1 and rect is not None and not self.transmissive_parts(scene):
+            ctx.scissor = rect
+            try:
+                fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            finally:
+                ctx.scissor = None
+        else:
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._write_lights(scene)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
@@ -786,7 +873,8 @@ class ForwardRenderer:
             if self._half_output:
                 defines = {**(defines or {}), "HALF_FLOAT_OUTPUT": None}
             return self.program(vertex, fragment, defines)
-        prog = self.program(vertex, fragment, {**(defines or {}), "DISPLAY_OUTPUT": None})
+        prog = self.program(vertex, fragment, {**(defines or {}), "DISPLAY_OUTPUT": None,
+                                               "TONEMAP_MODE": TONEMAPS.index(display.tonemap)})
         _set(prog, "u_exposure_scale", float(2.0 ** display.exposure))
         _set(prog, "u_tonemap", TONEMAPS.index(display.tonemap))
         return prog
@@ -920,11 +1008,14 @@ class ForwardRenderer:
         the radiance and/or the display image (at least one is written, so a frame is complete)."""
         radiance = radiance or not display
         mode = self._background_mode(scene, maps)
-        defines = {"BACKGROUND_MODE": mode, "SCENE_SAMPLES": targets.samples}
+        # After the sphere's impostor the surfaces are in the single-sample stand-in, resolved already.
+        defines = {"BACKGROUND_MODE": mode, "SCENE_SAMPLES": 1 if self._scene_single else targets.samples}
+        scene_texture = targets.single()[0] if self._scene_single else targets.color
         if radiance:
             defines["RADIANCE_OUTPUT"] = None
         if display:
             defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
+            defines["TONEMAP_MODE"] = TONEMAPS.index(scene.display.tonemap)
         w, h = targets.width, targets.height
         rect = self._last_surface_rect
         if rect is None or rect == (0, 0, w, h):
@@ -945,7 +1036,7 @@ class ForwardRenderer:
                 prog = self.program("render/background.vert", "render/resolve.frag", pass_defines)
                 # The rays of the scene pass just drawn (for a tile, the whole image's projection off centre).
                 self._bind_background(prog, scene, maps, self._last_inverse_vp, mode)
-                targets.color.use(UNIT_RADIANCE)
+                scene_texture.use(UNIT_RADIANCE)
                 _set(prog, "u_scene", UNIT_RADIANCE)
                 _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
                 _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
@@ -1125,6 +1216,15 @@ class ForwardRenderer:
         items = []
         size = image_size or tuple(ctx.viewport[2:])
         drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
+        # The built-in sphere as an impostor (_sphere_impostor), by forward programs only.
+        proxy_scale = self._sphere_impostor(scene, camera, size) if callable(prog) and self._impostor_samples else None
+        self.last_sphere_impostor = None
+        model = np.eye(4, dtype=np.float32)
+        if proxy_scale is not None:
+            drawn = [self._impostor_proxy(scene.mesh)]
+            sphere_radius = scene.mesh.lod_sphere[0]
+            model = np.diag([proxy_scale, proxy_scale, proxy_scale, 1.0]).astype(np.float32)
+            self.last_sphere_impostor = self._impostor_samples
         chosen = None if parts is None else set(parts)
         for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
             fm = part.material
@@ -1147,16 +1247,22 @@ class ForwardRenderer:
                     part_defines = self._part_defines(scene, gpu_part, part, user_maps)
                     if sphere_radius is not None:
                         part_defines["SPHERE_SURFACE"] = None
+                    if proxy_scale is not None:
+                        part_defines["SPHERE_IMPOSTOR"] = self._impostor_samples
                     program = prog(part_defines)
                 else:
                     program = prog
                 if id(program) not in prepared:
                     prepared.add(id(program))
-                    _set(program, "u_model", np.eye(4, dtype=np.float32).tobytes(), write=True)
+                    _set(program, "u_model", model.tobytes(), write=True)
                     _set(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
                     _set(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
                     _set(program, "u_camera_position", tuple(float(x) for x in camera.position))
                     _set(program, "u_sphere_radius", float(sphere_radius or 0.0))
+                    if proxy_scale is not None:
+                        inverse_vp = np.linalg.inv(np.asarray(view_projection, np.float64)).astype(np.float32)
+                        _set(program, "u_inverse_view_projection", inverse_vp.tobytes(), write=True)
+                        _set(program, "u_viewport_size", tuple(float(x) for x in ctx.viewport[2:]))
                 material, maps_used = self._part_material(scene, part)
                 _set_material(program, material)
                 fm = part.material if maps_used else None
@@ -1237,10 +1343,11 @@ class ForwardRenderer:
 
     def tonemap(self, radiance: moderngl.Texture, display: Display, fbo: moderngl.Framebuffer,
                 opaque: bool = True) -> None:
-        prog = self.program("render/fullscreen.vert", "render/tonemap.frag")
+        prog = self.program("render/fullscreen.vert", "render/tonemap.frag",
+                            {"TONEMAP_MODE": TONEMAPS.index(display.tonemap)})
         radiance.use(UNIT_RADIANCE)
         prog["u_exposure_scale"] = float(2.0 ** display.exposure)
-        prog["u_tonemap"] = TONEMAPS.index(display.tonemap)
+        _set(prog, "u_tonemap", TONEMAPS.index(display.tonemap))
         prog["u_opaque"] = opaque
         fbo.use()
         self.ctx.viewport = (0, 0) + fbo.size

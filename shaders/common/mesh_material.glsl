@@ -139,6 +139,32 @@ uniform mat3 u_map_transform[MAP_SLOTS];
 #include "common/sphere_surface.glsl"
 uniform float u_sphere_radius;   // centred at the origin; the camera is outside it (perspective)
 
+#ifdef SPHERE_IMPOSTOR
+// The built-in sphere drawn as an impostor (app/render/renderer.py _sphere_impostor): a coarse
+// proxy around the sphere is rasterised, and each pixel's coverage is the fraction of its
+// SPHERE_IMPOSTOR sample rays (1: the pixel centre; 4: the standard 4x MSAA pattern) that meet the
+// true sphere. llvmpipe shades a pixel once per triangle that covers any of its samples, so the
+// MSAA ball's small facets shaded most edge pixels twice; the proxy's few large triangles do not,
+// and the 4x frame needs no multisampled target at all.
+uniform mat4 u_inverse_view_projection;   // this pass's (a tile's off-centre projection included)
+uniform vec2 u_viewport_size;             // pixels
+
+float sphere_coverage() {
+#if SPHERE_IMPOSTOR == 4
+    // OpenGL's standard 4x positions (the D3D pattern), from the pixel centre.
+    const vec2 offsets[4] = vec2[4](vec2(-0.125, -0.375), vec2(0.375, -0.125), vec2(-0.375, 0.125), vec2(0.125, 0.375));
+#else
+    const vec2 offsets[1] = vec2[1](vec2(0.0));
+#endif
+    float covered = 0.0;
+    for (int i = 0; i < SPHERE_IMPOSTOR; ++i) {
+        vec2 ndc = (gl_FragCoord.xy + offsets[i]) / u_viewport_size * 2.0 - 1.0;
+        vec4 far = u_inverse_view_projection * vec4(ndc, 1.0, 1.0);
+        covered += ray_meets_sphere(u_camera_position, far.xyz / far.w - u_camera_position, u_sphere_radius) ? 1.0 : 0.0;
+    }
+    return covered / float(SPHERE_IMPOSTOR);
+}
+#endif
 #endif
 
 // The shaded point: the interpolated position, or on the built-in sphere the true surface's.

@@ -1,12 +1,21 @@
 // The built-in sphere shaded on the true sphere (common/mesh_material.glsl SPHERE_SURFACE): its
-// numpy twin is alight.core.sphere_lod.sphere_surface_point.
+// numpy twins are alight.core.sphere_lod.sphere_surface_point and ray_meets_sphere.
 
 // The view ray's first hit on the sphere |x| = r centred at the origin (ray-sphere intersection).
-// The flat facets lie inside the sphere, so the hit is a step s back along the ray from the facet
-// point p: |p - s d|^2 = r^2. Solved about p, not the eye, so that nothing cancels at grazing angles.
+// The hit is a step s back along the ray from the point p where the ray crossed the drawn mesh
+// (a facet inside the sphere, or the impostor's proxy outside it): |p - s d|^2 = r^2, the larger
+// root. Solved about p, not the eye, so that nothing cancels at grazing angles. A ray that misses
+// gets its point closest to the centre (the outline's edge pixels).
 vec3 sphere_surface_point(vec3 eye, vec3 facet_point, float r) {
     vec3 d = normalize(facet_point - eye);
     float pd = dot(facet_point, d);
     float s = pd + sqrt(max(pd * pd + (r * r - dot(facet_point, facet_point)), 0.0));
     return facet_point - s * d;
+}
+
+// Whether the ray from the eye (outside the sphere) along d (any length) meets the sphere
+// |x| = r in front of the eye: |eye + t d|^2 = r^2 has a root t > 0.
+bool ray_meets_sphere(vec3 eye, vec3 d, float r) {
+    float b = dot(eye, d);
+    return b < 0.0 && b * b >= dot(d, d) * (dot(eye, eye) - r * r);
 }

@@ -3,6 +3,7 @@
 // ALPHA_MODE (glTF 2.0 material.alphaMode): unset or 0 OPAQUE (alpha ignored, written as 1),
 // 1 MASK (fragments below the cutoff discarded), 2 BLEND (alpha written; the renderer blends).
 // UNLIT (KHR_materials_unlit): the base colour is the radiance.
+// SPHERE_IMPOSTOR: the built-in sphere's proxy, coverage per pixel (common/mesh_material.glsl).
 #include "common/shading.glsl"
 #include "common/mesh_material.glsl"
 #include "common/debug_views.glsl"
@@ -11,6 +12,10 @@
 layout(location = 0) out vec4 out_radiance;
 
 void main() {
+#ifdef SPHERE_IMPOSTOR
+    float coverage = sphere_coverage();
+    if (coverage == 0.0) discard;
+#endif
 #if defined(ALPHA_MODE) && ALPHA_MODE != 0
     float alpha = material_alpha();
 #if ALPHA_MODE == 1
@@ -30,5 +35,9 @@ void main() {
 #else
     out_radiance = encode_output(shade(material_surface(n), n, v, surface_position()), alpha);
 #endif
+#endif
+#if defined(SPHERE_IMPOSTOR) && SPHERE_IMPOSTOR > 1
+    // Premultiplied by coverage, as the mean of the samples an MSAA target would resolve to.
+    out_radiance *= coverage;
 #endif
 }

@@ -14,7 +14,14 @@
 
 in vec3 v_ray;    // render/background.vert: world-space, not normalised
 
-uniform sampler2DMS u_scene;   // the surfaces' radiance and alpha (coverage); cleared to 0 where none was drawn
+// The surfaces' radiance and alpha (coverage), cleared to 0 where none was drawn: the multisampled
+// target, or with SCENE_SAMPLES 1 a single-sample one holding the coverage-weighted mean already
+// (the built-in sphere's impostor: common/mesh_material.glsl SPHERE_IMPOSTOR).
+#if SCENE_SAMPLES == 1
+uniform sampler2D u_scene;
+#else
+uniform sampler2DMS u_scene;
+#endif
 uniform float u_exposure_scale;  // 2^EV
 uniform int u_tonemap;
 uniform bool u_opaque;           // false: keep the coverage as alpha (transparent background)
@@ -32,7 +39,11 @@ void main() {
     vec3 background = background_radiance(v_ray);
     vec4 sum = vec4(0.0);
 #ifndef NO_SURFACES   // (outside the mesh's screen rectangle no sample was drawn: renderer.py _resolve)
+#if SCENE_SAMPLES == 1
+    sum = texelFetch(u_scene, p, 0);
+#else
     for (int i = 0; i < SCENE_SAMPLES; ++i) sum += texelFetch(u_scene, p, i);
+#endif
 #endif
     // Porter-Duff 'under', summed over the samples: each sample's radiance is its surfaces' (alpha
     // 1 where opaque) and the background fills what they leave; an uncovered sample, cleared to
