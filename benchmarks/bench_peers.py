@@ -16,7 +16,9 @@ number of samples).
   bakes its own IBL maps on the GPU in every process).
 - **steady frame at 1920x1080**: one process per renderer and round; after two warm-up frames,
   each frame orbits the camera by 1 degree (so neither can reuse the last image) and reads the
-  8-bit image back into numpy (``alight.Renderer.render()``; pyvista's ``screenshot``).
+  8-bit image back into numpy (``alight.Renderer.render()``; pyvista's ``screenshot``). alight
+  runs twice: with its built-in sphere (drawn as an impostor: ForwardRenderer._sphere_impostor)
+  and with the same 128 x 64 UV sphere read from an OBJ file (drawn as a mesh, as any asset is).
 
 Every measurement alternates alight and VTK within a round (A B A B ...), so load from other
 work on a shared machine falls on both alike. Each is taken as wall time and as CPU time of the
@@ -86,8 +88,9 @@ ALIGHT_STEADY = r'''
 import sys, time, json
 import alight
 w, h, frames, env, roughness = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), sys.argv[4], float(sys.argv[5])
+mesh = sys.argv[6]
 with alight.Renderer(w, h, aa="msaa") as r:
-    r.set_mesh("sphere").set_environment(env).set_material("gold", roughness=roughness)
+    r.set_mesh(mesh).set_environment(env).set_material("gold", roughness=roughness)
     times, cpu = [], []
     for i in range(frames + 2):
         r.set_camera(orbit_deg=float(i))
@@ -135,7 +138,7 @@ def main() -> int:
         load_before = f.read().split()[:3]
     cold = {"alight first": [], "alight second": [], "vtk": []}
     cold_cpu = {k: [] for k in cold}
-    steady = {"alight": [], "vtk": []}
+    steady = {"alight": [], "alight mesh file": [], "vtk": []}
     steady_cpu = {k: [] for k in steady}
     with tempfile.TemporaryDirectory(prefix="alight-peers-") as tmp:
         tmp = Path(tmp)
@@ -146,6 +149,13 @@ def main() -> int:
         vtk_cold = [py, "-c", VTK_SCRIPT, "cold", "1024", "1024", "0", str(tmp / "vtk.png"), str(ENV),
                     json.dumps(GOLD), str(ROUGHNESS)]
         parts = set(args.parts.split(","))
+        sphere_file = tmp / "uv_sphere.obj"
+        if "steady" in parts:
+            import trimesh
+            from alight.core.mesh import sphere
+            part = sphere().parts[0]
+            trimesh.Trimesh(part.positions, part.indices, vertex_normals=part.normals, process=False,
+                            visual=trimesh.visual.TextureVisuals(uv=part.uvs)).export(sphere_file)
         for i in range(args.rounds if "cold" in parts else 0):
             # The BRDF LUT stays cached (it does not depend on the environment); the bake does not.
             shutil.rmtree(cache / "bakes", ignore_errors=True)
@@ -157,14 +167,17 @@ def main() -> int:
             print(f"round {i + 1}/{args.rounds}: cold alight {cold['alight first'][-1]:.2f} s, "
                   f"vtk {cold['vtk'][-1]:.2f} s, alight again {cold['alight second'][-1]:.2f} s", file=sys.stderr)
         for i in range(args.rounds if "steady" in parts else 0):
-            out = run([py, "-c", ALIGHT_STEADY, "1920", "1080", str(args.frames), str(ENV), str(ROUGHNESS)], env)[2]
-            steady["alight"] += json.loads(out)["frames"]
-            steady_cpu["alight"] += json.loads(out)["cpu"]
+            for key, mesh in (("alight", "sphere"), ("alight mesh file", str(sphere_file))):
+                out = run([py, "-c", ALIGHT_STEADY, "1920", "1080", str(args.frames), str(ENV), str(ROUGHNESS), mesh],
+                          env)[2]
+                steady[key] += json.loads(out)["frames"]
+                steady_cpu[key] += json.loads(out)["cpu"]
             out = run([py, "-c", VTK_SCRIPT, "steady", "1920", "1080", str(args.frames), "-", str(ENV),
                        json.dumps(GOLD), str(ROUGHNESS)])[2]
             steady["vtk"] += json.loads(out)["frames"]
             steady_cpu["vtk"] += json.loads(out)["cpu"]
             print(f"round {i + 1}/{args.rounds}: steady alight {statistics.median(steady['alight']) * 1000:.0f} ms, "
+                  f"alight mesh file {statistics.median(steady['alight mesh file']) * 1000:.0f} ms, "
                   f"vtk {statistics.median(steady['vtk']) * 1000:.0f} ms", file=sys.stderr)
         for name in ("alight.png", "vtk.png") if "cold" in parts else ():
             shutil.copy(tmp / name, Path(tempfile.gettempdir()) / f"bench_peers_{name}")
@@ -190,8 +203,10 @@ def main() -> int:
                         ("cold, bake cached / empty cache", "alight second", "alight first")) if cold else ():
         print(f"  {label:34s} {m(cold[a]) / m(cold[b]):.2f} ({m(cold_cpu[a]) / m(cold_cpu[b]):.2f})")
     if steady:
-        print(f"  {'steady 1920x1080 frame / VTK':34s} {m(steady['alight']) / m(steady['vtk']):.2f} "
-              f"({m(steady_cpu['alight']) / m(steady_cpu['vtk']):.2f})")
+        for label, key in (("steady 1920x1080 frame / VTK", "alight"),
+                           ("  the sphere from a mesh file / VTK", "alight mesh file")):
+            print(f"  {label:34s} {m(steady[key]) / m(steady['vtk']):.2f} "
+                  f"({m(steady_cpu[key]) / m(steady_cpu['vtk']):.2f})")
     if "cold" in parts:
         print(f"images: {tempfile.gettempdir()}/bench_peers_alight.png, {tempfile.gettempdir()}/bench_peers_vtk.png")
     return 0

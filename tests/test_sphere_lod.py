@@ -259,6 +259,25 @@ def test_the_impostors_outline_is_nearer_the_true_one_than_the_tessellated_balls
     assert abs(bias_impostor) < abs(bias_level), (bias_impostor, bias_level)
 
 
+@pytest.mark.parametrize("aa", ["msaa", "none"])
+def test_the_impostor_seen_from_close_and_off_centre_is_the_finest_ball(shared_data, aa):
+    """An eye 1.3 radii from the centre (the outline circle far from the sphere's equator) looking
+    past the sphere, which sits off the image centre: the proxy still covers the outline."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    camera = Camera(position=(0.3, 0.2, 1.3), target=(0.6, 0.1, 0.0), near=0.05, fov_y_deg=60.0)
+    size = (160, 120)
+    impostor, _ = _ball(r, maps, sphere(), size, aa, impostor=True, camera=camera)
+    finest, _ = _ball(r, maps, sphere(256, 128), size, aa, max_error=0.0, camera=camera)
+    alpha = impostor.linear[..., 3]
+    assert 0.1 < (alpha > 0).mean() < 0.9                          # the outline is in the picture
+    assert _rel(impostor.linear, finest.linear) < 0.01
+    inside = _inside(alpha, finest.linear[..., 3])
+    assert _rel(impostor.linear, finest.linear, inside) < 1e-4
+    want = _coverage(camera, size, STANDARD_4X if aa == "msaa" else [(0.0, 0.0)])
+    assert (alpha != want).sum() <= max(2, 0.02 * ((want > 0) & (want < 1)).sum())
+
+
 def test_tiles_draw_the_impostor_as_the_whole_image(shared_data):
     r = renderer()
     maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
@@ -273,7 +292,7 @@ def test_tiles_draw_the_impostor_as_the_whole_image(shared_data):
 
 def test_the_impostor_is_not_used_where_the_shading_needs_more_than_the_ray(shared_data):
     """Texture maps (their uvs), anisotropy (its tangents), transmission, a debug view, an
-    orthographic camera, an eye near the sphere: the tessellated ball."""
+    orthographic camera, an eye inside the sphere: the tessellated ball."""
     r = renderer()
     maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
     base = Scene(mesh=sphere(), material=Material())
@@ -291,7 +310,7 @@ def test_the_impostor_is_not_used_where_the_shading_needs_more_than_the_ray(shar
         dataclasses.replace(base, material=Material(transmission=1.0)),
         dataclasses.replace(base, debug_view=1),
         dataclasses.replace(base, camera=Camera(ortho_half_height=1.5)),
-        dataclasses.replace(base, camera=Camera(position=(0.0, 0.0, 1.1), near=0.01)),
+        dataclasses.replace(base, camera=Camera(position=(0.0, 0.0, 0.5), near=0.01)),   # inside
     ]
     for scene in cases:
         frame = r.render(scene, maps, 64, 64, aa="msaa")

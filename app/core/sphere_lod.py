@@ -90,23 +90,52 @@ def sphere_surface_point(eye, facet_point, radius: float) -> np.ndarray:
     return p - s * d
 
 
-# The impostor's proxy (alight.render.renderer ForwardRenderer._sphere_impostor): the 16-segment
-# level, scaled to hold the true outline with this many output pixels to spare. A pixel whose
-# samples (at most 0.53 px from its centre in the standard 4x pattern) meet the sphere then has
-# its centre inside the proxy.
-IMPOSTOR_PROXY_SEGMENTS = 16
+# The impostor's proxy (alight.render.renderer ForwardRenderer._sphere_impostor): a polygon of
+# this many sides facing the eye, in the plane of the sphere's outline circle, around that circle
+# with this many output pixels to spare. A pixel whose samples (at most 0.53 px from its centre
+# in the standard 4x pattern) meet the sphere then has its centre inside the proxy. Few, large
+# triangles: llvmpipe shades whole 4x4 blocks along every triangle edge.
+IMPOSTOR_PROXY_SIDES = 16
 IMPOSTOR_MARGIN_PX = 2.0
 
 
-def impostor_proxy_scale(radius_px: float, segments: int = IMPOSTOR_PROXY_SEGMENTS,
-                         margin_px: float = IMPOSTOR_MARGIN_PX) -> float | None:
-    """The factor on the sphere's radius that makes a ``segments`` UV sphere's facets lie outside
-    the true sphere by ``margin_px`` pixels of its outline (``radius_px``: its projected radius,
-    ``projected_radius_px``): the facets lie within ``R cos(sqrt(2) pi / n)`` of the centre
-    (the module docstring's model). None where the radius is not finite and positive."""
-    if not (math.isfinite(radius_px) and radius_px > 0.0):
+def impostor_proxy_polygon(sides: int = IMPOSTOR_PROXY_SIDES) -> tuple[np.ndarray, np.ndarray]:
+    """The proxy in its own frame: the unit circle's centre and ``sides`` vertices at radius 1 in
+    the plane z = 0, counter-clockwise seen from +z, as a triangle fan. Returns positions
+    (sides + 1, 3) float32 and indices (sides, 3) uint32."""
+    angles = 2.0 * np.pi * np.arange(sides) / sides
+    ring = np.stack([np.cos(angles), np.sin(angles), np.zeros(sides)], axis=1)
+    positions = np.vstack([[0.0, 0.0, 0.0], ring]).astype(np.float32)
+    k = np.arange(sides)
+    indices = np.stack([np.zeros(sides, int), 1 + k, 1 + (k + 1) % sides], axis=1).astype(np.uint32)
+    return positions, indices
+
+
+def impostor_proxy_model(eye, radius: float, radius_px: float, sides: int = IMPOSTOR_PROXY_SIDES,
+                         margin_px: float = IMPOSTOR_MARGIN_PX) -> np.ndarray | None:
+    """The (4, 4) float64 matrix (column vectors: ``world = M @ (p, 1)``) that places
+    ``impostor_proxy_polygon`` around the outline of the sphere ``|x| = radius`` seen from
+    ``eye`` (3,): in the plane of the circle where the view rays touch the sphere (its centre
+    ``a r^2 / d`` along the unit axis a toward the eye, its radius ``r sqrt(1 - r^2 / d^2)``),
+    facing the eye, scaled so the polygon's edges clear the circle by ``margin_px`` of the
+    outline's ``radius_px`` (``projected_radius_px``). The rays through the polygon are then a
+    cone around the sphere's outline. None where the eye is not outside the sphere or
+    ``radius_px`` is not finite and positive."""
+    e = np.asarray(eye, np.float64)
+    d = float(np.linalg.norm(e))
+    if not (math.isfinite(radius_px) and radius_px > 0.0) or d <= radius * 1.0000001:
         return None
-    return (1.0 + margin_px / radius_px) / math.cos(math.sqrt(2.0) * math.pi / segments)
+    axis = e / d
+    helper = np.array([0.0, 1.0, 0.0]) if abs(axis[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    x = np.cross(helper, axis)
+    x /= np.linalg.norm(x)
+    y = np.cross(axis, x)
+    circle = radius * math.sqrt(1.0 - (radius / d) ** 2)
+    scale = circle * (1.0 + margin_px / radius_px) / math.cos(math.pi / sides)
+    model = np.eye(4)
+    model[:3, 0], model[:3, 1], model[:3, 2] = x * scale, y * scale, axis
+    model[:3, 3] = axis * radius * radius / d
+    return model
 
 
 def ray_meets_sphere(eye, directions, radius: float) -> np.ndarray:

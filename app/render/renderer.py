@@ -37,7 +37,7 @@ from alight.core.gpu import ShaderLibrary, create_headless_context
 from alight.core.ibl_models import SUNS_AS_BAKED, ibl_model_index
 from alight.core.layers import layer_defines
 from alight.core.material import LAYERS, Material, with_overrides
-from alight.core.mesh import is_closed, sphere
+from alight.core.mesh import MeshPart, is_closed, sphere
 from alight.core.scene import (
     TONEMAPS,
     Camera,
@@ -49,7 +49,8 @@ from alight.core.shading import rotate_world_to_map
 from alight.core.sphere_lod import (
     MAX_SILHOUETTE_ERROR_PX,
     SPHERE_LOD_SEGMENTS,
-    impostor_proxy_scale,
+    impostor_proxy_model,
+    impostor_proxy_polygon,
     projected_radius_px,
     sphere_segments,
 )
@@ -480,46 +481,54 @@ class ForwardRenderer:
             entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, lod, textures)], textures)
         return entry[1], radius
 
-    def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int]) -> float | None:
-        """The scale of the impostor's proxy where the built-in sphere is drawn as one, else None.
+    def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int]) -> np.ndarray | None:
+        """Where the built-in sphere is drawn as an impostor, the (4, 4) matrix that places its
+        proxy (column vectors); else None.
 
-        The proxy is the 16-segment ball scaled so that its facets hold the true sphere's outline
-        with 2 px to spare (alight.core.sphere_lod.impostor_proxy_scale); each of its pixels
-        tests its sample rays against the true sphere (mesh_material.glsl SPHERE_IMPOSTOR) and is
-        shaded as the tessellated ball's are (SPHERE_SURFACE: on the true sphere, at the pixel
-        centre), so only the outline's coverage changes: it is the true sphere's. Used where the
-        shading depends on the view ray alone: a perspective camera well outside the proxy, and
-        a part without texture maps (their uvs would come from the proxy), anisotropy (its
-        tangents), transmission, blending, masks, vertex colours or a debug view."""
+        The proxy is a 16-sided polygon facing the eye around the sphere's outline with 2 px to
+        spare (alight.core.sphere_lod.impostor_proxy_model): few, large triangles. Each of its
+        pixels tests its sample rays against the true sphere (mesh_material.glsl SPHERE_IMPOSTOR)
+        and is shaded as the tessellated ball's are (SPHERE_SURFACE: on the true sphere, at the
+        pixel centre), so only the outline's coverage changes: it is the true sphere's. Used
+        where the shading depends on the view ray alone: a perspective camera outside the sphere
+        with the proxy between the clipping planes, and a part without texture maps (their uvs
+        would come from the proxy), anisotropy (its tangents), transmission, blending, masks,
+        vertex colours or a debug view."""
         mesh = scene.mesh
         if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
                 or len(mesh.parts) != 1 or camera.ortho_half_height is not None or scene.debug_view):
             return None
         radius = mesh.lod_sphere[0]
-        distance = float(np.linalg.norm(np.asarray(camera.position, np.float64)))
-        vp = camera.view_projection(image_size[0] / image_size[1])
-        scale = impostor_proxy_scale(projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size))
-        # The proxy whole between the clipping planes, the eye well outside it.
-        if (scale is None or distance <= 1.1 * scale * radius or distance - scale * radius <= 1.01 * camera.near
-                or distance + scale * radius >= 0.99 * camera.far):
+        vp = camera.view_projection(image_size[0] / image_size[1]).astype(np.float64)
+        model = impostor_proxy_model(camera.position, radius, projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size))
+        if model is None:
+            return None
+        polygon = impostor_proxy_polygon()[0].astype(np.float64)
+        polygon = np.hstack([polygon, np.ones((len(polygon), 1))])
+        clip = polygon @ model.T @ vp
+        if not (np.abs(clip[:, 2]) < 0.999 * clip[:, 3]).all():    # (w > 0 too)
             return None
         part = mesh.parts[0]
         defines = self._part_defines(scene, self._gpu_mesh(mesh)[0], part, self._user_maps_present(scene))
         if (defines["MATERIAL_MAPS_MASK"] or any(k in defines for k in (
                 "ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_ANISOTROPY", "HAS_TRANSMISSION"))):
             return None
-        return scale
+        return model
 
     def _impostor_proxy(self, mesh) -> _GpuPart:
-        """The built-in sphere's impostor proxy: its 16-segment level (drawn scaled)."""
+        """The impostor's proxy polygon (alight.core.sphere_lod.impostor_proxy_polygon), placed by
+        the model matrix of _sphere_impostor."""
         for old in [k for k, e in self._sphere_lods.items() if e[0] is not mesh]:   # another mesh's
             _release_mesh(self._sphere_lods.pop(old))
         key = (id(mesh), "proxy")
         entry = self._sphere_lods.get(key)
         if entry is None:
-            radius, part = mesh.lod_sphere[0], mesh.parts[0]
-            proxy = dataclasses.replace(sphere(16, 8, radius).parts[0], material=part.material, name=part.name,
-                                        element=part.element)
+            positions, indices = impostor_proxy_polygon()
+            n = len(positions)
+            part = mesh.parts[0]
+            proxy = MeshPart(part.name, positions, np.tile(np.float32([0.0, 0.0, 1.0]), (n, 1)),
+                             np.zeros((n, 2), np.float32), np.tile(np.float32([1.0, 0.0, 0.0, 1.0]), (n, 1)),
+                             indices, part.material, element=part.element)
             textures = _MeshTextures(self.ctx)
             entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, proxy, textures)], textures)
         return entry[1][0]
@@ -1217,13 +1226,13 @@ class ForwardRenderer:
         size = image_size or tuple(ctx.viewport[2:])
         drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
         # The built-in sphere as an impostor (_sphere_impostor), by forward programs only.
-        proxy_scale = self._sphere_impostor(scene, camera, size) if callable(prog) and self._impostor_samples else None
+        proxy_model = self._sphere_impostor(scene, camera, size) if callable(prog) and self._impostor_samples else None
         self.last_sphere_impostor = None
         model = np.eye(4, dtype=np.float32)
-        if proxy_scale is not None:
+        if proxy_model is not None:
             drawn = [self._impostor_proxy(scene.mesh)]
             sphere_radius = scene.mesh.lod_sphere[0]
-            model = np.diag([proxy_scale, proxy_scale, proxy_scale, 1.0]).astype(np.float32)
+            model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns
             self.last_sphere_impostor = self._impostor_samples
         chosen = None if parts is None else set(parts)
         for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
@@ -1247,7 +1256,7 @@ class ForwardRenderer:
                     part_defines = self._part_defines(scene, gpu_part, part, user_maps)
                     if sphere_radius is not None:
                         part_defines["SPHERE_SURFACE"] = None
-                    if proxy_scale is not None:
+                    if proxy_model is not None:
                         part_defines["SPHERE_IMPOSTOR"] = self._impostor_samples
                     program = prog(part_defines)
                 else:
@@ -1259,7 +1268,7 @@ class ForwardRenderer:
                     _set(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
                     _set(program, "u_camera_position", tuple(float(x) for x in camera.position))
                     _set(program, "u_sphere_radius", float(sphere_radius or 0.0))
-                    if proxy_scale is not None:
+                    if proxy_model is not None:
                         inverse_vp = np.linalg.inv(np.asarray(view_projection, np.float64)).astype(np.float32)
                         _set(program, "u_inverse_view_projection", inverse_vp.tobytes(), write=True)
                         _set(program, "u_viewport_size", tuple(float(x) for x in ctx.viewport[2:]))
