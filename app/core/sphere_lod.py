@@ -17,6 +17,7 @@ in by at most ``R (1 - cos(sqrt(2) pi / n))`` (the sagitta of that arc; R the sp
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -99,15 +100,17 @@ IMPOSTOR_PROXY_SIDES = 16
 IMPOSTOR_MARGIN_PX = 2.0
 
 
+@functools.lru_cache(maxsize=4)
 def impostor_proxy_polygon(sides: int = IMPOSTOR_PROXY_SIDES) -> tuple[np.ndarray, np.ndarray]:
     """The proxy in its own frame: the unit circle's centre and ``sides`` vertices at radius 1 in
     the plane z = 0, counter-clockwise seen from +z, as a triangle fan. Returns positions
-    (sides + 1, 3) float32 and indices (sides, 3) uint32."""
+    (sides + 1, 3) float32 and indices (sides, 3) uint32 (shared: read-only)."""
     angles = 2.0 * np.pi * np.arange(sides) / sides
     ring = np.stack([np.cos(angles), np.sin(angles), np.zeros(sides)], axis=1)
     positions = np.vstack([[0.0, 0.0, 0.0], ring]).astype(np.float32)
     k = np.arange(sides)
     indices = np.stack([np.zeros(sides, int), 1 + k, 1 + (k + 1) % sides], axis=1).astype(np.uint32)
+    positions.flags.writeable = indices.flags.writeable = False
     return positions, indices
 
 
@@ -121,15 +124,20 @@ def impostor_proxy_model(eye, radius: float, radius_px: float, sides: int = IMPO
     outline's ``radius_px`` (``projected_radius_px``). The rays through the polygon are then a
     cone around the sphere's outline. None where the eye is not outside the sphere or
     ``radius_px`` is not finite and positive."""
-    e = np.asarray(eye, np.float64)
-    d = float(np.linalg.norm(e))
+    ex, ey, ez = (float(c) for c in eye)
+    d = math.sqrt(ex * ex + ey * ey + ez * ez)
     if not (math.isfinite(radius_px) and radius_px > 0.0) or d <= radius * 1.0000001:
         return None
-    axis = e / d
-    helper = np.array([0.0, 1.0, 0.0]) if abs(axis[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    x = np.cross(helper, axis)
-    x /= np.linalg.norm(x)
-    y = np.cross(axis, x)
+    # (Per frame, in Python: scalar arithmetic, not numpy's small-array calls.)
+    ax, ay, az = ex / d, ey / d, ez / d
+    if abs(ay) < 0.9:      # x = normalize(cross((0, 1, 0), axis))
+        x = (az, 0.0, -ax)
+    else:                  # x = normalize(cross((1, 0, 0), axis))
+        x = (0.0, -az, ay)
+    n = math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2])
+    x = np.array(x) / n
+    axis = np.array([ax, ay, az])
+    y = np.array([ay * x[2] - az * x[1], az * x[0] - ax * x[2], ax * x[1] - ay * x[0]])    # cross(axis, x)
     circle = radius * math.sqrt(1.0 - (radius / d) ** 2)
     scale = circle * (1.0 + margin_px / radius_px) / math.cos(math.pi / sides)
     model = np.eye(4)

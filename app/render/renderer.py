@@ -385,6 +385,7 @@ class ForwardRenderer:
         self.sphere_impostor = True
         self.last_sphere_impostor: int | None = None   # the last mesh pass's coverage samples, or None
         self._impostor_samples = 1    # set by _draw_scene: 1, 4 (the fused resolve's stand-in), 0 (none)
+        self._impostor_model: np.ndarray | None = None   # the proxy's placement while _draw_scene runs
         self._scene_single = False    # the last scene pass drew into _Targets.single (for _resolve)
         self._targets: _Targets | None = None
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
@@ -481,7 +482,8 @@ class ForwardRenderer:
             entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, lod, textures)], textures)
         return entry[1], radius
 
-    def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int]) -> np.ndarray | None:
+    def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int],
+                         view_projection: np.ndarray | None = None) -> np.ndarray | None:
         """Where the built-in sphere is drawn as an impostor, the (4, 4) matrix that places its
         proxy (column vectors); else None.
 
@@ -493,13 +495,16 @@ class ForwardRenderer:
         where the shading depends on the view ray alone: a perspective camera outside the sphere
         with the proxy between the clipping planes, and a part without texture maps (their uvs
         would come from the proxy), anisotropy (its tangents), transmission, blending, masks,
-        vertex colours or a debug view."""
+        vertex colours or a debug view. ``view_projection``: the camera's for ``image_size`` (not a
+        tile's), where the caller has it."""
         mesh = scene.mesh
         if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
                 or len(mesh.parts) != 1 or camera.ortho_half_height is not None or scene.debug_view):
             return None
         radius = mesh.lod_sphere[0]
-        vp = camera.view_projection(image_size[0] / image_size[1]).astype(np.float64)
+        if view_projection is None:
+            view_projection = camera.view_projection(image_size[0] / image_size[1])
+        vp = np.asarray(view_projection, np.float64)
         model = impostor_proxy_model(camera.position, radius, projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size))
         if model is None:
             return None
@@ -757,14 +762,15 @@ class ForwardRenderer:
         # The built-in sphere as an impostor (_sphere_impostor): with one coverage sample a pixel
         # into a single-sample target, with 4 into the fused resolve's single-sample stand-in for
         # the multisampled one (its mean already taken); never into a multisampled target.
-        impostor = self._sphere_impostor(scene, camera, (view.width, view.height)) is not None
+        view_projection = camera.view_projection(aspect)
+        self._impostor_model = self._sphere_impostor(scene, camera, (view.width, view.height), view_projection)
+        impostor = self._impostor_model is not None
         self._scene_single = impostor and fbo is targets.draw and targets.aa == "msaa" and not background
         if self._scene_single:
             fbo = targets.single()[1]
         self._impostor_samples = 4 if self._scene_single else (1 if targets.aa != "msaa" else 0)
         fbo.use()
         ctx.viewport = (0, 0, width, height)
-        view_projection = camera.view_projection(aspect)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
             view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
@@ -804,6 +810,7 @@ class ForwardRenderer:
             self._finish_radiance(targets)
         self._display_output = None
         self._half_output = False
+        self._impostor_model = None
 
     def _surface_rect(self, scene: Scene, view_projection: np.ndarray,
                       size: tuple[int, int]) -> tuple[int, int, int, int] | None:
@@ -1226,7 +1233,8 @@ class ForwardRenderer:
         size = image_size or tuple(ctx.viewport[2:])
         drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
         # The built-in sphere as an impostor (_sphere_impostor), by forward programs only.
-        proxy_model = self._sphere_impostor(scene, camera, size) if callable(prog) and self._impostor_samples else None
+        # (decided once per scene pass, in _draw_scene)
+        proxy_model = self._impostor_model if callable(prog) and self._impostor_samples else None
         self.last_sphere_impostor = None
         model = np.eye(4, dtype=np.float32)
         if proxy_model is not None:
