@@ -735,17 +735,25 @@ class ForwardRenderer:
     def draw_hdr(self, scene: Scene, maps: IBLMaps | None, targets: _Targets) -> None:
         self._draw_scene(scene, maps, targets, targets.draw)
 
-    def draw_display(self, scene: Scene, maps: IBLMaps | None, targets: _Targets) -> None:
+    def draw_display(self, scene: Scene, maps: IBLMaps | None, targets: _Targets,
+                     into: moderngl.Framebuffer | None = None) -> moderngl.Framebuffer:
         """What ``draw_hdr`` then ``tonemap`` (opaque) leave in ``targets.display``, in one pass:
         the scene's programs tone map as they write (common/output_encoding.glsl), so neither the
         float image nor the tone map pass is needed (the editor's view). Without anti-aliasing
-        only: a resolve must average radiance, not display values."""
+        only: a resolve must average radiance, not display values.
+
+        ``into``: a framebuffer with a depth buffer (the editor's window) to draw the one pass
+        into instead of ``targets.display``, at its bottom-left, targets' size. Returns the
+        framebuffer that holds the picture: ``into`` where the one pass could be used, else
+        ``targets.display_fbo``."""
         if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
             # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
             self.draw_hdr(scene, maps, targets)
             self.tonemap(targets.radiance, scene.display, targets.display_fbo)
-            return
-        self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display)
+            return targets.display_fbo
+        fbo = into or targets.display_draw()
+        self._draw_scene(scene, maps, targets, fbo, scene.display)
+        return into or targets.display_fbo
 
     def _draw_scene(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, fbo: moderngl.Framebuffer,
                     display_output: Display | None = None, view: _View | None = None,
@@ -781,14 +789,16 @@ class ForwardRenderer:
         # (background=False) only the mesh's rectangle: no surface is drawn and no sample read
         # outside it (_resolve), and a 4x target's full clear was 66 ms of a 1920x1080 frame's
         # CPU time here. Not with transmissive parts: they read the opaque copy anywhere.
+        # Into a larger framebuffer (the editor's window: ForwardRenderer.draw_display's ``into``)
+        # only the part drawn.
+        clear_rect = None if tuple(fbo.size) == (width, height) else (0, 0, width, height)
         if not background and scale == 1 and rect is not None and not self.transmissive_parts(scene):
-            ctx.scissor = rect
-            try:
-                fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            finally:
-                ctx.scissor = None
-        else:
+            clear_rect = rect
+        ctx.scissor = clear_rect
+        try:
             fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        finally:
+            ctx.scissor = None
         self._write_lights(scene)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
@@ -1231,13 +1241,15 @@ class ForwardRenderer:
         tiling = scene.texture_maps or TextureMaps()
         items = []
         size = image_size or tuple(ctx.viewport[2:])
-        drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
-        # The built-in sphere as an impostor (_sphere_impostor), by forward programs only.
-        # (decided once per scene pass, in _draw_scene)
+        # The built-in sphere as an impostor (_sphere_impostor, decided once per scene pass in
+        # _draw_scene), by forward programs only; else its level or the mesh as given.
         proxy_model = self._impostor_model if callable(prog) and self._impostor_samples else None
         self.last_sphere_impostor = None
         model = np.eye(4, dtype=np.float32)
-        if proxy_model is not None:
+        if proxy_model is None:
+            drawn, sphere_radius = self._drawn_parts(scene.mesh, camera, size)
+        else:
+            self.last_sphere_segments = None
             drawn = [self._impostor_proxy(scene.mesh)]
             sphere_radius = scene.mesh.lod_sphere[0]
             model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns

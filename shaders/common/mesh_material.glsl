@@ -150,19 +150,20 @@ uniform mat4 u_inverse_view_projection;   // this pass's (a tile's off-centre pr
 uniform vec2 u_viewport_size;             // pixels
 
 float sphere_coverage() {
-#if SPHERE_IMPOSTOR == 4
+#if SPHERE_IMPOSTOR == 1
+    // The pixel centre's ray passes through the proxy's point here.
+    return ray_meets_sphere(u_camera_position, v_position - u_camera_position, u_sphere_radius) ? 1.0 : 0.0;
+#else
     // OpenGL's standard 4x positions (the D3D pattern), from the pixel centre.
     const vec2 offsets[4] = vec2[4](vec2(-0.125, -0.375), vec2(0.375, -0.125), vec2(-0.375, 0.125), vec2(0.125, 0.375));
-#else
-    const vec2 offsets[1] = vec2[1](vec2(0.0));
-#endif
     float covered = 0.0;
-    for (int i = 0; i < SPHERE_IMPOSTOR; ++i) {
+    for (int i = 0; i < 4; ++i) {
         vec2 ndc = (gl_FragCoord.xy + offsets[i]) / u_viewport_size * 2.0 - 1.0;
         vec4 far = u_inverse_view_projection * vec4(ndc, 1.0, 1.0);
         covered += ray_meets_sphere(u_camera_position, far.xyz / far.w - u_camera_position, u_sphere_radius) ? 1.0 : 0.0;
     }
-    return covered / float(SPHERE_IMPOSTOR);
+    return covered / 4.0;
+#endif
 }
 #endif
 #endif

@@ -145,7 +145,7 @@ def _profile(win, frames: int) -> dict[str, float]:
     for _ in range(frames):
         win.orbit.orbit(3.0, 0.0)
         t0 = time.perf_counter()
-        win.glfw.poll_events()
+        win.poll_events()
         win.impl.process_inputs()
         imgui.new_frame()
         win.panel.draw(win)
@@ -153,10 +153,13 @@ def _profile(win, frames: int) -> dict[str, float]:
         t1 = time.perf_counter()
         targets = win.targets(win.view_area())
         scene = win.state.scene(win.orbit.camera())
-        r.draw_display(scene, win.maps(), targets)
+        # As an orbiting frame is drawn (EditorWindow.render_view): straight into the window
+        # where it has a depth buffer, else into the view image and then copied.
+        drawn = r.draw_display(scene, win.maps(), targets, into=ctx.screen if win._screen_depth else None)
         ctx.finish()
         t2 = time.perf_counter()
-        ctx.copy_framebuffer(ctx.screen, targets.display_fbo)
+        if drawn is not ctx.screen:
+            ctx.copy_framebuffer(ctx.screen, targets.display_fbo)
         ctx.screen.use()
         ctx.finish()
         t3 = time.perf_counter()
