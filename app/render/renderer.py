@@ -783,22 +783,12 @@ class ForwardRenderer:
             view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
         self._last_inverse_vp = inverse_vp    # the resolve's background rays (this frame or tile)
-        self._last_surface_rect = rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
+        self._last_surface_rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
         # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag),
-        # and transmissive parts read the opaque parts' coverage from it. For the fused resolve
-        # (background=False) only the mesh's rectangle: no surface is drawn and no sample read
-        # outside it (_resolve), and a 4x target's full clear was 66 ms of a 1920x1080 frame's
-        # CPU time here. Not with transmissive parts: they read the opaque copy anywhere.
-        # Into a larger framebuffer (the editor's window: ForwardRenderer.draw_display's ``into``)
-        # only the part drawn.
-        clear_rect = None if tuple(fbo.size) == (width, height) else (0, 0, width, height)
-        if not background and scale == 1 and rect is not None and not self.transmissive_parts(scene):
-            clear_rect = rect
-        ctx.scissor = clear_rect
-        try:
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        finally:
-            ctx.scissor = None
+        # and transmissive parts read the opaque parts' coverage from it. The whole framebuffer:
+        # llvmpipe clears whole tiles lazily, and a scissored clear (the mesh's rectangle only)
+        # made a 1920x1080 4x frame 7-9% slower here, alternated in one process.
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._write_lights(scene)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
