@@ -28,6 +28,9 @@ PHASES = {
     "still": re.compile(r"^still view .*median ([\d.]+) ms"),
 }
 STAGES = re.compile(r"^full resolution, per stage .*: (.*)$")
+# The adaptive phase holds 30 FPS by moving the resolution: its frame time alone says little, the
+# scale it settled at says how sharp the moving view stayed.
+SCALE = re.compile(r"^orbiting, adaptive scale \(target 30 FPS; scale median ([\d.]+)")
 
 
 def run(alight: str, frames: int) -> tuple[dict[str, float], str]:
@@ -47,6 +50,9 @@ def run(alight: str, frames: int) -> tuple[dict[str, float], str]:
         m = STAGES.match(line)
         if m:
             stages = m.group(1)
+        m = SCALE.match(line)
+        if m:
+            found["adaptive scale"] = float(m.group(1))
     return found, stages
 
 
@@ -65,12 +71,17 @@ def main() -> int:
             found, stages = run(exe, args.frames)
             for k, v in found.items():
                 results[label].setdefault(k, []).append(v)
-            print(f"round {i + 1} {label}: " + ", ".join(f"{k} {v:.1f} ms" for k, v in found.items())
+            print(f"round {i + 1} {label}: " + ", ".join(f"{k} {v:.2f}" if k == "adaptive scale" else f"{k} {v:.1f} ms"
+                                                         for k, v in found.items())
                   + f"; stages: {stages}", flush=True)
     with open("/proc/loadavg") as f:
         load_after = f.read().split()[:3]
     print(f"\n{os.cpu_count()} cores, load average {'/'.join(load_before)} before, {'/'.join(load_after)} after; "
           f"{args.rounds} alternated rounds of {args.frames} frames per phase")
+    a, b = results["this"].get("adaptive scale"), results["other"].get("adaptive scale")
+    if a and b:
+        print(f"the adaptive phase's scale: this {statistics.median(a):.2f} ({min(a):.2f}-{max(a):.2f}), "
+              f"other {statistics.median(b):.2f} ({min(b):.2f}-{max(b):.2f}) (1: full resolution)")
     for phase in PHASES:
         a, b = results["this"].get(phase), results["other"].get(phase)
         if not a or not b:

@@ -43,6 +43,7 @@ def _setup(level: str):
     from alight.render.renderer import ForwardRenderer
 
     r = ForwardRenderer()   # the bake from the disk cache: callgrind would spend minutes re-baking
+    r.sphere_impostor = False   # the levels themselves (the impostor: bench_impostor.py)
     maps = r.bake(load_environment(str(ENV)), "low")
     mesh = sphere()
     if level == "before":

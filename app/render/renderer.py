@@ -493,10 +493,12 @@ class ForwardRenderer:
         and is shaded as the tessellated ball's are (SPHERE_SURFACE: on the true sphere, at the
         pixel centre), so only the outline's coverage changes: it is the true sphere's. Used
         where the shading depends on the view ray alone: a perspective camera outside the sphere
-        with the proxy between the clipping planes, and a part without texture maps (their uvs
-        would come from the proxy), anisotropy (its tangents), transmission, blending, masks,
-        vertex colours or a debug view. ``view_projection``: the camera's for ``image_size`` (not a
-        tile's), where the caller has it."""
+        with the proxy between the clipping planes, and a part without transmission, blending,
+        masks, vertex colours or a debug view. Its texture maps read the sphere's own uvs and
+        tangents at the shaded point (mesh_material.glsl surface_uv, surface_tangent), so they
+        are used with the user's tiling but no texture transform, second uv set or mirroring.
+        ``view_projection``: the camera's for ``image_size`` (not a tile's), where the caller has
+        it."""
         mesh = scene.mesh
         if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
                 or len(mesh.parts) != 1 or camera.ortho_half_height is not None or scene.debug_view):
@@ -515,8 +517,9 @@ class ForwardRenderer:
             return None
         part = mesh.parts[0]
         defines = self._part_defines(scene, self._gpu_mesh(mesh)[0], part, self._user_maps_present(scene))
-        if (defines["MATERIAL_MAPS_MASK"] or any(k in defines for k in (
-                "ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_ANISOTROPY", "HAS_TRANSMISSION"))):
+        if any(k in defines for k in ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_TRANSMISSION", "HAS_UV1")):
+            return None
+        if any(defines.get(k) for k in ("MAP_UV1_MASK", "MAP_TRANSFORM_MASK", "MAP_MIRROR_S_MASK", "MAP_MIRROR_T_MASK")):
             return None
         return model
 

@@ -181,8 +181,32 @@ bool has_map(int bit, bool present) {
     return (MATERIAL_MAPS_MASK & bit) != 0 && present;
 }
 
+// The mesh's uv (TEXCOORD_0), or on the impostor the built-in sphere's at the shaded point: the
+// proxy has none, and the tessellated ball's interpolated ones differ from it only by its facets.
+vec2 surface_uv() {
+#ifdef SPHERE_IMPOSTOR
+    // Across the seam the analytic u jumps from 1 to 0, and a 2x2 block straddling it would take
+    // a whole texture's width as its derivative (the smallest mip: a visible line). There u is
+    // read in (-0.5, 0.5] instead, equal under the maps' repeat wrap (Tarini 2012, "Cylindrical and
+    // toroidal parameterizations without vertex seams"); the block chooses as one.
+    vec2 uv = sphere_uv(surface_position());
+    return fwidth(uv.x) > 0.5 ? vec2(uv.x > 0.5 ? uv.x - 1.0 : uv.x, uv.y) : uv;
+#else
+    return v_uv;
+#endif
+}
+
+// The mesh's tangent and handedness, or on the impostor the built-in sphere's.
+vec4 surface_tangent() {
+#ifdef SPHERE_IMPOSTOR
+    return sphere_tangent(surface_position());
+#else
+    return v_tangent;
+#endif
+}
+
 vec2 material_uv() {
-    return v_uv * u_uv_scale + u_uv_offset;
+    return surface_uv() * u_uv_scale + u_uv_offset;
 }
 
 // The coordinates a map reads: its uv set, then its texture transform (glTF 2.0 textureInfo
@@ -236,10 +260,11 @@ vec3 geometric_normal() {
 // An orthonormal tangent frame about n from the mesh's tangent (Gram-Schmidt); a tangent
 // parallel to n (a broken file) gets any perpendicular instead. b carries the mesh's handedness.
 mat3 tangent_frame(vec3 n) {
-    vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
+    vec4 tangent = surface_tangent();
+    vec3 t = tangent.xyz - n * dot(n, tangent.xyz);
     if (dot(t, t) < 1e-12) t = cross(abs(n.y) < 0.999 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0), n);
     t = normalize(t);
-    vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+    vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
     return mat3(t, b, n);
 }
 

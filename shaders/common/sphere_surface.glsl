@@ -19,3 +19,18 @@ bool ray_meets_sphere(vec3 eye, vec3 d, float r) {
     float b = dot(eye, d);
     return b < 0.0 && b * b >= dot(d, d) * (dot(eye, eye) - r * r);
 }
+
+// alight.core.mesh.sphere's uv at the point x on the sphere (any radius): u = phi / 2 pi about +Y
+// from -Z (the seam), v = 1 at the north pole (+Y). atan(|x.xz|, x.y) rather than acos: llvmpipe's
+// acos is good to only ~1e-4 rad.
+vec2 sphere_uv(vec3 x) {
+    float u = atan(-x.x, -x.z) / (2.0 * PI);
+    return vec2(u < 0.0 ? u + 1.0 : u, 1.0 - atan(length(x.xz), x.y) / PI);
+}
+
+// alight.core.mesh.sphere's tangent (+u direction, handedness +1) at the point x: zero at the poles.
+vec4 sphere_tangent(vec3 x) {
+    vec3 t = vec3(x.z, 0.0, -x.x);
+    float len2 = dot(t, t);
+    return vec4(len2 > 0.0 ? t * inversesqrt(len2) : vec3(0.0), 1.0);
+}
