@@ -346,8 +346,8 @@ def test_the_textured_impostor_reads_the_spheres_own_uvs_and_tangents(shared_dat
 
 
 def test_the_impostor_is_not_used_where_the_shading_needs_more_than_the_ray(shared_data):
-    """Transmission (it reads the scene behind), a debug view, an orthographic camera, an eye
-    inside the sphere: the tessellated ball. Texture maps and anisotropy: the impostor."""
+    """An orthographic camera, an eye inside the sphere: the tessellated ball. Texture maps,
+    anisotropy, transmission and the debug views: the impostor."""
     r = renderer()
     maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
     base = Scene(mesh=sphere(), material=Material())
@@ -357,12 +357,12 @@ def test_the_impostor_is_not_used_where_the_shading_needs_more_than_the_ray(shar
     assert r.last_sphere_impostor == 1
     texture_maps, images = _checker_maps(16)
     for scene in (dataclasses.replace(base, texture_maps=texture_maps, texture_images=images),
-                  dataclasses.replace(base, material=Material(anisotropy_strength=0.5))):
+                  dataclasses.replace(base, material=Material(anisotropy_strength=0.5)),
+                  dataclasses.replace(base, material=Material(transmission=1.0)),
+                  dataclasses.replace(base, debug_view=1)):
         r.render(scene, maps, 64, 64, aa="msaa")
         assert r.last_sphere_impostor == 4
     cases = [
-        dataclasses.replace(base, material=Material(transmission=1.0)),
-        dataclasses.replace(base, debug_view=1),
         dataclasses.replace(base, camera=Camera(ortho_half_height=1.5)),
         dataclasses.replace(base, camera=Camera(position=(0.0, 0.0, 0.5), near=0.01)),   # inside
     ]

@@ -491,17 +491,16 @@ class ForwardRenderer:
         spare (alight.core.sphere_lod.impostor_proxy_model): few, large triangles. Each of its
         pixels tests its sample rays against the true sphere (mesh_material.glsl SPHERE_IMPOSTOR)
         and is shaded as the tessellated ball's are (SPHERE_SURFACE: on the true sphere, at the
-        pixel centre), so only the outline's coverage changes: it is the true sphere's. Used
-        where the shading depends on the view ray alone: a perspective camera outside the sphere
-        with the proxy between the clipping planes, and a part without transmission, blending,
-        masks, vertex colours or a debug view. Its texture maps read the sphere's own uvs and
-        tangents at the shaded point (mesh_material.glsl surface_uv, surface_tangent), so they
-        are used with the user's tiling but no texture transform, second uv set or mirroring.
+        pixel centre), with the sphere's own uv and tangent there (mesh_material.glsl surface_uv,
+        surface_tangent), so only the outline's coverage changes: it is the true sphere's. Used
+        for a perspective camera outside the sphere with the proxy between the clipping planes;
+        not for what a file's material could ask of a part and the built-in sphere's cannot
+        (blending, masks, vertex colours, texture transforms, a second uv set, mirroring).
         ``view_projection``: the camera's for ``image_size`` (not a tile's), where the caller has
         it."""
         mesh = scene.mesh
         if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
-                or len(mesh.parts) != 1 or camera.ortho_half_height is not None or scene.debug_view):
+                or len(mesh.parts) != 1 or camera.ortho_half_height is not None):
             return None
         radius = mesh.lod_sphere[0]
         if view_projection is None:
@@ -517,7 +516,7 @@ class ForwardRenderer:
             return None
         part = mesh.parts[0]
         defines = self._part_defines(scene, self._gpu_mesh(mesh)[0], part, self._user_maps_present(scene))
-        if any(k in defines for k in ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_TRANSMISSION", "HAS_UV1")):
+        if any(k in defines for k in ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_UV1")):
             return None
         if any(defines.get(k) for k in ("MAP_UV1_MASK", "MAP_TRANSFORM_MASK", "MAP_MIRROR_S_MASK", "MAP_MIRROR_T_MASK")):
             return None
