@@ -24,8 +24,10 @@ bool ray_meets_sphere(vec3 eye, vec3 d, float r) {
 // from -Z (the seam), v = 1 at the north pole (+Y). atan(|x.xz|, x.y) rather than acos: llvmpipe's
 // acos is good to only ~1e-4 rad.
 vec2 sphere_uv(vec3 x) {
-    float u = atan(-x.x, -x.z) / (2.0 * PI);
-    return vec2(u < 0.0 ? u + 1.0 : u, 1.0 - atan(length(x.xz), x.y) / PI);
+    // (1/pi spelled out: this file is also included without brdf.glsl's PI, by the reference's G-buffer)
+    const float INV_PI = 0.31830988618379067;
+    float u = 0.5 * INV_PI * atan(-x.x, -x.z);
+    return vec2(u < 0.0 ? u + 1.0 : u, 1.0 - INV_PI * atan(length(x.xz), x.y));
 }
 
 // alight.core.mesh.sphere's tangent (+u direction, handedness +1) at the point x: zero at the poles.
