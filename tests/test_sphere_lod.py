@@ -370,3 +370,17 @@ def test_the_impostor_is_not_used_where_the_shading_needs_more_than_the_ray(shar
         frame = r.render(scene, maps, 64, 64, aa="msaa")
         assert r.last_sphere_impostor is None, scene
         assert np.isfinite(frame.linear).all()
+
+
+def test_the_impostors_uv_and_tangent_are_the_meshs():
+    """common/sphere_surface.glsl's sphere_uv and sphere_tangent at the built-in sphere's vertices
+    give the uvs and tangents alight.core.mesh.sphere stores there (u modulo 1: the seam's two
+    columns; the poles, where u and the tangent are undefined, left out)."""
+    part = sphere(32, 16, 2.0).parts[0]
+    keep = np.abs(part.normals[:, 1]) < 0.999
+    got = evaluate("SPHERE_UV", part.positions[keep])
+    du = (got[:, 0] - part.uvs[keep, 0] + 0.5) % 1.0 - 0.5
+    np.testing.assert_allclose(du, 0.0, atol=2e-6)
+    np.testing.assert_allclose(got[:, 1], part.uvs[keep, 1], atol=2e-6)
+    np.testing.assert_allclose(got[:, 2:], part.tangents[keep][:, [0, 2]], atol=2e-6)
+    assert (part.tangents[keep, 3] == 1.0).all()       # (the GLSL's handedness is +1)

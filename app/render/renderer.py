@@ -315,7 +315,7 @@ class _Targets:
     def single(self) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
         """A single-sample colour target at the draw size, in the multisampled one's format, where
         the built-in sphere's impostor writes its coverage-weighted radiance for the fused resolve
-        (ForwardRenderer._sphere_impostor). No depth: the proxy is convex, its back faces culled."""
+        (ForwardRenderer._sphere_impostor). No depth: the proxy is one flat polygon facing the eye."""
         if self._single is None:
             tex = self.ctx.texture(self.draw_size, 4, dtype="f2" if self.half else "f4")
             tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -384,9 +384,10 @@ class ForwardRenderer:
         # its tessellation in every pass (the tests compare the two).
         self.sphere_impostor = True
         self.last_sphere_impostor: int | None = None   # the last mesh pass's coverage samples, or None
-        self._impostor_samples = 1    # set by _draw_scene: 1, 4 (the fused resolve's stand-in), 0 (none)
+        # Set by _draw_scene: 1, 4 (into the fused resolve's single-sample stand-in, _Targets.single,
+        # which _resolve then reads), 0 (none: a multisampled target).
+        self._impostor_samples = 1
         self._impostor_model: np.ndarray | None = None   # the proxy's placement while _draw_scene runs
-        self._scene_single = False    # the last scene pass drew into _Targets.single (for _resolve)
         self._targets: _Targets | None = None
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
@@ -470,17 +471,21 @@ class ForwardRenderer:
         self.last_sphere_segments = n
         if n == segments:
             return own, radius
-        for old in [k for k, e in self._sphere_lods.items() if e[0] is not mesh]:   # another mesh's levels
+        return [self._sphere_stand_in(mesh, n, lambda: sphere(n, n // 2, radius).parts[0])], radius
+
+    def _sphere_stand_in(self, mesh, key, make_part) -> _GpuPart:
+        """A part drawn in place of the built-in sphere ``mesh``'s own (a coarser level, the
+        impostor's proxy), kept by ``key`` while ``mesh`` is the one drawn; ``make_part`` builds
+        its MeshPart, which takes the sphere's material, name and element."""
+        for old in [k for k, e in self._sphere_lods.items() if e[0] is not mesh]:   # another mesh's
             _release_mesh(self._sphere_lods.pop(old))
-        key = (id(mesh), n)
-        entry = self._sphere_lods.get(key)
+        entry = self._sphere_lods.get((id(mesh), key))
         if entry is None:
             part = mesh.parts[0]
-            lod = dataclasses.replace(sphere(n, n // 2, radius).parts[0], material=part.material, name=part.name,
-                                      element=part.element)
+            stand_in = dataclasses.replace(make_part(), material=part.material, name=part.name, element=part.element)
             textures = _MeshTextures(self.ctx)
-            entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, lod, textures)], textures)
-        return entry[1], radius
+            entry = self._sphere_lods[(id(mesh), key)] = (mesh, [_GpuPart(self.ctx, stand_in, textures)], textures)
+        return entry[1][0]
 
     def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int],
                          view_projection: np.ndarray | None = None) -> np.ndarray | None:
@@ -509,9 +514,7 @@ class ForwardRenderer:
         model = impostor_proxy_model(camera.position, radius, projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size))
         if model is None:
             return None
-        polygon = impostor_proxy_polygon()[0].astype(np.float64)
-        polygon = np.hstack([polygon, np.ones((len(polygon), 1))])
-        clip = polygon @ model.T @ vp
+        clip = _PROXY_POINTS @ model.T @ vp
         if not (np.abs(clip[:, 2]) < 0.999 * clip[:, 3]).all():    # (w > 0 too)
             return None
         part = mesh.parts[0]
@@ -524,21 +527,14 @@ class ForwardRenderer:
 
     def _impostor_proxy(self, mesh) -> _GpuPart:
         """The impostor's proxy polygon (alight.core.sphere_lod.impostor_proxy_polygon), placed by
-        the model matrix of _sphere_impostor."""
-        for old in [k for k, e in self._sphere_lods.items() if e[0] is not mesh]:   # another mesh's
-            _release_mesh(self._sphere_lods.pop(old))
-        key = (id(mesh), "proxy")
-        entry = self._sphere_lods.get(key)
-        if entry is None:
+        the model matrix of _sphere_impostor; its normals, uvs and tangents are never read."""
+        def make_part() -> MeshPart:
             positions, indices = impostor_proxy_polygon()
             n = len(positions)
-            part = mesh.parts[0]
-            proxy = MeshPart(part.name, positions, np.tile(np.float32([0.0, 0.0, 1.0]), (n, 1)),
-                             np.zeros((n, 2), np.float32), np.tile(np.float32([1.0, 0.0, 0.0, 1.0]), (n, 1)),
-                             indices, part.material, element=part.element)
-            textures = _MeshTextures(self.ctx)
-            entry = self._sphere_lods[key] = (mesh, [_GpuPart(self.ctx, proxy, textures)], textures)
-        return entry[1][0]
+            return MeshPart("", positions, np.tile(np.float32([0.0, 0.0, 1.0]), (n, 1)), np.zeros((n, 2), np.float32),
+                            np.tile(np.float32([1.0, 0.0, 0.0, 1.0]), (n, 1)), indices, None)
+
+        return self._sphere_stand_in(mesh, "proxy", make_part)
 
     def _targets_for(self, width: int, height: int, aa: str, samples: int, half: bool = False) -> _Targets:
         t = self._targets
@@ -774,11 +770,13 @@ class ForwardRenderer:
         # the multisampled one (its mean already taken); never into a multisampled target.
         view_projection = camera.view_projection(aspect)
         self._impostor_model = self._sphere_impostor(scene, camera, (view.width, view.height), view_projection)
-        impostor = self._impostor_model is not None
-        self._scene_single = impostor and fbo is targets.draw and targets.aa == "msaa" and not background
-        if self._scene_single:
+        if targets.aa != "msaa":
+            self._impostor_samples = 1
+        elif self._impostor_model is not None and fbo is targets.draw and not background:
+            self._impostor_samples = 4
             fbo = targets.single()[1]
-        self._impostor_samples = 4 if self._scene_single else (1 if targets.aa != "msaa" else 0)
+        else:
+            self._impostor_samples = 0
         fbo.use()
         ctx.viewport = (0, 0, width, height)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
@@ -894,7 +892,6 @@ class ForwardRenderer:
         prog = self.program(vertex, fragment, {**(defines or {}), "DISPLAY_OUTPUT": None,
                                                "TONEMAP_MODE": TONEMAPS.index(display.tonemap)})
         _set(prog, "u_exposure_scale", float(2.0 ** display.exposure))
-        _set(prog, "u_tonemap", TONEMAPS.index(display.tonemap))
         return prog
 
     def _bind_ibl(self, program: moderngl.Program, scene: Scene, maps: IBLMaps | None) -> None:
@@ -1027,8 +1024,9 @@ class ForwardRenderer:
         radiance = radiance or not display
         mode = self._background_mode(scene, maps)
         # After the sphere's impostor the surfaces are in the single-sample stand-in, resolved already.
-        defines = {"BACKGROUND_MODE": mode, "SCENE_SAMPLES": 1 if self._scene_single else targets.samples}
-        scene_texture = targets.single()[0] if self._scene_single else targets.color
+        single = self._impostor_samples == 4
+        defines = {"BACKGROUND_MODE": mode, "SCENE_SAMPLES": 1 if single else targets.samples}
+        scene_texture = targets.single()[0] if single else targets.color
         if radiance:
             defines["RADIANCE_OUTPUT"] = None
         if display:
@@ -1057,7 +1055,6 @@ class ForwardRenderer:
                 scene_texture.use(UNIT_RADIANCE)
                 _set(prog, "u_scene", UNIT_RADIANCE)
                 _set(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
-                _set(prog, "u_tonemap", TONEMAPS.index(scene.display.tonemap))
                 _set(prog, "u_opaque", scene.display.background != "transparent")
                 self.ctx.scissor = scissor
                 self._fullscreen(prog)
@@ -1280,9 +1277,8 @@ class ForwardRenderer:
                     _set(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
                     _set(program, "u_camera_position", tuple(float(x) for x in camera.position))
                     _set(program, "u_sphere_radius", float(sphere_radius or 0.0))
-                    if proxy_model is not None:
-                        inverse_vp = np.linalg.inv(np.asarray(view_projection, np.float64)).astype(np.float32)
-                        _set(program, "u_inverse_view_projection", inverse_vp.tobytes(), write=True)
+                    if proxy_model is not None:   # (_draw_scene's inverse of this pass's view_projection)
+                        _set(program, "u_inverse_view_projection", self._last_inverse_vp.tobytes(), write=True)
                         _set(program, "u_viewport_size", tuple(float(x) for x in ctx.viewport[2:]))
                 material, maps_used = self._part_material(scene, part)
                 _set_material(program, material)
@@ -1368,7 +1364,6 @@ class ForwardRenderer:
                             {"TONEMAP_MODE": TONEMAPS.index(display.tonemap)})
         radiance.use(UNIT_RADIANCE)
         prog["u_exposure_scale"] = float(2.0 ** display.exposure)
-        _set(prog, "u_tonemap", TONEMAPS.index(display.tonemap))
         prog["u_opaque"] = opaque
         fbo.use()
         self.ctx.viewport = (0, 0) + fbo.size
@@ -1379,6 +1374,10 @@ class ForwardRenderer:
         if vao is None:
             vao = self._fullscreen_vaos[id(prog)] = self.ctx.vertex_array(prog, [])
         vao.render(moderngl.TRIANGLES, vertices=3)
+
+
+# The impostor's proxy polygon as homogeneous points (rows), for _sphere_impostor's clipping check.
+_PROXY_POINTS = np.hstack([impostor_proxy_polygon()[0], np.ones((len(impostor_proxy_polygon()[0]), 1))]).astype(np.float64)
 
 
 def _light_defines(scene: Scene) -> dict:

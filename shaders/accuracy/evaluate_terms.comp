@@ -32,6 +32,7 @@ const int TERM_CUBE_TEXEL_DIRECTION = 15;
 const int TERM_PUNCTUAL = 16;
 const int TERM_SPOT_RANGE = 17;
 const int TERM_SPHERE_SURFACE = 18;
+const int TERM_SPHERE_UV = 19;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -76,6 +77,8 @@ void main() {
         }
         // a = (facet point, the eye's distance on +z); the unit sphere.
         case TERM_SPHERE_SURFACE: o.xyz = sphere_surface_point(vec3(0.0, 0.0, a.w), a.xyz, 1.0); break;
+        // a = a point on the sphere; o = (its uv, its tangent's x and z).
+        case TERM_SPHERE_UV: o = vec4(sphere_uv(a.xyz), sphere_tangent(a.xyz).xz); break;
     }
     u_outputs[i] = o;
 }

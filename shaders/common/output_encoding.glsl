@@ -5,11 +5,10 @@
 #include "common/tonemapping.glsl"
 
 uniform float u_exposure_scale;  // 2^EV
-uniform int u_tonemap;
 
 vec4 encode_output(vec3 radiance, float alpha) {
 #ifdef DISPLAY_OUTPUT
-    return vec4(linear_to_srgb(tonemap(radiance * u_exposure_scale, u_tonemap)), 1.0);
+    return vec4(linear_to_srgb(tonemap(radiance * u_exposure_scale, TONEMAP_MODE)), 1.0);
 #elif defined(HALF_FLOAT_OUTPUT)
     // A half-float target (renderer.py HALF_FLOAT_MAX): its largest value, not +inf, where the
     // radiance exceeds it (the tone map has saturated long before: HALF_FLOAT_MIN_EXPOSURE).

@@ -41,12 +41,14 @@ vec3 tonemap_pbr_neutral(vec3 c) {
     return mix(c, vec3(new_peak), g);
 }
 
-// TONEMAP_MODE compiles one curve in (app/render/renderer.py sets it from the display): llvmpipe
-// runs both sides of a branch, so a uniform mode paid for both curves at every pixel.
-vec3 tonemap(vec3 c, int mode) {
-#ifdef TONEMAP_MODE
-    mode = TONEMAP_MODE;
+// The curve a pass applies is compiled in (app/render/renderer.py sets TONEMAP_MODE from the
+// display): llvmpipe runs both sides of a branch, so a uniform mode paid for both curves at
+// every pixel. (The default serves only programs compiled to check them, as the hot reload does.)
+#ifndef TONEMAP_MODE
+#define TONEMAP_MODE TONEMAP_ACES
 #endif
+
+vec3 tonemap(vec3 c, int mode) {
     if (mode == TONEMAP_ACES) return tonemap_aces_fitted(c);
     if (mode == TONEMAP_NEUTRAL) return tonemap_pbr_neutral(c);
     return clamp(c, 0.0, 1.0);

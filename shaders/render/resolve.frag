@@ -23,7 +23,6 @@ uniform sampler2D u_scene;
 uniform sampler2DMS u_scene;
 #endif
 uniform float u_exposure_scale;  // 2^EV
-uniform int u_tonemap;
 uniform bool u_opaque;           // false: keep the coverage as alpha (transparent background)
 
 #ifdef RADIANCE_OUTPUT
@@ -57,6 +56,6 @@ void main() {
     // As render/tonemap.frag: with a transparent background the radiance is premultiplied by
     // coverage and a PNG's alpha is straight (PNG specification 12.8), so divide before the curve.
     vec3 straight = u_opaque ? hdr.rgb : (hdr.a > 0.0 ? hdr.rgb / hdr.a : vec3(0.0));
-    out_display = vec4(linear_to_srgb(tonemap(straight * u_exposure_scale, u_tonemap)), u_opaque ? 1.0 : hdr.a);
+    out_display = vec4(linear_to_srgb(tonemap(straight * u_exposure_scale, TONEMAP_MODE)), u_opaque ? 1.0 : hdr.a);
 #endif
 }

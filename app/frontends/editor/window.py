@@ -67,6 +67,7 @@ class EditorWindow:
         glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
         glfw.window_hint(glfw.DEPTH_BITS, 24)   # moving views are drawn straight into the window (render_view)
         self.window = glfw.create_window(size[0], size[1], title, None, None)
+        self._size_cache: tuple[tuple[int, int], tuple[int, int]] | None = None   # _sizes
         if not self.window:
             glfw.terminate()
             raise AlightError("editor: cannot create an OpenGL 4.5 core window")
@@ -161,7 +162,7 @@ class EditorWindow:
     def _sizes(self) -> tuple[tuple[int, int], tuple[int, int]]:
         """(framebuffer size, window size), read once between polls: each is a round trip to the X
         server (0.06-0.09 ms under Xvfb here), and a frame asked for them up to seven times."""
-        if getattr(self, "_size_cache", None) is None:
+        if self._size_cache is None:
             self._size_cache = (tuple(self.glfw.get_framebuffer_size(self.window)),
                                 tuple(self.glfw.get_window_size(self.window)))
         return self._size_cache
@@ -353,21 +354,21 @@ class EditorWindow:
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
         into = self.ctx.screen if (moving and not full and size == window and self._screen_depth) else None
-        drawn_into = None
+        direct = False     # drawn into the window (the renderer may not: draw_display)
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
                 drawn_into = self.renderer.draw_display(scene, maps, targets, into=into)
+                direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
                 self.state.debug_view = 0
                 return None
-            direct = into is not None and drawn_into is into
             self._drawn_key, self._drawn_targets = (None, None) if direct else (key, targets)
             self.redraws += 1
             if scene.texture_maps != self._drawn_maps:   # uploaded maps no slot uses any more
                 self.renderer.forget_map_textures(set(scene.texture_maps.paths().values()))
                 self._drawn_maps = scene.texture_maps
-        if into is not None and drawn_into is into:
+        if direct:
             pass   # already in the window
         elif size == window:
             self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
