@@ -340,6 +340,51 @@ def test_adaptive_scale_follows_the_frame_time(window):
     s.adaptive_motion = False
 
 
+def test_orbiting_frame_in_the_window_matches_the_still_view(window):
+    """While the camera moves, a full-size frame is drawn straight into the window and the
+    window's write stage applies the sRGB curve (ForwardRenderer.draw_display into_encodes_srgb);
+    the still frame is drawn into the view image by the shaders' exact curve and copied. The two
+    pictures of one camera differ by at most 1 LSB (llvmpipe's encoder is a polynomial), and not
+    on most values."""
+    s = window.state
+    s.motion_scale, s.adaptive_motion = 1.0, False
+    into, encodes_srgb = window.direct_target()
+    assert into is not None and encodes_srgb, "Xvfb's llvmpipe window should have depth and sRGB: the path is untested"
+    w, h = window.view_area()
+
+    def view_pixels() -> np.ndarray:
+        return np.frombuffer(window.ctx.screen.read(viewport=(0, 0, w, h), components=3), np.uint8)\
+            .reshape(h, w, 3).astype(int)
+
+    window.frame()
+    window.orbit.orbit(7.0, 3.0)
+    drawn = window.redraws
+    window.draw()                                       # moving: into the window, sRGB by the window
+    assert window.redraws == drawn + 1 and window._drawn_key is None   # drawn direct, not kept
+    moving = view_pixels()
+    window.glfw.swap_buffers(window.window)
+    window.draw()                                       # still: the view image, copied
+    still = view_pixels()
+    window.glfw.swap_buffers(window.window)
+    difference = np.abs(moving - still)
+    assert difference.max() <= 1, difference.max()
+    assert (difference > 0).mean() < 0.35, (difference > 0).mean()
+    assert 20.0 < still.mean() < 235.0                  # a picture, not a cleared window
+    # Off (a window without sRGB), the shaders encode: the same bytes as the still view.
+    window._screen_srgb = False
+    try:
+        window.orbit.orbit(-7.0, -3.0)
+        window.draw()
+        window.glfw.swap_buffers(window.window)
+        window.orbit.orbit(7.0, 3.0)
+        window.draw()
+        assert np.abs(view_pixels() - still).max() <= 1
+        window.glfw.swap_buffers(window.window)
+    finally:
+        window._screen_srgb = True
+        window.frame()
+
+
 def test_built_in_file_browser(window, tmp_path):
     """Where no native dialog exists the panel's browser is an imgui window: it lists folders
     and the files of the asked types, and a pick goes to the caller (here: the texture slot)."""

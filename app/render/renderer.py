@@ -82,6 +82,7 @@ from alight.render.tiles import (
 )
 
 GL_SRGB8_ALPHA8 = 0x8C43
+GL_FRAMEBUFFER_SRGB = 0x8DB9
 AA_MODES = ("none", "msaa", "ssaa")
 MAX_LIGHTS = 16   # punctual.glsl's MAX_LIGHTS
 MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2 levels - 1)
@@ -394,6 +395,7 @@ class ForwardRenderer:
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
         self._units_assigned: set[int] = set()
         self._display_output: Display | None = None   # set while draw_display runs
+        self._srgb_by_framebuffer = False   # set while draw_display writes into a framebuffer that encodes sRGB
         self._half_output = False     # set while a scene pass draws into half floats (_Targets.half)
         # User-loaded texture maps (Scene.texture_maps): (path, sRGB) -> (image, texture),
         # uploaded once per decoded image.
@@ -734,7 +736,7 @@ class ForwardRenderer:
         self._draw_scene(scene, maps, targets, targets.draw)
 
     def draw_display(self, scene: Scene, maps: IBLMaps | None, targets: _Targets,
-                     into: moderngl.Framebuffer | None = None) -> moderngl.Framebuffer:
+                     into: moderngl.Framebuffer | None = None, into_encodes_srgb: bool = False) -> moderngl.Framebuffer:
         """What ``draw_hdr`` then ``tonemap`` (opaque) leave in ``targets.display``, in one pass:
         the scene's programs tone map as they write (common/output_encoding.glsl), so neither the
         float image nor the tone map pass is needed (the editor's view). Without anti-aliasing
@@ -743,14 +745,31 @@ class ForwardRenderer:
         ``into``: a framebuffer with a depth buffer (the editor's window) to draw the one pass
         into instead of ``targets.display``, at its bottom-left, targets' size. Returns the
         framebuffer that holds the picture: ``into`` where the one pass could be used, else
-        ``targets.display_fbo``."""
+        ``targets.display_fbo``.
+
+        ``into_encodes_srgb``: ``into`` is sRGB-capable (EditorWindow probes its window), so the
+        passes write tone-mapped linear values with GL_FRAMEBUFFER_SRGB on and the framebuffer's
+        write stage applies the sRGB curve (GL 4.5 section 17.3.7). A GPU does that for free;
+        llvmpipe's encoder is a polynomial, 2.1 ms cheaper than the shader's pow() on a
+        860x720 frame, within 1 LSB of the exact curve (7% of values 1 LSB off;
+        tests/test_editor.py bounds it). Not with parts that blend: GL would blend them in
+        linear space, the shader-encoded path blends sRGB values."""
         if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
             # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
             self.draw_hdr(scene, maps, targets)
             self.tonemap(targets.radiance, scene.display, targets.display_fbo)
             return targets.display_fbo
         fbo = into or targets.display_draw()
-        self._draw_scene(scene, maps, targets, fbo, scene.display)
+        srgb = into is not None and into_encodes_srgb and not self._has_blending_parts(scene)
+        if srgb:
+            self.ctx.enable_direct(GL_FRAMEBUFFER_SRGB)
+        self._srgb_by_framebuffer = srgb
+        try:
+            self._draw_scene(scene, maps, targets, fbo, scene.display)
+        finally:
+            if srgb:
+                self.ctx.disable_direct(GL_FRAMEBUFFER_SRGB)
+            self._srgb_by_framebuffer = False
         return into or targets.display_fbo
 
     def _draw_scene(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, fbo: moderngl.Framebuffer,
@@ -889,8 +908,10 @@ class ForwardRenderer:
             if self._half_output:
                 defines = {**(defines or {}), "HALF_FLOAT_OUTPUT": None}
             return self.program(vertex, fragment, defines)
-        prog = self.program(vertex, fragment, {**(defines or {}), "DISPLAY_OUTPUT": None,
-                                               "TONEMAP_MODE": TONEMAPS.index(display.tonemap)})
+        defines = {**(defines or {}), "DISPLAY_OUTPUT": None, "TONEMAP_MODE": TONEMAPS.index(display.tonemap)}
+        if self._srgb_by_framebuffer:
+            defines["SRGB_BY_FRAMEBUFFER"] = None
+        prog = self.program(vertex, fragment, defines)
         _set(prog, "u_exposure_scale", float(2.0 ** display.exposure))
         return prog
 

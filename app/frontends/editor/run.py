@@ -155,7 +155,8 @@ def _profile(win, frames: int) -> dict[str, float]:
         scene = win.state.scene(win.orbit.camera())
         # As an orbiting frame is drawn (EditorWindow.render_view): straight into the window
         # where it has a depth buffer, else into the view image and then copied.
-        drawn = r.draw_display(scene, win.maps(), targets, into=ctx.screen if win._screen_depth else None)
+        into, into_srgb = win.direct_target()
+        drawn = r.draw_display(scene, win.maps(), targets, into=into, into_encodes_srgb=into_srgb)
         ctx.finish()
         t2 = time.perf_counter()
         if drawn is not ctx.screen:

@@ -66,6 +66,7 @@ class EditorWindow:
         glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
         glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
         glfw.window_hint(glfw.DEPTH_BITS, 24)   # moving views are drawn straight into the window (render_view)
+        glfw.window_hint(glfw.SRGB_CAPABLE, True)   # ... and sRGB-encoded by it (_screen_encodes_srgb)
         self.window = glfw.create_window(size[0], size[1], title, None, None)
         self._size_cache: tuple[tuple[int, int], tuple[int, int]] | None = None   # _sizes
         if not self.window:
@@ -77,6 +78,7 @@ class EditorWindow:
         self.renderer = ForwardRenderer(self.ctx)
         # Whether the window has the depth buffer a scene pass needs (render_view draws into it).
         self._screen_depth = self._depth_bits() >= 16
+        self._screen_srgb = self._screen_depth and self._screen_encodes_srgb()
 
         imgui.create_context()
         implot.create_context()
@@ -153,6 +155,33 @@ class EditorWindow:
             return int((self.ctx.screen.bits or {}).get("depth", 0))
         except Exception:   # a GL that cannot say: draw into the view image, then copy
             return 0
+
+    def _screen_encodes_srgb(self) -> bool:
+        """Whether the window applies the sRGB curve to what is written with GL_FRAMEBUFFER_SRGB
+        on: tried, not asked (the GL's answer for a default framebuffer varies by platform). One
+        pixel of the back buffer, which the first frame overwrites, is cleared to 0.5: 188 back is
+        sRGB-encoded (llvmpipe: 187), 128 is not."""
+        from alight.render.renderer import GL_FRAMEBUFFER_SRGB
+
+        screen = self.ctx.screen
+        try:
+            screen.use()
+            self.ctx.enable_direct(GL_FRAMEBUFFER_SRGB)
+            self.ctx.scissor = (0, 0, 1, 1)
+            screen.clear(0.5, 0.5, 0.5, 1.0)
+            value = screen.read(viewport=(0, 0, 1, 1), components=4)[0]
+        except Exception:   # a GL that cannot: the shaders encode, as everywhere else
+            return False
+        finally:
+            self.ctx.scissor = None
+            self.ctx.disable_direct(GL_FRAMEBUFFER_SRGB)
+        return value > 160
+
+    def direct_target(self) -> tuple[moderngl.Framebuffer | None, bool]:
+        """Where an orbiting frame at the view's full size is drawn: (the window, whether it
+        encodes sRGB itself), or (None, False) where the window has no depth buffer (then into the
+        view image, and copied)."""
+        return (self.ctx.screen, self._screen_srgb) if self._screen_depth else (None, False)
 
     def poll_events(self) -> None:
         """GLFW's events; the window's sizes are read again after them (_sizes)."""
@@ -353,11 +382,11 @@ class EditorWindow:
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
-        into = self.ctx.screen if (moving and not full and size == window and self._screen_depth) else None
+        into, into_srgb = self.direct_target() if (moving and not full and size == window) else (None, False)
         direct = False     # drawn into the window (the renderer may not: draw_display)
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
-                drawn_into = self.renderer.draw_display(scene, maps, targets, into=into)
+                drawn_into = self.renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
                 direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
