@@ -21,6 +21,8 @@ from alight.core.scene import Camera, Scene, frame_camera, orbit_camera
 from alight.core.sphere_lod import (
     MAX_SILHOUETTE_ERROR_PX,
     SPHERE_LOD_SEGMENTS,
+    impostor_background_ring,
+    impostor_hole_model,
     projected_radius_px,
     silhouette_error,
     sphere_segments,
@@ -292,6 +294,90 @@ def test_tiles_draw_the_impostor_as_the_whole_image(shared_data):
     assert r.last_sphere_impostor == 4
     np.testing.assert_array_equal(tiled.linear[..., 3], whole.linear[..., 3])
     assert _rel(tiled.linear, whole.linear) < 1e-5
+
+
+RING_CAMERAS = {
+    "default": Camera(),
+    "orbit": Camera(position=(1.5, 0.7, 2.2)),
+    "from above": Camera(position=(0.0, 3.9, 0.3)),
+    "close, off centre": Camera(position=(0.3, 0.2, 1.3), target=(0.6, 0.1, 0.0), near=0.05, fov_y_deg=60.0),
+}
+
+
+@pytest.mark.parametrize("name", list(RING_CAMERAS))
+def test_the_background_ring_covers_the_view_once_but_a_hole_the_sphere_fills(name):
+    """impostor_background_ring's triangles, at 200 x 200 points over the NDC square: each point
+    lies in at most one triangle, and a point in none is one whose ray meets the sphere (the
+    impostor draws it). Counter-clockwise, as every pass's triangles."""
+    camera = RING_CAMERAS[name]
+    size = (860, 720)
+    vp = camera.view_projection(size[0] / size[1]).astype(np.float64)
+    radius_px = projected_radius_px(vp, (0.0, 0.0, 0.0), 1.0, size)
+    triangles = impostor_background_ring(impostor_hole_model(camera.position, 1.0, radius_px), vp)
+    assert triangles is not None and triangles.shape == (6 * 16, 2)
+    tri = triangles.astype(np.float64).reshape(-1, 3, 2)
+    edge_a, edge_b = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    assert (edge_a[:, 0] * edge_b[:, 1] - edge_a[:, 1] * edge_b[:, 0] > 0).all()
+    g = np.linspace(-0.9975, 0.9975, 200)
+    points = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    count = np.zeros(len(points), int)
+    for t in tri:
+        sides = np.stack([(t[(i + 1) % 3, 0] - t[i, 0]) * (points[:, 1] - t[i, 1])
+                          - (t[(i + 1) % 3, 1] - t[i, 1]) * (points[:, 0] - t[i, 0]) for i in range(3)], axis=1)
+        count += (sides > 0).all(axis=1)
+    assert count.max() == 1
+    far = np.hstack([points, np.ones((len(points), 2))]) @ np.linalg.inv(vp)
+    hit = ray_meets_sphere(camera.position, far[:, :3] / far[:, 3:] - np.asarray(camera.position), 1.0)
+    hole = count == 0
+    assert hole.sum() > 100 and hit[hole].all()
+    assert hole.sum() > 0.9 * hit.sum()                # the hole is most of the sphere
+
+
+@pytest.mark.parametrize("aa", ["none", "ssaa"])
+@pytest.mark.parametrize("name", ["default", "close, off centre"])
+def test_the_background_around_the_impostor_is_the_depth_tested_one(shared_data, aa, name):
+    """With one sample a pixel the background is drawn first around the impostor's hole, without
+    a depth buffer (ForwardRenderer.background_ring); against the depth-tested background after
+    it: the same radiance and coverage, and the same display bytes but for float rounding of the
+    rays (at most 1 LSB on a few pixels)."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    scene = Scene(mesh=sphere(), material=dataclasses.replace(load_preset("gold"), roughness=0.3),
+                  camera=RING_CAMERAS[name])
+    frames = {}
+    for ring in (True, False):
+        r.background_ring = ring
+        try:
+            frames[ring] = r.render(scene, maps, 240, 180, aa=aa, read_linear=True, read_srgb=True)
+        finally:
+            r.background_ring = True
+        assert r.last_sphere_impostor == 1 and r.last_background_ring == ring
+    ring, depth = frames[True], frames[False]
+    assert 0.05 < (depth.linear[..., 3] > 0).mean() < 0.95           # ball and background both in view
+    np.testing.assert_array_equal(ring.linear[..., 3], depth.linear[..., 3])
+    # The rays interpolate over other triangles: float rounding moves the texel weights (2e-6 here).
+    assert _rel(ring.linear, depth.linear) < 1e-5
+    inside = _inside(ring.linear[..., 3], depth.linear[..., 3])
+    np.testing.assert_array_equal(ring.linear[inside], depth.linear[inside])   # the ball: the same pass
+    difference = np.abs(ring.srgb.astype(int) - depth.srgb.astype(int))
+    assert difference.max() <= 1 and (difference > 0).mean() < 1e-3
+
+
+def test_the_background_ring_is_not_used_where_the_depth_is_needed(shared_data):
+    """A transparent background (nothing drawn around the hole), 4x MSAA (the fused resolve
+    composites the background) and a transmissive ball (the scene behind it is read before the
+    background) keep the depth-tested path."""
+    r = renderer()
+    maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    base = Scene(mesh=sphere(), material=load_preset("gold"))
+    r.render(base, maps, 64, 48, aa="none")
+    assert r.last_background_ring
+    from alight.core.scene import Display
+    for scene, aa in ((dataclasses.replace(base, display=Display(background="transparent")), "none"), (base, "msaa"),
+                      (dataclasses.replace(base, material=dataclasses.replace(load_preset("gold"), metallic=0.0,
+                                                                              transmission=1.0)), "none")):
+        r.render(scene, maps, 64, 48, aa=aa)
+        assert not r.last_background_ring
 
 
 def _checker_maps(n: int = 128):

@@ -114,19 +114,13 @@ def impostor_proxy_polygon(sides: int = IMPOSTOR_PROXY_SIDES) -> tuple[np.ndarra
     return positions, indices
 
 
-def impostor_proxy_model(eye, radius: float, radius_px: float, sides: int = IMPOSTOR_PROXY_SIDES,
-                         margin_px: float = IMPOSTOR_MARGIN_PX) -> np.ndarray | None:
-    """The (4, 4) float64 matrix (column vectors: ``world = M @ (p, 1)``) that places
-    ``impostor_proxy_polygon`` around the outline of the sphere ``|x| = radius`` seen from
-    ``eye`` (3,): in the plane of the circle where the view rays touch the sphere (its centre
-    ``a r^2 / d`` along the unit axis a toward the eye, its radius ``r sqrt(1 - r^2 / d^2)``),
-    facing the eye, scaled so the polygon's edges clear the circle by ``margin_px`` of the
-    outline's ``radius_px`` (``projected_radius_px``). The rays through the polygon are then a
-    cone around the sphere's outline. None where the eye is not outside the sphere or
-    ``radius_px`` is not finite and positive."""
+def _outline_frame(eye, radius: float):
+    """The sphere's outline seen from ``eye``: (x, y, axis, centre, circle): the unit vectors
+    spanning the plane of the circle where the view rays touch the sphere, its normal toward the
+    eye, the circle's centre and radius. None where the eye is not outside the sphere."""
     ex, ey, ez = (float(c) for c in eye)
     d = math.sqrt(ex * ex + ey * ey + ez * ez)
-    if not (math.isfinite(radius_px) and radius_px > 0.0) or d <= radius * 1.0000001:
+    if d <= radius * 1.0000001:
         return None
     # (Per frame, in Python: scalar arithmetic, not numpy's small-array calls.)
     ax, ay, az = ex / d, ey / d, ez / d
@@ -138,12 +132,74 @@ def impostor_proxy_model(eye, radius: float, radius_px: float, sides: int = IMPO
     x = np.array(x) / n
     axis = np.array([ax, ay, az])
     y = np.array([ay * x[2] - az * x[1], az * x[0] - ax * x[2], ax * x[1] - ay * x[0]])    # cross(axis, x)
-    circle = radius * math.sqrt(1.0 - (radius / d) ** 2)
-    scale = circle * (1.0 + margin_px / radius_px) / math.cos(math.pi / sides)
+    return x, y, axis, axis * radius * radius / d, radius * math.sqrt(1.0 - (radius / d) ** 2)
+
+
+def _polygon_model(frame, scale: float) -> np.ndarray:
+    x, y, axis, centre, _ = frame
     model = np.eye(4)
     model[:3, 0], model[:3, 1], model[:3, 2] = x * scale, y * scale, axis
-    model[:3, 3] = axis * radius * radius / d
+    model[:3, 3] = centre
     return model
+
+
+def impostor_proxy_model(eye, radius: float, radius_px: float, sides: int = IMPOSTOR_PROXY_SIDES,
+                         margin_px: float = IMPOSTOR_MARGIN_PX) -> np.ndarray | None:
+    """The (4, 4) float64 matrix (column vectors: ``world = M @ (p, 1)``) that places
+    ``impostor_proxy_polygon`` around the outline of the sphere ``|x| = radius`` seen from
+    ``eye`` (3,): in the plane of the circle where the view rays touch the sphere (its centre
+    ``a r^2 / d`` along the unit axis a toward the eye, its radius ``r sqrt(1 - r^2 / d^2)``),
+    facing the eye, scaled so the polygon's edges clear the circle by ``margin_px`` of the
+    outline's ``radius_px`` (``projected_radius_px``). The rays through the polygon are then a
+    cone around the sphere's outline. None where the eye is not outside the sphere or
+    ``radius_px`` is not finite and positive."""
+    if not (math.isfinite(radius_px) and radius_px > 0.0):
+        return None
+    frame = _outline_frame(eye, radius)
+    if frame is None:
+        return None
+    return _polygon_model(frame, frame[4] * (1.0 + margin_px / radius_px) / math.cos(math.pi / sides))
+
+
+def impostor_hole_model(eye, radius: float, radius_px: float, inset_px: float = 1.0) -> np.ndarray | None:
+    """As ``impostor_proxy_model``, but for the polygon inscribed in the outline circle, its
+    vertices ``inset_px`` of ``radius_px`` inside it: every ray through it meets the sphere, so
+    where the impostor is drawn over the background no background pixel lies inside it
+    (``impostor_background_ring``). None as ``impostor_proxy_model``, or where the outline is
+    within ``inset_px`` of a point."""
+    if not (math.isfinite(radius_px) and radius_px > inset_px):
+        return None
+    frame = _outline_frame(eye, radius)
+    if frame is None:
+        return None
+    return _polygon_model(frame, frame[4] * (1.0 - inset_px / radius_px))
+
+
+def impostor_background_ring(hole_model: np.ndarray, view_projection: np.ndarray,
+                             sides: int = IMPOSTOR_PROXY_SIDES) -> np.ndarray | None:
+    """Triangles covering the whole viewport but the polygon ``hole_model`` places
+    (``impostor_hole_model``): (6 sides, 2) float32 NDC points, three per triangle,
+    counter-clockwise. Each of the polygon's edges is joined to a far polygon along the rays from
+    the polygon's projected centroid through its vertices, far enough out to enclose the NDC
+    square, so neighbouring triangles share their edges exactly (no pixel twice, none missed:
+    OpenGL 4.5 section 14.6.1). ``view_projection``: (4, 4) row-vector matrix (``clip = p @ vp``).
+    None where a vertex is not in front of the eye."""
+    points = impostor_proxy_polygon(sides)[0][1:]
+    clip = np.hstack([points, np.ones((sides, 1))]) @ hole_model.T @ np.asarray(view_projection, np.float64)
+    if not (clip[:, 3] > 1e-9).all():
+        return None
+    inner = clip[:, :2] / clip[:, 3:]
+    centre = inner.mean(axis=0)
+    spoke = inner - centre
+    length = np.sqrt(np.sum(spoke * spoke, axis=1, keepdims=True))
+    if not (length > 0.0).all():
+        return None
+    # The far polygon's edges lie at least R cos(gap / 2) from the centre; a projected regular
+    # polygon's angular gaps stay well under 90 degrees, so R = 4 (|c| + 2) encloses the square.
+    outer = centre + spoke / length * (4.0 * (float(np.hypot(*centre)) + 2.0))
+    nxt = np.roll(np.arange(sides), -1)
+    triangles = np.stack([inner, outer[nxt], inner[nxt], inner, outer, outer[nxt]], axis=1)
+    return triangles.reshape(-1, 2).astype(np.float32)
 
 
 def ray_meets_sphere(eye, directions, radius: float) -> np.ndarray:

@@ -49,6 +49,8 @@ from alight.core.shading import rotate_world_to_map
 from alight.core.sphere_lod import (
     MAX_SILHOUETTE_ERROR_PX,
     SPHERE_LOD_SEGMENTS,
+    impostor_background_ring,
+    impostor_hole_model,
     impostor_proxy_model,
     impostor_proxy_polygon,
     projected_radius_px,
@@ -384,6 +386,10 @@ class ForwardRenderer:
         # The built-in sphere drawn as an impostor where it can be (_sphere_impostor); False draws
         # its tessellation in every pass (the tests compare the two).
         self.sphere_impostor = True
+        # With the impostor and one sample a pixel, the background drawn around a hole the impostor
+        # fills, without a depth buffer (_draw_scene); False: depth-tested after it (tests compare).
+        self.background_ring = True
+        self.last_background_ring = False   # whether the last scene pass drew it
         self.last_sphere_impostor: int | None = None   # the last mesh pass's coverage samples, or None
         # Set by _draw_scene: 1, 4 (into the fused resolve's single-sample stand-in, _Targets.single,
         # which _resolve then reads), 0 (none: a multisampled target).
@@ -392,10 +398,11 @@ class ForwardRenderer:
         self._targets: _Targets | None = None
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
-        self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
+        self._fullscreen_vaos: dict = {}   # by program id (and 'ring': _draw_background)
         self._units_assigned: set[int] = set()
         self._display_output: Display | None = None   # set while draw_display runs
         self._srgb_by_framebuffer = False   # set while draw_display writes into a framebuffer that encodes sRGB
+        self._ring_buffer: moderngl.Buffer | None = None   # the background's ring (_draw_background)
         self._half_output = False     # set while a scene pass draws into half floats (_Targets.half)
         # User-loaded texture maps (Scene.texture_maps): (path, sRGB) -> (image, texture),
         # uploaded once per decoded image.
@@ -490,9 +497,9 @@ class ForwardRenderer:
         return entry[1][0]
 
     def _sphere_impostor(self, scene: Scene, camera: Camera, image_size: tuple[int, int],
-                         view_projection: np.ndarray | None = None) -> np.ndarray | None:
+                         view_projection: np.ndarray | None = None) -> tuple[np.ndarray, float] | None:
         """Where the built-in sphere is drawn as an impostor, the (4, 4) matrix that places its
-        proxy (column vectors); else None.
+        proxy (column vectors) and the outline's radius in pixels; else None.
 
         The proxy is a 16-sided polygon facing the eye around the sphere's outline with 2 px to
         spare (alight.core.sphere_lod.impostor_proxy_model): few, large triangles. Each of its
@@ -513,7 +520,8 @@ class ForwardRenderer:
         if view_projection is None:
             view_projection = camera.view_projection(image_size[0] / image_size[1])
         vp = np.asarray(view_projection, np.float64)
-        model = impostor_proxy_model(camera.position, radius, projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size))
+        radius_px = projected_radius_px(vp, (0.0, 0.0, 0.0), radius, image_size)
+        model = impostor_proxy_model(camera.position, radius, radius_px)
         if model is None:
             return None
         clip = _PROXY_POINTS @ model.T @ vp
@@ -525,7 +533,7 @@ class ForwardRenderer:
             return None
         if any(defines.get(k) for k in ("MAP_UV1_MASK", "MAP_TRANSFORM_MASK", "MAP_MIRROR_S_MASK", "MAP_MIRROR_T_MASK")):
             return None
-        return model
+        return model, radius_px
 
     def _impostor_proxy(self, mesh) -> _GpuPart:
         """The impostor's proxy polygon (alight.core.sphere_lod.impostor_proxy_polygon), placed by
@@ -608,6 +616,12 @@ class ForwardRenderer:
             self._stretched_lobe = None
         if self._transmission_lut is not None:
             self._transmission_lut.release()
+        for vao in self._fullscreen_vaos.values():
+            vao.release()
+        self._fullscreen_vaos.clear()
+        if self._ring_buffer is not None:
+            self._ring_buffer.release()
+            self._ring_buffer = None
         self.shaders.reload()
 
     def transmission_lut(self) -> moderngl.Texture:
@@ -788,7 +802,8 @@ class ForwardRenderer:
         # into a single-sample target, with 4 into the fused resolve's single-sample stand-in for
         # the multisampled one (its mean already taken); never into a multisampled target.
         view_projection = camera.view_projection(aspect)
-        self._impostor_model = self._sphere_impostor(scene, camera, (view.width, view.height), view_projection)
+        impostor = self._sphere_impostor(scene, camera, (view.width, view.height), view_projection)
+        self._impostor_model = impostor[0] if impostor else None
         if targets.aa != "msaa":
             self._impostor_samples = 1
         elif self._impostor_model is not None and fbo is targets.draw and not background:
@@ -803,14 +818,33 @@ class ForwardRenderer:
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
         self._last_inverse_vp = inverse_vp    # the resolve's background rays (this frame or tile)
         self._last_surface_rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
+        ring = None
+        if self.background_ring and impostor and self._impostor_samples == 1 and background \
+                and self._background_mode(scene, maps) != 3 \
+                and not self.transmissive_parts(scene):
+            hole = impostor_hole_model(camera.position, scene.mesh.lod_sphere[0], impostor[1])
+            ring = impostor_background_ring(hole, view_projection) if hole is not None else None
         # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag),
         # and transmissive parts read the opaque parts' coverage from it. The whole framebuffer:
         # llvmpipe clears whole tiles lazily, and a scissored clear (the mesh's rectangle only)
         # made a 1920x1080 4x frame 7-9% slower here, alternated in one process.
+        self.last_background_ring = ring is not None
+        # With the background's ring no depth is read or written (colour only).
+        fbo.depth_mask = ring is None
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        fbo.depth_mask = True
         self._write_lights(scene)
-        ctx.enable(moderngl.DEPTH_TEST)
-        ctx.depth_func = "<="
+        if ring is not None:
+            # The one sphere's impostor with one sample a pixel: the background first, around a
+            # hole inside the sphere's outline (sphere_lod.impostor_background_ring), then the
+            # impostor over it. Every pixel is written once or, in the thin band between the hole
+            # and the outline, twice, and no depth buffer is cleared, tested or written: 2 ms of a
+            # 860x720 frame on llvmpipe (benchmarks/bench_impostor.py).
+            ctx.disable(moderngl.DEPTH_TEST)
+            self._draw_background(scene, maps, inverse_vp, ring)
+        else:
+            ctx.enable(moderngl.DEPTH_TEST)
+            ctx.depth_func = "<="
         if scene.view == "probe":
             self._draw_probe(scene, maps, view.width * scale, (view.origin[0] * scale, view.origin[1] * scale))
         elif scene.mesh is not None:
@@ -818,7 +852,7 @@ class ForwardRenderer:
                             pixels_per_radian=view.height * scale / 2.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0),
                             image_size=(view.width, view.height))
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
-        if background:
+        if background and ring is None:
             self._draw_background(scene, maps, inverse_vp)
             # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
             # (The fused MSAA resolve, background=False, is used only for scenes with none.)
@@ -1031,13 +1065,28 @@ class ForwardRenderer:
             _set(prog, "u_env_rotation", _rotation_cos_sin(scene.env_rotation_deg))
             _set(prog, "u_env_intensity", float(scene.env_intensity))
 
-    def _draw_background(self, scene: Scene, maps: IBLMaps | None, inverse_vp: np.ndarray) -> None:
+    def _draw_background(self, scene: Scene, maps: IBLMaps | None, inverse_vp: np.ndarray,
+                         ring: np.ndarray | None = None) -> None:
+        """The background pass: a full-screen triangle, or ``ring``'s triangles ((n, 2) NDC
+        points, sphere_lod.impostor_background_ring) where the impostor fills the rest."""
         mode = self._background_mode(scene, maps)
         if mode == 3:
             return
-        prog = self._scene_program("render/background.vert", "render/background.frag", {"BACKGROUND_MODE": mode})
+        defines = {"BACKGROUND_MODE": mode}
+        if ring is not None:
+            defines["BACKGROUND_RING"] = None
+        prog = self._scene_program("render/background.vert", "render/background.frag", defines)
         self._bind_background(prog, scene, maps, inverse_vp, mode)
-        self._fullscreen(prog)
+        if ring is None:
+            self._fullscreen(prog)
+            return
+        if self._ring_buffer is None:
+            self._ring_buffer = self.ctx.buffer(reserve=ring.nbytes)
+        self._ring_buffer.write(ring.tobytes())
+        vao = self._fullscreen_vaos.get((id(prog), "ring"))
+        if vao is None:
+            vao = self._fullscreen_vaos[(id(prog), "ring")] = self.ctx.vertex_array(prog, [(self._ring_buffer, "2f", "in_ndc")])
+        vao.render(moderngl.TRIANGLES, vertices=len(ring))
 
     def _resolve(self, scene: Scene, maps: IBLMaps | None, targets: _Targets, radiance: bool, display: bool) -> None:
         """render/resolve.frag: the multisampled surfaces resolved, the background under them, into
