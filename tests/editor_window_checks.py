@@ -385,6 +385,31 @@ def test_orbiting_frame_in_the_window_matches_the_still_view(window):
         window.frame()
 
 
+def test_native_imgui_renderer_draws_what_the_python_one_draws(window):
+    """The panel is drawn by Dear ImGui's C++ OpenGL 3 renderer (imgui-bundle's), where it starts;
+    imgui-bundle's Python renderer, the fallback, draws the same window bytes from the same
+    draw data."""
+    assert window._native_imgui, "the C++ renderer should start on llvmpipe's GL"
+    w, h = window.size
+
+    def window_pixels() -> np.ndarray:
+        return np.frombuffer(window.ctx.screen.read(components=3), np.uint8).reshape(h, w, 3).copy()
+
+    window.frame()
+    window.draw()
+    native = window_pixels()
+    window._native_imgui = False
+    try:
+        window.draw()
+        python = window_pixels()
+    finally:
+        window._native_imgui = True
+    window.glfw.swap_buffers(window.window)
+    panel = slice(w - round(window.panel_width() * w / window.glfw.get_window_size(window.window)[0]), w)
+    assert native[:, panel].std() > 5.0                 # the panel is there
+    np.testing.assert_array_equal(native, python)
+
+
 def test_built_in_file_browser(window, tmp_path):
     """Where no native dialog exists the panel's browser is an imgui window: it lists folders
     and the files of the asked types, and a pick goes to the caller (here: the texture slot)."""

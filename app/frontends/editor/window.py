@@ -5,12 +5,13 @@ scene with the ForwardRenderer, tone mapped as it is drawn (ForwardRenderer.draw
 view image the size of the area left of the panel, and only when something it depends on
 changed; copy that into the default framebuffer, draw imgui on top, swap. The ForwardRenderer never sees imgui; the panel never sees GL.
 
-imgui backend: imgui-bundle's own pure-python GLFW backend (python_backends.glfw_backend). It
-draws with PyOpenGL on the same context ModernGL uses (GL state is the context's, not the
-library's, and the backend saves and restores the state it touches). We chose it over drawing
-imgui's draw lists with ModernGL ourselves because imgui 1.92's dynamic font atlas protocol
-(ImTextureData create/update/destroy requests) is already handled there; redoing it would be
-a second, untested copy of the same code.
+imgui backends: input from imgui-bundle's pure-python GLFW backend (python_backends.glfw_backend,
+on the pyGLFW window we own); drawing by Dear ImGui's own OpenGL 3 renderer, the C++ one that
+imgui-bundle ships (imgui.backends.opengl3_*), on the same context ModernGL uses. Both save and
+restore the GL state they touch. The C++ renderer draws the same bytes as the Python one (checked
+side by side) and spends none of the Python one's ~2 ms a frame in PyOpenGL calls; where it
+cannot start (its GL loader finds no libGL) the Python renderer draws. Either handles imgui
+1.92's dynamic font atlas (ImTextureData requests): we do not write a third copy of that code.
 """
 
 from __future__ import annotations
@@ -85,7 +86,8 @@ class EditorWindow:
         # imgui's window layout lives in the user's config folder, never the working directory;
         # screenshots and benchmarks keep none, so they never depend on the last session.
         imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
-        self.impl = GlfwRenderer(self.window)
+        self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
+        self._native_imgui = self._start_native_imgui(imgui)
         glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
 
         self.state = state
@@ -155,6 +157,14 @@ class EditorWindow:
             return int((self.ctx.screen.bits or {}).get("depth", 0))
         except Exception:   # a GL that cannot say: draw into the view image, then copy
             return 0
+
+    @staticmethod
+    def _start_native_imgui(imgui) -> bool:
+        """Dear ImGui's C++ OpenGL 3 renderer (imgui-bundle's build), if it starts here."""
+        try:
+            return bool(imgui.backends.opengl3_init("#version 450"))
+        except Exception:   # no loader for this GL: the Python renderer draws
+            return False
 
     def _screen_encodes_srgb(self) -> bool:
         """Whether the window applies the sRGB curve to what is written with GL_FRAMEBUFFER_SRGB
@@ -435,8 +445,7 @@ class EditorWindow:
         ``frame`` swaps it; tools can read the whole window first."""
         glfw, imgui = self.glfw, self.imgui
         self.poll_events()
-        self.impl.process_inputs()
-        imgui.new_frame()
+        self.begin_imgui_frame()
         if self.show_panel:
             self.panel.draw(self)
         self._camera_input()
@@ -447,7 +456,21 @@ class EditorWindow:
         self.render_view()
         self.advance_bake()
         if self.show_panel:
-            self.impl.render(imgui.get_draw_data())
+            self.render_imgui()
+
+    def begin_imgui_frame(self) -> None:
+        """imgui's input and new frame (after poll_events)."""
+        self.impl.process_inputs()
+        if self._native_imgui:
+            self.imgui.backends.opengl3_new_frame()   # its device objects, made on the first frame
+        self.imgui.new_frame()
+
+    def render_imgui(self) -> None:
+        """imgui's draw data for this frame into the bound framebuffer (the window)."""
+        if self._native_imgui:
+            self.imgui.backends.opengl3_render_draw_data(self.imgui.get_draw_data())
+        else:
+            self.impl.render(self.imgui.get_draw_data())
 
     def screenshot(self, path: str) -> None:
         """The view without the panel, at window size: the last frame's radiance tone mapped again."""
@@ -478,6 +501,8 @@ class EditorWindow:
         for targets in self._target_cache.values():
             targets.release()
         self._target_cache.clear()
+        if self._native_imgui:
+            self.imgui.backends.opengl3_shutdown()   # its textures first: the Python backend then finds them gone
         self.impl.shutdown()
         self.implot.destroy_context()
         self.imgui.destroy_context()
