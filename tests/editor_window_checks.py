@@ -410,6 +410,55 @@ def test_native_imgui_renderer_draws_what_the_python_one_draws(window):
     np.testing.assert_array_equal(native, python)
 
 
+def test_kept_panel_pixels_are_the_panel_drawn_anew(window):
+    """While the panel's draw data stays the same its pixels are copied from an offscreen image
+    (panel_image.PanelImage); the window is then byte for byte the window drawn with imgui's
+    renderer. A window over the view (here a small imgui window; a tooltip or an open combo box)
+    is drawn straight in."""
+    kept = window._panel_image
+    w, h = window.size
+
+    def window_pixels() -> np.ndarray:
+        return np.frombuffer(window.ctx.screen.read(components=3), np.uint8).reshape(h, w, 3).copy()
+
+    window.finish_bake()
+    for _ in range(20):     # (the first frames rasterise glyphs into imgui's atlas: texture updates)
+        window.frame()
+        if kept.reused:
+            break
+    reused = kept.reused
+    assert reused > 0
+    window.draw()
+    assert kept.reused == reused + 1                    # the same draw data: copied
+    copied = window_pixels()
+    window.keep_panel_pixels = False
+    try:
+        window.draw()
+        drawn = window_pixels()
+    finally:
+        window.keep_panel_pixels = True
+    window.glfw.swap_buffers(window.window)
+    np.testing.assert_array_equal(copied, drawn)
+    assert copied[:, window.view_area()[0]:].std() > 5.0
+
+    imgui = window.imgui
+    for _ in range(3):                                  # an imgui window over the view, every frame
+        window.poll_events()
+        window.begin_imgui_frame()
+        window.panel.draw(window)
+        imgui.set_next_window_pos(imgui.ImVec2(4, 4))
+        imgui.begin("over the view")
+        imgui.text("x")
+        imgui.end()
+        imgui.render()
+        window.render_view()
+        reused = kept.reused
+        window.render_imgui()
+        window.glfw.swap_buffers(window.window)
+    # (imgui shows a new window from its second frame on)
+    assert kept.reused == reused and kept._key is None  # drawn straight in
+
+
 def test_built_in_file_browser(window, tmp_path):
     """Where no native dialog exists the panel's browser is an imgui window: it lists folders
     and the files of the asked types, and a pick goes to the caller (here: the texture slot)."""

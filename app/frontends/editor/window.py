@@ -88,6 +88,12 @@ class EditorWindow:
         imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
         self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
         self._native_imgui = self._start_native_imgui(imgui)
+        from alight.frontends.editor.panel_image import PanelImage
+
+        # The side bar's pixels, drawn again only when imgui's draw data changes (panel_image.py);
+        # False draws it every frame (the tests compare).
+        self.keep_panel_pixels = True
+        self._panel_image = PanelImage(self.ctx, self._render_imgui_direct)
         glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
 
         self.state = state
@@ -466,11 +472,20 @@ class EditorWindow:
         self.imgui.new_frame()
 
     def render_imgui(self) -> None:
-        """imgui's draw data for this frame into the bound framebuffer (the window)."""
-        if self._native_imgui:
-            self.imgui.backends.opengl3_render_draw_data(self.imgui.get_draw_data())
+        """imgui's draw data for this frame into the window, through the kept side-bar pixels
+        where they serve (panel_image.PanelImage)."""
+        draw_data = self.imgui.get_draw_data()
+        if self.keep_panel_pixels:
+            self._panel_image.draw(self.imgui, draw_data, self.size, self.view_area()[0])
         else:
-            self.impl.render(self.imgui.get_draw_data())
+            self._render_imgui_direct(draw_data)
+
+    def _render_imgui_direct(self, draw_data) -> None:
+        """imgui's draw data into the bound framebuffer."""
+        if self._native_imgui:
+            self.imgui.backends.opengl3_render_draw_data(draw_data)
+        else:
+            self.impl.render(draw_data)
 
     def screenshot(self, path: str) -> None:
         """The view without the panel, at window size: the last frame's radiance tone mapped again."""
@@ -501,6 +516,7 @@ class EditorWindow:
         for targets in self._target_cache.values():
             targets.release()
         self._target_cache.clear()
+        self._panel_image.release()
         if self._native_imgui:
             self.imgui.backends.opengl3_shutdown()   # its textures first: the Python backend then finds them gone
         self.impl.shutdown()
