@@ -817,7 +817,8 @@ class ForwardRenderer:
             view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
         inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
         self._last_inverse_vp = inverse_vp    # the resolve's background rays (this frame or tile)
-        self._last_surface_rect = self._surface_rect(scene, view_projection, (targets.width, targets.height))
+        # Only the fused resolve reads it (_resolve): computed there, from this pass's inputs.
+        self._last_surface_rect_args = (scene, view_projection, (targets.width, targets.height))
         ring = None
         if self.background_ring and impostor and self._impostor_samples == 1 and background \
                 and self._background_mode(scene, maps) != 3 \
@@ -1103,7 +1104,7 @@ class ForwardRenderer:
             defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
             defines["TONEMAP_MODE"] = TONEMAPS.index(scene.display.tonemap)
         w, h = targets.width, targets.height
-        rect = self._last_surface_rect
+        rect = self._surface_rect(*self._last_surface_rect_args)
         if rect is None or rect == (0, 0, w, h):
             passes = [(defines, None)]
         else:
