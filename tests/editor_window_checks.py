@@ -385,25 +385,30 @@ def test_orbiting_frame_in_the_window_matches_the_still_view(window):
         window.frame()
 
 
+def _drawn_with(window, **attributes) -> np.ndarray:
+    """The whole window's pixels (rows bottom-up) after a draw with the window's ``attributes``
+    set for it, then restored."""
+    saved = {k: getattr(window, k) for k in attributes}
+    for k, v in attributes.items():
+        setattr(window, k, v)
+    try:
+        window.draw()
+        w, h = window.size
+        return np.frombuffer(window.ctx.screen.read(components=3), np.uint8).reshape(h, w, 3).copy()
+    finally:
+        for k, v in saved.items():
+            setattr(window, k, v)
+
+
 def test_native_imgui_renderer_draws_what_the_python_one_draws(window):
     """The panel is drawn by Dear ImGui's C++ OpenGL 3 renderer (imgui-bundle's), where it starts;
     imgui-bundle's Python renderer, the fallback, draws the same window bytes from the same
     draw data."""
     assert window._native_imgui, "the C++ renderer should start on llvmpipe's GL"
-    w, h = window.size
-
-    def window_pixels() -> np.ndarray:
-        return np.frombuffer(window.ctx.screen.read(components=3), np.uint8).reshape(h, w, 3).copy()
-
+    w = window.size[0]
     window.frame()
-    window.draw()
-    native = window_pixels()
-    window._native_imgui = False
-    try:
-        window.draw()
-        python = window_pixels()
-    finally:
-        window._native_imgui = True
+    native = _drawn_with(window)
+    python = _drawn_with(window, _native_imgui=False)
     window.glfw.swap_buffers(window.window)
     panel = slice(w - round(window.panel_width() * w / window.glfw.get_window_size(window.window)[0]), w)
     assert native[:, panel].std() > 5.0                 # the panel is there
@@ -416,11 +421,6 @@ def test_kept_panel_pixels_are_the_panel_drawn_anew(window):
     renderer. A window over the view (here a small imgui window; a tooltip or an open combo box)
     is drawn straight in."""
     kept = window._panel_image
-    w, h = window.size
-
-    def window_pixels() -> np.ndarray:
-        return np.frombuffer(window.ctx.screen.read(components=3), np.uint8).reshape(h, w, 3).copy()
-
     window.finish_bake()
     for _ in range(20):     # (the first frames rasterise glyphs into imgui's atlas: texture updates)
         window.frame()
@@ -428,15 +428,9 @@ def test_kept_panel_pixels_are_the_panel_drawn_anew(window):
             break
     reused = kept.reused
     assert reused > 0
-    window.draw()
+    copied = _drawn_with(window)
     assert kept.reused == reused + 1                    # the same draw data: copied
-    copied = window_pixels()
-    window.keep_panel_pixels = False
-    try:
-        window.draw()
-        drawn = window_pixels()
-    finally:
-        window.keep_panel_pixels = True
+    drawn = _drawn_with(window, keep_panel_pixels=False)
     window.glfw.swap_buffers(window.window)
     np.testing.assert_array_equal(copied, drawn)
     assert copied[:, window.view_area()[0]:].std() > 5.0
