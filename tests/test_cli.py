@@ -284,6 +284,13 @@ def test_presets_lists_all_ten():
     assert "Traceback" not in proc.stdout + proc.stderr
     rows = [line.split()[0] for line in proc.stdout.splitlines()[1:] if line.strip()]
     assert rows[:10] == PRESETS, rows
+    # Each row's metallic and roughness are the preset's own (car_paint's 0.6 once printed as 1).
+    from alight.exchange.presets import load_preset
+
+    for line in proc.stdout.splitlines()[1:]:
+        name, metallic, roughness = line.split()[:3]
+        m = load_preset(name)
+        assert (float(metallic), float(roughness)) == (round(m.metallic, 2), round(m.roughness, 2)), line
 
 
 # ----------------------------------------------------------------------------- bad input

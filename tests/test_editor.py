@@ -90,6 +90,40 @@ def test_editor_cli_bad_input_is_one_line(display, tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
+def test_a_mesh_opened_by_script_is_drawn_as_the_mesh_option_draws_it(display, tmp_path, shared_data):
+    """--script open=FILE (as a drop) shows a glTF's own materials, as --mesh and 'alight render'
+    do; a file that cannot be opened stops the script: one line, exit 2, no screenshot."""
+    duck = str(shared_data / "models" / "Duck.glb")
+    opened = screenshot(tmp_path, "opened", "--new", "--script", f"open={duck}")
+    given = screenshot(tmp_path, "given", "--new", "--mesh", duck)
+    np.testing.assert_array_equal(opened, given)
+    assert ball(opened)[:, 0].mean() > ball(opened)[:, 2].mean() + 30   # the duck's yellow, not grey
+    missing = edit("--new", "--script", f"open={tmp_path / 'missing.glb'}", "--screenshot", str(tmp_path / "x.png"))
+    assert missing.returncode == 2 and missing.stderr.count("\n") == 1 and "missing.glb" in missing.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_the_editor_takes_renders_scene_options(display, tmp_path):
+    """--light replaces the editor's three lights (given as specs here: the same picture),
+    --env-rotation is the panel's rotation (as --script sets it); --view probe, which the editor
+    cannot show, is refused in one line."""
+    from alight.frontends.editor.state import default_lights
+
+    specs = []
+    for light in default_lights():
+        where = ("dir" if light.kind == "directional" else "pos") + "=" + ",".join(map(str, light.vector))
+        specs += ["--light", f"{light.kind}:{where}:color={','.join(map(str, light.color))}:intensity={light.intensity}"]
+    default = screenshot(tmp_path, "default")
+    assert np.abs(screenshot(tmp_path, "spelled", *specs) - default).max() <= 1
+    one = screenshot(tmp_path, "one", "--light", "point:pos=0,0,5:intensity=2")
+    assert np.abs(one - default).mean() > 2.0
+    rotated = screenshot(tmp_path, "rotated", "--env-rotation", "90")
+    np.testing.assert_array_equal(rotated, screenshot(tmp_path, "scripted", "--script", "env_rotation=90"))
+    assert np.abs(rotated - default).mean() > 1.0
+    probe = edit("--view", "probe", "--screenshot", str(tmp_path / "p.png"))
+    assert probe.returncode == 2 and probe.stderr.count("\n") == 1 and not (tmp_path / "p.png").exists()
+
+
 def test_window_checks_in_a_fresh_process(display):
     """The checks that drive the real window in-process (tests/editor_window_checks.py) run in
     their own interpreter: the other GPU tests keep a headless EGL context current on this

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from alight.core.material import load_preset
+from alight.exchange.presets import load_preset
 from alight.exchange.output import write_image
 from alight.frontends.editor.state import EditorState
 from alight.frontends.editor.window import EditorWindow

@@ -662,7 +662,7 @@ def _presets() -> int:
         m = load_preset(name)
         f0 = m.f0()
         srgb = linear_to_srgb(f0)
-        print(f"{name:20s} {m.metallic:8.0f} {m.roughness:9.2f}  "
+        print(f"{name:20s} {m.metallic:8.2f} {m.roughness:9.2f}  "
               f"({f0[0]:.2f}, {f0[1]:.2f}, {f0[2]:.2f})     ({srgb[0]:.2f}, {srgb[1]:.2f}, {srgb[2]:.2f})")
     return 0
 

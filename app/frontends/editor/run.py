@@ -26,6 +26,18 @@ def build_state(args) -> EditorState:
     from alight.core.mesh import BUILTIN_MESHES
 
     state.use_file_materials = args.preset is None and args.mesh not in BUILTIN_MESHES
+    # The rest of 'alight render''s scene options, as it reads them. Lights: --light replaces the
+    # editor's three (state.default_lights); without it a glTF's own lights do, as in 'render'.
+    from alight.core.scene import parse_light
+    from alight.errors import AlightError
+
+    if args.view != "camera":
+        raise AlightError("edit: --view probe is 'alight render''s; the editor shows the camera view")
+    state.env_rotation_deg, state.env_intensity = args.env_rotation, args.env_intensity
+    if args.light:
+        state.lights = [parse_light(spec) for spec in args.light]
+    elif state.mesh.lights and not args.no_file_lights:
+        state.lights = list(state.mesh.lights)
     return state
 
 
@@ -85,7 +97,8 @@ def _no_scene_options(args) -> bool:
 
     material_flags = (args.preset, args.base_color, args.metallic, args.roughness, args.specular_f0,
                       args.emissive, args.ior, *(getattr(args, f) for f in LAYER_FIELDS))
-    return (args.mesh, args.env) == ("sphere", "studio") and all(x is None for x in material_flags)
+    return (args.mesh, args.env) == ("sphere", "studio") and all(x is None for x in material_flags) \
+        and not args.light and (args.env_rotation, args.env_intensity) == (0.0, 1.0)
 
 
 def _benchmark(win, frames: int) -> int:

@@ -101,6 +101,9 @@ class EditorState:
 
         mesh = load_mesh(spec)
         self.mesh, self.mesh_spec = mesh, spec
+        # As 'alight render' draws a file: its own materials where it has any (the panel's
+        # checkbox switches to the panel's material), the panel's where it has none.
+        self.use_file_materials = any(part.material is not None for part in mesh.parts)
         self._say(mesh.warnings)
 
     def load_env(self, spec: str) -> None:
@@ -213,7 +216,8 @@ class EditorState:
             elif key == "preset":
                 self.load_material(value)
             elif key == "open":
-                self.open_file(value)
+                if not self.open_file(value):   # (a drop shows it in the panel; a script stops)
+                    raise AlightError(self.error)
             elif key == "mesh":
                 self.load_mesh(value)
             elif key == "env":
