@@ -278,6 +278,19 @@ def test_bake_writes_all_maps(tmp_path):
             assert (spec.width, spec.height) == (64, 32), name
 
 
+def test_a_flat_mesh_seen_edge_on_is_said(out_dir):
+    """The default camera (on +Z, CONVENTIONS.md) sees a y = 0 plane edge-on: one warning says so
+    and names the way out; from above (--elevation) it shows, without the warning."""
+    plane = SHARED_DATA / "bad" / "singlevn.obj"
+    edge_on = render(out_dir / "edge_on.png", "--mesh", plane)
+    assert "edge-on" in edge_on.stderr and "--elevation" in edge_on.stderr
+    above = render(out_dir / "above.png", "--mesh", plane, "--elevation", "30")
+    assert "edge-on" not in above.stderr
+    alpha_above = oiio.ImageBuf(str(out_dir / "above.png")).get_pixels(oiio.FLOAT)
+    assert alpha_above.std() > 0.01                     # the plane shows
+    assert "edge-on" not in render(out_dir / "ball.png").stderr
+
+
 def test_presets_lists_all_ten():
     proc = run("presets")
     assert proc.returncode == 0, proc.stderr

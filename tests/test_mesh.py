@@ -307,12 +307,15 @@ def test_bad_empty_files_are_refused(shared_data):
 
 
 def test_bad_nancolor_loads(shared_data):
-    """NaN vertex colours are ignored; the positions are a fine cube."""
+    """The positions are a fine cube; the NaN vertex colour (trimesh stores 0: black) is said in
+    one warning naming its line."""
     mesh = load_mesh(str(shared_data / "bad/nancolor.obj"))
     (part,) = mesh.parts
     check_part(part)
     assert len(part.positions) == 8 and len(part.indices) == 12
     assert part.material is None
+    (warning,) = [w for w in mesh.warnings if "vertex colour" in w]
+    assert "nancolor.obj" in warning and "line 7" in warning and "\n" not in warning
 
 
 def test_bad_negative_indices_load(shared_data):
@@ -360,8 +363,12 @@ def test_bad_no_indices_glb_loads(shared_data):
 
 
 def test_bad_notenoughindices_keeps_the_triangle(shared_data):
-    """The two-vertex face `f 1// 2//` is no polygon and is dropped; the triangle after it loads."""
-    (part,) = load_mesh(str(shared_data / "bad/notenoughindices.obj")).parts
+    """The two-vertex face `f 1// 2//` is no polygon and is dropped, with a warning naming its
+    line; the triangle after it loads."""
+    mesh = load_mesh(str(shared_data / "bad/notenoughindices.obj"))
+    (warning,) = [w for w in mesh.warnings if "fewer than 3" in w]
+    assert "notenoughindices.obj" in warning and "line 9" in warning
+    (part,) = mesh.parts
     check_part(part)
     assert len(part.indices) == 1
     np.testing.assert_allclose(part.positions[part.indices[0]], [(-500, 0, 500), (500, 0, 500), (500, 500, 500)])
@@ -382,6 +389,8 @@ def test_bad_singlevn_loads(shared_data):
     np.testing.assert_allclose(part.normals, np.tile([0, 1, 0], (4, 1)))
     assert ccw_fraction(part) == 1.0
     assert part.material is None  # surface.mtl does not exist: trimesh's placeholder is not a material
+    np.testing.assert_allclose(np.abs(load_mesh(str(shared_data / "bad/singlevn.obj")).flat_normal()), [0, 1, 0],
+                               atol=1e-9)   # flat: 'alight render' warns that +Z sees it edge-on
     # u along +X and v along -Z: tangent +X, cross(n, t) = -Z = dP/dv, so w = +1.
     np.testing.assert_allclose(part.tangents, np.tile([1, 0, 0, 1], (4, 1)), atol=1e-6)
 

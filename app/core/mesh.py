@@ -207,6 +207,16 @@ class Mesh:
         pick = np.array([[i >> 2 & 1, i >> 1 & 1, i & 1] for i in range(8)], dtype=bool)
         return np.where(pick, hi, lo)
 
+    def flat_normal(self) -> np.ndarray | None:
+        """The unit normal of the plane every vertex lies in (to 1e-5 of the mesh's size), or
+        None for a mesh with depth: the smallest principal axis of the vertices."""
+        points = np.concatenate([p.positions for p in self.parts]).astype(np.float64)
+        centred = points - points.mean(axis=0)
+        values, vectors = np.linalg.eigh(centred.T @ centred)
+        if values[-1] <= 0.0 or values[0] > 1e-10 * values[-1]:
+            return None
+        return vectors[:, 0]
+
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
         """Centre of the bounding box and the distance to the farthest vertex (camera framing)."""
         lo, hi = self.bounds()

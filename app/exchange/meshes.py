@@ -9,6 +9,7 @@ for it. Every problem with a file becomes a one-line :class:`AlightError` naming
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, Callable
 
@@ -74,13 +75,21 @@ def load_mesh(spec: str) -> Mesh:
             _attach_diffuse_maps(spec, path, extras, textures)
             warnings += [f"{spec}: mtllib '{name}' not found; its materials are drawn with the default material"
                          for name in missing_libraries(path)]
+            # What trimesh repairs as it parses without a word: only the text can tell.
+            short, bad_colors = _obj_text_checks(path)
+            if short:
+                warnings.append(f"{spec}: {short} face{'s' if short > 1 else ''} with fewer than 3 vertices "
+                                f"(line {short.first_line}) not drawn")
+            if bad_colors:
+                warnings.append(f"{spec}: {bad_colors} vertex colour{'s' if bad_colors > 1 else ''} NaN or Inf "
+                                f"(line {bad_colors.first_line}); drawn black")
         parts = []
         for node in scene.graph.nodes_geometry:
             transform, geom_name = scene.graph[node]
             geom = scene.geometry.get(geom_name)
             if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
                 continue  # point clouds and line paths have no triangles to render
-            part = _part_from_trimesh(spec, str(node), geom, np.asarray(transform), textures, extras)
+            part = _part_from_trimesh(spec, str(node), geom, np.asarray(transform), textures, extras, warnings)
             if part is not None:
                 parts.append(part)
     except AlightError:
@@ -93,8 +102,10 @@ def load_mesh(spec: str) -> Mesh:
 
 
 def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
-                       textures: dict[int, np.ndarray], extras: dict[str, dict]) -> MeshPart | None:
-    """One trimesh geometry placed by its node transform; None when no face survives."""
+                       textures: dict[int, np.ndarray], extras: dict[str, dict],
+                       warnings: list[str]) -> MeshPart | None:
+    """One trimesh geometry placed by its node transform; None when no face survives. What it
+    repairs (non-finite uvs or vertex colours) it says in ``warnings``, one line each."""
     positions = np.asarray(geom.vertices, dtype=np.float64)
     faces = np.asarray(geom.faces, dtype=np.int64).reshape(-1, 3)
     if not np.isfinite(positions).all():
@@ -132,7 +143,12 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
 
     uv = getattr(geom.visual, "uv", None)
     if uv is not None and np.shape(uv) == (len(positions), 2):
-        uvs = np.nan_to_num(np.asarray(uv, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+        uvs = np.asarray(uv, dtype=np.float64)
+        bad = ~np.isfinite(uvs).all(axis=1)
+        if bad.any():
+            warnings.append(f"{spec}: {int(bad.sum())} texture coordinate(s) of '{name}' are NaN or Inf; "
+                            f"drawn at (0, 0)")
+            uvs = np.where(bad[:, None], 0.0, uvs)
     else:
         uvs = np.zeros((len(positions), 2))
 
@@ -142,7 +158,12 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
 
         rgba = np.asarray(geom.visual.vertex_colors, dtype=np.float64)
         if rgba.shape == (len(positions), 4):
-            rgba = np.clip(np.nan_to_num(rgba / 255.0 if rgba.max(initial=0.0) > 1.0 else rgba), 0.0, 1.0)
+            bad = ~np.isfinite(rgba).all(axis=1)
+            if bad.any():   # white: the colour multiplies the base colour, which then shows unchanged
+                warnings.append(f"{spec}: {int(bad.sum())} vertex colour(s) of '{name}' are NaN or Inf; "
+                                f"drawn white (the base colour alone)")
+                rgba = np.where(bad[:, None], 255.0 if np.nanmax(rgba, initial=0.0) > 1.0 else 1.0, rgba)
+            rgba = np.clip(rgba / 255.0 if rgba.max(initial=0.0) > 1.0 else rgba, 0.0, 1.0)
             colors = np.concatenate([srgb_to_linear(rgba[:, :3]), rgba[:, 3:]], axis=1)
 
     return MeshPart(
@@ -155,6 +176,44 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
         material=_file_material(getattr(geom.visual, "material", None), textures, extras),
         colors=None if colors is None else np.ascontiguousarray(colors, dtype=np.float32),
     )
+
+
+class _Count(int):
+    """A count that also remembers where its first case was."""
+    first_line: int = 0
+
+
+def _obj_text_checks(path: Path) -> tuple[_Count, _Count]:
+    """In an OBJ's text: the ``f`` statements with fewer than 3 vertices (Wavefront OBJ: a face
+    has at least three), which trimesh drops, and the ``v x y z r g b`` colours that are not
+    finite, which trimesh stores as 0; each with its first line number."""
+    counts = [0, 0]
+    firsts = [0, 0]
+    with open(path, "rb") as f:
+        for number, line in enumerate(f, 1):
+            if line[:2] in (b"f ", b"f\t"):
+                bad, which = len(line.split(b"#", 1)[0].split()) < 4, 0
+            elif line[:2] in (b"v ", b"v\t"):
+                tokens = line.split(b"#", 1)[0].split()
+                bad, which = len(tokens) >= 7 and not all(_finite_token(t) for t in tokens[4:7]), 1
+            else:
+                continue
+            if bad:
+                counts[which] += 1
+                firsts[which] = firsts[which] or number
+    result = []
+    for count, first in zip(counts, firsts):
+        c = _Count(count)
+        c.first_line = first
+        result.append(c)
+    return result[0], result[1]
+
+
+def _finite_token(token: bytes) -> bool:
+    try:
+        return math.isfinite(float(token))
+    except ValueError:
+        return True   # not a number: trimesh's to judge
 
 
 def _texture(image: Any, cache: dict[int, np.ndarray]) -> np.ndarray | None:

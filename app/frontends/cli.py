@@ -486,6 +486,11 @@ def _render(args) -> int:
         if not args.light and not args.no_file_lights:
             lights = list(mesh.lights)
     camera = _camera(args, mesh, width / height)
+    if camera is None and mesh is not None:
+        normal = mesh.flat_normal()
+        if normal is not None and abs(normal[2]) < 0.02:   # the default camera's view is -Z (CONVENTIONS.md)
+            _warn([f"{args.mesh}: the mesh is flat and the default camera (on +Z) sees it edge-on, so it "
+                   f"may not show; --elevation 30 (or --orbit) looks at it from another side"])
     env = None if args.no_ibl else load_environment(args.env)
     if env is not None:
         _warn(env.warnings)
