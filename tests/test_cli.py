@@ -291,6 +291,24 @@ def test_a_flat_mesh_seen_edge_on_is_said(out_dir):
     assert "edge-on" not in render(out_dir / "ball.png").stderr
 
 
+def test_edit_help_names_every_script_field():
+    """'alight edit --help' lists every --script field EditorState.apply_edit takes, each map slot."""
+    import re
+
+    from alight.core.texture_maps import MAP_SLOTS
+    from alight.frontends.editor import state
+
+    text = " ".join(run("edit", "--help").stdout.split())
+    source = Path(state.__file__).read_text()
+    body = source[source.index("def apply_edit"):source.index("def _finite")]
+    fields = set(re.findall(r'key == "([a-z_]+)"', body))
+    for group in re.findall(r"key in \(([^)]*)\)", body):
+        fields |= set(re.findall(r'"([a-z_]+)"', group))
+    assert {"roughness", "open", "debug_mip", "uv_offset"} <= fields
+    for name in sorted(fields | set(MAP_SLOTS)):
+        assert re.search(rf"\b{name}\b", text), name
+
+
 def test_presets_lists_all_ten():
     proc = run("presets")
     assert proc.returncode == 0, proc.stderr

@@ -221,7 +221,13 @@ def _add_edit_parser(sub) -> None:
     e.add_argument("--benchmark", action="store_true",
                    help="1280x720, the material ball, IBL, 3 lights and the panel: print median and p95 frame times")
     e.add_argument("--script", action="append", default=[], metavar="FIELD=VALUE",
-                   help="an edit applied after a frame, e.g. roughness=0.9, preset=water, open=FILE (repeatable)")
+                   help="an edit applied after a frame (repeatable), e.g. roughness=0.9, preset=water, open=FILE. "
+                        "FIELD: roughness, metallic, ior, base_color, emissive, specular_f0 (R,G,B linear), the "
+                        "layers' fields (clearcoat, clearcoat_roughness, sheen_color, ..., as the material flags), "
+                        "preset, open, mesh, env (a name or path), exposure, tonemap, env_rotation, env_intensity, "
+                        "ibl (0/1), ibl_model, multiple_scattering (0/1), quality, debug_view, debug_mip, "
+                        "map_SLOT (an image path, '' clears; SLOT: base_color, metallic_roughness, metallic, roughness, normal, emissive, occlusion), "
+                        "uv_scale, uv_offset (U,V)")
     e.add_argument("--no-panel", action="store_true", help="draw the view only")
     e.add_argument("--new", action="store_true",
                    help="do not reopen the last session (it is reopened when no scene option is given)")
