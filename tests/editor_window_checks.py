@@ -453,6 +453,23 @@ def test_kept_panel_pixels_are_the_panel_drawn_anew(window):
     assert kept.reused == reused and kept._key is None  # drawn straight in
 
 
+def test_a_flat_mesh_seen_edge_on_is_said(window, shared_data):
+    """Framed from the default direction (+Z), a y = 0 plane is edge-on and shows nothing: the
+    panel says so, as 'alight render' warns (from whatever direction the view has when a mesh
+    arrives); the ball says nothing."""
+    s = window.state
+    window.orbit.yaw_deg = window.orbit.pitch_deg = 0.0    # the default direction (earlier checks orbit)
+    try:
+        assert s.open_file(str(shared_data / "bad" / "singlevn.obj"))
+        window.frame()
+        assert "edge-on" in s.message
+    finally:
+        s.load_mesh("sphere")
+        s.message = ""
+    window.frame()
+    assert "edge-on" not in s.message
+
+
 def test_built_in_file_browser(window, tmp_path):
     """Where no native dialog exists the panel's browser is an imgui window: it lists folders
     and the files of the asked types, and a pick goes to the caller (here: the texture slot)."""

@@ -47,6 +47,11 @@ class OrbitCamera:
     def zoom(self, wheel: float) -> None:
         self.distance = max(self.radius * 0.05, self.distance * 0.9 ** wheel)
 
+    def direction(self) -> np.ndarray:
+        """The unit vector from the target toward the eye (3,)."""
+        offset = self._offset()
+        return offset / max(float(np.linalg.norm(offset)), 1e-12)
+
     def frame(self, center, radius: float, aspect: float, margin: float = 1.3, corners=None) -> None:
         """Fit a sphere in the narrower field of view, or the bounding box's ``corners`` where
         they need less distance, from the current direction (alight.core.scene.fit_distance, as
@@ -54,6 +59,6 @@ class OrbitCamera:
         from alight.core.scene import fit_distance
 
         self.radius = max(float(radius), 1e-6)
-        direction = self._offset() / max(np.linalg.norm(self._offset()), 1e-12)
+        direction = self.direction()
         self.distance = fit_distance(center, self.radius, self.fov_y_deg, aspect, direction, corners, margin)
         self.target = tuple(float(x) for x in center)

@@ -155,6 +155,10 @@ class EditorWindow:
             center, radius = self.state.mesh.bounding_sphere()
             w, h = self.view_area()
             self.orbit.frame(center, radius, w / max(h, 1), corners=self.state.mesh.corners())
+            # A flat mesh seen edge-on shows nothing: say so, as 'alight render' warns.
+            normal = self.state.mesh.flat_normal()
+            if normal is not None and abs(float(normal @ self.orbit.direction())) < 0.02 and not self.state.error:
+                self.state.message = "the mesh is flat and seen edge-on: drag up or down to see it"
         self._framed_mesh = self.state.mesh
 
     def _depth_bits(self) -> int:
