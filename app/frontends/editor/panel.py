@@ -108,7 +108,10 @@ class Panel:
         m = s.material
         _, s.use_file_materials = imgui.checkbox("mesh file's own materials and maps", s.use_file_materials)
         if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
-            imgui.table_setup_column("preset")
+            # The names' column as wide as the longest name and its swatch: the F0 columns take the rest.
+            longest = max((name for name, *_ in self.presets), key=len, default="preset")
+            name_width = imgui.calc_text_size(longest).x + 14 + imgui.get_style().item_spacing.x
+            imgui.table_setup_column("preset", imgui.TableColumnFlags_.width_fixed, name_width)
             imgui.table_setup_column("F0 linear")
             imgui.table_setup_column("F0 sRGB")
             imgui.table_headers_row()
