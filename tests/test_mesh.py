@@ -318,6 +318,20 @@ def test_bad_nancolor_loads(shared_data):
     assert "nancolor.obj" in warning and "line 7" in warning and "\n" not in warning
 
 
+def test_a_ply_with_nan_vertex_colours_says_so(tmp_path):
+    """trimesh hands a PLY's colours back as uint8, a NaN already 0 (black): a warning says so."""
+    path = tmp_path / "nan_colour.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nproperty float red\nproperty float green\nproperty float blue\n"
+                    "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                    "0 0 0 nan 0.5 0.5\n1 0 0 0.5 0.5 0.5\n0 1 0 0.5 0.5 0.5\n3 0 1 2\n")
+    mesh = load_mesh(str(path))
+    (warning,) = [w for w in mesh.warnings if "vertex colour" in w]
+    assert "nan_colour.ply" in warning and "1 vertex colour" in warning
+    path.write_text(path.read_text().replace("nan", "0.5"))
+    assert not [w for w in load_mesh(str(path)).warnings if "vertex colour" in w]
+
+
 def test_bad_negative_indices_load(shared_data):
     """OBJ relative indices (-1 = last vertex so far) are legal: 6 quads -> 12 triangles.
 

@@ -765,8 +765,8 @@ class ForwardRenderer:
         passes write tone-mapped linear values with GL_FRAMEBUFFER_SRGB on and the framebuffer's
         write stage applies the sRGB curve (GL 4.5 section 17.3.7). A GPU does that for free;
         llvmpipe's encoder is a polynomial, 2.1 ms cheaper than the shader's pow() on a
-        860x720 frame, within 1 LSB of the exact curve (7% of values 1 LSB off;
-        tests/test_editor.py bounds it). Not with parts that blend: GL would blend them in
+        860x720 frame, within 1 LSB of the exact curve (on the editor's ball a fifth of the values
+        1 LSB off; tests/editor_window_checks.py bounds it). Not with parts that blend: GL would blend them in
         linear space, the shader-encoded path blends sRGB values."""
         if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
             # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
@@ -839,8 +839,8 @@ class ForwardRenderer:
             # The one sphere's impostor with one sample a pixel: the background first, around a
             # hole inside the sphere's outline (sphere_lod.impostor_background_ring), then the
             # impostor over it. Every pixel is written once or, in the thin band between the hole
-            # and the outline, twice, and no depth buffer is cleared, tested or written: 2 ms of a
-            # 860x720 frame on llvmpipe (benchmarks/bench_impostor.py).
+            # and the outline, twice, and no depth buffer is cleared, tested or written: 3.5-5% of
+            # the editor's 860x720 scene pass on llvmpipe (two renderers alternated in one process).
             ctx.disable(moderngl.DEPTH_TEST)
             self._draw_background(scene, maps, inverse_vp, ring)
         else:

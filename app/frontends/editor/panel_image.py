@@ -42,7 +42,10 @@ void main() {
 def draw_data_key(imgui, draw_data, framebuffer_size: tuple[int, int]) -> tuple | None:
     """Everything imgui's renderer reads from ``draw_data`` (vertices, indices, commands, display
     size and scale) and the framebuffer size, as one comparable value; None where a texture is
-    to be created or updated (the renderer must run to apply it; one left to destroy can wait)."""
+    to be created or updated (the renderer must run to apply it; one left to destroy can wait),
+    or where imgui's vertex is not the (pos, uv, col) layout drawn_left_edge reads."""
+    if imgui.VERTEX_SIZE != 20:
+        return None
     pending = (imgui.ImTextureStatus.want_create, imgui.ImTextureStatus.want_updates)
     for texture in draw_data.textures or ():
         if texture.status in pending:
@@ -55,19 +58,13 @@ def draw_data_key(imgui, draw_data, framebuffer_size: tuple[int, int]) -> tuple 
         lists.append((ctypes.string_at(vtx.data_address(), vtx.size() * imgui.VERTEX_SIZE),
                       ctypes.string_at(idx.data_address(), idx.size() * imgui.INDEX_SIZE), commands))
     return (tuple(draw_data.display_pos), tuple(draw_data.display_size), tuple(draw_data.framebuffer_scale),
-            framebuffer_size, tuple(lists), imgui.VERTEX_SIZE)
-
-
-def imgui_vertex_size(key: tuple) -> int:
-    return key[5]
+            framebuffer_size, tuple(lists))
 
 
 def drawn_left_edge(draw_data, key: tuple) -> float:
     """The leftmost framebuffer x any of the draw data's triangles can reach: the least vertex x
     (a triangle lies within its vertices), or the least clip rectangle's left edge if that is
     further right. ``key``: draw_data_key's (it holds the vertex bytes)."""
-    if len(key[4]) and imgui_vertex_size(key) != 20:     # not the (pos, uv, col) layout read here
-        return -math.inf
     sx = draw_data.framebuffer_scale[0]
     px = draw_data.display_pos[0]
     left = math.inf
@@ -102,14 +99,18 @@ class PanelImage:
         w, h = framebuffer_size
         key = draw_data_key(imgui, draw_data, framebuffer_size)
         last, self._last_key = self._last_key, key
-        if key is None or key != last or panel_x0 >= w or drawn_left_edge(draw_data, key) < panel_x0:
+        # The kept image shows this key: it was checked against panel_x0 (which the framebuffer
+        # size in the key fixes) when it was kept.
+        keep_new = key != self._key
+        if key is None or key != last or panel_x0 >= w or \
+                (keep_new and drawn_left_edge(draw_data, key) < panel_x0):
             # Over the view, a texture to update, or new this frame (a panel that changes every
             # frame, its frame-time plot in view, would pay for the image and the copy): straight in.
             self._key = None
             self._render(draw_data)
             return
         window = self.ctx.screen
-        if key != self._key:
+        if keep_new:
             if self._texture is None or self._texture.size != (w, h):
                 self.release_image()
                 self._texture = self.ctx.texture((w, h), 4)

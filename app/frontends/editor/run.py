@@ -11,8 +11,12 @@ from alight.frontends.editor.state import EditorState
 
 
 def build_state(args) -> EditorState:
+    from alight.core.scene import parse_light
+    from alight.errors import AlightError
     from alight.frontends.options import build_material
 
+    if args.view != "camera":   # (refused before anything is loaded)
+        raise AlightError("edit: --view probe is 'alight render''s; the editor shows the camera view")
     # --motion-scale fixes the scale while moving; without it the scale adapts to hold 30 FPS.
     state = EditorState(quality=args.quality, aa=args.aa, motion_scale=args.motion_scale or 0.5,
                         adaptive_motion=args.motion_scale is None)
@@ -28,11 +32,6 @@ def build_state(args) -> EditorState:
     state.use_file_materials = args.preset is None and args.mesh not in BUILTIN_MESHES
     # The rest of 'alight render''s scene options, as it reads them. Lights: --light replaces the
     # editor's three (state.default_lights); without it a glTF's own lights do, as in 'render'.
-    from alight.core.scene import parse_light
-    from alight.errors import AlightError
-
-    if args.view != "camera":
-        raise AlightError("edit: --view probe is 'alight render''s; the editor shows the camera view")
     state.env_rotation_deg, state.env_intensity = args.env_rotation, args.env_intensity
     if args.light:
         state.lights = [parse_light(spec) for spec in args.light]
