@@ -1,0 +1,106 @@
+"""The documentation: the MkDocs site builds with no warning (``mkdocs build --strict``: a broken
+link or anchor, a page missing from the nav or a docstring the API reference cannot read fails
+it), and every repository path that README.md and the pages name in their prose exists."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+# The pages whose prose is checked: the front page, the site, the shaders' guide.
+PAGES = sorted([REPO / "README.md", REPO / "shaders" / "README.md", *(REPO / "docs").rglob("*.md")])
+
+# A token naming a repository path starts with one of these folders.
+ROOTS = ("app/", "shaders/", "docs/", "benchmarks/", "tools/", "tests/", "presets/", ".ci/")
+# Shader paths are often named from inside shaders/ (common/brdf.glsl) and module paths from
+# inside the package (ibl/bake.py); those are checked there.
+SHADER_RELATIVE = re.compile(r"^(common|ibl|render|accuracy)/[\w/]+\.(glsl|comp|frag|vert)$")
+PACKAGE_RELATIVE = re.compile(r"^(core|exchange|ibl|render|accuracy|frontends)/[\w/]+\.py$")
+
+FENCE = re.compile(r"^(```|~~~).*?^\1", re.M | re.S)
+CODE_SPAN = re.compile(r"`([^`\n]+)`")
+LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
+
+
+def _prose(text: str) -> str:
+    """The page without its fenced code blocks: commands there name files they write."""
+    return FENCE.sub("", text)
+
+
+def _candidates(token: str) -> list[str]:
+    """Repository-relative paths a code-span token names (none if it names no path)."""
+    out = []
+    for word in re.split(r"[\s,;()]+", token):
+        word = word.strip(".:'\"")
+        if not word or "{" in word or "://" in word:
+            continue
+        if word.startswith(ROOTS):
+            out.append(word)
+        elif SHADER_RELATIVE.match(word):
+            out.append("shaders/" + word)
+        elif PACKAGE_RELATIVE.match(word):
+            out.append("app/" + word)
+        elif word.startswith("alight/") and word.endswith(".py"):
+            out.append("app/" + word.removeprefix("alight/"))
+    return out
+
+
+def _exists(path: Path) -> bool:
+    return any(path.parent.glob(path.name)) if "*" in path.name else path.exists()
+
+
+def named_paths(page: Path) -> list[tuple[str, Path]]:
+    """(as written, resolved path) for each repository path the page's prose names."""
+    text = _prose(page.read_text(encoding="utf-8"))
+    found = []
+    for span in CODE_SPAN.findall(text):
+        found += [(word, REPO / word) for word in _candidates(span)]
+    for target in LINK.findall(text):
+        if re.match(r"^[a-z]+:", target) or target.startswith("#"):
+            continue
+        target = target.split("#")[0]
+        found.append((target, (page.parent / target).resolve()))
+    return found
+
+
+def test_the_path_check_finds_paths():
+    # The check itself: it must see the paths this front page names, and refuse a made-up one.
+    names = {written for written, _ in named_paths(REPO / "README.md")}
+    assert {"docs/presets.png", "docs/conventions.md", "tools/readme_image.py"} <= names, names
+    assert _candidates("app/no_such_module.py: f")[0] == "app/no_such_module.py"
+    assert not _exists(REPO / "app/no_such_module.py")
+    assert _candidates("common/brdf.glsl") == ["shaders/common/brdf.glsl"]
+    assert _candidates("ibl/bake.py") == ["app/ibl/bake.py"]
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[p.relative_to(REPO).as_posix() for p in PAGES])
+def test_every_path_named_in_prose_exists(page):
+    missing = sorted({written for written, path in named_paths(page) if not _exists(path)})
+    assert not missing, f"{page.relative_to(REPO)} names paths that do not exist: {missing}"
+
+
+def test_no_page_mentions_an_issue_number():
+    offenders = [f"{p.relative_to(REPO)}:{n}: {line.strip()}"
+                 for p in PAGES for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+                 if re.search(r"\bissues? #?\d+", line, re.I)]
+    assert not offenders, "\n".join(offenders)
+
+
+def test_mkdocs_builds_strict(tmp_path):
+    # strict: every warning (a link to a missing page or anchor, a page not in the nav, a
+    # reference mkdocstrings cannot collect) fails the build.
+    env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
+    built = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
+                           cwd=REPO, env=env, capture_output=True, text=True, timeout=600)
+    log = built.stdout + built.stderr
+    assert built.returncode == 0, log[-6000:]
+    warnings = [line for line in log.splitlines() if line.startswith(("WARNING", "ERROR"))]
+    assert not warnings, "\n".join(warnings)
+    assert (tmp_path / "site" / "reference" / "api" / "index.html").read_text().count("set_material") > 0
