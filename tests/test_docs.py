@@ -104,3 +104,18 @@ def test_mkdocs_builds_strict(tmp_path):
     warnings = [line for line in log.splitlines() if line.startswith(("WARNING", "ERROR"))]
     assert not warnings, "\n".join(warnings)
     assert (tmp_path / "site" / "reference" / "api" / "index.html").read_text().count("set_material") > 0
+
+
+def test_the_shaders_readme_lists_every_shader():
+    # shaders/README.md has a table per folder ("## `common/`"); its first column names files.
+    text = (REPO / "shaders" / "README.md").read_text(encoding="utf-8")
+    listed: dict[str, set[str]] = {}
+    for folder, body in re.findall(r"^## `(\w+)/`\n(.*?)(?=^## |\Z)", text, re.M | re.S):
+        cells = [row.split("|")[1] for row in body.splitlines() if row.startswith("| `")]
+        listed[folder] = {name for cell in cells for name in re.findall(r"`([\w.]+)`", cell)}
+    on_disk = {d.name: {f.name for f in d.iterdir() if f.is_file()}
+               for d in (REPO / "shaders").iterdir() if d.is_dir() and d.name != "__pycache__"}
+    assert set(listed) == set(on_disk), (sorted(listed), sorted(on_disk))
+    for folder, files in on_disk.items():
+        assert listed[folder] == files, (f"shaders/README.md, {folder}/: not listed {sorted(files - listed[folder])}, "
+                                         f"no such file {sorted(listed[folder] - files)}")
