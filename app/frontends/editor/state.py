@@ -70,6 +70,7 @@ class EditorState:
     mesh: object = None
     env: object = None
     map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
+    map_conversions: dict = field(default_factory=dict)   # path -> the conversion its image was decoded with
 
     @property
     def look(self) -> tuple[Material, TextureMaps]:
@@ -130,12 +131,32 @@ class EditorState:
         self.map_images[path] = image
         self.texture_maps = maps
 
+    def set_map_conversion(self, name: str, on: bool) -> None:
+        """'normal_dx' (the normal map is DirectX's: green flipped) or 'roughness_gloss' (the
+        roughness slot holds gloss: inverted); the slot's image is decoded again."""
+        if name not in ("normal_dx", "roughness_gloss"):
+            raise AlightError(f"'{name}' is not a map conversion (normal_dx, roughness_gloss)")
+        maps = dataclasses.replace(self.texture_maps, **{name: bool(on)})
+        slot = "normal" if name == "normal_dx" else "roughness"
+        if getattr(maps, slot):
+            self.map_images = {**self.map_images, getattr(maps, slot): load_slot_image(maps, slot)}
+        self.texture_maps = maps
+
     def clear_map(self, slot: str) -> None:
         self.texture_maps = self.texture_maps.with_slot(slot, "")
 
     def sync_map_images(self) -> None:
         """Decode any slot's file not yet decoded (after undo/redo or a restored session); a file
         that no longer reads empties its slot and sets ``error``."""
+        maps = self.texture_maps
+        # An image decoded under the other conversion (undo of the DirectX or gloss toggle) again.
+        flags = {"normal": maps.normal_dx, "roughness": maps.roughness_gloss}
+        for slot, on in flags.items():
+            path = getattr(maps, slot)
+            if path and self.map_conversions.get(path, False) != on:
+                self.map_images.pop(path, None)
+            if path:
+                self.map_conversions[path] = on
         for slot, path in self.texture_maps.paths().items():
             if path not in self.map_images:
                 try:
