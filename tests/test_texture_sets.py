@@ -23,6 +23,7 @@ from alight.accuracy.metrics import read_linear, relative_mae
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.exchange.texture_sets import assign_files, assign_folder, load_slot_image, role_of
+from tests.test_editor import display  # noqa: F401  (Xvfb for the editor)
 from tests.test_gltf_material import validate  # noqa: F401  (the Khronos validator fixture)
 
 REPO = Path(__file__).resolve().parents[1]
@@ -404,3 +405,23 @@ def test_editor_drop_of_several_files_is_a_texture_set(tmp_path, validate):
     assert set(other.texture_maps.paths()) == {"base_color", "metallic_roughness", "normal", "occlusion", "emissive"}
     with pytest.raises(AlightError, match="save it as .gltf"):
         s.save_material(str(tmp_path / "look.json"))
+
+
+def test_editor_opens_a_texture_set_maps_and_a_saved_gltf_as_render_does(tmp_path, display):
+    """``alight edit --texture-set / --map / --preset FILE.gltf`` (screenshots under Xvfb): the
+    set, its maps one by one and the exported file give the same picture."""
+    from tests.test_editor import screenshot
+
+    c = canonical()
+    write_set(tmp_path / "set", SETS["polyhaven_arm_dx"], c)
+    twins = one_by_one(tmp_path, SETS["polyhaven_arm_dx"], c)
+    saved = tmp_path / "saved" / "look.gltf"
+    saved.parent.mkdir()
+    assert run("export", "--texture-set", tmp_path / "set", "--out", saved).returncode == 0
+    by_set = screenshot(tmp_path, "set", "--texture-set", str(tmp_path / "set"))
+    by_maps = screenshot(tmp_path, "maps", *map(str, twins))
+    by_file = screenshot(tmp_path, "file", "--preset", str(saved))
+    plain = screenshot(tmp_path, "plain", "--base-color", "1,1,1", "--metallic", "1", "--roughness", "1")
+    assert np.abs(by_set - by_maps).max() <= 1.0
+    assert np.abs(by_file - by_set).max() <= 1.0
+    assert np.abs(by_set - plain).mean() > 5.0
