@@ -425,3 +425,24 @@ def test_editor_opens_a_texture_set_maps_and_a_saved_gltf_as_render_does(tmp_pat
     assert np.abs(by_set - by_maps).max() <= 1.0
     assert np.abs(by_file - by_set).max() <= 1.0
     assert np.abs(by_set - plain).mean() > 5.0
+
+
+def test_api_set_material_takes_sets_maps_and_files(tmp_path):
+    from alight.frontends.api import Renderer
+
+    c = canonical()
+    write_set(tmp_path / "s", SETS["quixel_gloss"], c)
+    files = sorted(str(p) for p in (tmp_path / "s").iterdir())
+    r = Renderer(32)
+    r.set_material("gold", texture_set=files, metallic=0.5)
+    assert r.material.base_color == (1.0, 1.0, 1.0) and r.material.roughness == 1.0 and r.material.metallic == 0.5
+    assert r.texture_maps.roughness_gloss and r.last_texture_set.slots == ("base_color", "roughness", "normal")
+    assert not r.scene.use_file_materials and set(r.scene.texture_images) == set(files)
+    r.set_material(roughness=0.3)   # fields only: the maps stay
+    assert r.texture_maps is not None and r.material.roughness == 0.3
+    with pytest.raises(AlightError, match="unknown texture slot 'albedo'"):
+        r.set_material("gold", maps={"albedo": files[0]})
+    with pytest.raises(AlightError, match="no such file"):
+        r.set_material("gold", maps={"orm": str(tmp_path / "nope.png")})
+    r.set_material("gold")          # a new material without maps clears them
+    assert r.texture_maps is None and r.scene.texture_images == {}
