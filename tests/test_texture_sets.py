@@ -446,3 +446,11 @@ def test_api_set_material_takes_sets_maps_and_files(tmp_path):
         r.set_material("gold", maps={"orm": str(tmp_path / "nope.png")})
     r.set_material("gold")          # a new material without maps clears them
     assert r.texture_maps is None and r.scene.texture_images == {}
+
+
+def test_a_set_laid_over_maps_reports_only_its_own_slots(tmp_path):
+    c = canonical()
+    base = TextureMaps(emissive=write(tmp_path / "glow.png", c["emissive"]))
+    found = assign_files([write(tmp_path / "x_Albedo.png", c["color"]), write(tmp_path / "notes.png", c["ao"])], base)
+    assert found.slots == ("base_color",) and found.maps.emissive == base.emissive
+    assert assign_files([str(tmp_path / "notes.png")], base).slots == ()

@@ -87,15 +87,16 @@ class Assigned:
 
 @dataclass
 class TextureSet:
-    """The assignment: ``maps`` (the slots filled, with the conversions set), every file's
-    ``Assigned`` entry in name order, and the slots filled (whose factors go to 1)."""
+    """The assignment: ``maps`` (the base maps with the set's slots filled and conversions
+    set) and every file's ``Assigned`` entry in name order."""
 
     maps: TextureMaps
     files: list[Assigned] = field(default_factory=list)
 
     @property
     def slots(self) -> tuple[str, ...]:
-        return tuple(s for s in MAP_SLOTS if getattr(self.maps, s))
+        """The slots this set's files filled (not those of the maps it was laid over)."""
+        return tuple(s for s in MAP_SLOTS if any(s in a.slots for a in self.files))
 
     def lines(self) -> list[str]:
         return [a.line() for a in self.files]
