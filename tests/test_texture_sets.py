@@ -9,7 +9,6 @@ checked against twins written in the glTF layout.
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -307,6 +306,11 @@ def test_material_only_gltf_and_tiling_round_trip(tmp_path, validate):
     report = validate(out)[0]
     assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
     m, back, warnings = load_material_file(out)
+    from alight.frontends.editor.state import EditorState
+
+    editor = EditorState()   # the editor's open= / drop of a material-only .gltf: a material, not a mesh
+    assert editor.open_file(str(out)), editor.error
+    assert editor.texture_maps == back and editor.material == m and editor.mesh is None
     assert warnings == [] and back.uv_scale == (2.0, 3.0) and back.uv_offset == pytest.approx((0.25, 0.1), abs=1e-12)
     assert np.array_equal(load_slot_image(back, "normal"), load_slot_image(maps, "normal"))
     a = render(tmp_path / "a.exr", "--preset", out)
