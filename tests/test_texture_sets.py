@@ -474,3 +474,17 @@ def test_a_textured_khronos_model_exported_again_is_validator_clean_and_renders_
     gm = _json(out)["materials"][0]
     assert {"normalTexture", "occlusionTexture", "emissiveTexture"} <= set(gm)
     assert relative_mae(render(tmp_path / "a.exr", "--mesh", out), render(tmp_path / "b.exr", "--mesh", helmet)) <= TOL
+
+
+def test_editor_one_map_sets_its_factor_to_1_and_a_session_keeps_saved_factors(tmp_path):
+    from alight.core.material import Material
+    from alight.frontends.editor.state import EditorState
+
+    c = canonical()
+    s = EditorState()
+    s.material = Material(base_color=(1.0, 0.8, 0.3), metallic=1.0, roughness=0.2)
+    s.set_map("roughness", write(tmp_path / "r.png", c["rough"]))
+    assert s.material.roughness == 1.0 and s.material.base_color == (1.0, 0.8, 0.3)
+    s.material = Material(roughness=0.4)
+    s.set_map("roughness", str(tmp_path / "r.png"), factor_to_1=False)
+    assert s.material.roughness == 0.4

@@ -48,7 +48,7 @@ def restore_session(state, orbit) -> str:
                                      normal_dx=maps.normal_dx, roughness_gloss=maps.roughness_gloss)
     for slot, map_path in maps.paths().items():
         try:
-            state.set_map(slot, map_path)
+            state.set_map(slot, map_path, factor_to_1=False)
         except AlightError as exc:
             warning = str(exc)
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):

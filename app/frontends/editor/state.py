@@ -123,13 +123,19 @@ class EditorState:
             warn(line)
         self.warnings = len(warnings)
 
-    def set_map(self, slot: str, path: str) -> None:
-        """Fill a texture slot from an image file (read now: a bad file raises, nothing changes)."""
+    def set_map(self, slot: str, path: str, factor_to_1: bool = True) -> None:
+        """Fill a texture slot from an image file (read now: a bad file raises, nothing changes).
+        The slot's factor becomes 1 (glTF's convention: the map is the value), unless
+        ``factor_to_1`` is False (a restored session keeps the factors it saved)."""
+        from alight.core.texture_maps import map_factors
+
         maps = self.texture_maps.with_slot(slot, path)
         image = load_slot_image(maps, slot)
         self.map_images = {p: self.map_images[p] for p in maps.paths().values() if p in self.map_images}
         self.map_images[path] = image
         self.texture_maps = maps
+        if factor_to_1:
+            self.material = with_overrides(self.material, **map_factors((slot,)))
 
     def set_map_conversion(self, name: str, on: bool) -> None:
         """'normal_dx' (the normal map is DirectX's: green flipped) or 'roughness_gloss' (the
