@@ -23,10 +23,10 @@ from alight.exchange.gltf_material import (
     EXT_TRANSMISSION,
     EXT_VOLUME,
     export_material_gltf,
-    export_mesh_glb,
     import_material,
     read_gltf_json,
 )
+from alight.exchange.gltf_export import export_mesh_glb
 from alight.exchange.meshes import load_mesh
 from alight.exchange.presets import list_presets, load_preset
 

@@ -247,6 +247,12 @@ def export_gltf(material: Material, path: str | os.PathLike, maps: TextureMaps |
     return out, notes
 
 
+def export_mesh_glb(mesh, m: Material, path: str | os.PathLike) -> Path:
+    """Every part of an alight.core.mesh.Mesh (world space) as one node each, all with material
+    ``m`` (factors only), as .glb: positions, normals, tangents and uvs."""
+    return export_gltf(m, check_output_path(path, (".glb",)), None, mesh)[0]
+
+
 def _glb(doc: dict, blob: bytes) -> bytes:
     json_bytes = json.dumps(doc, separators=(",", ":")).encode("utf-8")
     json_bytes += b" " * (-len(json_bytes) % 4)   # chunks are 4-byte aligned; JSON pads with spaces

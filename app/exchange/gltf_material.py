@@ -1,5 +1,5 @@
 """glTF material round trip: a glTF/GLB material into alight.core.material.Material, and back out as a
-material-only ``.gltf`` or a mesh with the material as ``.glb``.
+material-only ``.gltf`` (a mesh with the material and its maps: alight.exchange.gltf_export).
 
 The two models meet like this (glTF 2.0 core, KHR_materials_ior, KHR_materials_specular,
 KHR_materials_emissive_strength):
@@ -253,15 +253,6 @@ def export_material_gltf(m: Material, path: str | os.PathLike) -> Path:
     text = json.dumps(_document(m), indent=2) + "\n"
     _write(out, text.encode("utf-8"))
     return out
-
-
-def export_mesh_glb(mesh, m: Material, path: str | os.PathLike) -> Path:
-    """Every part of an alight.core.mesh.Mesh (world space) as one node each, all with material
-    ``m``, as .glb: positions, normals, tangents and uvs (alight.exchange.gltf_export, which also
-    writes a material's maps)."""
-    from alight.exchange.gltf_export import export_gltf
-
-    return export_gltf(m, _check_out(path, (".glb",)), None, mesh)[0]
 
 
 def _write(out: Path, data: bytes) -> None:
