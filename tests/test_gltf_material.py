@@ -23,10 +23,10 @@ from alight.exchange.gltf_material import (
     EXT_TRANSMISSION,
     EXT_VOLUME,
     export_material_gltf,
-    export_mesh_glb,
     import_material,
     read_gltf_json,
 )
+from alight.exchange.gltf_export import export_mesh_glb
 from alight.exchange.meshes import load_mesh
 from alight.exchange.presets import list_presets, load_preset
 
@@ -244,7 +244,7 @@ def test_cli_export_gltf_and_glb(tmp_path, validate):
 
 @pytest.mark.parametrize("args, problem", [
     (["--out", "m.obj"], "unsupported output format"),
-    (["--mesh", "cube", "--out", "m.gltf"], "use .glb"),
+    (["--map", "base_color=missing.png", "--out", "m.gltf"], "no such file"),
     (["--preset", "nosuch", "--out", "m.gltf"], "no preset"),
     (["--material-from", "missing.glb", "--out", "m.gltf"], "cannot read"),
     (["--preset", "gold", "--material-from", "x.glb", "--out", "m.gltf"], "not both"),

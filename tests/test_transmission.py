@@ -273,7 +273,7 @@ def test_attenuation_renders_as_the_equivalent_tinted_base_colour(tmp_path, shar
     """A glTF volume with attenuation (KHR_materials_volume) against the same volume without it
     and base colour times T = c^(thickness / distance): with transmission 1 the base colour tints
     only the transmitted light, so the two files must render alike (EXR, no tone map, 1%)."""
-    from alight.exchange.gltf_material import export_mesh_glb
+    from alight.exchange.gltf_export import export_mesh_glb
 
     env = load_environment(str(shared_data / "env" / "venice_sunset_1k.hdr"))
     maps = maps_for(env)

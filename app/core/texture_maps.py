@@ -1,10 +1,21 @@
 """Texture maps loaded by the user for the edited material: which file fills each slot (plain,
 comparable state the editor's undo and session keep). ``alight.exchange.images`` reads the files.
 
+This is the one model of a material's maps that presets, the CLI, the Python API, batch and the
+editor share. Each slot is a glTF textureInfo with the defaults alight writes and reads for it:
+the image (a path), texCoord 0, the default sampler (repeat, trilinear) and one
+KHR_texture_transform shared by every slot (``uv_scale``/``uv_offset``, no rotation);
+``alight.exchange.gltf_export`` writes exactly that, ``alight.exchange.material_files`` reads it
+back.
+
 Slots follow glTF's metal-roughness model, plus separate greyscale metallic and roughness maps
 as many texture sets ship them (their R channel is read; over a metallic-roughness map they
 replace its B or G channel). Colour maps (base colour, emissive) are sRGB-encoded; the others
-hold data. The renderer gets paths and decoded images, never a file to read.
+hold data. The renderer gets paths and decoded images, never a file to read
+(``alight.exchange.texture_sets.load_map_images`` decodes them, applying the two conversions
+below).
+
+A path may name an image inside a glTF file: ``FILE.glb#images[N]``.
 """
 
 from __future__ import annotations
@@ -32,6 +43,10 @@ class TextureMaps:
     occlusion: str = ""
     uv_scale: tuple[float, float] = (1.0, 1.0)
     uv_offset: tuple[float, float] = (0.0, 0.0)
+    # Conversions applied as the file is decoded: a DirectX normal map (green down) has its
+    # green flipped to glTF's (OpenGL, green up); a gloss map in the roughness slot is inverted.
+    normal_dx: bool = False
+    roughness_gloss: bool = False
 
     def paths(self) -> dict[str, str]:
         """The filled slots: slot -> path."""
@@ -65,4 +80,25 @@ class TextureMaps:
             if len(pair) != 2 or not all(math.isfinite(x) for x in pair):
                 raise AlightError(f"{where}: texture_maps.{name} is not two finite numbers")
             kwargs[name] = pair
+        for name in ("normal_dx", "roughness_gloss"):
+            value = data.get(name, False)
+            if not isinstance(value, bool):
+                raise AlightError(f"{where}: texture_maps.{name} is not true or false")
+            kwargs[name] = value
         return cls(**kwargs)
+
+
+# The factor each slot multiplies (glTF 2.0 section 3.9: a map is multiplied by its factor).
+SLOT_FACTORS = {"base_color": {"base_color": (1.0, 1.0, 1.0)},
+                "metallic_roughness": {"metallic": 1.0, "roughness": 1.0},
+                "metallic": {"metallic": 1.0}, "roughness": {"roughness": 1.0},
+                "emissive": {"emissive": (1.0, 1.0, 1.0)}}
+
+
+def map_factors(slots) -> dict:
+    """The material fields set to 1 when maps are loaded into ``slots`` (glTF's convention:
+    a loaded map is the value, its factor 1), so a set loaded over gold is not tinted by it."""
+    out: dict = {}
+    for slot in slots:
+        out.update(SLOT_FACTORS.get(slot, {}))
+    return out

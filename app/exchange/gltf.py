@@ -689,3 +689,15 @@ def _one_line(exc: BaseException) -> str:
 def load_gltf(path: Path, spec: str) -> Mesh:
     """A .gltf/.glb file as world-space parts with its cameras, lights and warnings."""
     return _Reader(path, spec).load()
+
+
+def gltf_image(path: str | os.PathLike, index: int) -> np.ndarray:
+    """The file's ``images[index]`` decoded as (H, W, 4) uint8 (alight.exchange.images.decode_texture):
+    how a material read from a .glb names its maps (``FILE.glb#images[N]``). Errors: one line
+    naming the file and the image."""
+    p = Path(path)
+    if not p.is_file():
+        raise AlightError(f"{p}: no such file")
+    reader = _Reader(p, str(p))
+    reader._decode_images([int(index)])
+    return reader._images[int(index)]

@@ -1,5 +1,5 @@
 """glTF material round trip: a glTF/GLB material into alight.core.material.Material, and back out as a
-material-only ``.gltf`` or a mesh with the material as ``.glb``.
+material-only ``.gltf`` (a mesh with the material and its maps: alight.exchange.gltf_export).
 
 The two models meet like this (glTF 2.0 core, KHR_materials_ior, KHR_materials_specular,
 KHR_materials_emissive_strength):
@@ -31,8 +31,8 @@ The layers (issue 11; docs/layers.md) are the extensions' factors, one to one:
     anisotropy_rotation   = KHR_materials_anisotropy.anisotropyRotation
 
 An extension is written only when one of its fields differs from its default (the layer is
-on). Textures are not carried here: the material model has none (a mesh file's maps are read
-by alight.exchange.meshes).
+on). The factors only: a material's maps (alight.core.texture_maps) are written by
+alight.exchange.gltf_export and read back by alight.exchange.material_files.
 """
 
 from __future__ import annotations
@@ -44,7 +44,6 @@ import struct
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
 from alight.core.material import DEFAULT_IOR, Material, f0_from_ior, validate_material
 from alight.errors import AlightError
@@ -253,57 +252,6 @@ def export_material_gltf(m: Material, path: str | os.PathLike) -> Path:
     out = _check_out(path, (".gltf",))
     text = json.dumps(_document(m), indent=2) + "\n"
     _write(out, text.encode("utf-8"))
-    return out
-
-
-def export_mesh_glb(mesh, m: Material, path: str | os.PathLike) -> Path:
-    """Every part of an alight.core.mesh.Mesh (world space) as one node each, all with material ``m``.
-
-    Only positions, normals and indices are written: the material has no textures, so uvs and
-    tangents would be unused data.
-    """
-    out = _check_out(path, (".glb",))
-    doc = _document(m)
-    blob = bytearray()
-    views: list[dict] = []
-    accessors: list[dict] = []
-
-    def add(array: np.ndarray, component: int, kind: str, target: int, bounds: bool) -> int:
-        while len(blob) % 4:
-            blob.append(0)
-        data = np.ascontiguousarray(array).tobytes()
-        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
-        blob.extend(data)
-        acc: dict[str, Any] = {"bufferView": len(views) - 1, "componentType": component,
-                               "count": int(array.shape[0]) if kind != "SCALAR" else int(array.size), "type": kind}
-        if bounds:
-            acc["min"] = [float(x) for x in array.min(axis=0)]
-            acc["max"] = [float(x) for x in array.max(axis=0)]
-        accessors.append(acc)
-        return len(accessors) - 1
-
-    meshes, nodes = [], []
-    for part in mesh.parts:
-        positions = np.asarray(part.positions, np.float32)
-        normals = np.asarray(part.normals, np.float64)
-        # The validator wants unit normals to float32 precision: renormalise in float64.
-        normals = (normals / np.linalg.norm(normals, axis=1, keepdims=True)).astype(np.float32)
-        indices = np.asarray(part.indices, np.uint32).reshape(-1)
-        attrs = {"POSITION": add(positions, 5126, "VEC3", 34962, True),
-                 "NORMAL": add(normals, 5126, "VEC3", 34962, False)}
-        idx = add(indices, 5125, "SCALAR", 34963, False)
-        meshes.append({"name": part.name, "primitives": [{"attributes": attrs, "indices": idx, "material": 0}]})
-        nodes.append({"name": part.name, "mesh": len(meshes) - 1})
-    while len(blob) % 4:
-        blob.append(0)
-    doc.update({"scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes,
-                "accessors": accessors, "bufferViews": views, "buffers": [{"byteLength": len(blob)}]})
-    json_bytes = json.dumps(doc, separators=(",", ":")).encode("utf-8")
-    json_bytes += b" " * (-len(json_bytes) % 4)  # chunks are 4-byte aligned; JSON pads with spaces
-    total = 12 + 8 + len(json_bytes) + 8 + len(blob)
-    glb = b"".join([struct.pack("<III", GLB_MAGIC, 2, total), struct.pack("<II", len(json_bytes), GLB_JSON),
-                    json_bytes, struct.pack("<II", len(blob), GLB_BIN), bytes(blob)])
-    _write(out, glb)
     return out
 
 

@@ -26,6 +26,7 @@ import numpy as np
 
 from alight.core.material import Material, validate_material, with_overrides
 from alight.core.mesh import Mesh
+from alight.core.texture_maps import TextureMaps
 from alight.core.scene import (
     BACKGROUNDS,
     TONEMAPS,
@@ -37,7 +38,6 @@ from alight.core.scene import (
 )
 from alight.errors import AlightError, warn
 from alight.exchange.meshes import load_mesh
-from alight.exchange.presets import load_preset
 from alight.ibl.environment import Environment, load_environment
 
 Quality = Literal["low", "medium", "high", "auto"]
@@ -60,6 +60,7 @@ class Renderer:
         # fraction); the last choice is kept in self.last_auto_choice.
         self.error_budget = float(error_budget)
         self.last_auto_choice = None
+        self.last_texture_set = None   # the assignment of the last set_material(texture_set=...)
         self._features: dict[str, object] = {}
         self.aa: str = aa
         self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
@@ -138,24 +139,71 @@ class Renderer:
         return self._env
 
     def set_material(self, material: Material | str | os.PathLike | None = None, *,
+                     maps: TextureMaps | dict[str, str] | None = None,
+                     texture_set: str | os.PathLike | Iterable[str | os.PathLike] | None = None,
                      use_file_materials: bool | None = None, **fields) -> "Renderer":
-        """A Material, a preset name or preset file; keyword fields (``roughness=0.3``) on top.
+        """A Material, a preset name, a preset .json or a .gltf/.glb file (its first material
+        with its maps); keyword fields (``roughness=0.3``) on top.
+
+        ``texture_set``: a folder of maps, or a list of files, assigned to slots by their names
+        (alight.exchange.texture_sets; the assignment is kept in ``last_texture_set``).
+        ``maps``: a TextureMaps, or {slot: path} with the slots of ``alight render --map``
+        (base_color, metallic_roughness, metallic, roughness, normal, emissive, occlusion,
+        normal_dx, gloss, orm), applied after the set. The slots these load get factor 1
+        (glTF's convention) before ``fields`` apply. A new material without maps clears the
+        maps; with no material, only fields, the current material and maps are edited.
 
         A material given here replaces a mesh file's own materials unless ``use_file_materials``
-        is True; with no material, only the fields, the current material is edited.
+        is True. Errors: AlightError of one line (a bad slot, a missing file).
         """
+        from alight.core.texture_maps import map_factors
+        from alight.exchange.material_files import load_material_file
+        from alight.exchange.texture_sets import apply_map, assign_files, assign_folder, load_map_images
+
+        current = self.scene.texture_maps
         if material is None:
             base = self.scene.material
         elif isinstance(material, Material):
-            base = validate_material(material)
+            base, current = validate_material(material), None
         else:
-            base = load_preset(material)
+            base, current, warnings = load_material_file(material)
+            for line in warnings:
+                warn(line)
+        loaded: set[str] = set()
+        if texture_set is not None:
+            if isinstance(texture_set, (str, os.PathLike)):
+                found = assign_folder(texture_set, current)
+            else:
+                found = assign_files(list(texture_set), current)
+            for entry in found.notes():
+                warn(f"texture set: {entry}")
+            self.last_texture_set = found
+            current = found.maps
+            loaded.update(found.slots)
+        if isinstance(maps, TextureMaps):
+            current = maps
+            loaded.update(maps.paths())
+        elif maps is not None:
+            for name, path in dict(maps).items():
+                current, slots = apply_map(current or TextureMaps(), str(name), os.fspath(path), f"maps[{name!r}]")
+                loaded.update(slots)
+        if loaded:
+            base = with_overrides(base, **map_factors(loaded))
         self.scene.material = with_overrides(base, **fields) if fields else base
+        if current is not None and current.paths():
+            self.scene.texture_maps, self.scene.texture_images = current, load_map_images(current)
+        else:
+            self.scene.texture_maps, self.scene.texture_images = None, {}
         if use_file_materials is not None:
             self.scene.use_file_materials = bool(use_file_materials)
-        elif material is not None:
+        elif material is not None or self.scene.texture_maps is not None:
             self.scene.use_file_materials = False
         return self
+
+    @property
+    def texture_maps(self) -> TextureMaps | None:
+        """The material's maps (None: none)."""
+        return self.scene.texture_maps
 
     @property
     def material(self) -> Material:

@@ -7,7 +7,8 @@ A spec (paths are relative to the spec file's folder)::
     quality = "low"                 # bake quality: low | medium | high
     meshes = ["sphere", "models/duck.glb"]
     environments = ["studio", "env/venice.hdr"]
-    materials = ["gold", "my_preset.json", "model.glb", {name = "rough_gold", preset = "gold", roughness = 0.6}]
+    materials = ["gold", "my_preset.json", "model.glb", {name = "rough_gold", preset = "gold", roughness = 0.6},
+                 {name = "rock", texture_set = "maps/rock", maps = {normal_dx = "maps/rock_n.png"}}]
     camera_angles = [0, 90]         # orbit about +Y, degrees (default [0])
     environment_angles = [0]        # environment rotation, degrees (default [0])
     contact_sheet = true            # contact_sheet.png with every still, labelled
@@ -129,7 +130,7 @@ def _material_label(m: Any, source: Path) -> str:
     if isinstance(m, str):
         return Path(m).stem if ("/" in m or "." in m) else m
     if isinstance(m, dict):
-        unknown = set(m) - MATERIAL_FIELDS - {"name", "preset", "from"}
+        unknown = set(m) - MATERIAL_FIELDS - {"name", "preset", "from", "texture_set", "maps"}
         if unknown:
             raise AlightError(f"{source}: material {m!r}: unknown field {sorted(unknown)[0]!r}")
         return str(m.get("name") or m.get("preset") or Path(str(m.get("from", "material"))).stem)
@@ -156,6 +157,19 @@ def _material_inputs(m: Any, base: Path) -> tuple[Any, list[str]]:
         if key in m:
             m[key], dep = one(str(m[key]))
             deps += [dep] if dep else []
+    # A texture set (a folder; its images are the inputs) and maps {slot: path} (the same slot
+    # names as 'alight render --map'), relative to the spec's folder.
+    if "texture_set" in m:
+        folder = Path(str(m["texture_set"]))
+        folder = folder if folder.is_absolute() else base / folder
+        m["texture_set"] = str(folder)
+        if folder.is_dir():
+            deps += sorted(str(p) for p in folder.iterdir() if p.is_file())
+    if "maps" in m:
+        if not isinstance(m["maps"], dict) or not all(isinstance(v, str) for v in m["maps"].values()):
+            raise AlightError(f"material {m.get('name', '')!r}: 'maps' must be a table of slot = \"path\"")
+        m["maps"] = {k: str(Path(v) if Path(v).is_absolute() else base / v) for k, v in m["maps"].items()}
+        deps += list(m["maps"].values())
     return m, deps
 
 

@@ -55,33 +55,29 @@ def _render(item, warnings: list[str]) -> None:
     r.quality, r.aa = item.quality, item.aa
     r.width, r.height = item.size
     r.set_mesh(meshes[item.mesh]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)
-    r.set_material(_material(item.material)).set_display(tonemap=item.tonemap, background=item.background)
+    material, maps = _material(item.material)
+    r.set_material(material, **maps).set_display(tonemap=item.tonemap, background=item.background)
     r.set_camera(orbit_deg=item.camera_deg)
     Path(item.out).parent.mkdir(parents=True, exist_ok=True)
     r.save(item.out)
 
 
-def _material(m: Any):
-    from alight.core.material import with_overrides
-    from alight.exchange.presets import load_preset
-
-    def load(text: str):
-        if Path(text).suffix.lower() in (".gltf", ".glb"):
-            from alight.exchange.gltf_material import import_material
-
-            return import_material(text)
-        return load_preset(text)
-
+def _material(m: Any) -> tuple[Any, dict]:
+    """The item's material for ``Renderer.set_material``: (a preset name or file, a .gltf/.glb
+    with its maps, or a Material) and the keywords on top: texture_set and maps (the slots they
+    load get factor 1), then the spec's fields, which win."""
     if isinstance(m, str):
-        return load(m)
-    base = load(m["from"]) if "from" in m else load(m.get("preset", "gold")) if "preset" in m else None
-    if base is None:
+        return m, {}
+    if "from" in m or "preset" in m:
+        base = str(m["from"] if "from" in m else m["preset"])
+    else:
         from alight.core.material import Material
 
         base = Material()
-    fields = {k: (tuple(v) if isinstance(v, list) else v) for k, v in m.items() if k in MATERIAL_FIELDS}
+    keywords = {k: (tuple(v) if isinstance(v, list) else v) for k, v in m.items() if k in MATERIAL_FIELDS}
     if "name" in m:
-        fields["name"] = str(m["name"])
-    import dataclasses
-
-    return with_overrides(dataclasses.replace(base, name=fields.pop("name", base.name)), **fields)
+        keywords["name"] = str(m["name"])
+    for key in ("texture_set", "maps"):
+        if key in m:
+            keywords[key] = m[key]
+    return base, keywords

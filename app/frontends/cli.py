@@ -14,7 +14,7 @@ import time
 
 from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 from alight.errors import AlightError
-from alight.frontends.options import build_material
+from alight.frontends.options import build_look
 
 QUALITIES = ("low", "medium", "high")
 
@@ -136,6 +136,14 @@ def _add_material_options(p: argparse.ArgumentParser) -> None:
     m = p.add_argument_group("material (flags override the preset's fields)")
     m.add_argument("--preset", metavar="NAME|PATH",
                    help="a preset name (see 'alight presets') or a preset .json file; replaces the mesh file's own materials")
+    m.add_argument("--texture-set", metavar="DIR",
+                   help="a folder of texture maps assigned to slots by their names (Substance, ambientCG, Poly Haven, "
+                        "Quixel/Unreal suffixes: _BaseColor, _Normal(GL|DX), _Roughness, _Gloss, _Metallic, _AO, _ORM, "
+                        "...); the loaded slots' factors become 1 (glTF's convention); -v lists the assignment")
+    m.add_argument("--map", action="append", default=[], metavar="SLOT=PATH",
+                   help="one texture map (repeatable, after --texture-set): SLOT is base_color, metallic_roughness, "
+                        "metallic, roughness, normal, emissive, occlusion, or normal_dx (a DirectX normal map, "
+                        "green flipped), gloss (inverted into roughness), orm/arm (R occlusion, G rough, B metal)")
     m.add_argument("--base-color", metavar="R,G,B", help="linear base colour in [0,1]; the F0 of metals")
     m.add_argument("--metallic", type=_number("--metallic", 0.0, 1.0), metavar="X", help="0 dielectric .. 1 metal")
     m.add_argument("--roughness", type=_number("--roughness", 0.0, 1.0), metavar="X",
@@ -296,13 +304,16 @@ def build_parser() -> argparse.ArgumentParser:
                                    "the field flags on top) as glTF 2.0: a material-only .gltf, or --mesh with "
                                    "the material as .glb. A dielectric F0 other than 0.04 is written with "
                                    "KHR_materials_ior (and KHR_materials_specular when coloured).")
-    e.add_argument("--mesh", help="sphere, cube, plane, or a mesh file; .glb only (default for .glb: sphere)")
+    e.add_argument("--mesh", help="sphere, cube, plane, or a mesh file (default: none for .gltf, a material only; "
+                                  "sphere for .glb); written with UVs, tangents and the maps")
     e.add_argument("--material-from", metavar="FILE.gltf|FILE.glb",
                    help="start from this glTF file's material instead of a preset")
     e.add_argument("--material-index", type=int, default=0, metavar="N",
                    help="which material of --material-from (default: 0)")
     _add_material_options(e)
-    e.add_argument("--out", required=True, metavar="FILE.gltf|FILE.glb", help="the file to write")
+    e.add_argument("--out", required=True, metavar="FILE.gltf|FILE.glb",
+                   help="the file to write (.gltf: its images and .bin beside it)")
+    e.add_argument("--verbose", "-v", action="store_true", help="list the texture set's assignment and conversions")
     # --- end alight export ---------------------------------------------------------------
     # --- alight batch (app/frontends/batch.py) ---------------------------------------------------------
     bt = sub.add_parser("batch", help="render meshes x environments x materials x angles from a spec",
@@ -479,9 +490,10 @@ def _render(args) -> int:
         raise AlightError("--irradiance: --quality auto chooses the irradiance method itself")
     if args.quality != "auto" and args.error_budget is not None:
         raise AlightError("--error-budget: only with --quality auto")
-    material, overrides = build_material(args)
+    material, overrides, texture_maps = build_look(args)
 
     from alight.core.scene import Display, Scene, parse_light
+    from alight.exchange.texture_sets import load_map_images
     from alight.exchange.meshes import load_mesh
     from alight.ibl.environment import load_environment
 
@@ -505,7 +517,8 @@ def _render(args) -> int:
         from alight.core.material import parse_color
 
         display.background_color = parse_color(args.background_color, "--background-color")
-    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
+    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None and texture_maps is None,
+                  texture_maps=texture_maps, texture_images=load_map_images(texture_maps) if texture_maps else {},
                   material_overrides=overrides, lights=lights, camera=camera, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, ibl_model=args.ibl,
@@ -683,28 +696,27 @@ def _export(args) -> int:
     from alight.exchange.output import check_output_path
 
     out = check_output_path(args.out, (".gltf", ".glb"))
-    glb = out.suffix.lower() == ".glb"
-    if args.mesh is not None and not glb:
-        raise AlightError(f"{out}: a .gltf export is material-only; use .glb to include --mesh")
     if args.material_from is not None and args.preset is not None:
         raise AlightError("--material-from: give either --preset or --material-from, not both")
-    material, overrides = build_material(args)
-
-    from alight.core.material import with_overrides
-    from alight.exchange.gltf_material import (
-        export_material_gltf,
-        export_mesh_glb,
-        import_material,
-    )
-
     if args.material_from is not None:
-        material = with_overrides(import_material(args.material_from, args.material_index), **overrides)
-    if glb:
+        from alight.exchange.material_files import is_gltf
+
+        if not is_gltf(args.material_from):
+            raise AlightError(f"--material-from: {args.material_from} is not a .gltf or .glb file")
+        args.preset = args.material_from   # build_look reads its material and its maps
+    material, overrides, texture_maps = build_look(args, index=args.material_index)
+
+    from alight.exchange.gltf_export import export_gltf
+
+    mesh = None
+    if args.mesh is not None or out.suffix.lower() == ".glb":
         from alight.exchange.meshes import load_mesh
 
-        export_mesh_glb(load_mesh(args.mesh or "sphere"), material, out)
-    else:
-        export_material_gltf(material, out)
+        mesh = load_mesh(args.mesh or "sphere")
+    _, notes = export_gltf(material, out, texture_maps, mesh)
+    if args.verbose:
+        for line in notes:
+            print(f"alight: {line}", file=sys.stderr)
     print(out)
     return 0
 # --- end alight export --------------------------------------------------------------------
@@ -727,10 +739,11 @@ def _reference(args) -> int:
             raise AlightError(f"--env-level: '{args.env_level}' is not a whole number or 'auto'") from None
         if not 0 <= level <= 8:
             raise AlightError(f"--env-level: {level} is out of range [0, 8]")
-    material, overrides = build_material(args)
+    material, overrides, texture_maps = build_look(args)
 
     from alight.accuracy.reference import check_layer_roughness, check_roughness
     from alight.core.scene import Scene, parse_light
+    from alight.exchange.texture_sets import load_map_images
     from alight.exchange.meshes import load_mesh
     from alight.ibl.environment import load_environment
 
@@ -742,7 +755,8 @@ def _reference(args) -> int:
     env = None if args.no_ibl else load_environment(args.env)
     if env is not None:
         _warn(env.warnings)
-    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None,
+    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None and texture_maps is None,
+                  texture_maps=texture_maps, texture_images=load_map_images(texture_maps) if texture_maps else {},
                   material_overrides=overrides, lights=lights, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None)

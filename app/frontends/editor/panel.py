@@ -186,7 +186,7 @@ class Panel:
         self._browse("browse files", (".hdr", ".exr", ".obj", ".gltf", ".glb", ".ply", ".stl", ".json"),
                      s.open_file)
         _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
-        if imgui.button("export glTF"):   # .gltf: the material alone; .glb: the mesh with it
+        if imgui.button("export glTF"):   # the mesh with the material and its maps (.gltf or .glb)
             try:
                 s.export_gltf(self.gltf_path)
                 s.error, s.message = "", f"exported {self.gltf_path}"

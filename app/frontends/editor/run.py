@@ -13,15 +13,16 @@ from alight.frontends.editor.state import EditorState
 def build_state(args) -> EditorState:
     from alight.core.scene import parse_light
     from alight.errors import AlightError
-    from alight.frontends.options import build_material
+    from alight.frontends.options import build_look
 
     if args.view != "camera":   # (refused before anything is loaded)
         raise AlightError("edit: --view probe is 'alight render''s; the editor shows the camera view")
     # --motion-scale fixes the scale while moving; without it the scale adapts to hold 30 FPS.
     state = EditorState(quality=args.quality, aa=args.aa, motion_scale=args.motion_scale or 0.5,
                         adaptive_motion=args.motion_scale is None)
-    material, _ = build_material(args)
+    material, _, maps = build_look(args)
     state.material = state.saved_material = material
+    _start_maps(state, maps)
     state.load_mesh(args.mesh)
     state.load_env(args.env)
     if args.no_ibl:
@@ -29,7 +30,7 @@ def build_state(args) -> EditorState:
     # As in 'alight render': a mesh file without --preset shows its own materials and maps.
     from alight.core.mesh import BUILTIN_MESHES
 
-    state.use_file_materials = args.preset is None and args.mesh not in BUILTIN_MESHES
+    state.use_file_materials = args.preset is None and maps is None and args.mesh not in BUILTIN_MESHES
     # The rest of 'alight render''s scene options, as it reads them. Lights: --light replaces the
     # editor's three (state.default_lights); without it a glTF's own lights do, as in 'render'.
     state.env_rotation_deg, state.env_intensity = args.env_rotation, args.env_intensity
@@ -91,13 +92,23 @@ def _imgui_ini():
     return config_dir() / "imgui.ini"
 
 
+def _start_maps(state: EditorState, maps) -> None:
+    """--texture-set, --map and a .gltf --preset's maps, as 'alight render' draws them."""
+    if maps is not None:
+        from alight.exchange.texture_sets import load_map_images
+
+        state.map_images = load_map_images(maps)
+        state.texture_maps = maps
+
+
 def _no_scene_options(args) -> bool:
     from alight.core.material import LAYER_FIELDS
 
     material_flags = (args.preset, args.base_color, args.metallic, args.roughness, args.specular_f0,
                       args.emissive, args.ior, *(getattr(args, f) for f in LAYER_FIELDS))
     return (args.mesh, args.env) == ("sphere", "studio") and all(x is None for x in material_flags) \
-        and not args.light and (args.env_rotation, args.env_intensity) == (0.0, 1.0)
+        and not args.light and (args.env_rotation, args.env_intensity) == (0.0, 1.0) \
+        and not getattr(args, "texture_set", None) and not getattr(args, "map", None)
 
 
 def _benchmark(win, frames: int) -> int:

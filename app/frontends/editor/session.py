@@ -44,10 +44,11 @@ def restore_session(state, orbit) -> str:
     warning = ""
     state.material = state.saved_material = material
     # Each map is read again; one that no longer reads (moved, broken since) is left empty.
-    state.texture_maps = TextureMaps(uv_scale=maps.uv_scale, uv_offset=maps.uv_offset)
+    state.texture_maps = TextureMaps(uv_scale=maps.uv_scale, uv_offset=maps.uv_offset,
+                                     normal_dx=maps.normal_dx, roughness_gloss=maps.roughness_gloss)
     for slot, map_path in maps.paths().items():
         try:
-            state.set_map(slot, map_path)
+            state.set_map(slot, map_path, factor_to_1=False)
         except AlightError as exc:
             warning = str(exc)
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):

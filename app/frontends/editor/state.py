@@ -18,8 +18,8 @@ from alight.core.material import LAYER_FIELDS, Material, validate_material, with
 from alight.core.scene import TONEMAPS, Display, Light, Scene
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
-from alight.exchange.images import IMAGE_SUFFIXES, load_map_image
-from alight.exchange.presets import load_preset, save_preset
+from alight.exchange.images import IMAGE_SUFFIXES
+from alight.exchange.texture_sets import load_slot_image
 from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")
@@ -70,6 +70,7 @@ class EditorState:
     mesh: object = None
     env: object = None
     map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
+    map_conversions: dict = field(default_factory=dict)   # path -> the conversion its image was decoded with
 
     @property
     def look(self) -> tuple[Material, TextureMaps]:
@@ -122,12 +123,29 @@ class EditorState:
             warn(line)
         self.warnings = len(warnings)
 
-    def set_map(self, slot: str, path: str) -> None:
-        """Fill a texture slot from an image file (read now: a bad file raises, nothing changes)."""
+    def set_map(self, slot: str, path: str, factor_to_1: bool = True) -> None:
+        """Fill a texture slot from an image file (read now: a bad file raises, nothing changes).
+        The slot's factor becomes 1 (glTF's convention: the map is the value), unless
+        ``factor_to_1`` is False (a restored session keeps the factors it saved)."""
+        from alight.core.texture_maps import map_factors
+
         maps = self.texture_maps.with_slot(slot, path)
-        image = load_map_image(path)
+        image = load_slot_image(maps, slot)
         self.map_images = {p: self.map_images[p] for p in maps.paths().values() if p in self.map_images}
         self.map_images[path] = image
+        self.texture_maps = maps
+        if factor_to_1:
+            self.material = with_overrides(self.material, **map_factors((slot,)))
+
+    def set_map_conversion(self, name: str, on: bool) -> None:
+        """'normal_dx' (the normal map is DirectX's: green flipped) or 'roughness_gloss' (the
+        roughness slot holds gloss: inverted); the slot's image is decoded again."""
+        if name not in ("normal_dx", "roughness_gloss"):
+            raise AlightError(f"'{name}' is not a map conversion (normal_dx, roughness_gloss)")
+        maps = dataclasses.replace(self.texture_maps, **{name: bool(on)})
+        slot = "normal" if name == "normal_dx" else "roughness"
+        if getattr(maps, slot):
+            self.map_images = {**self.map_images, getattr(maps, slot): load_slot_image(maps, slot)}
         self.texture_maps = maps
 
     def clear_map(self, slot: str) -> None:
@@ -136,31 +154,68 @@ class EditorState:
     def sync_map_images(self) -> None:
         """Decode any slot's file not yet decoded (after undo/redo or a restored session); a file
         that no longer reads empties its slot and sets ``error``."""
+        maps = self.texture_maps
+        # An image decoded under the other conversion (undo of the DirectX or gloss toggle) again.
+        flags = {"normal": maps.normal_dx, "roughness": maps.roughness_gloss}
+        for slot, on in flags.items():
+            path = getattr(maps, slot)
+            if path and self.map_conversions.get(path, False) != on:
+                self.map_images.pop(path, None)
+            if path:
+                self.map_conversions[path] = on
         for slot, path in self.texture_maps.paths().items():
             if path not in self.map_images:
                 try:
-                    self.map_images[path] = load_map_image(path)
+                    self.map_images[path] = load_slot_image(self.texture_maps, slot)
                 except AlightError as exc:
                     self.texture_maps = self.texture_maps.with_slot(slot, "")
                     self.fail(exc)
 
     def load_material(self, name_or_path: str) -> None:
-        m = load_preset(name_or_path)
+        """A preset (.json: factors; .gltf/.glb: factors and maps, alight.exchange.material_files)."""
+        from alight.exchange.material_files import load_material_file
+        from alight.exchange.texture_sets import load_map_images
+
+        m, maps, warnings = load_material_file(name_or_path)
+        images = load_map_images(maps)   # read first: a bad map changes nothing
+        self._say(warnings)
         self.material = self.saved_material = m
+        self.texture_maps = dataclasses.replace(maps)
+        self.map_images = images
 
     def save_material(self, path: str) -> None:
-        save_preset(self.material, path)
+        """The material with its maps: .gltf (images beside it) or .glb with the mesh shown, so
+        the file reopens (here, in ``alight render --preset/--mesh``, other viewers) as drawn;
+        .json holds factors only and is refused when there are maps."""
+        from alight.exchange.material_files import is_gltf, save_material_file
+
+        save_material_file(self.material, path, self.texture_maps, mesh=self.mesh if is_gltf(path) else None)
         self.saved_material = self.material
 
     def export_gltf(self, path: str) -> None:
-        """The edited material as a material-only .gltf, or the mesh with it as a .glb
-        (alight.exchange.gltf_material: F0 other than 0.04 goes out as KHR_materials_ior/specular)."""
-        from alight.exchange.gltf_material import export_material_gltf, export_mesh_glb
+        """The edited material, its maps and the mesh (UVs, tangents) as .gltf or .glb
+        (alight.exchange.gltf_export: F0 other than 0.04 goes out as KHR_materials_ior/specular)."""
+        from alight.exchange.gltf_export import export_gltf
 
-        if Path(path).suffix.lower() == ".glb":
-            export_mesh_glb(self.mesh, self.material, path)
-        else:
-            export_material_gltf(self.material, path)
+        export_gltf(self.material, path, self.texture_maps, self.mesh)
+
+    def open_texture_set(self, paths) -> list[str]:
+        """Image files dropped together, assigned to slots by their names
+        (alight.exchange.texture_sets); the loaded slots' factors become 1 (glTF's convention;
+        one undo step). Returns the assignment's lines, also shown as the panel's message."""
+        from alight.core.texture_maps import map_factors
+        from alight.exchange.texture_sets import assign_files, load_map_images
+
+        found = assign_files(paths, self.texture_maps)
+        if not found.slots:
+            raise AlightError(f"{os.path.basename(paths[0])}: no file of the {len(paths)} has a texture map's name "
+                              f"(e.g. NAME_BaseColor.png, NAME_Normal.png); drop one at a time into the armed slot")
+        images = load_map_images(found.maps)
+        self.map_images = images
+        self.texture_maps = found.maps
+        self.material = with_overrides(self.material, **map_factors(found.slots))
+        self.error, self.message = "", "texture set: " + "; ".join(found.lines())
+        return found.lines()
 
     def open_file(self, path: str) -> bool:
         """A dropped or typed file, by its suffix. Returns False (and sets ``error``) on failure."""
@@ -170,8 +225,10 @@ class EditorState:
         try:
             if suffix in ENV_SUFFIXES:
                 self.load_env(path)
-            elif suffix in MESH_EXTENSIONS:
+            elif suffix in MESH_EXTENSIONS and not _material_only(path):
                 self.load_mesh(path)
+            elif suffix in (".gltf", ".glb"):   # a material without a mesh (alight export --out X.gltf)
+                self.load_material(path)
             elif suffix in PRESET_SUFFIXES:
                 self.load_material(path)
             elif suffix in IMAGE_SUFFIXES:    # a texture map, into the armed slot
@@ -262,6 +319,17 @@ class EditorState:
                 raise AlightError(f"--script: unknown field '{key}'")
         except ValueError:
             raise AlightError(f"--script: '{edit}': '{value}' is not a number") from None
+
+
+def _material_only(path: str) -> bool:
+    """A glTF file with materials and no meshes: opened as a material."""
+    from alight.exchange.gltf_material import read_gltf_json
+
+    try:
+        doc = read_gltf_json(path)
+    except AlightError:
+        return False   # load_mesh says what is wrong with it
+    return not doc.get("meshes") and bool(doc.get("materials"))
 
 
 def _finite(value: str, edit: str) -> float:

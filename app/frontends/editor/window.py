@@ -24,6 +24,7 @@ import time
 
 from alight.core.gpu import ShaderCompileError
 from alight.errors import AlightError
+from alight.exchange.images import IMAGE_SUFFIXES
 from alight.frontends.editor.camera import OrbitCamera
 from alight.frontends.editor.state import EditorState, History
 from alight.ibl.bake import QUALITY
@@ -127,9 +128,21 @@ class EditorWindow:
     # --- input --------------------------------------------------------------------------------
 
     def drop(self, paths: list[str]) -> None:
-        """glfw's drop callback: each file by its suffix; a bad one keeps the previous state."""
+        """glfw's drop callback: each file by its suffix; a bad one keeps the previous state.
+        Several image files dropped together are a texture set (``drop_texture_set``)."""
+        images = [p for p in paths if os.path.splitext(p)[1].lower() in IMAGE_SUFFIXES]
         for path in paths:
-            self.state.open_file(path)
+            if len(images) < 2 or path not in images:
+                self.state.open_file(path)
+        if len(images) >= 2:
+            self.drop_texture_set(images)
+
+    def drop_texture_set(self, images: list[str]) -> None:
+        """Images assigned to slots by their names (EditorState.open_texture_set), one undo step."""
+        try:
+            self.state.open_texture_set(images)
+        except Exception as exc:   # one line in the panel, never a traceback
+            self.state.fail(exc)
 
     def _camera_input(self) -> None:
         imgui, io = self.imgui, self.imgui.get_io()

@@ -1,0 +1,268 @@
+"""A material with its maps written as glTF 2.0: ``.gltf`` (JSON, its images and buffer beside
+it as files) or ``.glb`` (one file), optionally with a mesh (UVs and tangents included).
+
+The maps are ``alight.core.texture_maps.TextureMaps``; what goes out is what alight draws:
+
+    base_color, emissive            -> baseColorTexture, emissiveTexture (sRGB PNG)
+    normal (normal_dx: green flipped) -> normalTexture (OpenGL convention, as glTF defines)
+    occlusion                       -> occlusionTexture (R)
+    metallic_roughness              -> metallicRoughnessTexture (G roughness, B metal)
+    metallic, roughness (greyscale; roughness_gloss: inverted)
+                                    -> packed into that one image's B and G (a channel with no
+                                       map is 255, so its factor alone acts, as in the shader)
+    uv_scale, uv_offset             -> KHR_texture_transform on every textureInfo
+
+Images are written as PNG with the 8-bit values alight decoded (no re-encoding loss), so a file
+written here renders the same pixels through ``alight render --mesh`` (the file's material) and
+``--preset`` (alight.exchange.material_files). The factors come from
+``alight.exchange.gltf_material.material_to_gltf``. Every file is written atomically; the
+.gltf's JSON last, so a failure never leaves a document pointing at missing files.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+import struct
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from alight.core.material import Material
+from alight.core.texture_maps import TextureMaps
+from alight.errors import AlightError
+from alight.exchange.gltf_material import GLB_BIN, GLB_JSON, GLB_MAGIC, material_to_gltf
+from alight.exchange.output import atomic_path, check_output_path
+
+EXT_TRANSFORM = "KHR_texture_transform"
+# glTF sampler: LINEAR, LINEAR_MIPMAP_LINEAR, REPEAT: how alight samples a user's maps.
+SAMPLER = {"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}
+
+
+def _png(image: np.ndarray, channels: int) -> bytes:
+    from PIL import Image
+
+    buf = io.BytesIO()
+    pixels = np.ascontiguousarray(image[:, :, :channels])
+    Image.fromarray(pixels, "RGB" if channels == 3 else "RGBA").save(buf, "PNG")
+    return buf.getvalue()
+
+
+def _resized(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    from PIL import Image
+
+    if image.shape[1::-1] == size:
+        return image
+    return np.asarray(Image.fromarray(np.ascontiguousarray(image[:, :, :3]), "RGB").resize(size, Image.BILINEAR))
+
+
+def map_images(maps: TextureMaps) -> tuple[dict[str, np.ndarray], list[str]]:
+    """The glTF slots' images (slot -> (H, W, 3|4) uint8) for ``maps``, and one-line notes on
+    what was converted. Separate metallic/roughness maps are packed into one image (B metal,
+    G roughness; R the occlusion where an occlusion map of the same size exists, else 255)."""
+    from alight.exchange.texture_sets import load_slot_image
+
+    decoded = {slot: load_slot_image(maps, slot) for slot in maps.paths()}
+    out = {s: decoded[s] for s in ("base_color", "normal", "emissive", "occlusion", "metallic_roughness") if s in decoded}
+    notes = []
+    if "metallic" in decoded or "roughness" in decoded:
+        parts = [decoded[s] for s in ("metallic_roughness", "metallic", "roughness") if s in decoded]
+        size = max((p.shape[1], p.shape[0]) for p in parts)
+        if any(p.shape[1::-1] != size for p in parts):
+            notes.append(f"metallic and roughness maps of different sizes resized to {size[0]}x{size[1]} to pack them")
+        packed = (_resized(decoded["metallic_roughness"], size)[:, :, :3].copy() if "metallic_roughness" in decoded
+                  else np.full((size[1], size[0], 3), 255, np.uint8))
+        if "roughness" in decoded:
+            packed[:, :, 1] = _resized(decoded["roughness"], size)[:, :, 0]
+        if "metallic" in decoded:
+            packed[:, :, 2] = _resized(decoded["metallic"], size)[:, :, 0]
+        out["metallic_roughness"] = packed
+        notes.append("separate metallic and roughness maps packed into one metallicRoughness image (G rough, B metal)")
+    return out, notes
+
+
+def _texture_info(maps: TextureMaps, index: int) -> dict:
+    info: dict[str, Any] = {"index": index}
+    if tuple(maps.uv_scale) != (1.0, 1.0) or tuple(maps.uv_offset) != (0.0, 0.0):
+        (su, sv), (ou, ov) = maps.uv_scale, maps.uv_offset
+        # alight tiles OpenGL uvs (v up): uv * scale + offset. In glTF's (v down) that is the same
+        # scale with offset (ou, 1 - sv - ov) (v_gltf = 1 - v_gl on both sides).
+        info["extensions"] = {EXT_TRANSFORM: {"offset": [float(ou), float(1.0 - sv - ov)], "scale": [float(su), float(sv)]}}
+    return info
+
+
+class _Builder:
+    """The document and its binary data as they grow (buffer views 4-byte aligned)."""
+
+    def __init__(self, m: Material):
+        gm, used = material_to_gltf(m)
+        self.material = gm
+        self.used = set(used)
+        self.blob = bytearray()
+        self.doc: dict[str, Any] = {"asset": {"version": "2.0", "generator": "alight"}}
+        self.views: list[dict] = []
+        self.accessors: list[dict] = []
+        self.images: list[dict] = []
+        self.textures: list[dict] = []
+        self.files: dict[str, bytes] = {}     # image files beside a .gltf: name -> bytes
+        self._by_hash: dict[str, int] = {}
+
+    def view(self, data: bytes, target: int | None = None) -> int:
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        view: dict[str, Any] = {"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data)}
+        if target is not None:
+            view["target"] = target
+        self.views.append(view)
+        self.blob.extend(data)
+        return len(self.views) - 1
+
+    def accessor(self, array: np.ndarray, component: int, kind: str, target: int, bounds: bool) -> int:
+        acc: dict[str, Any] = {"bufferView": self.view(np.ascontiguousarray(array).tobytes(), target),
+                               "componentType": component, "type": kind,
+                               "count": int(array.shape[0]) if kind != "SCALAR" else int(array.size)}
+        if bounds:
+            acc["min"] = [float(x) for x in array.min(axis=0)]
+            acc["max"] = [float(x) for x in array.max(axis=0)]
+        self.accessors.append(acc)
+        return len(self.accessors) - 1
+
+    def texture(self, png: bytes, name: str, glb: bool) -> int:
+        """A texture for this PNG (one image and texture per distinct content)."""
+        key = hashlib.sha1(png).hexdigest()
+        if key in self._by_hash:
+            return self._by_hash[key]
+        if glb:
+            self.images.append({"bufferView": self.view(png), "mimeType": "image/png"})
+        else:
+            self.files[name] = png
+            self.images.append({"uri": name})
+        self.textures.append({"sampler": 0, "source": len(self.images) - 1})
+        self._by_hash[key] = len(self.textures) - 1
+        return self._by_hash[key]
+
+
+def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]:
+    images, notes = map_images(maps)
+    if not images:
+        return notes
+    gm, pbr = b.material, b.material["pbrMetallicRoughness"]
+    for slot in ("base_color", "metallic_roughness", "normal", "occlusion", "emissive"):
+        if slot not in images:
+            continue
+        index = b.texture(_png(images[slot], 3), f"{stem}_{slot}.png", glb)
+        info = _texture_info(maps, index)
+        if slot == "base_color":
+            pbr["baseColorTexture"] = info
+        elif slot == "metallic_roughness":
+            pbr["metallicRoughnessTexture"] = info
+        else:
+            gm[f"{slot}Texture"] = info
+    b.doc["samplers"] = [dict(SAMPLER)]
+    if any("extensions" in info for info in _infos(gm)):
+        b.used.add(EXT_TRANSFORM)
+    return notes
+
+
+def _infos(gm: dict) -> list[dict]:
+    pbr = gm.get("pbrMetallicRoughness", {})
+    return [x for x in (pbr.get("baseColorTexture"), pbr.get("metallicRoughnessTexture"), gm.get("normalTexture"),
+                        gm.get("occlusionTexture"), gm.get("emissiveTexture")) if x]
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    v = np.asarray(v, np.float64)
+    n = np.linalg.norm(v, axis=1, keepdims=True)
+    return v / np.where(n > 0, n, 1.0)
+
+
+def _tangents(normals: np.ndarray, tangents: np.ndarray) -> np.ndarray:
+    """(N, 4) float32 unit tangents with w = +-1, as the validator checks: a zero or parallel
+    tangent (a pole) is replaced by any direction orthogonal to the normal."""
+    t = np.asarray(tangents, np.float64)[:, :3]
+    t = t - normals * np.sum(t * normals, axis=1, keepdims=True)
+    bad = np.linalg.norm(t, axis=1) < 1e-6
+    if bad.any():
+        axis = np.where(np.abs(normals[bad, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+        t[bad] = np.cross(normals[bad], axis)
+    w = np.where(np.asarray(tangents, np.float64)[:, 3] < 0.0, -1.0, 1.0)
+    return np.concatenate([_unit(t), w[:, None]], axis=1).astype(np.float32)
+
+
+def _add_mesh(b: _Builder, mesh) -> None:
+    meshes, nodes = [], []
+    for part in mesh.parts:
+        positions = np.asarray(part.positions, np.float32)
+        normals = _unit(part.normals)
+        uvs = np.asarray(part.uvs, np.float32).copy()
+        uvs[:, 1] = 1.0 - uvs[:, 1]   # alight's uvs are OpenGL's (v up); glTF's v runs down
+        attrs = {"POSITION": b.accessor(positions, 5126, "VEC3", 34962, True),
+                 "NORMAL": b.accessor(normals.astype(np.float32), 5126, "VEC3", 34962, False),
+                 "TANGENT": b.accessor(_tangents(normals, part.tangents), 5126, "VEC4", 34962, False),
+                 "TEXCOORD_0": b.accessor(uvs, 5126, "VEC2", 34962, False)}
+        idx = b.accessor(np.asarray(part.indices, np.uint32).reshape(-1), 5125, "SCALAR", 34963, False)
+        meshes.append({"name": part.name, "primitives": [{"attributes": attrs, "indices": idx, "material": 0}]})
+        nodes.append({"name": part.name, "mesh": len(meshes) - 1})
+    b.doc.update({"scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes})
+
+
+def export_gltf(material: Material, path: str | os.PathLike, maps: TextureMaps | None = None,
+                mesh=None) -> tuple[Path, list[str]]:
+    """Write ``material`` with ``maps`` (and ``mesh``, an alight.core.mesh.Mesh, when given)
+    to ``path`` (.gltf: images ``STEM_SLOT.png`` and ``STEM.bin`` beside it; .glb: one file).
+    Returns the path and one-line notes on what was converted. Errors: AlightError naming the
+    file (an unwritable folder, a map that does not read)."""
+    out = check_output_path(path, (".gltf", ".glb"))
+    glb = out.suffix.lower() == ".glb"
+    b = _Builder(material)
+    notes = _add_maps(b, maps or TextureMaps(), out.stem, glb)
+    if mesh is not None:
+        _add_mesh(b, mesh)
+    while len(b.blob) % 4:
+        b.blob.append(0)
+    doc = b.doc
+    doc["materials"] = [b.material]
+    if b.used:
+        doc["extensionsUsed"] = sorted(b.used)
+    for key, value in (("accessors", b.accessors), ("bufferViews", b.views), ("images", b.images),
+                       ("textures", b.textures)):
+        if value:
+            doc[key] = value
+    if b.blob:
+        doc["buffers"] = [{"byteLength": len(b.blob)} if glb else {"byteLength": len(b.blob), "uri": f"{out.stem}.bin"}]
+    try:
+        if glb:
+            _write(out, _glb(doc, bytes(b.blob)))
+        else:
+            for name, data in b.files.items():
+                _write(out.with_name(name), data)
+            if b.blob:
+                _write(out.with_name(f"{out.stem}.bin"), bytes(b.blob))
+            _write(out, (json.dumps(doc, indent=1) + "\n").encode("utf-8"))
+    except OSError as e:
+        raise AlightError(f"{out}: cannot write ({e.strerror or e})") from None
+    return out, notes
+
+
+def export_mesh_glb(mesh, m: Material, path: str | os.PathLike) -> Path:
+    """Every part of an alight.core.mesh.Mesh (world space) as one node each, all with material
+    ``m`` (factors only), as .glb: positions, normals, tangents and uvs."""
+    return export_gltf(m, check_output_path(path, (".glb",)), None, mesh)[0]
+
+
+def _glb(doc: dict, blob: bytes) -> bytes:
+    json_bytes = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    json_bytes += b" " * (-len(json_bytes) % 4)   # chunks are 4-byte aligned; JSON pads with spaces
+    chunks = [struct.pack("<II", len(json_bytes), GLB_JSON), json_bytes]
+    if blob:
+        chunks += [struct.pack("<II", len(blob), GLB_BIN), blob]
+    body = b"".join(chunks)
+    return struct.pack("<III", GLB_MAGIC, 2, 12 + len(body)) + body
+
+
+def _write(out: Path, data: bytes) -> None:
+    with atomic_path(out) as tmp:
+        tmp.write_bytes(data)
