@@ -35,7 +35,10 @@ def test_include_is_inlined_once_with_defines_after_version(tmp_path):
     (tmp_path / "main.comp").write_text('#version 450 core\n#include "common/a.glsl"\n#include "common/b.glsl"\nvoid main() {}\n')
     src = gpu.load_source("main.comp", {"QUALITY": 2}, root=tmp_path)
     lines = src.text.splitlines()
-    assert lines[0] == "#version 450 core" and lines[1] == "#define QUALITY 2"
+    # The version first, then the shared names (app/core/shader_names.py), then the caller's defines.
+    generated = len(gpu.glsl_header())
+    assert lines[0] == "#version 450 core" and lines[1:1 + generated] == gpu.glsl_header()
+    assert lines[1 + generated] == "#define QUALITY 2"
     assert src.text.count("float a()") == 1                 # included twice, inlined once
     assert [p.name for p in src.files] == ["main.comp", "a.glsl", "b.glsl"]
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import moderngl
 
+from alight.core.shader_names import SHADER_OPTIONS, glsl_header
 from alight.errors import AlightError
 from alight.paths import shader_dir
 
@@ -66,8 +67,17 @@ class ShaderCompileError(AlightError):
 
 def load_source(name: str, defines: dict[str, object] | None = None, root: Path | None = None) -> ShaderSource:
     """Read ``shaders/<name>``, inline each ``#include "path"`` once (relative to shaders/), and put
-    ``#define``s after ``#version``. ``#line`` directives carry a file number so that compiler
-    messages can be mapped back to the file and line (see ``translate_log``)."""
+    ``#define``s after ``#version``: first the names both languages share
+    (``app/core/shader_names.py``'s ``glsl_defines``), then ``defines``. ``#line`` directives carry a
+    file number so that compiler messages can be mapped back to the file and line (see
+    ``translate_log``). For alight's own shaders (``root`` None) a define that
+    ``shader_names.SHADER_OPTIONS`` does not declare is refused (ShaderCompileError): a misspelt
+    option would otherwise compile the default silently."""
+    if root is None:
+        unknown = sorted(set(defines or {}) - set(SHADER_OPTIONS))
+        if unknown:
+            raise ShaderCompileError(f"{name}: shader option(s) {', '.join(unknown)} not declared in "
+                                     "app/core/shader_names.py SHADER_OPTIONS")
     root = root or shader_dir()
     files: list[Path] = []
     included: set[Path] = set()
@@ -103,6 +113,7 @@ def load_source(name: str, defines: dict[str, object] | None = None, root: Path 
         first_line = 2
     else:
         header.append(f"#version {GL_VERSION} core")
+    header.extend(glsl_header())
     for key, value in (defines or {}).items():
         header.append(f"#define {key} {value}" if value is not None else f"#define {key}")
     header.append(f"#line {first_line}")

@@ -34,16 +34,26 @@ import moderngl
 import numpy as np
 
 from alight.core.gpu import ShaderLibrary, create_headless_context
-from alight.core.ibl_models import SUNS_AS_BAKED, ibl_model_index
+from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.layers import layer_defines
 from alight.core.material import LAYERS, Material, with_overrides
 from alight.core.mesh import MeshPart, is_closed, sphere
 from alight.core.scene import (
-    TONEMAPS,
     Camera,
     Display,
     Scene,
     frame_camera,
+)
+from alight.core.shader_names import (
+    MATERIAL_MAPS,
+    AlphaMode,
+    BackgroundMode,
+    IblModel,
+    LightKind,
+    Tonemap,
+    glsl_member,
+    map_bit,
+    map_mask,
 )
 from alight.core.shading import rotate_world_to_map
 from alight.core.sphere_lod import (
@@ -96,9 +106,6 @@ HALF_FLOAT_MIN_EXPOSURE = -6.0
 
 # Texture units, fixed so that binding one map never disturbs another.
 UNIT_IRRADIANCE, UNIT_PREFILTERED, UNIT_PREFILTERED_MID, UNIT_LUT, UNIT_ENVIRONMENT, UNIT_RADIANCE = range(6)
-MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
-                 "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy",
-                 "transmission", "thickness", "specular", "specular_color")
 UNIT_MATERIAL = {name: 6 + i for i, name in enumerate(MATERIAL_MAPS)}
 UNIT_SHEEN_LUT = 6 + len(MATERIAL_MAPS)   # the sheen LUT (common/sheen.glsl), bound with HAS_SHEEN
 UNIT_TRANSMISSION_LUT = UNIT_SHEEN_LUT + 1          # ibl/transmission_lut.comp's table (HAS_VOLUME)
@@ -821,7 +828,7 @@ class ForwardRenderer:
         self._last_surface_rect_args = (scene, view_projection, (targets.width, targets.height))
         ring = None
         if self.background_ring and impostor and self._impostor_samples == 1 and background \
-                and self._background_mode(scene, maps) != 3 \
+                and self._background_mode(scene, maps) != BackgroundMode.TRANSPARENT \
                 and not self.transmissive_parts(scene):
             hole = impostor_hole_model(camera.position, scene.mesh.lod_sphere[0], impostor[1])
             ring = impostor_background_ring(hole, view_projection) if hole is not None else None
@@ -900,7 +907,7 @@ class ForwardRenderer:
     @staticmethod
     def _ibl_defines(scene: Scene) -> dict:
         """The shader defines that pick the scene's IBL model (app/core/ibl_models.py)."""
-        defines = {"IBL_MODEL": ibl_model_index(scene.ibl_model)}
+        defines = {"IBL_MODEL": int(glsl_member(IblModel, scene.ibl_model))}
         if scene.multiple_scattering:
             defines["MULTIPLE_SCATTERING"] = None
         return defines
@@ -943,7 +950,7 @@ class ForwardRenderer:
             if self._half_output:
                 defines = {**(defines or {}), "HALF_FLOAT_OUTPUT": None}
             return self.program(vertex, fragment, defines)
-        defines = {**(defines or {}), "DISPLAY_OUTPUT": None, "TONEMAP_MODE": TONEMAPS.index(display.tonemap)}
+        defines = {**(defines or {}), "DISPLAY_OUTPUT": None, "TONEMAP_MODE": int(glsl_member(Tonemap, display.tonemap))}
         if self._srgb_by_framebuffer:
             defines["SRGB_BY_FRAMEBUFFER"] = None
         prog = self.program(vertex, fragment, defines)
@@ -1024,7 +1031,7 @@ class ForwardRenderer:
         lights = scene.lights[:MAX_LIGHTS]
         for i, light in enumerate(lights):
             vectors[i, :3] = light.vector
-            vectors[i, 3] = {"point": 0.0, "directional": 1.0, "spot": 2.0}[light.kind]
+            vectors[i, 3] = float(glsl_member(LightKind, light.kind))
             radiance[i, :3] = np.asarray(light.color, np.float32) * light.intensity
             if light.kind == "spot":
                 d = np.asarray(light.direction, np.float64)
@@ -1043,20 +1050,21 @@ class ForwardRenderer:
         self._lights_ubo.bind_to_uniform_block(0)
 
     @staticmethod
-    def _background_mode(scene: Scene, maps: IBLMaps | None) -> int:
-        """common/background.glsl's BACKGROUND_MODE for the scene (3: none)."""
-        mode = scene.display.background
-        if mode == "transparent" or (mode in ("env", "blur") and maps is None):
-            return 3
-        return {"env": 0, "blur": 1, "color": 2}[mode]
+    def _background_mode(scene: Scene, maps: IBLMaps | None) -> BackgroundMode:
+        """common/background.glsl's BACKGROUND_MODE for the scene: an environment background without
+        an environment draws nothing."""
+        mode = glsl_member(BackgroundMode, scene.display.background)
+        if mode in (BackgroundMode.ENV, BackgroundMode.BLUR) and maps is None:
+            return BackgroundMode.TRANSPARENT
+        return mode
 
     @staticmethod
     def _bind_background(prog: moderngl.Program, scene: Scene, maps: IBLMaps | None, inverse_vp: np.ndarray,
                          mode: int) -> None:
         """common/background.glsl's inputs."""
-        if mode == 2:
+        if mode == BackgroundMode.COLOR:
             prog["u_color"] = tuple(scene.display.background_color)
-        elif mode in (0, 1):
+        elif mode in (BackgroundMode.ENV, BackgroundMode.BLUR):
             maps.environment.use(UNIT_ENVIRONMENT)
             maps.prefiltered_radiance.use(UNIT_PREFILTERED)
             # Grid A's mip for the blur roughness (half the grid step; see bake.grid_roughness).
@@ -1071,9 +1079,9 @@ class ForwardRenderer:
         """The background pass: a full-screen triangle, or ``ring``'s triangles ((n, 2) NDC
         points, sphere_lod.impostor_background_ring) where the impostor fills the rest."""
         mode = self._background_mode(scene, maps)
-        if mode == 3:
+        if mode == BackgroundMode.TRANSPARENT:
             return
-        defines = {"BACKGROUND_MODE": mode}
+        defines = {"BACKGROUND_MODE": int(mode)}
         if ring is not None:
             defines["BACKGROUND_RING"] = None
         prog = self._scene_program("render/background.vert", "render/background.frag", defines)
@@ -1096,13 +1104,13 @@ class ForwardRenderer:
         mode = self._background_mode(scene, maps)
         # After the sphere's impostor the surfaces are in the single-sample stand-in, resolved already.
         single = self._impostor_samples == 4
-        defines = {"BACKGROUND_MODE": mode, "SCENE_SAMPLES": 1 if single else targets.samples}
+        defines = {"BACKGROUND_MODE": int(mode), "SCENE_SAMPLES": 1 if single else targets.samples}
         scene_texture = targets.single()[0] if single else targets.color
         if radiance:
             defines["RADIANCE_OUTPUT"] = None
         if display:
             defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
-            defines["TONEMAP_MODE"] = TONEMAPS.index(scene.display.tonemap)
+            defines["TONEMAP_MODE"] = int(glsl_member(Tonemap, scene.display.tonemap))
         w, h = targets.width, targets.height
         rect = self._surface_rect(*self._last_surface_rect_args)
         if rect is None or rect == (0, 0, w, h):
@@ -1249,10 +1257,9 @@ class ForwardRenderer:
         defines: dict = {}
         if file_material:
             present = set(gpu_part.textures)
-            bits = {name: 1 << i for i, name in enumerate(MATERIAL_MAPS)}
             masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
             for name, info in gpu_part.infos.items():
-                bit = bits[name]
+                bit = map_bit(name)
                 if info.tex_coord == 1 and gpu_part.has_uv1:
                     masks["MAP_UV1_MASK"] |= bit
                 if info.transform is not None:
@@ -1265,16 +1272,16 @@ class ForwardRenderer:
             if masks["MAP_UV1_MASK"]:
                 defines["HAS_UV1"] = None
             if fm.alpha_mode == "MASK":
-                defines["ALPHA_MODE"] = 1
+                defines["ALPHA_MODE"] = int(AlphaMode.MASK)
             elif fm.alpha_mode == "BLEND":
-                defines["ALPHA_MODE"] = 2
+                defines["ALPHA_MODE"] = int(AlphaMode.BLEND)
             if fm.unlit:
                 defines["UNLIT"] = None
         else:
             present = set(user_maps)
         if gpu_part.has_colors and scene.use_file_materials:
             defines["HAS_VERTEX_COLOR"] = None
-        defines["MATERIAL_MAPS_MASK"] = sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in present)
+        defines["MATERIAL_MAPS_MASK"] = map_mask(present & set(MATERIAL_MAPS))
         # The layers this part's material uses, and only those (alight.core.layers).
         defines.update(layer_defines([ForwardRenderer._part_material(scene, part)[0]]))
         return defines
@@ -1432,7 +1439,7 @@ class ForwardRenderer:
     def tonemap(self, radiance: moderngl.Texture, display: Display, fbo: moderngl.Framebuffer,
                 opaque: bool = True) -> None:
         prog = self.program("render/fullscreen.vert", "render/tonemap.frag",
-                            {"TONEMAP_MODE": TONEMAPS.index(display.tonemap)})
+                            {"TONEMAP_MODE": int(glsl_member(Tonemap, display.tonemap))})
         radiance.use(UNIT_RADIANCE)
         prog["u_exposure_scale"] = float(2.0 ** display.exposure)
         prog["u_opaque"] = opaque

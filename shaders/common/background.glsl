@@ -4,10 +4,7 @@
 // the resolved samples).
 #include "common/equirect.glsl"
 
-#define BACKGROUND_ENV 0
-#define BACKGROUND_BLUR 1
-#define BACKGROUND_COLOR 2
-#define BACKGROUND_NONE 3
+// BACKGROUND_ENV, _BLUR, _COLOR, _TRANSPARENT: app/core/shader_names.py BackgroundMode (generated).
 // The mode is compiled in (app/render/renderer.py sets it): llvmpipe runs both sides of a branch, so a
 // uniform mode would cost the sharp and the blurred fetch at every pixel.
 #ifndef BACKGROUND_MODE
@@ -25,7 +22,7 @@ uniform vec3 u_color;
 vec3 background_radiance(vec3 ray) {
 #if BACKGROUND_MODE == BACKGROUND_COLOR
     return u_color;
-#elif BACKGROUND_MODE == BACKGROUND_NONE
+#elif BACKGROUND_MODE == BACKGROUND_TRANSPARENT
     return vec3(0.0);
 #else
     vec3 d = rotate_world_to_map(normalize(ray), u_env_rotation);

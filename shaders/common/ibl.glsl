@@ -6,10 +6,11 @@
 
 #include "common/suns.glsl"
 
-// The model: IBL_MODEL is the position of its name in app/core/ibl_models.py's IBL_MODELS, set by
-// app/render/renderer.py (ibl_model below), so only the chosen model is compiled.
+// The model: IBL_MODEL is one of the IBL_MODEL_* names generated from app/core/ibl_models.py's
+// IBL_MODELS (app/core/shader_names.py IblModel), set by app/render/renderer.py (ibl_model below), so
+// only the chosen model is compiled.
 #ifndef IBL_MODEL
-#define IBL_MODEL 4
+#define IBL_MODEL IBL_MODEL_ALIGHT
 #endif
 
 uniform samplerCube u_irradiance;            // E/pi: the cosine-weighted mean radiance
@@ -128,7 +129,7 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
     return normalize(mix(n, r, t));
 }
 
-#if IBL_MODEL == 5
+#if IBL_MODEL == IBL_MODEL_STRETCHED
 // ---- the stretched lobe (model `stretched`) -------------------------------------------------
 
 // app/core/stretched_lobe.json over (n.v, roughness) at texel centres, for the lobe's F0-scaled
@@ -256,7 +257,7 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
 #ifdef HAS_ANISOTROPY
     lut.xy *= anisotropic_energy_ratio(s, n, v);
     vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, d, with_suns);
-#elif IBL_MODEL == 5
+#elif IBL_MODEL == IBL_MODEL_STRETCHED
     vec3 prefiltered = stretched_prefiltered_radiance(n, v, f0, lut, s.roughness, d, with_suns);
 #else
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
@@ -300,18 +301,17 @@ vec3 ibl_stretched(Surface s, vec3 n, vec3 v) {
     return ibl_alight(s, n, v);
 }
 
-// The model the forward pass uses: IBL_MODEL is the position of its name in app/core/ibl_models.py's
-// IBL_MODELS, set by app/render/renderer.py, so only the chosen model is compiled.
+// The model the forward pass uses (IBL_MODEL, above), so only the chosen model is compiled.
 vec3 ibl_model(Surface s, vec3 n, vec3 v) {
-#if IBL_MODEL == 0
+#if IBL_MODEL == IBL_MODEL_LECTURE
     return ibl_lecture(s, n, v);
-#elif IBL_MODEL == 1
+#elif IBL_MODEL == IBL_MODEL_LECTURE_SCHLICK
     return ibl_lecture_schlick(s, n, v);
-#elif IBL_MODEL == 2
+#elif IBL_MODEL == IBL_MODEL_KARIS
     return ibl_karis(s, n, v);
-#elif IBL_MODEL == 3
+#elif IBL_MODEL == IBL_MODEL_DOMINANT
     return ibl_dominant(s, n, v);
-#elif IBL_MODEL == 4
+#elif IBL_MODEL == IBL_MODEL_ALIGHT
     return ibl_alight(s, n, v);
 #else
     return ibl_stretched(s, n, v);

@@ -86,11 +86,11 @@ uniform bool u_has_thickness_map;             // G multiplies thickness
 uniform sampler2D u_thickness_map;
 #endif
 
-// The maps compiled in, a bit each (app/render/renderer.py MATERIAL_MAPS order). llvmpipe runs both
+// The maps compiled in, a bit each (app/core/shader_names.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
 // passes only the bits of maps present, and has_map() folds to false for the rest. Unset: all.
 #ifndef MATERIAL_MAPS_MASK
-#define MATERIAL_MAPS_MASK 131071
+#define MATERIAL_MAPS_MASK MAP_ALL
 #endif
 #ifndef MAP_UV1_MASK
 #define MAP_UV1_MASK 0
@@ -104,26 +104,10 @@ uniform sampler2D u_thickness_map;
 #ifndef MAP_MIRROR_T_MASK
 #define MAP_MIRROR_T_MASK 0
 #endif
-const int MAP_BASE_COLOR = 1;
-const int MAP_METALLIC_ROUGHNESS = 2;
-const int MAP_NORMAL = 4;
-const int MAP_EMISSIVE = 8;
-const int MAP_OCCLUSION = 16;
-const int MAP_METALLIC = 32;
-const int MAP_ROUGHNESS = 64;
-const int MAP_CLEARCOAT = 128;
-const int MAP_CLEARCOAT_ROUGHNESS = 256;
-const int MAP_CLEARCOAT_NORMAL = 512;
-const int MAP_SHEEN_COLOR = 1024;
-const int MAP_SHEEN_ROUGHNESS = 2048;
-const int MAP_ANISOTROPY = 4096;
-const int MAP_TRANSMISSION = 8192;
-const int MAP_THICKNESS = 16384;
-const int MAP_SPECULAR = 32768;
-const int MAP_SPECULAR_COLOR = 65536;
-const int MAP_SLOTS = 17;
-// KHR_materials_specular's textures, compiled in only where a part has one (the mask's bits 15, 16).
-#if (MATERIAL_MAPS_MASK & 98304) != 0
+// MAP_BASE_COLOR ... MAP_SPECULAR_COLOR (a bit each), MAP_SLOTS and MAP_ALL: app/core/shader_names.py
+// MATERIAL_MAPS (generated).
+// KHR_materials_specular's textures, compiled in only where a part has one 
+#if (MATERIAL_MAPS_MASK & (MAP_SPECULAR | MAP_SPECULAR_COLOR)) != 0
 #define HAS_SPECULAR_MAPS
 uniform bool u_has_specular_map;              // A multiplies specularFactor
 uniform bool u_has_specular_color_map;        // RGB (sRGB) multiplies specularColorFactor

@@ -2,9 +2,7 @@
 // integral). Spot cones and range windows are compiled in only for scenes that have them
 // (PUNCTUAL_SPOT, PUNCTUAL_RANGE): llvmpipe runs both sides of a branch.
 
-const int LIGHT_POINT = 0;
-const int LIGHT_DIRECTIONAL = 1;
-const int LIGHT_SPOT = 2;
+// LIGHT_POINT, LIGHT_DIRECTIONAL, LIGHT_SPOT: app/core/shader_names.py LightKind (generated).
 const int MAX_LIGHTS = 16;
 
 // xyz: position (point, spot) or direction the light travels (directional); w: LIGHT_* type.

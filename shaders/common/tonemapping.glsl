@@ -1,8 +1,6 @@
 // Exposure, tone mapping and the sRGB curve. Numpy twins: app/core/shading.py.
 
-const int TONEMAP_NONE = 0;
-const int TONEMAP_ACES = 1;
-const int TONEMAP_NEUTRAL = 2;
+// TONEMAP_NONE, TONEMAP_ACES, ...: app/core/shader_names.py Tonemap (generated).
 
 // Exposed radiance is limited to this before a curve: both curves are white (to 1/255) far
 // below it, so no pixel changes, and the ACES fit's v*v stays finite in float32 (a 1e30 texel,

@@ -1,7 +1,8 @@
 #version 450 core
 // Forward PBR pass: a mesh with the metal-roughness material (factors times glTF textures).
-// ALPHA_MODE (glTF 2.0 material.alphaMode): unset or 0 OPAQUE (alpha ignored, written as 1),
-// 1 MASK (fragments below the cutoff discarded), 2 BLEND (alpha written; the renderer blends).
+// ALPHA_MODE (glTF 2.0 material.alphaMode; app/core/shader_names.py AlphaMode): unset or OPAQUE
+// (alpha ignored, written as 1), MASK (fragments below the cutoff discarded), BLEND (alpha
+// written; the renderer blends).
 // UNLIT (KHR_materials_unlit): the base colour is the radiance.
 // SPHERE_IMPOSTOR: the built-in sphere's proxy, coverage per pixel (common/mesh_material.glsl).
 #include "common/shading.glsl"
@@ -16,9 +17,9 @@ void main() {
     float coverage = sphere_coverage();
     if (coverage == 0.0) discard;
 #endif
-#if defined(ALPHA_MODE) && ALPHA_MODE != 0
+#if defined(ALPHA_MODE) && ALPHA_MODE != ALPHA_MODE_OPAQUE
     float alpha = material_alpha();
-#if ALPHA_MODE == 1
+#if ALPHA_MODE == ALPHA_MODE_MASK
     if (alpha < u_alpha_cutoff) discard;
     alpha = 1.0;
 #endif

@@ -16,6 +16,7 @@ from pathlib import Path
 from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 from alight.core.material import LAYER_FIELDS, Material, validate_material, with_overrides
 from alight.core.scene import TONEMAPS, Display, Light, Scene
+from alight.core.shader_names import DATA_VIEWS, DEBUG_VIEWS
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
@@ -24,11 +25,6 @@ from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
-# shaders/common/debug_views.glsl's u_debug_view, in order; DATA_VIEWS show values, not radiance.
-DEBUG_VIEWS = ("shaded", "base colour", "normal", "roughness", "metallic", "F0", "n.v", "diffuse only (IBL)",
-               "specular only (IBL)", "irradiance", "prefiltered radiance at mip", "BRDF LUT", "D (first light)",
-               "G (first light)", "F (first light)")
-DATA_VIEWS = {1, 2, 3, 4, 5, 6, 11, 12, 13, 14}
 VECTOR_LAYER_FIELDS = ("sheen_color", "attenuation_color")
 SCALAR_LAYER_FIELDS = tuple(f for f in LAYER_FIELDS if f not in VECTOR_LAYER_FIELDS)
 
