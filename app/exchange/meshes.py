@@ -61,8 +61,17 @@ def load_mesh(spec: str) -> Mesh:
 
     import trimesh  # lazily: importing trimesh costs start-up time the built-ins do not need
 
+    faces = _obj_faces(spec, path) if ext == ".obj" else None
     try:
-        scene = trimesh.load(str(path), force="scene", process=False)
+        if faces is not None and faces.rewrite is not None:
+            import io
+
+            # The faces made explicit (ear-clipped, normals written): trimesh reads the rewritten
+            # text, and the MTL and textures beside the file through the resolver.
+            scene = trimesh.load(io.BytesIO(faces.rewrite), file_type="obj", force="scene", process=False,
+                                 resolver=trimesh.resolvers.FilePathResolver(str(path)))
+        else:
+            scene = trimesh.load(str(path), force="scene", process=False)
     except Exception as exc:  # trimesh raises anything from ValueError to KeyError on bad files
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     try:
@@ -70,6 +79,10 @@ def load_mesh(spec: str) -> Mesh:
         textures: dict[int, np.ndarray] = {}
         warnings: list[str] = []
         if ext == ".obj":
+            warnings += _unknown_materials(spec, path, faces.usemtl)
+            if faces.fan_fallbacks:
+                warnings.append(f"{spec}: {faces.fan_fallbacks} polygon(s) that do not lie flat or cross "
+                                f"themselves could not be ear-clipped; drawn as fans")
             from alight.exchange.mtl import missing_libraries
 
             _attach_diffuse_maps(spec, path, extras, textures)
@@ -89,6 +102,10 @@ def load_mesh(spec: str) -> Mesh:
             geom = scene.geometry.get(geom_name)
             if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
                 continue  # point clouds and line paths have no triangles to render
+            if ext == ".stl":
+                # STL is a list of facets: flat. trimesh's ASCII reader shares the corners of
+                # touching facets (the binary one does not), which smoothed across every edge.
+                geom.unmerge_vertices()
             part = _part_from_trimesh(spec, str(node), geom, np.asarray(transform), textures, extras, warnings)
             if part is not None:
                 parts.append(part)
@@ -99,6 +116,36 @@ def load_mesh(spec: str) -> Mesh:
     if not parts:
         raise AlightError(f"{spec}: no triangles in the file")
     return Mesh(parts, str(spec), warnings=warnings)
+
+
+def _obj_faces(spec: str, path: Path):
+    """The OBJ's faces made explicit (alight.exchange.obj_faces); a file that cannot be read is
+    an AlightError naming it."""
+    from alight.exchange.obj_faces import read_faces
+
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise AlightError(f"{spec}: cannot read the file ({e.strerror or e})") from None
+    return read_faces(data)
+
+
+def _unknown_materials(spec: str, path: Path, usemtl: dict[str, int]) -> list[str]:
+    """One line naming the ``usemtl`` materials that no MTL file defines (drawn with the default
+    material, which trimesh does silently); none when an mtllib is missing (said already)."""
+    from alight.exchange.mtl import material_names, missing_libraries
+
+    if not usemtl or missing_libraries(path):
+        return []
+    known = material_names(path)
+    unknown = [(name, line) for name, line in usemtl.items() if name not in known]
+    if not unknown:
+        return []
+    where = "the MTL files do not define" if known else "no mtllib defines"
+    listed = ", ".join(f"'{name}' (line {line})" for name, line in unknown[:5])
+    more = f" and {len(unknown) - 5} more" if len(unknown) > 5 else ""
+    return [f"{spec}: usemtl {listed}{more}: {where} {'it' if len(unknown) == 1 else 'them'}; drawn with "
+            f"the default material"]
 
 
 def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
