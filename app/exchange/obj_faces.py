@@ -153,11 +153,19 @@ def read_faces(data: bytes) -> ObjFaces:
 
     out = list(lines)
     polygons = fans = 0
+    flat_index: dict[tuple[float, float, float], int] = {}
     for (number, corners, grp), nn in zip(faces, face_normal):
         if any(c[2] is None for c in corners):
+            if not np.linalg.norm(nn) > 0.0:
+                out[number] = b""      # no area, no normal: nothing to draw (dropped as before)
+                continue
             if grp == 0:
-                new_normals.append(unit(nn))
-                flat = n_vn + len(new_normals) - 1
+                n = unit(nn)
+                key = tuple(np.round(n, 9))      # coplanar faces share one vn: fewer vertices
+                if key not in flat_index:
+                    new_normals.append(n)
+                    flat_index[key] = n_vn + len(new_normals) - 1
+                flat = flat_index[key]
                 corners = [(v, vt, flat if vn is None else vn) for v, vt, vn in corners]
             else:
                 filled = []
