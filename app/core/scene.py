@@ -18,7 +18,10 @@ if TYPE_CHECKING:
     from alight.core.texture_maps import TextureMaps
 
 VIEWS = ("camera", "probe")
-TONEMAPS = ("none", "aces", "neutral")
+# The display curves, in tonemapping.glsl's TONEMAP_* order: 'aces' is Hill's fit (alight's
+# default, as before), 'aces-hill' the same by the Sample Viewer's name; 'neutral' is Khronos PBR
+# Neutral. docs/files_notes.md says which peer uses which by default.
+TONEMAPS = ("none", "aces", "neutral", "aces-narkowicz", "aces-hill", "aces-hill-exposure-boost", "agx")
 BACKGROUNDS = ("env", "blur", "color", "transparent")
 LIGHT_KINDS = ("point", "directional", "spot")
 

@@ -19,6 +19,8 @@ from alight.errors import AlightError
 from alight.frontends.options import build_material
 
 QUALITIES = ("low", "medium", "high")
+# alight.core.scene.TONEMAPS, written out so that --help needs no numpy (a test keeps them equal).
+TONEMAP_CHOICES = ("none", "aces", "neutral", "aces-narkowicz", "aces-hill", "aces-hill-exposure-boost", "agx")
 
 
 def _number(option: str, low: float | None = None, high: float | None = None):
@@ -293,9 +295,11 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--size", type=_size, default=_Size(1024, 1024, True), metavar="W|WxH",
                    help="image size; W alone is square, or with --camera gltf the camera's aspect ratio "
                         "(default: 1024)")
-    d.add_argument("--tonemap", choices=("none", "aces", "neutral"), default=None,
-                   help="PNG only (refused with .exr, which is linear): none (clamp), ACES fitted (Hill), "
-                        "Khronos PBR Neutral (default: aces)")
+    d.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None,
+                   help="PNG only (refused with .exr, which is linear): none (clamp); aces = aces-hill, Hill's "
+                        "ACES fit; neutral, Khronos PBR Neutral; aces-narkowicz; aces-hill-exposure-boost (Hill "
+                        "after /0.6: three.js's, model-viewer's and the glTF Sample Viewer's ACES); agx "
+                        "(Blender's default view since 4.0) (default: aces)")
     d.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
                    help="PNG only (refused with .exr): multiply radiance by 2^EV before tone mapping (default: 0)")
     d.add_argument("--background", choices=("env", "blur", "color", "transparent"), default="env",
