@@ -108,3 +108,66 @@ def test_texture_beyond_the_gl_limit_is_refused_in_one_line(tmp_path):
     proc = run("render", "--size", "16", "--mesh", path, "--out", out)
     assert proc.returncode == 2 and "16385x2" in proc.stderr and "16384" in proc.stderr
     assert len(proc.stderr.splitlines()) == 1 and not out.exists()
+
+
+# --- far from the origin ---------------------------------------------------------------------
+
+def test_far_case_renders_like_its_control(tmp_path):
+    a, warn = render_exr(tmp_path / "a.exr", "--mesh", CONTROLS / "far_1e6.glb")
+    b, _ = render_exr(tmp_path / "b.exr", "--mesh", CONTROLS / "far_ctrl_origin.glb")
+    assert warn == [] and rel_mae(a, b) < 0.01
+
+
+def _sphere_glb(path, translation):
+    from alight.core.mesh import sphere
+
+    part = sphere().parts[0]
+    g = Gltf()
+    prim = {"attributes": {"POSITION": g.accessor(part.positions, FLOAT, bounds=True),
+                           "NORMAL": g.accessor(part.normals)},
+            "indices": g.accessor(part.indices.reshape(-1), UINT),
+            "material": g.material(pbrMetallicRoughness={"metallicFactor": 1.0, "roughnessFactor": 0.1})}
+    g.mesh([prim], translation=list(translation))
+    return g.save(path)
+
+
+@pytest.mark.parametrize("far", [(1e6, 0.0, 1e6), (-3e7, 2e5, 0.0)])
+def test_far_gltf_renders_like_at_the_origin(tmp_path, far):
+    x, y, z = far
+    a, _ = render_exr(tmp_path / "a.exr", "--mesh", _sphere_glb(tmp_path / "a.glb", far),
+                      "--target", f"{x!r},{y!r},{z!r}", "--orbit", "-20", "--distance", "4")
+    b, _ = render_exr(tmp_path / "b.exr", "--mesh", _sphere_glb(tmp_path / "b.glb", (0, 0, 0)),
+                      "--target", "0,0,0", "--orbit", "-20", "--distance", "4")
+    assert rel_mae(a, b) < 0.01
+
+
+def test_far_obj_renders_like_at_the_origin(tmp_path):
+    from alight.core.mesh import sphere
+
+    part = sphere().parts[0]
+    for name, offset in (("far.obj", np.array([1e6, 0.0, -1e6])), ("near.obj", np.zeros(3))):
+        p = part.positions.astype(np.float64) + offset
+        text = "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in p)
+        text += "".join(f"vn {x} {y} {z}\n" for x, y, z in part.normals)
+        text += "".join("f " + " ".join(f"{i + 1}//{i + 1}" for i in tri) + "\n" for tri in part.indices)
+        (tmp_path / name).write_text(text)
+    a, _ = render_exr(tmp_path / "a.exr", "--mesh", tmp_path / "far.obj")
+    b, _ = render_exr(tmp_path / "b.exr", "--mesh", tmp_path / "near.obj")
+    assert rel_mae(a, b) < 0.01
+
+
+def test_a_file_light_moves_with_the_model(tmp_path):
+    """A point light placed beside a far model lights it as beside the same model at the origin."""
+    def with_light(path, offset):
+        g = Gltf()
+        pos, nor, uv, idx = grid_plane(2, 2.0)
+        g.mesh([{"attributes": {"POSITION": g.accessor(pos, FLOAT, bounds=True), "NORMAL": g.accessor(nor)},
+                 "indices": g.accessor(idx.reshape(-1), UINT)}], translation=list(offset))
+        g.doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 5.0}]}}
+        g.node(translation=[offset[0] + 0.5, offset[1], offset[2] + 1.0], extensions={"KHR_lights_punctual": {"light": 0}})
+        g.use("KHR_lights_punctual")
+        return g.save(path)
+
+    a, _ = render_exr(tmp_path / "a.exr", "--mesh", with_light(tmp_path / "a.glb", (2e6, 0.0, 0.0)), "--no-ibl")
+    b, _ = render_exr(tmp_path / "b.exr", "--mesh", with_light(tmp_path / "b.glb", (0.0, 0.0, 0.0)), "--no-ibl")
+    assert rel_mae(a, b) < 0.01 and a[..., :3].max() > 0.05

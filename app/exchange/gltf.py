@@ -36,6 +36,7 @@ from alight.core.mesh import (
     TextureInfo,
     TextureTransform,
     _normalize,
+    far_origin,
 )
 from alight.core.scene import Camera, Light
 from alight.errors import AlightError
@@ -520,6 +521,7 @@ class _Reader:
             children = {c for n in nodes for c in (n.children or [])}
             roots = [i for i in range(len(nodes)) if i not in children]
         parts: list[MeshPart] = []
+        placements: list[tuple[int, np.ndarray, str]] = []
         cameras: list[tuple[int, np.ndarray]] = []
         lights: list[Light] = []
         light_defs = ((doc.extensions or {}).get("KHR_lights_punctual") or {}).get("lights") or []
@@ -535,7 +537,7 @@ class _Reader:
             node = nodes[index]
             world = parent @ _local_matrix(node, self.source, index)
             if node.mesh is not None:
-                parts.extend(self._place(int(node.mesh), world, node.name or f"node{index}"))
+                placements.append((int(node.mesh), world, node.name or f"node{index}"))
             if node.camera is not None:
                 cameras.append((int(node.camera), world))
             light_ref = (node.extensions or {}).get("KHR_lights_punctual")
@@ -543,10 +545,18 @@ class _Reader:
                 lights.append(self._light(int(light_ref["light"]), light_defs, world))
             for child in reversed(node.children or []):
                 stack.append((int(child), world))
+        origin = far_origin([world[:3, 3] for _, world, _ in placements])
+        shift = np.eye(4)
+        shift[:3, 3] = -origin
+        for mesh_index, world, name in placements:
+            parts.extend(self._place(mesh_index, shift @ world, name))
         if not parts:
             raise AlightError(f"{self.source}: no triangles in the file")
-        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings)
-        mesh.cameras = [self._camera(i, world, mesh) for i, world in cameras]
+        for light in lights:
+            if light.kind != "directional":
+                light.vector = tuple(float(x) for x in np.asarray(light.vector, np.float64) - origin)
+        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings, origin=tuple(map(float, origin)))
+        mesh.cameras = [self._camera(i, shift @ world, mesh) for i, world in cameras]
         return mesh
 
     def _place(self, mesh_index: int, world: np.ndarray, name: str) -> list[MeshPart]:

@@ -23,6 +23,7 @@ from alight.core.mesh import (
     _normalize,
     compute_tangents,
     cube,
+    far_origin,
     plane,
     smooth_normals,
     sphere,
@@ -97,16 +98,26 @@ def load_mesh(spec: str) -> Mesh:
                 warnings.append(f"{spec}: {bad_colors} vertex colour{'s' if bad_colors > 1 else ''} NaN or Inf "
                                 f"(line {colour_line}); drawn black")
         parts = []
+        placed = []
         for node in scene.graph.nodes_geometry:
             transform, geom_name = scene.graph[node]
             geom = scene.geometry.get(geom_name)
             if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
                 continue  # point clouds and line paths have no triangles to render
+            placed.append((node, np.asarray(transform, np.float64), geom))
+        # Far from the origin (a survey's coordinates): moved near it in float64 (Mesh.origin).
+        # (From the vertices themselves: trimesh's bounds index them by the faces, checked later.)
+        centres = [t[:3, :3] @ (np.nanmin(v, axis=0) + np.nanmax(v, axis=0)) / 2.0 + t[:3, 3]
+                   for _, t, g in placed for v in [np.asarray(g.vertices, np.float64)] if len(v)]
+        origin = far_origin([c for c in centres if np.isfinite(c).all()])
+        for node, transform, geom in placed:
             if ext == ".stl":
                 # STL is a list of facets: flat. trimesh's ASCII reader shares the corners of
                 # touching facets (the binary one does not), which smoothed across every edge.
                 geom.unmerge_vertices()
-            part = _part_from_trimesh(spec, str(node), geom, np.asarray(transform), textures, extras, warnings)
+            transform = transform.copy()
+            transform[:3, 3] -= origin
+            part = _part_from_trimesh(spec, str(node), geom, transform, textures, extras, warnings)
             if part is not None:
                 parts.append(part)
     except AlightError:
@@ -115,7 +126,7 @@ def load_mesh(spec: str) -> Mesh:
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     if not parts:
         raise AlightError(f"{spec}: no triangles in the file")
-    return Mesh(parts, str(spec), warnings=warnings)
+    return Mesh(parts, str(spec), warnings=warnings, origin=tuple(float(x) for x in origin))
 
 
 def _obj_faces(spec: str, path: Path):

@@ -156,7 +156,7 @@ def read_faces(data: bytes) -> ObjFaces:
     flat_index: dict[tuple[float, float, float], int] = {}
     for (number, corners, grp), nn in zip(faces, face_normal):
         if any(c[2] is None for c in corners):
-            if not np.linalg.norm(nn) > 0.0:
+            if np.linalg.norm(nn) == 0.0:   # (NaN positions are kept: the loader refuses them)
                 out[number] = b""      # no area, no normal: nothing to draw (dropped as before)
                 continue
             if grp == 0:

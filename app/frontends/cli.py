@@ -125,6 +125,8 @@ def _camera(args, mesh, aspect: float):
                 raise AlightError(f"--target: '{args.target}' is not three comma-separated numbers")
         if mesh is None:
             raise AlightError("--orbit/--elevation/--distance/--fov/--target: only with --view camera")
+        if target is not None:   # the file's coordinates, where the mesh was moved from (Mesh.origin)
+            target = tuple(t - o for t, o in zip(target, getattr(mesh, "origin", (0.0, 0.0, 0.0))))
         centre, radius = mesh.bounding_sphere()
         return orbit_camera(centre, radius, aspect, args.orbit, args.elevation, args.distance,
                             35.0 if args.fov is None else args.fov, target, corners=mesh.corners())
