@@ -35,6 +35,8 @@ def test_case_renders_like_its_control(tmp_path, feature, control, flags):
 def _l_shape(notches: str = "L") -> list[tuple[float, float]]:
     if notches == "L":
         return [(1, 0), (0, 0), (0, 1), (-1, 1), (-1, -1), (1, -1)]
+    if notches == "dart":   # a concave quad, its reflex corner second: a-c runs outside it
+        return [(-1, -1), (0, -0.3), (1, -1), (0, 1)]
     # a U: two notches' worth of reflex corners
     return [(-1, 1), (-1, -1), (1, -1), (1, 1), (0.5, 1), (0.5, -0.4), (-0.5, -0.4), (-0.5, 1)]
 
@@ -43,10 +45,12 @@ def _triangles_by_hand(poly):
     """A correct triangulation of the shapes above, written out (the control)."""
     if len(poly) == 6:   # the L: the square (-1..0, -1..1) and the square (0..1, -1..0)
         return [(4, 5, 0), (4, 0, 1), (4, 1, 2), (4, 2, 3)]
+    if len(poly) == 4:   # the dart, cut from its reflex corner
+        return [(1, 2, 3), (1, 3, 0)]
     return [(0, 1, 7), (1, 6, 7), (1, 2, 6), (2, 5, 6), (2, 3, 5), (3, 4, 5)]
 
 
-@pytest.mark.parametrize("shape", ["L", "U"])
+@pytest.mark.parametrize("shape", ["L", "U", "dart"])
 def test_concave_polygon_renders_like_its_triangles(tmp_path, shape):
     poly = _l_shape(shape)
     verts = "".join(f"v {x} {y} 0\n" for x, y in poly) + "vn 0 0 1\n"

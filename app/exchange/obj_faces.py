@@ -134,62 +134,103 @@ def read_faces(data: bytes) -> ObjFaces:
                 faces.append((number, corners, group))
 
     points = np.asarray(positions, np.float64).reshape(-1, 3)
-    # Normals for corners without one: flat per face, or per (group, vertex) accumulated.
-    new_normals: list[np.ndarray] = []
-    smooth_sum: dict[tuple[int, int], np.ndarray] = {}
-    face_normal: list[np.ndarray] = []
-    for _, corners, grp in faces:
-        nn = newell_normal(points[[c[0] for c in corners]])
-        face_normal.append(nn)
-        if grp and any(c[2] is None for c in corners):
-            for c in corners:
-                key = (grp, c[0])
-                smooth_sum[key] = smooth_sum.get(key, 0.0) + nn
+    extra: list[np.ndarray] = []          # the vn lines to append, in order
+    out = list(lines)
+    polygons = fans = 0
     smooth_index: dict[tuple[int, int], int] = {}
+    # Faces of one corner count at a time, so the normals and the quads' diagonals are numpy
+    # operations over all of them (250k quads: a few seconds, not a minute of per-face calls).
+    by_size: dict[int, list[int]] = {}
+    for f, (_, corners, _) in enumerate(faces):
+        by_size.setdefault(len(corners), []).append(f)
+    smooth_sum: dict[tuple[int, int], np.ndarray] = {}
+    unit_of = np.zeros((len(faces), 3))
+    zero_of = np.zeros(len(faces), bool)
+    for k, members in by_size.items():
+        v = np.array([[c[0] for c in faces[f][1]] for f in members], np.int64)
+        p = points[v]
+        nxt = np.roll(p, -1, axis=1)
+        nn = np.stack([np.sum((p[..., 1] - nxt[..., 1]) * (p[..., 2] + nxt[..., 2]), axis=1),
+                       np.sum((p[..., 2] - nxt[..., 2]) * (p[..., 0] + nxt[..., 0]), axis=1),
+                       np.sum((p[..., 0] - nxt[..., 0]) * (p[..., 1] + nxt[..., 1]), axis=1)], axis=1)
+        length = np.linalg.norm(nn, axis=1)
+        idx = np.asarray(members)
+        zero_of[idx] = length == 0.0          # (NaN positions are kept: the loader refuses them)
+        unit_of[idx] = np.where((length > 0)[:, None], nn / np.where(length > 0, length, 1.0)[:, None], (0, 1, 0))
+        for row, f in enumerate(members):
+            _, corners, grp = faces[f]
+            if grp and any(c[2] is None for c in corners):
+                for c in corners:
+                    key = (grp, c[0])
+                    smooth_sum[key] = smooth_sum.get(key, 0.0) + nn[row]
+    quad_split = _quad_diagonals(faces, by_size.get(4, []), points)
+    # Coplanar flat faces share one vn (fewer vertices): their unit normals, rounded, made unique.
+    needs = np.array([any(c[2] is None for c in corners) for _, corners, _ in faces], bool)
+    flat = needs & ~zero_of & np.array([grp == 0 for _, _, grp in faces], bool)
+    flat_vn = np.full(len(faces), -1, np.int64)
+    if flat.any():
+        keys, inverse = np.unique(np.round(unit_of[flat], 9), axis=0, return_inverse=True)
+        extra.extend(keys)
+        flat_vn[flat] = n_vn + inverse.reshape(-1)
 
     def unit(vec) -> np.ndarray:
         length = float(np.linalg.norm(vec))
         return vec / length if length > 0 else np.array([0.0, 1.0, 0.0])
 
-    out = list(lines)
-    polygons = fans = 0
-    flat_index: dict[tuple[float, float, float], int] = {}
-    for (number, corners, grp), nn in zip(faces, face_normal):
-        if any(c[2] is None for c in corners):
-            if np.linalg.norm(nn) == 0.0:   # (NaN positions are kept: the loader refuses them)
+    for f, (number, corners, grp) in enumerate(faces):
+        if needs[f]:
+            if zero_of[f]:
                 out[number] = b""      # no area, no normal: nothing to draw (dropped as before)
                 continue
             if grp == 0:
-                n = unit(nn)
-                key = tuple(np.round(n, 9))      # coplanar faces share one vn: fewer vertices
-                if key not in flat_index:
-                    new_normals.append(n)
-                    flat_index[key] = n_vn + len(new_normals) - 1
-                flat = flat_index[key]
-                corners = [(v, vt, flat if vn is None else vn) for v, vt, vn in corners]
+                fv = int(flat_vn[f])
+                corners = [(v, vt, fv if vn is None else vn) for v, vt, vn in corners]
             else:
                 filled = []
                 for v, vt, vn in corners:
                     if vn is None:
-                        key = (grp, v)
-                        if key not in smooth_index:
-                            new_normals.append(unit(smooth_sum[key]))
-                            smooth_index[key] = n_vn + len(new_normals) - 1
-                        vn = smooth_index[key]
+                        key2 = (grp, v)
+                        if key2 not in smooth_index:
+                            extra.append(unit(smooth_sum[key2]))
+                            smooth_index[key2] = n_vn + len(extra) - 1
+                        vn = smooth_index[key2]
                     filled.append((v, vt, vn))
                 corners = filled
-        if len(corners) > 3:
+        if len(corners) == 4:
+            polygons += 1
+            tris = _QUAD_TRIANGLES[quad_split[f]]
+        elif len(corners) > 4:
             polygons += 1
             tris = ear_clip(points[[c[0] for c in corners]])
             if tris is None:
                 fans += 1
-                tris = np.array([(0, i, i + 1) for i in range(1, len(corners) - 1)])
+                tris = [(0, i, i + 1) for i in range(1, len(corners) - 1)]
         else:
-            tris = np.array([(0, 1, 2)])
-        out[number] = b"\n".join(b"f " + b" ".join(_corner(corners[i]) for i in tri) for tri in tris)
-    tail = [b"vn %.9g %.9g %.9g" % tuple(n) for n in new_normals]
+            tris = ((0, 1, 2),)
+        words = [_corner(c) for c in corners]
+        out[number] = b"\n".join(b"f " + words[a] + b" " + words[b] + b" " + words[c] for a, b, c in tris)
+    tail = [b"vn %.9g %.9g %.9g" % tuple(n) for n in extra]
     text = b"\n".join(out + tail) + b"\n"
     return ObjFaces(text, usemtl, polygons, fans)
+
+
+# A quad (a, b, c, d) cut along a-c or along b-d.
+_QUAD_TRIANGLES = {0: ((0, 1, 2), (0, 2, 3)), 1: ((1, 2, 3), (1, 3, 0))}
+
+
+def _quad_diagonals(faces, members: list[int], points: np.ndarray) -> dict[int, int]:
+    """For each quad, 0 to cut it along a-c, 1 along b-d: a-c unless it leaves the quad (a
+    concave quad whose reflex corner is b or d), the ear clipping of a 4-gon, for all at once.
+    The diagonal a-c lies inside iff b and d are on opposite sides of it in the quad's plane."""
+    if not members:
+        return {}
+    v = np.array([[c[0] for c in faces[f][1]] for f in members], np.int64)
+    a, b, c, d = (points[v[:, i]] for i in range(4))
+    n = np.cross(c - a, d - b)                      # the quad's normal (twice its vector area)
+    side_b = np.einsum("ij,ij->i", np.cross(c - a, b - a), n)
+    side_d = np.einsum("ij,ij->i", np.cross(c - a, d - a), n)
+    use_bd = (side_b * side_d >= 0)                  # same side (or on it): a-c is outside the quad
+    return {f: int(x) for f, x in zip(members, use_bd)}
 
 
 def _corner(c: tuple[int, int | None, int | None]) -> bytes:
