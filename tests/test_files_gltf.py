@@ -164,7 +164,8 @@ def test_a_file_light_moves_with_the_model(tmp_path):
         g.mesh([{"attributes": {"POSITION": g.accessor(pos, FLOAT, bounds=True), "NORMAL": g.accessor(nor)},
                  "indices": g.accessor(idx.reshape(-1), UINT)}], translation=list(offset))
         g.doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 5.0}]}}
-        g.node(translation=[offset[0] + 0.5, offset[1], offset[2] + 1.0], extensions={"KHR_lights_punctual": {"light": 0}})
+        g.node(translation=[offset[0] + 0.5, offset[1], offset[2] + 1.0],
+               extensions={"KHR_lights_punctual": {"light": 0}})
         g.use("KHR_lights_punctual")
         return g.save(path)
 

@@ -290,7 +290,8 @@ def read_equirect(path: str, max_width: int) -> tuple[np.ndarray, list[str]]:
             pass
 
     if decode:
-        warnings.insert(0, f"{path}: {'an' if decode.startswith('8') else 'a'} {decode} is display-referred (sRGB, clipped at 1): decoded from "
+        article = "an" if decode.startswith("8") else "a"
+        warnings.insert(0, f"{path}: {article} {decode} is display-referred (sRGB, clipped at 1): decoded from "
                            f"sRGB to linear, but its bright sources are clipped, so the lighting is dimmer "
                            f"and flatter than the scene's; an .hdr or .exr keeps the radiance")
     warnings += repairs.lines(path)
