@@ -312,7 +312,7 @@ def test_bad_nancolor_loads(shared_data):
     mesh = load_mesh(str(shared_data / "bad/nancolor.obj"))
     (part,) = mesh.parts
     check_part(part)
-    assert len(part.positions) == 8 and len(part.indices) == 12
+    assert len(part.positions) == 24 and len(part.indices) == 12   # no vn, no s: flat, 4 corners a side
     assert part.material is None
     (warning,) = [w for w in mesh.warnings if "vertex colour" in w]
     assert "nancolor.obj" in warning and "line 7" in warning and "\n" not in warning

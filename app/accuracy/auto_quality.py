@@ -292,7 +292,8 @@ def choose_quality(needs: list[MaterialNeed], env: EnvironmentFeatures | None,
     kinds = sorted({a for n in needs for a in n.archetypes})
     lo = min([n.roughness_min for n in needs if n.archetypes] or [max_r])
     reason = (f"{'/'.join(kinds) or 'no'} materials at roughness {lo:.2f}-{max_r:.2f}; environment: "
-              f"{env.describe()}; measured on {envs}")
+              f"{env.describe()}; errors predicted from the table's runs on the environments with these "
+              f"features ({envs}), not measured on this one")
     if not meets:
         reason += "; no candidate meets the budget, so the most accurate one"
     return Choice(q, name, err, secs, meets, reason)

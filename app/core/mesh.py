@@ -195,6 +195,10 @@ class Mesh:
     # ``sphere`` made it: a renderer may draw it with fewer segments where its size on screen
     # allows (alight.core.sphere_lod), never more. None for every other mesh: drawn as given.
     lod_sphere: tuple[float, int] | None = None
+    # Where the file's origin went: every position, camera and light here is the file's minus
+    # this (float64). A model far from its origin (1e6) is moved near it before positions become
+    # float32, whose spacing there (0.06) faceted a unit sphere and broke its reflections.
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space min and max corners over all parts."""
@@ -398,3 +402,18 @@ def is_closed(positions: np.ndarray, indices: np.ndarray) -> bool:
     if (counts != 1).any():
         return False
     return bool(np.isin(backward, uniq, assume_unique=False).all())
+
+
+# A model whose nodes lie farther than this from the file's origin is moved near it before its
+# positions become float32 (spacing 6e-5 here, 0.06 at 1e6).
+FAR_FROM_ORIGIN = 1.0e3
+
+
+def far_origin(translations) -> np.ndarray:
+    """Where to put the origin for models placed at ``translations`` ((3,) each, float64): their
+    mean when it is farther than FAR_FROM_ORIGIN from (0, 0, 0), else (0, 0, 0), so ordinary
+    files keep their coordinates exactly."""
+    if not len(translations):
+        return np.zeros(3)
+    centre = np.mean(np.asarray(translations, np.float64), axis=0)
+    return centre if np.isfinite(centre).all() and np.abs(centre).max() > FAR_FROM_ORIGIN else np.zeros(3)

@@ -18,7 +18,10 @@ if TYPE_CHECKING:
     from alight.core.texture_maps import TextureMaps
 
 VIEWS = ("camera", "probe")
-TONEMAPS = ("none", "aces", "neutral")
+# The display curves, in tonemapping.glsl's TONEMAP_* order: 'aces' is Hill's fit (alight's
+# default, as before), 'aces-hill' the same by the Sample Viewer's name; 'neutral' is Khronos PBR
+# Neutral. docs/files_notes.md says which peer uses which by default.
+TONEMAPS = ("none", "aces", "neutral", "aces-narkowicz", "aces-hill", "aces-hill-exposure-boost", "agx")
 BACKGROUNDS = ("env", "blur", "color", "transparent")
 LIGHT_KINDS = ("point", "directional", "spot")
 
@@ -139,10 +142,19 @@ def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
     return values
 
 
+# The fields that place each kind of light: parse_light refuses a spec without them.
+_LIGHT_NEEDS = {"point": ("pos",), "spot": ("pos", "dir"), "directional": ("dir",)}
+
+
 def parse_light(spec: str) -> Light:
     """``point:pos=X,Y,Z[:color=R,G,B][:intensity=I][:range=R]``, ``directional:dir=X,Y,Z[:...]``
     or ``spot:pos=X,Y,Z:dir=X,Y,Z[:inner=DEG][:outer=DEG][:...]`` (cone half-angles, default 0
-    and 45 degrees, as KHR_lights_punctual's defaults)."""
+    and 45 degrees, as KHR_lights_punctual's defaults). What places a light has no default and
+    must be given: a point's ``pos``, a spot's ``pos`` and ``dir``, a directional light's ``dir``
+    (a point at the origin sits inside the mesh and lights nothing: a black image, exit 0).
+
+    Raises AlightError (one line naming the spec) for an unknown kind or field, a bad number, or
+    a missing required field."""
     fields = spec.split(":")
     kind = {"point": "point", "dir": "directional", "directional": "directional", "sun": "directional",
             "spot": "spot"}.get(fields[0])
@@ -150,8 +162,10 @@ def parse_light(spec: str) -> Light:
         raise AlightError(f"--light: '{spec}': the kind must be point, directional or spot")
     light = Light(kind=kind, vector=(0.0, -1.0, 0.0) if kind == "directional" else (0.0, 0.0, 0.0),
                   intensity=3.0 if kind == "directional" else 10.0)
+    given = set()
     for item in fields[1:]:
         key, _, value = item.partition("=")
+        given.add({"position": "pos", "direction": "dir"}.get(key, key))
         if key in ("pos", "position") and kind != "directional":
             light.vector = _floats(value, 3, key)
         elif key in ("dir", "direction") and kind != "point":
@@ -182,6 +196,12 @@ def parse_light(spec: str) -> Light:
         else:
             raise AlightError(f"--light: '{spec}': unknown field '{key}' (point takes pos=, directional "
                               f"dir=, spot pos=, dir=, inner=, outer=; all take color= and intensity=)")
+    missing = [k for k in _LIGHT_NEEDS[kind] if k not in given]
+    if missing:
+        form = {"point": "point:pos=X,Y,Z", "directional": "directional:dir=X,Y,Z",
+                "spot": "spot:pos=X,Y,Z:dir=X,Y,Z"}[kind]
+        raise AlightError(f"--light: '{spec}': a {kind} light needs {' and '.join(k + '=' for k in missing)} "
+                          f"(the form is {form}[:...])")
     if kind == "spot" and light.inner_cone_deg >= light.outer_cone_deg:
         raise AlightError(f"--light: '{spec}': inner must be below outer")
     return light

@@ -195,6 +195,41 @@ def tonemap_pbr_neutral(c):
     return np.where(peak < start, c, mixed)
 
 
+def tonemap_aces_narkowicz(c):
+    """Narkowicz's ACES fit (2016), per channel, as the glTF Sample Viewer applies it."""
+    c = np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX)
+    return np.clip((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14), 0.0, 1.0)
+
+
+def tonemap_aces_hill_exposure_boost(c):
+    """Hill's fit of c / 0.6: three.js's, model-viewer's and the Sample Viewer's default ACES."""
+    return tonemap_aces_fitted(np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX) / 0.6)
+
+
+_SRGB_TO_REC2020 = np.array([[0.6274, 0.3293, 0.0433], [0.0691, 0.9195, 0.0113], [0.0164, 0.0880, 0.8956]])
+_REC2020_TO_SRGB = np.array([[1.6605, -0.5876, -0.0728], [-0.1246, 1.1329, -0.0083], [-0.0182, -0.1006, 1.1187]])
+_AGX_INSET = np.array([[0.856627153315983, 0.0951212405381588, 0.0482516061458583],
+                       [0.137318972929847, 0.761241990602591, 0.101439036467562],
+                       [0.11189821299995, 0.0767994186031903, 0.811302368396859]])
+_AGX_OUTSET = np.array([[1.1271005818144368, -0.11060664309660323, -0.016493938717834573],
+                        [-0.1413297634984383, 1.157823702216272, -0.016493938717834257],
+                        [-0.14132976349843826, -0.11060664309660294, 1.2519364065950405]])
+
+
+def tonemap_agx(c):
+    """AgX as Filament and three.js implement it (tonemapping.glsl's tonemap_agx); sRGB in and out.
+    The matrices are the GLSL's transposed (GLSL's mat3 takes columns)."""
+    c = np.minimum(np.asarray(c, dtype=np.float64), TONEMAP_INPUT_MAX)
+    min_ev, max_ev = -12.47393, 4.026069
+    c = c @ _SRGB_TO_REC2020.T @ _AGX_INSET.T
+    x = np.clip((np.log2(np.maximum(c, 1e-10)) - min_ev) / (max_ev - min_ev), 0.0, 1.0)
+    x2 = x * x
+    x4 = x2 * x2
+    s = 15.5 * x4 * x2 - 40.14 * x4 * x + 31.96 * x4 - 6.868 * x2 * x + 0.4298 * x2 + 0.1191 * x - 0.00232
+    c = np.maximum(s @ _AGX_OUTSET.T, 0.0) ** 2.2
+    return np.clip(c @ _REC2020_TO_SRGB.T, 0.0, 1.0)
+
+
 def linear_to_srgb(c):
     """The sRGB transfer function (IEC 61966-2-1)."""
     c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)

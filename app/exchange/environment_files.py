@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from alight.core.equirect import _box_factor, _reduce_columns, _reduce_rows
+from alight.core.equirect import _reduce_columns, _reduce_rows, area_resample
 from alight.errors import AlightError
 
 # Bytes of float32 read per strip (before reduction); bounds the loader's memory.
@@ -260,21 +260,27 @@ def read_equirect(path: str, max_width: int) -> tuple[np.ndarray, list[str]]:
         if width != 2 * height:
             raise AlightError(f"{path}: not a 2:1 equirectangular map ({width}x{height})")
 
-        factor = _box_factor(width, height, max_width) if width > max_width else 1
+        factor, out_w = _reduction(width, height, max_width)
+        out_h = out_w // 2
         stored_w, stored_h = layout.display[2], layout.display[3]
         tile_h = int(spec.tile_height) if int(spec.tile_width) > 0 else 0
         # Strip height: a multiple of the box factor (and of the tile height for tiled files).
-        unit = factor if not tile_h else factor * tile_h // math.gcd(factor, tile_h)
+        step = max(factor, 1)    # a resampled map (factor 0) takes strips of any height
+        unit = step if not tile_h else step * tile_h // math.gcd(step, tile_h)
         nread = max(part.channels) - min(part.channels) + 1
         rows = max(1, _STRIP_BYTES // (max(stored_w, layout.data[2]) * nread * 4) // unit) * unit
 
-        out = np.empty((height // factor, width // factor, 3), dtype=np.float32)
+        # A resampled map is summed into (each output texel gets parts of several strips).
+        out = (np.empty if factor else np.zeros)((out_h, out_w, 3), dtype=np.float32)
         repairs = Repairs()
+        decode = _display_referred(inp, spec)
         for r0 in range(0, stored_h, rows):
             r1 = min(stored_h, r0 + rows)
             strip = _read_rows(inp, path, part, spec, layout, r0, r1)
             if strip.shape[2] == 1:
                 strip = np.repeat(strip, 3, axis=2)
+            if decode:
+                strip = _srgb_decode(strip)
             strip = repair_radiance(strip, repairs)
             _place(out, strip, r0, r1, layout, factor, height, width)
     finally:
@@ -283,17 +289,70 @@ def read_equirect(path: str, max_width: int) -> tuple[np.ndarray, list[str]]:
         except Exception:
             pass
 
+    if decode:
+        article = "an" if decode.startswith("8") else "a"
+        warnings.insert(0, f"{path}: {article} {decode} is display-referred (sRGB, clipped at 1): decoded from "
+                           f"sRGB to linear, but its bright sources are clipped, so the lighting is dimmer "
+                           f"and flatter than the scene's; an .hdr or .exr keeps the radiance")
     warnings += repairs.lines(path)
     if factor > 1:
         warnings.append(f"{path}: {width}x{height} is wider than {max_width}; box-reduced by {factor} "
                         f"to {width // factor}x{height // factor}")
+    elif factor == 0:
+        warnings.append(f"{path}: {width}x{height} is wider than {max_width}; area-resampled to {out_w}x{out_h}")
     return np.ascontiguousarray(out, dtype=np.float32), warnings
+
+
+def _reduction(width: int, height: int, max_width: int) -> tuple[int, int]:
+    """(box factor, output width) for a map ``width`` wide: factor 1 when it fits; the whole
+    factor ceil(width / max_width) when it divides the height (an exact box); else factor 0:
+    area-resampled to ``max_width`` (an awkward height, e.g. a prime 4099, has no whole factor
+    near the ratio, and the smallest one that divides could be the height itself)."""
+    if width <= max_width:
+        return 1, width
+    factor = -(-width // max_width)
+    if height % factor == 0:
+        return factor, width // factor
+    return 0, max_width // 2 * 2
+
+
+# OpenImageIO's names of the formats whose pixels are display-referred 8/16-bit sRGB.
+_DISPLAY_FORMATS = {"png": "PNG", "jpeg": "JPEG", "bmp": "BMP", "targa": "TGA", "gif": "GIF", "webp": "WebP"}
+
+
+def _display_referred(inp, spec) -> str:
+    """The format's name when the file holds display-referred integer sRGB (PNG, JPEG, ...: what
+    a photo or a screenshot is), to be decoded; '' for scene-referred files (.hdr, .exr, float
+    TIFF) and for integer files that say they are linear."""
+    import OpenImageIO as oiio
+
+    name = inp.format_name()
+    space = str(spec.getattribute("oiio:ColorSpace") or "").lower()
+    # OpenImageIO 3 names an 8-bit PNG's space "srgb_rec709_scene" and linear ones "lin_..." or
+    # "linear"; only a file that says it is linear is taken as it is.
+    if space.startswith("lin") or "linear" in space:
+        return ""
+    if name in _DISPLAY_FORMATS:
+        bits = 16 if spec.format in (oiio.UINT16, oiio.INT16) else 8
+        return f"{bits}-bit {_DISPLAY_FORMATS[name]}"
+    return ""
+
+
+def _srgb_decode(strip: np.ndarray) -> np.ndarray:
+    """IEC 61966-2-1's sRGB decode of values read as 0..1 (OpenImageIO scales 8- and 16-bit
+    integers to 0..1 and leaves the transfer function to us)."""
+    from alight.core.shading import srgb_to_linear
+
+    return np.asarray(srgb_to_linear(np.clip(strip, 0.0, 1.0)), dtype=np.float32)
 
 
 def _place(out: np.ndarray, strip: np.ndarray, r0: int, r1: int, layout: _Layout, factor: int,
            height: int, width: int) -> None:
     """Put stored rows r0..r1-1 where the picture has them (rows, or columns if transposed),
-    box-reduced by ``factor``."""
+    box-reduced by ``factor``, or (factor 0) area-resampled to ``out``'s size and added in."""
+    if factor == 0:
+        _resample_into(out, strip, r0, r1, layout, height, width)
+        return
     if layout.transpose:
         block = strip.transpose(1, 0, 2)                  # stored rows become picture columns
         if layout.flip_rows:
@@ -312,3 +371,29 @@ def _place(out: np.ndarray, strip: np.ndarray, r0: int, r1: int, layout: _Layout
     if factor > 1:
         block = _reduce_rows(_reduce_columns(block, factor), factor, y0, height)
     out[y0 // factor:y1 // factor] = block
+
+
+def _resample_into(out: np.ndarray, strip: np.ndarray, r0: int, r1: int, layout: _Layout,
+                   height: int, width: int) -> None:
+    """Stored rows r0..r1-1, oriented, area-resampled (alight.core.equirect.area_resample) and
+    added to ``out`` (out_h, out_w, 3): the axis the strip holds whole is resampled in full, the
+    other gives the strip's share of the output texels it overlaps."""
+    out_h, out_w = out.shape[:2]
+    if layout.transpose:
+        block = strip.transpose(1, 0, 2)                  # all picture rows, columns c0..c1-1
+        if layout.flip_rows:
+            block = block[::-1]
+        c0 = width - r1 if layout.flip_cols else r0
+        if layout.flip_cols:
+            block = block[:, ::-1]
+        _, rows = area_resample(block, 0, height, out_h, 0, True)
+        o0, share = area_resample(rows, c0, width, out_w, 1, False)
+        out[:, o0:o0 + share.shape[1]] += share.astype(np.float32)
+        return
+    block = strip[::-1] if layout.flip_rows else strip
+    if layout.flip_cols:
+        block = block[:, ::-1]
+    y0 = height - r1 if layout.flip_rows else r0
+    _, cols = area_resample(block, 0, width, out_w, 1, False)
+    o0, share = area_resample(cols, y0, height, out_h, 0, True)
+    out[o0:o0 + share.shape[0]] += share.astype(np.float32)

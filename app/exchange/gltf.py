@@ -36,6 +36,7 @@ from alight.core.mesh import (
     TextureInfo,
     TextureTransform,
     _normalize,
+    far_origin,
 )
 from alight.core.scene import Camera, Light
 from alight.errors import AlightError
@@ -186,6 +187,11 @@ class _Reader:
             raise fail(self.source, where, "does not exist")
         image = images[index]
         if image.uri is not None:
+            missing = _missing_image_file(self.base, image.uri)
+            if missing is not None:   # as viewers do: drawn without it, said once
+                self.warn(f"missing-image:{index}", f"{where}: '{image.uri}' not found ({missing}); the "
+                                                    f"materials that use it are drawn without this texture")
+                return None
             return read_uri(self.source, self.base, image.uri, where)
         if image.bufferView is not None:
             data, start, length, _ = self.acc.view_bytes(image.bufferView)
@@ -200,6 +206,11 @@ class _Reader:
         if not todo:
             return
         blobs = [self._image_bytes(i) for i in todo]
+        for i in [i for i, blob in zip(todo, blobs) if blob is None]:   # a missing file: no texture
+            self._images[i] = None
+        todo, blobs = [i for i, b in zip(todo, blobs) if b is not None], [b for b in blobs if b is not None]
+        if not todo:
+            return
         wheres = [f"{self.source}: images[{i}]" for i in todo]
         if len(todo) == 1:
             self._images[todo[0]] = decode_texture(blobs[0], wheres[0])
@@ -326,6 +337,8 @@ class _Reader:
         self._decode_images([image_index for _, image_index in infos.values()])
         textures = {}
         for slot, (info, image_index) in infos.items():
+            if self._images[image_index] is None:   # its file is missing (warned)
+                continue
             info.image = self._images[image_index]
             textures[f"{slot}_texture"] = info
         fm = FileMaterial(
@@ -508,6 +521,7 @@ class _Reader:
             children = {c for n in nodes for c in (n.children or [])}
             roots = [i for i in range(len(nodes)) if i not in children]
         parts: list[MeshPart] = []
+        placements: list[tuple[int, np.ndarray, str]] = []
         cameras: list[tuple[int, np.ndarray]] = []
         lights: list[Light] = []
         light_defs = ((doc.extensions or {}).get("KHR_lights_punctual") or {}).get("lights") or []
@@ -523,7 +537,7 @@ class _Reader:
             node = nodes[index]
             world = parent @ _local_matrix(node, self.source, index)
             if node.mesh is not None:
-                parts.extend(self._place(int(node.mesh), world, node.name or f"node{index}"))
+                placements.append((int(node.mesh), world, node.name or f"node{index}"))
             if node.camera is not None:
                 cameras.append((int(node.camera), world))
             light_ref = (node.extensions or {}).get("KHR_lights_punctual")
@@ -531,10 +545,18 @@ class _Reader:
                 lights.append(self._light(int(light_ref["light"]), light_defs, world))
             for child in reversed(node.children or []):
                 stack.append((int(child), world))
+        origin = far_origin([world[:3, 3] for _, world, _ in placements])
+        shift = np.eye(4)
+        shift[:3, 3] = -origin
+        for mesh_index, world, name in placements:
+            parts.extend(self._place(mesh_index, shift @ world, name))
         if not parts:
             raise AlightError(f"{self.source}: no triangles in the file")
-        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings)
-        mesh.cameras = [self._camera(i, world, mesh) for i, world in cameras]
+        for light in lights:
+            if light.kind != "directional":
+                light.vector = tuple(float(x) for x in np.asarray(light.vector, np.float64) - origin)
+        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings, origin=tuple(map(float, origin)))
+        mesh.cameras = [self._camera(i, shift @ world, mesh) for i, world in cameras]
         return mesh
 
     def _place(self, mesh_index: int, world: np.ndarray, name: str) -> list[MeshPart]:
@@ -632,6 +654,19 @@ def _any_tangents(normals: np.ndarray) -> np.ndarray:
     axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     t, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
     return np.concatenate([t, np.ones((len(t), 1))], axis=1)
+
+
+def _missing_image_file(base: Path, uri: str) -> Path | None:
+    """The path a relative image URI names when no file is there (None: a data: URI, or present)."""
+    import urllib.parse
+
+    if uri.startswith("data:"):
+        return None
+    parsed = urllib.parse.urlsplit(uri)
+    if parsed.scheme and len(parsed.scheme) > 1:
+        return None              # read_uri refuses it with its own line
+    path = base / urllib.parse.unquote(parsed.path)
+    return None if path.exists() else path
 
 
 def _json_slot(slot: str) -> str:

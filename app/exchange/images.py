@@ -15,7 +15,10 @@ from alight.errors import AlightError
 
 # What a dropped file with one of these suffixes is (.hdr and .exr stay environments).
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tga", ".tif", ".tiff", ".bmp", ".webp")
-MAX_MAP_SIZE = 8192
+# The largest texture side: OpenGL 4.1 and later guarantee GL_MAX_TEXTURE_SIZE >= 16384 (llvmpipe
+# and current GPUs give 16384 or more), so every image up to it uploads; a valid 9000x4 strip was
+# refused at 8192.
+MAX_MAP_SIZE = 16384
 
 
 # Decoded images by (absolute path, modification time, size): reloading an unchanged file is free.

@@ -23,6 +23,7 @@ from alight.core.mesh import (
     _normalize,
     compute_tangents,
     cube,
+    far_origin,
     plane,
     smooth_normals,
     sphere,
@@ -61,8 +62,17 @@ def load_mesh(spec: str) -> Mesh:
 
     import trimesh  # lazily: importing trimesh costs start-up time the built-ins do not need
 
+    faces = _obj_faces(spec, path) if ext == ".obj" else None
     try:
-        scene = trimesh.load(str(path), force="scene", process=False)
+        if faces is not None and faces.rewrite is not None:
+            import io
+
+            # The faces made explicit (ear-clipped, normals written): trimesh reads the rewritten
+            # text, and the MTL and textures beside the file through the resolver.
+            scene = trimesh.load(io.BytesIO(faces.rewrite), file_type="obj", force="scene", process=False,
+                                 resolver=trimesh.resolvers.FilePathResolver(str(path)))
+        else:
+            scene = trimesh.load(str(path), force="scene", process=False)
     except Exception as exc:  # trimesh raises anything from ValueError to KeyError on bad files
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     try:
@@ -70,6 +80,10 @@ def load_mesh(spec: str) -> Mesh:
         textures: dict[int, np.ndarray] = {}
         warnings: list[str] = []
         if ext == ".obj":
+            warnings += _unknown_materials(spec, path, faces.usemtl)
+            if faces.fan_fallbacks:
+                warnings.append(f"{spec}: {faces.fan_fallbacks} polygon(s) that do not lie flat or cross "
+                                f"themselves could not be ear-clipped; drawn as fans")
             from alight.exchange.mtl import missing_libraries
 
             _attach_diffuse_maps(spec, path, extras, textures)
@@ -84,12 +98,26 @@ def load_mesh(spec: str) -> Mesh:
                 warnings.append(f"{spec}: {bad_colors} vertex colour{'s' if bad_colors > 1 else ''} NaN or Inf "
                                 f"(line {colour_line}); drawn black")
         parts = []
+        placed = []
         for node in scene.graph.nodes_geometry:
             transform, geom_name = scene.graph[node]
             geom = scene.geometry.get(geom_name)
             if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
                 continue  # point clouds and line paths have no triangles to render
-            part = _part_from_trimesh(spec, str(node), geom, np.asarray(transform), textures, extras, warnings)
+            placed.append((node, np.asarray(transform, np.float64), geom))
+        # Far from the origin (a survey's coordinates): moved near it in float64 (Mesh.origin).
+        # (From the vertices themselves: trimesh's bounds index them by the faces, checked later.)
+        centres = [t[:3, :3] @ (np.nanmin(v, axis=0) + np.nanmax(v, axis=0)) / 2.0 + t[:3, 3]
+                   for _, t, g in placed for v in [np.asarray(g.vertices, np.float64)] if len(v)]
+        origin = far_origin([c for c in centres if np.isfinite(c).all()])
+        for node, transform, geom in placed:
+            if ext == ".stl":
+                # STL is a list of facets: flat. trimesh's ASCII reader shares the corners of
+                # touching facets (the binary one does not), which smoothed across every edge.
+                geom.unmerge_vertices()
+            transform = transform.copy()
+            transform[:3, 3] -= origin
+            part = _part_from_trimesh(spec, str(node), geom, transform, textures, extras, warnings)
             if part is not None:
                 parts.append(part)
     except AlightError:
@@ -98,7 +126,37 @@ def load_mesh(spec: str) -> Mesh:
         raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
     if not parts:
         raise AlightError(f"{spec}: no triangles in the file")
-    return Mesh(parts, str(spec), warnings=warnings)
+    return Mesh(parts, str(spec), warnings=warnings, origin=tuple(float(x) for x in origin))
+
+
+def _obj_faces(spec: str, path: Path):
+    """The OBJ's faces made explicit (alight.exchange.obj_faces); a file that cannot be read is
+    an AlightError naming it."""
+    from alight.exchange.obj_faces import read_faces
+
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise AlightError(f"{spec}: cannot read the file ({e.strerror or e})") from None
+    return read_faces(data)
+
+
+def _unknown_materials(spec: str, path: Path, usemtl: dict[str, int]) -> list[str]:
+    """One line naming the ``usemtl`` materials that no MTL file defines (drawn with the default
+    material, which trimesh does silently); none when an mtllib is missing (said already)."""
+    from alight.exchange.mtl import material_names, missing_libraries
+
+    if not usemtl or missing_libraries(path):
+        return []
+    known = material_names(path)
+    unknown = [(name, line) for name, line in usemtl.items() if name not in known]
+    if not unknown:
+        return []
+    where = "the MTL files do not define" if known else "no mtllib defines"
+    listed = ", ".join(f"'{name}' (line {line})" for name, line in unknown[:5])
+    more = f" and {len(unknown) - 5} more" if len(unknown) > 5 else ""
+    return [f"{spec}: usemtl {listed}{more}: {where} {'it' if len(unknown) == 1 else 'them'}; drawn with "
+            f"the default material"]
 
 
 def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,

@@ -104,3 +104,18 @@ def diffuse_maps(obj_path: Path) -> dict[str, DiffuseMap]:
                                            offset=pair(options.get("-o", []), 0.0),
                                            scale=pair(options.get("-s", []), 1.0))
     return maps
+
+
+def material_names(obj_path: Path) -> set[str]:
+    """The names every MTL file the OBJ names defines (``newmtl``)."""
+    names: set[str] = set()
+    for lib in _libraries(obj_path):
+        try:
+            text = lib.read_text("utf-8", "replace")
+        except OSError:
+            continue
+        for line in text.splitlines():
+            key, _, rest = line.strip().partition(" ")
+            if key == "newmtl":
+                names.add(rest.strip())
+    return names

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import re
 import sys
 import time
 
@@ -17,6 +19,8 @@ from alight.errors import AlightError
 from alight.frontends.options import build_look
 
 QUALITIES = ("low", "medium", "high")
+# alight.core.scene.TONEMAPS, written out so that --help needs no numpy (a test keeps them equal).
+TONEMAP_CHOICES = ("none", "aces", "neutral", "aces-narkowicz", "aces-hill", "aces-hill-exposure-boost", "agx")
 
 
 def _number(option: str, low: float | None = None, high: float | None = None):
@@ -41,11 +45,22 @@ def _size(text: str) -> tuple[int, int]:
         parts = [int(x) for x in text.lower().split("x")]
     except ValueError:
         raise argparse.ArgumentTypeError(f"'{text}' is not W or WxH") from None
-    if len(parts) == 1:
+    one_side = len(parts) == 1
+    if one_side:
         parts *= 2
     if len(parts) != 2 or not all(1 <= x <= 16384 for x in parts):
         raise argparse.ArgumentTypeError(f"'{text}' is not W or WxH with sides 1..16384")
-    return parts[0], parts[1]
+    return _Size(parts[0], parts[1], one_side)
+
+
+class _Size(tuple):
+    """(width, height) as --size gave it; ``one_side``: only W was given (a square unless a
+    camera's aspect ratio decides the height)."""
+
+    def __new__(cls, width: int, height: int, one_side: bool = False):
+        size = super().__new__(cls, (width, height))
+        size.one_side = one_side
+        return size
 
 
 def _add_scene_options(p: argparse.ArgumentParser) -> None:
@@ -110,6 +125,8 @@ def _camera(args, mesh, aspect: float):
                 raise AlightError(f"--target: '{args.target}' is not three comma-separated numbers")
         if mesh is None:
             raise AlightError("--orbit/--elevation/--distance/--fov/--target: only with --view camera")
+        if target is not None:   # the file's coordinates, where the mesh was moved from (Mesh.origin)
+            target = tuple(t - o for t, o in zip(target, getattr(mesh, "origin", (0.0, 0.0, 0.0))))
         centre, radius = mesh.bounding_sphere()
         return orbit_camera(centre, radius, aspect, args.orbit, args.elevation, args.distance,
                             35.0 if args.fov is None else args.fov, target, corners=mesh.corners())
@@ -200,8 +217,20 @@ def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:
                         "a white furnace then gives 1, but the result leaves CONVENTIONS.md's single-scattering truth")
 
 
+# A value that starts with '-' and is a number or comma-separated numbers (-0.18,0,0; -1e-3; -inf)
+# is an option's value, not an option: argparse's own pattern takes only -1 and -.5 and so refused
+# '--target -0.18,0,0' with 'expected one argument'. No option of alight's looks like a number.
+_NUMBER = r"(?:\d+\.?\d*(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?|inf|infinity|nan)"
+_NEGATIVE_VALUE = re.compile(rf"^-{_NUMBER}(?:,[-+]?{_NUMBER})*$", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse, but a bad option is one line (no usage dump), like every other user error."""
+    """argparse, but a bad option is one line (no usage dump), like every other user error, and
+    a negative number or vector is a value wherever an option takes one."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_VALUE
 
     def error(self, message: str):
         self.exit(2, f"alight: error: {' '.join(message.split())} (see '{self.prog} --help')\n")
@@ -273,11 +302,16 @@ def build_parser() -> argparse.ArgumentParser:
     _add_camera_options(r)
     _add_bake_options(r, auto=True)
     d = r.add_argument_group("image")
-    d.add_argument("--size", type=_size, default=(1024, 1024), metavar="W|WxH", help="image size (default: 1024)")
-    d.add_argument("--tonemap", choices=("none", "aces", "neutral"), default="aces",
-                   help="PNG only: none (clamp), ACES fitted (Hill), Khronos PBR Neutral (default: aces)")
+    d.add_argument("--size", type=_size, default=_Size(1024, 1024, True), metavar="W|WxH",
+                   help="image size; W alone is square, or with --camera gltf the camera's aspect ratio "
+                        "(default: 1024)")
+    d.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None,
+                   help="PNG only (refused with .exr, which is linear): none (clamp); aces = aces-hill, Hill's "
+                        "ACES fit; neutral, Khronos PBR Neutral; aces-narkowicz; aces-hill-exposure-boost (Hill "
+                        "after /0.6: three.js's, model-viewer's and the glTF Sample Viewer's ACES); agx "
+                        "(Blender's default view since 4.0) (default: aces)")
     d.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
-                   help="PNG only: multiply radiance by 2^EV before tone mapping (default: 0)")
+                   help="PNG only (refused with .exr): multiply radiance by 2^EV before tone mapping (default: 0)")
     d.add_argument("--background", choices=("env", "blur", "color", "transparent"), default="env",
                    help="what lies behind the object (default: env); alpha is 0 there in every mode")
     d.add_argument("--background-color", metavar="R,G,B", help="linear colour for --background color")
@@ -389,6 +423,29 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The ``alight`` command; returns the exit status. A reader that closes the pipe early
+    (``alight presets | head``) ends the command quietly, as ``cat`` does: status 141 (128 +
+    SIGPIPE), no traceback."""
+    try:
+        try:
+            return _main(argv)
+        finally:
+            sys.stdout.flush()   # inside the try: a closed pipe shows here, not at interpreter exit
+    except BrokenPipeError:
+        _quiet_stdout()
+        return 128 + 13
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null so that Python's final flush of the closed pipe is silent."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
@@ -490,6 +547,7 @@ def _render(args) -> int:
         raise AlightError("--irradiance: --quality auto chooses the irradiance method itself")
     if args.quality != "auto" and args.error_budget is not None:
         raise AlightError("--error-budget: only with --quality auto")
+    _check_output_options(args, out)
     material, overrides, texture_maps = build_look(args)
 
     from alight.core.scene import Display, Scene, parse_light
@@ -503,6 +561,7 @@ def _render(args) -> int:
         _warn(mesh.warnings)
         if not args.light and not args.no_file_lights:
             lights = list(mesh.lights)
+    width, height = _camera_size(args, mesh, width, height)
     camera = _camera(args, mesh, width / height)
     if camera is None and mesh is not None:
         normal = mesh.flat_normal()
@@ -512,7 +571,7 @@ def _render(args) -> int:
     env = None if args.no_ibl else load_environment(args.env)
     if env is not None:
         _warn(env.warnings)
-    display = Display(tonemap=args.tonemap, exposure=args.exposure, background=args.background)
+    display = Display(tonemap=args.tonemap or "aces", exposure=args.exposure, background=args.background)
     if args.background_color:
         from alight.core.material import parse_color
 
@@ -560,6 +619,54 @@ def _render(args) -> int:
                   file=sys.stderr)
     print(out)
     return 0
+
+
+def _check_output_options(args, out) -> None:
+    """Refuse the render options that would do nothing for this output, and warn about those
+    that do nothing for this scene, before anything is loaded: an option silently ignored reads
+    as a bug in the picture."""
+    if out.suffix.lower() == ".exr":
+        if args.tonemap not in (None, "none"):
+            raise AlightError(f"--tonemap {args.tonemap}: {out} is linear radiance, never tone mapped; "
+                              f"write a .png to tone map, or drop --tonemap")
+        if args.exposure != 0.0:
+            raise AlightError(f"--exposure: {out} is linear radiance, written without exposure; write a .png "
+                              f"or scale the EXR afterwards")
+    if args.background_color and args.background != "color":
+        raise AlightError(f"--background-color: only with --background color (got --background {args.background})")
+    if args.no_ibl:
+        unused = [flag for flag, on in (("--env-rotation", args.env_rotation != 0.0),
+                                        ("--env-intensity", args.env_intensity != 1.0)) if on]
+        if unused:
+            _warn([f"{' and '.join(unused)}: no effect with --no-ibl (there is no environment light)"])
+    if args.light and args.no_file_lights:
+        _warn(["--no-file-lights: no effect with --light (the file's lights are used only without --light)"])
+
+
+def _camera_size(args, mesh, width: int, height: int) -> tuple[int, int]:
+    """The image size for --camera gltf: a --size of one side takes the camera's aspect ratio
+    (glTF's perspective.aspectRatio, or xmag/ymag), as viewers do; a size that does not match
+    it is kept and warned (the vertical field of view is the camera's, so the sides are cut or
+    widened)."""
+    if args.camera == "auto" or mesh is None:
+        return width, height
+    from alight.exchange.camera_aspect import gltf_camera_aspects
+
+    kind, _, index = args.camera.partition(":")
+    try:
+        aspect = gltf_camera_aspects(args.mesh)[int(index) if index else 0]
+    except (IndexError, ValueError):
+        return width, height        # _camera says what is wrong with the spec
+    if aspect is None:
+        return width, height
+    if getattr(args.size, "one_side", False):
+        return width, max(1, round(width / aspect))
+    if abs(width / height - aspect) > 0.5 / height * aspect + 1e-9:
+        side = "cut off" if width / height < aspect else "widened beyond the camera's frame"
+        _warn([f"--camera {args.camera}: {args.mesh}'s camera has aspect ratio {aspect:.4g} but --size "
+               f"{width}x{height} is {width / height:.4g}: the image's sides are {side}; give --size {width} "
+               f"to take the camera's aspect"])
+    return width, height
 
 
 def _cache(args) -> int:
