@@ -337,8 +337,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="--integrator path: samples per pixel (default: 256); noise falls as 1/sqrt(N)")
     rd.add_argument("--seed", type=int, default=0, metavar="N",
                     help="--integrator path: the random generator's seed; the same seed gives the same image (default: 0)")
-    rd.add_argument("--max-bounces", type=int, default=6, metavar="N",
-                    help="--integrator path: surface vertices per path at most, 1 = direct light only (default: 6)")
+    rd.add_argument("--max-bounces", type=int, default=8, metavar="N",
+                    help="--integrator path: surface vertices per path at most, 1 = direct light only (default: 8)")
     rd.add_argument("--size", type=_size, default=(256, 256), metavar="W|WxH", help="image size (default: 256)")
     rd.add_argument("--env-level", default="auto", metavar="N|auto",
                     help="sum over the map box-reduced by 2^N (area-weighted): 4^N times faster. Level 1 "
