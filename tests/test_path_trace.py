@@ -179,3 +179,21 @@ def test_cli_without_embree_says_so_in_one_line(tmp_path):
 def test_cli_refuses_the_probe_view_for_the_path_tracer(tmp_path):
     proc = _cli("--view", "probe", "--integrator", "path", "--size", 8, "--out", tmp_path / "x.exr")
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "camera" in proc.stderr
+
+
+def test_compare_bins_the_noise_of_a_path_traced_reference(tmp_path, shared_data):
+    # alight compare --bin 4 against a 16-sample reference of the same scene: the reference's
+    # noise counts per pixel and is a quarter of that binned, so the binned figure is lower.
+    mesh = write_scene("bowl", tmp_path)
+    env = shared_data / "env" / "royal_esplanade_1k.hdr"
+    common = ["--mesh", mesh, "--env", env, "--roughness", 0.5, "--elevation", 45, "--size", 32]
+    ref, test = tmp_path / "ref.exr", tmp_path / "test.exr"
+    assert _cli(*common, "--samples", 16, "--out", ref).returncode == 0
+    assert _cli(*common, "--samples", 16, "--seed", 1, "--out", test).returncode == 0
+    proc = subprocess.run([sys.executable, "-m", "alight", "compare", str(test), str(ref), "--bin", "4"], cwd=REPO,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    per_pixel = float(lines[0].split()[1].rstrip("%"))
+    binned = float(lines[1].split()[3].rstrip("%"))
+    assert lines[1].startswith("binned 4x4 relMAE") and 0.0 < binned < 0.6 * per_pixel, lines

@@ -362,6 +362,9 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--flip-heatmap", metavar="OUT.png", help="write the per-pixel FLIP error as a heat map")
     cp.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
                     help="exposure before tone mapping, for FLIP (default: 0)")
+    cp.add_argument("--bin", type=int, default=1, metavar="N",
+                    help="also print relMAE after summing both images over NxN blocks (the blocks covered in both): "
+                         "against a path-traced reference it divides the reference's noise by N (default: 1, off)")
     ch = sub.add_parser("chart", help="sweep the IBL settings: bake time, frame time, error against the ground truth",
                         description="Measure, one factor at a time around the medium quality, every IBL setting "
                                     "(irradiance method and size, specular cube size, sample counts, filtered "
@@ -817,6 +820,8 @@ def _reference(args) -> int:
 def _compare(args) -> int:
     from alight.exchange.output import check_output_path
 
+    if not 1 <= args.bin <= 64:
+        raise AlightError(f"--bin: {args.bin} must be from 1 to 64")
     for opt, path in (("--heatmap", args.heatmap), ("--flip-heatmap", args.flip_heatmap)):
         if path:
             check_output_path(path, (".png",))
@@ -835,6 +840,13 @@ def _compare(args) -> int:
     if c.covered == 0:
         raise AlightError(f"{args.ref}: no covered pixel (alpha is 0 everywhere)")
     print(f"relMAE {c.relative_mae * 100:.4g}%  FLIP {c.flip:.4g}  over {c.covered} covered pixels")
+    if args.bin > 1:
+        from alight.accuracy.binned import binned_relative_mae, covered_blocks
+
+        blocks = int(covered_blocks(test, ref, args.bin).sum())
+        if blocks == 0:
+            raise AlightError(f"--bin: no {args.bin}x{args.bin} block is covered in both images")
+        print(f"binned {args.bin}x{args.bin} relMAE {binned_relative_mae(test, ref, args.bin) * 100:.4g}%  over {blocks} blocks")
     if args.heatmap:
         print(write_relative_heatmap(args.heatmap, c.relative_map))
     if args.flip_heatmap:
