@@ -324,7 +324,9 @@ def build_parser() -> argparse.ArgumentParser:
                         description="Compute CONVENTIONS.md's ground truth per pixel on the GPU: the sum over "
                                     "every texel of the environment of f(l, v) L(l) max(n.l, 0) dOmega (k = r^2/2, "
                                     "F per direction at v.h), plus emission and the punctual lights (k = (r+1)^2/8), "
-                                    "no occlusion. Roughness below 0.1 is refused when an environment is used.")
+                                    "no occlusion. Roughness below 0.1 is refused when an environment is used. "
+                                    "--integrator path (the default for a mesh file) path-traces the scene instead, "
+                                    "with the same BRDF, shadows and inter-reflection (docs/ptrace_notes.md).")
     _add_scene_options(rf)
     _add_camera_options(rf)
     rd = rf.add_argument_group("reference")
