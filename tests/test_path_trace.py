@@ -197,3 +197,23 @@ def test_compare_bins_the_noise_of_a_path_traced_reference(tmp_path, shared_data
     per_pixel = float(lines[0].split()[1].rstrip("%"))
     binned = float(lines[1].split()[3].rstrip("%"))
     assert lines[1].startswith("binned 4x4 relMAE") and 0.0 < binned < 0.6 * per_pixel, lines
+
+
+@pytest.mark.parametrize("name", ["corner", "bowl", "product"])
+def test_scenes_load_as_one_material_less_part_standing_on_y0(tmp_path, name):
+    from alight.accuracy.scenes import SCENES
+
+    assert name in SCENES
+    mesh = load_mesh(str(write_scene(name, tmp_path)))
+    assert len(mesh.parts) == 1 and mesh.parts[0].material is None and not mesh.warnings
+    lo, hi = mesh.bounds()
+    assert abs(lo[1]) < 1e-6 and hi[1] > 0.9
+    n = mesh.parts[0].normals
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-4)
+    # the floor faces +Y (corner, product: some vertices at y = 0 with n = +Y); the bowl's
+    # lowest point is its outside bottom, facing -Y
+    y = mesh.parts[0].positions[:, 1]
+    if name == "bowl":
+        assert n[np.argmin(y), 1] < -0.99
+    else:
+        assert np.any((y < 1e-6) & (n[:, 1] > 0.999))
