@@ -63,7 +63,8 @@ def main() -> int:
                    "sampler": {"type": "independent", "sample_count": spp, "seed": 0}},
         "env": {"type": "constant", "radiance": {"type": "rgb", "value": 1.0}},
         "mesh": {"type": "obj", "filename": str(path), "face_normals": True,
-                 "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.7}}}},
+                 "bsdf": {"type": "twosided",
+                          "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.7}}}},
     })
     theirs = np.array(mi.render(mscene))[..., :3]
     t2 = time.perf_counter()

@@ -96,7 +96,8 @@ def part_scenes(envs, renderer, exact, size, samples, pictures: Path | None, suf
     notes = [f"{size[0]}x{size[1]} px, path tracer {samples} samples a pixel (seed 0), max 8 bounces; relMAE "
              "(linear RGB) after 4x4 binning over the blocks covered in both images. render: `alight render` "
              "defaults (medium, the default IBL model, MSAA); exact: `alight reference --integrator exact` (no "
-             "occlusion; on royal_esplanade and venice_sunset only, for time); path: `alight reference --integrator path`. path noise: seed 1 against seed 0, "
+             "occlusion; on royal_esplanade and venice_sunset only, for time); path: `alight reference "
+             "--integrator path`. path noise: seed 1 against seed 0, "
              "divided by sqrt(2). Views (orbit, elevation): " +
              ", ".join(f"{k} {v}" for k, v in SCENE_VIEWS.items()) + ", sphere (0, 0)."]
     header = ["scene", "environment", "material", "render vs path %", "render vs exact %", "exact vs path %",
@@ -193,7 +194,8 @@ def part_oblique(envs, renderer, exact, size, suffix: str) -> None:
                     write_md(RESULTS / f"oblique_ibl{suffix}.md", "Every IBL model on flat faces and oblique views",
                              header, rows, notes)
                     write_csv(RESULTS / f"oblique_ibl{suffix}.csv", header, rows)
-    write_md(RESULTS / f"oblique_ibl{suffix}.md", "Every IBL model on flat faces and oblique views", header, rows, notes)
+    write_md(RESULTS / f"oblique_ibl{suffix}.md", "Every IBL model on flat faces and oblique views", header, rows,
+             notes)
     write_csv(RESULTS / f"oblique_ibl{suffix}.csv", header, rows)
 
 

@@ -34,7 +34,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alight.core.shading import MIN_N_DOT_V, MIN_PUNCTUAL_ROUGHNESS, punctual_light, spot_attenuation, range_attenuation
+from alight.core.shading import (
+    MIN_N_DOT_V,
+    MIN_PUNCTUAL_ROUGHNESS,
+    punctual_light,
+    range_attenuation,
+    spot_attenuation,
+)
 from alight.errors import AlightError
 
 PI = math.pi
@@ -309,11 +315,13 @@ class _Rays:
 
     def hit(self, origins, dirs):
         """Triangle index (-1: none), distance, barycentrics u, v of each ray."""
-        out = self.scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(dirs, np.float32), output=1)
+        out = self.scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(dirs, np.float32),
+                             output=1)
         prim = np.asarray(out["primID"], np.int64)
         geom = np.asarray(out["geomID"], np.int64)
         prim = np.where(geom < 0, -1, prim)
-        return prim, np.asarray(out["tfar"], np.float64), np.asarray(out["u"], np.float64), np.asarray(out["v"], np.float64)
+        t, u, v = (np.asarray(out[k], np.float64) for k in ("tfar", "u", "v"))
+        return prim, t, u, v
 
     def blocked(self, origins, dirs, dists):
         """True where something lies between each origin and its distance along dir."""

@@ -334,11 +334,13 @@ def build_parser() -> argparse.ArgumentParser:
                     help="exact: the texel sum above, no occlusion (exact on a convex mesh, noise-free); path: "
                          "path-trace the scene with the same BRDF, with shadows and inter-reflection "
                          "(app/accuracy/path_trace.py, needs embreex: pip install 'alight[reference]'); auto: path "
-                         "for a mesh file in the camera view, exact for the built-in meshes and the probe (default: auto)")
+                         "for a mesh file in the camera view, exact for the built-in meshes and the probe "
+                         "(default: auto)")
     rd.add_argument("--samples", type=int, default=256, metavar="N",
                     help="--integrator path: samples per pixel (default: 256); noise falls as 1/sqrt(N)")
     rd.add_argument("--seed", type=int, default=0, metavar="N",
-                    help="--integrator path: the random generator's seed; the same seed gives the same image (default: 0)")
+                    help="--integrator path: the random generator's seed; the same seed gives the same image "
+                         "(default: 0)")
     rd.add_argument("--max-bounces", type=int, default=8, metavar="N",
                     help="--integrator path: surface vertices per path at most, 1 = direct light only (default: 8)")
     rd.add_argument("--size", type=_size, default=(256, 256), metavar="W|WxH", help="image size (default: 256)")
@@ -794,7 +796,8 @@ def _reference(args) -> int:
         write_image(out, result.linear, linear=True)
         if args.verbose:
             print(f"path traced, {args.samples} samples a pixel, seed {args.seed}; total "
-                  f"{time.perf_counter() - start:.3f}s; " + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
+                  f"{time.perf_counter() - start:.3f}s; "
+                  + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
                   file=sys.stderr)
         print(out)
         return 0
@@ -848,7 +851,8 @@ def _compare(args) -> int:
         blocks = int(covered_blocks(test, ref, args.bin).sum())
         if blocks == 0:
             raise AlightError(f"--bin: no {args.bin}x{args.bin} block is covered in both images")
-        print(f"binned {args.bin}x{args.bin} relMAE {binned_relative_mae(test, ref, args.bin) * 100:.4g}%  over {blocks} blocks")
+        value = binned_relative_mae(test, ref, args.bin)
+        print(f"binned {args.bin}x{args.bin} relMAE {value * 100:.4g}%  over {blocks} blocks")
     if args.heatmap:
         print(write_relative_heatmap(args.heatmap, c.relative_map))
     if args.flip_heatmap:
