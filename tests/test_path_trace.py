@@ -218,3 +218,19 @@ def test_scenes_load_as_one_material_less_part_standing_on_y0(tmp_path, name):
         assert n[np.argmin(y), 1] < -0.99
     else:
         assert np.any((y < 1e-6) & (n[:, 1] > 0.999))
+
+
+def test_exact_reference_takes_the_render_camera_flags(tmp_path):
+    # Both integrators see the scene from alight render's camera: --elevation moves the view of
+    # the exact sum too (the cube's top face shows from above).
+    from alight.accuracy.metrics import read_linear
+
+    outs = []
+    for elevation in (0, 40):
+        out = tmp_path / f"e{elevation}.exr"
+        proc = _cli("--mesh", "cube", "--integrator", "exact", "--no-ibl", "--light", "directional:dir=0,-1,0",
+                    "--elevation", elevation, "--size", 16, "--out", out)
+        assert proc.returncode == 0, proc.stderr
+        outs.append(read_linear(out))
+    assert outs[0][..., :3].max() < 1e-6            # from the side the light (straight down) grazes
+    assert outs[1][..., :3].max() > 0.05             # from above the top face is lit
