@@ -369,9 +369,25 @@ def build_parser() -> argparse.ArgumentParser:
                         description="Compute CONVENTIONS.md's ground truth per pixel on the GPU: the sum over "
                                     "every texel of the environment of f(l, v) L(l) max(n.l, 0) dOmega (k = r^2/2, "
                                     "F per direction at v.h), plus emission and the punctual lights (k = (r+1)^2/8), "
-                                    "no occlusion. Roughness below 0.1 is refused when an environment is used.")
+                                    "no occlusion. Roughness below 0.1 is refused when an environment is used. "
+                                    "--integrator path (the default for a mesh file) path-traces the scene instead, "
+                                    "with the same BRDF, shadows and inter-reflection (docs/ptrace_notes.md).")
     _add_scene_options(rf)
+    _add_camera_options(rf)
     rd = rf.add_argument_group("reference")
+    rd.add_argument("--integrator", choices=("auto", "exact", "path"), default="auto",
+                    help="exact: the texel sum above, no occlusion (exact on a convex mesh, noise-free); path: "
+                         "path-trace the scene with the same BRDF, with shadows and inter-reflection "
+                         "(app/accuracy/path_trace.py, needs embreex: pip install 'alight[reference]'); auto: path "
+                         "for a mesh file in the camera view, exact for the built-in meshes and the probe "
+                         "(default: auto)")
+    rd.add_argument("--samples", type=int, default=256, metavar="N",
+                    help="--integrator path: samples per pixel (default: 256); noise falls as 1/sqrt(N)")
+    rd.add_argument("--seed", type=int, default=0, metavar="N",
+                    help="--integrator path: the random generator's seed; the same seed gives the same image "
+                         "(default: 0)")
+    rd.add_argument("--max-bounces", type=int, default=8, metavar="N",
+                    help="--integrator path: surface vertices per path at most, 1 = direct light only (default: 8)")
     rd.add_argument("--size", type=_size, default=(256, 256), metavar="W|WxH", help="image size (default: 256)")
     rd.add_argument("--env-level", default="auto", metavar="N|auto",
                     help="sum over the map box-reduced by 2^N (area-weighted): 4^N times faster. Level 1 "
@@ -395,6 +411,9 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--flip-heatmap", metavar="OUT.png", help="write the per-pixel FLIP error as a heat map")
     cp.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
                     help="exposure before tone mapping, for FLIP (default: 0)")
+    cp.add_argument("--bin", type=int, default=1, metavar="N",
+                    help="also print relMAE after summing both images over NxN blocks (the blocks covered in both): "
+                         "against a path-traced reference it divides the reference's noise by N (default: 1, off)")
     ch = sub.add_parser("chart", help="sweep the IBL settings: bake time, frame time, error against the ground truth",
                         description="Measure, one factor at a time around the medium quality, every IBL setting "
                                     "(irradiance method and size, specular cube size, sample counts, filtered "
@@ -847,6 +866,22 @@ def _reference(args) -> int:
         if not 0 <= level <= 8:
             raise AlightError(f"--env-level: {level} is out of range [0, 8]")
     material, overrides, texture_maps = build_look(args)
+    from alight.core.mesh import BUILTIN_MESHES
+
+    integrator = args.integrator
+    if integrator == "auto":
+        integrator = "path" if args.view == "camera" and args.mesh not in BUILTIN_MESHES else "exact"
+    if integrator == "path":
+        for option, value, low in (("--samples", args.samples, 1), ("--max-bounces", args.max_bounces, 1)):
+            if value < low:
+                raise AlightError(f"{option}: {value} must be at least {low}")
+        if args.view != "camera":
+            raise AlightError("--integrator path: only with --view camera (the probe has nothing to occlude)")
+        if level is not None:
+            raise AlightError("--env-level: only with --integrator exact (the path tracer samples the full map)")
+        from alight.accuracy.path_trace import _import_embree
+
+        _import_embree()   # a missing install is said before any file is read
 
     from alight.accuracy.reference import check_layer_roughness, check_roughness
     from alight.core.scene import Scene, parse_light
@@ -854,19 +889,39 @@ def _reference(args) -> int:
     from alight.exchange.meshes import load_mesh
     from alight.ibl.environment import load_environment
 
-    if not args.no_ibl:
+    if not args.no_ibl and integrator == "exact":
         check_roughness(material.roughness)   # before any file is read
         check_layer_roughness(material)
     lights = [parse_light(spec) for spec in args.light]
     mesh = load_mesh(args.mesh) if args.view == "camera" else None
+    if mesh is not None:
+        _warn(mesh.warnings)
+        if not args.light and not args.no_file_lights:
+            lights = list(mesh.lights)
+    camera = _camera(args, mesh, width / height)
     env = None if args.no_ibl else load_environment(args.env)
     if env is not None:
         _warn(env.warnings)
     scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None and texture_maps is None,
                   texture_maps=texture_maps, texture_images=load_map_images(texture_maps) if texture_maps else {},
-                  material_overrides=overrides, lights=lights, view=args.view,
+                  material_overrides=overrides, lights=lights, camera=camera, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None)
+    if integrator == "path":
+        from alight.accuracy.path_trace import TraceSettings, trace
+        from alight.exchange.output import write_image
+
+        result = trace(scene, env.radiance if env is not None else None, width, height,
+                       TraceSettings(samples=args.samples, max_bounces=args.max_bounces, seed=args.seed))
+        _warn(result.warnings)
+        write_image(out, result.linear, linear=True)
+        if args.verbose:
+            print(f"path traced, {args.samples} samples a pixel, seed {args.seed}; total "
+                  f"{time.perf_counter() - start:.3f}s; "
+                  + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
+                  file=sys.stderr)
+        print(out)
+        return 0
 
     from alight.accuracy.reference import ReferenceRenderer
     from alight.exchange.output import write_image
@@ -891,6 +946,8 @@ def _reference(args) -> int:
 def _compare(args) -> int:
     from alight.exchange.output import check_output_path
 
+    if not 1 <= args.bin <= 64:
+        raise AlightError(f"--bin: {args.bin} must be from 1 to 64")
     for opt, path in (("--heatmap", args.heatmap), ("--flip-heatmap", args.flip_heatmap)):
         if path:
             check_output_path(path, (".png",))
@@ -909,6 +966,14 @@ def _compare(args) -> int:
     if c.covered == 0:
         raise AlightError(f"{args.ref}: no covered pixel (alpha is 0 everywhere)")
     print(f"relMAE {c.relative_mae * 100:.4g}%  FLIP {c.flip:.4g}  over {c.covered} covered pixels")
+    if args.bin > 1:
+        from alight.accuracy.binned import binned_relative_mae, covered_blocks
+
+        blocks = int(covered_blocks(test, ref, args.bin).sum())
+        if blocks == 0:
+            raise AlightError(f"--bin: no {args.bin}x{args.bin} block is covered in both images")
+        value = binned_relative_mae(test, ref, args.bin)
+        print(f"binned {args.bin}x{args.bin} relMAE {value * 100:.4g}%  over {blocks} blocks")
     if args.heatmap:
         print(write_relative_heatmap(args.heatmap, c.relative_map))
     if args.flip_heatmap:
