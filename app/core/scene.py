@@ -214,6 +214,7 @@ class Scene:
     ibl_model: str = DEFAULT_IBL_MODEL                        # a key of app/core/ibl_models.py's IBL_MODELS
     multiple_scattering: bool = False                         # Fdez-Aguera 2019 energy compensation
     display: Display = field(default_factory=Display)
+    shadows: str = "auto"      # auto, on, off (alight.render.shadows: auto where something can be shadowed)
     debug_view: int = 0        # 0: shaded; else an index of app/frontends/editor/state.py's DEBUG_VIEWS
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view
     # User-loaded maps for ``material`` (app/core/texture_maps.py: paths and UV tiling) and their

@@ -72,6 +72,7 @@ from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
+from alight.render.shadows import ShadowMaps
 from alight.render.tiles import (
     TILE_BYTES,
     Tile,
@@ -120,6 +121,9 @@ SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_
 # The `stretched` IBL model's lobe table (alight.core.stretched_lobe), bound where a program reads it.
 UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_BEHIND + 3, UNIT_SCENE_BEHIND + 4
 SAMPLER_UNITS.update(u_stretched_lobe_a=UNIT_STRETCHED_LOBE_A, u_stretched_lobe_b=UNIT_STRETCHED_LOBE_B)
+# The shadow atlas (alight.render.shadows): with comparison (PCF) and as depths (the blocker search).
+UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH = UNIT_SCENE_BEHIND + 5, UNIT_SCENE_BEHIND + 6
+SAMPLER_UNITS.update(u_shadow_atlas=UNIT_SHADOW_ATLAS, u_shadow_depth=UNIT_SHADOW_DEPTH)
 
 
 @dataclass
@@ -396,6 +400,8 @@ class ForwardRenderer:
         self._impostor_samples = 1
         self._impostor_model: np.ndarray | None = None   # the proxy's placement while _draw_scene runs
         self._targets: _Targets | None = None
+        self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
+        self._shadowed = False                    # set by _draw_scene: this pass reads the shadow maps
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict = {}   # by program id (and 'ring': _draw_background)
@@ -607,6 +613,7 @@ class ForwardRenderer:
             self._targets.release()
             self._targets = None
         self.luts.release()
+        self.shadow_maps.release()
         if self.bake_cache is not None:
             self.bake_cache.close()
         self.anisotropy_lut.release()
@@ -811,6 +818,7 @@ class ForwardRenderer:
             fbo = targets.single()[1]
         else:
             self._impostor_samples = 0
+        self._shadowed = self._prepare_shadows(scene, maps)    # (its own framebuffer: before this pass's)
         fbo.use()
         ctx.viewport = (0, 0, width, height)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
@@ -865,6 +873,23 @@ class ForwardRenderer:
         self._display_output = None
         self._half_output = False
         self._impostor_model = None
+
+    def _prepare_shadows(self, scene: Scene, maps: IBLMaps | None) -> bool:
+        """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows);
+        whether this pass reads them. The casters: every part but those that blend."""
+        if scene.view == "probe" or scene.mesh is None or not self.shadow_maps.wanted(scene, maps):
+            self.shadow_maps.last_active = False
+            return False
+        gpu_parts = [g for g, part in zip(self._gpu_mesh(scene.mesh), scene.mesh.parts)
+                     if not (part.material is not None and scene.use_file_materials and part.material.alpha_mode == "BLEND")]
+
+        def draw_parts(matrix: bytes, parts) -> None:
+            prog = self.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+            prog["u_view_projection"].write(matrix)
+            for gpu_part in parts:
+                gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+
+        return self.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts)
 
     def _surface_rect(self, scene: Scene, view_projection: np.ndarray,
                       size: tuple[int, int]) -> tuple[int, int, int, int] | None:
@@ -1164,6 +1189,8 @@ class ForwardRenderer:
                                                 any_maps))
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
+        if self._shadowed:
+            defines["HAS_SHADOWS"] = None
         bound: set[int] = set()
 
         def program_for(part_defines: dict) -> moderngl.Program:
@@ -1175,6 +1202,8 @@ class ForwardRenderer:
                     _set(prog, "u_debug_view", int(scene.debug_view))
                     _set(prog, "u_debug_mip", float(scene.debug_mip))
                 self._bind_ibl(prog, scene, maps)
+                if self._shadowed:
+                    self.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
             self._bind_layer_luts(all_defines)
             return prog
 
