@@ -3,7 +3,7 @@
 // Compiled in only with HAS_SHADOWS: a scene that cannot shadow itself pays nothing.
 //
 // Filtering: percentage-closer filtering (Reeves et al. 1987) with the hardware's bilinear
-// comparison per tap over a 16-tap Poisson disk; where the source has a size (a sun's angular
+// comparison per tap over a few taps of Vogel's spiral disk; where the source has a size (a sun's angular
 // radius), percentage-closer soft shadows (Fernando 2005): a blocker search gives the mean
 // occluder depth, and the penumbra's width follows from similar triangles.
 // Bias: the receiver is moved along its geometric normal by a texel's size (normal offset,
@@ -39,13 +39,13 @@ void set_shadow_receiver(vec3 position, vec3 geometric_normal) {
     shadow_receiver_normal = geometric_normal;
 }
 
-const vec2 SHADOW_POISSON[16] = vec2[](
-    vec2(-0.94201624, -0.39906216), vec2(0.94558609, -0.76890725), vec2(-0.09418410, -0.92938870),
-    vec2(0.34495938, 0.29387760), vec2(-0.91588581, 0.45771432), vec2(-0.81544232, -0.87912464),
-    vec2(-0.38277543, 0.27676845), vec2(0.97484398, 0.75648379), vec2(0.44323325, -0.97511554),
-    vec2(0.53742981, -0.47373420), vec2(-0.26496911, -0.41893023), vec2(0.79197514, 0.19090188),
-    vec2(-0.24188840, 0.99706507), vec2(-0.81409955, 0.91437590), vec2(0.19984126, 0.78641367),
-    vec2(0.14383161, -0.14100790));
+// Tap k of n on the unit disk: Vogel's spiral (golden-angle steps, radius sqrt((k + 0.5) / n)),
+// even at any n; with constant n and k the compiler folds it.
+vec2 shadow_tap(int k, int n) {
+    float r = sqrt((float(k) + 0.5) / float(n));
+    float a = 2.39996323 * float(k);
+    return r * vec2(cos(a), sin(a));
+}
 
 // World distance along the view from a depth in [0, 1], and back.
 float shadow_linear_depth(int view, float z) {
@@ -62,64 +62,90 @@ float shadow_depth01(int view, float linear) {
     return ndc * 0.5 + 0.5;
 }
 
-// The fraction of light ``l`` (unit, toward the light) that reaches the receiver through
-// ``view``'s map: 1 lit, 0 in shadow.
-float shadow_visibility(int view, vec3 l) {
+// Where a receiver meets a view's map: its atlas uv, its depth along the view (world units),
+// the receiver plane's depth change per texel (x, y), the bias, the tile's clamp and a texel's size.
+struct ShadowLookup {
+    bool inside;
+    vec2 uv;
+    float receiver;
+    vec2 slope;
+    float bias;
+    vec2 lo, hi;
+    float texel;
+};
+
+ShadowLookup shadow_lookup(int view, vec3 l) {
+    ShadowLookup look;
     vec3 n = shadow_receiver_normal;
     if (dot(n, l) < 0.0) n = -n;        // a two-sided face lit from behind
     float n_dot_l = max(dot(n, l), 1e-3);
     mat4 m = u_shadow_matrix[view];
-    vec4 params = u_shadow_params[view];
     vec4 clip = m * vec4(shadow_receiver_position, 1.0);
     // clip.w: 1 (orthographic) or the distance along the view (perspective)
-    float texel = params.y * max(clip.w, 0.0);
+    look.texel = u_shadow_params[view].y * max(clip.w, 0.0);
     float sin_l = sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0));
-    vec3 p = shadow_receiver_position + n * texel * (0.5 + 1.5 * sin_l);
+    vec3 p = shadow_receiver_position + n * look.texel * (0.5 + 1.5 * sin_l);
     clip = m * vec4(p, 1.0);
-    if (clip.w <= 0.0) return 1.0;
-    vec3 ndc = clip.xyz / clip.w;
-    if (any(greaterThan(abs(ndc), vec3(1.0)))) return 1.0;    // outside the map: nothing casts there
+    vec3 ndc = clip.xyz / max(clip.w, 1e-12);
+    // Outside the map (or behind a perspective view's eye) nothing casts.
+    look.inside = clip.w > 0.0 && all(lessThanEqual(abs(ndc), vec3(1.0)));
     vec4 rect = u_shadow_rect[view];
-    vec3 c = vec3(mix(rect.xy, rect.zw, ndc.xy * 0.5 + 0.5), ndc.z * 0.5 + 0.5);
-    float receiver = shadow_linear_depth(view, c.z);
+    look.uv = mix(rect.xy, rect.zw, ndc.xy * 0.5 + 0.5);
+    look.receiver = shadow_linear_depth(view, ndc.z * 0.5 + 0.5);
     // The receiver's plane in the view's texel axes: depth change per texel along x and y.
     vec3 axis_x = normalize(vec3(m[0][0], m[1][0], m[2][0]));
     vec3 axis_y = normalize(vec3(m[0][1], m[1][1], m[2][1]));
-    vec2 slope = clamp(vec2(dot(n, axis_x), dot(n, axis_y)) / n_dot_l, -SHADOW_MAX_SLOPE, SHADOW_MAX_SLOPE) * texel;
-    float bias = texel * (0.5 + min(length(slope) / max(texel, 1e-12), SHADOW_MAX_SLOPE));
+    vec2 slope = clamp(vec2(dot(n, axis_x), dot(n, axis_y)) / n_dot_l, -SHADOW_MAX_SLOPE, SHADOW_MAX_SLOPE);
+    look.slope = slope * look.texel;
+    look.bias = look.texel * (0.5 + min(length(slope), SHADOW_MAX_SLOPE));
     vec2 texel_uv = 1.0 / u_shadow_atlas_size;
-    vec2 lo = rect.xy + texel_uv, hi = rect.zw - texel_uv;
+    look.lo = rect.xy + texel_uv;
+    look.hi = rect.zw - texel_uv;
+    return look;
+}
 
-    float radius = 1.0;      // texels: the delta light's edge, anti-aliased
-    if (params.z > 0.0) {
-        // Blocker search over the region that could hide part of the source.
-        float reach = params.x < 0.5 ? (receiver - u_shadow_range[view].x) * params.z
-                                     : params.z * (receiver - u_shadow_range[view].x) / receiver;
-        float search = clamp(reach / texel, 1.0, SHADOW_MAX_RADIUS);
-        float blockers = 0.0, count = 0.0;
-        for (int k = 0; k < 16; ++k) {
-            vec2 o = SHADOW_POISSON[k] * search;
-            vec2 uv = clamp(c.xy + o * texel_uv, lo, hi);
-            float stored = shadow_linear_depth(view, textureLod(u_shadow_depth, uv, 0.0).r);
-            if (stored < receiver + dot(slope, o) - bias) {
-                blockers += stored;
-                count += 1.0;
-            }
-        }
-        if (count == 0.0) return 1.0;
-        float blocker = blockers / count;
-        float penumbra = params.x < 0.5 ? (receiver - blocker) * params.z
-                                        : params.z * (receiver - blocker) / max(blocker, 1e-6);
-        radius = clamp(penumbra / texel, 1.0, SHADOW_MAX_RADIUS);
-    }
+// The comparison at offset o (texels) from the receiver against its plane there, bilinear.
+float shadow_tap_lit(int view, ShadowLookup look, vec2 o) {
+    vec2 uv = clamp(look.uv + o / u_shadow_atlas_size, look.lo, look.hi);
+    return texture(u_shadow_atlas, vec3(uv, shadow_depth01(view, look.receiver + dot(look.slope, o) - look.bias)));
+}
+
+// A delta light (no size): 4 bilinear taps within a texel, an edge 2-3 texels wide.
+float shadow_hard(int view, vec3 l) {
+    ShadowLookup look = shadow_lookup(view, l);
+    if (!look.inside) return 1.0;
     float lit = 0.0;
-    for (int k = 0; k < 16; ++k) {
-        vec2 o = SHADOW_POISSON[k] * radius;
-        vec2 uv = clamp(c.xy + o * texel_uv, lo, hi);
-        float ref = shadow_depth01(view, receiver + dot(slope, o) - bias);
-        lit += texture(u_shadow_atlas, vec3(uv, ref));
+    for (int k = 0; k < 4; ++k) lit += shadow_tap_lit(view, look, shadow_tap(k, 4));
+    return lit * 0.25;
+}
+
+// A source of angular (orthographic) or world (perspective) radius u_shadow_params[view].z: PCSS.
+float shadow_soft(int view, vec3 l) {
+    ShadowLookup look = shadow_lookup(view, l);
+    if (!look.inside) return 1.0;
+    vec4 params = u_shadow_params[view];
+    float near = u_shadow_range[view].x;
+    bool ortho = params.x < 0.5;
+    // Blocker search over the region that could hide part of the source.
+    float reach = ortho ? (look.receiver - near) * params.z : params.z * (look.receiver - near) / look.receiver;
+    float search = clamp(reach / look.texel, 1.0, SHADOW_MAX_RADIUS);
+    float blockers = 0.0, count = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        vec2 o = shadow_tap(k, 8) * search;
+        vec2 uv = clamp(look.uv + o / u_shadow_atlas_size, look.lo, look.hi);
+        float stored = shadow_linear_depth(view, textureLod(u_shadow_depth, uv, 0.0).r);
+        bool blocks = stored < look.receiver + dot(look.slope, o) - look.bias;
+        blockers += blocks ? stored : 0.0;
+        count += blocks ? 1.0 : 0.0;
     }
-    return lit / 16.0;
+    if (count == 0.0) return 1.0;
+    float blocker = blockers / count;
+    float penumbra = ortho ? (look.receiver - blocker) * params.z
+                           : params.z * (look.receiver - blocker) / max(blocker, 1e-6);
+    float radius = clamp(penumbra / look.texel, 1.0, SHADOW_MAX_RADIUS);
+    float lit = 0.0;
+    for (int k = 0; k < 12; ++k) lit += shadow_tap_lit(view, look, shadow_tap(k, 12) * radius);
+    return lit / 12.0;
 }
 
 // Light i of punctual.glsl's block: its view (a point light's by the cube face the receiver
@@ -133,12 +159,12 @@ float light_shadow(int i, int kind, vec3 l, vec3 light_position) {
         int axis = (a.x >= a.y && a.x >= a.z) ? 0 : (a.y >= a.z ? 1 : 2);
         first += 2 * axis + (v[axis] >= 0.0 ? 0 : 1);
     }
-    return shadow_visibility(first, l);
+    return shadow_hard(first, l);      // punctual lights have no size
 }
 
 float sun_shadow(int i, vec3 l) {
     int view = u_sun_shadow[i];
-    return view < 0 ? 1.0 : shadow_visibility(view, l);
+    return view < 0 ? 1.0 : shadow_soft(view, l);
 }
 
 #endif
