@@ -252,3 +252,16 @@ def test_sun_of_the_map_casts_the_box_shadow(rotation):
     assert overlap(shadowed, expected) >= 0.9
     # In the shadow only the sky is left: the sun's share is gone.
     assert np.median(ratio[expected & ~_dilate(~expected, 2)]) < 0.4
+
+
+def test_glsl_taps_are_vogel_disks():
+    import re
+
+    from alight.core.shadow_fit import vogel_disk
+    from alight.paths import shader_dir
+
+    text = (shader_dir() / "common" / "shadows.glsl").read_text()
+    for n in (4, 8, 12):
+        body = re.search(rf"SHADOW_TAPS_{n}\[{n}\] = vec2\[\]\((.*?)\);", text, re.S).group(1)
+        values = np.array([float(x) for x in re.findall(r"-?\d+\.\d+", body)]).reshape(-1, 2)
+        np.testing.assert_allclose(values, vogel_disk(n), atol=1e-6)

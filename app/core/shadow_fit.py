@@ -130,6 +130,15 @@ def point_views(position, centre, radius: float, resolution: int, source_radius:
             for forward, up in CUBE_FACES]
 
 
+def vogel_disk(n: int) -> np.ndarray:
+    """(n, 2) taps on the unit disk, Vogel's spiral: tap k at radius sqrt((k + 0.5) / n), angle
+    k times the golden angle (shaders/common/shadows.glsl's SHADOW_TAPS_n)."""
+    k = np.arange(n, dtype=np.float64)
+    r = np.sqrt((k + 0.5) / n)
+    a = 2.39996323 * k
+    return np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+
+
 def cube_face(vector) -> int:
     """The index into CUBE_FACES of the face a direction (from the light) falls on: its major axis."""
     v = np.asarray(vector, np.float64)

@@ -283,6 +283,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--shadows", choices=("auto", "on", "off"), default="auto",
                    help="shadow maps for the lights and the environment's suns: auto draws them only where "
                         "something can be shadowed (not for a convex mesh such as the built-in sphere) (default: auto)")
+    d.add_argument("--ground", action="store_true",
+                   help="a ground under the model's bounding box that catches its shadow, composited over the "
+                        "background (with --background transparent: the shadow in alpha)")
 
     b = sub.add_parser("bake", help="bake an environment's IBL maps and write them as images",
                        description="Write the baked maps as equirectangular images (linear .exr and "
@@ -512,7 +515,8 @@ def _render(args) -> int:
                   material_overrides=overrides, lights=lights, camera=camera, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, ibl_model=args.ibl,
-                  multiple_scattering=args.multiple_scattering, display=display, shadows=args.shadows)
+                  multiple_scattering=args.multiple_scattering, display=display, shadows=args.shadows,
+                  ground=args.ground)
     loaded = time.perf_counter()
 
     from alight.exchange.output import image_rows_writer

@@ -72,6 +72,7 @@ from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
+from alight.render.ground import GroundPass
 from alight.render.shadows import ShadowMaps
 from alight.render.tiles import (
     TILE_BYTES,
@@ -402,6 +403,7 @@ class ForwardRenderer:
         self._targets: _Targets | None = None
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self._shadowed = False                    # set by _draw_scene: this pass reads the shadow maps
+        self._ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict = {}   # by program id (and 'ring': _draw_background)
@@ -519,7 +521,7 @@ class ForwardRenderer:
         ``view_projection``: the camera's for ``image_size`` (not a tile's), where the caller has
         it."""
         mesh = scene.mesh
-        if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
+        if (not self.sphere_impostor or scene.view == "probe" or mesh is None or scene.ground or mesh.lod_sphere is None
                 or len(mesh.parts) != 1 or camera.ortho_half_height is not None):
             return None
         radius = mesh.lod_sphere[0]
@@ -614,6 +616,9 @@ class ForwardRenderer:
             self._targets = None
         self.luts.release()
         self.shadow_maps.release()
+        if self._ground_pass is not None:
+            self._ground_pass.release()
+            self._ground_pass = None
         if self.bake_cache is not None:
             self.bake_cache.close()
         self.anisotropy_lut.release()
@@ -860,9 +865,13 @@ class ForwardRenderer:
             self._draw_mesh(scene, maps, camera, view_projection, blend=False, targets=targets, fbo=fbo,
                             pixels_per_radian=view.height * scale / 2.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0),
                             image_size=(view.width, view.height))
+            if not background:     # (the fused resolve composites the background under it)
+                self._draw_ground(scene, maps, view_projection)
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         if background and ring is None:
             self._draw_background(scene, maps, inverse_vp)
+            if scene.view != "probe" and scene.mesh is not None:
+                self._draw_ground(scene, maps, view_projection)
             # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
             # (The fused MSAA resolve, background=False, is used only for scenes with none.)
             if scene.view != "probe" and scene.mesh is not None:
@@ -877,7 +886,8 @@ class ForwardRenderer:
     def _prepare_shadows(self, scene: Scene, maps: IBLMaps | None) -> bool:
         """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows);
         whether this pass reads them. The casters: every part but those that blend."""
-        if scene.view == "probe" or scene.mesh is None or not self.shadow_maps.wanted(scene, maps):
+        ground = scene.ground and scene.view != "probe" and scene.mesh is not None and bool(scene.mesh.parts)
+        if scene.view == "probe" or scene.mesh is None or not self.shadow_maps.wanted(scene, maps, receivers=ground):
             self.shadow_maps.last_active = False
             return False
         gpu_parts = [g for g, part in zip(self._gpu_mesh(scene.mesh), scene.mesh.parts)
@@ -889,7 +899,22 @@ class ForwardRenderer:
             for gpu_part in parts:
                 gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
 
-        return self.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts)
+        bounds = GroundPass.ground_for(scene.mesh).bounds if ground else None
+        return self.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts, bounds)
+
+    def _draw_ground(self, scene: Scene, maps: IBLMaps | None, view_projection: np.ndarray) -> None:
+        """Scene.ground's shadow catcher (alight.render.ground) into the bound framebuffer, after
+        the surfaces (and the background, where a pass draws one). Only where shadows are drawn:
+        a ground without them takes nothing from the background."""
+        if not (scene.ground and self._shadowed and scene.mesh is not None):
+            return
+        if self._ground_pass is None:
+            self._ground_pass = GroundPass(self.ctx)
+        prog = self._scene_program("render/ground.vert", "render/ground.frag",
+                                   {**_light_defines(scene), "HAS_SHADOWS": None})
+        self._bind_ibl(prog, scene, maps)
+        self.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
+        self._ground_pass.draw(prog, GroundPass.ground_for(scene.mesh), view_projection)
 
     def _surface_rect(self, scene: Scene, view_projection: np.ndarray,
                       size: tuple[int, int]) -> tuple[int, int, int, int] | None:

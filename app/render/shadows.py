@@ -38,8 +38,8 @@ MAX_SHADOW_VIEWS = 16      # shaders/common/shadows.glsl's MAX_SHADOW_VIEWS
 MAX_SHADOW_LIGHTS = 16     # punctual.glsl's MAX_LIGHTS
 MAX_SHADOW_SUNS = 4        # suns.glsl's MAX_SUNS
 # Texels along a view's side. Orthographic views cover the whole scene; a point light's faces
-# cover a quarter of its sphere each.
-RESOLUTION = {"directional": 2048, "sun": 2048, "spot": 1024, "point": 512}
+# cover a quarter of its sphere each; a sun's shadow is soft (PCSS), so it needs fewer texels.
+RESOLUTION = {"directional": 2048, "sun": 1024, "spot": 1024, "point": 512}
 # The source's RMS angular spread (alight.ibl.sun.Sun.spread) as a disk's radius: a uniform
 # disk of radius R has RMS angle R / sqrt(2).
 SPREAD_TO_RADIUS = math.sqrt(2.0)

@@ -39,13 +39,20 @@ void set_shadow_receiver(vec3 position, vec3 geometric_normal) {
     shadow_receiver_normal = geometric_normal;
 }
 
-// Tap k of n on the unit disk: Vogel's spiral (golden-angle steps, radius sqrt((k + 0.5) / n)),
-// even at any n; with constant n and k the compiler folds it.
-vec2 shadow_tap(int k, int n) {
-    float r = sqrt((float(k) + 0.5) / float(n));
-    float a = 2.39996323 * float(k);
-    return r * vec2(cos(a), sin(a));
-}
+// Taps on the unit disk: Vogel's spiral (golden-angle steps, radius sqrt((k + 0.5) / n)), even at
+// any n (app/core/shadow_fit.py vogel_disk prints them).
+const vec2 SHADOW_TAPS_4[4] = vec2[](
+    vec2(0.353553, 0.000000), vec2(-0.451544, 0.413652), vec2(0.069116, -0.787542),
+    vec2(0.569142, 0.742346));
+const vec2 SHADOW_TAPS_8[8] = vec2[](
+    vec2(0.250000, 0.000000), vec2(-0.319290, 0.292496), vec2(0.048872, -0.556877),
+    vec2(0.402444, 0.524918), vec2(-0.738535, -0.130636), vec2(0.699605, -0.445031),
+    vec2(-0.234004, 0.870484), vec2(-0.446271, -0.859268));
+const vec2 SHADOW_TAPS_12[12] = vec2[](
+    vec2(0.204124, 0.000000), vec2(-0.260699, 0.238822), vec2(0.039904, -0.454688),
+    vec2(0.328595, 0.428593), vec2(-0.603011, -0.106664), vec2(0.571225, -0.363367),
+    vec2(-0.191064, 0.710747), vec2(-0.364379, -0.701590), vec2(0.790557, 0.288710),
+    vec2(-0.822442, 0.339492), vec2(0.396472, -0.847237), vec2(0.292982, 0.934074));
 
 // World distance along the view from a depth in [0, 1], and back.
 float shadow_linear_depth(int view, float z) {
@@ -115,14 +122,16 @@ float shadow_hard(int view, vec3 l) {
     ShadowLookup look = shadow_lookup(view, l);
     if (!look.inside) return 1.0;
     float lit = 0.0;
-    for (int k = 0; k < 4; ++k) lit += shadow_tap_lit(view, look, shadow_tap(k, 4));
+    for (int k = 0; k < 4; ++k) lit += shadow_tap_lit(view, look, SHADOW_TAPS_4[k]);
     return lit * 0.25;
 }
 
 // A source of angular (orthographic) or world (perspective) radius u_shadow_params[view].z: PCSS.
 float shadow_soft(int view, vec3 l) {
     ShadowLookup look = shadow_lookup(view, l);
-    if (!look.inside) return 1.0;
+    // Loops with counts that a block of pixels may share as 0 (outside the map, no blocker):
+    // llvmpipe runs both sides of a branch, but leaves a loop once no pixel of a block is in it.
+    int searches = look.inside ? 8 : 0;
     vec4 params = u_shadow_params[view];
     float near = u_shadow_range[view].x;
     bool ortho = params.x < 0.5;
@@ -130,22 +139,22 @@ float shadow_soft(int view, vec3 l) {
     float reach = ortho ? (look.receiver - near) * params.z : params.z * (look.receiver - near) / look.receiver;
     float search = clamp(reach / look.texel, 1.0, SHADOW_MAX_RADIUS);
     float blockers = 0.0, count = 0.0;
-    for (int k = 0; k < 8; ++k) {
-        vec2 o = shadow_tap(k, 8) * search;
+    for (int k = 0; k < searches; ++k) {
+        vec2 o = SHADOW_TAPS_8[k] * search;
         vec2 uv = clamp(look.uv + o / u_shadow_atlas_size, look.lo, look.hi);
         float stored = shadow_linear_depth(view, textureLod(u_shadow_depth, uv, 0.0).r);
         bool blocks = stored < look.receiver + dot(look.slope, o) - look.bias;
         blockers += blocks ? stored : 0.0;
         count += blocks ? 1.0 : 0.0;
     }
-    if (count == 0.0) return 1.0;
-    float blocker = blockers / count;
+    float blocker = blockers / max(count, 1.0);
     float penumbra = ortho ? (look.receiver - blocker) * params.z
                            : params.z * (look.receiver - blocker) / max(blocker, 1e-6);
     float radius = clamp(penumbra / look.texel, 1.0, SHADOW_MAX_RADIUS);
+    int taps = count > 0.0 ? 12 : 0;
     float lit = 0.0;
-    for (int k = 0; k < 12; ++k) lit += shadow_tap_lit(view, look, shadow_tap(k, 12) * radius);
-    return lit / 12.0;
+    for (int k = 0; k < taps; ++k) lit += shadow_tap_lit(view, look, SHADOW_TAPS_12[k] * radius);
+    return count > 0.0 ? lit / 12.0 : 1.0;
 }
 
 // Light i of punctual.glsl's block: its view (a point light's by the cube face the receiver
