@@ -265,3 +265,51 @@ def test_glsl_taps_are_vogel_disks():
         body = re.search(rf"SHADOW_TAPS_{n}\[{n}\] = vec2\[\]\((.*?)\);", text, re.S).group(1)
         values = np.array([float(x) for x in re.findall(r"-?\d+\.\d+", body)]).reshape(-1, 2)
         np.testing.assert_allclose(values, vogel_disk(n), atol=1e-6)
+
+
+def test_ground_catches_the_sphere_shadow_where_it_falls():
+    """The built-in sphere (radius 1) on --ground under a light at 45 degrees: seen from above, the
+    shadow in alpha (transparent background) is the ellipse the light's projection puts on the
+    plane y = -1 (centre x = -1, semi-axes sqrt(2) along x and 1 along z), outside the ball."""
+    light = Light(kind="directional", vector=(-1.0, -1.0, 0.0), intensity=3.0)
+    scene = Scene(mesh=sphere(), lights=[light], ibl_enabled=False, ground=True, camera=top_view(),
+                  display=Display(background="transparent"))
+    r = renderer()
+    frame = r.render(scene, None, SIZE, SIZE)
+    assert r.shadow_maps.last_active     # the ground needs the pass the convex sphere alone does not
+    x, z = pixel_world_xz()
+    ball = x * x + z * z <= 1.0
+    near = x * x + z * z < 1.7 ** 2      # inside the fade (alight.core.ground)
+    expected = (((x + 1.0) / np.sqrt(2.0)) ** 2 + z * z <= 1.0) & ~ball & near
+    alpha = frame.linear[..., 3]
+    shadowed = (alpha > 0.5) & ~ball & near
+    assert overlap(shadowed, expected) >= 0.9
+    assert alpha[~_dilate(ball, 2) & ~_dilate(expected, 3) & near].max() < 0.02     # lit ground: transparent
+    # Without the ground the same scene has no shadow pass and nothing off the ball.
+    scene.ground = False
+    before = r.shadow_maps.passes_run
+    plain = r.render(scene, None, SIZE, SIZE)
+    assert r.shadow_maps.passes_run == before and plain.linear[..., 3][~_dilate(ball, 2)].max() == 0.0
+
+
+@pytest.mark.parametrize("aa", ["none", "msaa", "ssaa"])
+def test_cli_ground_over_background_is_the_background_darkened_by_the_alpha(tmp_path, aa):
+    """alight render --ground: over a colour background each pixel off the ball is the colour
+    times (1 - the shadow's alpha) of the same render over a transparent background."""
+    from PIL import Image
+
+    common = [sys.executable, "-m", "alight", "render", "--mesh", "sphere", "--no-ibl", "--ground", "--size", "96",
+              "--elevation", "35", "--light", "directional:dir=-1,-1,-0.3:intensity=3", "--tonemap", "none", "--aa", aa]
+    a, b = tmp_path / "t.png", tmp_path / "c.png"
+    subprocess.run(common + ["--background", "transparent", "--out", str(a)], check=True, capture_output=True)
+    subprocess.run(common + ["--background", "color", "--background-color", "0.5,0.5,0.5", "--out", str(b)],
+                   check=True, capture_output=True)
+    t = np.asarray(Image.open(a), np.float64) / 255.0
+    c = np.asarray(Image.open(b), np.float64) / 255.0
+    off_ball = t[..., 3] < 0.999
+    shadow = off_ball & (t[..., 3] > 0.2)
+    assert shadow.sum() > 50
+    # sRGB of linear 0.5 times (1 - alpha), against the colour render (8-bit rounding).
+    expected = 0.5 * (1.0 - t[..., 3])
+    srgb = np.where(expected <= 0.0031308, 12.92 * expected, 1.055 * expected ** (1 / 2.4) - 0.055)
+    np.testing.assert_allclose(c[..., 0][off_ball & ~_dilate(~off_ball, 1)], srgb[off_ball & ~_dilate(~off_ball, 1)], atol=3 / 255)

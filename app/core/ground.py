@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FADE_RADII = 1.6      # where the ground's shadow has faded out, in bounding-sphere radii
+FADE_RADII = 3.0      # where the ground's shadow has faded out, in bounding-sphere radii (a 45-degree light
+                      # casts a unit sphere's shadow out to 2.4 radii)
 
 
 @dataclass(frozen=True)

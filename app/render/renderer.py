@@ -707,7 +707,8 @@ class ForwardRenderer:
                 if aa == "msaa" and not self._has_blending_parts(scene):
                     self._draw_scene(scene, maps, targets, targets.draw, view=view, background=False)
                     self._resolve(scene, maps, targets, read_linear, read_srgb)
-                elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe":
+                elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe" \
+                        and not scene.ground:   # (the ground darkens radiance: it blends before the tone map)
                     self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display, view=view)
                 else:
                     self._draw_scene(scene, maps, targets, targets.draw, view=view)
@@ -780,8 +781,9 @@ class ForwardRenderer:
         860x720 frame, within 1 LSB of the exact curve (on the editor's ball a fifth of the values
         1 LSB off; tests/editor_window_checks.py bounds it). Not with parts that blend: GL would blend them in
         linear space, the shader-encoded path blends sRGB values."""
-        if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
-            # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
+        if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene) or scene.ground:
+            # (transmissive parts read the opaque parts' radiance, which must not be tone mapped;
+            # the ground darkens radiance, before the tone map)
             self.draw_hdr(scene, maps, targets)
             self.tonemap(targets.radiance, scene.display, targets.display_fbo)
             return targets.display_fbo
@@ -930,6 +932,10 @@ class ForwardRenderer:
             return (0, 0, 0, 0)
         lo = np.min([p.lo for p in parts], axis=0)
         hi = np.max([p.hi for p in parts], axis=0)
+        if scene.ground and self._shadowed:     # the ground's square is drawn too (_draw_ground)
+            g = GroundPass.ground_for(scene.mesh)
+            lo = np.minimum(lo, g.centre - (g.half_size, 0.0, g.half_size))
+            hi = np.maximum(hi, g.centre + (g.half_size, 0.0, g.half_size))
         corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
         clip = corners @ np.asarray(view_projection, np.float64)
         if (clip[:, 3] <= 1e-6).any():
