@@ -313,3 +313,26 @@ def test_cli_ground_over_background_is_the_background_darkened_by_the_alpha(tmp_
     expected = 0.5 * (1.0 - t[..., 3])
     srgb = np.where(expected <= 0.0031308, 12.92 * expected, 1.055 * expected ** (1 / 2.4) - 0.055)
     np.testing.assert_allclose(c[..., 0][off_ball & ~_dilate(~off_ball, 1)], srgb[off_ball & ~_dilate(~off_ball, 1)], atol=3 / 255)
+
+
+@pytest.mark.parametrize("kind", ["point", "spot"])
+def test_point_and_spot_shadows_lie_where_the_box_projects(kind):
+    """From a light at P the box's shadow on y = 0 is the hull of its corners projected from P."""
+    p = np.array([1.3, 2.2, 0.9])
+    if kind == "point":
+        light = Light(kind="point", vector=tuple(p), intensity=8.0)
+    else:
+        light = Light(kind="spot", vector=tuple(p), direction=tuple(-p), inner_cone_deg=60.0, outer_cone_deg=70.0,
+                      intensity=8.0)
+    lit = render(_box_scene(lights=[light], ibl_enabled=False, shadows="off"))
+    shadowed_img = render(_box_scene(lights=[light], ibl_enabled=False, shadows="on"))
+    x, z = pixel_world_xz()
+    plane = ~((np.abs(x) <= 0.5) & (np.abs(z) <= 0.5))
+    ratio = shadowed_img[..., :3].mean(axis=2) / np.maximum(lit[..., :3].mean(axis=2), 1e-9)
+    valid = lit[..., :3].mean(axis=2) > 1e-4 * lit[..., :3].max()        # inside the spot's cone
+    shadowed = (ratio < 0.5) & plane & valid
+    t = p[1] / (p[1] - BOX_CORNERS[:, 1])
+    projected = p + (BOX_CORNERS - p) * t[:, None]
+    expected = _hull_mask(projected[:, [0, 2]], x, z) & plane & valid
+    assert expected.sum() > 300
+    assert overlap(shadowed, expected) >= 0.9

@@ -216,6 +216,7 @@ class Scene:
     display: Display = field(default_factory=Display)
     shadows: str = "auto"      # auto, on, off (alight.render.shadows: auto where something can be shadowed)
     ground: bool = False       # a shadow-catching ground under the model (alight.render.ground)
+    occlusion: str = "off"     # baked ambient occlusion: off, on, auto (alight.render.occlusion)
     debug_view: int = 0        # 0: shaded; else an index of app/frontends/editor/state.py's DEBUG_VIEWS
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view
     # User-loaded maps for ``material`` (app/core/texture_maps.py: paths and UV tiling) and their

@@ -73,6 +73,7 @@ from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
 from alight.render.ground import GroundPass
+from alight.render.occlusion import OcclusionBake
 from alight.render.shadows import ShadowMaps
 from alight.render.tiles import (
     TILE_BYTES,
@@ -404,6 +405,8 @@ class ForwardRenderer:
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self._shadowed = False                    # set by _draw_scene: this pass reads the shadow maps
         self._ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
+        self.occlusion_bake = OcclusionBake(self.ctx)   # Scene.occlusion's per-vertex bake
+        self._occlusion_by_part: dict[int, moderngl.Buffer] = {}   # set by _draw_mesh: id(_GpuPart) -> buffer
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict = {}   # by program id (and 'ring': _draw_background)
@@ -616,6 +619,7 @@ class ForwardRenderer:
             self._targets = None
         self.luts.release()
         self.shadow_maps.release()
+        self.occlusion_bake.release()
         if self._ground_pass is not None:
             self._ground_pass.release()
             self._ground_pass = None
@@ -826,6 +830,7 @@ class ForwardRenderer:
         else:
             self._impostor_samples = 0
         self._shadowed = self._prepare_shadows(scene, maps)    # (its own framebuffer: before this pass's)
+        self._occlusion_by_part = self._vertex_occlusion(scene)   # (baked on first use, likewise)
         fbo.use()
         ctx.viewport = (0, 0, width, height)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
@@ -903,6 +908,26 @@ class ForwardRenderer:
 
         bounds = GroundPass.ground_for(scene.mesh).bounds if ground else None
         return self.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts, bounds)
+
+    def _vertex_occlusion(self, scene: Scene) -> dict[int, moderngl.Buffer]:
+        """Scene.occlusion's baked buffers by id of the mesh's GPU parts (alight.render.occlusion),
+        or {} where it is off. 'auto' and 'on' alike skip a mesh that cannot shadow itself (a convex
+        solid sees the whole environment: its occlusion is 1 everywhere), so the built-in sphere's
+        stand-ins never need one."""
+        if scene.occlusion == "off" or scene.view == "probe" or scene.mesh is None or not scene.ibl_enabled:
+            return {}
+        if not self.shadow_maps.mesh_can_shadow_itself(scene.mesh):
+            return {}
+        own = self._gpu_mesh(scene.mesh)
+
+        def draw_parts(matrix: bytes, parts) -> None:
+            prog = self.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+            prog["u_view_projection"].write(matrix)
+            for gpu_part in parts:
+                gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+
+        buffers = self.occlusion_bake.buffers(scene.mesh, own, draw_parts)
+        return {id(g): b for g, b in zip(own, buffers)}
 
     def _draw_ground(self, scene: Scene, maps: IBLMaps | None, view_projection: np.ndarray) -> None:
         """Scene.ground's shadow catcher (alight.render.ground) into the bound framebuffer, after
@@ -1222,6 +1247,8 @@ class ForwardRenderer:
             defines["DEBUG_VIEW"] = None
         if self._shadowed:
             defines["HAS_SHADOWS"] = None
+        if self._occlusion_by_part:
+            defines["HAS_VERTEX_OCCLUSION"] = None
         bound: set[int] = set()
 
         def program_for(part_defines: dict) -> moderngl.Program:
@@ -1450,6 +1477,9 @@ class ForwardRenderer:
                     # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
                     # behind (the shader flips n).
                     cull = gpu_part.closed
+                occlusion = self._occlusion_by_part.get(id(gpu_part))
+                if occlusion is not None:    # pbr.vert's VertexOcclusion (alight.render.occlusion)
+                    occlusion.bind_to_storage_buffer(2)
                 if cull:
                     ctx.front_face = "ccw"
                     ctx.enable(moderngl.CULL_FACE)
