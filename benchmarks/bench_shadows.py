@@ -13,6 +13,8 @@ in one process (A B C A B C ...), render + read back, medians and ranges:
 - ``on``: shadows forced on, the maps drawn once and reused (a still scene, or the camera moving);
 - ``on, maps redrawn``: the maps drawn again every frame (the cost of a frame where a light or
   the mesh changed).
+
+Then the per-vertex occlusion bake of DamagedHelmet on its own (3 runs).
 """
 
 from __future__ import annotations
@@ -67,6 +69,18 @@ def main() -> None:
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {med['on'] / med['off']:.2f} | "
                      f"{med['on, maps redrawn'] / med['off']:.2f} |")
         print(lines[-1], flush=True)
+    # The per-vertex occlusion bake (alight.render.occlusion), once per mesh: timed on its own.
+    bakes = []
+    helmet = Scene(mesh=meshes["DamagedHelmet"], occlusion="on")
+    for _ in range(3):
+        r.occlusion_bake.release()
+        t = time.perf_counter()
+        r._vertex_occlusion(helmet)
+        bakes.append(time.perf_counter() - t)
+    lines += ["", f"Occlusion bake, DamagedHelmet ({len(helmet.mesh.parts)} part(s), "
+              f"{sum(len(p.positions) for p in helmet.mesh.parts)} vertices, 96 directions at 512 texels): "
+              f"{statistics.median(bakes):.2f} s median [{min(bakes):.2f}-{max(bakes):.2f}] of 3"]
+    print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "shadows.md").write_text(text)

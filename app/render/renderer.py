@@ -889,6 +889,7 @@ class ForwardRenderer:
         self._display_output = None
         self._half_output = False
         self._impostor_model = None
+        self._occlusion_by_part = {}    # (buffers may be released with their mesh before the next pass)
 
     def _prepare_shadows(self, scene: Scene, maps: IBLMaps | None) -> bool:
         """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows);

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.mesh import is_closed
 from alight.core.shading import rotate_world_to_map
 from alight.core.shadow_fit import (
@@ -120,6 +121,7 @@ class ShadowMaps:
         self._sampler: moderngl.Sampler | None = None
         self._fbo: moderngl.Framebuffer | None = None
         self._key = None
+        self._mesh = None      # the mesh the atlas was drawn for (its id alone could be reused)
         self._plan: ShadowPlan | None = None
         self._self_shadowing: dict[int, tuple[object, bool]] = {}   # by id(mesh): (mesh, result)
 
@@ -138,7 +140,7 @@ class ShadowMaps:
         mode = getattr(scene, "shadows", "auto")
         if mode == "off" or scene.view == "probe" or scene.mesh is None or not scene.mesh.parts:
             return False
-        suns = maps.suns if (maps is not None and scene.ibl_enabled) else []
+        suns = _shadowed_suns(scene, maps)
         if not scene.lights and not suns:
             return False
         return mode == "on" or receivers or self.mesh_can_shadow_itself(scene.mesh)
@@ -152,19 +154,19 @@ class ShadowMaps:
         self.last_active = self.wanted(scene, maps, receivers)
         if not self.last_active:
             return False
-        suns = list(maps.suns) if (maps is not None and scene.ibl_enabled) else []
+        suns = _shadowed_suns(scene, maps)
         centre, radius = bounds if bounds is not None else scene.mesh.bounding_sphere()
         key = (id(scene.mesh), tuple(_light_key(x) for x in scene.lights),
                tuple((tuple(np.round(s.direction, 9)), round(float(s.spread), 9)) for s in suns),
                float(scene.env_rotation_deg) if suns else 0.0, tuple(np.round(centre, 9)), round(float(radius), 9))
-        if key == self._key and self._atlas is not None:
+        if key == self._key and self._atlas is not None and self._mesh is scene.mesh:
             return True
         plan = plan_views(scene.lights, suns, centre, radius, scene.env_rotation_deg)
         if not plan.views:
             self.last_active = False
             return False
         self._draw(plan, draw_parts, gpu_parts)
-        self._plan, self._key = plan, key
+        self._plan, self._key, self._mesh = plan, key, scene.mesh
         return True
 
     def _draw(self, plan: ShadowPlan, draw_parts, gpu_parts) -> None:
@@ -227,11 +229,19 @@ class ShadowMaps:
             if obj is not None:
                 obj.release()
         self._fbo = self._sampler = self._atlas = None
-        self._key = None
+        self._key = self._mesh = None
 
     def release(self) -> None:
         self._release_atlas()
         self._self_shadowing.clear()
+
+
+def _shadowed_suns(scene, maps) -> list:
+    """The compact sources the frame shades exactly, hence can shadow: none for the models that
+    keep them baked into the maps (alight.core.ibl_models.SUNS_AS_BAKED)."""
+    if maps is None or not scene.ibl_enabled or scene.ibl_model in SUNS_AS_BAKED:
+        return []
+    return list(maps.suns)
 
 
 def _light_key(light) -> tuple:
