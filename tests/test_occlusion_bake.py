@@ -101,3 +101,45 @@ def test_convex_meshes_bake_nothing():
     assert r.occlusion_bake.bakes_run == before
     scene.occlusion = "off"
     np.testing.assert_array_equal(r.render(scene, maps, 48, 48).linear, on)
+
+
+def test_compute_shader_matches_its_numpy_twin():
+    """render/occlusion_accumulate.comp against alight.core.occlusion_bake's visible_from and
+    accumulate, on the same depth maps read back."""
+    import moderngl
+
+    from alight.core.occlusion_bake import accumulate, occlusion, visible_from
+    from alight.core.shadow_fit import directional_view
+    from alight.render.occlusion import DIRECTIONS, RESOLUTION
+
+    r = renderer()
+    mesh = corner()
+    maps = r.bake(constant_environment(1.0, 64), "low")
+    r.render(Scene(mesh=mesh, occlusion="on"), maps, 16, 16)
+    gpu = r.occlusion_bake.values(mesh)
+    ctx = r.ctx
+    depth = ctx.depth_texture((RESOLUTION, RESOLUTION))
+    fbo = ctx.framebuffer(depth_attachment=depth)
+    prog = r.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+    centre, radius = mesh.bounding_sphere()
+    sums = [(np.zeros(len(p.positions)), np.zeros(len(p.positions))) for p in mesh.parts]
+    try:
+        for toward in sphere_directions(DIRECTIONS):
+            view = directional_view(-toward, centre, radius, RESOLUTION)
+            fbo.use()
+            ctx.viewport = (0, 0, RESOLUTION, RESOLUTION)
+            fbo.clear(depth=1.0)
+            ctx.enable(moderngl.DEPTH_TEST)
+            prog["u_view_projection"].write(np.ascontiguousarray(view.matrix.T, np.float32).tobytes())
+            for g in r._gpu_mesh(mesh):
+                g.vao_for(prog).render(moderngl.TRIANGLES)
+            ctx.disable(moderngl.DEPTH_TEST)
+            d = np.frombuffer(depth.read(), np.float32).reshape(RESOLUTION, RESOLUTION)
+            for (w, s), p in zip(sums, mesh.parts):
+                nrm = np.asarray(p.normals, np.float64)
+                accumulate(w, s, nrm, toward, visible_from(view, d, np.asarray(p.positions, np.float64), nrm, toward))
+    finally:
+        fbo.release()
+        depth.release()
+    for (w, s), g in zip(sums, gpu):
+        np.testing.assert_allclose(g, occlusion(w, s), atol=0.03)

@@ -1,6 +1,7 @@
 """Per-vertex ambient occlusion of the environment light, baked once per mesh on the GPU
-(``Scene.occlusion``; alight.core.occlusion_bake has the maths): the mesh's depth seen from
-DIRECTIONS directions spread over the sphere, each read back and tested against every vertex.
+(``Scene.occlusion``; alight.core.occlusion_bake has the maths and its numpy twin): the mesh's
+depth seen from DIRECTIONS directions spread over the sphere, every vertex tested against each
+map in a compute shader.
 The result is one float per vertex in a storage buffer per part, which pbr.vert reads by
 gl_VertexID (HAS_VERTEX_OCCLUSION) so the vertex layout is unchanged; mesh_material.glsl takes
 the minimum with the glTF occlusion texture.
@@ -13,7 +14,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from alight.core.occlusion_bake import accumulate, occlusion, sphere_directions, visible_from
+from alight.core.occlusion_bake import occlusion, sphere_directions
 from alight.core.shadow_fit import directional_view
 
 DIRECTIONS = 96
@@ -21,8 +22,9 @@ RESOLUTION = 512
 
 
 class OcclusionBake:
-    def __init__(self, ctx: moderngl.Context):
+    def __init__(self, ctx: moderngl.Context, shaders):
         self.ctx = ctx
+        self.shaders = shaders     # alight.core.gpu.ShaderLibrary
         self.bakes_run = 0
         self._cache: dict[int, tuple[object, list[moderngl.Buffer], list[np.ndarray]]] = {}
         self._depth: moderngl.Texture | None = None
@@ -48,15 +50,22 @@ class OcclusionBake:
         return buffers
 
     def _bake(self, mesh, gpu_parts, draw_parts) -> list[np.ndarray]:
+        """Each direction: its depth map drawn, then every vertex tested in a compute shader
+        (render/occlusion_accumulate.comp) that adds to per-vertex sums kept on the GPU, read
+        back once at the end (a read back per direction cost 60 ms of llvmpipe's time each)."""
         ctx = self.ctx
         if self._depth is None:
             self._depth = ctx.depth_texture((RESOLUTION, RESOLUTION))
+            self._depth.compare_func = ""             # read as depths (texelFetch)
             self._fbo = ctx.framebuffer(depth_attachment=self._depth)
+        prog = self.shaders.compute("render/occlusion_accumulate.comp")
         centre, radius = mesh.bounding_sphere()
-        positions = [np.asarray(p.positions, np.float64) for p in mesh.parts]
-        normals = [np.asarray(p.normals, np.float64) for p in mesh.parts]
-        weights = [np.zeros(len(p)) for p in positions]
-        seen = [np.zeros(len(p)) for p in positions]
+        parts = []
+        for p in mesh.parts:
+            n = len(p.positions)
+            parts.append((n, ctx.buffer(np.ascontiguousarray(p.positions, np.float32).tobytes()),
+                          ctx.buffer(np.ascontiguousarray(p.normals, np.float32).tobytes()),
+                          ctx.buffer(np.zeros((max(n, 1), 2), np.float32).tobytes())))
         self._fbo.use()
         ctx.viewport = (0, 0, RESOLUTION, RESOLUTION)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -65,16 +74,35 @@ class OcclusionBake:
         try:
             for toward in sphere_directions(DIRECTIONS):
                 view = directional_view(-toward, centre, radius, RESOLUTION)
+                self._fbo.use()
                 self._fbo.clear(depth=1.0)
                 draw_parts(np.ascontiguousarray(view.matrix.T, np.float32).tobytes(), gpu_parts)
-                depth = np.frombuffer(self._depth.read(), np.float32).reshape(RESOLUTION, RESOLUTION)
-                for i in range(len(positions)):
-                    visible = visible_from(view, depth, positions[i], normals[i], toward)
-                    accumulate(weights[i], seen[i], normals[i], toward, visible)
+                self._depth.use(0)
+                prog["u_depth"] = 0
+                prog["u_matrix"].write(np.ascontiguousarray(view.matrix.T, np.float32).tobytes())
+                prog["u_toward"] = tuple(float(x) for x in toward)
+                prog["u_texel"] = float(view.texel)
+                prog["u_depth_range"] = float(view.far - view.near)
+                for n, positions, normals, sums in parts:
+                    if n == 0:
+                        continue
+                    positions.bind_to_storage_buffer(0)
+                    normals.bind_to_storage_buffer(1)
+                    sums.bind_to_storage_buffer(2)
+                    prog["u_count"] = n
+                    prog.run((n + 63) // 64)
+                ctx.memory_barrier()
+            out = []
+            for n, *_, sums in parts:
+                s = np.frombuffer(sums.read(), np.float32).reshape(-1, 2)[:n].astype(np.float64)
+                out.append(occlusion(s[:, 0], s[:, 1]))
         finally:
             ctx.disable(moderngl.DEPTH_TEST)
+            for _, *buffers in parts:
+                for buf in buffers:
+                    buf.release()
         self.bakes_run += 1
-        return [occlusion(w, s) for w, s in zip(weights, seen)]
+        return out
 
     def release(self) -> None:
         for entry in self._cache.values():
