@@ -336,3 +336,34 @@ def test_point_and_spot_shadows_lie_where_the_box_projects(kind):
     expected = _hull_mask(projected[:, [0, 2]], x, z) & plane & valid
     assert expected.sum() > 300
     assert overlap(shadowed, expected) >= 0.9
+
+
+def test_batch_spec_takes_shadows_and_ground(tmp_path):
+    """A batch spec's 'ground' under a map with a sun darkens the background where the ball's
+    shadow falls; a bad 'shadows' value is one error naming the spec."""
+    import io
+
+    from PIL import Image
+
+    from alight.errors import AlightError
+    from alight.exchange.output import write_image
+    from alight.frontends.batch import plan, run
+
+    write_image(tmp_path / "sun.exr", synthetic_sun_map((0.5, 1.0, 0.3), size=256), linear=True)
+    base = 'size = 48\nquality = "low"\nmeshes = ["sphere"]\nenvironments = ["sun.exr"]\nmaterials = ["gold"]\n' \
+           'camera_angles = [0]\ncontact_sheet = false\nbackground = "color"\n'
+    images = {}
+    for name, extra in (("plain", ""), ("ground", "ground = true\n")):
+        spec = tmp_path / f"{name}.toml"
+        spec.write_text(base + extra)
+        result = run(plan(spec), executor="inline", log=io.StringIO())
+        (png,) = (tmp_path / name).glob("*.png")
+        images[name] = np.asarray(Image.open(png), np.float64)
+        assert result is not None
+    darker = images["ground"][..., :3].mean(axis=2) < images["plain"][..., :3].mean(axis=2) - 5
+    assert darker.sum() > 20
+    assert not (images["ground"][..., :3].mean(axis=2) > images["plain"][..., :3].mean(axis=2) + 1).any()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(base + 'shadows = "sometimes"\n')
+    with pytest.raises(AlightError, match="bad.toml: 'shadows' must be auto, on or off"):
+        plan(bad)

@@ -156,7 +156,7 @@ class ShadowMaps:
             return False
         suns = _shadowed_suns(scene, maps)
         centre, radius = bounds if bounds is not None else scene.mesh.bounding_sphere()
-        key = (id(scene.mesh), tuple(_light_key(x) for x in scene.lights),
+        key = (id(scene.mesh), bool(scene.use_file_materials), tuple(_light_key(x) for x in scene.lights),
                tuple((tuple(np.round(s.direction, 9)), round(float(s.spread), 9)) for s in suns),
                float(scene.env_rotation_deg) if suns else 0.0, tuple(np.round(centre, 9)), round(float(radius), 9))
         if key == self._key and self._atlas is not None and self._mesh is scene.mesh:
