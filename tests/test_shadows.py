@@ -367,3 +367,20 @@ def test_batch_spec_takes_shadows_and_ground(tmp_path):
     bad.write_text(base + 'shadows = "sometimes"\n')
     with pytest.raises(AlightError, match="bad.toml: 'shadows' must be auto, on or off"):
         plan(bad)
+
+
+def test_api_set_shadows():
+    """alight.Renderer.set_shadows: the ground's shadow over a transparent background is in alpha;
+    bad modes are one-line errors."""
+    from alight import Renderer
+    from alight.errors import AlightError
+
+    with Renderer(48, quality="low", background="transparent") as r:
+        r.set_environment(None).set_lights(["directional:dir=-1,-1,-0.2:intensity=3"])
+        plain = r.render()
+        shadowed = r.set_shadows("auto", ground=True).render()
+        assert (plain[..., 3] == 0).sum() > (shadowed[..., 3] == 0).sum() + 20
+        with pytest.raises(AlightError, match="shadows: 'sometimes'"):
+            r.set_shadows("sometimes")
+        with pytest.raises(AlightError, match="occlusion: 'x'"):
+            r.set_shadows(occlusion="x")
