@@ -143,3 +143,20 @@ def test_compute_shader_matches_its_numpy_twin():
         depth.release()
     for (w, s), g in zip(sums, gpu):
         np.testing.assert_allclose(g, occlusion(w, s), atol=0.03)
+
+
+def test_bake_is_kept_on_disk_for_the_next_process(tmp_path):
+    """A second renderer on the same store loads the bake instead of running it; values equal."""
+    from alight.ibl.bake_cache import BakeCache
+    from alight.render.renderer import ForwardRenderer
+
+    mesh = corner()
+    env = constant_environment(1.0, 16)
+    values = []
+    for _ in range(2):
+        with ForwardRenderer(bake_cache=BakeCache(tmp_path)) as r:
+            r.render(Scene(mesh=mesh, occlusion="on"), r.bake(env, "low"), 16, 16)
+            values.append((r.occlusion_bake.bakes_run, r.occlusion_bake.bakes_loaded, r.occlusion_bake.values(mesh)))
+    assert values[0][:2] == (1, 0) and values[1][:2] == (0, 1)
+    for a, b in zip(values[0][2], values[1][2]):
+        np.testing.assert_array_equal(a, b)

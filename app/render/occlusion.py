@@ -7,9 +7,16 @@ gl_VertexID (HAS_VERTEX_OCCLUSION) so the vertex layout is unchanged; mesh_mater
 the minimum with the glTF occlusion texture.
 
 The bake is for still renders and the editor alike: DamagedHelmet's took the time
-docs/shadows_notes.md gives, once per mesh and process (kept in memory by mesh)."""
+docs/shadows_notes.md gives, once per mesh: kept in memory by mesh, and on disk in the IBL bake's
+store (alight.ibl.bake_cache) under the hash of the mesh's geometry, the bake's settings, its
+shaders and code and the GL renderer, so a later process loads it."""
 
 from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -22,10 +29,12 @@ RESOLUTION = 512
 
 
 class OcclusionBake:
-    def __init__(self, ctx: moderngl.Context, shaders):
+    def __init__(self, ctx: moderngl.Context, shaders, cache=None):
         self.ctx = ctx
         self.shaders = shaders     # alight.core.gpu.ShaderLibrary
+        self.cache = cache         # alight.ibl.bake_cache.BakeCache, or None: memory only
         self.bakes_run = 0
+        self.bakes_loaded = 0
         self._cache: dict[int, tuple[object, list[moderngl.Buffer], list[np.ndarray]]] = {}
         self._depth: moderngl.Texture | None = None
         self._fbo: moderngl.Framebuffer | None = None
@@ -44,7 +53,10 @@ class OcclusionBake:
         for old in [k for k, e in self._cache.items() if e[0] is not mesh]:
             for buf in self._cache.pop(old)[1]:
                 buf.release()
-        values = self._bake(mesh, gpu_parts, draw_parts)
+        values = self._load(mesh)
+        if values is None:
+            values = self._bake(mesh, gpu_parts, draw_parts)
+            self._save(mesh, values)
         buffers = [self.ctx.buffer(np.ascontiguousarray(v, np.float32).tobytes()) for v in values]
         self._cache[id(mesh)] = (mesh, buffers, values)
         return buffers
@@ -103,6 +115,49 @@ class OcclusionBake:
                     buf.release()
         self.bakes_run += 1
         return out
+
+    def _key(self, mesh) -> tuple[str, dict]:
+        from alight.core.gpu import describe
+
+        geometry = hashlib.sha256()
+        for p in mesh.parts:
+            for a in (p.positions, p.normals, p.indices):
+                a = np.ascontiguousarray(a)
+                geometry.update(str((a.dtype.str, a.shape)).encode())
+                geometry.update(a.tobytes())
+        code = hashlib.sha256()
+        for name in ("alight.render.occlusion", "alight.core.occlusion_bake", "alight.core.shadow_fit"):
+            code.update(Path(importlib.util.find_spec(name).origin).read_bytes())
+        description = {
+            "what": "vertex occlusion", "geometry": geometry.hexdigest(), "directions": DIRECTIONS,
+            "resolution": RESOLUTION, "code": code.hexdigest(), "renderer": describe(self.ctx),
+            "shaders": {name: self.shaders.digest(name) for name in
+                        ("render/occlusion_accumulate.comp", "render/shadow_depth.vert", "render/shadow_depth.frag")},
+        }
+        text = json.dumps(description, sort_keys=True)
+        return "alight-occlusion-" + hashlib.sha256(text.encode()).hexdigest(), description
+
+    def _load(self, mesh) -> list[np.ndarray] | None:
+        if self.cache is None:
+            return None
+        key, description = self._key(mesh)
+        arrays = self.cache.load(key, description, f"{mesh.source}'s occlusion")
+        if arrays is None:
+            return None
+        values = [arrays.get(f"part{i}") for i in range(len(mesh.parts))]
+        if any(v is None or v.shape != (len(p.positions),) for v, p in zip(values, mesh.parts)):
+            self.cache.reject(key, f"{mesh.source}'s occlusion", "not a bake of this mesh")
+            return None
+        self.bakes_loaded += 1
+        return [np.asarray(v, np.float32) for v in values]
+
+    def _save(self, mesh, values: list[np.ndarray]) -> None:
+        if self.cache is None:
+            return
+        from alight.ibl.bake_cache import encode_entry
+
+        key, description = self._key(mesh)
+        self.cache.save(key, encode_entry(description, {f"part{i}": v for i, v in enumerate(values)}))
 
     def release(self) -> None:
         for entry in self._cache.values():

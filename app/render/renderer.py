@@ -405,7 +405,7 @@ class ForwardRenderer:
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self._shadowed = False                    # set by _draw_scene: this pass reads the shadow maps
         self._ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
-        self.occlusion_bake = OcclusionBake(self.ctx, self.shaders)   # Scene.occlusion's per-vertex bake
+        self.occlusion_bake = OcclusionBake(self.ctx, self.shaders, self.bake_cache)   # Scene.occlusion's per-vertex bake
         self._occlusion_by_part: dict[int, moderngl.Buffer] = {}   # set by _draw_mesh: id(_GpuPart) -> buffer
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
