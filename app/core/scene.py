@@ -234,6 +234,9 @@ class Scene:
     ibl_model: str = DEFAULT_IBL_MODEL                        # a key of app/core/ibl_models.py's IBL_MODELS
     multiple_scattering: bool = False                         # Fdez-Aguera 2019 energy compensation
     display: Display = field(default_factory=Display)
+    shadows: str = "auto"      # auto, on, off (alight.render.shadows: auto where something can be shadowed)
+    ground: bool = False       # a shadow-catching ground under the model (alight.render.ground)
+    occlusion: str = "off"     # baked ambient occlusion: off, on, auto (alight.render.occlusion)
     debug_view: int = 0        # 0: shaded; else a DebugView (app/core/shader_names.py)
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view
     # User-loaded maps for ``material`` (app/core/texture_maps.py: paths and UV tiling) and their

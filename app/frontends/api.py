@@ -214,6 +214,27 @@ class Renderer:
         self.scene.lights = [parse_light(x) if isinstance(x, str) else x for x in lights]
         return self
 
+    def set_shadows(self, mode: str | None = None, *, ground: bool | None = None,
+                    occlusion: str | None = None) -> "Renderer":
+        """Shadow maps for the lights and the environment's suns: ``mode`` 'auto' (the default:
+        only where something can be shadowed, never for a convex mesh such as the built-in
+        sphere), 'on' or 'off' (alight.render.shadows). ``ground``: a shadow-catching ground under
+        the model's bounding box (alight.render.ground): it darkens the background by the model's
+        shadow, or with background 'transparent' leaves the shadow in alpha. ``occlusion``: the
+        environment light's ambient occlusion baked per vertex, 'off' (the default), 'on' or
+        'auto' (alight.render.occlusion; never for a convex mesh)."""
+        if mode is not None:
+            if mode not in ("auto", "on", "off"):
+                raise AlightError(f"shadows: {mode!r} is not one of auto, on, off")
+            self.scene.shadows = mode
+        if ground is not None:
+            self.scene.ground = bool(ground)
+        if occlusion is not None:
+            if occlusion not in ("auto", "on", "off"):
+                raise AlightError(f"occlusion: {occlusion!r} is not one of auto, on, off")
+            self.scene.occlusion = occlusion
+        return self
+
     def add_light(self, light: Light | str) -> "Renderer":
         self.scene.lights.append(parse_light(light) if isinstance(light, str) else light)
         return self

@@ -43,7 +43,7 @@ from alight.errors import AlightError
 from alight.frontends.batch_worker import MATERIAL_FIELDS, render_item
 
 _KEYS = {"out", "size", "quality", "meshes", "environments", "materials", "camera_angles",
-         "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background"}
+         "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background", "shadows", "ground"}
 _TURNTABLE_KEYS = {"frames", "rotate", "format", "fps"}
 
 
@@ -63,6 +63,8 @@ class Item:
     aa: str = "msaa"
     tonemap: str = "aces"
     background: str = "env"
+    shadows: str = "auto"     # alight.render.shadows
+    ground: bool = False      # alight.render.ground
     inputs: list[str] = field(default_factory=list)  # files whose change makes the output stale
     label: str = ""
 
@@ -195,7 +197,11 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
     materials = _list(spec, "materials", ["gold"], source, (str, dict))
     cams = _list(spec, "camera_angles", [0], source, (int, float))
     env_angles = _list(spec, "environment_angles", [0], source, (int, float))
-    options = {k: spec[k] for k in ("aa", "tonemap", "background") if k in spec}
+    options = {k: spec[k] for k in ("aa", "tonemap", "background", "shadows", "ground") if k in spec}
+    if options.get("shadows", "auto") not in ("auto", "on", "off"):
+        raise AlightError(f"{source}: 'shadows' must be auto, on or off")
+    if not isinstance(options.get("ground", False), bool):
+        raise AlightError(f"{source}: 'ground' must be true or false")
     out_dir = Path(out) if out is not None else base / str(spec.get("out", source.stem))
 
     mesh_names = [Path(m).stem for m in meshes]

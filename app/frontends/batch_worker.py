@@ -57,6 +57,7 @@ def _render(item, warnings: list[str]) -> None:
     r.set_mesh(meshes[item.mesh]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)
     material, maps = _material(item.material)
     r.set_material(material, **maps).set_display(tonemap=item.tonemap, background=item.background)
+    r.set_shadows(item.shadows, ground=item.ground)
     r.set_camera(orbit_deg=item.camera_deg)
     Path(item.out).parent.mkdir(parents=True, exist_ok=True)
     r.save(item.out)

@@ -322,6 +322,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help=".png: 8-bit sRGB after exposure and tone mapping; .exr: linear float32 RGBA radiance, "
                         "alpha 1 on the surface (CONVENTIONS.md)")
     d.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer and time per step")
+    d.add_argument("--shadows", choices=("auto", "on", "off"), default="auto",
+                   help="shadow maps for the lights and the environment's suns: auto draws them only where "
+                        "something can be shadowed (not for a convex mesh such as the built-in sphere) (default: auto)")
+    d.add_argument("--occlusion", choices=("auto", "on", "off"), default="off",
+                   help="ambient occlusion of the environment light, baked per vertex once per mesh and combined "
+                        "with a glTF occlusion map by their minimum: auto and on bake it where the mesh can "
+                        "occlude itself (not for a convex mesh) (default: off)")
+    d.add_argument("--ground", action="store_true",
+                   help="a ground under the model's bounding box that catches its shadow, composited over the "
+                        "background (with --background transparent: the shadow in alpha)")
 
     b = sub.add_parser("bake", help="bake an environment's IBL maps and write them as images",
                        description="Write the baked maps as equirectangular images (linear .exr and "
@@ -600,7 +610,8 @@ def _render(args) -> int:
                   material_overrides=overrides, lights=lights, camera=camera, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, ibl_model=args.ibl,
-                  multiple_scattering=args.multiple_scattering, display=display)
+                  multiple_scattering=args.multiple_scattering, display=display, shadows=args.shadows,
+                  ground=args.ground, occlusion=args.occlusion)
     loaded = time.perf_counter()
 
     from alight.exchange.output import image_rows_writer

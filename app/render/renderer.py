@@ -82,6 +82,9 @@ from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
+from alight.render.ground import GroundPass
+from alight.render.occlusion import OcclusionBake
+from alight.render.shadows import ShadowMaps
 from alight.render.tiles import (
     TILE_BYTES,
     Tile,
@@ -127,6 +130,9 @@ SAMPLER_UNITS.update(u_anisotropy_ratio_a=UNIT_ANISOTROPY_RATIO_A, u_anisotropy_
 # The `stretched` IBL model's lobe table (alight.core.stretched_lobe), bound where a program reads it.
 UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_BEHIND + 3, UNIT_SCENE_BEHIND + 4
 SAMPLER_UNITS.update(u_stretched_lobe_a=UNIT_STRETCHED_LOBE_A, u_stretched_lobe_b=UNIT_STRETCHED_LOBE_B)
+# The shadow atlas (alight.render.shadows): with comparison (PCF) and as depths (the blocker search).
+UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH = UNIT_SCENE_BEHIND + 5, UNIT_SCENE_BEHIND + 6
+SAMPLER_UNITS.update(u_shadow_atlas=UNIT_SHADOW_ATLAS, u_shadow_depth=UNIT_SHADOW_DEPTH)
 
 
 @dataclass
@@ -403,6 +409,11 @@ class ForwardRenderer:
         self._impostor_samples = 1
         self._impostor_model: np.ndarray | None = None   # the proxy's placement while _draw_scene runs
         self._targets: _Targets | None = None
+        self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
+        self._shadowed = False                    # set by _draw_scene: this pass reads the shadow maps
+        self._ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
+        self.occlusion_bake = OcclusionBake(self.ctx, self.shaders, self.bake_cache)   # Scene.occlusion's per-vertex bake
+        self._occlusion_by_part: dict[int, moderngl.Buffer] = {}   # set by _draw_mesh: id(_GpuPart) -> buffer
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict = {}   # by program id (and 'ring': _draw_background)
@@ -520,7 +531,7 @@ class ForwardRenderer:
         ``view_projection``: the camera's for ``image_size`` (not a tile's), where the caller has
         it."""
         mesh = scene.mesh
-        if (not self.sphere_impostor or scene.view == "probe" or mesh is None or mesh.lod_sphere is None
+        if (not self.sphere_impostor or scene.view == "probe" or mesh is None or scene.ground or mesh.lod_sphere is None
                 or len(mesh.parts) != 1 or camera.ortho_half_height is not None):
             return None
         radius = mesh.lod_sphere[0]
@@ -568,6 +579,7 @@ class ForwardRenderer:
         full-screen VAOs are rebuilt on the next draw; the bakes stay valid."""
         old, self.shaders = self.shaders, shaders
         self.luts.shaders = shaders
+        self.occlusion_bake.shaders = shaders
         for vao in self._fullscreen_vaos.values():
             vao.release()
         self._fullscreen_vaos.clear()
@@ -614,6 +626,11 @@ class ForwardRenderer:
             self._targets.release()
             self._targets = None
         self.luts.release()
+        self.shadow_maps.release()
+        self.occlusion_bake.release()
+        if self._ground_pass is not None:
+            self._ground_pass.release()
+            self._ground_pass = None
         if self.bake_cache is not None:
             self.bake_cache.close()
         self.anisotropy_lut.release()
@@ -702,7 +719,8 @@ class ForwardRenderer:
                 if aa == "msaa" and not self._has_blending_parts(scene):
                     self._draw_scene(scene, maps, targets, targets.draw, view=view, background=False)
                     self._resolve(scene, maps, targets, read_linear, read_srgb)
-                elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe":
+                elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe" \
+                        and not scene.ground:   # (the ground darkens radiance: it blends before the tone map)
                     self._draw_scene(scene, maps, targets, targets.display_draw(), scene.display, view=view)
                 else:
                     self._draw_scene(scene, maps, targets, targets.draw, view=view)
@@ -775,8 +793,9 @@ class ForwardRenderer:
         860x720 frame, within 1 LSB of the exact curve (on the editor's ball a fifth of the values
         1 LSB off; tests/editor_window_checks.py bounds it). Not with parts that blend: GL would blend them in
         linear space, the shader-encoded path blends sRGB values."""
-        if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene):
-            # (transmissive parts read the opaque parts' radiance, which must not be tone mapped)
+        if targets.aa != "none" or scene.view == "probe" or self.transmissive_parts(scene) or scene.ground:
+            # (transmissive parts read the opaque parts' radiance, which must not be tone mapped;
+            # the ground darkens radiance, before the tone map)
             self.draw_hdr(scene, maps, targets)
             self.tonemap(targets.radiance, scene.display, targets.display_fbo)
             return targets.display_fbo
@@ -818,6 +837,8 @@ class ForwardRenderer:
             fbo = targets.single()[1]
         else:
             self._impostor_samples = 0
+        self._shadowed = self._prepare_shadows(scene, maps)    # (its own framebuffer: before this pass's)
+        self._occlusion_by_part = self._vertex_occlusion(scene)   # (baked on first use, likewise)
         fbo.use()
         ctx.viewport = (0, 0, width, height)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
@@ -859,9 +880,13 @@ class ForwardRenderer:
             self._draw_mesh(scene, maps, camera, view_projection, blend=False, targets=targets, fbo=fbo,
                             pixels_per_radian=view.height * scale / 2.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0),
                             image_size=(view.width, view.height))
+            if not background:     # (the fused resolve composites the background under it)
+                self._draw_ground(scene, maps, view_projection)
         # After the surfaces: the depth test keeps the background's shading off covered pixels.
         if background and ring is None:
             self._draw_background(scene, maps, inverse_vp)
+            if scene.view != "probe" and scene.mesh is not None:
+                self._draw_ground(scene, maps, view_projection)
             # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
             # (The fused MSAA resolve, background=False, is used only for scenes with none.)
             if scene.view != "probe" and scene.mesh is not None:
@@ -872,6 +897,60 @@ class ForwardRenderer:
         self._display_output = None
         self._half_output = False
         self._impostor_model = None
+        self._occlusion_by_part = {}    # (buffers may be released with their mesh before the next pass)
+
+    def _prepare_shadows(self, scene: Scene, maps: IBLMaps | None) -> bool:
+        """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows);
+        whether this pass reads them. The casters: every part but those that blend."""
+        ground = scene.ground and scene.view != "probe" and scene.mesh is not None and bool(scene.mesh.parts)
+        if scene.view == "probe" or scene.mesh is None or not self.shadow_maps.wanted(scene, maps, receivers=ground):
+            self.shadow_maps.last_active = False
+            return False
+        gpu_parts = [g for g, part in zip(self._gpu_mesh(scene.mesh), scene.mesh.parts)
+                     if not (part.material is not None and scene.use_file_materials and part.material.alpha_mode == "BLEND")]
+
+        def draw_parts(matrix: bytes, parts) -> None:
+            prog = self.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+            prog["u_view_projection"].write(matrix)
+            for gpu_part in parts:
+                gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+
+        bounds = GroundPass.ground_for(scene.mesh).bounds if ground else None
+        return self.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts, bounds)
+
+    def _vertex_occlusion(self, scene: Scene) -> dict[int, moderngl.Buffer]:
+        """Scene.occlusion's baked buffers by id of the mesh's GPU parts (alight.render.occlusion),
+        or {} where it is off. 'auto' and 'on' alike skip a mesh that cannot shadow itself (a convex
+        solid sees the whole environment: its occlusion is 1 everywhere), so the built-in sphere's
+        stand-ins never need one."""
+        if scene.occlusion == "off" or scene.view == "probe" or scene.mesh is None or not scene.ibl_enabled:
+            return {}
+        if not self.shadow_maps.mesh_can_shadow_itself(scene.mesh):
+            return {}
+        own = self._gpu_mesh(scene.mesh)
+
+        def draw_parts(matrix: bytes, parts) -> None:
+            prog = self.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+            prog["u_view_projection"].write(matrix)
+            for gpu_part in parts:
+                gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+
+        buffers = self.occlusion_bake.buffers(scene.mesh, own, draw_parts)
+        return {id(g): b for g, b in zip(own, buffers)}
+
+    def _draw_ground(self, scene: Scene, maps: IBLMaps | None, view_projection: np.ndarray) -> None:
+        """Scene.ground's shadow catcher (alight.render.ground) into the bound framebuffer, after
+        the surfaces (and the background, where a pass draws one). Only where shadows are drawn:
+        a ground without them takes nothing from the background."""
+        if not (scene.ground and self._shadowed and scene.mesh is not None):
+            return
+        if self._ground_pass is None:
+            self._ground_pass = GroundPass(self.ctx)
+        prog = self._scene_program("render/ground.vert", "render/ground.frag",
+                                   {**_light_defines(scene), "HAS_SHADOWS": None})
+        self._bind_ibl(prog, scene, maps)
+        self.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
+        self._ground_pass.draw(prog, GroundPass.ground_for(scene.mesh), view_projection)
 
     def _surface_rect(self, scene: Scene, view_projection: np.ndarray,
                       size: tuple[int, int]) -> tuple[int, int, int, int] | None:
@@ -887,6 +966,10 @@ class ForwardRenderer:
             return (0, 0, 0, 0)
         lo = np.min([p.lo for p in parts], axis=0)
         hi = np.max([p.hi for p in parts], axis=0)
+        if scene.ground and self._shadowed:     # the ground's square is drawn too (_draw_ground)
+            g = GroundPass.ground_for(scene.mesh)
+            lo = np.minimum(lo, g.centre - (g.half_size, 0.0, g.half_size))
+            hi = np.maximum(hi, g.centre + (g.half_size, 0.0, g.half_size))
         corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
         clip = corners @ np.asarray(view_projection, np.float64)
         if (clip[:, 3] <= 1e-6).any():
@@ -1172,6 +1255,10 @@ class ForwardRenderer:
                                                 any_maps))
         if scene.debug_view:
             defines["DEBUG_VIEW"] = None
+        if self._shadowed:
+            defines["HAS_SHADOWS"] = None
+        if self._occlusion_by_part:
+            defines["HAS_VERTEX_OCCLUSION"] = None
         bound: set[int] = set()
 
         def program_for(part_defines: dict) -> moderngl.Program:
@@ -1183,6 +1270,8 @@ class ForwardRenderer:
                     _set(prog, "u_debug_view", int(scene.debug_view))
                     _set(prog, "u_debug_mip", float(scene.debug_mip))
                 self._bind_ibl(prog, scene, maps)
+                if self._shadowed:
+                    self.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
             self._bind_layer_luts(all_defines)
             return prog
 
@@ -1397,6 +1486,9 @@ class ForwardRenderer:
                     # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
                     # behind (the shader flips n).
                     cull = gpu_part.closed
+                occlusion = self._occlusion_by_part.get(id(gpu_part))
+                if occlusion is not None:    # pbr.vert's VertexOcclusion (alight.render.occlusion)
+                    occlusion.bind_to_storage_buffer(2)
                 if cull:
                     ctx.front_face = "ccw"
                     ctx.enable(moderngl.CULL_FACE)

@@ -200,7 +200,13 @@ vec3 sun_layered(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
 vec3 suns_exact(Surface s, vec3 n, vec3 v) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < u_sun_count; ++i) {
+#ifdef HAS_SHADOWS
+        float visible = sun_shadow(i, u_sun_direction[i]);   // (common/shadows.glsl)
+        if (visible <= 0.0) continue;
+        sum += visible * sun_layered(s, n, v, u_sun_direction[i], u_sun_power[i], u_sun_spread[i]);
+#else
         sum += sun_layered(s, n, v, u_sun_direction[i], u_sun_power[i], u_sun_spread[i]);
+#endif
     }
     return sum;
 }

@@ -88,6 +88,9 @@ vec3 punctual_lights(Surface s, vec3 n, vec3 v, vec3 position) {
             if (int(vec.w) == LIGHT_SPOT) radiance_in *= spot_attenuation(u_light_spot[i].xyz, l, u_light_cone[i].xy);
 #endif
         }
+#ifdef HAS_SHADOWS
+        radiance_in *= light_shadow(i, int(vec.w), l, vec.xyz);   // (common/shadows.glsl)
+#endif
         sum += punctual_light(s, n, v, l, radiance_in);
     }
     return sum;

@@ -3,6 +3,7 @@
 #include "common/equirect.glsl"
 #include "common/surface.glsl"
 #include "common/layers.glsl"
+#include "common/shadows.glsl"
 #include "common/ibl.glsl"
 #include "common/punctual.glsl"
 // The layers' definitions (each under its HAS_* define), after the lookups they use.

@@ -31,6 +31,9 @@ void main() {
 #else
     vec3 n = shading_normal();
     vec3 v = normalize(u_camera_position - surface_position());
+#ifdef HAS_SHADOWS
+    set_shadow_receiver(surface_position(), geometric_normal());   // (common/shadows.glsl)
+#endif
 #ifdef DEBUG_VIEW
     out_radiance = encode_output(debug_view(material_surface(n), n, v, surface_position()), alpha);
 #else

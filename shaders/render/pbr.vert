@@ -19,6 +19,12 @@ uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_view_projection;
 
+#ifdef HAS_VERTEX_OCCLUSION
+// The part's baked ambient occlusion, one value per vertex (app/render/occlusion.py).
+layout(std430, binding = 2) readonly buffer VertexOcclusion { float vertex_occlusion[]; };
+out float v_occlusion;
+#endif
+
 out vec3 v_position;
 out vec3 v_normal;
 out vec2 v_uv;
@@ -35,6 +41,9 @@ void main() {
 #endif
 #ifdef HAS_VERTEX_COLOR
     v_color = in_color;
+#endif
+#ifdef HAS_VERTEX_OCCLUSION
+    v_occlusion = vertex_occlusion[gl_VertexID];
 #endif
     gl_Position = u_view_projection * world;
 }
