@@ -124,6 +124,9 @@ SHADER_OPTIONS: dict[str, str] = {
     "TRANSMISSION_SCENE": "transmission refracts a copy of the opaque scene behind the part",
     "ANISOTROPY_LOOKUP": "how the anisotropic lobe's IBL is looked up (1: table, 2: fetches)",
     "ANISOTROPY_FETCHES": "the number of prefiltered fetches along the stretched anisotropic lobe",
+    # Light that is blocked.
+    "HAS_SHADOWS": "shadow maps are read for the lights and suns (app/render/shadows.py)",
+    "HAS_VERTEX_OCCLUSION": "the baked per-vertex ambient occlusion is read (app/render/occlusion.py)",
     # Views and passes.
     "DEBUG_VIEW": "the editor's debug views are compiled in (u_debug_view picks one)",
     "SPHERE_IMPOSTOR": "the built-in sphere drawn as an impostor with this many samples a pixel",
