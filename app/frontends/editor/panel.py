@@ -105,7 +105,11 @@ class Panel:
     def _material(self, s, win) -> None:
         from imgui_bundle import imgui
 
+        # Every widget below edits this local copy; it is written back once, after the last of
+        # them. Nothing in between may assign s.material: the write-back would undo it (a preset
+        # click once did, and 'revert' then applied the click of the frame before).
         m = s.material
+        picked = None   # the preset clicked this frame: it also becomes what 'revert' goes back to
         _, s.use_file_materials = imgui.checkbox("mesh file's own materials and maps", s.use_file_materials)
         if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
             # The names' column as wide as the longest name and its swatch: the F0 columns take the rest.
@@ -120,8 +124,9 @@ class Panel:
                 imgui.table_next_column()
                 imgui.color_button(f"##sw{name}", imgui.ImVec4(*f0_srgb, 1.0), 0, imgui.ImVec2(14, 14))
                 imgui.same_line()
-                if imgui.selectable(name, m.name == preset.name)[0]:
-                    s.material = s.saved_material = preset
+                # Highlighted: the preset the material is now (none once any field is edited).
+                if imgui.selectable(name, m == preset)[0]:
+                    m = picked = preset
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0))
                 imgui.table_next_column()
@@ -154,7 +159,9 @@ class Panel:
         if changed and name.strip() and name.isprintable():
             m = dataclasses.replace(m, name=name)
         m = self._layers(s, m)
-        if m != s.material:
+        if picked is not None and m is picked:   # a click and no other edit: the preset as it is
+            s.material = s.saved_material = picked
+        elif m != s.material:
             try:
                 s.material = validate_material(m, "panel")
             except AlightError as exc:
