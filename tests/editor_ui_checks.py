@@ -1,0 +1,281 @@
+"""The editor's panel operated as an artist does, by the Dear ImGui Test Engine: run by
+tests/test_editor_ui.py as ``alight edit --new --ui-test tests/editor_ui_checks.py`` (a real
+window under Xvfb); not collected by pytest. Each function clicks, types, drags or presses keys
+through the engine and checks the effect on the rendered view or on the file written; none sets
+the editor's state itself.
+
+The engine runs these on its own thread between frames: they read the editor's plain state
+(editor().state) and ask the main thread for the view's pixels (view(ctx))."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from alight.frontends.editor.ui_test import editor, view
+
+OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
+
+
+def ball(image: np.ndarray) -> np.ndarray:
+    """Pixels well inside the ball (it fills the middle of the view)."""
+    h, w = image.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2].astype(np.float64)
+
+
+def contrast(image: np.ndarray) -> float:
+    """Mean horizontal luminance step inside the ball: high for a mirror, low for a rough ball."""
+    lum = image.astype(np.float64).mean(axis=2)
+    step = np.zeros_like(lum)
+    step[:, 1:] = np.abs(np.diff(lum, axis=1))
+    return float(ball(step[:, :, None]).mean())
+
+
+def void(ctx) -> None:
+    """A click on the view (no window there): the panel lets go of the keyboard."""
+    ctx.mouse_click_on_void()
+
+
+# --- the F0 table, revert, undo and redo -----------------------------------------------------------
+
+def test_preset_click_revert_undo_redo(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/water")
+    assert s.material.name == "water", s.material.name
+    water = ball(view(ctx))
+    ctx.item_click("**/copper")
+    assert s.material.name == "copper", s.material.name
+    copper = ball(view(ctx)).mean(axis=0)
+    # Copper's F0 is red over green over blue; water's grey.
+    w = water.mean(axis=0)
+    assert copper[0] > copper[1] > copper[2] and copper[0] / copper[2] > w[0] / w[2] + 0.15, (copper, w)
+    # The highlighted row is the preset the material equals: edited, none is; revert brings it back.
+    ctx.item_input_value("**/roughness", 0.8)
+    assert abs(s.material.roughness - 0.8) < 1e-6 and s.material.name == "copper"
+    assert not any(s.material == preset for _, preset, *_ in editor().panel.presets)
+    ctx.item_click("**/revert")
+    assert any(s.material == preset and name == "copper" for name, preset, *_ in editor().panel.presets)
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), copper, atol=0.5)
+    # Ctrl+Z goes back through revert, the roughness edit and the click; Ctrl+Shift+Z forward.
+    void(ctx)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert abs(s.material.roughness - 0.8) < 1e-6, s.material
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.name == "copper" and s.material.roughness != 0.8
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.name == "water", s.material.name
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), water.mean(axis=0), atol=0.5)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("mod_shift") | imgui_key("z"))
+    assert s.material.name == "copper", s.material.name
+    # The panel's undo and redo buttons do the same.
+    ctx.item_click("**/undo")
+    assert s.material.name == "water"
+    ctx.item_click("**/redo")
+    assert s.material.name == "copper"
+
+
+def imgui_key(name: str):
+    from imgui_bundle import imgui
+
+    return getattr(imgui.Key, name)
+
+
+# --- material sliders, colour, fields --------------------------------------------------------------
+
+def test_roughness_and_metallic_sliders(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/roughness", 0.05)
+    sharp = view(ctx)
+    ctx.item_input_value("**/roughness", 0.9)
+    assert abs(s.material.roughness - 0.9) < 1e-6
+    rough = view(ctx)
+    assert contrast(sharp) > 1.5 * contrast(rough), (contrast(sharp), contrast(rough))
+    # Metallic 0 on gold's base colour: a yellow diffuse ball with a white rim of reflection;
+    # metallic 1: the reflection itself is yellow. The blue channel tells them apart.
+    ctx.item_input_value("**/metallic", 0.0)
+    assert s.material.metallic == 0.0
+    dielectric = ball(view(ctx)).mean(axis=0)
+    ctx.item_input_value("**/metallic", 1.0)
+    metal = ball(view(ctx)).mean(axis=0)
+    assert s.material.metallic == 1.0
+    assert metal[2] / metal[0] < 0.8 * dielectric[2] / dielectric[0], (metal, dielectric)
+
+
+def test_base_colour_edit(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/roughness", 0.6)
+    # The colour edit's three sRGB components, typed as an artist types them (0-255).
+    ctx.item_input_value("base colour (sRGB)/##X", 40)
+    ctx.item_input_value("base colour (sRGB)/##Y", 200)
+    ctx.item_input_value("base colour (sRGB)/##Z", 40)
+    r, g, b = s.material.base_color
+    assert g > 5 * r and abs(r - b) < 1e-6, s.material.base_color
+    green = ball(view(ctx)).mean(axis=0)
+    assert green[1] > 1.6 * green[0] and green[1] > 1.6 * green[2], green
+
+
+def test_hex_colour_entry(ctx):
+    """The colour's picker (a click on its swatch) takes a hex code: typed, it applies."""
+    from imgui_bundle import imgui
+
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_click("base colour (sRGB)/##ColorButton")
+    ctx.item_input_value("//$FOCUSED/##picker/##hex/##Text", "#2040E0")
+    ctx.key_press(imgui.Key.escape)
+    r, g, b = s.material.base_color   # stored linear: sRGB 0x20, 0x40, 0xE0
+    np.testing.assert_allclose((r, g, b), (0.0144, 0.0513, 0.7454), atol=2e-3)
+    blue = ball(view(ctx)).mean(axis=0)
+    assert blue[2] > 1.5 * blue[0], blue
+
+
+def test_emissive_and_name_fields(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    before = ball(view(ctx)).mean()
+    ctx.item_input_value("emissive/$$0", 4.0)
+    assert s.material.emissive[0] == 4.0, s.material.emissive
+    glowing = ball(view(ctx)).mean(axis=0)
+    assert glowing[0] > 200 and glowing.mean() > before, glowing
+    ctx.item_input_value("emissive/$$0", 0.0)
+    ctx.item_input_value("**/name", "my_plastic")
+    assert s.material.name == "my_plastic", s.material.name
+
+
+# --- saving -----------------------------------------------------------------------------------------
+
+def test_save_preset_button_writes_the_material(ctx):
+    from alight.exchange.presets import load_preset
+
+    s = editor().state
+    path = os.path.join(OUT, "from_panel.json")
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.42)
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    assert os.path.isfile(path), (s.error, s.message, editor().panel.preset_path)
+    assert load_preset(path) == s.material
+    assert abs(json.loads(open(path, encoding="utf-8").read())["roughness"] - 0.42) < 1e-6
+    assert s.message == f"saved {path}"
+
+
+def test_export_gltf_button_writes_a_gltf(ctx):
+    path = os.path.join(OUT, "from_panel.gltf")
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/glTF file", path)
+    ctx.item_click("**/export glTF")
+    data = json.loads(open(path, encoding="utf-8").read())
+    assert data["asset"]["version"] == "2.0" and data["materials"], data
+
+
+# --- environment, lights, display -------------------------------------------------------------------
+
+def test_image_based_lighting_checkbox(ctx):
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    lit = ball(view(ctx)).mean()
+    ctx.item_open("**/Lights")
+    ctx.item_uncheck("**/image-based lighting")
+    assert not editor().state.ibl_enabled
+    unlit = ball(view(ctx)).mean()
+    ctx.item_check("**/image-based lighting")
+    assert editor().state.ibl_enabled
+    assert unlit < 0.7 * lit, (unlit, lit)
+    ctx.item_close("**/Lights")
+
+
+def test_add_and_remove_a_light(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    before = view(ctx).astype(np.float64)
+    ctx.item_click("**/add point")
+    assert len(s.lights) == n + 1 and s.lights[-1].kind == "point"
+    assert view(ctx).astype(np.float64).mean() > before.mean() + 0.5
+    ctx.item_click(f"$${n}/remove")
+    assert len(s.lights) == n
+    ctx.item_close("**/Lights")
+
+
+def test_tone_map_and_exposure(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.combo_click("tone map/none")
+    assert s.display.tonemap == "none"
+    clipped = view(ctx).astype(np.float64)
+    ctx.combo_click("tone map/aces")
+    assert s.display.tonemap == "aces"
+    aces = view(ctx).astype(np.float64)
+    assert np.abs(aces - clipped).mean() > 0.5
+    ctx.item_input_value("**/exposure (EV)", 2.0)
+    assert s.display.exposure == 2.0
+    assert view(ctx).astype(np.float64).mean() > aces.mean() + 10
+    ctx.item_input_value("**/exposure (EV)", 0.0)
+    ctx.combo_click("tone map/neutral")
+    ctx.item_close("**/Display & camera")
+
+
+def test_debug_view_combo(ctx):
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.combo_click("debug view/normal")
+    image = view(ctx)
+    h, w = image.shape[:2]
+    # The ball's centre faces the camera: n = (0, 0, 1) is shown as (0.5, 0.5, 1).
+    centre = image[h // 2 - 2:h // 2 + 2, w // 2 - 2:w // 2 + 2].astype(np.float64)
+    assert np.abs(centre - [128, 128, 255]).max() <= 4, centre.mean(axis=(0, 1))
+    ctx.combo_click("debug view/shaded")
+    assert editor().state.debug_view == 0
+    ctx.item_close("**/Display & camera")
+
+
+def test_environment_rotation_and_background(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    before = view(ctx).astype(np.float64)
+    ctx.item_input_value("**/rotation", 90.0)
+    assert s.env_rotation_deg == 90.0
+    assert np.abs(view(ctx).astype(np.float64) - before).mean() > 1.0
+    ctx.item_input_value("**/rotation", 0.0)
+    ctx.combo_click("background/color")
+    assert s.display.background == "color"
+    corner = view(ctx)[:8, :8].astype(np.float64)
+    assert np.abs(corner - corner.mean(axis=(0, 1))).max() < 1.0   # a flat colour, not the studio
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+
+
+# --- the view: keys and the mouse ------------------------------------------------------------------
+
+def test_orbit_drag_frame_key_and_f12(ctx):
+    from imgui_bundle import imgui
+
+    win = editor()
+    void(ctx)
+    yaw = win.orbit.yaw_deg
+    w, h = imgui.get_io().display_size.x, imgui.get_io().display_size.y
+    ctx.mouse_move_to_pos(imgui.ImVec2(w * 0.2, h * 0.5))
+    ctx.mouse_drag_with_delta(imgui.ImVec2(60, 0))
+    assert win.orbit.yaw_deg != yaw, "a left drag in the view did not orbit"
+    # F frames the mesh again: the same distance as before the drag.
+    ctx.key_press(imgui.Key.f)
+    names = set(os.listdir("."))
+    ctx.key_press(imgui.Key.f12)
+    ctx.yield_(3)
+    shots = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")]
+    assert shots, editor().state.error
+
