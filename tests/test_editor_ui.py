@@ -91,3 +91,53 @@ def test_bad_ui_test_files_are_one_line(display, tmp_path):
     both = ui_test(tmp_path, empty, "--new", "--script", "roughness=0.5")
     assert both.returncode == 2 and both.stderr.count("\n") == 1
 
+
+FIRST_RUN = """
+import numpy as np
+from alight.frontends.editor.ui_test import editor, view
+def test_set_the_view(ctx):
+    ctx.set_ref('alight')
+    ctx.item_click('**/silver')
+    ctx.item_open('**/Environment')
+    ctx.item_input_value('**/rotation', 75.0)
+    ctx.item_input_value('**/intensity', 1.5)
+    ctx.combo_click('background/color')
+    ctx.item_close('**/Environment')
+    ctx.item_open('**/Display & camera')
+    ctx.combo_click('tone map/neutral')
+    ctx.item_input_value('**/exposure (EV)', -0.5)
+    ctx.item_close('**/Display & camera')
+    ctx.item_open('**/Lights')
+    ctx.item_click('**/add directional')
+    ctx.item_close('**/Lights')
+    s = editor().state
+    assert (s.env_rotation_deg, s.display.tonemap, s.display.background) == (75.0, 'neutral', 'color')
+    np.save('first.npy', view(ctx))
+"""
+
+SECOND_RUN = """
+import numpy as np
+from alight.frontends.editor.ui_test import editor, view
+def test_reopened(ctx):
+    s = editor().state
+    assert (s.env_rotation_deg, s.env_intensity) == (75.0, 1.5), (s.env_rotation_deg, s.env_intensity)
+    assert (s.display.tonemap, s.display.exposure, s.display.background) == ('neutral', -0.5, 'color'), s.display
+    assert len(s.lights) == 4 and s.lights[-1].kind == 'directional', s.lights
+    assert s.material.name == 'silver'
+    np.save('second.npy', view(ctx))
+"""
+
+
+def test_view_settings_survive_close_and_reopen(display, tmp_path):
+    """Environment rotation and intensity, tone map, exposure, background and lights set through
+    the panel come back when the editor is opened again, and the view is the same picture."""
+    (tmp_path / "first.py").write_text(FIRST_RUN)
+    (tmp_path / "second.py").write_text(SECOND_RUN)
+    first = ui_test(tmp_path, tmp_path / "first.py", "--new", size="320x240")
+    assert first.returncode == 0, first.stdout + first.stderr
+    second = ui_test(tmp_path, tmp_path / "second.py", size="320x240")   # the last session reopens
+    assert second.returncode == 0, second.stdout + second.stderr
+    a, b = (np.load(tmp_path / f"{n}.npy").astype(np.int32) for n in ("first", "second"))
+    assert np.abs(a - b).max() <= 1
+    fresh = ui_test(tmp_path, tmp_path / "second.py", "--new", size="320x240")   # --new: none of it
+    assert fresh.returncode == 1 and "test_reopened failed" in fresh.stderr
