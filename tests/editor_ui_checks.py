@@ -279,3 +279,47 @@ def test_orbit_drag_frame_key_and_f12(ctx):
     shots = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")]
     assert shots, editor().state.error
 
+
+def test_shift_right_drag_turns_the_environment(ctx):
+    from imgui_bundle import imgui
+
+    s = editor().state
+    void(ctx)
+    before, target = s.env_rotation_deg, editor().orbit.target
+    w, h = imgui.get_io().display_size.x, imgui.get_io().display_size.y
+    ctx.mouse_move_to_pos(imgui.ImVec2(w * 0.2, h * 0.5))
+    ctx.key_down(imgui.Key.left_shift)
+    ctx.mouse_drag_with_delta(imgui.ImVec2(40, 0), imgui.MouseButton_.right)
+    ctx.key_up(imgui.Key.left_shift)
+    assert s.env_rotation_deg != before, "Shift + right drag did not turn the environment"
+    assert editor().orbit.target == target, "Shift + right drag panned"
+    turned = view(ctx).astype(np.float64)
+    ctx.mouse_move_to_pos(imgui.ImVec2(w * 0.2, h * 0.5))
+    ctx.mouse_drag_with_delta(imgui.ImVec2(40, 0), imgui.MouseButton_.right)   # without Shift: a pan
+    assert editor().orbit.target != target
+    assert np.abs(turned - view(ctx)).mean() > 0.5
+    ctx.key_press(imgui.Key.f)   # framed again: the next checks see the ball in the middle
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/rotation", before)
+    ctx.item_close("**/Environment")
+
+
+def test_add_a_spot_light_and_aim_it(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    before = ball(view(ctx)).mean()
+    ctx.item_click("**/add spot")
+    assert len(s.lights) == n + 1 and s.lights[-1].kind == "spot", s.lights
+    lit = ball(view(ctx)).mean()
+    assert lit > before + 0.5, (lit, before)
+    ctx.item_input_value(f"$${n}/outer cone", 60.0)
+    assert s.lights[-1].outer_cone_deg == 60.0 and s.lights[-1].direction != (0.0, 0.0, -1.0)
+    # Aimed away from the ball, it no longer lights it.
+    ctx.item_input_value(f"$${n}/direction (spot points)/$$1", 1.0)
+    ctx.item_input_value(f"$${n}/direction (spot points)/$$2", 1.0)
+    assert ball(view(ctx)).mean() < lit - 0.5
+    ctx.item_click(f"$${n}/remove")
+    ctx.item_close("**/Lights")

@@ -167,6 +167,12 @@ class EditorWindow:
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
             if imgui.is_mouse_dragging(imgui.MouseButton_.left):
                 self.orbit.orbit(dx, dy)
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and io.key_shift:
+                # Shift + right drag turns the environment (as Substance's viewers do): a view's
+                # width of drag is a full turn, the lighting follows the hand.
+                s = self.state
+                turned = s.env_rotation_deg + dx * 360.0 / max(1, self._sizes()[1][0] - self.panel_width())
+                s.env_rotation_deg = (turned + 180.0) % 360.0 - 180.0
             elif imgui.is_mouse_dragging(imgui.MouseButton_.right) or imgui.is_mouse_dragging(imgui.MouseButton_.middle):
                 self.orbit.pan(dx, dy, self.size[1])
             if io.mouse_wheel:
