@@ -280,6 +280,36 @@ def test_orbit_drag_frame_key_and_f12(ctx):
     assert shots, editor().state.error
 
 
+def test_f12_saves_the_view_with_alpha_on_a_transparent_background(ctx):
+    """F12 writes the view as framed (the area left of the panel, not the window), RGB; with the
+    transparent background RGBA: the ball opaque, the corners clear."""
+    import OpenImageIO as oiio
+    from imgui_bundle import imgui
+
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/transparent")
+    ctx.item_close("**/Environment")
+    void(ctx)
+    names = set(os.listdir("."))
+    ctx.key_press(imgui.Key.f12)
+    ctx.yield_(3)
+    shot = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")]
+    assert shot, win.state.error
+    image = oiio.ImageBuf(shot[0]).get_pixels(oiio.UINT8)
+    w, h = win.view_area()
+    assert image.shape == (h, w, 4), (image.shape, (w, h), win.size)
+    assert image[h // 2, w // 2, 3] == 255 and image[:4, :4, 3].max() == 0, (image[h // 2, w // 2], image[0, 0])
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.item_click("**/screenshot (F12)")   # the button does the same, RGB once the background is back
+    ctx.item_close("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+
+
 def test_shift_right_drag_turns_the_environment(ctx):
     from imgui_bundle import imgui
 

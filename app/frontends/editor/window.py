@@ -483,7 +483,7 @@ class EditorWindow:
         if self.screenshot_request:
             path, self.screenshot_request = self.screenshot_request, ""
             try:
-                self.screenshot(path)
+                self.save_view(path)
                 self.state.error, self.state.message = "", f"wrote {path}"
             except AlightError as exc:
                 self.state.fail(exc)
@@ -552,6 +552,20 @@ class EditorWindow:
         out = check_output_path(path, (".png",))
         pixels = self.view_pixels(what=str(out))
         write_image(out, pixels, linear=False)
+
+    def save_view(self, path: str) -> None:
+        """F12 and the panel's button: the view as it is framed (the area left of the panel, at
+        full resolution whatever the render and motion scales), drawn again by the renderer's
+        offline path; RGBA with the coverage as alpha when the background is transparent."""
+        from alight.exchange.output import check_output_path, write_image
+
+        out = check_output_path(path, (".png",))
+        self.finish_bake()
+        w, h = self.view_area()
+        scene = self.state.scene(self.orbit.camera())
+        frame = self.renderer.render(scene, self.maps(), w, h, aa=self.state.aa, read_linear=False, read_srgb=True)
+        alpha = scene.display.background == "transparent"
+        write_image(out, frame.srgb if alpha else frame.srgb[:, :, :3], linear=False)
 
     def view_pixels(self, what: str = "the view"):
         """The view without the panel at window size, top row first: uint8 (h, w, 3), sRGB."""
