@@ -353,3 +353,136 @@ def test_add_a_spot_light_and_aim_it(ctx):
     assert ball(view(ctx)).mean() < lit - 0.5
     ctx.item_click(f"$${n}/remove")
     ctx.item_close("**/Lights")
+
+
+# --- more of the panel: layers, lighting settings, display, files ------------------------------------
+
+SHARED = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data")
+
+
+def test_clearcoat_layer_section(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.7)
+    dull = view(ctx)
+    ctx.item_open("**/###layer_clearcoat")
+    ctx.item_input_value("**/clearcoat", 1.0)
+    ctx.item_input_value("**/clearcoat roughness", 0.03)
+    assert (s.material.clearcoat, s.material.clearcoat_roughness) == (1.0, np.float32(0.03)), s.material
+    coated = view(ctx)
+    # The coat's sharp reflections over the rough copper: more local contrast, a changed ball.
+    assert contrast(coated) > 1.1 * contrast(dull), (contrast(coated), contrast(dull))
+    assert np.abs(ball(coated) - ball(dull)).mean() > 2.0
+    ctx.item_close("**/###layer_clearcoat")
+    ctx.item_click("**/revert")
+    assert s.material.clearcoat == 0.0
+
+
+def test_intensity_multiple_scattering_and_ibl_model(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/roughness", 0.9)
+    ctx.item_open("**/Environment")
+    base = ball(view(ctx)).mean()
+    ctx.item_check("**/multiple scattering")
+    assert s.multiple_scattering
+    brighter = ball(view(ctx)).mean()
+    assert brighter > base + 1.0, (brighter, base)   # a rough metal gets back the energy single scattering loses
+    ctx.item_uncheck("**/multiple scattering")
+    ctx.combo_click("IBL model/lecture")
+    assert s.ibl_model == "lecture"
+    assert np.abs(ball(view(ctx)).mean() - base) > 0.2
+    ctx.combo_click("IBL model/alight")
+    ctx.item_input_value("**/intensity", 2.0)
+    assert s.env_intensity == 2.0
+    assert ball(view(ctx)).mean() > base + 10
+    ctx.item_input_value("**/intensity", 1.0)
+    ctx.item_close("**/Environment")
+
+
+def test_open_env_typed_and_studio_button(ctx):
+    s = editor().state
+    path = os.path.join(SHARED, "env", "venice_sunset_1k.hdr")
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    studio = view(ctx).astype(np.float64)
+    ctx.item_input_value("**/env file", path)
+    ctx.item_click("**/open env")
+    assert s.env_spec == path, (s.env_spec, s.error)
+    assert np.abs(view(ctx).astype(np.float64) - studio).mean() > 5.0
+    ctx.item_click("**/studio")
+    assert s.env_spec == "studio"
+    np.testing.assert_allclose(view(ctx).astype(np.float64).mean(), studio.mean(), atol=0.5)
+    ctx.item_close("**/Environment")
+
+
+def test_open_mesh_typed(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/mesh", "cube")
+    ctx.item_click("**/open mesh")
+    assert s.mesh_spec == "cube", s.error
+    cube = view(ctx)
+    ctx.item_input_value("**/mesh", "sphere")
+    ctx.item_click("**/open mesh")
+    assert s.mesh_spec == "sphere" and np.abs(view(ctx).astype(np.float64) - cube).mean() > 1.0
+    ctx.item_close("**/Environment")
+
+
+def test_field_of_view_aa_and_render_scale(ctx):
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/color")   # a flat background: the ball is what differs from it
+    ctx.item_close("**/Environment")
+    ctx.item_click("**/frame mesh (F)")
+
+    def ball_pixels(image):
+        return int((np.abs(image.astype(np.float64) - image[2, 2]).sum(axis=2) > 30).sum())
+
+    fov = win.orbit.fov_y_deg
+    framed = ball_pixels(view(ctx))
+    ctx.item_input_value("**/field of view", fov + 20.0)
+    assert win.orbit.fov_y_deg == fov + 20.0
+    assert ball_pixels(view(ctx)) < 0.8 * framed, (ball_pixels(view(ctx)), framed)
+    ctx.item_input_value("**/field of view", fov)
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+    ctx.item_click("**/frame mesh (F)")
+    ctx.combo_click("anti-aliasing/msaa")
+    assert win.state.aa == "msaa"
+    ctx.combo_click("anti-aliasing/none")
+    ctx.item_input_value("**/render scale", 0.5)
+    assert win.state.render_scale == 0.5
+    ctx.item_input_value("**/render scale", 1.0)
+    ctx.item_close("**/Display & camera")
+
+
+def test_base_colour_map_typed_load_and_clear(ctx):
+    import OpenImageIO as oiio
+
+    s = editor().state
+    path = os.path.join(OUT, "red.png")
+    red = np.zeros((16, 16, 3), np.uint8)
+    red[..., 0] = 230
+    oiio.ImageBuf(red).write(path)
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/base colour (sRGB)/##X", 255)
+    ctx.item_input_value("**/base colour (sRGB)/##Y", 255)
+    ctx.item_input_value("**/base colour (sRGB)/##Z", 255)
+    white = ball(view(ctx)).mean(axis=0)
+    ctx.item_click("texture maps/base_color/##armed")
+    ctx.item_input_value("**/map file", path)
+    ctx.item_click("**/load##typed")
+    assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
+    mapped = ball(view(ctx)).mean(axis=0)
+    assert mapped[0] > 2 * mapped[1] and white[0] < 1.3 * white[1], (mapped, white)
+    ctx.item_click("texture maps/base_color/clear")
+    assert "base_color" not in s.texture_maps.paths()
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), white, atol=0.5)

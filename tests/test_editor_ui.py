@@ -35,7 +35,7 @@ def test_every_panel_check_passes_through_the_test_engine(display, tmp_path):
     assert list(tmp_path.glob("alight-screenshot-*.png"))
     # The session is saved at the end, as after a normal close: the last material clicked.
     session = json.loads((tmp_path / "config" / "editor-session.json").read_text())
-    assert session["material"]["name"] == "gold", session   # the last preset clicked (IBL checkbox test)
+    assert session["material"]["name"] == "plastic_high", session   # the last preset clicked (the map check)
 
 
 def test_failures_exit_1_with_their_message_and_the_view_is_the_editors(display, tmp_path):
@@ -141,3 +141,23 @@ def test_view_settings_survive_close_and_reopen(display, tmp_path):
     assert np.abs(a - b).max() <= 1
     fresh = ui_test(tmp_path, tmp_path / "second.py", "--new", size="320x240")   # --new: none of it
     assert fresh.returncode == 1 and "test_reopened failed" in fresh.stderr
+
+
+def test_a_bad_setting_in_the_session_file_is_one_warning(tmp_path, monkeypatch):
+    """A session file edited by hand (a tone map that does not exist) restores the material and
+    camera and says which setting it left out, in one line."""
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session, session_path
+    from alight.frontends.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
+    state = EditorState()
+    state.env_rotation_deg = 30.0
+    save_session(state, OrbitCamera())
+    data = json.loads(session_path().read_text())
+    data["settings"]["display"]["tonemap"] = "sepia"
+    session_path().write_text(json.dumps(data))
+    fresh = EditorState()
+    warning = restore_session(fresh, OrbitCamera())
+    assert "tonemap 'sepia'" in warning and "\n" not in warning
+    assert fresh.env_rotation_deg == 0.0 and fresh.display.tonemap == "aces"   # the settings left as they were

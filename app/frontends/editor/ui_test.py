@@ -134,10 +134,11 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
             except BaseException as exc:   # a failed check: its message, for the report
                 raised[name] = f"{type(exc).__name__}: {' '.join(str(exc).split())}" if str(exc) \
                     else type(exc).__name__
-                tb = traceback.extract_tb(exc.__traceback__)
-                user = [f for f in tb if f.filename == getattr(fn, "__code__", None).co_filename] if hasattr(fn, "__code__") else []
-                if user:
-                    raised[name] += f" (line {user[-1].lineno})"
+                code = getattr(fn, "__code__", None)   # the line in the user's file that raised
+                lines = [f.lineno for f in traceback.extract_tb(exc.__traceback__)
+                         if code is not None and f.filename == code.co_filename]
+                if lines:
+                    raised[name] += f" (line {lines[-1]})"
         return test_func
 
     def register_tests() -> None:
