@@ -486,3 +486,190 @@ def test_base_colour_map_typed_load_and_clear(ctx):
     ctx.item_click("texture maps/base_color/clear")
     assert "base_color" not in s.texture_maps.paths()
     np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), white, atol=0.5)
+
+
+def test_anisotropy_and_sheen_sections(ctx):
+    s = editor().state
+
+    def changed(before, what):
+        after = view(ctx).astype(np.float64)
+        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
+        return after
+
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.4)
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_anisotropy")
+    ctx.item_input_value("**/anisotropy strength", 0.9)
+    assert abs(s.material.anisotropy_strength - 0.9) < 1e-6
+    image = changed(image, "anisotropy strength")
+    ctx.item_input_value("**/anisotropy rotation", 60.0)   # degrees, stored in radians
+    assert abs(s.material.anisotropy_rotation - np.radians(60.0)) < 1e-4, s.material.anisotropy_rotation
+    image = changed(image, "anisotropy rotation")
+    ctx.item_close("**/###layer_anisotropy")
+    ctx.item_click("**/plastic_high")
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_sheen")
+    ctx.item_input_value("###layer_sheen/sheen colour (sRGB)/##X", 255)
+    ctx.item_input_value("**/sheen roughness", 0.5)
+    assert s.material.sheen_color[0] == 1.0 and abs(s.material.sheen_roughness - 0.5) < 1e-6, s.material
+    image = changed(image, "sheen")
+    ctx.item_close("**/###layer_sheen")
+    ctx.item_click("**/revert")
+    assert s.material.sheen_color == (0.0, 0.0, 0.0)
+
+
+def test_transmission_and_volume_sections(ctx):
+    s = editor().state
+
+    def changed(before, what):
+        after = view(ctx).astype(np.float64)
+        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
+        return after
+
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_transmission")
+    ctx.item_input_value("**/transmission", 1.0)
+    assert s.material.transmission == 1.0
+    image = changed(image, "transmission")
+    ctx.item_close("**/###layer_transmission")
+    ctx.item_open("**/###layer_volume")
+    ctx.item_input_value("**/thickness", 1.0)
+    ctx.item_check("**/attenuate")
+    ctx.item_input_value("###layer_volume/attenuation colour (sRGB)/##Y", 40)
+    assert s.material.thickness == 1.0 and s.material.attenuation_distance == 1.0, s.material
+    changed(image, "volume")
+    ctx.item_close("**/###layer_volume")
+    ctx.item_click("**/revert")
+    assert s.material.transmission == 0.0 and s.material.thickness == 0.0
+
+
+def test_bake_quality_combo(ctx):
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("bake quality/low")
+    assert win.state.quality == "low"
+    view(ctx)   # (the bake is finished for the view)
+    assert win._maps_key[1:] == ("low",), win._maps_key
+    ctx.combo_click("bake quality/medium")
+    view(ctx)
+    assert win._maps_key[1:] == ("medium",)
+    ctx.item_close("**/Environment")
+
+
+def test_a_lights_position_colour_and_intensity(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_open("**/Lights")
+    ctx.item_uncheck("**/image-based lighting")   # the punctual lights alone
+    first = s.lights[0]
+    image = view(ctx).astype(np.float64)
+    ctx.item_input_value("$$0/intensity", 0.0)
+    assert s.lights[0].intensity == 0.0
+    darker = view(ctx).astype(np.float64)
+    assert ball(darker).mean() < ball(image).mean() - 1.0
+    ctx.item_input_value("$$0/intensity", first.intensity)
+    ctx.item_input_value("$$0/colour/##X", 0)
+    ctx.item_input_value("$$0/colour/##Y", 0)
+    assert s.lights[0].color[:2] == (0.0, 0.0), s.lights[0]
+    blue, white = ball(view(ctx)).mean(axis=0), ball(image).mean(axis=0)
+    assert blue[0] < white[0] - 0.5 and blue[0] - blue[2] < white[0] - white[2], (blue, white)
+    ctx.item_input_value("$$0/position/$$0", -first.vector[0])
+    assert s.lights[0].vector[0] == np.float32(-first.vector[0]), s.lights[0]
+    assert np.abs(view(ctx).astype(np.float64) - image).mean() > 0.3
+    ctx.item_input_value("$$0/colour/##X", first.color[0])
+    ctx.item_input_value("$$0/colour/##Y", first.color[1])
+    ctx.item_input_value("$$0/position/$$0", first.vector[0])
+    ctx.item_check("**/image-based lighting")
+    ctx.item_close("**/Lights")
+
+
+def test_file_materials_checkbox_and_motion_settings(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/mesh", os.path.join(SHARED, "models", "Duck.glb"))
+    ctx.item_click("**/open mesh")
+    assert s.use_file_materials, s.error
+    own = ball(view(ctx)).mean(axis=0)
+    assert own[0] > own[2] + 30, own   # the duck's own yellow texture
+    ctx.item_uncheck("**/mesh file's own materials and maps")
+    ctx.item_click("**/water")
+    panel = ball(view(ctx)).mean(axis=0)
+    assert panel[0] < own[0] - 20, (panel, own)
+    ctx.item_input_value("**/mesh", "sphere")
+    ctx.item_click("**/open mesh")
+    ctx.item_close("**/Environment")
+    ctx.item_open("**/Display & camera")
+    adaptive = s.adaptive_motion
+    ctx.item_click("**/###adaptive_motion")
+    assert s.adaptive_motion != adaptive
+    if not s.adaptive_motion:
+        ctx.item_input_value("**/scale while moving", 0.5)
+        assert s.motion_scale == 0.5
+        ctx.item_click("**/###adaptive_motion")
+    ctx.item_close("**/Display & camera")
+
+
+def test_uv_tiling_of_a_map(ctx):
+    import OpenImageIO as oiio
+
+    s = editor().state
+    path = os.path.join(OUT, "halves.png")
+    halves = np.zeros((16, 16, 3), np.uint8)
+    halves[:, :8, 0] = 230
+    halves[:, 8:, 1] = 230
+    oiio.ImageBuf(halves).write(path)
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/map file", path)
+    ctx.item_click("texture maps/base_color/##armed")
+    ctx.item_click("**/load##typed")
+    assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
+    once = view(ctx).astype(np.float64)
+    ctx.item_input_value("texture maps/UV tiling/$$0", 8.0)
+    assert s.texture_maps.uv_scale[0] == 8.0, s.texture_maps
+    assert np.abs(view(ctx).astype(np.float64) - once).mean() > 1.0
+    ctx.item_input_value("texture maps/UV offset/$$1", 0.25)
+    assert s.texture_maps.uv_offset[1] == 0.25
+    ctx.item_input_value("texture maps/UV tiling/$$0", 1.0)
+    ctx.item_input_value("texture maps/UV offset/$$1", 0.0)
+    ctx.item_click("texture maps/base_color/clear")
+
+
+def test_ior_and_specular_f0_follow_each_other(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    before = ball(view(ctx)).mean()
+    ctx.item_input_value("**/ior", 1.2)   # F0 = ((ior - 1) / (ior + 1))^2 = 0.0083: a fainter reflection
+    assert abs(s.material.ior - 1.2) < 1e-6
+    f0 = s.material.f0()
+    assert abs(float(np.mean(f0)) - (0.2 / 2.2) ** 2) < 2e-3, f0
+    assert ball(view(ctx)).mean() < before - 0.3
+    ctx.item_input_value("specular F0/$$0", 0.08)
+    ctx.item_input_value("specular F0/$$1", 0.08)
+    ctx.item_input_value("specular F0/$$2", 0.08)
+    assert s.material.ior > 1.5, s.material   # the ior follows the F0 typed
+
+
+def test_load_preset_button(ctx):
+    from alight.exchange.presets import load_preset
+
+    s = editor().state
+    path = os.path.join(OUT, "to_load.json")
+    ctx.set_ref("alight")
+    ctx.item_click("**/iron")
+    ctx.item_input_value("**/roughness", 0.66)
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    saved = load_preset(path)
+    ctx.item_click("**/water")
+    assert s.material != saved
+    ctx.item_click("**/load preset")
+    assert s.material == saved, (s.material, s.error)

@@ -451,8 +451,9 @@ class Panel:
         if changed:
             s.aa = AA_CHOICES[i]
         _, s.render_scale = imgui.slider_float("render scale", s.render_scale, 0.25, 1.0)
-        _, s.adaptive_motion = imgui.checkbox(f"adaptive scale while moving ({win.adaptive_scale:.2f})",
-                                              s.adaptive_motion)
+        # (A fixed ID: the label's number changes while the view moves.)
+        _, s.adaptive_motion = imgui.checkbox(f"adaptive scale while moving ({win.adaptive_scale:.2f})"
+                                              "###adaptive_motion", s.adaptive_motion)
         if not s.adaptive_motion:
             _, s.motion_scale = imgui.slider_float("scale while moving", s.motion_scale, 0.25, 1.0)
         _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)

@@ -29,6 +29,7 @@ from pathlib import Path
 
 from alight.errors import AlightError
 
+WATCHDOG_S = 600.0   # seconds one test may run before the engine stops it
 _window = None       # the EditorWindow the tests drive (set once the runner has a GL context)
 _requests: list = []  # (function, result box) to run on the main thread after a frame
 
@@ -126,6 +127,10 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
             if warning:
                 state.error = " ".join(warning.split())
             _window.history.committed = state.look
+        # The environment's first bake done before the tests start: while it runs, its progress
+        # bar tops the panel and every row below moves up a line when it ends, under a click the
+        # engine is making (on a loaded machine it clicked the row after the one asked for).
+        _window.finish_bake()
 
     def wrap(name, fn):
         def test_func(ctx) -> None:
@@ -147,6 +152,9 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
         io.config_run_speed = te.TestRunSpeed.fast
         io.config_no_throttle = True
         io.config_log_to_tty = False
+        # The engine stops a test after 60 s by default; a software GL under load can take that
+        # for a handful of transmissive frames. Ten minutes, then the test fails as timed out.
+        io.config_watchdog_warning, io.config_watchdog_kill_test = 300.0, WATCHDOG_S
         for name, fn in tests:
             test = te.register_test(engine, "alight", name)
             test.test_func = wrap(name, fn)
