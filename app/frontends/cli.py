@@ -265,6 +265,10 @@ def _add_edit_parser(sub) -> None:
                         "ibl (0/1), ibl_model, multiple_scattering (0/1), quality, debug_view, debug_mip, "
                         "map_SLOT (an image path, '' clears; SLOT: base_color, metallic_roughness, metallic, roughness, normal, emissive, occlusion), "
                         "uv_scale, uv_offset (U,V)")
+    e.add_argument("--ui-test", metavar="FILE.py",
+                   help="run FILE's test_*(ctx) functions with the Dear ImGui Test Engine against the real "
+                        "window (ctx.set_ref('alight'); ctx.item_click('**/copper')); exit 0 when all pass, "
+                        "1 with each failure; the session is saved as after a normal close")
     e.add_argument("--no-panel", action="store_true", help="draw the view only")
     e.add_argument("--new", action="store_true",
                    help="do not reopen the last session (it is reopened when no scene option is given)")

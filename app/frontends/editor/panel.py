@@ -105,7 +105,11 @@ class Panel:
     def _material(self, s, win) -> None:
         from imgui_bundle import imgui
 
+        # Every widget below edits this local copy; it is written back once, after the last of
+        # them. Nothing in between may assign s.material: the write-back would undo it (a preset
+        # click once did, and 'revert' then applied the click of the frame before).
         m = s.material
+        picked = None   # the preset clicked this frame: it also becomes what 'revert' goes back to
         _, s.use_file_materials = imgui.checkbox("mesh file's own materials and maps", s.use_file_materials)
         if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
             # The names' column as wide as the longest name and its swatch: the F0 columns take the rest.
@@ -120,8 +124,9 @@ class Panel:
                 imgui.table_next_column()
                 imgui.color_button(f"##sw{name}", imgui.ImVec4(*f0_srgb, 1.0), 0, imgui.ImVec2(14, 14))
                 imgui.same_line()
-                if imgui.selectable(name, m.name == preset.name)[0]:
-                    s.material = s.saved_material = preset
+                # Highlighted: the preset the material is now (none once any field is edited).
+                if imgui.selectable(name, m == preset)[0]:
+                    m = picked = preset
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0))
                 imgui.table_next_column()
@@ -154,7 +159,9 @@ class Panel:
         if changed and name.strip() and name.isprintable():
             m = dataclasses.replace(m, name=name)
         m = self._layers(s, m)
-        if m != s.material:
+        if picked is not None and m is picked:   # a click and no other edit: the preset as it is
+            s.material = s.saved_material = picked
+        elif m != s.material:
             try:
                 s.material = validate_material(m, "panel")
             except AlightError as exc:
@@ -354,6 +361,9 @@ class Panel:
             except AlightError as exc:
                 s.fail(exc)
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("or Shift + right drag in the view")
+        imgui.text_disabled("turn the environment: Shift + right drag in the view")
         _, s.env_intensity = imgui.slider_float("intensity", s.env_intensity, 0.0, 4.0)
         d = s.display
         changed, i = imgui.combo("background", BACKGROUNDS.index(d.background), BACKGROUNDS)
@@ -392,14 +402,25 @@ class Panel:
             imgui.same_line()
             if imgui.small_button("remove"):
                 remove = i
-            label = "position" if light.kind == "point" else "direction"
+            label = "direction (light travels)" if light.kind == "directional" else "position"
             c1, vec = imgui.drag_float3(label, list(light.vector), 0.05)
             c2, col = imgui.color_edit3("colour", list(light.color))
             c3, inten = imgui.drag_float("intensity", light.intensity, 0.1, 0.0, 1000.0)
             if c1 or c2 or c3:
                 if light.kind == "directional" and not any(vec):
                     vec = list(light.vector)   # a zero direction has no meaning
-                s.lights[i] = Light(light.kind, tuple(vec), tuple(max(0.0, x) for x in col), max(0.0, inten))
+                # replace, not rebuild: a spot keeps its direction, cones and range
+                light = dataclasses.replace(light, vector=tuple(vec), color=tuple(max(0.0, x) for x in col),
+                                            intensity=max(0.0, inten))
+            if light.kind == "spot":
+                c4, axis = imgui.drag_float3("direction (spot points)", list(light.direction), 0.02)
+                c5, inner = imgui.slider_float("inner cone", light.inner_cone_deg, 0.0, 90.0, "%.1f deg")
+                c6, outer = imgui.slider_float("outer cone", light.outer_cone_deg, 0.0, 90.0, "%.1f deg")
+                if (c4 and any(axis)) or c5 or c6:
+                    light = dataclasses.replace(light, direction=tuple(axis) if any(axis) else light.direction,
+                                                inner_cone_deg=min(inner, outer), outer_cone_deg=max(outer, 1e-3))
+            if light != s.lights[i]:
+                s.lights[i] = light
             imgui.pop_id()
         if remove is not None:
             del s.lights[remove]
@@ -408,6 +429,10 @@ class Panel:
         imgui.same_line()
         if imgui.button("add directional"):
             s.lights.append(Light("directional", (0.0, -1.0, -1.0), (1.0, 1.0, 1.0), 2.0))
+        imgui.same_line()
+        if imgui.button("add spot"):   # above and in front, pointing at the origin
+            s.lights.append(Light("spot", (0.0, 3.0, 3.0), (1.0, 1.0, 1.0), 30.0,
+                                  direction=(0.0, -0.7071, -0.7071), inner_cone_deg=15.0, outer_cone_deg=30.0))
 
     def _display(self, s, win) -> None:
         from imgui_bundle import imgui
@@ -426,8 +451,9 @@ class Panel:
         if changed:
             s.aa = AA_CHOICES[i]
         _, s.render_scale = imgui.slider_float("render scale", s.render_scale, 0.25, 1.0)
-        _, s.adaptive_motion = imgui.checkbox(f"adaptive scale while moving ({win.adaptive_scale:.2f})",
-                                              s.adaptive_motion)
+        # (A fixed ID: the label's number changes while the view moves.)
+        _, s.adaptive_motion = imgui.checkbox(f"adaptive scale while moving ({win.adaptive_scale:.2f})"
+                                              "###adaptive_motion", s.adaptive_motion)
         if not s.adaptive_motion:
             _, s.motion_scale = imgui.slider_float("scale while moving", s.motion_scale, 0.25, 1.0)
         _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)
@@ -437,6 +463,7 @@ class Panel:
         if imgui.button("screenshot (F12)"):
             win.screenshot_request = win.next_screenshot_name()   # the window writes it after the frame
         imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
+        imgui.text_disabled("turn the environment: Shift + right drag")
 
     def _performance(self, win) -> None:
         from imgui_bundle import imgui, implot

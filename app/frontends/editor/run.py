@@ -44,7 +44,18 @@ def build_state(args) -> EditorState:
 def run(args) -> int:
     from alight.frontends.editor.window import EditorWindow
 
+    ui_tests = None
+    if getattr(args, "ui_test", None):   # the file is read before a window opens
+        from alight.frontends.editor import ui_test
+
+        if args.benchmark or args.screenshot or args.script or args.no_panel:
+            from alight.errors import AlightError
+
+            raise AlightError("--ui-test drives the panel: not with --benchmark, --screenshot, --script or --no-panel")
+        ui_tests = ui_test.load_tests(args.ui_test)
     state = build_state(args)
+    if ui_tests is not None:   # under hello_imgui's runner (ui_test.py says why)
+        return ui_test.run(state, args.size, ui_tests, restore=not args.new and _no_scene_options(args))
     size = (1280, 720) if args.benchmark else args.size
     # Interactive only (screenshots and benchmarks must not depend on the last session), and
     # only with no scene given on the command line.

@@ -4,7 +4,9 @@ atomically on close."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 from pathlib import Path
 
 from alight.core.material import material_from_dict
@@ -14,6 +16,8 @@ from alight.exchange.output import write_text_atomic
 from alight.paths import config_dir
 
 CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "radius")
+# The view's settings kept beside the material and camera (with the display and the lights).
+SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering")
 
 
 def session_path() -> Path:
@@ -23,7 +27,10 @@ def session_path() -> Path:
 def save_session(state, orbit) -> None:
     data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
             "texture_maps": state.texture_maps.to_dict(),
-            "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS}}
+            "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
+            "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
+                         "display": dataclasses.asdict(state.display),
+                         "lights": [dataclasses.asdict(light) for light in state.lights]}}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))
@@ -57,6 +64,16 @@ def restore_session(state, orbit) -> str:
                 loader(spec)
             except AlightError as exc:
                 warning = str(exc)
+    settings = data.get("settings")
+    if isinstance(settings, dict):
+        try:
+            values, display, lights = _read_settings(settings)
+        except (KeyError, TypeError, ValueError) as exc:
+            warning = f"{path}: the view's settings not restored ({' '.join(str(exc).split())})"
+        else:
+            for k, v in values.items():
+                setattr(state, k, v)
+            state.display, state.lights = display, lights
     camera = data.get("camera")
     if isinstance(camera, dict):
         try:
@@ -68,3 +85,46 @@ def restore_session(state, orbit) -> str:
         except (KeyError, TypeError, ValueError):
             pass
     return warning
+
+
+def _read_settings(data: dict):
+    """(state fields, Display, lights) from a session's "settings", checked as strictly as the
+    CLI checks them. Errors: KeyError, TypeError, ValueError naming the field."""
+    from alight.core.ibl_models import IBL_MODELS
+    from alight.core.scene import BACKGROUNDS, LIGHT_KINDS, TONEMAPS, Display, Light
+
+    def number(v, what):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"{what} is not a finite number")
+        return float(v)
+
+    def vec3(v, what):
+        if not isinstance(v, (list, tuple)) or len(v) != 3:
+            raise ValueError(f"{what} is not 3 numbers")
+        return tuple(number(x, what) for x in v)
+
+    def choice(v, options, what):
+        if v not in options:
+            raise ValueError(f"{what} '{v}' is not one of {', '.join(options)}")
+        return v
+
+    values = {"env_rotation_deg": number(data["env_rotation_deg"], "env_rotation_deg"),
+              "env_intensity": max(0.0, number(data["env_intensity"], "env_intensity")),
+              "ibl_enabled": bool(data["ibl_enabled"]),
+              "ibl_model": choice(data["ibl_model"], tuple(IBL_MODELS), "ibl_model"),
+              "multiple_scattering": bool(data["multiple_scattering"])}
+    d = data["display"]
+    display = Display(tonemap=choice(d["tonemap"], TONEMAPS, "tonemap"), exposure=number(d["exposure"], "exposure"),
+                      background=choice(d["background"], BACKGROUNDS, "background"),
+                      background_color=vec3(d["background_color"], "background_color"),
+                      blur_roughness=number(d["blur_roughness"], "blur_roughness"))
+    lights = []
+    for i, item in enumerate(data["lights"]):
+        what = f"lights[{i}]"
+        lights.append(Light(kind=choice(item["kind"], LIGHT_KINDS, f"{what}.kind"), vector=vec3(item["vector"], what),
+                            color=vec3(item["color"], what), intensity=max(0.0, number(item["intensity"], what)),
+                            direction=vec3(item["direction"], what),
+                            inner_cone_deg=number(item["inner_cone_deg"], what),
+                            outer_cone_deg=number(item["outer_cone_deg"], what),
+                            range=None if item.get("range") is None else number(item["range"], what)))
+    return values, display, lights

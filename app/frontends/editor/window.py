@@ -44,7 +44,10 @@ TARGET_CACHE = 4   # view framebuffers kept, by size
 
 class EditorWindow:
     def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
-                 show_panel: bool = True, ini_path=None):
+                 show_panel: bool = True, ini_path=None, hosted: bool = False):
+        """``hosted``: hello_imgui's runner owns the window, its GL context (current now) and the
+        imgui context, polls, renders imgui and swaps (ui_test.py); this object then draws the
+        scene and the panel in the runner's callbacks: ``build_frame``, ``render_scene``, ``after_swap``."""
         # PyOpenGL must pick GLX (X11/Xvfb) before the backend imports it.
         if os.environ.get("XDG_SESSION_TYPE") == "wayland":
             os.environ.setdefault("PYOPENGL_PLATFORM", "x11")
@@ -61,6 +64,42 @@ class EditorWindow:
         from alight.render.renderer import ForwardRenderer
 
         self.glfw, self.imgui, self.implot = glfw, imgui, implot
+        self.hosted = hosted
+        if hosted:
+            self._open_hosted(glfw)
+        else:
+            self._open_window(glfw, size, title)
+        self.ctx = moderngl.create_context(require=450)
+        self.renderer = ForwardRenderer(self.ctx)
+        # Whether the window has the depth buffer a scene pass needs (render_view draws into it).
+        self._screen_depth = self._depth_bits() >= 16
+        self._screen_srgb = self._screen_depth and self._screen_encodes_srgb()
+
+        if hosted:   # the runner made imgui's context and renders its draw data; implot's is ours
+            self.impl, self._native_imgui = None, False
+        else:
+            imgui.create_context()
+        implot.create_context()
+        if not hosted:
+            # imgui's window layout lives in the user's config folder, never the working directory;
+            # screenshots and benchmarks keep none, so they never depend on the last session.
+            imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
+            self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
+            self._native_imgui = self._start_native_imgui(imgui)
+        from alight.frontends.editor.panel_image import PanelImage
+
+        # The side bar's pixels, drawn again only when imgui's draw data changes (panel_image.py);
+        # False draws it every frame (the tests compare). The runner draws imgui itself.
+        self.keep_panel_pixels = not hosted
+        self._panel_image = PanelImage(self.ctx, self._render_imgui_direct)
+        glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
+        self._init_state(state, show_panel)
+        # The probes above (depth bits, the sRGB pixel) may leave a GL error pending; hello_imgui
+        # checks glGetError after its first frame and would report it as its own.
+        _ = self.ctx.error
+
+    def _open_window(self, glfw, size, title) -> None:
+        """Our own glfw window with an OpenGL 4.5 core context, current on this thread."""
         if not glfw.init():
             raise AlightError("editor: cannot open a window (no display? set DISPLAY, or run under xvfb-run -a)")
         glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
@@ -76,27 +115,16 @@ class EditorWindow:
             raise AlightError("editor: cannot create an OpenGL 4.5 core window")
         glfw.make_context_current(self.window)
         glfw.swap_interval(0)  # frame times measure our work, not the display's refresh
-        self.ctx = moderngl.create_context(require=450)
-        self.renderer = ForwardRenderer(self.ctx)
-        # Whether the window has the depth buffer a scene pass needs (render_view draws into it).
-        self._screen_depth = self._depth_bits() >= 16
-        self._screen_srgb = self._screen_depth and self._screen_encodes_srgb()
 
-        imgui.create_context()
-        implot.create_context()
-        # imgui's window layout lives in the user's config folder, never the working directory;
-        # screenshots and benchmarks keep none, so they never depend on the last session.
-        imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
-        self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
-        self._native_imgui = self._start_native_imgui(imgui)
-        from alight.frontends.editor.panel_image import PanelImage
+    def _open_hosted(self, glfw) -> None:
+        """hello_imgui's glfw window, through pyGLFW on the same libglfw (imgui_bundle sets
+        PYGLFW_LIBRARY when it is imported, before pyGLFW loads)."""
+        from imgui_bundle.glfw_utils import glfw_window_hello_imgui
 
-        # The side bar's pixels, drawn again only when imgui's draw data changes (panel_image.py);
-        # False draws it every frame (the tests compare).
-        self.keep_panel_pixels = True
-        self._panel_image = PanelImage(self.ctx, self._render_imgui_direct)
-        glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
+        self.window = glfw_window_hello_imgui()
+        self._size_cache = None
 
+    def _init_state(self, state, show_panel) -> None:
         self.state = state
         self.show_panel = show_panel
         self.history = History(state.look)
@@ -113,6 +141,8 @@ class EditorWindow:
         self._framed_mesh = None
         self._drawn_key = self._drawn_targets = self._last_camera = self._drawn_maps = None
         self._target_cache: collections.OrderedDict = collections.OrderedDict()
+        import moderngl
+
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
@@ -150,6 +180,12 @@ class EditorWindow:
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
             if imgui.is_mouse_dragging(imgui.MouseButton_.left):
                 self.orbit.orbit(dx, dy)
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and io.key_shift:
+                # Shift + right drag turns the environment (as Substance's viewers do): a view's
+                # width of drag is a full turn, the lighting follows the hand.
+                s = self.state
+                turned = s.env_rotation_deg + dx * 360.0 / max(1, self._sizes()[1][0] - self.panel_width())
+                s.env_rotation_deg = (turned + 180.0) % 360.0 - 180.0
             elif imgui.is_mouse_dragging(imgui.MouseButton_.right) or imgui.is_mouse_dragging(imgui.MouseButton_.middle):
                 self.orbit.pan(dx, dy, self.size[1])
             if io.mouse_wheel:
@@ -453,10 +489,14 @@ class EditorWindow:
     def frame(self) -> None:
         self.draw()
         self.glfw.swap_buffers(self.window)
+        self.after_swap()
+
+    def after_swap(self) -> None:
+        """After the frame is shown: the screenshot asked for during it, the frame time."""
         if self.screenshot_request:
             path, self.screenshot_request = self.screenshot_request, ""
             try:
-                self.screenshot(path)
+                self.save_view(path)
                 self.state.error, self.state.message = "", f"wrote {path}"
             except AlightError as exc:
                 self.state.fail(exc)
@@ -468,20 +508,30 @@ class EditorWindow:
     def draw(self) -> None:
         """One frame into the window's back buffer (events, panel, view, imgui), not yet shown:
         ``frame`` swaps it; tools can read the whole window first."""
-        glfw, imgui = self.glfw, self.imgui
         self.poll_events()
         self.begin_imgui_frame()
+        self.build_frame()
+        self.imgui.render()
+        self.render_scene()
+        if self.show_panel:
+            self.render_imgui()
+
+    def build_frame(self) -> None:
+        """Between imgui's new frame and its render: the panel, the view's mouse and keys, the
+        shader watcher, the undo history."""
+        if self.hosted:
+            self._size_cache = None   # the runner polled the events
         if self.show_panel:
             self.panel.draw(self)
         self._camera_input()
         self.check_shaders()
-        self.history.settle(self.state.look, imgui.is_any_item_active())
+        self.history.settle(self.state.look, self.imgui.is_any_item_active())
         self.state.sync_map_images()   # undo/redo may bring back a map not decoded now
-        imgui.render()
+
+    def render_scene(self) -> None:
+        """The view into the window's back buffer (under the panel), and a slice of a pending bake."""
         self.render_view()
         self.advance_bake()
-        if self.show_panel:
-            self.render_imgui()
 
     def begin_imgui_frame(self) -> None:
         """imgui's input and new frame (after poll_events)."""
@@ -513,13 +563,34 @@ class EditorWindow:
         from alight.exchange.output import check_output_path, write_image
 
         out = check_output_path(path, (".png",))
+        pixels = self.view_pixels(what=str(out))
+        write_image(out, pixels, linear=False)
+
+    def save_view(self, path: str) -> None:
+        """F12 and the panel's button: the view as it is framed (the area left of the panel, at
+        full resolution whatever the render and motion scales), drawn again by the renderer's
+        offline path; RGBA with the coverage as alpha when the background is transparent."""
+        from alight.exchange.output import check_output_path, write_image
+
+        out = check_output_path(path, (".png",))
+        self.finish_bake()
+        w, h = self.view_area()
+        scene = self.state.scene(self.orbit.camera())
+        frame = self.renderer.render(scene, self.maps(), w, h, aa=self.state.aa, read_linear=False, read_srgb=True)
+        alpha = scene.display.background == "transparent"
+        write_image(out, frame.srgb if alpha else frame.srgb[:, :, :3], linear=False)
+
+    def view_pixels(self, what: str = "the view"):
+        """The view without the panel at window size, top row first: uint8 (h, w, 3), sRGB."""
+        import numpy as np
+
         self.finish_bake()
         targets = self.render_view(full=True)   # display_fbo holds the view, without the panel
         if targets is None:
-            raise AlightError(f"{out}: the window has no area to capture")
+            raise AlightError(f"{what}: the window has no area to capture")
         w, h = targets.width, targets.height
         pixels = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)
-        write_image(out, pixels[::-1, :, :3].copy(), linear=False)
+        return pixels[::-1, :, :3].copy()
 
     @staticmethod
     def next_screenshot_name() -> str:
@@ -536,6 +607,10 @@ class EditorWindow:
             targets.release()
         self._target_cache.clear()
         self._panel_image.release()
+        if self.hosted:   # the runner closes imgui, the window and its context after this
+            self.implot.destroy_context()
+            self.renderer.release()
+            return
         if self._native_imgui:
             self.imgui.backends.opengl3_shutdown()   # its textures first: the Python backend then finds them gone
         self.impl.shutdown()

@@ -1,0 +1,675 @@
+"""The editor's panel operated as an artist does, by the Dear ImGui Test Engine: run by
+tests/test_editor_ui.py as ``alight edit --new --ui-test tests/editor_ui_checks.py`` (a real
+window under Xvfb); not collected by pytest. Each function clicks, types, drags or presses keys
+through the engine and checks the effect on the rendered view or on the file written; none sets
+the editor's state itself.
+
+The engine runs these on its own thread between frames: they read the editor's plain state
+(editor().state) and ask the main thread for the view's pixels (view(ctx))."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from alight.frontends.editor.ui_test import editor, view
+
+OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
+
+
+def ball(image: np.ndarray) -> np.ndarray:
+    """Pixels well inside the ball (it fills the middle of the view)."""
+    h, w = image.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2].astype(np.float64)
+
+
+def contrast(image: np.ndarray) -> float:
+    """Mean horizontal luminance step inside the ball: high for a mirror, low for a rough ball."""
+    lum = image.astype(np.float64).mean(axis=2)
+    step = np.zeros_like(lum)
+    step[:, 1:] = np.abs(np.diff(lum, axis=1))
+    return float(ball(step[:, :, None]).mean())
+
+
+def void(ctx) -> None:
+    """A click on the view (no window there): the panel lets go of the keyboard."""
+    ctx.mouse_click_on_void()
+
+
+# --- the F0 table, revert, undo and redo -----------------------------------------------------------
+
+def test_preset_click_revert_undo_redo(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/water")
+    assert s.material.name == "water", s.material.name
+    water = ball(view(ctx))
+    ctx.item_click("**/copper")
+    assert s.material.name == "copper", s.material.name
+    copper = ball(view(ctx)).mean(axis=0)
+    # Copper's F0 is red over green over blue; water's grey.
+    w = water.mean(axis=0)
+    assert copper[0] > copper[1] > copper[2] and copper[0] / copper[2] > w[0] / w[2] + 0.15, (copper, w)
+    # The highlighted row is the preset the material equals: edited, none is; revert brings it back.
+    ctx.item_input_value("**/roughness", 0.8)
+    assert abs(s.material.roughness - 0.8) < 1e-6 and s.material.name == "copper"
+    assert not any(s.material == preset for _, preset, *_ in editor().panel.presets)
+    ctx.item_click("**/revert")
+    assert any(s.material == preset and name == "copper" for name, preset, *_ in editor().panel.presets)
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), copper, atol=0.5)
+    # Ctrl+Z goes back through revert, the roughness edit and the click; Ctrl+Shift+Z forward.
+    void(ctx)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert abs(s.material.roughness - 0.8) < 1e-6, s.material
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.name == "copper" and s.material.roughness != 0.8
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.name == "water", s.material.name
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), water.mean(axis=0), atol=0.5)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("mod_shift") | imgui_key("z"))
+    assert s.material.name == "copper", s.material.name
+    # The panel's undo and redo buttons do the same.
+    ctx.item_click("**/undo")
+    assert s.material.name == "water"
+    ctx.item_click("**/redo")
+    assert s.material.name == "copper"
+
+
+def imgui_key(name: str):
+    from imgui_bundle import imgui
+
+    return getattr(imgui.Key, name)
+
+
+# --- material sliders, colour, fields --------------------------------------------------------------
+
+def test_roughness_and_metallic_sliders(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/roughness", 0.05)
+    sharp = view(ctx)
+    ctx.item_input_value("**/roughness", 0.9)
+    assert abs(s.material.roughness - 0.9) < 1e-6
+    rough = view(ctx)
+    assert contrast(sharp) > 1.5 * contrast(rough), (contrast(sharp), contrast(rough))
+    # Metallic 0 on gold's base colour: a yellow diffuse ball with a white rim of reflection;
+    # metallic 1: the reflection itself is yellow. The blue channel tells them apart.
+    ctx.item_input_value("**/metallic", 0.0)
+    assert s.material.metallic == 0.0
+    dielectric = ball(view(ctx)).mean(axis=0)
+    ctx.item_input_value("**/metallic", 1.0)
+    metal = ball(view(ctx)).mean(axis=0)
+    assert s.material.metallic == 1.0
+    assert metal[2] / metal[0] < 0.8 * dielectric[2] / dielectric[0], (metal, dielectric)
+
+
+def test_base_colour_edit(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/roughness", 0.6)
+    # The colour edit's three sRGB components, typed as an artist types them (0-255).
+    ctx.item_input_value("base colour (sRGB)/##X", 40)
+    ctx.item_input_value("base colour (sRGB)/##Y", 200)
+    ctx.item_input_value("base colour (sRGB)/##Z", 40)
+    r, g, b = s.material.base_color
+    assert g > 5 * r and abs(r - b) < 1e-6, s.material.base_color
+    green = ball(view(ctx)).mean(axis=0)
+    assert green[1] > 1.6 * green[0] and green[1] > 1.6 * green[2], green
+
+
+def test_hex_colour_entry(ctx):
+    """The colour's picker (a click on its swatch) takes a hex code: typed, it applies."""
+    from imgui_bundle import imgui
+
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_click("base colour (sRGB)/##ColorButton")
+    ctx.item_input_value("//$FOCUSED/##picker/##hex/##Text", "#2040E0")
+    ctx.key_press(imgui.Key.escape)
+    r, g, b = s.material.base_color   # stored linear: sRGB 0x20, 0x40, 0xE0
+    np.testing.assert_allclose((r, g, b), (0.0144, 0.0513, 0.7454), atol=2e-3)
+    blue = ball(view(ctx)).mean(axis=0)
+    assert blue[2] > 1.5 * blue[0], blue
+
+
+def test_emissive_and_name_fields(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    before = ball(view(ctx)).mean()
+    ctx.item_input_value("emissive/$$0", 4.0)
+    assert s.material.emissive[0] == 4.0, s.material.emissive
+    glowing = ball(view(ctx)).mean(axis=0)
+    assert glowing[0] > 200 and glowing.mean() > before, glowing
+    ctx.item_input_value("emissive/$$0", 0.0)
+    ctx.item_input_value("**/name", "my_plastic")
+    assert s.material.name == "my_plastic", s.material.name
+
+
+# --- saving -----------------------------------------------------------------------------------------
+
+def test_save_preset_button_writes_the_material(ctx):
+    from alight.exchange.presets import load_preset
+
+    s = editor().state
+    path = os.path.join(OUT, "from_panel.json")
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.42)
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    assert os.path.isfile(path), (s.error, s.message, editor().panel.preset_path)
+    assert load_preset(path) == s.material
+    assert abs(json.loads(open(path, encoding="utf-8").read())["roughness"] - 0.42) < 1e-6
+    assert s.message == f"saved {path}"
+
+
+def test_export_gltf_button_writes_a_gltf(ctx):
+    path = os.path.join(OUT, "from_panel.gltf")
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/glTF file", path)
+    ctx.item_click("**/export glTF")
+    data = json.loads(open(path, encoding="utf-8").read())
+    assert data["asset"]["version"] == "2.0" and data["materials"], data
+
+
+# --- environment, lights, display -------------------------------------------------------------------
+
+def test_image_based_lighting_checkbox(ctx):
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    lit = ball(view(ctx)).mean()
+    ctx.item_open("**/Lights")
+    ctx.item_uncheck("**/image-based lighting")
+    assert not editor().state.ibl_enabled
+    unlit = ball(view(ctx)).mean()
+    ctx.item_check("**/image-based lighting")
+    assert editor().state.ibl_enabled
+    assert unlit < 0.7 * lit, (unlit, lit)
+    ctx.item_close("**/Lights")
+
+
+def test_add_and_remove_a_light(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    before = view(ctx).astype(np.float64)
+    ctx.item_click("**/add point")
+    assert len(s.lights) == n + 1 and s.lights[-1].kind == "point"
+    assert view(ctx).astype(np.float64).mean() > before.mean() + 0.5
+    ctx.item_click(f"$${n}/remove")
+    assert len(s.lights) == n
+    ctx.item_close("**/Lights")
+
+
+def test_tone_map_and_exposure(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.combo_click("tone map/none")
+    assert s.display.tonemap == "none"
+    clipped = view(ctx).astype(np.float64)
+    ctx.combo_click("tone map/aces")
+    assert s.display.tonemap == "aces"
+    aces = view(ctx).astype(np.float64)
+    assert np.abs(aces - clipped).mean() > 0.5
+    ctx.item_input_value("**/exposure (EV)", 2.0)
+    assert s.display.exposure == 2.0
+    assert view(ctx).astype(np.float64).mean() > aces.mean() + 10
+    ctx.item_input_value("**/exposure (EV)", 0.0)
+    ctx.combo_click("tone map/neutral")
+    ctx.item_close("**/Display & camera")
+
+
+def test_debug_view_combo(ctx):
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.combo_click("debug view/normal")
+    image = view(ctx)
+    h, w = image.shape[:2]
+    # The ball's centre faces the camera: n = (0, 0, 1) is shown as (0.5, 0.5, 1).
+    centre = image[h // 2 - 2:h // 2 + 2, w // 2 - 2:w // 2 + 2].astype(np.float64)
+    assert np.abs(centre - [128, 128, 255]).max() <= 4, centre.mean(axis=(0, 1))
+    ctx.combo_click("debug view/shaded")
+    assert editor().state.debug_view == 0
+    ctx.item_close("**/Display & camera")
+
+
+def test_environment_rotation_and_background(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    before = view(ctx).astype(np.float64)
+    ctx.item_input_value("**/rotation", 90.0)
+    assert s.env_rotation_deg == 90.0
+    assert np.abs(view(ctx).astype(np.float64) - before).mean() > 1.0
+    ctx.item_input_value("**/rotation", 0.0)
+    ctx.combo_click("background/color")
+    assert s.display.background == "color"
+    corner = view(ctx)[:8, :8].astype(np.float64)
+    assert np.abs(corner - corner.mean(axis=(0, 1))).max() < 1.0   # a flat colour, not the studio
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+
+
+# --- the view: keys and the mouse ------------------------------------------------------------------
+
+def test_orbit_drag_frame_key_and_f12(ctx):
+    from imgui_bundle import imgui
+
+    win = editor()
+    void(ctx)
+    yaw = win.orbit.yaw_deg
+    w, h = imgui.get_io().display_size.x, imgui.get_io().display_size.y
+    ctx.mouse_move_to_pos(imgui.ImVec2(w * 0.2, h * 0.5))
+    ctx.mouse_drag_with_delta(imgui.ImVec2(60, 0))
+    assert win.orbit.yaw_deg != yaw, "a left drag in the view did not orbit"
+    # F frames the mesh again: the same distance as before the drag.
+    ctx.key_press(imgui.Key.f)
+    names = set(os.listdir("."))
+    ctx.key_press(imgui.Key.f12)
+    ctx.yield_(3)
+    shots = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")]
+    assert shots, editor().state.error
+
+
+def test_f12_saves_the_view_with_alpha_on_a_transparent_background(ctx):
+    """F12 writes the view as framed (the area left of the panel, not the window), RGB; with the
+    transparent background RGBA: the ball opaque, the corners clear."""
+    import OpenImageIO as oiio
+    from imgui_bundle import imgui
+
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/transparent")
+    ctx.item_close("**/Environment")
+    void(ctx)
+    names = set(os.listdir("."))
+    ctx.key_press(imgui.Key.f12)
+    ctx.yield_(3)
+    shot = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")]
+    assert shot, win.state.error
+    image = oiio.ImageBuf(shot[0]).get_pixels(oiio.UINT8)
+    w, h = win.view_area()
+    assert image.shape == (h, w, 4), (image.shape, (w, h), win.size)
+    assert image[h // 2, w // 2, 3] == 255 and image[:4, :4, 3].max() == 0, (image[h // 2, w // 2], image[0, 0])
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.item_click("**/screenshot (F12)")   # the button does the same, RGB once the background is back
+    ctx.item_close("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+
+
+def test_shift_right_drag_turns_the_environment(ctx):
+    from imgui_bundle import imgui
+
+    s = editor().state
+    void(ctx)
+    before, target = s.env_rotation_deg, editor().orbit.target
+    w, h = imgui.get_io().display_size.x, imgui.get_io().display_size.y
+    ctx.mouse_move_to_pos(imgui.ImVec2(w * 0.2, h * 0.5))
+    ctx.key_down(imgui.Key.left_shift)
+    ctx.mouse_drag_with_delta(imgui.ImVec2(40, 0), imgui.MouseButton_.right)
+    ctx.key_up(imgui.Key.left_shift)
+    assert s.env_rotation_deg != before, "Shift + right drag did not turn the environment"
+    assert editor().orbit.target == target, "Shift + right drag panned"
+    turned = view(ctx).astype(np.float64)
+    ctx.mouse_move_to_pos(imgui.ImVec2(w * 0.2, h * 0.5))
+    ctx.mouse_drag_with_delta(imgui.ImVec2(40, 0), imgui.MouseButton_.right)   # without Shift: a pan
+    assert editor().orbit.target != target
+    assert np.abs(turned - view(ctx)).mean() > 0.5
+    ctx.key_press(imgui.Key.f)   # framed again: the next checks see the ball in the middle
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/rotation", before)
+    ctx.item_close("**/Environment")
+
+
+def test_add_a_spot_light_and_aim_it(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    before = ball(view(ctx)).mean()
+    ctx.item_click("**/add spot")
+    assert len(s.lights) == n + 1 and s.lights[-1].kind == "spot", s.lights
+    lit = ball(view(ctx)).mean()
+    assert lit > before + 0.5, (lit, before)
+    ctx.item_input_value(f"$${n}/outer cone", 60.0)
+    assert s.lights[-1].outer_cone_deg == 60.0 and s.lights[-1].direction != (0.0, 0.0, -1.0)
+    # Aimed away from the ball, it no longer lights it.
+    ctx.item_input_value(f"$${n}/direction (spot points)/$$1", 1.0)
+    ctx.item_input_value(f"$${n}/direction (spot points)/$$2", 1.0)
+    assert ball(view(ctx)).mean() < lit - 0.5
+    ctx.item_click(f"$${n}/remove")
+    ctx.item_close("**/Lights")
+
+
+# --- more of the panel: layers, lighting settings, display, files ------------------------------------
+
+SHARED = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data")
+
+
+def test_clearcoat_layer_section(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.7)
+    dull = view(ctx)
+    ctx.item_open("**/###layer_clearcoat")
+    ctx.item_input_value("**/clearcoat", 1.0)
+    ctx.item_input_value("**/clearcoat roughness", 0.03)
+    assert (s.material.clearcoat, s.material.clearcoat_roughness) == (1.0, np.float32(0.03)), s.material
+    coated = view(ctx)
+    # The coat's sharp reflections over the rough copper: more local contrast, a changed ball.
+    assert contrast(coated) > 1.1 * contrast(dull), (contrast(coated), contrast(dull))
+    assert np.abs(ball(coated) - ball(dull)).mean() > 2.0
+    ctx.item_close("**/###layer_clearcoat")
+    ctx.item_click("**/revert")
+    assert s.material.clearcoat == 0.0
+
+
+def test_intensity_multiple_scattering_and_ibl_model(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/roughness", 0.9)
+    ctx.item_open("**/Environment")
+    base = ball(view(ctx)).mean()
+    ctx.item_check("**/multiple scattering")
+    assert s.multiple_scattering
+    brighter = ball(view(ctx)).mean()
+    assert brighter > base + 1.0, (brighter, base)   # a rough metal gets back the energy single scattering loses
+    ctx.item_uncheck("**/multiple scattering")
+    ctx.combo_click("IBL model/lecture")
+    assert s.ibl_model == "lecture"
+    assert np.abs(ball(view(ctx)).mean() - base) > 0.2
+    ctx.combo_click("IBL model/alight")
+    ctx.item_input_value("**/intensity", 2.0)
+    assert s.env_intensity == 2.0
+    assert ball(view(ctx)).mean() > base + 10
+    ctx.item_input_value("**/intensity", 1.0)
+    ctx.item_close("**/Environment")
+
+
+def test_open_env_typed_and_studio_button(ctx):
+    s = editor().state
+    path = os.path.join(SHARED, "env", "venice_sunset_1k.hdr")
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    studio = view(ctx).astype(np.float64)
+    ctx.item_input_value("**/env file", path)
+    ctx.item_click("**/open env")
+    assert s.env_spec == path, (s.env_spec, s.error)
+    assert np.abs(view(ctx).astype(np.float64) - studio).mean() > 5.0
+    ctx.item_click("**/studio")
+    assert s.env_spec == "studio"
+    np.testing.assert_allclose(view(ctx).astype(np.float64).mean(), studio.mean(), atol=0.5)
+    ctx.item_close("**/Environment")
+
+
+def test_open_mesh_typed(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/mesh", "cube")
+    ctx.item_click("**/open mesh")
+    assert s.mesh_spec == "cube", s.error
+    cube = view(ctx)
+    ctx.item_input_value("**/mesh", "sphere")
+    ctx.item_click("**/open mesh")
+    assert s.mesh_spec == "sphere" and np.abs(view(ctx).astype(np.float64) - cube).mean() > 1.0
+    ctx.item_close("**/Environment")
+
+
+def test_field_of_view_aa_and_render_scale(ctx):
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_open("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/color")   # a flat background: the ball is what differs from it
+    ctx.item_close("**/Environment")
+    ctx.item_click("**/frame mesh (F)")
+
+    def ball_pixels(image):
+        return int((np.abs(image.astype(np.float64) - image[2, 2]).sum(axis=2) > 30).sum())
+
+    fov = win.orbit.fov_y_deg
+    framed = ball_pixels(view(ctx))
+    ctx.item_input_value("**/field of view", fov + 20.0)
+    assert win.orbit.fov_y_deg == fov + 20.0
+    assert ball_pixels(view(ctx)) < 0.8 * framed, (ball_pixels(view(ctx)), framed)
+    ctx.item_input_value("**/field of view", fov)
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+    ctx.item_click("**/frame mesh (F)")
+    ctx.combo_click("anti-aliasing/msaa")
+    assert win.state.aa == "msaa"
+    ctx.combo_click("anti-aliasing/none")
+    ctx.item_input_value("**/render scale", 0.5)
+    assert win.state.render_scale == 0.5
+    ctx.item_input_value("**/render scale", 1.0)
+    ctx.item_close("**/Display & camera")
+
+
+def test_base_colour_map_typed_load_and_clear(ctx):
+    import OpenImageIO as oiio
+
+    s = editor().state
+    path = os.path.join(OUT, "red.png")
+    red = np.zeros((16, 16, 3), np.uint8)
+    red[..., 0] = 230
+    oiio.ImageBuf(red).write(path)
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/base colour (sRGB)/##X", 255)
+    ctx.item_input_value("**/base colour (sRGB)/##Y", 255)
+    ctx.item_input_value("**/base colour (sRGB)/##Z", 255)
+    white = ball(view(ctx)).mean(axis=0)
+    ctx.item_click("texture maps/base_color/##armed")
+    ctx.item_input_value("**/map file", path)
+    ctx.item_click("**/load##typed")
+    assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
+    mapped = ball(view(ctx)).mean(axis=0)
+    assert mapped[0] > 2 * mapped[1] and white[0] < 1.3 * white[1], (mapped, white)
+    ctx.item_click("texture maps/base_color/clear")
+    assert "base_color" not in s.texture_maps.paths()
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), white, atol=0.5)
+
+
+def test_anisotropy_and_sheen_sections(ctx):
+    s = editor().state
+
+    def changed(before, what):
+        after = view(ctx).astype(np.float64)
+        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
+        return after
+
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.4)
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_anisotropy")
+    ctx.item_input_value("**/anisotropy strength", 0.9)
+    assert abs(s.material.anisotropy_strength - 0.9) < 1e-6
+    image = changed(image, "anisotropy strength")
+    ctx.item_input_value("**/anisotropy rotation", 60.0)   # degrees, stored in radians
+    assert abs(s.material.anisotropy_rotation - np.radians(60.0)) < 1e-4, s.material.anisotropy_rotation
+    image = changed(image, "anisotropy rotation")
+    ctx.item_close("**/###layer_anisotropy")
+    ctx.item_click("**/plastic_high")
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_sheen")
+    ctx.item_input_value("###layer_sheen/sheen colour (sRGB)/##X", 255)
+    ctx.item_input_value("**/sheen roughness", 0.5)
+    assert s.material.sheen_color[0] == 1.0 and abs(s.material.sheen_roughness - 0.5) < 1e-6, s.material
+    image = changed(image, "sheen")
+    ctx.item_close("**/###layer_sheen")
+    ctx.item_click("**/revert")
+    assert s.material.sheen_color == (0.0, 0.0, 0.0)
+
+
+def test_transmission_and_volume_sections(ctx):
+    s = editor().state
+
+    def changed(before, what):
+        after = view(ctx).astype(np.float64)
+        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
+        return after
+
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_transmission")
+    ctx.item_input_value("**/transmission", 1.0)
+    assert s.material.transmission == 1.0
+    image = changed(image, "transmission")
+    ctx.item_close("**/###layer_transmission")
+    ctx.item_open("**/###layer_volume")
+    ctx.item_input_value("**/thickness", 1.0)
+    ctx.item_check("**/attenuate")
+    ctx.item_input_value("###layer_volume/attenuation colour (sRGB)/##Y", 40)
+    assert s.material.thickness == 1.0 and s.material.attenuation_distance == 1.0, s.material
+    changed(image, "volume")
+    ctx.item_close("**/###layer_volume")
+    ctx.item_click("**/revert")
+    assert s.material.transmission == 0.0 and s.material.thickness == 0.0
+
+
+def test_bake_quality_combo(ctx):
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("bake quality/low")
+    assert win.state.quality == "low"
+    view(ctx)   # (the bake is finished for the view)
+    assert win._maps_key[1:] == ("low",), win._maps_key
+    ctx.combo_click("bake quality/medium")
+    view(ctx)
+    assert win._maps_key[1:] == ("medium",)
+    ctx.item_close("**/Environment")
+
+
+def test_a_lights_position_colour_and_intensity(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_open("**/Lights")
+    ctx.item_uncheck("**/image-based lighting")   # the punctual lights alone
+    first = s.lights[0]
+    image = view(ctx).astype(np.float64)
+    ctx.item_input_value("$$0/intensity", 0.0)
+    assert s.lights[0].intensity == 0.0
+    darker = view(ctx).astype(np.float64)
+    assert ball(darker).mean() < ball(image).mean() - 1.0
+    ctx.item_input_value("$$0/intensity", first.intensity)
+    ctx.item_input_value("$$0/colour/##X", 0)
+    ctx.item_input_value("$$0/colour/##Y", 0)
+    assert s.lights[0].color[:2] == (0.0, 0.0), s.lights[0]
+    blue, white = ball(view(ctx)).mean(axis=0), ball(image).mean(axis=0)
+    assert blue[0] < white[0] - 0.5 and blue[0] - blue[2] < white[0] - white[2], (blue, white)
+    ctx.item_input_value("$$0/position/$$0", -first.vector[0])
+    assert s.lights[0].vector[0] == np.float32(-first.vector[0]), s.lights[0]
+    assert np.abs(view(ctx).astype(np.float64) - image).mean() > 0.3
+    ctx.item_input_value("$$0/colour/##X", first.color[0])
+    ctx.item_input_value("$$0/colour/##Y", first.color[1])
+    ctx.item_input_value("$$0/position/$$0", first.vector[0])
+    ctx.item_check("**/image-based lighting")
+    ctx.item_close("**/Lights")
+
+
+def test_file_materials_checkbox_and_motion_settings(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/mesh", os.path.join(SHARED, "models", "Duck.glb"))
+    ctx.item_click("**/open mesh")
+    assert s.use_file_materials, s.error
+    own = ball(view(ctx)).mean(axis=0)
+    assert own[0] > own[2] + 30, own   # the duck's own yellow texture
+    ctx.item_uncheck("**/mesh file's own materials and maps")
+    ctx.item_click("**/water")
+    panel = ball(view(ctx)).mean(axis=0)
+    assert panel[0] < own[0] - 20, (panel, own)
+    ctx.item_input_value("**/mesh", "sphere")
+    ctx.item_click("**/open mesh")
+    ctx.item_close("**/Environment")
+    ctx.item_open("**/Display & camera")
+    adaptive = s.adaptive_motion
+    ctx.item_click("**/###adaptive_motion")
+    assert s.adaptive_motion != adaptive
+    if not s.adaptive_motion:
+        ctx.item_input_value("**/scale while moving", 0.5)
+        assert s.motion_scale == 0.5
+        ctx.item_click("**/###adaptive_motion")
+    ctx.item_close("**/Display & camera")
+
+
+def test_uv_tiling_of_a_map(ctx):
+    import OpenImageIO as oiio
+
+    s = editor().state
+    path = os.path.join(OUT, "halves.png")
+    halves = np.zeros((16, 16, 3), np.uint8)
+    halves[:, :8, 0] = 230
+    halves[:, 8:, 1] = 230
+    oiio.ImageBuf(halves).write(path)
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/map file", path)
+    ctx.item_click("texture maps/base_color/##armed")
+    ctx.item_click("**/load##typed")
+    assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
+    once = view(ctx).astype(np.float64)
+    ctx.item_input_value("texture maps/UV tiling/$$0", 8.0)
+    assert s.texture_maps.uv_scale[0] == 8.0, s.texture_maps
+    assert np.abs(view(ctx).astype(np.float64) - once).mean() > 1.0
+    ctx.item_input_value("texture maps/UV offset/$$1", 0.25)
+    assert s.texture_maps.uv_offset[1] == 0.25
+    ctx.item_input_value("texture maps/UV tiling/$$0", 1.0)
+    ctx.item_input_value("texture maps/UV offset/$$1", 0.0)
+    ctx.item_click("texture maps/base_color/clear")
+
+
+def test_ior_and_specular_f0_follow_each_other(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    before = ball(view(ctx)).mean()
+    ctx.item_input_value("**/ior", 1.2)   # F0 = ((ior - 1) / (ior + 1))^2 = 0.0083: a fainter reflection
+    assert abs(s.material.ior - 1.2) < 1e-6
+    f0 = s.material.f0()
+    assert abs(float(np.mean(f0)) - (0.2 / 2.2) ** 2) < 2e-3, f0
+    assert ball(view(ctx)).mean() < before - 0.3
+    ctx.item_input_value("specular F0/$$0", 0.08)
+    ctx.item_input_value("specular F0/$$1", 0.08)
+    ctx.item_input_value("specular F0/$$2", 0.08)
+    assert s.material.ior > 1.5, s.material   # the ior follows the F0 typed
+
+
+def test_load_preset_button(ctx):
+    from alight.exchange.presets import load_preset
+
+    s = editor().state
+    path = os.path.join(OUT, "to_load.json")
+    ctx.set_ref("alight")
+    ctx.item_click("**/iron")
+    ctx.item_input_value("**/roughness", 0.66)
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    saved = load_preset(path)
+    ctx.item_click("**/water")
+    assert s.material != saved
+    ctx.item_click("**/load preset")
+    assert s.material == saved, (s.material, s.error)

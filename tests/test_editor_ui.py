@@ -1,0 +1,165 @@
+"""The editor's panel through its real UI: `alight edit --ui-test` runs test functions with the
+Dear ImGui Test Engine against the real window under Xvfb (tests/editor_ui_checks.py clicks,
+types, drags and presses keys; none goes through --script)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from test_editor import display  # noqa: F401  (the Xvfb fixture)
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def ui_test(tmp_path: Path, file: Path, *args: str, size: str = "640x400") -> subprocess.CompletedProcess:
+    env = dict(os.environ, ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"),
+               ALIGHT_UI_TEST_OUT=str(tmp_path))
+    return subprocess.run([sys.executable, "-m", "alight", "edit", "--size", size, *args, "--ui-test", str(file)],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+
+
+def test_every_panel_check_passes_through_the_test_engine(display, tmp_path):
+    result = ui_test(tmp_path, REPO / "tests" / "editor_ui_checks.py", "--new")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    checks = [line for line in (REPO / "tests" / "editor_ui_checks.py").read_text().splitlines()
+              if line.startswith("def test_")]
+    assert f"{len(checks)} passed, 0 failed" in result.stdout, result.stdout
+    # Files the panel's buttons and F12 wrote, in the run's folder.
+    assert (tmp_path / "from_panel.json").is_file() and (tmp_path / "from_panel.gltf").is_file()
+    assert list(tmp_path.glob("alight-screenshot-*.png"))
+    # The session is saved at the end, as after a normal close: the last material clicked.
+    session = json.loads((tmp_path / "config" / "editor-session.json").read_text())
+    assert session["material"]["name"] == "iron", session   # the last material (the load preset check)
+
+
+def test_failures_exit_1_with_their_message_and_the_view_is_the_editors(display, tmp_path):
+    """A failed check and an item the engine cannot find each give a line and exit 1; the other
+    tests still run. The window under the runner draws the view `alight edit --screenshot` draws."""
+    file = tmp_path / "mine.py"
+    file.write_text(
+        "import numpy as np\n"
+        "from alight.frontends.editor.ui_test import editor, view\n"
+        "def test_copper(ctx):\n"
+        "    ctx.set_ref('alight')\n"
+        "    ctx.item_click('**/copper')\n"
+        "    assert editor().state.material.name == 'copper'\n"
+        "    np.save('view.npy', view(ctx))\n"
+        "def test_wrong(ctx):\n"
+        "    assert 1 + 1 == 3, 'arithmetic is broken'\n"
+        "def test_missing_item(ctx):\n"
+        "    ctx.set_ref('alight')\n"
+        "    ctx.item_click('**/no such button')\n")
+    result = ui_test(tmp_path, file, "--new", size="320x240")
+    assert result.returncode == 1, result.stdout + result.stderr
+    assert "ok   test_copper" in result.stdout and "1 passed, 2 failed" in result.stdout
+    failures = [line for line in result.stderr.splitlines() if line.startswith("alight: ui test")]
+    assert len(failures) == 2, result.stderr
+    assert "test_wrong failed: AssertionError: arithmetic is broken (line 9)" in failures[0]
+    assert "test_missing_item failed:" in failures[1] and "Unable to locate item" in failures[1]
+    # The same scene through the editor's own loop: the same pixels.
+    import OpenImageIO as oiio
+
+    shot = tmp_path / "copper.png"
+    own = subprocess.run([sys.executable, "-m", "alight", "edit", "--size", "320x240", "--preset", "copper",
+                          "--screenshot", str(shot), "--frames", "3"], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=120, env=dict(os.environ, ALIGHT_CONFIG_DIR=str(tmp_path / "config2")))
+    assert own.returncode == 0, own.stderr
+    hosted = np.load(tmp_path / "view.npy").astype(np.int32)
+    drawn = oiio.ImageBuf(str(shot)).get_pixels(oiio.UINT8).astype(np.int32)
+    assert hosted.shape == drawn.shape == (240, 320, 3)
+    assert np.abs(hosted - drawn).max() <= 1, np.abs(hosted - drawn).max()
+
+
+def test_bad_ui_test_files_are_one_line(display, tmp_path):
+    missing = ui_test(tmp_path, tmp_path / "absent.py", "--new")
+    assert missing.returncode == 2 and missing.stderr.count("\n") == 1 and "absent.py" in missing.stderr
+    broken = tmp_path / "broken.py"
+    broken.write_text("def test_x(ctx):\n    pass\nraise ValueError('oops')\n")
+    result = ui_test(tmp_path, broken, "--new")
+    assert result.returncode == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert "broken.py: line 3:" in result.stderr and "oops" in result.stderr
+    empty = tmp_path / "empty.py"
+    empty.write_text("x = 1\n")
+    result = ui_test(tmp_path, empty, "--new")
+    assert result.returncode == 2 and "no test_*(ctx) function" in result.stderr
+    both = ui_test(tmp_path, empty, "--new", "--script", "roughness=0.5")
+    assert both.returncode == 2 and both.stderr.count("\n") == 1
+
+
+FIRST_RUN = """
+import numpy as np
+from alight.frontends.editor.ui_test import editor, view
+def test_set_the_view(ctx):
+    ctx.set_ref('alight')
+    ctx.item_click('**/silver')
+    assert editor().state.material.name == 'silver', editor().state.material.name
+    ctx.item_open('**/Environment')
+    ctx.item_input_value('**/rotation', 75.0)
+    ctx.item_input_value('**/intensity', 1.5)
+    ctx.combo_click('background/color')
+    ctx.item_close('**/Environment')
+    ctx.item_open('**/Display & camera')
+    ctx.combo_click('tone map/neutral')
+    ctx.item_input_value('**/exposure (EV)', -0.5)
+    ctx.item_close('**/Display & camera')
+    ctx.item_open('**/Lights')
+    ctx.item_click('**/add directional')
+    ctx.item_close('**/Lights')
+    s = editor().state
+    assert (s.env_rotation_deg, s.display.tonemap, s.display.background) == (75.0, 'neutral', 'color')
+    assert s.material.name == 'silver', s.material.name
+    np.save('first.npy', view(ctx))
+"""
+
+SECOND_RUN = """
+import numpy as np
+from alight.frontends.editor.ui_test import editor, view
+def test_reopened(ctx):
+    s = editor().state
+    assert (s.env_rotation_deg, s.env_intensity) == (75.0, 1.5), (s.env_rotation_deg, s.env_intensity)
+    assert (s.display.tonemap, s.display.exposure, s.display.background) == ('neutral', -0.5, 'color'), s.display
+    assert len(s.lights) == 4 and s.lights[-1].kind == 'directional', s.lights
+    assert s.material.name == 'silver', s.material.name
+    np.save('second.npy', view(ctx))
+"""
+
+
+def test_view_settings_survive_close_and_reopen(display, tmp_path):
+    """Environment rotation and intensity, tone map, exposure, background and lights set through
+    the panel come back when the editor is opened again, and the view is the same picture."""
+    (tmp_path / "first.py").write_text(FIRST_RUN)
+    (tmp_path / "second.py").write_text(SECOND_RUN)
+    first = ui_test(tmp_path, tmp_path / "first.py", "--new", size="320x240")
+    assert first.returncode == 0, first.stdout + first.stderr
+    second = ui_test(tmp_path, tmp_path / "second.py", size="320x240")   # the last session reopens
+    assert second.returncode == 0, second.stdout + second.stderr
+    a, b = (np.load(tmp_path / f"{n}.npy").astype(np.int32) for n in ("first", "second"))
+    assert np.abs(a - b).max() <= 1
+    fresh = ui_test(tmp_path, tmp_path / "second.py", "--new", size="320x240")   # --new: none of it
+    assert fresh.returncode == 1 and "test_reopened failed" in fresh.stderr
+
+
+def test_a_bad_setting_in_the_session_file_is_one_warning(tmp_path, monkeypatch):
+    """A session file edited by hand (a tone map that does not exist) restores the material and
+    camera and says which setting it left out, in one line."""
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session, session_path
+    from alight.frontends.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
+    state = EditorState()
+    state.env_rotation_deg = 30.0
+    save_session(state, OrbitCamera())
+    data = json.loads(session_path().read_text())
+    data["settings"]["display"]["tonemap"] = "sepia"
+    session_path().write_text(json.dumps(data))
+    fresh = EditorState()
+    warning = restore_session(fresh, OrbitCamera())
+    assert "tonemap 'sepia'" in warning and "\n" not in warning
+    assert fresh.env_rotation_deg == 0.0 and fresh.display.tonemap == "aces"   # the settings left as they were
