@@ -171,16 +171,25 @@ class _GpuPart:
             columns.append(part.colors)
             self.layout[0] += " 4f"
             self.layout.append("in_color")
-        vertices = np.hstack([np.asarray(c, np.float32) for c in columns])
-        self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
-        self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
+        # Interleaved into one array and handed to GL as it is (no hstack of float64 copies, no
+        # tobytes() copy): the CPU side peaks at one vertex buffer's bytes, then lets it go.
+        widths = [np.shape(c)[1] for c in columns]
+        vertices = np.empty((len(part.positions), sum(widths)), np.float32)
+        at = 0
+        for column, width in zip(columns, widths):
+            vertices[:, at:at + width] = column
+            at += width
+        self.vbo = ctx.buffer(vertices)
+        del vertices
+        self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32))
         self.ctx = ctx
         # A vertex array belongs to one program: one per program this part is drawn with (the
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
         self.textures: dict[str, moderngl.Texture] = {}
         self.infos: dict = {}
-        self.closed = is_closed(part.positions, part.indices)
+        self._part = part
+        self._closed: bool | None = None
         positions = np.asarray(part.positions, np.float64)
         self.lo = positions.min(axis=0) if len(positions) else np.zeros(3)    # bounding box corners
         self.hi = positions.max(axis=0) if len(positions) else np.zeros(3)
@@ -190,6 +199,15 @@ class _GpuPart:
             for name, info in fm.textures().items():
                 self.infos[name] = info
                 self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
+
+    @property
+    def closed(self) -> bool:
+        """Whether the part is closed (alight.core.mesh.is_closed), found on first use: only a
+        part without a glTF material's doubleSided needs to know (a 4M-triangle mesh's test
+        takes seconds)."""
+        if self._closed is None:
+            self._closed = is_closed(self._part.positions, self._part.indices)
+        return self._closed
 
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
