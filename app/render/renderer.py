@@ -56,6 +56,7 @@ from alight.core.sphere_lod import (
     projected_radius_px,
     sphere_segments,
 )
+from alight.core.texture_footprint import anisotropy_for_view, footprints
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.ibl.bake import (
@@ -190,6 +191,8 @@ class _GpuPart:
         self.infos: dict = {}
         self._part = part
         self._closed: bool | None = None
+        self._anisotropy_key = None
+        self._anisotropy = 1.0
         positions = np.asarray(part.positions, np.float64)
         self.lo = positions.min(axis=0) if len(positions) else np.zeros(3)    # bounding box corners
         self.hi = positions.max(axis=0) if len(positions) else np.zeros(3)
@@ -209,6 +212,19 @@ class _GpuPart:
             self._closed = is_closed(self._part.positions, self._part.indices)
         return self._closed
 
+    def anisotropy(self, view_projection: np.ndarray, image_size: tuple[int, int],
+                   texture_size: tuple[int, int]) -> float:
+        """The anisotropic filtering level this view of the part gains from
+        (alight.core.texture_footprint), remembered for the last view asked."""
+        key = (np.asarray(view_projection, np.float32).tobytes(), tuple(image_size), tuple(texture_size))
+        if self._anisotropy_key != key:
+            part = self._part
+            area, p_max, p_min = footprints(part.positions, part.uvs, part.indices, view_projection,
+                                            image_size, texture_size)
+            self._anisotropy = anisotropy_for_view(area, p_max, p_min)
+            self._anisotropy_key = key
+        return self._anisotropy
+
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
         if vao is None:
@@ -224,6 +240,8 @@ class _GpuPart:
         self.ibo.release()
 
 
+_ANISOTROPIC_FILTERS = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR_MIPMAP_NEAREST,
+                        moderngl.NEAREST_MIPMAP_LINEAR, moderngl.NEAREST_MIPMAP_NEAREST)
 _MIN_FILTERS = {"nearest": moderngl.NEAREST, "linear": moderngl.LINEAR,
                 "nearest_mipmap_nearest": moderngl.NEAREST_MIPMAP_NEAREST,
                 "linear_mipmap_nearest": moderngl.LINEAR_MIPMAP_NEAREST,
@@ -409,6 +427,7 @@ class ForwardRenderer:
         self.background_ring = True
         self.last_background_ring = False   # whether the last scene pass drew it
         self.last_sphere_impostor: int | None = None   # the last mesh pass's coverage samples, or None
+        self.last_anisotropy: dict[str, float] = {}    # per textured part's name, the level it was last drawn with
         # Set by _draw_scene: 1, 4 (into the fused resolve's single-sample stand-in, _Targets.single,
         # which _resolve then reads), 0 (none: a multisampled target).
         self._impostor_samples = 1
@@ -1394,11 +1413,23 @@ class ForwardRenderer:
                         # array after the last slot the variant reads.
                         used = transforms.transpose(0, 2, 1)[:member.array_length]
                         member.write(np.ascontiguousarray(used, dtype=np.float32).tobytes())
+                bound_maps = []
                 for name in MATERIAL_MAPS:
                     tex = gpu_part.textures.get(name) if maps_used else user.get(name)
                     _set(program, f"u_has_{name}_map", tex is not None)
                     if tex is not None:
                         tex.use(UNIT_MATERIAL[name])
+                        if tex.filter[0] in _ANISOTROPIC_FILTERS:
+                            bound_maps.append(tex)
+                if bound_maps:
+                    # Anisotropic filtering where this view gains from it (alight.core.texture_footprint),
+                    # not everywhere: on llvmpipe 8x costs a textured frame 2-5x.
+                    finest = max((t.size for t in bound_maps), key=lambda wh: wh[0] * wh[1])
+                    level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
+                    self.last_anisotropy[part.name] = level
+                    for tex in bound_maps:
+                        if tex.anisotropy != level:
+                            tex.anisotropy = level
                 if part.element.startswith("meshes["):
                     # A glTF primitive: the file decides (the default material is single-sided).
                     cull = not (part.material is not None and part.material.double_sided)
