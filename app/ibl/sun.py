@@ -61,16 +61,17 @@ def extract_suns(radiance: np.ndarray, max_count: int = MAX_SUNS) -> tuple[np.nd
 
     One copy of the map, one luminance image, updated in the few rows each source covers: the
     cost is a couple of passes over the map whatever the number of sources."""
-    radiance = np.array(radiance, copy=True)
     lum = radiance.mean(axis=2)
     h, w, _ = radiance.shape
     total = float((lum.sum(axis=1, dtype=np.float64) * _omega(h, w)).sum())
     suns: list[Sun] = []
     while len(suns) < max_count and total > 0.0:
-        sun = _take_sun(radiance, lum, total)
-        if sun is None:
+        found = _find_sun(radiance, lum, total)
+        if found is None:
             break
-        suns.append(sun)
+        if not suns:
+            radiance = np.array(radiance, copy=True)   # the caller's map is never changed
+        suns.append(_remove(radiance, lum, *found))
     return radiance, suns
 
 
@@ -81,14 +82,26 @@ def extract_sun(radiance: np.ndarray, total: float | None = None) -> tuple[np.nd
     lum = radiance.mean(axis=2)
     if total is None:
         total = float((lum.sum(axis=1, dtype=np.float64) * _omega(h, w)).sum())
+    found = _find_sun(radiance, lum, total)
+    if found is None:
+        return radiance, None
     without = np.array(radiance, copy=True)
-    sun = _take_sun(without, lum, total)
-    return (radiance, None) if sun is None else (without, sun)
+    return without, _remove(without, lum, *found)
 
 
-def _take_sun(radiance: np.ndarray, lum: np.ndarray, total: float) -> Sun | None:
-    """Remove the brightest compact source from ``radiance`` in place (and from its luminance
-    ``lum``), returning it; None, and nothing changed, if there is none worth taking."""
+def _remove(radiance: np.ndarray, lum: np.ndarray, sun: "Sun", r0: int, cone: np.ndarray,
+            excess: np.ndarray) -> "Sun":
+    """Take a found source's excess out of ``radiance`` rows r0.. in place, and out of ``lum``."""
+    band = radiance[r0:r0 + cone.shape[0]]     # a view: the map changes in place
+    band[cone] = band[cone] - excess
+    lum[r0:r0 + cone.shape[0]] = band.mean(axis=2)
+    return sun
+
+
+def _find_sun(radiance: np.ndarray, lum: np.ndarray, total: float):
+    """The brightest compact source of ``radiance`` (``lum``: its mean over RGB) as (Sun, its
+    first row, its cone mask over the rows from there, the excess radiance inside the cone);
+    None if there is none worth taking. Changes nothing."""
     h, w, _ = radiance.shape
     if h < _MIN_HEIGHT or total <= 0.0:
         return None
@@ -116,6 +129,5 @@ def _take_sun(radiance: np.ndarray, lum: np.ndarray, total: float) -> Sun | None
     direction = direction / np.linalg.norm(direction)
     angle = np.arccos(np.clip(np.einsum("ij,j->i", band_dirs[cone], direction), -1.0, 1.0))
     spread = float(np.sqrt((weights * angle * angle).sum() / max(float(weights.sum()), 1e-30)))
-    band[cone] = band[cone] - excess          # a view of rows r0..r1: radiance changes in place
-    lum[r0:r1] = band.mean(axis=2)
-    return Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()), spread)
+    sun = Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()), spread)
+    return sun, r0, cone, excess
