@@ -1419,11 +1419,13 @@ class ForwardRenderer:
                     _set(program, f"u_has_{name}_map", tex is not None)
                     if tex is not None:
                         tex.use(UNIT_MATERIAL[name])
-                        if tex.filter[0] in _ANISOTROPIC_FILTERS:
-                            bound_maps.append(tex)
+                        if tex.filter[0] in _ANISOTROPIC_FILTERS and tex.filter[1] != moderngl.NEAREST:
+                            bound_maps.append(tex)   # (a sampler's nearest magnification keeps 1: _MeshTextures)
                 if bound_maps:
                     # Anisotropic filtering where this view gains from it (alight.core.texture_footprint),
-                    # not everywhere: on llvmpipe 8x costs a textured frame 2-5x.
+                    # not everywhere: on llvmpipe 8x costs a textured frame 2-5x. Measured on
+                    # TEXCOORD_0 as the file gives it (not a TEXCOORD_1 map's uvs, nor the user
+                    # maps' tiling).
                     finest = max((t.size for t in bound_maps), key=lambda wh: wh[0] * wh[1])
                     level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
                     self.last_anisotropy[part.name] = level
