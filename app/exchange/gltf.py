@@ -36,7 +36,9 @@ from alight.core.mesh import (
     TextureInfo,
     TextureTransform,
     _normalize,
+    cross_rows,
     far_origin,
+    rows_times,
 )
 from alight.core.scene import Camera, Light
 from alight.errors import AlightError
@@ -441,7 +443,7 @@ class _Reader:
             uv1 = uv1[corner] if uv1 is not None else None
             colors = colors[corner] if colors is not None else None
             p = positions[faces]
-            face_n, ok = _normalize(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
+            face_n, ok = _normalize(cross_rows(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
             face_n[~ok] = (0.0, 1.0, 0.0)
             normals = np.repeat(face_n, 3, axis=0)
             tangents = None
@@ -578,10 +580,10 @@ class _Reader:
             faces = local.indices
             if det < 0:
                 faces, cof = faces[:, ::-1], -cof
-            normals, ok = _normalize(local.normals @ cof.T)
+            normals, ok = _normalize(rows_times(local.normals, cof))
             normals[~ok] = (0.0, 1.0, 0.0)
-            t_xyz, t_ok = _normalize(local.tangents[:, :3] @ m.T)
-            t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
+            t_xyz, t_ok = _normalize(rows_times(local.tangents[:, :3], m))
+            t_xyz = t_xyz - normals * np.einsum("ij,ij->i", normals, t_xyz)[:, None]
             t_xyz, t_ok = _normalize(t_xyz)
             if not t_ok.all():
                 axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
@@ -590,7 +592,7 @@ class _Reader:
             w = local.tangents[:, 3:4] * (1.0 if det >= 0 else -1.0)
             out.append(MeshPart(
                 name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
-                positions=np.ascontiguousarray(local.positions @ m.T + t, dtype=np.float32),
+                positions=np.ascontiguousarray(rows_times(local.positions, m) + t, dtype=np.float32),
                 normals=np.ascontiguousarray(normals, dtype=np.float32),
                 uvs=np.ascontiguousarray(local.uvs, dtype=np.float32),
                 tangents=np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32),

@@ -25,6 +25,7 @@ from alight.core.mesh import (
     cube,
     far_origin,
     plane,
+    rows_times,
     smooth_normals,
     sphere,
 )
@@ -187,7 +188,7 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
     m, t = transform[:3, :3].astype(np.float64), transform[:3, 3].astype(np.float64)
     cof = np.stack([np.cross(m[1], m[2]), np.cross(m[2], m[0]), np.cross(m[0], m[1])])
     det = float(np.dot(m[0], cof[0]))
-    positions = positions @ m.T + t
+    positions = rows_times(positions, m) + t
     if det < 0:
         faces = faces[:, ::-1]
         cof = -cof
@@ -195,7 +196,7 @@ def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,
     computed, computed_ok = _normalize(smooth_normals(positions, faces))
     normals = computed
     if file_normals is not None and np.shape(file_normals) == positions.shape:
-        from_file, file_ok = _normalize(np.asarray(file_normals, dtype=np.float64) @ cof.T)
+        from_file, file_ok = _normalize(rows_times(file_normals, cof))
         normals = np.where(file_ok[:, None], from_file, computed)
         computed_ok = computed_ok | file_ok
     normals[~computed_ok] = (0.0, 1.0, 0.0)

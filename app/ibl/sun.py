@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from alight.core.shading import texel_directions
+from alight.core.shading import equirect_uv_to_direction
 
 # The choices, in one place: a source is what lies within SUN_RADIUS_DEG of the brightest texel
 # above the surrounding sky; up to MAX_SUNS of them (shaders' MAX_SUNS) are taken out, brightest
@@ -41,24 +41,37 @@ class Sun:
 
 
 @functools.lru_cache(maxsize=4)
-def _directions(height: int, width: int):
-    dirs, omega = texel_directions(height, width)
-    return dirs.astype(np.float32), np.ascontiguousarray(omega, dtype=np.float32)
+def _omega(height: int, width: int) -> np.ndarray:
+    """(H,) float32: one texel's solid angle on each row (as alight.core.shading.texel_directions)."""
+    theta = (np.arange(height) + 0.5) / height * np.pi
+    return ((2.0 * np.pi / width) * (np.pi / height) * np.sin(theta)).astype(np.float32)
+
+
+def _band_directions(r0: int, r1: int, height: int, width: int) -> np.ndarray:
+    """(r1 - r0, W, 3) float32 texel-centre directions of rows r0..r1 only: the search looks at a
+    band a few degrees tall, so it never builds the whole map's (H, W, 3) directions."""
+    rows = (np.arange(r0, r1) + 0.5) / height
+    cols = (np.arange(width) + 0.5) / width
+    return equirect_uv_to_direction(np.stack(np.meshgrid(cols, rows), axis=-1)).astype(np.float32)
 
 
 def extract_suns(radiance: np.ndarray, max_count: int = MAX_SUNS) -> tuple[np.ndarray, list[Sun]]:
     """The radiance without its compact bright sources, and those sources (brightest first).
-    Power is conserved: the returned map's power plus the sources' equals the map's."""
+    Power is conserved: the returned map's power plus the sources' equals the map's.
+
+    One copy of the map, one luminance image, updated in the few rows each source covers: the
+    cost is a couple of passes over the map whatever the number of sources."""
+    lum = radiance.mean(axis=2)
     h, w, _ = radiance.shape
-    _, omega = _directions(h, w)
-    total = float((radiance.mean(axis=2) * omega).sum())
+    total = float((lum.sum(axis=1, dtype=np.float64) * _omega(h, w)).sum())
     suns: list[Sun] = []
     while len(suns) < max_count and total > 0.0:
-        without, sun = extract_sun(radiance, total)
-        if sun is None:
+        found = _find_sun(radiance, lum, total)
+        if found is None:
             break
-        radiance = without
-        suns.append(sun)
+        if not suns:
+            radiance = np.array(radiance, copy=True)   # the caller's map is never changed
+        suns.append(_remove(radiance, lum, *found))
     return radiance, suns
 
 
@@ -66,35 +79,55 @@ def extract_sun(radiance: np.ndarray, total: float | None = None) -> tuple[np.nd
     """The brightest compact source, if it holds SUN_MIN_POWER_FRACTION of ``total`` (default:
     this map's power): the radiance without it, and it; else the radiance unchanged and None."""
     h, w, _ = radiance.shape
-    if h < _MIN_HEIGHT:
-        return radiance, None
-    dirs, omega = _directions(h, w)
     lum = radiance.mean(axis=2)
     if total is None:
-        total = float((lum * omega).sum())
-    if total <= 0.0:
+        total = float((lum.sum(axis=1, dtype=np.float64) * _omega(h, w)).sum())
+    found = _find_sun(radiance, lum, total)
+    if found is None:
         return radiance, None
+    without = np.array(radiance, copy=True)
+    return without, _remove(without, lum, *found)
+
+
+def _remove(radiance: np.ndarray, lum: np.ndarray, sun: "Sun", r0: int, cone: np.ndarray,
+            excess: np.ndarray) -> "Sun":
+    """Take a found source's excess out of ``radiance`` rows r0.. in place, and out of ``lum``."""
+    band = radiance[r0:r0 + cone.shape[0]]     # a view: the map changes in place
+    band[cone] = band[cone] - excess
+    lum[r0:r0 + cone.shape[0]] = band.mean(axis=2)
+    return sun
+
+
+def _find_sun(radiance: np.ndarray, lum: np.ndarray, total: float):
+    """The brightest compact source of ``radiance`` (``lum``: its mean over RGB) as (Sun, its
+    first row, its cone mask over the rows from there, the excess radiance inside the cone);
+    None if there is none worth taking. Changes nothing."""
+    h, w, _ = radiance.shape
+    if h < _MIN_HEIGHT or total <= 0.0:
+        return None
+    omega_rows = _omega(h, w)
     peak = np.unravel_index(np.argmax(lum), lum.shape)
     # Only the rows within the ring's reach of the peak can hold the cone or the ring.
     reach = int(np.ceil(np.radians(SUN_RING_DEG[1]) / np.pi * h)) + 1
     r0, r1 = max(0, peak[0] - reach), min(h, peak[0] + reach + 1)
-    band, band_dirs, band_omega = radiance[r0:r1], dirs[r0:r1], omega[r0:r1]
-    cos_to_peak = band_dirs @ dirs[peak]
+    band, band_dirs = radiance[r0:r1], _band_directions(r0, r1, h, w)
+    band_omega = np.broadcast_to(omega_rows[r0:r1, None], band.shape[:2])
+    to_peak = band_dirs[peak[0] - r0, peak[1]]
+    cos_to_peak = band_dirs[..., 0] * to_peak[0] + band_dirs[..., 1] * to_peak[1] + band_dirs[..., 2] * to_peak[2]
     cone = cos_to_peak > np.cos(np.radians(SUN_RADIUS_DEG))
     ring = (cos_to_peak <= np.cos(np.radians(SUN_RING_DEG[0]))) & (cos_to_peak > np.cos(np.radians(SUN_RING_DEG[1])))
     if not ring.any():   # no sky around the peak to measure: nothing is compact at this resolution
-        return radiance, None
+        return None
     fill = (band[ring] * band_omega[ring, None]).sum(axis=0) / max(float(band_omega[ring].sum()), 1e-30)
     excess = np.maximum(band[cone] - fill, 0.0)
     power = (excess * band_omega[cone, None]).sum(axis=0)
     fraction = float(power.mean()) / total
     if fraction < SUN_MIN_POWER_FRACTION:
-        return radiance, None
+        return None
     weights = excess.mean(axis=1) * band_omega[cone]
     direction = (band_dirs[cone] * weights[:, None]).sum(axis=0)
     direction = direction / np.linalg.norm(direction)
-    angle = np.arccos(np.clip(band_dirs[cone] @ direction, -1.0, 1.0))
+    angle = np.arccos(np.clip(np.einsum("ij,j->i", band_dirs[cone], direction), -1.0, 1.0))
     spread = float(np.sqrt((weights * angle * angle).sum() / max(float(weights.sum()), 1e-30)))
-    without = radiance.copy()
-    without[r0:r1][cone] = band[cone] - excess
-    return without, Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()), spread)
+    sun = Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()), spread)
+    return sun, r0, cone, excess

@@ -66,6 +66,7 @@ from alight.core.sphere_lod import (
     projected_radius_px,
     sphere_segments,
 )
+from alight.core.texture_footprint import anisotropy_for_view, footprints
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.ibl.bake import (
@@ -184,16 +185,27 @@ class _GpuPart:
             columns.append(part.colors)
             self.layout[0] += " 4f"
             self.layout.append("in_color")
-        vertices = np.hstack([np.asarray(c, np.float32) for c in columns])
-        self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
-        self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
+        # Interleaved into one array and handed to GL as it is (no hstack of float64 copies, no
+        # tobytes() copy): the CPU side peaks at one vertex buffer's bytes, then lets it go.
+        widths = [np.shape(c)[1] for c in columns]
+        vertices = np.empty((len(part.positions), sum(widths)), np.float32)
+        at = 0
+        for column, width in zip(columns, widths):
+            vertices[:, at:at + width] = column
+            at += width
+        self.vbo = ctx.buffer(vertices)
+        del vertices
+        self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32))
         self.ctx = ctx
         # A vertex array belongs to one program: one per program this part is drawn with (the
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
         self.textures: dict[str, moderngl.Texture] = {}
         self.infos: dict = {}
-        self.closed = is_closed(part.positions, part.indices)
+        self._part = part
+        self._closed: bool | None = None
+        self._anisotropy_key = None
+        self._anisotropy = 1.0
         positions = np.asarray(part.positions, np.float64)
         self.lo = positions.min(axis=0) if len(positions) else np.zeros(3)    # bounding box corners
         self.hi = positions.max(axis=0) if len(positions) else np.zeros(3)
@@ -203,6 +215,28 @@ class _GpuPart:
             for name, info in fm.textures().items():
                 self.infos[name] = info
                 self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
+
+    @property
+    def closed(self) -> bool:
+        """Whether the part is closed (alight.core.mesh.is_closed), found on first use: only a
+        part without a glTF material's doubleSided needs to know (a 4M-triangle mesh's test
+        takes seconds)."""
+        if self._closed is None:
+            self._closed = is_closed(self._part.positions, self._part.indices)
+        return self._closed
+
+    def anisotropy(self, view_projection: np.ndarray, image_size: tuple[int, int],
+                   texture_size: tuple[int, int]) -> float:
+        """The anisotropic filtering level this view of the part gains from
+        (alight.core.texture_footprint), remembered for the last view asked."""
+        key = (np.asarray(view_projection, np.float32).tobytes(), tuple(image_size), tuple(texture_size))
+        if self._anisotropy_key != key:
+            part = self._part
+            area, p_max, p_min = footprints(part.positions, part.uvs, part.indices, view_projection,
+                                            image_size, texture_size)
+            self._anisotropy = anisotropy_for_view(area, p_max, p_min)
+            self._anisotropy_key = key
+        return self._anisotropy
 
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
@@ -219,6 +253,8 @@ class _GpuPart:
         self.ibo.release()
 
 
+_ANISOTROPIC_FILTERS = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR_MIPMAP_NEAREST,
+                        moderngl.NEAREST_MIPMAP_LINEAR, moderngl.NEAREST_MIPMAP_NEAREST)
 _MIN_FILTERS = {"nearest": moderngl.NEAREST, "linear": moderngl.LINEAR,
                 "nearest_mipmap_nearest": moderngl.NEAREST_MIPMAP_NEAREST,
                 "linear_mipmap_nearest": moderngl.LINEAR_MIPMAP_NEAREST,
@@ -404,6 +440,7 @@ class ForwardRenderer:
         self.background_ring = True
         self.last_background_ring = False   # whether the last scene pass drew it
         self.last_sphere_impostor: int | None = None   # the last mesh pass's coverage samples, or None
+        self.last_anisotropy: dict[str, float] = {}    # per textured part's name, the level it was last drawn with
         # Set by _draw_scene: 1, 4 (into the fused resolve's single-sample stand-in, _Targets.single,
         # which _resolve then reads), 0 (none: a multisampled target).
         self._impostor_samples = 1
@@ -1472,11 +1509,25 @@ class ForwardRenderer:
                         # array after the last slot the variant reads.
                         used = transforms.transpose(0, 2, 1)[:member.array_length]
                         member.write(np.ascontiguousarray(used, dtype=np.float32).tobytes())
+                bound_maps = []
                 for name in MATERIAL_MAPS:
                     tex = gpu_part.textures.get(name) if maps_used else user.get(name)
                     _set(program, f"u_has_{name}_map", tex is not None)
                     if tex is not None:
                         tex.use(UNIT_MATERIAL[name])
+                        if tex.filter[0] in _ANISOTROPIC_FILTERS and tex.filter[1] != moderngl.NEAREST:
+                            bound_maps.append(tex)   # (a sampler's nearest magnification keeps 1: _MeshTextures)
+                if bound_maps:
+                    # Anisotropic filtering where this view gains from it (alight.core.texture_footprint),
+                    # not everywhere: on llvmpipe 8x costs a textured frame 2-5x. Measured on
+                    # TEXCOORD_0 as the file gives it (not a TEXCOORD_1 map's uvs, nor the user
+                    # maps' tiling).
+                    finest = max((t.size for t in bound_maps), key=lambda wh: wh[0] * wh[1])
+                    level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
+                    self.last_anisotropy[part.name] = level
+                    for tex in bound_maps:
+                        if tex.anisotropy != level:
+                            tex.anisotropy = level
                 if part.element.startswith("meshes["):
                     # A glTF primitive: the file decides (the default material is single-sided).
                     cull = not (part.material is not None and part.material.double_sided)
