@@ -220,3 +220,6 @@ class Scene:
     # decoded images by path; parts shaded with a file's own material ignore them.
     texture_maps: "TextureMaps | None" = None
     texture_images: dict = field(default_factory=dict)
+    # Occlusion of the environment light by the mesh itself (alight.core.visibility): 'auto'
+    # bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in sphere.
+    occlusion: str = "auto"

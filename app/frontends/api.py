@@ -210,6 +210,16 @@ class Renderer:
             self.scene.multiple_scattering = bool(multiple_scattering)
         return self
 
+    def set_occlusion(self, mode: Literal["auto", "on", "off"]) -> "Renderer":
+        """Occlusion of the environment light by the mesh itself, with one diffuse bounce
+        (alight.core.visibility: a per-vertex ray-traced bake, cached like the IBL bake): 'auto'
+        (default) bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in
+        sphere, 'off' never. Raises AlightError for another mode."""
+        if mode not in ("auto", "on", "off"):
+            raise AlightError(f"occlusion: {mode!r} is not 'auto', 'on' or 'off'")
+        self.scene.occlusion = mode
+        return self
+
     def set_display(self, *, tonemap: str | None = None, exposure: float | None = None,
                     background: str | None = None) -> "Renderer":
         d = self.scene.display

@@ -264,6 +264,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scene_options(r)
     _add_camera_options(r)
     _add_bake_options(r, auto=True)
+    r.add_argument("--occlusion", choices=("auto", "on", "off"), default="auto",
+                   help="occlusion of the environment light and one diffuse bounce from a per-vertex "
+                        "ray-traced visibility bake (cached like the IBL bake): auto bakes it where the mesh "
+                        "can occlude itself (not for the built-in sphere or a convex mesh) (default: auto)")
     d = r.add_argument_group("image")
     d.add_argument("--size", type=_size, default=(1024, 1024), metavar="W|WxH", help="image size (default: 1024)")
     d.add_argument("--tonemap", choices=("none", "aces", "neutral"), default="aces",
@@ -509,7 +513,8 @@ def _render(args) -> int:
                   material_overrides=overrides, lights=lights, camera=camera, view=args.view,
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, ibl_model=args.ibl,
-                  multiple_scattering=args.multiple_scattering, display=display)
+                  multiple_scattering=args.multiple_scattering, display=display,
+                  occlusion=args.occlusion)
     loaded = time.perf_counter()
 
     from alight.exchange.output import image_rows_writer

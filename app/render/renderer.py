@@ -72,6 +72,7 @@ from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
+from alight.render.occlusion import OcclusionParts
 from alight.render.tiles import (
     TILE_BYTES,
     Tile,
@@ -175,6 +176,10 @@ class _GpuPart:
         self.vbo = ctx.buffer(np.ascontiguousarray(vertices).tobytes())
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
         self.ctx = ctx
+        # More per-vertex buffers, (buffer, format, *names), and whether they carry the visibility
+        # bake's values (alight.render.occlusion: HAS_VISIBILITY).
+        self.extra_buffers: list[tuple] = []
+        self.has_visibility = False
         # A vertex array belongs to one program: one per program this part is drawn with (the
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
@@ -195,7 +200,7 @@ class _GpuPart:
         vao = self._vaos.get(id(program))
         if vao is None:
             vao = self._vaos[id(program)] = self.ctx.vertex_array(
-                program, [(self.vbo, *self.layout)], self.ibo, index_element_size=4,
+                program, [(self.vbo, *self.layout), *self.extra_buffers], self.ibo, index_element_size=4,
                 skip_errors=True)  # a debug view may not read every attribute
         return vao
 
@@ -372,6 +377,8 @@ class ForwardRenderer:
         self.bake_cache = BakeCache() if bake_cache == "default" else bake_cache
         self.bakes_run = 0
         self.bakes_loaded = 0
+        # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.occlusion).
+        self.occlusion = OcclusionParts(self.ctx, self.bake_cache)
         self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
         self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
         self._transmission_lut: TransmissionLut | None = None
@@ -603,6 +610,7 @@ class ForwardRenderer:
             _release_mesh(entry)
         self._meshes.clear()
         self._sphere_lods.clear()
+        self.occlusion.release()
         if self._targets:
             self._targets.release()
             self._targets = None
@@ -1274,6 +1282,8 @@ class ForwardRenderer:
             present = set(user_maps)
         if gpu_part.has_colors and scene.use_file_materials:
             defines["HAS_VERTEX_COLOR"] = None
+        if gpu_part.has_visibility:
+            defines["HAS_VISIBILITY"] = None
         defines["MATERIAL_MAPS_MASK"] = sum(1 << i for i, name in enumerate(MATERIAL_MAPS) if name in present)
         # The layers this part's material uses, and only those (alight.core.layers).
         defines.update(layer_defines([ForwardRenderer._part_material(scene, part)[0]]))
@@ -1314,6 +1324,8 @@ class ForwardRenderer:
             sphere_radius = scene.mesh.lod_sphere[0]
             model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns
             self.last_sphere_impostor = self._impostor_samples
+        if callable(prog) and sphere_radius is None and proxy_model is None:
+            drawn = self._occluded_parts(scene, drawn)
         chosen = None if parts is None else set(parts)
         for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
             fm = part.material
@@ -1401,6 +1413,13 @@ class ForwardRenderer:
             if blend:
                 ctx.disable(moderngl.BLEND)
                 ctx.depth_mask = True
+
+    def _occluded_parts(self, scene: Scene, drawn: list[_GpuPart]) -> list[_GpuPart]:
+        """The mesh's parts refined and baked with visibility where ``scene.occlusion`` wants
+        them (alight.render.occlusion), else ``drawn``."""
+        textures = self._meshes[id(scene.mesh)][2]
+        return self.occlusion.parts_for(scene.mesh, scene.occlusion, drawn,
+                                        lambda part: _GpuPart(self.ctx, part, textures))
 
     @staticmethod
     def _part_material(scene: Scene, part) -> tuple[Material, bool]:
