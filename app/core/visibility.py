@@ -12,19 +12,21 @@ vertex gets
   radiance, albedo * V_hit * E(bent_hit)/pi (the hit's own occluded irradiance, one bounce). Its
   mean over all rays is stored as (direction, weight): ``bounce_weight`` = mean of V_hit over
   all rays (0 for the unoccluded ones) and ``bounce_direction`` = the V_hit-weighted mean of
-  bent_hit. The shader reads albedo * bounce_weight * E(bounce_direction)/pi: exact under a
-  uniform environment, and close elsewhere since E/pi is smooth (its first two SH bands are
-  linear in the direction). The hit's albedo is taken to be the shading point's (one material
-  per scene, as the test scenes and most product shots; docs/occl_notes.md).
+  bent_hit. The occluders' radiance is then hit albedo * w / (1 - V) * E(bounce_direction)/pi:
+  exact under a uniform environment, and close elsewhere since E/pi is smooth (its first two SH
+  bands are linear in the direction). It replaces the sky in the occluded directions of both the
+  diffuse and the specular lobe. The hit's albedo is taken to be the shading point's, diffuse
+  plus specular (one material per scene, as the test scenes and most product shots).
 
-A per-vertex bake needs vertices where the occlusion changes: ``refine_part`` first splits the
-part's triangles whose edges are longer than a fraction of the mesh's size (every attribute
-interpolated linearly, which the rasteriser does anyway, so the picture without occlusion is
-unchanged). Baked once per mesh content and settings and cached (``VisibilityCache``) like the
+A per-vertex bake needs vertices where the occlusion changes, and no more (llvmpipe pays per
+small triangle): the part's edges are split to a coarse size first, then again where V changes
+across them (``bake_visibility``), every attribute interpolated linearly, which the rasteriser does
+anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached (``VisibilityCache``) like the
 IBL bake. Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
-``specular_occlusion`` and ``occluded_diffuse`` here (tests/test_occlusion.py holds them equal).
+``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility`` and
+``occluded_environment`` here (tests/test_occlusion.py holds them equal).
 """
 
 from __future__ import annotations
@@ -42,9 +44,12 @@ from alight.errors import AlightError
 
 # Bake settings (all in the cache key).
 DEFAULT_RAYS = 192            # rays per vertex: V's noise is about sqrt(V(1-V)/N) <= 0.036
-DEFAULT_EDGE_FRACTION = 1.0 / 40.0   # refine edges longer than this times the bounding-box diagonal
-DEFAULT_MAX_VERTICES = 400_000       # refinement stops growing a mesh past this
-BAKE_VERSION = 1
+DEFAULT_BOUNCE_RAYS = 64      # rays per vertex for the bounce (a smooth mean: fewer suffice)
+DEFAULT_COARSE_FRACTION = 1.0 / 12.0  # first, edges split to this times the bounding-box diagonal
+DEFAULT_EDGE_FRACTION = 1.0 / 96.0    # then where V changes, down to this
+DEFAULT_THRESHOLD = 0.06              # ... by more than this across an edge
+DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
+BAKE_VERSION = 2
 OCCLUSION_MODES = ("auto", "on", "off")
 
 
@@ -129,12 +134,18 @@ def combined_visibility(visibility, occlusion_texture):
     return np.minimum(np.asarray(visibility, np.float64), np.asarray(occlusion_texture, np.float64))
 
 
-def occluded_diffuse(albedo, visibility, irradiance_bent, bounce_weight, irradiance_bounce):
-    """The diffuse IBL's incident term (E/pi per unit albedo, then times albedo): what arrives
-    unblocked, V * E(bent)/pi, plus the one bounce, albedo * w * E(bounce_direction)/pi."""
-    a = np.asarray(albedo, np.float64)
-    return a * (np.asarray(visibility)[..., None] * irradiance_bent
-                + a * np.asarray(bounce_weight)[..., None] * irradiance_bounce)
+def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
+                         hit_albedo, so, prefiltered):
+    """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
+    radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
+    and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
+    (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
+    hit albedo * w / (1 - V_baked) * E(bounce)/pi."""
+    v = np.asarray(visibility, np.float64)[..., None]
+    occluder = (np.minimum(hit_albedo, 1.0) * (np.asarray(bounce_weight, np.float64)
+                / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3))[..., None] * irradiance_bounce)
+    so = np.asarray(so, np.float64)[..., None]
+    return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 
 
 # ---- which meshes need it -----------------------------------------------------------------------
@@ -194,57 +205,55 @@ def _attributes(part) -> list[np.ndarray]:
     return [np.asarray(c, np.float64) for c in cols]
 
 
+def _split_step(data: np.ndarray, faces: np.ndarray, mark_edges) -> tuple[np.ndarray, np.ndarray, bool]:
+    """One step of red-green refinement: the edges ``mark_edges(unique_edges (E, 2)) -> (E,) bool``
+    picks are split at their midpoints (one shared vertex per edge, appended after ``data``'s
+    rows, every attribute interpolated linearly); a face with 1, 2 or 3 split edges becomes 2, 3
+    or 4 faces, so no T-junction remains. Returns (data, faces, whether anything was split)."""
+    edges = np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], axis=1)   # (F, 3, 2)
+    keys = np.sort(edges, axis=2).reshape(-1, 2)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1, 3)
+    marked = np.asarray(mark_edges(unique), bool)
+    if not marked.any():
+        return data, faces, False
+    mid_index = np.full(len(unique), -1, np.int64)
+    mid_index[marked] = len(data) + np.arange(marked.sum())
+    data = np.vstack([data, 0.5 * (data[unique[marked, 0]] + data[unique[marked, 1]])])
+    m = mid_index[inverse]                        # (F, 3): midpoint of edge (0-1, 1-2, 2-0) or -1
+    a, b, c = faces[:, 0], faces[:, 1], faces[:, 2]
+    count = (m >= 0).sum(axis=1)
+    full = count == 3
+    out = [np.column_stack([a, m[:, 0], m[:, 2]])[full], np.column_stack([m[:, 0], b, m[:, 1]])[full],
+           np.column_stack([m[:, 2], m[:, 1], c])[full], np.column_stack([m[:, 0], m[:, 1], m[:, 2]])[full],
+           faces[count == 0]]
+    for k in range(3):                            # one split edge k: (v_k, v_k+1) halves
+        one = (count == 1) & (m[:, k] >= 0)
+        v0, v1, v2 = faces[one, k], faces[one, (k + 1) % 3], faces[one, (k + 2) % 3]
+        out += [np.column_stack([v0, m[one, k], v2]), np.column_stack([m[one, k], v1, v2])]
+    for k in range(3):                            # two split edges: all but edge k
+        two = (count == 2) & (m[:, k] < 0)
+        v0, v1, v2 = faces[two, k], faces[two, (k + 1) % 3], faces[two, (k + 2) % 3]
+        m12, m20 = m[two, (k + 1) % 3], m[two, (k + 2) % 3]
+        out += [np.column_stack([m12, v2, m20]), np.column_stack([v0, v1, m12]), np.column_stack([v0, m12, m20])]
+    return data, np.vstack([o for o in out if len(o)]), True
+
+
 def refine_part(part, max_edge: float, max_vertices: int = DEFAULT_MAX_VERTICES):
-    """The part's triangles split at their edges' midpoints (1 to 4, shared midpoints, so no
-    cracks) while any edge is longer than ``max_edge``; a triangle whose edges are all short is
-    kept, and an edge split on one side only is split on the other too (the neighbour becomes 2
-    or 3 triangles: red-green refinement), so no T-junction remains. Every attribute is
-    interpolated linearly, as the rasteriser does. Returns (attributes list, indices (M, 3))."""
+    """The part's edges longer than ``max_edge`` split at their midpoints until none is
+    (``_split_step``), or the part has ``max_vertices``. Every attribute is interpolated
+    linearly, as the rasteriser does, so the picture without occlusion is unchanged.
+    Returns (data (N, W): the attributes side by side, widths, indices (M, 3))."""
     attrs = _attributes(part)
-    widths = [a.shape[1] for a in attrs]
     data = np.hstack(attrs)
     faces = np.asarray(part.indices, np.int64).reshape(-1, 3)
     while len(data) < max_vertices and len(faces):
         p = data[:, :3]
-        edges = np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], axis=1)   # (F, 3, 2)
-        lengths = np.linalg.norm(p[edges[..., 0]] - p[edges[..., 1]], axis=2)
-        split_face = (lengths > max_edge).any(axis=1)
-        if not split_face.any():
+        data, faces, split = _split_step(
+            data, faces, lambda e: np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1) > max_edge)
+        if not split:
             break
-        # Every edge of a split face is split; the neighbours' matching edges with it.
-        keys = np.sort(edges, axis=2).reshape(-1, 2)
-        unique, inverse = np.unique(keys, axis=0, return_inverse=True)
-        inverse = inverse.reshape(-1, 3)
-        marked = np.zeros(len(unique), bool)
-        marked[inverse[split_face].ravel()] = True
-        mid_index = np.full(len(unique), -1, np.int64)
-        mid_index[marked] = len(data) + np.arange(marked.sum())
-        mids = 0.5 * (data[unique[marked, 0]] + data[unique[marked, 1]])
-        data = np.vstack([data, mids])
-        m = mid_index[inverse]                        # (F, 3): midpoint of edge (0-1, 1-2, 2-0) or -1
-        a, b, c = faces[:, 0], faces[:, 1], faces[:, 2]
-        out = []
-        count = (m >= 0).sum(axis=1)
-        full = count == 3
-        out += [np.column_stack([a, m[:, 0], m[:, 2]])[full], np.column_stack([m[:, 0], b, m[:, 1]])[full],
-                np.column_stack([m[:, 2], m[:, 1], c])[full], np.column_stack([m[:, 0], m[:, 1], m[:, 2]])[full]]
-        out.append(faces[count == 0])
-        for k in range(3):                            # one split edge k: (v_k, v_k+1) halves
-            one = (count == 1) & (m[:, k] >= 0)
-            v0, v1, v2 = faces[one, k], faces[one, (k + 1) % 3], faces[one, (k + 2) % 3]
-            mk = m[one, k]
-            out += [np.column_stack([v0, mk, v2]), np.column_stack([mk, v1, v2])]
-        for k in range(3):                            # two split edges: all but edge k
-            two = (count == 2) & (m[:, k] < 0)
-            v0, v1, v2 = faces[two, k], faces[two, (k + 1) % 3], faces[two, (k + 2) % 3]
-            m12, m20 = m[two, (k + 1) % 3], m[two, (k + 2) % 3]
-            out += [np.column_stack([m12, v2, m20]), np.column_stack([v0, v1, m12]),
-                    np.column_stack([v0, m12, m20])]
-        faces = np.vstack([o for o in out if len(o)])
-    split = np.cumsum(widths)[:-1]
-    cols = np.split(data, split, axis=1)
-    cols[1] = cols[1] / np.maximum(np.linalg.norm(cols[1], axis=1, keepdims=True), 1e-30)
-    return cols, faces
+    return data, [a.shape[1] for a in attrs], faces
 
 
 # ---- the bake -------------------------------------------------------------------------------
@@ -309,95 +318,146 @@ def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2):
     return prim, u, v
 
 
+def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.ndarray:
+    """Where a vertex's rays start: eps off the surface along n, and nudged toward the vertex's own
+    faces: a vertex on a crease (the floor's corner, where two walls stand) would otherwise start
+    in the walls' planes, where a hit at t = 0 is a coin toss."""
+    centroid = np.zeros_like(p)
+    face_centroid = np.repeat(p[faces].mean(axis=1), 3, axis=0)
+    for k in range(3):
+        centroid[:, k] = np.bincount(faces.ravel(), face_centroid[:, k], minlength=len(p))
+    uses = np.bincount(faces.ravel(), minlength=len(p))[:, None]
+    toward = centroid / np.maximum(uses, 1) - p
+    reach = np.linalg.norm(toward, axis=1, keepdims=True)
+    nudge = toward / np.maximum(reach, 1e-30) * np.minimum(10.0 * eps, 0.5 * reach)
+    return (p + nudge + eps * n).astype(np.float32)
+
+
+class _Occluders:
+    """Embree's scene of triangles (T, 3, 3) and their unit normals."""
+
+    def __init__(self, triangles: np.ndarray):
+        rtcore_scene, TriangleMesh = _import_embree()
+        self.triangles = np.ascontiguousarray(triangles, np.float32)
+        self.scene = rtcore_scene.EmbreeScene()
+        self._mesh = TriangleMesh(scene=self.scene, vertices=self.triangles)
+        n = np.cross(self.triangles[:, 1] - self.triangles[:, 0], self.triangles[:, 2] - self.triangles[:, 0])
+        self.normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+
+    def hemisphere(self, origins, normals, rays: int, rng, eps: float):
+        """Cast ``rays`` cosine-weighted rays from each origin about its normal: (hit triangle
+        (N, R) or -1, Embree's u, v (N, R, 2), the unoccluded directions' sum (N, 3))."""
+        local = cosine_directions(rays).astype(np.float32)
+        count = len(origins)
+        hit = np.empty((count, rays), np.int32)
+        uv = np.empty((count, rays, 2), np.float32)
+        open_sum = np.zeros((count, 3), np.float64)
+        chunk = max(1, 262_144 // rays)
+        for s0 in range(0, count, chunk):
+            n = normals[s0:s0 + chunk]
+            t, b = _frame(n)
+            angle = rng.uniform(0.0, 2.0 * math.pi, len(n))
+            c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+            t, b = c * t + s * b, c * b - s * t
+            frame = np.stack([t, b, n], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
+            d = np.ascontiguousarray((local @ frame).reshape(-1, 3))         # (C * R, 3)
+            o = np.ascontiguousarray(np.repeat(origins[s0:s0 + chunk], rays, axis=0))
+            prim, u, v = _cast(self.scene, o, d, self.normals, eps)
+            hit[s0:s0 + chunk] = prim.reshape(len(n), rays)
+            uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
+            open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
+        return hit, uv, open_sum
+
+
 def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
-                    max_vertices: int = DEFAULT_MAX_VERTICES, seed: int = 0) -> MeshVisibility:
-    """Refine every part (``refine_part``) and cast ``rays`` cosine-weighted rays from each
-    vertex against all parts (Embree, float32). Seeded: the same mesh gives the same values."""
-    rtcore_scene, TriangleMesh = _import_embree()
+                    max_vertices: int = DEFAULT_MAX_VERTICES, seed: int = 0,
+                    coarse_fraction: float = DEFAULT_COARSE_FRACTION, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
+                    threshold: float = DEFAULT_THRESHOLD) -> MeshVisibility:
+    """Visibility per vertex, the mesh refined where it changes. Every part is first split to
+    edges of ``coarse_fraction`` of the bounding-box diagonal (``refine_part``); then, level by
+    level, ``rays`` cosine-weighted rays from each new vertex against the mesh (Embree, float32)
+    give V and the bent normal, and an edge is split where V differs by more than ``threshold``
+    across it (or the bent normals by more than 25 degrees) while it is longer than
+    ``edge_fraction`` of the diagonal. Last, ``bounce_rays`` rays from every vertex against the
+    refined mesh find what each sees for the bounce. Seeded: the same mesh gives the same values."""
     start = time.perf_counter()
     lo, hi = mesh.bounds()
     size = float(np.linalg.norm(hi - lo)) or 1.0
-    per_part_limit = max(max_vertices // max(len(mesh.parts), 1), 1000)
-    refined = [refine_part(p, edge_fraction * size, per_part_limit) for p in mesh.parts]
-    positions = [cols[0] for cols, _ in refined]
-    normals = [cols[1] for cols, _ in refined]
-    offsets = np.cumsum([0] + [len(p) for p in positions])
-    all_p = np.concatenate(positions)
-    all_n = np.concatenate(normals)
-    all_f = np.concatenate([f + o for (_, f), o in zip(refined, offsets[:-1])])
-    scene = rtcore_scene.EmbreeScene()
-    triangles = all_p[all_f].astype(np.float32)
-    _mesh = TriangleMesh(scene=scene, vertices=triangles)   # noqa: F841 (kept alive with the scene)
-    face_n = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    face_n /= np.maximum(np.linalg.norm(face_n, axis=1, keepdims=True), 1e-30)
-    # Rays start off the surface (eps along n) and nudged toward the vertex's own faces: a vertex
-    # on a crease (the floor's corner, where two walls stand) would otherwise start inside the
-    # walls' planes, where a hit at t = 0 is a coin toss.
-    centroid = np.zeros_like(all_p)
-    face_centroid = np.repeat(all_p[all_f].mean(axis=1), 3, axis=0)
-    for k in range(3):
-        centroid[:, k] = np.bincount(all_f.ravel(), face_centroid[:, k], minlength=len(all_p))
-    uses = np.bincount(all_f.ravel(), minlength=len(all_p))[:, None]
-    toward = centroid / np.maximum(uses, 1) - all_p
-    reach = np.linalg.norm(toward, axis=1, keepdims=True)
-    nudge = toward / np.maximum(reach, 1e-30) * np.minimum(10.0 * eps_of(size), 0.5 * reach)
-    origins = (all_p + nudge + eps_of(size) * all_n).astype(np.float32)
-    local = cosine_directions(rays).astype(np.float32)
-    rng = np.random.default_rng(seed)
-    count = len(all_p)
-    hit_face = np.empty((count, rays), np.int32)
-    hit_uv = np.empty((count, rays, 2), np.float32)
-    open_sum = np.zeros((count, 3), np.float64)
     eps = eps_of(size)
-    chunk = max(1, 262_144 // rays)
-    for s0 in range(0, count, chunk):
-        n = all_n[s0:s0 + chunk]
-        t, b = _frame(n)
-        angle = rng.uniform(0.0, 2.0 * math.pi, len(n))
-        c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-        t, b = c * t + s * b, c * b - s * t
-        frame = np.stack([t, b, n], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
-        d = np.ascontiguousarray((local @ frame).reshape(-1, 3))         # (C * R, 3)
-        o = np.ascontiguousarray(np.repeat(origins[s0:s0 + chunk], rays, axis=0))
-        prim, u, v = _cast(scene, o, d, face_n, eps)
-        hit_face[s0:s0 + chunk] = prim.reshape(len(n), rays)
-        hit_uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
-        open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
-    open_ = hit_face < 0
-    visibility = open_.mean(axis=1)
-    length = np.linalg.norm(open_sum, axis=1, keepdims=True)
-    bent = np.where(length > 1e-8, open_sum / np.maximum(length, 1e-30), all_n)
-    # The bounce: each hit's V and bent normal, interpolated over its triangle.
-    vertex_values = np.column_stack([bent, visibility]).astype(np.float32)    # (N, 4)
-    bounce_weight = np.zeros(count)
-    bounce_dir = np.zeros((count, 3))
-    for s0 in range(0, count, chunk):
-        hf = hit_face[s0:s0 + chunk]
-        rows, cols = np.nonzero(hf >= 0)
-        corners = all_f[hf[rows, cols]]                                    # (H, 3)
-        uv = hit_uv[s0:s0 + chunk][rows, cols]
-        w = np.column_stack([1.0 - uv[:, 0] - uv[:, 1], uv[:, 0], uv[:, 1]]).astype(np.float32)
-        at_hit = np.einsum("hk,hkc->hc", w, vertex_values[corners])          # (H, 4): bent, V
-        rows += s0
-        bounce_weight += np.bincount(rows, at_hit[:, 3], minlength=count)
-        for k in range(3):
-            bounce_dir[:, k] += np.bincount(rows, at_hit[:, k] * at_hit[:, 3], minlength=count)
-    bounce_weight /= rays
+    rng = np.random.default_rng(seed)
+    per_part_limit = max(max_vertices // max(len(mesh.parts), 1), 1000)
+    occluders = _Occluders(np.concatenate([np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)]
+                                           for p in mesh.parts]))
+    state = [refine_part(p, coarse_fraction * size, per_part_limit) for p in mesh.parts]
+    values = [np.zeros((0, 4)) for _ in state]        # per vertex: bent normal, V
+    cast = 0
+    fine = edge_fraction * size
+    cos_limit = math.cos(math.radians(25.0))
+    while True:
+        split_any = False
+        for i, (data, widths, faces) in enumerate(state):
+            known = len(values[i])
+            if known < len(data):
+                p, n = data[:, :3], data[:, 3:6] / np.maximum(np.linalg.norm(data[:, 3:6], axis=1, keepdims=True), 1e-30)
+                origins = _origins(p, n, faces, eps)[known:]
+                hit, _, open_sum = occluders.hemisphere(origins, n[known:].astype(np.float32), rays, rng, eps)
+                cast += hit.size
+                length = np.linalg.norm(open_sum, axis=1, keepdims=True)
+                bent = np.where(length > 1e-8, open_sum / np.maximum(length, 1e-30), n[known:])
+                values[i] = np.vstack([values[i], np.column_stack([bent, (hit < 0).mean(axis=1)])])
+            if len(data) >= per_part_limit:
+                continue
+            p, val = data[:, :3], values[i]
+
+            def mark(e, p=p, val=val):
+                long = np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1) > fine
+                dv = np.abs(val[e[:, 0], 3] - val[e[:, 1], 3]) > threshold
+                db = np.einsum("ij,ij->i", val[e[:, 0], :3], val[e[:, 1], :3]) < cos_limit
+                return long & (dv | db)
+
+            data, faces, split = _split_step(data, faces, mark)
+            state[i] = (data, widths, faces)
+            split_any |= split
+        if not split_any:
+            break
+    # The bounce: what each vertex's rays hit on the refined mesh, and the V and bent normal there.
+    offsets = np.cumsum([0] + [len(d) for d, _, _ in state])
+    all_p = np.concatenate([d[:, :3] for d, _, _ in state])
+    all_n = np.concatenate([d[:, 3:6] for d, _, _ in state])
+    all_n = all_n / np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
+    all_f = np.concatenate([f + o for (_, _, f), o in zip(state, offsets[:-1])])
+    all_values = np.concatenate(values).astype(np.float32)
+    refined = _Occluders(all_p[all_f])
+    origins = np.concatenate([_origins(d[:, :3], all_n[a:b], f, eps)
+                              for (d, _, f), a, b in zip(state, offsets[:-1], offsets[1:])])
+    hit, uv, _ = refined.hemisphere(origins, all_n.astype(np.float32), bounce_rays, rng, eps)
+    cast += hit.size
+    count = len(all_p)
+    rows, cols = np.nonzero(hit >= 0)
+    corners = all_f[hit[rows, cols]]                                        # (H, 3)
+    huv = uv[rows, cols]
+    w = np.column_stack([1.0 - huv[:, 0] - huv[:, 1], huv[:, 0], huv[:, 1]]).astype(np.float32)
+    at_hit = np.einsum("hk,hkc->hc", w, all_values[corners])                # (H, 4): bent, V
+    bounce_weight = np.bincount(rows, at_hit[:, 3], minlength=count) / bounce_rays
+    bounce_dir = np.column_stack([np.bincount(rows, at_hit[:, k] * at_hit[:, 3], minlength=count) for k in range(3)])
     length = np.linalg.norm(bounce_dir, axis=1, keepdims=True)
     bounce_dir = np.where(length > 1e-8, bounce_dir / np.maximum(length, 1e-30), -all_n)
     parts = []
-    for (cols, faces), part, a, b in zip(refined, mesh.parts, offsets[:-1], offsets[1:]):
-        extra = cols[4:]
+    for (data, widths, faces), part, val, a, b in zip(state, mesh.parts, values, offsets[:-1], offsets[1:]):
+        cols_ = np.split(data, np.cumsum(widths)[:-1], axis=1)
+        cols_[1] = cols_[1] / np.maximum(np.linalg.norm(cols_[1], axis=1, keepdims=True), 1e-30)
+        extra = cols_[4:]
         uvs1 = extra.pop(0) if part.uvs1 is not None else None
         colors = extra.pop(0) if part.colors is not None else None
         parts.append(PartVisibility(
-            positions=cols[0].astype(np.float32), normals=cols[1].astype(np.float32), uvs=cols[2].astype(np.float32),
-            tangents=cols[3].astype(np.float32), indices=faces.astype(np.uint32),
+            positions=cols_[0].astype(np.float32), normals=cols_[1].astype(np.float32),
+            uvs=cols_[2].astype(np.float32), tangents=cols_[3].astype(np.float32), indices=faces.astype(np.uint32),
             uvs1=None if uvs1 is None else uvs1.astype(np.float32),
             colors=None if colors is None else colors.astype(np.float32),
-            visibility=visibility[a:b].astype(np.float32), bent_normal=bent[a:b].astype(np.float32),
-            bounce_direction=bounce_dir[a:b].astype(np.float32), bounce_weight=bounce_weight[a:b].astype(np.float32)))
-    return MeshVisibility(parts, seconds=time.perf_counter() - start, rays=count * rays)
+            visibility=val[:, 3].astype(np.float32), bent_normal=val[:, :3].astype(np.float32),
+            bounce_direction=bounce_dir[a:b].astype(np.float32),
+            bounce_weight=bounce_weight[a:b].astype(np.float32)))
+    return MeshVisibility(parts, seconds=time.perf_counter() - start, rays=int(cast))
 
 
 # ---- the cache ----------------------------------------------------------------------------------
@@ -419,7 +479,9 @@ def mesh_digest(mesh) -> str:
 def visibility_key(mesh, rays: int, edge_fraction: float, max_vertices: int) -> tuple[str, dict]:
     """The cache key of a visibility bake and the description it hashes."""
     description = {"what": "visibility", "version": BAKE_VERSION, "mesh": mesh_digest(mesh), "rays": rays,
-                   "edge_fraction": edge_fraction, "max_vertices": max_vertices}
+                   "edge_fraction": edge_fraction, "max_vertices": max_vertices,
+                   "coarse_fraction": DEFAULT_COARSE_FRACTION, "bounce_rays": DEFAULT_BOUNCE_RAYS,
+                   "threshold": DEFAULT_THRESHOLD}
     text = json.dumps(description, sort_keys=True)
     return "alight-visibility-" + hashlib.sha256(text.encode()).hexdigest(), description
 

@@ -243,8 +243,9 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
 #else
     vec3 prefiltered = prefiltered_radiance_at(reflect(-v, n), s.roughness, true);
 #endif
-    prefiltered *= occluded_specular(s, n, reflect(-v, n));
-    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, occluded_irradiance(s, n, true), prefiltered);
+    vec3 irradiance = irradiance_at(n, true);
+    occlude_environment(s, n, reflect(-v, n), F * lut.x + lut.y, true, irradiance, prefiltered);
+    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance, prefiltered);
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
@@ -265,9 +266,10 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
 #else
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
 #endif
-    prefiltered *= occluded_specular(s, n, d);
+    vec3 irradiance = irradiance_at(n, with_suns);
+    occlude_environment(s, n, d, f0 * lut.x + lut.y, with_suns, irradiance, prefiltered);
     return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
-                       occluded_irradiance(s, n, with_suns), prefiltered);
+                       irradiance, prefiltered);
 }
 
 // The lecture's cook_torrance_IBL: kd and F from the roughness-aware Fresnel at n.v.

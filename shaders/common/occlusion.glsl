@@ -1,6 +1,6 @@
 // Occlusion of the environment light and one diffuse bounce, from the per-vertex visibility bake
-// (app/core/visibility.py; its numpy twins there: cone_aperture_cos, specular_occlusion,
-// combined_visibility, occluded_diffuse). Compiled only with HAS_VISIBILITY, which
+// (app/core/visibility.py; its numpy twins there: cone_aperture_cos, spherical_caps_intersection,
+// specular_occlusion, combined_visibility, occluded_environment). Compiled only with HAS_VISIBILITY, which
 // app/render/occlusion.py sets for a mesh that was baked: every other mesh reads the glTF
 // occlusion texture alone, exactly as before.
 
@@ -63,29 +63,32 @@ float combined_visibility(Surface s, vec3 n) {
 
 #endif
 
-// E/pi reaching the diffuse lobe: unoccluded, V E(bent)/pi, plus one bounce off the mesh,
-// albedo w E(bounce direction)/pi (the hit's albedo taken as this surface's); the compact sources
-// (with_suns) unoccluded here (shadows are theirs).
-vec3 occluded_irradiance(Surface s, vec3 n, bool with_suns) {
+// The environment's light as the mesh lets it through (HAS_VISIBILITY; else unchanged), given
+// the split sum's E/pi at n (irradiance) and its prefiltered radiance around r, and the
+// surface's specular albedo (the split sum's weight on the prefiltered radiance).
+// What the occluded directions see instead of the sky is the mesh: its radiance, one bounce, is
+// hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo taken as this surface's
+// (diffuse plus specular: a rough metal's walls light each other too).
+// Diffuse: V E(bent)/pi + (1 - V) times that; specular: the prefiltered radiance for the share of
+// the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
+// The compact sources (with_suns) stay unoccluded here (shadows are theirs).
+void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool with_suns,
+                         inout vec3 irradiance, inout vec3 prefiltered) {
 #ifdef HAS_VISIBILITY
+    bool baked = baked_side(n);
     float visibility = combined_visibility(s, n);
-    vec3 e = visibility * irradiance_at(bent_normal(n), false);
-    if (baked_side(n)) {
-        vec3 albedo = s.base_color * (1.0 - s.metallic);
-        e += albedo * v_bounce.w * irradiance_at(normalize(v_bounce.xyz), false);
+    float baked_visibility = baked ? v_visibility.w : 1.0;
+    vec3 bent = bent_normal(n);
+    vec3 occluder = vec3(0.0);
+    if (baked && v_bounce.w > 0.0) {
+        vec3 hit_albedo = min(s.base_color * (1.0 - s.metallic) + specular_albedo, vec3(1.0));
+        occluder = hit_albedo * (v_bounce.w / max(1.0 - baked_visibility, 1e-3))
+                   * irradiance_at(normalize(v_bounce.xyz), false);
     }
-    return with_suns ? e + suns_irradiance_over_pi(n) : e;
-#else
-    return irradiance_at(n, with_suns);
-#endif
-}
-
-// The factor on the prefiltered radiance fetched around direction r.
-float occluded_specular(Surface s, vec3 n, vec3 r) {
-#ifdef HAS_VISIBILITY
-    return specular_occlusion(dot(bent_normal(n), r), dot(n, r), combined_visibility(s, n), s.roughness);
-#else
-    return 1.0;
+    irradiance = visibility * irradiance_at(bent, false) + (1.0 - visibility) * occluder;
+    if (with_suns) irradiance += suns_irradiance_over_pi(n);
+    float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
+    prefiltered = so * prefiltered + (1.0 - so) * occluder;
 #endif
 }
 
