@@ -200,16 +200,17 @@ def test_the_render_reads_the_bake(corner_obj, corner_bake):
 
 def test_the_bake_is_cached(corner_obj, tmp_path):
     from alight.ibl.bake_cache import BakeCache
+    from alight.render.occlusion import cached_visibility
 
     mesh = load_mesh(str(corner_obj))
     cache = BakeCache(tmp_path / "cache")
-    first = vis.cached_visibility(mesh, cache, rays=32)
-    second = vis.cached_visibility(mesh, cache, rays=32)
+    first = cached_visibility(mesh, cache, rays=32)
+    second = cached_visibility(mesh, cache, rays=32)
     assert not first.from_cache and second.from_cache
     for a, b in zip(first.parts, second.parts):
         np.testing.assert_array_equal(a.visibility, b.visibility)
         np.testing.assert_array_equal(a.indices, b.indices)
-    third = vis.cached_visibility(mesh, cache, rays=48)   # other settings: another key
+    third = cached_visibility(mesh, cache, rays=48)   # other settings: another key
     assert not third.from_cache
     cache.close()
 

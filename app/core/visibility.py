@@ -21,8 +21,8 @@ vertex gets
 A per-vertex bake needs vertices where the occlusion changes, and no more (llvmpipe pays per
 small triangle): the part's edges are split to a coarse size first, then again where V changes
 across them (``bake_visibility``), every attribute interpolated linearly, which the rasteriser does
-anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached (``VisibilityCache``) like the
-IBL bake. Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
+anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached like the
+IBL bake (alight.render.occlusion.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility`` and
@@ -462,7 +462,7 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
 
 # ---- the cache ----------------------------------------------------------------------------------
 
-_FIELDS = ("positions", "normals", "uvs", "tangents", "indices", "uvs1", "colors",
+VISIBILITY_FIELDS = ("positions", "normals", "uvs", "tangents", "indices", "uvs1", "colors",
            "visibility", "bent_normal", "bounce_direction", "bounce_weight")
 
 
@@ -484,34 +484,6 @@ def visibility_key(mesh, rays: int, edge_fraction: float, max_vertices: int) -> 
                    "threshold": DEFAULT_THRESHOLD}
     text = json.dumps(description, sort_keys=True)
     return "alight-visibility-" + hashlib.sha256(text.encode()).hexdigest(), description
-
-
-def cached_visibility(mesh, cache=None, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
-                      max_vertices: int = DEFAULT_MAX_VERTICES) -> MeshVisibility:
-    """``bake_visibility``, through ``cache`` (an ``alight.ibl.bake_cache.BakeCache``; None: no
-    cache) keyed by the mesh's content and the bake settings (``visibility_key``)."""
-    from alight.ibl.bake_cache import BadEntry, decode_entry, encode_entry
-
-    key, description = visibility_key(mesh, rays, edge_fraction, max_vertices)
-    if cache is not None:
-        arrays = cache.load(key, description, "visibility bake")
-        if arrays is not None:
-            try:
-                parts = []
-                for i in range(len(mesh.parts)):
-                    values = {f: arrays.get(f"{i}.{f}") for f in _FIELDS}
-                    if any(values[f] is None for f in _FIELDS if f not in ("uvs1", "colors")):
-                        raise BadEntry("a part's arrays are missing")
-                    parts.append(PartVisibility(**values))
-                return MeshVisibility(parts, from_cache=True)
-            except BadEntry as exc:
-                cache.reject(key, "visibility bake", str(exc))
-    result = bake_visibility(mesh, rays, edge_fraction, max_vertices)
-    if cache is not None:
-        arrays = {f"{i}.{f}": getattr(p, f) for i, p in enumerate(result.parts) for f in _FIELDS
-                  if getattr(p, f) is not None}
-        cache.save(key, encode_entry(description, arrays))
-    return result
 
 
 def refined_mesh_part(part, vis: PartVisibility):

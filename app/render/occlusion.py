@@ -12,8 +12,36 @@ from __future__ import annotations
 
 import numpy as np
 
-from alight.core.visibility import (DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS, cached_visibility,
-                                    refined_mesh_part, wants_occlusion)
+from alight.core.visibility import (VISIBILITY_FIELDS, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
+                                    MeshVisibility, PartVisibility, bake_visibility, refined_mesh_part,
+                                    visibility_key, wants_occlusion)
+from alight.ibl.bake_cache import BadEntry, encode_entry
+
+
+def cached_visibility(mesh, cache=None, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
+                      max_vertices: int = DEFAULT_MAX_VERTICES) -> MeshVisibility:
+    """``bake_visibility``, through ``cache`` (an ``alight.ibl.bake_cache.BakeCache``; None: no
+    cache) keyed by the mesh's content and the bake settings (``visibility_key``)."""
+    key, description = visibility_key(mesh, rays, edge_fraction, max_vertices)
+    if cache is not None:
+        arrays = cache.load(key, description, "visibility bake")
+        if arrays is not None:
+            try:
+                parts = []
+                for i in range(len(mesh.parts)):
+                    values = {f: arrays.get(f"{i}.{f}") for f in VISIBILITY_FIELDS}
+                    if any(values[f] is None for f in VISIBILITY_FIELDS if f not in ("uvs1", "colors")):
+                        raise BadEntry("a part's arrays are missing")
+                    parts.append(PartVisibility(**values))
+                return MeshVisibility(parts, from_cache=True)
+            except BadEntry as exc:
+                cache.reject(key, "visibility bake", str(exc))
+    result = bake_visibility(mesh, rays, edge_fraction, max_vertices)
+    if cache is not None:
+        arrays = {f"{i}.{f}": getattr(p, f) for i, p in enumerate(result.parts) for f in VISIBILITY_FIELDS
+                  if getattr(p, f) is not None}
+        cache.save(key, encode_entry(description, arrays))
+    return result
 
 
 class OcclusionParts:
