@@ -46,9 +46,10 @@ from alight.errors import AlightError
 DEFAULT_RAYS = 192            # rays per vertex: V's noise is about sqrt(V(1-V)/N) <= 0.036
 DEFAULT_BOUNCE_RAYS = 64      # rays per vertex for the bounce (a smooth mean: fewer suffice)
 DEFAULT_COARSE_FRACTION = 1.0 / 12.0  # first, edges split to this times the bounding-box diagonal
-DEFAULT_EDGE_FRACTION = 1.0 / 96.0    # then where V changes, down to this
-DEFAULT_THRESHOLD = 0.06              # ... by more than this across an edge
+DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
+DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
+MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
 BAKE_VERSION = 2
 OCCLUSION_MODES = ("auto", "on", "off")
 
@@ -375,10 +376,10 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
                     threshold: float = DEFAULT_THRESHOLD) -> MeshVisibility:
     """Visibility per vertex, the mesh refined where it changes. Every part is first split to
     edges of ``coarse_fraction`` of the bounding-box diagonal (``refine_part``); then, level by
-    level, ``rays`` cosine-weighted rays from each new vertex against the mesh (Embree, float32)
-    give V and the bent normal, and an edge is split where V differs by more than ``threshold``
-    across it (or the bent normals by more than 25 degrees) while it is longer than
-    ``edge_fraction`` of the diagonal. Last, ``bounce_rays`` rays from every vertex against the
+    level (MAX_LEVELS at most), ``rays`` cosine-weighted rays from each new vertex against the
+    mesh (Embree, float32) give V and the bent normal, and an edge is split where V differs by more
+    than ``threshold`` across it (or the bent normals by more than 25 degrees) while it is longer
+    than ``edge_fraction`` of the diagonal. Last, ``bounce_rays`` rays from every vertex against the
     refined mesh find what each sees for the bounce. Seeded: the same mesh gives the same values."""
     start = time.perf_counter()
     lo, hi = mesh.bounds()
@@ -393,7 +394,7 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     cast = 0
     fine = edge_fraction * size
     cos_limit = math.cos(math.radians(25.0))
-    while True:
+    for level in range(MAX_LEVELS + 1):
         split_any = False
         for i, (data, widths, faces) in enumerate(state):
             known = len(values[i])
@@ -405,7 +406,7 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
                 length = np.linalg.norm(open_sum, axis=1, keepdims=True)
                 bent = np.where(length > 1e-8, open_sum / np.maximum(length, 1e-30), n[known:])
                 values[i] = np.vstack([values[i], np.column_stack([bent, (hit < 0).mean(axis=1)])])
-            if len(data) >= per_part_limit:
+            if len(data) >= per_part_limit or level == MAX_LEVELS:
                 continue
             p, val = data[:, :3], values[i]
 
