@@ -251,3 +251,19 @@ def test_cli_occlusion_flag(corner_obj, tmp_path):
     bad = _cli("render", "--mesh", corner_obj, "--occlusion", "sometimes", "--out", tmp_path / "x.png", cache=cache)
     assert bad.returncode == 2
     assert len(bad.stderr.strip().splitlines()) == 1 and "--occlusion" in bad.stderr
+
+
+def test_auto_without_embree_renders_and_says_so(corner_obj, monkeypatch, capsys):
+    """'auto' never stops a render: without embreex it draws without occlusion and warns once."""
+    import alight.render.occlusion as occlusion
+
+    monkeypatch.setattr(occlusion, "embree_available", lambda: False)
+    r = renderer()
+    maps = r.bake(constant_environment(1.0), "low")
+    mesh = load_mesh(str(corner_obj))
+    runs = r.occlusion.bakes_run + r.occlusion.bakes_loaded
+    scene = Scene(mesh=mesh, material=Material(), occlusion="auto")
+    r.render(scene, maps, 32, 32)
+    assert r.occlusion.bakes_run + r.occlusion.bakes_loaded == runs
+    err = capsys.readouterr().err
+    assert "without occlusion" in err and "embreex" in err and len(err.strip().splitlines()) == 1

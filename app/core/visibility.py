@@ -259,6 +259,15 @@ def refine_part(part, max_edge: float, max_vertices: int = DEFAULT_MAX_VERTICES)
 
 # ---- the bake -------------------------------------------------------------------------------
 
+def embree_available() -> bool:
+    """Whether Intel Embree's binding (embreex) imports."""
+    try:
+        _import_embree()
+    except AlightError:
+        return False
+    return True
+
+
 def _import_embree():
     try:
         from embreex import rtcore_scene

@@ -13,8 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from alight.core.visibility import (VISIBILITY_FIELDS, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
-                                    MeshVisibility, PartVisibility, bake_visibility, refined_mesh_part,
+                                    MeshVisibility, PartVisibility, bake_visibility, embree_available, refined_mesh_part,
                                     visibility_key, wants_occlusion)
+from alight.errors import warn
 from alight.ibl.bake_cache import BadEntry, encode_entry
 
 
@@ -72,6 +73,11 @@ class OcclusionParts:
         ``make_part(part)`` uploads a MeshPart (alight.render.renderer._GpuPart, the mesh's
         textures shared)."""
         if not self.wanted(mesh, mode):
+            return drawn
+        if mode == "auto" and not embree_available():
+            # 'auto' never stops a render: it says once what it drew without ('on' raises).
+            warn(f"{mesh.source}: rendered without occlusion of the environment light: the visibility bake "
+                 f"needs embreex (pip install embreex)")
             return drawn
         entry = self._parts.get(id(mesh))
         if entry is None or entry[0] is not mesh:
