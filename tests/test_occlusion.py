@@ -184,7 +184,7 @@ def test_the_render_reads_the_bake(corner_obj, corner_bake):
     for mode in ("off", "on"):
         scene = Scene(mesh=mesh, material=material, camera=camera, occlusion=mode)
         images[mode] = r.render(scene, maps, size, size, aa="none", read_linear=True, read_srgb=False).linear
-    assert r.occlusion.wanted(mesh, "on")
+    assert r.visibility_parts.wanted(mesh, "on")
     j, i = np.mgrid[0:size, 0:size]
     x = (2.0 * (i + 0.5) / size - 1.0).ravel()
     z = (2.0 * (j + 0.5) / size - 1.0).ravel()      # row 0 at the top: up is -z
@@ -200,7 +200,7 @@ def test_the_render_reads_the_bake(corner_obj, corner_bake):
 
 def test_the_bake_is_cached(corner_obj, tmp_path):
     from alight.ibl.bake_cache import BakeCache
-    from alight.render.occlusion import cached_visibility
+    from alight.render.visibility_parts import cached_visibility
 
     mesh = load_mesh(str(corner_obj))
     cache = BakeCache(tmp_path / "cache")
@@ -218,13 +218,13 @@ def test_the_bake_is_cached(corner_obj, tmp_path):
 def test_the_built_in_sphere_is_drawn_as_before():
     r = renderer()
     maps = r.bake(constant_environment(0.7), "low")
-    runs = r.occlusion.bakes_run
+    runs = r.visibility_parts.bakes_run
     mesh = load_mesh("sphere")
     frames = {}
     for mode in ("off", "auto", "on"):
         scene = Scene(mesh=mesh, material=Material(roughness=0.4), occlusion=mode)
         frames[mode] = r.render(scene, maps, 64, 64, read_linear=True, read_srgb=False).linear
-    assert r.occlusion.bakes_run == runs
+    assert r.visibility_parts.bakes_run == runs
     np.testing.assert_array_equal(frames["off"], frames["auto"])
     np.testing.assert_array_equal(frames["off"], frames["on"])
 
@@ -255,15 +255,15 @@ def test_cli_occlusion_flag(corner_obj, tmp_path):
 
 def test_auto_without_embree_renders_and_says_so(corner_obj, monkeypatch, capsys):
     """'auto' never stops a render: without embreex it draws without occlusion and warns once."""
-    import alight.render.occlusion as occlusion
+    import alight.render.visibility_parts as occlusion
 
     monkeypatch.setattr(occlusion, "embree_available", lambda: False)
     r = renderer()
     maps = r.bake(constant_environment(1.0), "low")
     mesh = load_mesh(str(corner_obj))
-    runs = r.occlusion.bakes_run + r.occlusion.bakes_loaded
+    runs = r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded
     scene = Scene(mesh=mesh, material=Material(), occlusion="auto")
     r.render(scene, maps, 32, 32)
-    assert r.occlusion.bakes_run + r.occlusion.bakes_loaded == runs
+    assert r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded == runs
     err = capsys.readouterr().err
     assert "without occlusion" in err and "embreex" in err and len(err.strip().splitlines()) == 1

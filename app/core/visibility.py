@@ -22,7 +22,7 @@ A per-vertex bake needs vertices where the occlusion changes, and no more (llvmp
 small triangle): the part's edges are split to a coarse size first, then again where V changes
 across them (``bake_visibility``), every attribute interpolated linearly, which the rasteriser does
 anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached like the
-IBL bake (alight.render.occlusion.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
+IBL bake (alight.render.visibility_parts.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility`` and

@@ -72,7 +72,7 @@ from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
-from alight.render.occlusion import OcclusionParts
+from alight.render.visibility_parts import OcclusionParts
 from alight.render.tiles import (
     TILE_BYTES,
     Tile,
@@ -177,7 +177,7 @@ class _GpuPart:
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32).tobytes())
         self.ctx = ctx
         # More per-vertex buffers, (buffer, format, *names), and whether they carry the visibility
-        # bake's values (alight.render.occlusion: HAS_VISIBILITY).
+        # bake's values (alight.render.visibility_parts: HAS_VISIBILITY).
         self.extra_buffers: list[tuple] = []
         self.has_visibility = False
         # A vertex array belongs to one program: one per program this part is drawn with (the
@@ -377,8 +377,8 @@ class ForwardRenderer:
         self.bake_cache = BakeCache() if bake_cache == "default" else bake_cache
         self.bakes_run = 0
         self.bakes_loaded = 0
-        # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.occlusion).
-        self.occlusion = OcclusionParts(self.ctx, self.bake_cache)
+        # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.visibility_parts).
+        self.visibility_parts = OcclusionParts(self.ctx, self.bake_cache)
         self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
         self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
         self._transmission_lut: TransmissionLut | None = None
@@ -610,7 +610,7 @@ class ForwardRenderer:
             _release_mesh(entry)
         self._meshes.clear()
         self._sphere_lods.clear()
-        self.occlusion.release()
+        self.visibility_parts.release()
         if self._targets:
             self._targets.release()
             self._targets = None
@@ -1416,9 +1416,9 @@ class ForwardRenderer:
 
     def _occluded_parts(self, scene: Scene, drawn: list[_GpuPart]) -> list[_GpuPart]:
         """The mesh's parts refined and baked with visibility where ``scene.occlusion`` wants
-        them (alight.render.occlusion), else ``drawn``."""
+        them (alight.render.visibility_parts), else ``drawn``."""
         textures = self._meshes[id(scene.mesh)][2]
-        return self.occlusion.parts_for(scene.mesh, scene.occlusion, drawn,
+        return self.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
                                         lambda part: _GpuPart(self.ctx, part, textures))
 
     @staticmethod

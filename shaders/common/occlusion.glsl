@@ -1,7 +1,7 @@
 // Occlusion of the environment light and one diffuse bounce, from the per-vertex visibility bake
 // (app/core/visibility.py; its numpy twins there: cone_aperture_cos, spherical_caps_intersection,
 // specular_occlusion, combined_visibility, occluded_environment). Compiled only with HAS_VISIBILITY, which
-// app/render/occlusion.py sets for a mesh that was baked: every other mesh reads the glTF
+// app/render/visibility_parts.py sets for a mesh that was baked: every other mesh reads the glTF
 // occlusion texture alone, exactly as before.
 
 // cos of the visibility cone's half-angle: a cone of half-angle a holds cosine-weighted
