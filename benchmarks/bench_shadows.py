@@ -58,7 +58,7 @@ def main() -> None:
         times = {k: [] for k in settings}
         for _ in range(args.rounds + 1):      # the first round warms programs and maps up
             for key, (mode, redraw) in settings.items():
-                scene = Scene(mesh=mesh, lights=[light], shadows=mode)
+                scene = Scene(mesh=mesh, lights=[light], shadows=mode, occlusion="off")
                 if redraw:
                     r.shadow_maps._key = None
                 t = time.perf_counter()
@@ -69,18 +69,6 @@ def main() -> None:
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {med['on'] / med['off']:.2f} | "
                      f"{med['on, maps redrawn'] / med['off']:.2f} |")
         print(lines[-1], flush=True)
-    # The per-vertex occlusion bake (alight.render.occlusion), once per mesh: timed on its own.
-    bakes = []
-    helmet = Scene(mesh=meshes["DamagedHelmet"], occlusion="on")
-    for _ in range(3):
-        r.occlusion_bake.release()
-        t = time.perf_counter()
-        r._vertex_occlusion(helmet)
-        bakes.append(time.perf_counter() - t)
-    lines += ["", f"Occlusion bake, DamagedHelmet ({len(helmet.mesh.parts)} part(s), "
-              f"{sum(len(p.positions) for p in helmet.mesh.parts)} vertices, 96 directions at 512 texels): "
-              f"{statistics.median(bakes):.2f} s median [{min(bakes):.2f}-{max(bakes):.2f}] of 3"]
-    print(lines[-1], flush=True)
     text = "\n".join(lines) + "\n"
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "shadows.md").write_text(text)

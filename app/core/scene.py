@@ -236,10 +236,12 @@ class Scene:
     display: Display = field(default_factory=Display)
     shadows: str = "auto"      # auto, on, off (alight.render.shadows: auto where something can be shadowed)
     ground: bool = False       # a shadow-catching ground under the model (alight.render.ground)
-    occlusion: str = "off"     # baked ambient occlusion: off, on, auto (alight.render.occlusion)
     debug_view: int = 0        # 0: shaded; else a DebugView (app/core/shader_names.py)
     debug_mip: float = 0.0     # the prefiltered mip shown by that debug view
     # User-loaded maps for ``material`` (app/core/texture_maps.py: paths and UV tiling) and their
     # decoded images by path; parts shaded with a file's own material ignore them.
     texture_maps: "TextureMaps | None" = None
     texture_images: dict = field(default_factory=dict)
+    # Occlusion of the environment light by the mesh itself (alight.core.visibility): 'auto'
+    # bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in sphere.
+    occlusion: str = "auto"

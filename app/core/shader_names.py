@@ -126,7 +126,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "ANISOTROPY_FETCHES": "the number of prefiltered fetches along the stretched anisotropic lobe",
     # Light that is blocked.
     "HAS_SHADOWS": "shadow maps are read for the lights and suns (app/render/shadows.py)",
-    "HAS_VERTEX_OCCLUSION": "the baked per-vertex ambient occlusion is read (app/render/occlusion.py)",
+    "HAS_VISIBILITY": "the visibility bake's per-vertex occlusion, bent normal and bounce are read "
+                      "(app/core/visibility.py, common/occlusion.glsl)",
     # Views and passes.
     "DEBUG_VIEW": "the editor's debug views are compiled in (u_debug_view picks one)",
     "SPHERE_IMPOSTOR": "the built-in sphere drawn as an impostor with this many samples a pixel",

@@ -220,9 +220,8 @@ class Renderer:
         only where something can be shadowed, never for a convex mesh such as the built-in
         sphere), 'on' or 'off' (alight.render.shadows). ``ground``: a shadow-catching ground under
         the model's bounding box (alight.render.ground): it darkens the background by the model's
-        shadow, or with background 'transparent' leaves the shadow in alpha. ``occlusion``: the
-        environment light's ambient occlusion baked per vertex, 'off' (the default), 'on' or
-        'auto' (alight.render.occlusion; never for a convex mesh)."""
+        shadow, or with background 'transparent' leaves the shadow in alpha. ``occlusion``: as
+        ``set_occlusion``."""
         if mode is not None:
             if mode not in ("auto", "on", "off"):
                 raise AlightError(f"shadows: {mode!r} is not one of auto, on, off")
@@ -230,9 +229,7 @@ class Renderer:
         if ground is not None:
             self.scene.ground = bool(ground)
         if occlusion is not None:
-            if occlusion not in ("auto", "on", "off"):
-                raise AlightError(f"occlusion: {occlusion!r} is not one of auto, on, off")
-            self.scene.occlusion = occlusion
+            self.set_occlusion(occlusion)
         return self
 
     def add_light(self, light: Light | str) -> "Renderer":
@@ -277,6 +274,16 @@ class Renderer:
         self.scene.ibl_model = model
         if multiple_scattering is not None:
             self.scene.multiple_scattering = bool(multiple_scattering)
+        return self
+
+    def set_occlusion(self, mode: Literal["auto", "on", "off"]) -> "Renderer":
+        """Occlusion of the environment light by the mesh itself, with one diffuse bounce
+        (alight.core.visibility: a per-vertex ray-traced bake, cached like the IBL bake): 'auto'
+        (default) bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in
+        sphere, 'off' never. Raises AlightError for another mode."""
+        if mode not in ("auto", "on", "off"):
+            raise AlightError(f"occlusion: {mode!r} is not 'auto', 'on' or 'off'")
+        self.scene.occlusion = mode
         return self
 
     def set_display(self, *, tonemap: str | None = None, exposure: float | None = None,

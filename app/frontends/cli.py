@@ -305,6 +305,10 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scene_options(r)
     _add_camera_options(r)
     _add_bake_options(r, auto=True)
+    r.add_argument("--occlusion", choices=("auto", "on", "off"), default="auto",
+                   help="occlusion of the environment light and one diffuse bounce from a per-vertex "
+                        "ray-traced visibility bake (cached like the IBL bake): auto bakes it where the mesh "
+                        "can occlude itself (not for the built-in sphere or a convex mesh) (default: auto)")
     d = r.add_argument_group("image")
     d.add_argument("--size", type=_size, default=_Size(1024, 1024, True), metavar="W|WxH",
                    help="image size; W alone is square, or with --camera gltf the camera's aspect ratio "
@@ -329,10 +333,6 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--shadows", choices=("auto", "on", "off"), default="auto",
                    help="shadow maps for the lights and the environment's suns: auto draws them only where "
                         "something can be shadowed (not for a convex mesh such as the built-in sphere) (default: auto)")
-    d.add_argument("--occlusion", choices=("auto", "on", "off"), default="off",
-                   help="ambient occlusion of the environment light, baked per vertex once per mesh and combined "
-                        "with a glTF occlusion map by their minimum: auto and on bake it where the mesh can "
-                        "occlude itself (not for a convex mesh) (default: off)")
     d.add_argument("--ground", action="store_true",
                    help="a ground under the model's bounding box that catches its shadow, composited over the "
                         "background (with --background transparent: the shadow in alpha)")

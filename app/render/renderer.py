@@ -84,8 +84,8 @@ from alight.ibl.anisotropy_lut import AnisotropyLut
 from alight.ibl.sun import MAX_SUNS
 from alight.ibl.transmission_lut import TransmissionLut
 from alight.render.ground import GroundPass
-from alight.render.occlusion import OcclusionBake
 from alight.render.shadows import ShadowMaps
+from alight.render.visibility_parts import OcclusionParts
 from alight.render.tiles import (
     TILE_BYTES,
     Tile,
@@ -197,6 +197,10 @@ class _GpuPart:
         del vertices
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32))
         self.ctx = ctx
+        # More per-vertex buffers, (buffer, format, *names), and whether they carry the visibility
+        # bake's values (alight.render.visibility_parts: HAS_VISIBILITY).
+        self.extra_buffers: list[tuple] = []
+        self.has_visibility = False
         # A vertex array belongs to one program: one per program this part is drawn with (the
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
@@ -242,7 +246,7 @@ class _GpuPart:
         vao = self._vaos.get(id(program))
         if vao is None:
             vao = self._vaos[id(program)] = self.ctx.vertex_array(
-                program, [(self.vbo, *self.layout)], self.ibo, index_element_size=4,
+                program, [(self.vbo, *self.layout), *self.extra_buffers], self.ibo, index_element_size=4,
                 skip_errors=True)  # a debug view may not read every attribute
         return vao
 
@@ -421,6 +425,8 @@ class ForwardRenderer:
         self.bake_cache = BakeCache() if bake_cache == "default" else bake_cache
         self.bakes_run = 0
         self.bakes_loaded = 0
+        # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.visibility_parts).
+        self.visibility_parts = OcclusionParts(self.ctx, self.bake_cache)
         self.anisotropy_lut = AnisotropyLut(self.ctx, self.shaders)   # baked on first anisotropic draw
         self._stretched_lobe: tuple[moderngl.Texture, moderngl.Texture] | None = None   # uploaded on first use
         self._transmission_lut: TransmissionLut | None = None
@@ -449,8 +455,6 @@ class ForwardRenderer:
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self._shadowed = False                    # set by _draw_scene: this pass reads the shadow maps
         self._ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
-        self.occlusion_bake = OcclusionBake(self.ctx, self.shaders, self.bake_cache)   # Scene.occlusion's per-vertex bake
-        self._occlusion_by_part: dict[int, moderngl.Buffer] = {}   # set by _draw_mesh: id(_GpuPart) -> buffer
         self._lights_ubo = self.ctx.buffer(reserve=MAX_LIGHTS * 64 + 16)
         self._lights_bytes = b""
         self._fullscreen_vaos: dict = {}   # by program id (and 'ring': _draw_background)
@@ -616,7 +620,6 @@ class ForwardRenderer:
         full-screen VAOs are rebuilt on the next draw; the bakes stay valid."""
         old, self.shaders = self.shaders, shaders
         self.luts.shaders = shaders
-        self.occlusion_bake.shaders = shaders
         for vao in self._fullscreen_vaos.values():
             vao.release()
         self._fullscreen_vaos.clear()
@@ -659,12 +662,12 @@ class ForwardRenderer:
             _release_mesh(entry)
         self._meshes.clear()
         self._sphere_lods.clear()
+        self.visibility_parts.release()
         if self._targets:
             self._targets.release()
             self._targets = None
         self.luts.release()
         self.shadow_maps.release()
-        self.occlusion_bake.release()
         if self._ground_pass is not None:
             self._ground_pass.release()
             self._ground_pass = None
@@ -875,7 +878,6 @@ class ForwardRenderer:
         else:
             self._impostor_samples = 0
         self._shadowed = self._prepare_shadows(scene, maps)    # (its own framebuffer: before this pass's)
-        self._occlusion_by_part = self._vertex_occlusion(scene)   # (baked on first use, likewise)
         fbo.use()
         ctx.viewport = (0, 0, width, height)
         if view.matrix is not None:     # a tile: the whole image's projection, off centre
@@ -934,7 +936,6 @@ class ForwardRenderer:
         self._display_output = None
         self._half_output = False
         self._impostor_model = None
-        self._occlusion_by_part = {}    # (buffers may be released with their mesh before the next pass)
 
     def _prepare_shadows(self, scene: Scene, maps: IBLMaps | None) -> bool:
         """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows);
@@ -954,26 +955,6 @@ class ForwardRenderer:
 
         bounds = GroundPass.ground_for(scene.mesh).bounds if ground else None
         return self.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts, bounds)
-
-    def _vertex_occlusion(self, scene: Scene) -> dict[int, moderngl.Buffer]:
-        """Scene.occlusion's baked buffers by id of the mesh's GPU parts (alight.render.occlusion),
-        or {} where it is off. 'auto' and 'on' alike skip a mesh that cannot shadow itself (a convex
-        solid sees the whole environment: its occlusion is 1 everywhere), so the built-in sphere's
-        stand-ins never need one."""
-        if scene.occlusion == "off" or scene.view == "probe" or scene.mesh is None or not scene.ibl_enabled:
-            return {}
-        if not self.shadow_maps.mesh_can_shadow_itself(scene.mesh):
-            return {}
-        own = self._gpu_mesh(scene.mesh)
-
-        def draw_parts(matrix: bytes, parts) -> None:
-            prog = self.program("render/shadow_depth.vert", "render/shadow_depth.frag")
-            prog["u_view_projection"].write(matrix)
-            for gpu_part in parts:
-                gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
-
-        buffers = self.occlusion_bake.buffers(scene.mesh, own, draw_parts)
-        return {id(g): b for g, b in zip(own, buffers)}
 
     def _draw_ground(self, scene: Scene, maps: IBLMaps | None, view_projection: np.ndarray) -> None:
         """Scene.ground's shadow catcher (alight.render.ground) into the bound framebuffer, after
@@ -1294,8 +1275,6 @@ class ForwardRenderer:
             defines["DEBUG_VIEW"] = None
         if self._shadowed:
             defines["HAS_SHADOWS"] = None
-        if self._occlusion_by_part:
-            defines["HAS_VERTEX_OCCLUSION"] = None
         bound: set[int] = set()
 
         def program_for(part_defines: dict) -> moderngl.Program:
@@ -1407,6 +1386,8 @@ class ForwardRenderer:
             present = set(user_maps)
         if gpu_part.has_colors and scene.use_file_materials:
             defines["HAS_VERTEX_COLOR"] = None
+        if gpu_part.has_visibility:
+            defines["HAS_VISIBILITY"] = None
         defines["MATERIAL_MAPS_MASK"] = map_mask(present & set(MATERIAL_MAPS))
         # The layers this part's material uses, and only those (alight.core.layers).
         defines.update(layer_defines([ForwardRenderer._part_material(scene, part)[0]]))
@@ -1447,6 +1428,8 @@ class ForwardRenderer:
             sphere_radius = scene.mesh.lod_sphere[0]
             model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns
             self.last_sphere_impostor = self._impostor_samples
+        if callable(prog) and sphere_radius is None and proxy_model is None:
+            drawn = self._occluded_parts(scene, drawn)
         chosen = None if parts is None else set(parts)
         for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
             fm = part.material
@@ -1537,9 +1520,6 @@ class ForwardRenderer:
                     # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
                     # behind (the shader flips n).
                     cull = gpu_part.closed
-                occlusion = self._occlusion_by_part.get(id(gpu_part))
-                if occlusion is not None:    # pbr.vert's VertexOcclusion (alight.render.occlusion)
-                    occlusion.bind_to_storage_buffer(2)
                 if cull:
                     ctx.front_face = "ccw"
                     ctx.enable(moderngl.CULL_FACE)
@@ -1551,6 +1531,13 @@ class ForwardRenderer:
             if blend:
                 ctx.disable(moderngl.BLEND)
                 ctx.depth_mask = True
+
+    def _occluded_parts(self, scene: Scene, drawn: list[_GpuPart]) -> list[_GpuPart]:
+        """The mesh's parts refined and baked with visibility where ``scene.occlusion`` wants
+        them (alight.render.visibility_parts), else ``drawn``."""
+        textures = self._meshes[id(scene.mesh)][2]
+        return self.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
+                                        lambda part: _GpuPart(self.ctx, part, textures))
 
     @staticmethod
     def _part_material(scene: Scene, part) -> tuple[Material, bool]:

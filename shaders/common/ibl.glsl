@@ -106,6 +106,9 @@ vec3 irradiance_at(vec3 n, bool with_suns) {
     return with_suns ? e + suns_irradiance_over_pi(n) : e;
 }
 
+// Occlusion of these lookups by the mesh itself (HAS_VISIBILITY; else they pass through).
+#include "common/occlusion.glsl"
+
 vec4 brdf_lut_at(float n_dot_v, float roughness) {
     return textureLod(u_brdf_lut, vec2(n_dot_v, roughness), 0.0);   // one level: no derivatives
 }
@@ -247,7 +250,9 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
 #else
     vec3 prefiltered = prefiltered_radiance_at(reflect(-v, n), s.roughness, true);
 #endif
-    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance_at(n, true), prefiltered);
+    vec3 irradiance = irradiance_at(n, true);
+    occlude_environment(s, n, reflect(-v, n), F * lut.x + lut.y, true, irradiance, prefiltered);
+    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance, prefiltered);
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
@@ -268,29 +273,31 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
 #else
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
 #endif
+    vec3 irradiance = irradiance_at(n, with_suns);
+    occlude_environment(s, n, d, f0 * lut.x + lut.y, with_suns, irradiance, prefiltered);
     return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
-                       irradiance_at(n, with_suns), prefiltered);
+                       irradiance, prefiltered);
 }
 
 // The lecture's cook_torrance_IBL: kd and F from the roughness-aware Fresnel at n.v.
 vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
     vec3 F = F_SchlickRoughness(max(dot(n, v), 0.0), surface_f0(s), s.roughness);
-    return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * s.occlusion;
+    return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * ibl_outer_occlusion(s);
 }
 
 // The lecture with plain Schlick at n.v for kd and F (the diffuse weight ignores roughness).
 vec3 ibl_lecture_schlick(Surface s, vec3 n, vec3 v) {
     vec3 F = F_Schlick(max(dot(n, v), 0.0), surface_f0(s));
-    return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * s.occlusion;
+    return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * ibl_outer_occlusion(s);
 }
 
 vec3 ibl_karis(Surface s, vec3 n, vec3 v) {
-    return layered_ibl(s, n, v, karis_split_sum(s, n, v, false, true), true) * s.occlusion;
+    return layered_ibl(s, n, v, karis_split_sum(s, n, v, false, true), true) * ibl_outer_occlusion(s);
 }
 
 // Karis' split fetched at the lobe's mean direction instead of R.
 vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
-    return layered_ibl(s, n, v, karis_split_sum(s, n, v, true, true), true) * s.occlusion;
+    return layered_ibl(s, n, v, karis_split_sum(s, n, v, true, true), true) * ibl_outer_occlusion(s);
 }
 
 // alight's model: ibl_dominant for the environment without its compact sources, and those
@@ -298,7 +305,7 @@ vec3 ibl_dominant(Surface s, vec3 n, vec3 v) {
 // too, where app/render/renderer.py binds the source cube without them).
 vec3 ibl_alight(Surface s, vec3 n, vec3 v) {
     vec3 suns = u_sun_count > 0 ? suns_exact(s, n, v) : vec3(0.0);
-    return (layered_ibl(s, n, v, karis_split_sum(s, n, v, true, false), false) + suns) * s.occlusion;
+    return (layered_ibl(s, n, v, karis_split_sum(s, n, v, true, false), false) + suns) * ibl_outer_occlusion(s);
 }
 
 // alight's model with the lobe's shape from two round fetches fitted to the real lobe in lobe

@@ -19,9 +19,6 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
-#ifdef HAS_VERTEX_OCCLUSION
-in float v_occlusion;    // baked per vertex (app/render/occlusion.py)
-#endif
 #ifdef HAS_UV1
 in vec2 v_uv1;
 #endif
@@ -309,11 +306,6 @@ Surface material_surface(vec3 n) {
     }
 #endif
     if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);
-#ifdef HAS_VERTEX_OCCLUSION
-    // Both are the visibility of the distant environment: the smaller one, never their product,
-    // which would count a blocker both see twice (alight.core.occlusion_bake).
-    s.occlusion = min(s.occlusion, v_occlusion);
-#endif
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)

@@ -1,6 +1,7 @@
 #version 450 core
 // Forward PBR pass: world-space position, normal and tangent for the fragment shader; the
-// second uv set (HAS_UV1) and vertex colours (HAS_VERTEX_COLOR) only for parts that have them.
+// second uv set (HAS_UV1), vertex colours (HAS_VERTEX_COLOR) and baked visibility (HAS_VISIBILITY)
+// only for parts that have them.
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
@@ -15,15 +16,17 @@ layout(location = 5) in vec4 in_color;
 out vec4 v_color;
 #endif
 
+#ifdef HAS_VISIBILITY
+// The visibility bake's per-vertex values (app/core/visibility.py), for common/occlusion.glsl.
+layout(location = 6) in vec4 in_visibility;
+layout(location = 7) in vec4 in_bounce;
+out vec4 v_visibility;
+out vec4 v_bounce;
+#endif
+
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_view_projection;
-
-#ifdef HAS_VERTEX_OCCLUSION
-// The part's baked ambient occlusion, one value per vertex (app/render/occlusion.py).
-layout(std430, binding = 2) readonly buffer VertexOcclusion { float vertex_occlusion[]; };
-out float v_occlusion;
-#endif
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -42,8 +45,9 @@ void main() {
 #ifdef HAS_VERTEX_COLOR
     v_color = in_color;
 #endif
-#ifdef HAS_VERTEX_OCCLUSION
-    v_occlusion = vertex_occlusion[gl_VertexID];
+#ifdef HAS_VISIBILITY
+    v_visibility = vec4(u_normal_matrix * in_visibility.xyz, in_visibility.w);
+    v_bounce = vec4(u_normal_matrix * in_bounce.xyz, in_bounce.w);
 #endif
     gl_Position = u_view_projection * world;
 }

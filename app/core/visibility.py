@@ -1,0 +1,502 @@
+"""Per-vertex visibility for still previews: ambient occlusion, bent normals and one diffuse bounce.
+
+For every vertex of a mesh part, cosine-weighted rays over the hemisphere of its normal are cast
+against the whole mesh with Intel Embree (``embreex``; 2-core figures in docs/occl_notes.md). Each
+vertex gets
+- ``visibility`` V: the cosine-weighted unoccluded fraction, (1/pi) * integral of V(l) (n.l) dl,
+  the ambient occlusion of the diffuse term;
+- ``bent_normal``: the mean unoccluded direction; with V it is the visibility cone of Jimenez et
+  al. 2016 ("Practical Real-Time Strategies for Accurate Indirect Occlusion"): a cone around the
+  bent normal holding cosine-weighted visibility V has cos(aperture) = sqrt(1 - V);
+- ``bounce``: one diffuse inter-reflection. A ray that hits the mesh sees the hit point's diffuse
+  radiance, albedo * V_hit * E(bent_hit)/pi (the hit's own occluded irradiance, one bounce). Its
+  mean over all rays is stored as (direction, weight): ``bounce_weight`` = mean of V_hit over
+  all rays (0 for the unoccluded ones) and ``bounce_direction`` = the V_hit-weighted mean of
+  bent_hit. The occluders' radiance is then hit albedo * w / (1 - V) * E(bounce_direction)/pi:
+  exact under a uniform environment, and close elsewhere since E/pi is smooth (its first two SH
+  bands are linear in the direction). It replaces the sky in the occluded directions of both the
+  diffuse and the specular lobe. The hit's albedo is taken to be the shading point's, diffuse
+  plus specular (one material per scene, as the test scenes and most product shots).
+
+A per-vertex bake needs vertices where the occlusion changes, and no more (llvmpipe pays per
+small triangle): the part's edges are split to a coarse size first, then again where V changes
+across them (``bake_visibility``), every attribute interpolated linearly, which the rasteriser does
+anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached like the
+IBL bake (alight.render.visibility_parts.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
+
+The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
+``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility`` and
+``occluded_environment`` here (tests/test_occlusion.py holds them equal).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from alight.errors import AlightError
+
+# Bake settings (all in the cache key).
+DEFAULT_RAYS = 192            # rays per vertex: V's noise is about sqrt(V(1-V)/N) <= 0.036
+DEFAULT_BOUNCE_RAYS = 64      # rays per vertex for the bounce (a smooth mean: fewer suffice)
+DEFAULT_COARSE_FRACTION = 1.0 / 12.0  # first, edges split to this times the bounding-box diagonal
+DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
+DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
+DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
+MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
+BAKE_VERSION = 2
+OCCLUSION_MODES = ("auto", "on", "off")
+
+
+@dataclass
+class PartVisibility:
+    """One part's refined geometry (world space, as MeshPart's fields) and its per-vertex
+    visibility: ``visibility`` (N,) in [0, 1]; ``bent_normal`` (N, 3) unit; ``bounce_direction``
+    (N, 3) unit; ``bounce_weight`` (N,) in [0, 1]."""
+
+    positions: np.ndarray
+    normals: np.ndarray
+    uvs: np.ndarray
+    tangents: np.ndarray
+    indices: np.ndarray
+    uvs1: np.ndarray | None
+    colors: np.ndarray | None
+    visibility: np.ndarray
+    bent_normal: np.ndarray
+    bounce_direction: np.ndarray
+    bounce_weight: np.ndarray
+
+    def vertex_data(self) -> np.ndarray:
+        """(N, 8) float32: bent normal and V, bounce direction and weight (pbr.vert's
+        in_visibility, in_bounce)."""
+        return np.ascontiguousarray(np.column_stack([self.bent_normal, self.visibility,
+                                                     self.bounce_direction, self.bounce_weight]), np.float32)
+
+
+@dataclass
+class MeshVisibility:
+    parts: list[PartVisibility]
+    seconds: float = 0.0          # the bake's wall time (0 when loaded from the cache)
+    rays: int = 0
+    from_cache: bool = False
+
+
+# ---- the shader's terms (numpy twins of shaders/common/occlusion.glsl) -------------------------
+
+def cone_aperture_cos(visibility):
+    """cos of the visibility cone's half-angle: a cone of half-angle a around the bent normal has
+    cosine-weighted visibility sin^2 a (Jimenez et al. 2016, section 5), so cos a = sqrt(1 - V)."""
+    return np.sqrt(np.clip(1.0 - np.asarray(visibility, np.float64), 0.0, 1.0))
+
+
+def spherical_caps_intersection(cos_cap1, cos_cap2, cos_distance):
+    """Solid angle / (2 pi) shared by two spherical caps (Oat and Sander 2007, "Ambient Aperture
+    Lighting"), with the smoothstep approximation Jimenez et al. 2016 use (as Filament's
+    ambient_occlusion.fs)."""
+    c1, c2, cd = (np.asarray(x, np.float64) for x in (cos_cap1, cos_cap2, cos_distance))
+    r1 = np.arccos(np.clip(c1, -1.0, 1.0))
+    r2 = np.arccos(np.clip(c2, -1.0, 1.0))
+    d = np.arccos(np.clip(cd, -1.0, 1.0))
+    small = 1.0 - np.maximum(c1, c2)
+    delta = np.abs(r1 - r2)
+    x = 1.0 - np.clip((d - delta) / np.maximum(r1 + r2 - delta, 1e-4), 0.0, 1.0)
+    area = x * x * (3.0 - 2.0 * x) * small
+    return np.where(np.minimum(r1, r2) <= np.maximum(r1, r2) - d, small, np.where(r1 + r2 <= d, 0.0, area))
+
+
+def specular_occlusion(bent_dot_r, n_dot_r, visibility, roughness):
+    """The share of the specular lobe inside the visibility cone (Jimenez et al. 2016, "specular
+    occlusion" by cone-cone intersection): the lobe as a cone around the reflected direction r with
+    cos(aperture) = 0.1^(alpha^2) (alpha = roughness^2, their fit to GGX), the visibility cone
+    around the bent normal as ``cone_aperture_cos``. Divided by what the open hemisphere of n
+    (V = 1) passes, since the split sum already holds the horizon: an unoccluded point keeps its
+    whole reflection. Faded in over alpha 0.01..0.09 as Filament does, so a near-mirror is not
+    switched off by a coarse cone. Arguments: bent.r, n.r, V, perceptual roughness (broadcast)."""
+    alpha = np.asarray(roughness, np.float64) ** 2
+    cos_as = np.exp2(-3.321928 * alpha * alpha)
+    inside = spherical_caps_intersection(cone_aperture_cos(visibility), cos_as, bent_dot_r)
+    open_ = spherical_caps_intersection(0.0, cos_as, n_dot_r)
+    so = np.clip(inside / np.maximum(open_, 1e-6), 0.0, 1.0)
+    t = np.clip((alpha - 0.01) / 0.08, 0.0, 1.0)
+    return 1.0 + (so - 1.0) * t * t * (3.0 - 2.0 * t)
+
+
+def combined_visibility(visibility, occlusion_texture):
+    """The diffuse visibility with a glTF occlusion texture: the smaller of the two. Both estimate
+    the same quantity for the same geometry (the texture is this mesh's own baked AO), so
+    multiplying would darken a crease twice; the minimum keeps the texture's finer detail where it
+    is darker and the ray-traced value where the texture misses an occluder (another part)."""
+    return np.minimum(np.asarray(visibility, np.float64), np.asarray(occlusion_texture, np.float64))
+
+
+def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
+                         hit_albedo, so, prefiltered):
+    """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
+    radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
+    and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
+    (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
+    hit albedo * w / (1 - V_baked) * E(bounce)/pi."""
+    v = np.asarray(visibility, np.float64)[..., None]
+    occluder = (np.minimum(hit_albedo, 1.0) * (np.asarray(bounce_weight, np.float64)
+                / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3))[..., None] * irradiance_bounce)
+    so = np.asarray(so, np.float64)[..., None]
+    return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
+
+
+# ---- which meshes need it -----------------------------------------------------------------------
+
+def self_occludes(parts, faces: int = 2000, vertices: int = 20000, tolerance: float = 1e-4) -> bool:
+    """Whether a face of the mesh can see another part of it: some vertex lies in front of some
+    face's plane (by more than ``tolerance`` times the mesh's size). False for a convex mesh and a
+    flat one, whose faces see only the sky. Up to ``faces`` faces against up to ``vertices``
+    vertices (seeded samples beyond those counts, for big meshes)."""
+    positions = np.concatenate([np.asarray(p.positions, np.float64) for p in parts])
+    if len(positions) < 4:
+        return False
+    size = float(np.linalg.norm(positions.max(axis=0) - positions.min(axis=0))) or 1.0
+    rng = np.random.default_rng(0)
+    centroids, normals = [], []
+    for p in parts:
+        tri = np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        length = np.linalg.norm(n, axis=1)
+        keep = length > 1e-12 * size * size
+        centroids.append(tri[keep].mean(axis=1))
+        normals.append(n[keep] / length[keep, None])
+    centroids = np.concatenate(centroids)
+    normals = np.concatenate(normals)
+    if len(centroids) > faces:
+        pick = rng.choice(len(centroids), faces, replace=False)
+        centroids, normals = centroids[pick], normals[pick]
+    if len(positions) > vertices:
+        positions = positions[rng.choice(len(positions), vertices, replace=False)]
+    for start in range(0, len(centroids), 256):
+        c, n = centroids[start:start + 256], normals[start:start + 256]
+        offset = np.einsum("ij,ij->i", c, n)
+        ahead = positions @ n.T - offset                  # (V, C): > 0 in front of the face
+        if (ahead > tolerance * size).any():
+            return True
+    return False
+
+
+def wants_occlusion(mesh, mode: str) -> bool:
+    """``mode`` 'on': bake unless the mesh is the built-in sphere; 'off': never; 'auto': where
+    the mesh occludes itself (``self_occludes``)."""
+    if mode not in OCCLUSION_MODES:
+        raise AlightError(f"--occlusion: '{mode}' is not one of {', '.join(OCCLUSION_MODES)}")
+    if mode == "off" or mesh is None or mesh.lod_sphere is not None:
+        return False
+    return mode == "on" or self_occludes(mesh.parts)
+
+
+# ---- refinement ----------------------------------------------------------------------------------
+
+def _attributes(part) -> list[np.ndarray]:
+    cols = [part.positions, part.normals, part.uvs, part.tangents]
+    if part.uvs1 is not None:
+        cols.append(part.uvs1)
+    if part.colors is not None:
+        cols.append(part.colors)
+    return [np.asarray(c, np.float64) for c in cols]
+
+
+def _split_step(data: np.ndarray, faces: np.ndarray, mark_edges) -> tuple[np.ndarray, np.ndarray, bool]:
+    """One step of red-green refinement: the edges ``mark_edges(unique_edges (E, 2)) -> (E,) bool``
+    picks are split at their midpoints (one shared vertex per edge, appended after ``data``'s
+    rows, every attribute interpolated linearly); a face with 1, 2 or 3 split edges becomes 2, 3
+    or 4 faces, so no T-junction remains. Returns (data, faces, whether anything was split)."""
+    edges = np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], axis=1)   # (F, 3, 2)
+    keys = np.sort(edges, axis=2).reshape(-1, 2)
+    unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1, 3)
+    marked = np.asarray(mark_edges(unique), bool)
+    if not marked.any():
+        return data, faces, False
+    mid_index = np.full(len(unique), -1, np.int64)
+    mid_index[marked] = len(data) + np.arange(marked.sum())
+    data = np.vstack([data, 0.5 * (data[unique[marked, 0]] + data[unique[marked, 1]])])
+    m = mid_index[inverse]                        # (F, 3): midpoint of edge (0-1, 1-2, 2-0) or -1
+    a, b, c = faces[:, 0], faces[:, 1], faces[:, 2]
+    count = (m >= 0).sum(axis=1)
+    full = count == 3
+    out = [np.column_stack([a, m[:, 0], m[:, 2]])[full], np.column_stack([m[:, 0], b, m[:, 1]])[full],
+           np.column_stack([m[:, 2], m[:, 1], c])[full], np.column_stack([m[:, 0], m[:, 1], m[:, 2]])[full],
+           faces[count == 0]]
+    for k in range(3):                            # one split edge k: (v_k, v_k+1) halves
+        one = (count == 1) & (m[:, k] >= 0)
+        v0, v1, v2 = faces[one, k], faces[one, (k + 1) % 3], faces[one, (k + 2) % 3]
+        out += [np.column_stack([v0, m[one, k], v2]), np.column_stack([m[one, k], v1, v2])]
+    for k in range(3):                            # two split edges: all but edge k
+        two = (count == 2) & (m[:, k] < 0)
+        v0, v1, v2 = faces[two, k], faces[two, (k + 1) % 3], faces[two, (k + 2) % 3]
+        m12, m20 = m[two, (k + 1) % 3], m[two, (k + 2) % 3]
+        out += [np.column_stack([m12, v2, m20]), np.column_stack([v0, v1, m12]), np.column_stack([v0, m12, m20])]
+    return data, np.vstack([o for o in out if len(o)]), True
+
+
+def refine_part(part, max_edge: float, max_vertices: int = DEFAULT_MAX_VERTICES):
+    """The part's edges longer than ``max_edge`` split at their midpoints until none is
+    (``_split_step``), or the part has ``max_vertices``. Every attribute is interpolated
+    linearly, as the rasteriser does, so the picture without occlusion is unchanged.
+    Returns (data (N, W): the attributes side by side, widths, indices (M, 3))."""
+    attrs = _attributes(part)
+    data = np.hstack(attrs)
+    faces = np.asarray(part.indices, np.int64).reshape(-1, 3)
+    while len(data) < max_vertices and len(faces):
+        p = data[:, :3]
+        data, faces, split = _split_step(
+            data, faces, lambda e: np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1) > max_edge)
+        if not split:
+            break
+    return data, [a.shape[1] for a in attrs], faces
+
+
+# ---- the bake -------------------------------------------------------------------------------
+
+def embree_available() -> bool:
+    """Whether Intel Embree's binding (embreex) imports."""
+    try:
+        _import_embree()
+    except AlightError:
+        return False
+    return True
+
+
+def _import_embree():
+    try:
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+    except ImportError:
+        raise AlightError("occlusion: the visibility bake needs Intel Embree's Python binding "
+                          "(pip install embreex), or use --occlusion off") from None
+    return rtcore_scene, TriangleMesh
+
+
+def _frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit tangents (N, 3) orthogonal to unit normals n (Duff et al. 2017's branchless basis)."""
+    sign = np.where(n[:, 2] >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t = np.column_stack([1.0 + sign * n[:, 0] ** 2 * a, sign * b, -sign * n[:, 0]])
+    s = np.column_stack([b, sign + n[:, 1] ** 2 * a, -n[:, 1]])
+    return t, s
+
+
+def cosine_directions(count: int) -> np.ndarray:
+    """(count, 3) cosine-weighted hemisphere directions about +Z from a Fibonacci lattice
+    (low discrepancy; every vertex uses the same set, turned by its own random angle)."""
+    i = np.arange(count) + 0.5
+    r = np.sqrt(i / count)
+    phi = i * math.pi * (3.0 - math.sqrt(5.0))
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(1.0 - r * r, 0.0))])
+
+
+def eps_of(size: float) -> float:
+    """The rays' offset off the surface, for a mesh of bounding-box diagonal ``size``."""
+    return 1e-4 * size
+
+
+def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2):
+    """First hits (triangle index, -1 for none; Embree's barycentric u, v). A ray that starts on
+    or just behind a triangle (its own, or a wall its vertex stands against) and leaves through
+    it in the direction of its normal hits it at t ~ 0: such hits are skipped by casting again
+    from just past them."""
+    out = scene.run(origins, dirs, output=1)
+    prim = np.where(np.asarray(out["geomID"]) < 0, -1, np.asarray(out["primID"])).astype(np.int32)
+    tfar = np.asarray(out["tfar"], np.float32)
+    u = np.asarray(out["u"], np.float32).copy()
+    v = np.asarray(out["v"], np.float32).copy()
+    for _ in range(retries):
+        hit = prim >= 0
+        self_hit = np.zeros(len(prim), bool)
+        self_hit[hit] = (tfar[hit] < 4.0 * eps) & (np.einsum("ij,ij->i", dirs[hit], face_normals[prim[hit]]) > 0.0)
+        if not self_hit.any():
+            break
+        again = np.nonzero(self_hit)[0]
+        o2 = np.ascontiguousarray(origins[again] + dirs[again] * (tfar[again, None] + eps))
+        out = scene.run(o2, np.ascontiguousarray(dirs[again]), output=1)
+        prim[again] = np.where(np.asarray(out["geomID"]) < 0, -1, np.asarray(out["primID"]))
+        tfar[again] = np.asarray(out["tfar"], np.float32) + tfar[again] + eps
+        u[again] = out["u"]
+        v[again] = out["v"]
+    return prim, u, v
+
+
+def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.ndarray:
+    """Where a vertex's rays start: eps off the surface along n, and nudged toward the vertex's own
+    faces: a vertex on a crease (the floor's corner, where two walls stand) would otherwise start
+    in the walls' planes, where a hit at t = 0 is a coin toss."""
+    centroid = np.zeros_like(p)
+    face_centroid = np.repeat(p[faces].mean(axis=1), 3, axis=0)
+    for k in range(3):
+        centroid[:, k] = np.bincount(faces.ravel(), face_centroid[:, k], minlength=len(p))
+    uses = np.bincount(faces.ravel(), minlength=len(p))[:, None]
+    toward = centroid / np.maximum(uses, 1) - p
+    reach = np.linalg.norm(toward, axis=1, keepdims=True)
+    nudge = toward / np.maximum(reach, 1e-30) * np.minimum(10.0 * eps, 0.5 * reach)
+    return (p + nudge + eps * n).astype(np.float32)
+
+
+class _Occluders:
+    """Embree's scene of triangles (T, 3, 3) and their unit normals."""
+
+    def __init__(self, triangles: np.ndarray):
+        rtcore_scene, TriangleMesh = _import_embree()
+        self.triangles = np.ascontiguousarray(triangles, np.float32)
+        self.scene = rtcore_scene.EmbreeScene()
+        self._mesh = TriangleMesh(scene=self.scene, vertices=self.triangles)
+        n = np.cross(self.triangles[:, 1] - self.triangles[:, 0], self.triangles[:, 2] - self.triangles[:, 0])
+        self.normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+
+    def hemisphere(self, origins, normals, rays: int, rng, eps: float):
+        """Cast ``rays`` cosine-weighted rays from each origin about its normal: (hit triangle
+        (N, R) or -1, Embree's u, v (N, R, 2), the unoccluded directions' sum (N, 3))."""
+        local = cosine_directions(rays).astype(np.float32)
+        count = len(origins)
+        hit = np.empty((count, rays), np.int32)
+        uv = np.empty((count, rays, 2), np.float32)
+        open_sum = np.zeros((count, 3), np.float64)
+        chunk = max(1, 262_144 // rays)
+        for s0 in range(0, count, chunk):
+            n = normals[s0:s0 + chunk]
+            t, b = _frame(n)
+            angle = rng.uniform(0.0, 2.0 * math.pi, len(n))
+            c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+            t, b = c * t + s * b, c * b - s * t
+            frame = np.stack([t, b, n], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
+            d = np.ascontiguousarray((local @ frame).reshape(-1, 3))         # (C * R, 3)
+            o = np.ascontiguousarray(np.repeat(origins[s0:s0 + chunk], rays, axis=0))
+            prim, u, v = _cast(self.scene, o, d, self.normals, eps)
+            hit[s0:s0 + chunk] = prim.reshape(len(n), rays)
+            uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
+            open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
+        return hit, uv, open_sum
+
+
+def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
+                    max_vertices: int = DEFAULT_MAX_VERTICES, seed: int = 0,
+                    coarse_fraction: float = DEFAULT_COARSE_FRACTION, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
+                    threshold: float = DEFAULT_THRESHOLD) -> MeshVisibility:
+    """Visibility per vertex, the mesh refined where it changes. Every part is first split to
+    edges of ``coarse_fraction`` of the bounding-box diagonal (``refine_part``); then, level by
+    level (MAX_LEVELS at most), ``rays`` cosine-weighted rays from each new vertex against the
+    mesh (Embree, float32) give V and the bent normal, and an edge is split where V differs by more
+    than ``threshold`` across it (or the bent normals by more than 25 degrees) while it is longer
+    than ``edge_fraction`` of the diagonal. Last, ``bounce_rays`` rays from every vertex against the
+    refined mesh find what each sees for the bounce. Seeded: the same mesh gives the same values."""
+    start = time.perf_counter()
+    lo, hi = mesh.bounds()
+    size = float(np.linalg.norm(hi - lo)) or 1.0
+    eps = eps_of(size)
+    rng = np.random.default_rng(seed)
+    per_part_limit = max(max_vertices // max(len(mesh.parts), 1), 1000)
+    occluders = _Occluders(np.concatenate([np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)]
+                                           for p in mesh.parts]))
+    state = [refine_part(p, coarse_fraction * size, per_part_limit) for p in mesh.parts]
+    values = [np.zeros((0, 4)) for _ in state]        # per vertex: bent normal, V
+    cast = 0
+    fine = edge_fraction * size
+    cos_limit = math.cos(math.radians(25.0))
+    for level in range(MAX_LEVELS + 1):
+        split_any = False
+        for i, (data, widths, faces) in enumerate(state):
+            known = len(values[i])
+            if known < len(data):
+                p, n = data[:, :3], data[:, 3:6] / np.maximum(np.linalg.norm(data[:, 3:6], axis=1, keepdims=True), 1e-30)
+                origins = _origins(p, n, faces, eps)[known:]
+                hit, _, open_sum = occluders.hemisphere(origins, n[known:].astype(np.float32), rays, rng, eps)
+                cast += hit.size
+                length = np.linalg.norm(open_sum, axis=1, keepdims=True)
+                bent = np.where(length > 1e-8, open_sum / np.maximum(length, 1e-30), n[known:])
+                values[i] = np.vstack([values[i], np.column_stack([bent, (hit < 0).mean(axis=1)])])
+            if len(data) >= per_part_limit or level == MAX_LEVELS:
+                continue
+            p, val = data[:, :3], values[i]
+
+            def mark(e, p=p, val=val):
+                long = np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1) > fine
+                dv = np.abs(val[e[:, 0], 3] - val[e[:, 1], 3]) > threshold
+                db = np.einsum("ij,ij->i", val[e[:, 0], :3], val[e[:, 1], :3]) < cos_limit
+                return long & (dv | db)
+
+            data, faces, split = _split_step(data, faces, mark)
+            state[i] = (data, widths, faces)
+            split_any |= split
+        if not split_any:
+            break
+    # The bounce: what each vertex's rays hit on the refined mesh, and the V and bent normal there.
+    offsets = np.cumsum([0] + [len(d) for d, _, _ in state])
+    all_p = np.concatenate([d[:, :3] for d, _, _ in state])
+    all_n = np.concatenate([d[:, 3:6] for d, _, _ in state])
+    all_n = all_n / np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
+    all_f = np.concatenate([f + o for (_, _, f), o in zip(state, offsets[:-1])])
+    all_values = np.concatenate(values).astype(np.float32)
+    refined = _Occluders(all_p[all_f])
+    origins = np.concatenate([_origins(d[:, :3], all_n[a:b], f, eps)
+                              for (d, _, f), a, b in zip(state, offsets[:-1], offsets[1:])])
+    hit, uv, _ = refined.hemisphere(origins, all_n.astype(np.float32), bounce_rays, rng, eps)
+    cast += hit.size
+    count = len(all_p)
+    rows, cols = np.nonzero(hit >= 0)
+    corners = all_f[hit[rows, cols]]                                        # (H, 3)
+    huv = uv[rows, cols]
+    w = np.column_stack([1.0 - huv[:, 0] - huv[:, 1], huv[:, 0], huv[:, 1]]).astype(np.float32)
+    at_hit = np.einsum("hk,hkc->hc", w, all_values[corners])                # (H, 4): bent, V
+    bounce_weight = np.bincount(rows, at_hit[:, 3], minlength=count) / bounce_rays
+    bounce_dir = np.column_stack([np.bincount(rows, at_hit[:, k] * at_hit[:, 3], minlength=count) for k in range(3)])
+    length = np.linalg.norm(bounce_dir, axis=1, keepdims=True)
+    bounce_dir = np.where(length > 1e-8, bounce_dir / np.maximum(length, 1e-30), -all_n)
+    parts = []
+    for (data, widths, faces), part, val, a, b in zip(state, mesh.parts, values, offsets[:-1], offsets[1:]):
+        cols_ = np.split(data, np.cumsum(widths)[:-1], axis=1)
+        cols_[1] = cols_[1] / np.maximum(np.linalg.norm(cols_[1], axis=1, keepdims=True), 1e-30)
+        extra = cols_[4:]
+        uvs1 = extra.pop(0) if part.uvs1 is not None else None
+        colors = extra.pop(0) if part.colors is not None else None
+        parts.append(PartVisibility(
+            positions=cols_[0].astype(np.float32), normals=cols_[1].astype(np.float32),
+            uvs=cols_[2].astype(np.float32), tangents=cols_[3].astype(np.float32), indices=faces.astype(np.uint32),
+            uvs1=None if uvs1 is None else uvs1.astype(np.float32),
+            colors=None if colors is None else colors.astype(np.float32),
+            visibility=val[:, 3].astype(np.float32), bent_normal=val[:, :3].astype(np.float32),
+            bounce_direction=bounce_dir[a:b].astype(np.float32),
+            bounce_weight=bounce_weight[a:b].astype(np.float32)))
+    return MeshVisibility(parts, seconds=time.perf_counter() - start, rays=int(cast))
+
+
+# ---- the cache ----------------------------------------------------------------------------------
+
+VISIBILITY_FIELDS = ("positions", "normals", "uvs", "tangents", "indices", "uvs1", "colors",
+           "visibility", "bent_normal", "bounce_direction", "bounce_weight")
+
+
+def mesh_digest(mesh) -> str:
+    """sha256 of the mesh's geometry (every part's vertex attributes and indices, in order)."""
+    h = hashlib.sha256()
+    for part in mesh.parts:
+        for a in _attributes(part) + [np.asarray(part.indices, np.int64)]:
+            h.update(str(a.shape).encode())
+            h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def visibility_key(mesh, rays: int, edge_fraction: float, max_vertices: int) -> tuple[str, dict]:
+    """The cache key of a visibility bake and the description it hashes."""
+    description = {"what": "visibility", "version": BAKE_VERSION, "mesh": mesh_digest(mesh), "rays": rays,
+                   "edge_fraction": edge_fraction, "max_vertices": max_vertices,
+                   "coarse_fraction": DEFAULT_COARSE_FRACTION, "bounce_rays": DEFAULT_BOUNCE_RAYS,
+                   "threshold": DEFAULT_THRESHOLD}
+    text = json.dumps(description, sort_keys=True)
+    return "alight-visibility-" + hashlib.sha256(text.encode()).hexdigest(), description
+
+
+def refined_mesh_part(part, vis: PartVisibility):
+    """A MeshPart with the refined geometry of ``vis`` and ``part``'s material, name and element."""
+    return dataclasses.replace(part, positions=vis.positions, normals=vis.normals, uvs=vis.uvs,
+                               tangents=vis.tangents, indices=vis.indices, uvs1=vis.uvs1, colors=vis.colors)

@@ -1,0 +1,34 @@
+#version 450 core
+// Evaluates the occlusion functions of common/occlusion.glsl per row of inputs (tests/gpu.py's
+// evaluate, with shader="accuracy/evaluate_occlusion.comp"), for tests/test_occlusion.py to
+// compare with their numpy twins (app/core/visibility.py). Not used for rendering.
+#include "common/shading.glsl"
+
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer Inputs { vec4 u_inputs[]; };
+layout(std430, binding = 1) writeonly buffer Outputs { vec4 u_outputs[]; };
+uniform int u_count;
+uniform int u_term;
+
+const int TERM_CAPS_INTERSECTION = 0;   // (cos cap 1, cos cap 2, cos distance)
+const int TERM_CONE_APERTURE = 1;       // (V)
+const int TERM_SPECULAR_OCCLUSION = 2;  // (bent.r, n.r, V, roughness)
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= uint(u_count)) return;
+    vec4 a = u_inputs[i];
+    vec4 o = vec4(0.0);
+    switch (u_term) {
+        case TERM_CAPS_INTERSECTION:
+            o.x = spherical_caps_intersection(a.x, a.y, a.z);
+            break;
+        case TERM_CONE_APERTURE:
+            o.x = cone_aperture_cos(a.x);
+            break;
+        case TERM_SPECULAR_OCCLUSION:
+            o.x = specular_occlusion(a.x, a.y, a.z, a.w);
+            break;
+    }
+    u_outputs[i] = o;
+}

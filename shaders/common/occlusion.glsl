@@ -1,0 +1,103 @@
+// Occlusion of the environment light and one diffuse bounce, from the per-vertex visibility bake
+// (app/core/visibility.py; its numpy twins there: cone_aperture_cos, spherical_caps_intersection,
+// specular_occlusion, combined_visibility, occluded_environment). Compiled only with HAS_VISIBILITY, which
+// app/render/visibility_parts.py sets for a mesh that was baked: every other mesh reads the glTF
+// occlusion texture alone, exactly as before.
+
+// cos of the visibility cone's half-angle: a cone of half-angle a holds cosine-weighted
+// visibility sin^2 a (Jimenez et al. 2016, "Practical Real-Time Strategies for Accurate Indirect
+// Occlusion"), so cos a = sqrt(1 - V).
+float cone_aperture_cos(float visibility) {
+    return sqrt(clamp(1.0 - visibility, 0.0, 1.0));
+}
+
+// Solid angle / (2 pi) two caps share (Oat and Sander 2007), with the smoothstep of Jimenez et
+// al. 2016 (as Filament's ambient_occlusion.fs sphericalCapsIntersection).
+float spherical_caps_intersection(float cos_cap1, float cos_cap2, float cos_distance) {
+    float r1 = acos(clamp(cos_cap1, -1.0, 1.0));
+    float r2 = acos(clamp(cos_cap2, -1.0, 1.0));
+    float d = acos(clamp(cos_distance, -1.0, 1.0));
+    float small = 1.0 - max(cos_cap1, cos_cap2);
+    if (min(r1, r2) <= max(r1, r2) - d) return small;
+    if (r1 + r2 <= d) return 0.0;
+    float delta = abs(r1 - r2);
+    float x = 1.0 - clamp((d - delta) / max(r1 + r2 - delta, 1e-4), 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x) * small;
+}
+
+// The share of the specular lobe around direction r inside the visibility cone (Jimenez et al.
+// 2016, cone-cone specular occlusion): the lobe's cone has cos(aperture) = 0.1^(alpha^2), the
+// visibility cone's axis is the bent normal. Relative to what the open hemisphere of n passes
+// (the cone of V = 1 around n), whose horizon the split sum already holds, so an unoccluded point
+// keeps exactly its reflection; faded in over alpha 0.01..0.09 as Filament does, so a near-mirror
+// is not switched off by a coarse cone. Arguments: bent.r, n.r, V, perceptual roughness.
+float specular_occlusion(float bent_dot_r, float n_dot_r, float visibility, float roughness) {
+    float alpha = roughness * roughness;
+    float cos_as = exp2(-3.321928 * alpha * alpha);
+    float inside = spherical_caps_intersection(cone_aperture_cos(visibility), cos_as, bent_dot_r);
+    float open = spherical_caps_intersection(0.0, cos_as, n_dot_r);
+    float so = clamp(inside / max(open, 1e-6), 0.0, 1.0);
+    return mix(1.0, so, smoothstep(0.01, 0.09, alpha));
+}
+#ifdef HAS_VISIBILITY
+in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
+in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
+
+// The baked values at this fragment, or none (V = 1) where the shading normal n faces away from
+// the side that was baked (an open mesh seen from behind: its bent normal lies in the front
+// hemisphere).
+bool baked_side(vec3 n) {
+    return dot(n, v_visibility.xyz) > 0.0;
+}
+
+vec3 bent_normal(vec3 n) {
+    return baked_side(n) ? normalize(v_visibility.xyz) : n;
+}
+
+// The diffuse visibility with the glTF occlusion texture (s.occlusion): the smaller of the two,
+// not the product. The texture is this mesh's own baked AO, so the same crease would otherwise
+// be darkened twice; the minimum keeps the texture's finer detail where it is darker.
+float combined_visibility(Surface s, vec3 n) {
+    return min(baked_side(n) ? v_visibility.w : 1.0, s.occlusion);
+}
+
+#endif
+
+// The environment's light as the mesh lets it through (HAS_VISIBILITY; else unchanged), given
+// the split sum's E/pi at n (irradiance) and its prefiltered radiance around r, and the
+// surface's specular albedo (the split sum's weight on the prefiltered radiance).
+// What the occluded directions see instead of the sky is the mesh: its radiance, one bounce, is
+// hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo taken as this surface's
+// (diffuse plus specular: a rough metal's walls light each other too).
+// Diffuse: V E(bent)/pi + (1 - V) times that; specular: the prefiltered radiance for the share of
+// the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
+// The compact sources (with_suns) stay unoccluded here (shadows are theirs).
+void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool with_suns,
+                         inout vec3 irradiance, inout vec3 prefiltered) {
+#ifdef HAS_VISIBILITY
+    bool baked = baked_side(n);
+    float visibility = combined_visibility(s, n);
+    float baked_visibility = baked ? v_visibility.w : 1.0;
+    vec3 bent = bent_normal(n);
+    vec3 occluder = vec3(0.0);
+    if (baked && v_bounce.w > 0.0) {
+        vec3 hit_albedo = min(s.base_color * (1.0 - s.metallic) + specular_albedo, vec3(1.0));
+        occluder = hit_albedo * (v_bounce.w / max(1.0 - baked_visibility, 1e-3))
+                   * irradiance_at(normalize(v_bounce.xyz), false);
+    }
+    irradiance = visibility * irradiance_at(bent, false) + (1.0 - visibility) * occluder;
+    if (with_suns) irradiance += suns_irradiance_over_pi(n);
+    float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
+    prefiltered = so * prefiltered + (1.0 - so) * occluder;
+#endif
+}
+
+// What multiplies the whole IBL result (layers too): the occlusion texture alone without a bake;
+// with one it is already in the base's terms above.
+float ibl_outer_occlusion(Surface s) {
+#ifdef HAS_VISIBILITY
+    return 1.0;
+#else
+    return s.occlusion;
+#endif
+}

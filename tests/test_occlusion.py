@@ -1,0 +1,269 @@
+"""The visibility bake (alight.core.visibility) and the forward pass's occlusion (--occlusion):
+analytic visibility at the foot of a wall, the corner darker than the open floor, the shader's
+functions against their numpy twins, the render against the bake's values, the cache, the
+built-in sphere untouched, and the command line."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("embreex")
+trimesh = pytest.importorskip("trimesh")
+
+from alight.core import visibility as vis  # noqa: E402
+from alight.core.material import Material  # noqa: E402
+from alight.core.scene import Camera, Scene  # noqa: E402
+from alight.exchange.meshes import load_mesh  # noqa: E402
+from alight.ibl.environment import constant_environment  # noqa: E402
+from tests.gpu import evaluate, renderer  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _quad(a, b, c, d):
+    return np.array([a, b, c, d], np.float64), np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def _flat_obj(quads, path: Path) -> Path:
+    """Quads (counter-clockwise seen from the front) as an OBJ with face normals, written by trimesh."""
+    verts, faces, normals, base = [], [], [], 0
+    for v, f in quads:
+        n = np.cross(v[1] - v[0], v[2] - v[0])
+        verts.append(v)
+        faces.append(f + base)
+        normals.append(np.repeat((n / np.linalg.norm(n))[None], len(v), axis=0))
+        base += len(v)
+    mesh = trimesh.Trimesh(np.concatenate(verts), np.concatenate(faces), vertex_normals=np.concatenate(normals),
+                           process=False)
+    path.write_text(mesh.export(file_type="obj", include_normals=True, include_texture=False))
+    return path
+
+
+def _box_quads(lo, hi):
+    x0, y0, z0 = lo
+    x1, y1, z1 = hi
+    return [_quad((x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)),
+            _quad((x1, y0, z0), (x0, y0, z0), (x0, y1, z0), (x1, y1, z0)),
+            _quad((x1, y0, z1), (x1, y0, z0), (x1, y1, z0), (x1, y1, z1)),
+            _quad((x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)),
+            _quad((x0, y1, z1), (x1, y1, z1), (x1, y1, z0), (x0, y1, z0))]
+
+
+@pytest.fixture(scope="module")
+def corner_obj(tmp_path_factory) -> Path:
+    """Floor y = 0 over [-1, 1]^2, walls at z = -1 and x = -1 (1.2 high), a 0.6 box near the corner."""
+    quads = [_quad((-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1)),
+             _quad((-1, 0, -1), (1, 0, -1), (1, 1.2, -1), (-1, 1.2, -1)),
+             _quad((-1, 0, 1), (-1, 0, -1), (-1, 1.2, -1), (-1, 1.2, 1)),
+             *_box_quads((-0.55, 0.0, -0.55), (0.05, 0.7, 0.05))]
+    return _flat_obj(quads, tmp_path_factory.mktemp("corner") / "corner.obj")
+
+
+@pytest.fixture(scope="module")
+def corner_bake(corner_obj):
+    mesh = load_mesh(str(corner_obj))
+    return mesh, vis.bake_visibility(mesh)
+
+
+def test_foot_of_an_infinite_wall_matches_the_form_factor(tmp_path):
+    """A floor point at distance d from a wall of height H (infinitely long) sees the wall with
+    form factor (1 - d / sqrt(d^2 + H^2)) / 2 (the 2D strip rule F = (sin a2 - sin a1) / 2 with the
+    wall's edges at 90 degrees and atan(d / H) from the normal), so its cosine-weighted visibility
+    is 1/2 + d / (2 sqrt(d^2 + H^2)): 1/2 at the foot for any height. The wall here is 40 long, so
+    the missing ends change V by under 0.002 at d <= 1."""
+    height = 1.0
+    quads = [_quad((0, 0, 1), (2, 0, 1), (2, 0, -1), (0, 0, -1)),                   # floor, x >= 0
+             _quad((0, 0, 20), (0, 0, -20), (0, height, -20), (0, height, 20))]     # wall x = 0, facing +x
+    mesh = load_mesh(str(_flat_obj(quads, tmp_path / "wall.obj")))
+    assert vis.self_occludes(mesh.parts)
+    baked = vis.bake_visibility(mesh, rays=256, coarse_fraction=1.0 / 500.0, threshold=1.0)
+    floor = baked.parts[0]
+    p = floor.positions
+    on_floor = (np.abs(p[:, 1]) < 1e-6) & (np.abs(p[:, 2]) < 0.8)
+    for d in (0.0, 0.25, 0.5, 1.0):
+        near = on_floor & (np.abs(p[:, 0] - d) < 0.02)
+        assert near.sum() >= 10
+        expected = 0.5 + 0.5 * d / np.hypot(d, height)
+        got = float(floor.visibility[near].mean())
+        assert abs(got - expected) < 0.02, (d, got, expected)
+    # The bent normal leans away from the wall, toward +x.
+    at_foot = on_floor & (p[:, 0] < 0.02)
+    assert (floor.bent_normal[at_foot, 0] > 0.3).all()
+
+
+def test_the_inner_corner_is_darker_than_the_open_floor(corner_bake):
+    mesh, baked = corner_bake
+    assert vis.self_occludes(mesh.parts)
+    p = np.concatenate([part.positions for part in baked.parts])
+    v = np.concatenate([part.visibility for part in baked.parts])
+    floor = np.abs(p[:, 1]) < 1e-6
+    corner = floor & (np.linalg.norm(p[:, [0, 2]] - (-1.0, -1.0), axis=1) < 0.05)
+    open_floor = floor & (np.linalg.norm(p[:, [0, 2]] - (0.95, 0.95), axis=1) < 0.1)
+    assert corner.any() and open_floor.any()
+    # Two infinite walls would leave a quarter of the hemisphere (V = 0.25) at the corner.
+    assert v[corner].max() < 0.3
+    assert v[open_floor].min() > 0.8
+    w = np.concatenate([part.bounce_weight for part in baked.parts])
+    assert w[corner].mean() > w[open_floor].mean()
+    # Refinement kept the geometry: the same area.
+    def area(pos, idx):
+        t = pos[idx]
+        return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum()
+    before = sum(area(np.asarray(q.positions, np.float64), q.indices) for q in mesh.parts)
+    after = sum(area(np.asarray(q.positions, np.float64), q.indices) for q in baked.parts)
+    assert after == pytest.approx(before, rel=1e-5)
+
+
+def test_convex_and_flat_meshes_need_no_bake():
+    for name in ("sphere", "cube", "plane"):
+        mesh = load_mesh(name)
+        assert not vis.self_occludes(mesh.parts), name
+        assert not vis.wants_occlusion(mesh, "auto"), name
+    assert not vis.wants_occlusion(load_mesh("sphere"), "on")   # the built-in sphere never
+    assert vis.wants_occlusion(load_mesh("cube"), "on")
+    assert not vis.wants_occlusion(load_mesh("cube"), "off")
+
+
+def test_shader_functions_match_their_numpy_twins():
+    rng = np.random.default_rng(3)
+    n = 600
+    caps = np.column_stack([rng.uniform(-0.2, 1, n), rng.uniform(0, 1, n), rng.uniform(-1, 1, n)])
+    gpu = evaluate(0, caps, shader="accuracy/evaluate_occlusion.comp")[:, 0]
+    np.testing.assert_allclose(gpu, vis.spherical_caps_intersection(caps[:, 0], caps[:, 1], caps[:, 2]),
+                               atol=2e-4)
+    v = rng.uniform(0, 1, n)
+    gpu = evaluate(1, v[:, None], shader="accuracy/evaluate_occlusion.comp")[:, 0]
+    np.testing.assert_allclose(gpu, vis.cone_aperture_cos(v), atol=1e-5)
+    so_in = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(0, 1, n), rng.uniform(0, 1, n), rng.uniform(0, 1, n)])
+    gpu = evaluate(2, so_in, shader="accuracy/evaluate_occlusion.comp")[:, 0]
+    np.testing.assert_allclose(gpu, vis.specular_occlusion(*so_in.T), atol=2e-3)
+    # An unoccluded point (V = 1, bent = n) keeps its whole reflection at every angle.
+    r = np.linspace(0.0, 1.0, 11)
+    assert np.allclose(vis.specular_occlusion(r, r, 1.0, 0.6), 1.0)
+
+
+def _floor_values(baked, x, z):
+    """V and the bounce weight interpolated on the refined floor at points (x, z)."""
+    part = baked.parts[0]
+    p = part.positions.astype(np.float64)
+    tri = part.indices.astype(np.int64)
+    tri = tri[(np.abs(p[tri][:, :, 1]) < 1e-6).all(axis=1)]
+    a, b, c = (p[tri[:, k]][:, [0, 2]] for k in range(3))
+    q = np.column_stack([x, z])[:, None, :]
+    det = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
+    l1 = ((b[:, 1] - c[:, 1]) * (q[..., 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (q[..., 1] - c[:, 1])) / det
+    l2 = ((c[:, 1] - a[:, 1]) * (q[..., 0] - c[:, 0]) + (a[:, 0] - c[:, 0]) * (q[..., 1] - c[:, 1])) / det
+    l3 = 1.0 - l1 - l2
+    inside = (l1 >= -1e-6) & (l2 >= -1e-6) & (l3 >= -1e-6)
+    k = inside.argmax(axis=1)
+    rows = np.arange(len(x))
+    weights = np.column_stack([l1[rows, k], l2[rows, k], l3[rows, k]])
+    corners = tri[k]
+    return ((part.visibility[corners] * weights).sum(axis=1), (part.bounce_weight[corners] * weights).sum(axis=1))
+
+
+def test_the_render_reads_the_bake(corner_obj, corner_bake):
+    """Seen from straight above (orthographic) under a uniform white environment, a diffuse floor's
+    radiance with occlusion over without it is what occluded_diffuse gives for the baked V and
+    bounce weight interpolated there: V + albedo w (the environment's E/pi is 1 everywhere)."""
+    mesh, baked = corner_bake
+    r = renderer()
+    maps = r.bake(constant_environment(1.0), "low")
+    camera = Camera(position=(0.0, 5.0, 0.0), target=(0.0, 0.0, 0.0), up=(0.0, 0.0, -1.0), near=1.0, far=10.0,
+                    ortho_half_height=1.0)
+    albedo = 0.8
+    material = Material(base_color=(albedo,) * 3, metallic=0.0, roughness=1.0, specular_f0=(0.0, 0.0, 0.0))
+    size = 96
+    images = {}
+    for mode in ("off", "on"):
+        scene = Scene(mesh=mesh, material=material, camera=camera, occlusion=mode)
+        images[mode] = r.render(scene, maps, size, size, aa="none", read_linear=True, read_srgb=False).linear
+    assert r.visibility_parts.wanted(mesh, "on")
+    j, i = np.mgrid[0:size, 0:size]
+    x = (2.0 * (i + 0.5) / size - 1.0).ravel()
+    z = (2.0 * (j + 0.5) / size - 1.0).ravel()      # row 0 at the top: up is -z
+    open_floor = (np.abs(x) < 0.97) & (np.abs(z) < 0.97) & ~((x > -0.6) & (x < 0.1) & (z > -0.6) & (z < 0.1))
+    v, w = _floor_values(baked, x[open_floor], z[open_floor])
+    ratio = (images["on"][..., 0] / images["off"][..., 0]).ravel()[open_floor]
+    ones = np.ones((len(v), 3))
+    expected = vis.occluded_environment(v, v, w, ones, ones, albedo, np.ones(len(v)), ones)[0][:, 0]
+    # The remainder: the small specular bias B (f0 = 0), in the hit's albedo and in the lobe.
+    assert np.abs(ratio - expected).max() < 0.03
+    assert expected.min() < 0.6 and ratio.min() < 0.6   # the corners are in the picture
+
+
+def test_the_bake_is_cached(corner_obj, tmp_path):
+    from alight.ibl.bake_cache import BakeCache
+    from alight.render.visibility_parts import cached_visibility
+
+    mesh = load_mesh(str(corner_obj))
+    cache = BakeCache(tmp_path / "cache")
+    first = cached_visibility(mesh, cache, rays=32)
+    second = cached_visibility(mesh, cache, rays=32)
+    assert not first.from_cache and second.from_cache
+    for a, b in zip(first.parts, second.parts):
+        np.testing.assert_array_equal(a.visibility, b.visibility)
+        np.testing.assert_array_equal(a.indices, b.indices)
+    third = cached_visibility(mesh, cache, rays=48)   # other settings: another key
+    assert not third.from_cache
+    cache.close()
+
+
+def test_the_built_in_sphere_is_drawn_as_before():
+    r = renderer()
+    maps = r.bake(constant_environment(0.7), "low")
+    runs = r.visibility_parts.bakes_run
+    mesh = load_mesh("sphere")
+    frames = {}
+    for mode in ("off", "auto", "on"):
+        scene = Scene(mesh=mesh, material=Material(roughness=0.4), occlusion=mode)
+        frames[mode] = r.render(scene, maps, 64, 64, read_linear=True, read_srgb=False).linear
+    assert r.visibility_parts.bakes_run == runs
+    np.testing.assert_array_equal(frames["off"], frames["auto"])
+    np.testing.assert_array_equal(frames["off"], frames["on"])
+
+
+def _cli(*args, cache: Path):
+    env = dict(os.environ, ALIGHT_CACHE_DIR=str(cache))
+    return subprocess.run([sys.executable, "-m", "alight", *map(str, args)], cwd=REPO, env=env,
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_cli_occlusion_flag(corner_obj, tmp_path):
+    cache = tmp_path / "cache"
+    outs = {}
+    for mode in ("off", "on"):
+        out = tmp_path / f"{mode}.exr"
+        p = _cli("render", "--mesh", corner_obj, "--size", "48", "--quality", "low", "--occlusion", mode,
+                 "--out", out, cache=cache)
+        assert p.returncode == 0, p.stderr
+        import OpenImageIO as oiio
+
+        outs[mode] = oiio.ImageBuf(str(out)).get_pixels(oiio.FLOAT)
+    # The occluded corner is darker; nothing is brighter by more than the bounce can add.
+    assert outs["on"][..., :3].sum() < 0.95 * outs["off"][..., :3].sum()
+    bad = _cli("render", "--mesh", corner_obj, "--occlusion", "sometimes", "--out", tmp_path / "x.png", cache=cache)
+    assert bad.returncode == 2
+    assert len(bad.stderr.strip().splitlines()) == 1 and "--occlusion" in bad.stderr
+
+
+def test_auto_without_embree_renders_and_says_so(corner_obj, monkeypatch, capsys):
+    """'auto' never stops a render: without embreex it draws without occlusion and warns once."""
+    import alight.render.visibility_parts as occlusion
+
+    monkeypatch.setattr(occlusion, "embree_available", lambda: False)
+    r = renderer()
+    maps = r.bake(constant_environment(1.0), "low")
+    mesh = load_mesh(str(corner_obj))
+    runs = r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded
+    scene = Scene(mesh=mesh, material=Material(), occlusion="auto")
+    r.render(scene, maps, 32, 32)
+    assert r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded == runs
+    err = capsys.readouterr().err
+    assert "without occlusion" in err and "embreex" in err and len(err.strip().splitlines()) == 1
