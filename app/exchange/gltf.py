@@ -390,13 +390,17 @@ class _Reader:
             if got is not None:
                 infos[slot] = got
         specular = {}
+        spec_ext = ext.get("KHR_materials_specular")
+        if isinstance(spec_ext, dict):
+            # F90 = specularFactor (its texture's A multiplies it in the shader, as for F0)
+            specular["specular_f90"] = float(spec_ext.get("specularFactor", 1.0))
         if "specular" in infos or "specular_color" in infos:
             # the texels multiply the factors before the extension's min(..., 1) (FileMaterial)
             spec = ext.get("KHR_materials_specular") or {}
             ior = float(factors.ior) if factors.ior is not None else 1.5
             f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
             color = spec.get("specularColorFactor") or [1.0, 1.0, 1.0]
-            specular = dict(specular_factor=float(spec.get("specularFactor", 1.0)),
+            specular.update(specular_factor=float(spec.get("specularFactor", 1.0)),
                             specular_color_f0=tuple(f0 * float(c) for c in color))
         self._decode_images([image_index for _, image_index in infos.values()])
         textures = {}
