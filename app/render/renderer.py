@@ -1250,8 +1250,7 @@ class ForwardRenderer:
         if file_material:
             present = set(gpu_part.textures)
             bits = {name: 1 << i for i, name in enumerate(MATERIAL_MAPS)}
-            masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0,
-                     "MAP_CLAMP_S_MASK": 0, "MAP_CLAMP_T_MASK": 0}
+            masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
             for name, info in gpu_part.infos.items():
                 bit = bits[name]
                 if info.tex_coord == 1 and gpu_part.has_uv1:
@@ -1262,11 +1261,6 @@ class ForwardRenderer:
                     masks["MAP_MIRROR_S_MASK"] |= bit
                 if info.sampler.wrap_t == "mirrored_repeat":
                     masks["MAP_MIRROR_T_MASK"] |= bit
-                # (common/mesh_material.glsl's sample_map takes REPEAT coordinates into [0, 1))
-                if info.sampler.wrap_s == "clamp_to_edge":
-                    masks["MAP_CLAMP_S_MASK"] |= bit
-                if info.sampler.wrap_t == "clamp_to_edge":
-                    masks["MAP_CLAMP_T_MASK"] |= bit
             defines.update({k: v for k, v in masks.items() if v})
             if masks["MAP_UV1_MASK"]:
                 defines["HAS_UV1"] = None

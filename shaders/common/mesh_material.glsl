@@ -8,9 +8,7 @@
 //   MAP_UV1_MASK         maps read with TEXCOORD_1 (needs HAS_UV1), the rest TEXCOORD_0;
 //   MAP_TRANSFORM_MASK   maps with KHR_texture_transform (u_map_transform[slot]);
 //   MAP_MIRROR_S_MASK,   maps whose sampler wraps by MIRRORED_REPEAT in s or t (REPEAT and
-//   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state);
-//   MAP_CLAMP_S_MASK,    maps whose sampler clamps to the edge in s or t (the rest repeat,
-//   MAP_CLAMP_T_MASK     so their coordinates are taken into [0, 1) before the lookup).
+//   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state).
 // HAS_VERTEX_COLOR: COLOR_0 multiplies the base colour and alpha (glTF 2.0 section 3.9.2).
 // SPHERE_SURFACE: the part is the built-in sphere drawn at a coarser level (alight.core.sphere_lod):
 // the surface point is where the view ray meets the true sphere, and the normal is the sphere's.
@@ -105,12 +103,6 @@ uniform sampler2D u_thickness_map;
 #endif
 #ifndef MAP_MIRROR_T_MASK
 #define MAP_MIRROR_T_MASK 0
-#endif
-#ifndef MAP_CLAMP_S_MASK
-#define MAP_CLAMP_S_MASK 0
-#endif
-#ifndef MAP_CLAMP_T_MASK
-#define MAP_CLAMP_T_MASK 0
 #endif
 const int MAP_BASE_COLOR = 1;
 const int MAP_METALLIC_ROUGHNESS = 2;
@@ -234,56 +226,17 @@ float mirrored_repeat(float x) {
     return 1.0 - abs(mod(x, 2.0) - 1.0);
 }
 
-// Whether a pixel's footprint in the map (the uv derivatives du, dv) is, along its narrowest
-// axis, at least as wide as the whole level-0 image: every filter then lands on (or next to) the
-// last mip level, the one texel that is the image's mean, and that is the answer (a footprint
-// one period wide each way of a repeating map averages to its mean). The narrow axis is bounded
-// from below by |det J| / |J|_F (the smaller singular value of J = [du dv] in texels), so a
-// footprint is only called that wide when it is.
-bool footprint_covers_image(sampler2D map, vec2 du, vec2 dv) {
-    vec2 size = vec2(textureSize(map, 0));
-    vec2 a = du * size;
-    vec2 b = dv * size;
-    float frobenius2 = dot(a, a) + dot(b, b);
-    float narrow = abs(a.x * b.y - a.y * b.x) * inversesqrt(max(frobenius2, 1e-30));
-    return narrow >= max(size.x, size.y);
-}
-
-// A map's texel at its coordinates, filtered by the texture's sampler (trilinear, anisotropic)
-// with the coordinates' own derivatives. Mirrored axes are folded here and sampled with the
-// unfolded derivatives, so the mip level does not jump at the folds; REPEAT axes lose their
-// whole periods (fract) the same way. What large coordinates and large derivatives cost is
-// bounded here, where it arises: on llvmpipe a sphere with its 64x64 texture tiled 1000 times
-// took 3.2-7x the frame of the same sphere tiled once (4x MSAA, 256-384 px), 1.4-1.7x at 1024 px;
-// with the measures below 0.9x (256 px), 1.4x (384 px) and 1.5x (1024 px)
-// (benchmarks/bench_gltf_sampling.py, each measured on this shared machine, interleaved):
-// - REPEAT coordinates in [0, 1) before the lookup (alone: 3.2x -> 2x at 256 px);
-// - a footprint axis longer than one period of a repeating map cut to one period (it filters to
-//   the mean along that axis as one period does);
-// - a footprint that covers the whole image takes the last level's texel (the mean) by
-//   texelFetch. Both lookups run (llvmpipe evaluates a texture lookup on either side of a
-//   branch for the whole SIMD group: a branch saved nothing, measured), so the filtered one is
-//   sent to one texel with zero derivatives there, and its answer dropped: the same texel for
-//   every such pixel, which is what made it cheap (texels scattered by fract cost 1.9x).
+// A map's texel at its coordinates. Mirrored axes are folded here and sampled with the
+// unfolded derivatives, so the mip level does not jump at the folds.
 vec4 sample_map(sampler2D map, int bit, int slot) {
     vec2 uv = map_uv(bit, slot);
-    vec2 du = dFdx(uv);
-    vec2 dv = dFdy(uv);
-    vec2 at = uv;
-    if ((MAP_MIRROR_S_MASK & bit) != 0) at.x = mirrored_repeat(uv.x);
-    else if ((MAP_CLAMP_S_MASK & bit) == 0) at.x = fract(uv.x);
-    if ((MAP_MIRROR_T_MASK & bit) != 0) at.y = mirrored_repeat(uv.y);
-    else if ((MAP_CLAMP_T_MASK & bit) == 0) at.y = fract(uv.y);
-    bool whole = footprint_covers_image(map, du, dv);
-    float keep = whole ? 0.0 : 1.0;
-    if (((MAP_CLAMP_S_MASK | MAP_CLAMP_T_MASK) & bit) == 0) {
-        // A repeating map: a footprint axis longer than one period (1 in uv) filters to the
-        // mean along it as one period does, so it is cut to one.
-        du *= 1.0 / max(length(du), 1.0);
-        dv *= 1.0 / max(length(dv), 1.0);
+    if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
+        vec2 folded = uv;
+        if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
+        if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
+        return textureGrad(map, folded, dFdx(uv), dFdy(uv));
     }
-    vec4 filtered = textureGrad(map, whole ? vec2(0.5) : at, du * keep, dv * keep);
-    return whole ? texelFetch(map, ivec2(0), textureQueryLevels(map) - 1) : filtered;
+    return texture(map, uv);
 }
 
 // The interpolated normal, or the face normal from screen derivatives where it is zero (bad
