@@ -17,7 +17,8 @@ def renderer() -> ForwardRenderer:
 TERMS = {name: i for i, name in enumerate([
     "D_GGX", "G1", "G_SMITH", "F_SCHLICK", "F_SCHLICK_ROUGHNESS", "DIRECTION_TO_EQUIRECT",
     "EQUIRECT_TO_DIRECTION", "ROTATE_WORLD_TO_MAP", "HAMMERSLEY", "IMPORTANCE_SAMPLE_GGX", "ACES",
-    "NEUTRAL", "SRGB", "K", "GRID_STEP", "CUBE_TEXEL_DIRECTION", "PUNCTUAL", "SPOT_RANGE", "SPHERE_SURFACE", "SPHERE_UV"])}
+    "NEUTRAL", "SRGB", "K", "GRID_STEP", "CUBE_TEXEL_DIRECTION", "PUNCTUAL", "SPOT_RANGE", "SPHERE_SURFACE", "SPHERE_UV",
+    "F_SCHLICK_F90"])}
 
 
 def evaluate(term: str | int, inputs: np.ndarray, uniforms: dict | None = None,

@@ -38,6 +38,9 @@ def test_geometry_terms():
 def test_fresnel_terms():
     x = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1, (400, 3))])
     close(evaluate("F_SCHLICK", x)[:, :3], shading.F_Schlick(x[:, 0], x[:, 1:4]))
+    z = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1, 400), rng.uniform(0, 1, 400)])
+    close(evaluate("F_SCHLICK_F90", z)[:, :3], shading.F_Schlick(z[:, 0], np.repeat(z[:, 1:2], 3, axis=1), z[:, 2]))
+    assert shading.F_Schlick(0.0, (0.0, 0.0, 0.0), 0.0).max() == 0.0   # specularFactor 0: no grazing rim
     y = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1, 400), rng.uniform(0, 1, 400)])
     close(evaluate("F_SCHLICK_ROUGHNESS", y)[:, :3],
           shading.F_SchlickRoughness(y[:, 0], np.repeat(y[:, 1:2], 3, axis=1), y[:, 2]))

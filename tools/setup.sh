@@ -37,8 +37,13 @@ if ! .venv/bin/python -m pip install --quiet --disable-pip-version-check ".[test
 fi
 rm -f "$log"
 
-# The Khronos glTF validator (npm), for the tests of `alight export`; skipped without node.
+# The Khronos glTF validator (npm), for the tests of `alight export`, and the optimisers whose
+# files the compressed-glTF tests read (gltfpack, @gltf-transform/cli); skipped without node.
 if command -v npm >/dev/null 2>&1 && [ ! -d tools/node/node_modules/gltf-validator ]; then
   echo "setup: installing gltf-validator (npm) into tools/node"
   npm install --silent --no-save --prefix tools/node gltf-validator >/dev/null
+fi
+if command -v npm >/dev/null 2>&1 && { [ ! -d tools/node/node_modules/gltfpack ] || [ ! -d tools/node/node_modules/@gltf-transform/cli ]; }; then
+  echo "setup: installing gltfpack and @gltf-transform/cli (npm) into tools/node"
+  npm install --silent --no-save --prefix tools/node gltf-validator gltfpack @gltf-transform/cli >/dev/null
 fi

@@ -20,6 +20,7 @@ import numpy as np
 from alight.core.equirect import box_reduce
 from alight.core.shading import (
     PI,
+    F_Schlick,
     F_SchlickRoughness,
     G_Smith,
     direction_to_equirect_uv,
@@ -367,7 +368,7 @@ def split_sum_converged(radiance, normals, view, base_color, metallic, roughness
 
 def ibl_converged(model: str, radiance, normals, view, base_color, metallic, roughness, specular_f0,
                   multiple_scattering: bool = False, material=None, tangents=None,
-                  diffuse_scale: float = 1.0) -> np.ndarray:
+                  diffuse_scale: float = 1.0, specular_f90: float = 1.0) -> np.ndarray:
     """What the forward pass's IBL model ``model`` (app/core/ibl_models.py) tends to with a converged
     bake: (P, 3) float64, the numpy twin of ibl.glsl's ibl_<model> (occlusion 1, no emission).
 
@@ -387,6 +388,10 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     sheen, the coat; the diffuse lobe scaled by 1 - transmission), and the compact sources through
     the whole layered BRDF. Without it, ``diffuse_scale`` scales the diffuse lobe alone (the
     reflected part of a transmissive material, without what it transmits).
+
+    ``specular_f90``: the dielectric's Fresnel at grazing incidence (KHR_materials_specular's
+    specularFactor; F90 = mix(specular_f90, 1, metallic)), which scales the split sum's B and
+    enters the diffuse weight as 1 - F0 - (F90 - F0) Fc (surface.glsl's surface_f90).
     """
     from alight.core.ibl_models import IBL_MODELS, SUNS_AS_BAKED
     from alight.ibl.sun import extract_suns
@@ -399,6 +404,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     m = float(metallic)
     base = np.asarray(base_color, dtype=np.float64)
     f0 = f0_of(base, m, np.asarray(specular_f0, dtype=np.float64))
+    f90 = float(specular_f90) * (1.0 - m) + m
     nv = np.maximum(np.sum(n * v, axis=-1), 0.0)
     A, B = brdf_lut_converged(nv, r)
     A, B = A[:, None], B[:, None]
@@ -410,11 +416,11 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     else:
         lighting, suns = extract_suns(rad)
     if model in ("lecture", "lecture-schlick"):
-        F = F_SchlickRoughness(nv, f0, r) if model == "lecture" else f0 + (1.0 - f0) * ((1.0 - nv) ** 5)[:, None]
-        diffuse_weight, spec_weight, direction = 1.0 - F, F * A + B, R
+        F = F_SchlickRoughness(nv, f0, r) if model == "lecture" else f0 + (f90 - f0) * ((1.0 - nv) ** 5)[:, None]
+        diffuse_weight, spec_weight, direction = 1.0 - F, F * A + f90 * B, R
     else:
-        diffuse_weight = (1.0 - f0) * (1.0 - diffuse_fresnel(nv))[:, None]
-        spec_weight = f0 * A + B
+        diffuse_weight = 1.0 - f0 - (f90 - f0) * diffuse_fresnel(nv)[:, None]
+        spec_weight = f0 * A + f90 * B
         direction = R
         if model in ("dominant", "alight", "stretched"):
             t_a, t_b = lobe_directions_converged(nv, r)
@@ -435,7 +441,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         azimuth = np.arctan2(np.abs(np.sum(b_dir * v, -1)), np.abs(np.sum(t_dir * v, -1)))
         ratios = np.array([anisotropy_lut_converged(x, r, strength, a, 128, 128) for x, a in zip(nv, azimuth)])
         A, B = A * ratios[:, :1], B * ratios[:, 1:]
-        spec_weight = f0 * A + B if model not in ("lecture", "lecture-schlick") else F * A + B
+        spec_weight = f0 * A + f90 * B if model not in ("lecture", "lecture-schlick") else F * A + f90 * B
         prefiltered = anisotropic_prefiltered_converged(lighting, n, v, t_dir, f0, r, strength)
     elif model == "stretched":
         from alight.core.stretched_lobe import stretched_fetches
@@ -451,7 +457,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     if multiple_scattering:
         e_ss = A + B
         e_ms = 1.0 - e_ss
-        f_avg = f0 + (1.0 - f0) / 21.0
+        f_avg = f0 + (f90 - f0) / 21.0
         f_ms = spec_weight * f_avg / (1.0 - e_ms * f_avg)
         out = spec_weight * prefiltered + (f_ms * e_ms + albedo * (1.0 - (spec_weight + f_ms * e_ms))) * irradiance
     else:
@@ -467,7 +473,7 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
             pairs = Pairs(n=n, v=v, l=l, t=t0, b=np.cross(n, t0), spread=sun.spread)
             out = out + layered_brdf_cos(material, pairs)[:, 0, :] * np.asarray(sun.power)[None, :]
         else:
-            out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread, diffuse_scale)
+            out = out + _sun_exact(n, v, sun.direction, sun.power, base, m, f0, r, sun.spread, diffuse_scale, f90)
     return out
 
 
@@ -507,7 +513,7 @@ def layered_ibl_converged(material, radiance, normals, view, base) -> np.ndarray
     return out
 
 
-def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0, diffuse_scale=1.0):
+def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0, diffuse_scale=1.0, f90=1.0):
     """ibl.glsl's sun_light: the exact BRDF (IBL k, F at v.h) times the power P, D widened to
     alpha' = sqrt(alpha^2 + spread^2) for the source's size."""
     l = np.asarray(l, dtype=np.float64)
@@ -522,7 +528,7 @@ def _sun_exact(n, v, l, power, base, metallic, f0, roughness, spread=0.0, diffus
     nlc = np.maximum(nl, 0.0)
     k = k_ibl(max(roughness, 0.045))
     G = G_Smith(nv, np.where(nl > 0, nl, 1.0), k)
-    F = f0 + (1.0 - f0) * ((1.0 - vh) ** 5)[:, None]
+    F = F_Schlick(vh, f0, f90)
     spec = (D * G / (4.0 * np.where(nl > 0, nl, 1.0) * nv))[:, None] * F
     diffuse = (1.0 - F) * (1.0 - metallic) * base / PI * diffuse_scale
     return np.where((nl > 0)[:, None], (diffuse + spec) * nlc[:, None] * np.asarray(power)[None, :], 0.0)

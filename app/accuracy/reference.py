@@ -143,6 +143,7 @@ def probe_gbuffer(size: int, material) -> dict[str, np.ndarray]:
     g["view"][..., 3] = material.metallic
     g["base_color"][..., :3] = material.base_color
     g["specular_f0"][..., :3] = material.specular_f0
+    g["specular_f0"][..., 3] = 1.0   # F90 (a probe's material has no KHR_materials_specular)
     g["emissive"][..., :3] = material.emissive
     g["tangent"][..., :3] = probe_tangents(normals)
     g["tangent"][..., 3] = 1.0

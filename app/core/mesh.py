@@ -142,6 +142,9 @@ class FileMaterial:
     specular_color_texture: TextureInfo | None = None
     specular_factor: float = 1.0
     specular_color_f0: tuple[float, float, float] = (0.04, 0.04, 0.04)
+    # KHR_materials_specular's F90 of the dielectric part: its specularFactor (the extension
+    # scales the Fresnel at grazing incidence too; a metal's F90 stays 1). 1 without it.
+    specular_f90: float = 1.0
 
     def __post_init__(self) -> None:
         for slot in TEXTURE_SLOTS + LAYER_TEXTURE_SLOTS + SPECULAR_TEXTURE_SLOTS:

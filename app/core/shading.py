@@ -52,11 +52,15 @@ def G_Smith(n_dot_v, n_dot_l, k):
     return G1_SchlickGGX(n_dot_v, k) * G1_SchlickGGX(n_dot_l, k)
 
 
-def F_Schlick(v_dot_h, f0):
-    """Schlick's Fresnel approximation (Schlick 1994). f0 broadcasts against v_dot_h[..., None]."""
+def F_Schlick(v_dot_h, f0, f90=1.0):
+    """Schlick's Fresnel approximation (Schlick 1994): f0 + (f90 - f0)(1 - v.h)^5. f0 broadcasts
+    against v_dot_h[..., None]; f90 (scalar or v_dot_h's shape) is 1 but for KHR_materials_specular,
+    whose specularFactor is the dielectric's F90 (brdf.glsl's three-argument F_Schlick)."""
     x = np.clip(1.0 - np.asarray(v_dot_h, dtype=np.float64), 0.0, 1.0) ** 5
     f0 = np.asarray(f0, dtype=np.float64)
-    return f0 + (1.0 - f0) * x[..., None]
+    f90 = np.asarray(f90, dtype=np.float64)
+    f90 = f90[..., None] if f90.ndim else f90
+    return f0 + (f90 - f0) * x[..., None]
 
 
 def F_SchlickRoughness(n_dot_v, f0, roughness):

@@ -42,7 +42,7 @@ from alight.core.mesh import (
 )
 from alight.core.scene import Camera, Light
 from alight.errors import AlightError
-from alight.exchange.gltf_accessors import Accessors, fail, read_uri
+from alight.exchange.gltf_accessors import Accessors, fail, meshopt_available, read_uri
 
 # Extensions alight renders as their specifications say.
 SUPPORTED = {
@@ -66,7 +66,7 @@ LAYER_TEXTURES = {
     "specular_color": ("KHR_materials_specular", "specularColorTexture"),
 }
 # Compression a file cannot be read without: refused in one line when no library decodes it.
-COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_texture_basisu"}
+COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu"}
 
 _WRAP = {10497: "repeat", 33071: "clamp_to_edge", 33648: "mirrored_repeat"}
 _MAG = {9728: "nearest", 9729: "linear"}
@@ -74,6 +74,73 @@ _MIN = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest", 9985: "
         9986: "nearest_mipmap_linear", 9987: "linear_mipmap_linear"}
 _SRGB_SLOTS = ("base_color", "emissive")
 _MODE_NAMES = {0: "POINTS", 1: "LINES", 2: "LINE_LOOP", 3: "LINE_STRIP"}
+
+
+# The vertex attributes read: skins need the joints and weights, the rest is drawn.
+_ATTRIBUTES = ("POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0",
+               "JOINTS_0", "WEIGHTS_0", "JOINTS_1", "WEIGHTS_1")
+
+
+def draco_values(values: np.ndarray, accessor, normalize: bool = True) -> np.ndarray:
+    """A Draco-decoded attribute (N, k) as its accessor says: the values cast to the accessor's
+    componentType, then float32 (dequantized when ``normalized``) unless ``normalize`` is False.
+    DracoPy hands quantized attributes back as float32 or uint32 holding the integers."""
+    from alight.exchange.gltf_accessors import COMPONENT_TYPES, dequantize
+
+    dtype = COMPONENT_TYPES.get(accessor.componentType, np.float32)
+    if dtype is np.float32:
+        return np.asarray(values, np.float32)
+    typed = np.rint(np.asarray(values, np.float64)).astype(dtype) if values.dtype.kind == "f" else values.astype(dtype)
+    if not normalize:
+        return typed
+    return dequantize(typed) if accessor.normalized else typed.astype(np.float32)
+
+
+def _has_plain_data(doc, attrs) -> bool:
+    """Whether a primitive's POSITION accessor holds data of its own (Draco's fallback)."""
+    index = getattr(attrs, "POSITION", None)
+    accessors = doc.accessors or []
+    return index is not None and 0 <= int(index) < len(accessors) and (
+        accessors[int(index)].bufferView is not None or accessors[int(index)].sparse is not None)
+
+
+def _skin_attributes(arrays: dict, kind: str, origin: np.ndarray) -> tuple[np.ndarray, ...]:
+    """JOINTS_n or WEIGHTS_n (n = 0, 1, ... while present), each (N, 4), in the decoded vertex order."""
+    out = []
+    while f"{kind}_{len(out)}" in arrays:
+        out.append(np.asarray(arrays[f"{kind}_{len(out)}"])[origin])
+    return tuple(out)
+
+
+KTX2_MAGIC = b"\xabKTX 20\xbb\r\n\x1a\n"
+
+
+def _ktx2_available() -> bool:
+    try:
+        import alktx2  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def decode_image(data: bytes, where: str) -> np.ndarray:
+    """A glTF image's bytes as (H, W, 4) uint8 RGBA, row 0 = top: KTX2 (KHR_texture_basisu's
+    Basis Universal ETC1S or UASTC) transcoded to RGBA8 by alktx2 (Basis Universal's own
+    transcoder), everything else decoded by Pillow (``alight.exchange.images.decode_texture``).
+    The top mip level is taken; alight builds its own mip chain as for any image."""
+    from alight.exchange.images import decode_texture
+
+    if data[:12] == KTX2_MAGIC:
+        if not _ktx2_available():
+            raise AlightError(f"{where}: a KTX2 image and alktx2 (its transcoder) is not installed")
+        import alktx2
+
+        try:
+            # TGA: an uncompressed container Pillow reads, so nothing is spent compressing.
+            data, _ = alktx2.decode_ktx2_to_bytes(bytes(data), format="tga")
+        except Exception as exc:   # the binding raises RuntimeError or ValueError
+            raise AlightError(f"{where}: cannot transcode the KTX2 image ({_one_line(exc)})") from None
+    return decode_texture(data, where)
 
 
 def _draco_available() -> bool:
@@ -96,6 +163,8 @@ class _Local:
     tangents: np.ndarray
     indices: np.ndarray
     material: FileMaterial | None
+    joints: tuple[np.ndarray, ...] = ()    # JOINTS_n (N, 4) ints, with WEIGHTS_n, for a skin
+    weights: tuple[np.ndarray, ...] = ()
 
 
 class _Json(dict):
@@ -155,7 +224,7 @@ class _Reader:
         self._warned: set[str] = set()
         self._images: dict[int, np.ndarray] = {}
         self._materials: dict[int, FileMaterial] = {}
-        self._locals: dict[tuple[int, int], _Local | None] = {}
+        self._locals: dict[tuple, _Local | None] = {}
         self._check_extensions()
 
     # --- messages ------------------------------------------------------------------------
@@ -171,6 +240,10 @@ class _Reader:
         supported = set(SUPPORTED)
         if not _draco_available():
             supported.discard("KHR_draco_mesh_compression")
+        if meshopt_available():
+            supported.update(("EXT_meshopt_compression", "KHR_meshopt_compression"))
+        if _ktx2_available():
+            supported.add("KHR_texture_basisu")
         for name in required:
             if name not in supported:
                 why = ("no library that decodes it installs here" if name in COMPRESSION
@@ -202,8 +275,6 @@ class _Reader:
 
     def _decode_images(self, indices: list[int]) -> None:
         """Decode the images materials use, two at a time (Pillow releases the GIL while decoding)."""
-        from alight.exchange.images import decode_texture
-
         todo = [i for i in dict.fromkeys(indices) if i not in self._images]
         if not todo:
             return
@@ -215,10 +286,10 @@ class _Reader:
             return
         wheres = [f"{self.source}: images[{i}]" for i in todo]
         if len(todo) == 1:
-            self._images[todo[0]] = decode_texture(blobs[0], wheres[0])
+            self._images[todo[0]] = decode_image(blobs[0], wheres[0])
             return
         with ThreadPoolExecutor(max_workers=min(len(todo), os.cpu_count() or 2)) as pool:
-            for i, image in zip(todo, pool.map(decode_texture, blobs, wheres)):
+            for i, image in zip(todo, pool.map(decode_image, blobs, wheres)):
                 self._images[i] = image
 
     def _texture_source(self, index: int, element: str) -> int:
@@ -227,12 +298,16 @@ class _Reader:
             raise fail(self.source, element, f"textures[{index}] does not exist")
         tex = textures[index]
         ext = tex.extensions or {}
-        if "KHR_texture_basisu" in ext and tex.source is None:
-            raise fail(self.source, f"textures[{index}]", "KHR_texture_basisu: no library that decodes it installs here")
         source = tex.source
         webp = ext.get("EXT_texture_webp")
         if isinstance(webp, dict) and webp.get("source") is not None:
             source = webp["source"]
+        basisu = ext.get("KHR_texture_basisu")
+        if isinstance(basisu, dict) and basisu.get("source") is not None:
+            if _ktx2_available():
+                source = basisu["source"]
+            elif tex.source is None:
+                raise fail(self.source, f"textures[{index}]", "KHR_texture_basisu: no library that decodes it installs here")
         if source is None:
             raise fail(self.source, f"textures[{index}]", "has no image source alight can decode")
         return int(source)
@@ -328,13 +403,17 @@ class _Reader:
             if got is not None:
                 infos[slot] = got
         specular = {}
+        spec_ext = ext.get("KHR_materials_specular")
+        if isinstance(spec_ext, dict):
+            # F90 = specularFactor (its texture's A multiplies it in the shader, as for F0)
+            specular["specular_f90"] = float(spec_ext.get("specularFactor", 1.0))
         if "specular" in infos or "specular_color" in infos:
             # the texels multiply the factors before the extension's min(..., 1) (FileMaterial)
             spec = ext.get("KHR_materials_specular") or {}
             ior = float(factors.ior) if factors.ior is not None else 1.5
             f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
             color = spec.get("specularColorFactor") or [1.0, 1.0, 1.0]
-            specular = dict(specular_factor=float(spec.get("specularFactor", 1.0)),
+            specular.update(specular_factor=float(spec.get("specularFactor", 1.0)),
                             specular_color_f0=tuple(f0 * float(c) for c in color))
         self._decode_images([image_index for _, image_index in infos.values()])
         textures = {}
@@ -368,13 +447,14 @@ class _Reader:
 
     # --- geometry --------------------------------------------------------------------------
 
-    def primitive(self, mesh_index: int, prim_index: int) -> _Local | None:
-        key = (mesh_index, prim_index)
+    def primitive(self, mesh_index: int, prim_index: int, weights: tuple[float, ...] = ()) -> _Local | None:
+        """A primitive in its mesh's space with its morph targets applied at ``weights``."""
+        key = (mesh_index, prim_index, weights)
         if key not in self._locals:
-            self._locals[key] = self._decode_primitive(mesh_index, prim_index)
+            self._locals[key] = self._decode_primitive(mesh_index, prim_index, weights)
         return self._locals[key]
 
-    def _decode_primitive(self, mesh_index: int, prim_index: int) -> _Local | None:
+    def _decode_primitive(self, mesh_index: int, prim_index: int, weights: tuple[float, ...] = ()) -> _Local | None:
         element = f"meshes[{mesh_index}].primitives[{prim_index}]"
         prim = self.doc.meshes[mesh_index].primitives[prim_index]
         mode = 4 if prim.mode is None else int(prim.mode)
@@ -386,24 +466,32 @@ class _Reader:
         attrs = prim.attributes
         ext = prim.extensions or {}
         draco = ext.get("KHR_draco_mesh_compression")
-        if "EXT_meshopt_compression" in (self.doc.extensionsRequired or []):
-            raise fail(self.source, element, "EXT_meshopt_compression: no library that decodes it installs here")
+        arrays = None
         if isinstance(draco, dict) and _draco_available():
-            arrays, indices = self._draco(draco, element)
-        else:
+            try:
+                arrays, indices = self._draco(draco, prim, element)
+            except AlightError as exc:
+                # The extension's fallback: a file that does not require Draco also holds the
+                # plain accessors, which a viewer without Draco (or with a failing one) draws.
+                if "KHR_draco_mesh_compression" in (self.doc.extensionsRequired or []) or not _has_plain_data(self.doc, attrs):
+                    raise
+                self.warn("draco-fallback", f"{str(exc)[len(self.source) + 2:]}; the uncompressed accessors are drawn")
+        if arrays is None:
             if getattr(attrs, "POSITION", None) is None:
                 raise fail(self.source, element, "has no POSITION attribute")
             arrays = {}
-            for name in ("POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0"):
+            for name in _ATTRIBUTES:
                 index = getattr(attrs, name, None)
                 if index is not None:
-                    arrays[name] = self.acc.read(index, f"{element}: {name}")
+                    arrays[name] = self.acc.read(index, f"{element}: {name}", normalize=not name.startswith("JOINTS_"))
             count = len(arrays["POSITION"])
             for name, array in arrays.items():
                 if len(array) != count:
                     raise fail(self.source, f"{element}: {name}", f"has {len(array)} elements, POSITION has {count}")
             indices = (self.acc.indices(prim.indices, element, count) if prim.indices is not None
                        else np.arange(count, dtype=np.int64))
+        if prim.targets:
+            arrays = self._morph(arrays, prim.targets, weights, element)
         faces = _triangles(indices, mode)
         positions = arrays["POSITION"][:, :3].astype(np.float64)
         if not np.isfinite(positions).all():
@@ -431,6 +519,7 @@ class _Reader:
                 colors = np.concatenate([colors, np.ones((len(colors), 1))], axis=1)
             elif colors.shape[1] != 4:
                 raise fail(self.source, f"{element}: COLOR_0", "must be VEC3 or VEC4")
+        origin = np.arange(len(positions))   # each vertex's index in the file (a skin's joints follow it)
         # glTF uvs have v down from the image's top; alight's are OpenGL's (v up from the bottom).
         for uv in (uv0, uv1):
             if uv is not None:
@@ -442,6 +531,7 @@ class _Reader:
             uv0 = uv0[corner] if uv0 is not None else None
             uv1 = uv1[corner] if uv1 is not None else None
             colors = colors[corner] if colors is not None else None
+            origin = origin[corner]
             p = positions[faces]
             face_n, ok = _normalize(cross_rows(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
             face_n[~ok] = (0.0, 1.0, 0.0)
@@ -473,6 +563,7 @@ class _Reader:
             positions, normals, uvs = positions[source], normals[source], uvs[source]
             uv1 = uv1[source] if uv1 is not None else None
             colors = colors[source] if colors is not None else None
+            origin = origin[source]
         if tangents is None and uv0 is None:
             tangents = _any_tangents(normals)   # no uvs: no map can be placed on it
         elif tangents is None:
@@ -480,33 +571,74 @@ class _Reader:
 
             tangents = compute_tangents(positions, normals, uvs, faces)   # for maps the user loads
         return _Local(positions=positions, normals=normals, uvs=uvs, uvs1=uv1, colors=colors,
-                      tangents=np.asarray(tangents, np.float64), indices=faces, material=material)
+                      tangents=np.asarray(tangents, np.float64), indices=faces, material=material,
+                      joints=_skin_attributes(arrays, "JOINTS", origin),
+                      weights=_skin_attributes(arrays, "WEIGHTS", origin))
 
-    def _draco(self, draco: dict, element: str) -> tuple[dict, np.ndarray]:
-        """KHR_draco_mesh_compression decoded with DracoPy (Google's Draco library)."""
+    def _morph(self, arrays: dict, targets: list, weights: tuple[float, ...], element: str) -> dict:
+        """Morph targets at the given weights (glTF 2.0 section 3.7.2.2): each attribute plus
+        the weighted sum of its targets' displacements; a weight the file leaves out is 0."""
+        out = dict(arrays)
+        for t, target in enumerate(targets):
+            w = weights[t] if t < len(weights) else 0.0
+            if w == 0.0 or not isinstance(target, dict):
+                continue
+            for name, index in target.items():
+                if name not in out or name.startswith(("JOINTS_", "WEIGHTS_")):
+                    continue
+                delta = self.acc.read(int(index), f"{element}: targets[{t}].{name}")
+                base = out[name]
+                if len(delta) != len(base):
+                    raise fail(self.source, f"{element}: targets[{t}].{name}",
+                               f"has {len(delta)} elements, the attribute has {len(base)}")
+                width = min(delta.shape[1], base.shape[1], 3)   # a TANGENT's w is no displacement
+                moved = base.astype(np.float64)
+                moved[:, :width] += w * delta[:, :width].astype(np.float64)
+                out[name] = moved
+        return out
+
+    def _draco(self, draco: dict, prim, element: str) -> tuple[dict, np.ndarray]:
+        """KHR_draco_mesh_compression decoded with DracoPy (Google's Draco library). Each decoded
+        attribute holds the values of its glTF accessor's componentType (the extension's rule),
+        so it is cast to that type and dequantized when the accessor is ``normalized``, as a
+        plain accessor would be (KHR_mesh_quantization's normalized positions and UVs, glTF's
+        normalized byte colours)."""
         import DracoPy
 
+        where = f"{element}: KHR_draco_mesh_compression"
         data, start, length, _ = self.acc.view_bytes(draco.get("bufferView"))
         try:
             mesh = DracoPy.decode(data[start:start + length])
         except Exception as exc:
-            raise fail(self.source, f"{element}: KHR_draco_mesh_compression", f"cannot decode ({_one_line(exc)})") from None
-        arrays = {"POSITION": np.asarray(mesh.points, np.float32).reshape(-1, 3)}
-        ids = draco.get("attributes", {})
+            raise fail(self.source, where, f"cannot decode ({_one_line(exc)})") from None
         by_id = {}
         for attr in getattr(mesh, "attributes", []) or []:
             uid = attr.get("unique_id") if isinstance(attr, dict) else None
             if uid is not None:
-                by_id[int(uid)] = np.asarray(attr["data"], np.float32).reshape(len(arrays["POSITION"]), -1)
-        for name in ("NORMAL", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0", "TANGENT"):
-            if name in ids and int(ids[name]) in by_id:
-                arrays[name] = by_id[int(ids[name])]
-        if "NORMAL" in ids and "NORMAL" not in arrays and getattr(mesh, "normals", None) is not None:
-            arrays["NORMAL"] = np.asarray(mesh.normals, np.float32).reshape(-1, 3)
-        if "TEXCOORD_0" in ids and "TEXCOORD_0" not in arrays and getattr(mesh, "tex_coord", None) is not None:
-            arrays["TEXCOORD_0"] = np.asarray(mesh.tex_coord, np.float32).reshape(-1, 2)
+                by_id[int(uid)] = np.asarray(attr["data"])
+        count = len(np.asarray(mesh.points).reshape(-1, 3))
+        arrays = {}
+        for name, uid in (draco.get("attributes") or {}).items():
+            if name not in _ATTRIBUTES:
+                continue
+            values = by_id.get(int(uid))
+            if values is None:
+                raise fail(self.source, where, f"attribute {name} (id {uid}) is not in the Draco data")
+            accessor_index = getattr(prim.attributes, name, None)
+            arrays[name] = draco_values(values.reshape(count, -1), self._accessor(accessor_index, f"{element}: {name}"),
+                                        normalize=not name.startswith("JOINTS_"))
+        if "POSITION" not in arrays:
+            raise fail(self.source, where, "has no POSITION attribute")
         faces = np.asarray(mesh.faces, np.int64).reshape(-1)
+        if len(faces) and (faces.min() < 0 or faces.max() >= count):
+            raise fail(self.source, where, f"a face index is out of range ({count} vertices)")
         return arrays, faces
+
+    def _accessor(self, index, element: str):
+        accessors = self.doc.accessors or []
+        if index is None or not 0 <= int(index) < len(accessors):
+            raise fail(self.source, f"{element} (accessors[{index}])", "does not exist")
+        return accessors[int(index)]
 
     # --- the scene --------------------------------------------------------------------------
 
@@ -523,11 +655,12 @@ class _Reader:
             children = {c for n in nodes for c in (n.children or [])}
             roots = [i for i in range(len(nodes)) if i not in children]
         parts: list[MeshPart] = []
-        placements: list[tuple[int, np.ndarray, str]] = []
         cameras: list[tuple[int, np.ndarray]] = []
         lights: list[Light] = []
         light_defs = ((doc.extensions or {}).get("KHR_lights_punctual") or {}).get("lights") or []
         visited: set[int] = set()
+        worlds: dict[int, np.ndarray] = {}
+        placed: list[tuple[int, int, np.ndarray]] = []   # (node, mesh, world), placed once all worlds are known
         stack = [(int(r), np.eye(4)) for r in reversed(roots)]
         while stack:
             index, parent = stack.pop()
@@ -538,8 +671,9 @@ class _Reader:
             visited.add(index)
             node = nodes[index]
             world = parent @ _local_matrix(node, self.source, index)
+            worlds[index] = world
             if node.mesh is not None:
-                placements.append((int(node.mesh), world, node.name or f"node{index}"))
+                placed.append((index, int(node.mesh), world))
             if node.camera is not None:
                 cameras.append((int(node.camera), world))
             light_ref = (node.extensions or {}).get("KHR_lights_punctual")
@@ -547,11 +681,23 @@ class _Reader:
                 lights.append(self._light(int(light_ref["light"]), light_defs, world))
             for child in reversed(node.children or []):
                 stack.append((int(child), world))
-        origin = far_origin([world[:3, 3] for _, world, _ in placements])
+        # A model far from the file's origin is moved near it (with its cameras and lights, below)
+        # before its positions become float32; a skin's joints move with it.
+        origin = far_origin([world[:3, 3] for _, _, world in placed])
         shift = np.eye(4)
         shift[:3, 3] = -origin
-        for mesh_index, world, name in placements:
-            parts.extend(self._place(mesh_index, shift @ world, name))
+        for index, mesh_index, world in placed:
+            node = nodes[index]
+            name = node.name or f"node{index}"
+            weights = self._morph_weights(node, index, mesh_index)
+            skin = self._skin_matrices(node, index, worlds) if node.skin is not None else None
+            if skin is not None:
+                skin = shift @ skin
+            parts.extend(self._place(mesh_index, shift @ world, name, weights, skin))
+        if doc.animations:
+            n = len(doc.animations)
+            self.warn("animations", f"animations: {n} animation{'s' if n != 1 else ''} not played; "
+                                    f"the rest pose the nodes give is drawn")
         if not parts:
             raise AlightError(f"{self.source}: no triangles in the file")
         for light in lights:
@@ -561,7 +707,83 @@ class _Reader:
         mesh.cameras = [self._camera(i, shift @ world, mesh) for i, world in cameras]
         return mesh
 
-    def _place(self, mesh_index: int, world: np.ndarray, name: str) -> list[MeshPart]:
+    def _morph_weights(self, node, index: int, mesh_index: int) -> tuple[float, ...]:
+        """The morph weights a node draws its mesh with: node.weights, else mesh.weights."""
+        meshes = self.doc.meshes or []
+        mesh = meshes[mesh_index] if 0 <= mesh_index < len(meshes) else None
+        weights = node.weights if node.weights is not None else (mesh.weights if mesh is not None else None)
+        if weights is None:
+            return ()
+        try:
+            values = tuple(float(w) for w in weights)
+        except (TypeError, ValueError):
+            raise fail(self.source, f"nodes[{index}]", "weights must be numbers") from None
+        if not all(map(math.isfinite, values)):
+            raise fail(self.source, f"nodes[{index}]", "weights contain NaN or Inf")
+        return values
+
+    def _node_world(self, index: int, worlds: dict[int, np.ndarray]) -> np.ndarray:
+        """A node's world matrix, from the scene's walk or, for a joint outside it, its parents'."""
+        if index in worlds:
+            return worlds[index]
+        nodes = self.doc.nodes or []
+        if not 0 <= index < len(nodes):
+            raise fail(self.source, f"nodes[{index}]", "does not exist")
+        parents = getattr(self, "_parents", None)
+        if parents is None:
+            parents = self._parents = {int(c): i for i, n in enumerate(nodes) for c in (n.children or [])}
+        chain, i = [], index
+        while i is not None and i not in worlds and i not in chain:
+            chain.append(i)
+            i = parents.get(i)
+        world = worlds[i] if i in worlds else np.eye(4)
+        for j in reversed(chain):
+            world = world @ _local_matrix(nodes[j], self.source, j)
+            worlds[j] = world
+        return worlds[index]
+
+    def _skin_matrices(self, node, index: int, worlds: dict[int, np.ndarray]) -> np.ndarray:
+        """(J, 4, 4) joint matrices of a node's skin (glTF 2.0 section 3.7.3): each joint's world
+        matrix times its inverse bind matrix. The skinned node's own transform takes no part."""
+        skins = self.doc.skins or []
+        where = f"nodes[{index}].skin"
+        if not 0 <= int(node.skin) < len(skins):
+            raise fail(self.source, where, f"skins[{node.skin}] does not exist")
+        skin = skins[int(node.skin)]
+        joints = [int(j) for j in (skin.joints or [])]
+        if not joints:
+            raise fail(self.source, f"skins[{node.skin}]", "has no joints")
+        if skin.inverseBindMatrices is not None:
+            ibm = self.acc.read(int(skin.inverseBindMatrices), f"skins[{node.skin}].inverseBindMatrices")
+            if ibm.shape != (len(joints), 16):
+                raise fail(self.source, f"skins[{node.skin}].inverseBindMatrices",
+                           f"must be {len(joints)} MAT4 (one a joint)")
+            ibm = ibm.astype(np.float64).reshape(-1, 4, 4).transpose(0, 2, 1)   # column-major
+        else:
+            ibm = np.broadcast_to(np.eye(4), (len(joints), 4, 4))
+        mats = np.stack([self._node_world(j, worlds) for j in joints]) @ ibm
+        if not np.isfinite(mats).all():
+            raise fail(self.source, f"skins[{node.skin}]", "a joint matrix contains NaN or Inf")
+        return mats
+
+    def _skinned(self, local: _Local, joint_mats: np.ndarray, element: str) -> np.ndarray | None:
+        """(N, 4, 4) per-vertex skinning matrices: sum_k WEIGHTS[k] * joint_mats[JOINTS[k]]."""
+        if not local.joints or len(local.joints) != len(local.weights):
+            self.warn(f"skin:{element}", f"{element}: a skinned mesh without matching JOINTS_n and WEIGHTS_n; "
+                                         f"drawn with its node's transform")
+            return None
+        per_vertex = np.zeros((len(local.positions), 4, 4))
+        for joints, weights in zip(local.joints, local.weights):
+            j = np.asarray(joints, np.int64)
+            if len(j) and (j.min() < 0 or j.max() >= len(joint_mats)):
+                raise fail(self.source, f"{element}: JOINTS", f"joint {int(j.max())} is out of range "
+                                                              f"(the skin has {len(joint_mats)} joints)")
+            w = np.asarray(weights, np.float64)
+            per_vertex += np.einsum("nk,nkij->nij", w, joint_mats[j])
+        return per_vertex
+
+    def _place(self, mesh_index: int, world: np.ndarray, name: str, weights: tuple[float, ...] = (),
+               skin: np.ndarray | None = None) -> list[MeshPart]:
         meshes = self.doc.meshes or []
         if not 0 <= mesh_index < len(meshes):
             raise fail(self.source, f"meshes[{mesh_index}]", "does not exist")
@@ -569,30 +791,39 @@ class _Reader:
             raise fail(self.source, f"meshes[{mesh_index}]", "its node transform contains NaN or Inf")
         out = []
         for p in range(len(meshes[mesh_index].primitives or [])):
-            local = self.primitive(mesh_index, p)
+            local = self.primitive(mesh_index, p, weights)
             if local is None:
                 continue
-            m, t = world[:3, :3], world[:3, 3]
+            element = f"meshes[{mesh_index}].primitives[{p}]"
+            per_vertex = self._skinned(local, skin, element) if skin is not None else None
+            if per_vertex is None:
+                m, t = world[None, :3, :3], world[None, :3, 3]
+            else:
+                m, t = per_vertex[:, :3, :3], per_vertex[:, :3, 3]
             # Normals take the cofactor matrix (det * inverse transpose) times sign(det); a
             # mirroring transform also reverses the winding (section 3.7.4) and the bitangent.
-            cof = np.stack([np.cross(m[1], m[2]), np.cross(m[2], m[0]), np.cross(m[0], m[1])])
-            det = float(np.dot(m[0], cof[0]))
+            cof = np.stack([np.cross(m[:, 1], m[:, 2]), np.cross(m[:, 2], m[:, 0]), np.cross(m[:, 0], m[:, 1])], axis=1)
+            det = np.einsum("ni,ni->n", m[:, 0], cof[:, 0])
+            sign = np.where(det < 0, -1.0, 1.0)
             faces = local.indices
-            if det < 0:
-                faces, cof = faces[:, ::-1], -cof
-            normals, ok = _normalize(rows_times(local.normals, cof))
+            flip = (sign < 0) if len(sign) == 1 else (sign[faces[:, 0]] < 0)
+            if len(sign) == 1:
+                flip = np.repeat(flip, len(faces))
+            faces = np.where(flip[:, None], faces[:, ::-1], faces)
+            cof = cof * sign[:, None, None]
+            normals, ok = _normalize(_apply(cof, local.normals))
             normals[~ok] = (0.0, 1.0, 0.0)
-            t_xyz, t_ok = _normalize(rows_times(local.tangents[:, :3], m))
-            t_xyz = t_xyz - normals * np.einsum("ij,ij->i", normals, t_xyz)[:, None]
+            t_xyz, t_ok = _normalize(_apply(m, local.tangents[:, :3]))
+            t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
             t_xyz, t_ok = _normalize(t_xyz)
             if not t_ok.all():
                 axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
                 fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
                 t_xyz[~t_ok] = fallback[~t_ok]
-            w = local.tangents[:, 3:4] * (1.0 if det >= 0 else -1.0)
+            w = local.tangents[:, 3:4] * sign[:, None]
             out.append(MeshPart(
                 name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
-                positions=np.ascontiguousarray(rows_times(local.positions, m) + t, dtype=np.float32),
+                positions=np.ascontiguousarray(_apply(m, local.positions) + t, dtype=np.float32),
                 normals=np.ascontiguousarray(normals, dtype=np.float32),
                 uvs=np.ascontiguousarray(local.uvs, dtype=np.float32),
                 tangents=np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32),
@@ -600,7 +831,7 @@ class _Reader:
                 material=local.material,
                 uvs1=None if local.uvs1 is None else np.ascontiguousarray(local.uvs1, dtype=np.float32),
                 colors=None if local.colors is None else np.ascontiguousarray(local.colors, dtype=np.float32),
-                element=f"meshes[{mesh_index}].primitives[{p}]",
+                element=element,
             ))
         return out
 
@@ -649,6 +880,11 @@ class _Reader:
             light.inner_cone_deg = math.degrees(float(spot.get("innerConeAngle", 0.0)))
             light.outer_cone_deg = math.degrees(float(spot.get("outerConeAngle", math.pi / 4)))
         return light
+
+
+def _apply(m: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(N, 3) vectors times (1, 3, 3) one matrix or (N, 3, 3) one a vertex."""
+    return rows_times(v, m[0]) if len(m) == 1 else np.einsum("nij,nj->ni", m, v)
 
 
 def _any_tangents(normals: np.ndarray) -> np.ndarray:

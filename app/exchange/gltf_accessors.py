@@ -5,7 +5,10 @@ Handled as the specification says: interleaved views (``byteStride``), every com
 ``normalized`` integers (section 3.11, the dequantisation ``f = max(c / (2^(b-1) - 1), -1)`` and
 ``f = c / (2^b - 1)``), which KHR_mesh_quantization relies on, sparse accessors (section 3.6.2.3,
 with or without a ``bufferView`` underneath), and buffer URIs that are relative,
-percent-encoded (RFC 3986) or ``data:`` URIs. Every problem is an AlightError naming the file
+percent-encoded (RFC 3986) or ``data:`` URIs. A bufferView compressed with
+EXT_meshopt_compression (or its KHR_ successor) is decoded by meshoptimizer's own decoder (PyPI
+``meshopt``, a binding of its C++ sources) the first time an accessor reads it; its filters
+(octahedral, quaternion, exponential, colour) are undone by the same call. Every problem is an AlightError naming the file
 and the element (``accessors[4]``, ``buffers[0]``).
 """
 
@@ -23,6 +26,17 @@ from alight.errors import AlightError
 COMPONENT_TYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 TYPE_SIZES = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
 INDEX_TYPES = (5121, 5123, 5125)
+MESHOPT = ("EXT_meshopt_compression", "KHR_meshopt_compression")
+_MESHOPT_MODES = ("ATTRIBUTES", "TRIANGLES", "INDICES")
+_MESHOPT_FILTERS = ("NONE", "OCTAHEDRAL", "QUATERNION", "EXPONENTIAL", "COLOR")
+
+
+def meshopt_available() -> bool:
+    try:
+        import meshopt  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
 
 def fail(source: str, element: str, problem: str) -> AlightError:
@@ -63,6 +77,7 @@ class Accessors:
     def __init__(self, doc, source: str, base: Path, glb_blob: bytes | None):
         self.doc, self.source, self.base, self.glb_blob = doc, source, base, glb_blob
         self._buffers: dict[int, bytes] = {}
+        self._decoded: dict[int, bytes] = {}   # meshopt-compressed bufferViews, decoded once
 
     def buffer(self, index: int) -> bytes:
         data = self._buffers.get(index)
@@ -88,12 +103,49 @@ class Accessors:
         if index is None or not 0 <= index < len(views):
             raise fail(self.source, f"bufferViews[{index}]", "does not exist")
         view = views[index]
+        extensions = view.extensions or {}
+        compressed = next((extensions[n] for n in MESHOPT if isinstance(extensions.get(n), dict)), None)
+        if compressed is not None and meshopt_available():
+            data = self._meshopt(index, compressed)
+            return data, 0, len(data), view.byteStride
         data = self.buffer(view.buffer)
         start, length = int(view.byteOffset or 0), int(view.byteLength or 0)
         if start + length > len(data):
             raise fail(self.source, f"bufferViews[{index}]", f"bytes {start}..{start + length} lie past the end "
                                                              f"of buffers[{view.buffer}] ({len(data)} bytes)")
         return data, start, length, view.byteStride
+
+    def _meshopt(self, index: int, ext: dict) -> bytes:
+        """bufferViews[index]'s data decoded from its EXT_meshopt_compression stream:
+        ``count`` elements of ``byteStride`` bytes (the extension's decoder interface)."""
+        data = self._decoded.get(index)
+        if data is not None:
+            return data
+        import meshopt
+
+        where = f"bufferViews[{index}].extensions.EXT_meshopt_compression"
+        try:
+            source, start, length = int(ext["buffer"]), int(ext.get("byteOffset") or 0), int(ext["byteLength"])
+            count, stride = int(ext["count"]), int(ext["byteStride"])
+        except (KeyError, TypeError, ValueError):
+            raise fail(self.source, where, "needs buffer, byteLength, byteStride and count") from None
+        mode, filt = ext.get("mode"), ext.get("filter") or "NONE"
+        if mode not in _MESHOPT_MODES:
+            raise fail(self.source, where, f"mode {mode!r} is not ATTRIBUTES, TRIANGLES or INDICES")
+        if filt not in _MESHOPT_FILTERS:
+            raise fail(self.source, where, f"filter {filt!r} is not a meshopt filter")
+        blob = self.buffer(source)
+        if start + length > len(blob):
+            raise fail(self.source, where, f"bytes {start}..{start + length} lie past the end of buffers[{source}]")
+        try:
+            rows = meshopt.decode_gltf_buffer(blob[start:start + length], count, stride, mode,
+                                              None if filt == "NONE" else filt)
+        except (ValueError, RuntimeError) as exc:
+            raise fail(self.source, where, f"cannot decode ({' '.join(str(exc).split())})") from None
+        if mode != "ATTRIBUTES":   # the decoder gives index values; the view holds them as stride-byte ints
+            rows = np.asarray(rows).astype({2: np.uint16, 4: np.uint32}.get(stride, np.uint32))
+        data = self._decoded[index] = np.ascontiguousarray(rows).tobytes()
+        return data
 
     def _strided(self, element: str, view_index: int, offset: int, count: int, dtype, width: int,
                  allow_stride: bool = True) -> np.ndarray:

@@ -1476,6 +1476,7 @@ class ForwardRenderer:
                 _set(program, "u_alpha", float(fm.alpha) if fm else 1.0)
                 _set(program, "u_alpha_cutoff", float(fm.alpha_cutoff) if fm else 0.5)
                 _set(program, "u_specular_factor", float(fm.specular_factor) if fm else 1.0)
+                _set(program, "u_specular_f90", float(fm.specular_f90) if fm else 1.0)
                 _set(program, "u_specular_color_f0", tuple(float(x) for x in fm.specular_color_f0) if fm
                      else tuple(float(x) for x in material.specular_f0))
                 # A file's maps use its own UVs as they are; the user's maps are tiled.

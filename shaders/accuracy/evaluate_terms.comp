@@ -33,6 +33,7 @@ const int TERM_PUNCTUAL = 16;
 const int TERM_SPOT_RANGE = 17;
 const int TERM_SPHERE_SURFACE = 18;
 const int TERM_SPHERE_UV = 19;
+const int TERM_F_SCHLICK_F90 = 20;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -79,6 +80,8 @@ void main() {
         case TERM_SPHERE_SURFACE: o.xyz = sphere_surface_point(vec3(0.0, 0.0, a.w), a.xyz, 1.0); break;
         // a = a point on the sphere; o = (its uv, its tangent's x and z).
         case TERM_SPHERE_UV: o = vec4(sphere_uv(a.xyz), sphere_tangent(a.xyz).xz); break;
+        // a = (v.h, grey f0, f90).
+        case TERM_F_SCHLICK_F90: o.xyz = F_Schlick(a.x, vec3(a.y), a.z); break;
     }
     u_outputs[i] = o;
 }

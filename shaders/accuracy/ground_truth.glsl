@@ -21,7 +21,7 @@ vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l
         vec3 h = lv / max(length(lv), 1e-7);
         float n_dot_h = dot(n, h);
         float v_dot_h = clamp(dot(v, h), 0.0, 1.0);
-        vec3 F = F_Schlick(v_dot_h, f0);
+        vec3 F = F_Schlick(v_dot_h, f0, surface_f90(s));
         vec3 kd = (1.0 - F) * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
         kd *= 1.0 - s.transmission;

@@ -39,6 +39,7 @@ void main() {
     vec4 vm = texelFetch(u_g_view, p, 0);
     Surface s = surface_base(texelFetch(u_g_base_color, p, 0).rgb, vm.w, nr.w,
                              texelFetch(u_g_specular_f0, p, 0).rgb, texelFetch(u_g_emissive, p, 0).rgb, 1.0);
+    s.specular_f90 = texelFetch(u_g_specular_f0, p, 0).a;   // 1 unless KHR_materials_specular
     vec3 n = normalize(nr.xyz);
     vec3 v = normalize(vm.xyz);
     vec3 n_map = rotate_world_to_map(n, u_env_rotation);

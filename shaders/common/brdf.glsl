@@ -46,6 +46,14 @@ vec3 F_Schlick(float v_dot_h, vec3 f0) {
     return f0 + (1.0 - f0) * (x2 * x2 * x);
 }
 
+// Schlick's Fresnel with a reflectance f90 at grazing incidence other than 1 (Schlick 1994's
+// form, as KHR_materials_specular's F90 = specularFactor uses it): f0 + (f90 - f0)(1 - v.h)^5.
+vec3 F_Schlick(float v_dot_h, vec3 f0, float f90) {
+    float x = clamp(1.0 - v_dot_h, 0.0, 1.0);
+    float x2 = x * x;
+    return f0 + (f90 - f0) * (x2 * x2 * x);
+}
+
 // The lecture's roughness-aware Fresnel for ambient light (Lagarde 2011, after Schlick).
 vec3 F_SchlickRoughness(float n_dot_v, vec3 f0, float roughness) {
     float x = clamp(1.0 - n_dot_v, 0.0, 1.0);

@@ -173,7 +173,7 @@ vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, float spread) {
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
     float n_dot_h = max(dot(n, h), 0.0);
-    vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s));
+    vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s), surface_f90(s));
 #ifdef HAS_ANISOTROPY
     vec3 specular = anisotropic_specular(s, n, v, l, F, false, spread);
 #else
@@ -227,7 +227,7 @@ vec3 ibl_combine(Surface s, vec3 f0, vec3 diffuse_weight, vec3 spec_weight, vec4
 #ifdef MULTIPLE_SCATTERING
     float e_ss = lut.x + lut.y;
     float e_ms = 1.0 - e_ss;
-    vec3 f_avg = f0 + (1.0 - f0) / 21.0;
+    vec3 f_avg = f0 + (surface_f90(s) - f0) / 21.0;
     vec3 f_ms = spec_weight * f_avg / (1.0 - e_ms * f_avg);
     vec3 e_dss = 1.0 - (spec_weight + f_ms * e_ms);
     return spec_weight * prefiltered + (f_ms * e_ms + albedo * e_dss) * irradiance;
@@ -251,8 +251,9 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
     vec3 prefiltered = prefiltered_radiance_at(reflect(-v, n), s.roughness, true);
 #endif
     vec3 irradiance = irradiance_at(n, true);
-    occlude_environment(s, n, reflect(-v, n), F * lut.x + lut.y, true, irradiance, prefiltered);
-    return ibl_combine(s, surface_f0(s), 1.0 - F, F * lut.x + lut.y, lut, irradiance, prefiltered);
+    vec3 spec_albedo = F * lut.x + surface_f90(s) * lut.y;
+    occlude_environment(s, n, reflect(-v, n), spec_albedo, true, irradiance, prefiltered);
+    return ibl_combine(s, surface_f0(s), 1.0 - F, spec_albedo, lut, irradiance, prefiltered);
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
@@ -274,8 +275,12 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
 #endif
     vec3 irradiance = irradiance_at(n, with_suns);
-    occlude_environment(s, n, d, f0 * lut.x + lut.y, with_suns, irradiance, prefiltered);
-    return ibl_combine(s, f0, (1.0 - f0) * (1.0 - diffuse_fresnel(n_dot_v)), f0 * lut.x + lut.y, lut,
+    // With F90 = 1 the diffuse weight is (1 - F0)(1 - Fc); KHR_materials_specular's F90 makes it
+    // 1 - F0 - (F90 - F0) Fc, and the split sum's B scales by F90.
+    float f90 = surface_f90(s);
+    vec3 spec_albedo = f0 * lut.x + f90 * lut.y;
+    occlude_environment(s, n, d, spec_albedo, with_suns, irradiance, prefiltered);
+    return ibl_combine(s, f0, 1.0 - f0 - (f90 - f0) * diffuse_fresnel(n_dot_v), spec_albedo, lut,
                        irradiance, prefiltered);
 }
 
@@ -287,7 +292,7 @@ vec3 ibl_lecture(Surface s, vec3 n, vec3 v) {
 
 // The lecture with plain Schlick at n.v for kd and F (the diffuse weight ignores roughness).
 vec3 ibl_lecture_schlick(Surface s, vec3 n, vec3 v) {
-    vec3 F = F_Schlick(max(dot(n, v), 0.0), surface_f0(s));
+    vec3 F = F_Schlick(max(dot(n, v), 0.0), surface_f0(s), surface_f90(s));
     return layered_ibl(s, n, v, lecture_split_sum(s, n, v, F), true) * ibl_outer_occlusion(s);
 }
 

@@ -116,6 +116,7 @@ uniform sampler2D u_specular_color_map;
 uniform float u_specular_factor;
 uniform vec3 u_specular_color_f0;             // F0(ior) * specularColorFactor, before the min(., 1)
 #endif
+uniform float u_specular_f90 = 1.0;           // KHR_materials_specular's specularFactor (1 without it)
 // KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
 uniform mat3 u_map_transform[MAP_SLOTS];
 
@@ -285,6 +286,7 @@ float material_alpha() {
 // The material at this fragment; n is shading_normal() (the layers' directions are built about it).
 Surface material_surface(vec3 n) {
     Surface s = surface_base(material_base_color().rgb, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
+    s.specular_f90 = u_specular_f90;
     // glTF's packing: G = roughness, B = metallic; a separate greyscale map takes precedence.
     vec2 metal_rough = vec2(1.0);
     if (has_map(MAP_METALLIC_ROUGHNESS, u_has_metallic_roughness_map)) metal_rough = sample_map(u_metallic_roughness_map, MAP_METALLIC_ROUGHNESS, 1).bg;
@@ -303,6 +305,7 @@ Surface material_surface(vec3 n) {
         }
         if (has_map(MAP_SPECULAR, u_has_specular_map)) factor *= sample_map(u_specular_map, MAP_SPECULAR, 15).a;
         s.specular_f0 = min(color, vec3(1.0)) * factor;
+        s.specular_f90 = factor;   // the extension's F90 = specular (factor times texture A)
     }
 #endif
     if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);

@@ -33,7 +33,7 @@ vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
     float n_dot_h = max(dot(n, h), 0.0);
     float v_dot_h = max(dot(v, h), 0.0);
     float roughness = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
-    vec3 F = F_Schlick(v_dot_h, surface_f0(s));
+    vec3 F = F_Schlick(v_dot_h, surface_f0(s), surface_f90(s));
     vec3 kd = (1.0 - F) * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
     kd *= 1.0 - s.transmission;

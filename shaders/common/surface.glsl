@@ -8,6 +8,7 @@ struct Surface {
     float metallic;
     float roughness;   // perceptual; alpha = roughness^2
     vec3 specular_f0;  // F0 of the dielectric part
+    float specular_f90; // F90 of the dielectric part: KHR_materials_specular's specularFactor, else 1
     vec3 emissive;     // linear radiance added on top
     float occlusion;   // ambient occlusion, scales image-based light only
 #ifdef HAS_CLEARCOAT
@@ -40,6 +41,12 @@ vec3 surface_f0(Surface s) {
     return mix(s.specular_f0, s.base_color, s.metallic);
 }
 
+// F90 = mix(specular_f90, 1, metallic): KHR_materials_specular scales the dielectric Fresnel at
+// grazing incidence too (its specularFactor), a metal's F90 stays 1.
+float surface_f90(Surface s) {
+    return mix(s.specular_f90, 1.0, s.metallic);
+}
+
 // A Surface with the base model's fields; every compiled-in layer starts off (glTF's defaults).
 // The layers' own values come from common/material_layers.glsl (uniforms and maps).
 Surface surface_base(vec3 base_color, float metallic, float roughness, vec3 specular_f0, vec3 emissive,
@@ -49,6 +56,7 @@ Surface surface_base(vec3 base_color, float metallic, float roughness, vec3 spec
     s.metallic = metallic;
     s.roughness = roughness;
     s.specular_f0 = specular_f0;
+    s.specular_f90 = 1.0;
     s.emissive = emissive;
     s.occlusion = occlusion;
 #ifdef HAS_CLEARCOAT

@@ -63,7 +63,7 @@ vec3 transmission_light(Surface s, vec3 n, vec3 v, vec3 l, bool punctual, float 
     if (spread > 0.0) roughness = max(widened_transmission_roughness(s, s.roughness, spread), MIN_PUNCTUAL_ROUGHNESS);
     float v_dot_h;
     float btdf = transmission_btdf(n, v, l, roughness, k, s.ior, thin_walled(s), v_dot_h);
-    vec3 F = F_Schlick(v_dot_h, surface_f0(s));
+    vec3 F = F_Schlick(v_dot_h, surface_f0(s), surface_f90(s));
     return transmission_weight(s) * s.base_color * (1.0 - F) * (btdf * -n_dot_l);
 }
 

@@ -8,7 +8,7 @@ layout(location = 0) out vec4 out_position;     // world position, 1
 layout(location = 1) out vec4 out_normal;       // shading normal n, roughness
 layout(location = 2) out vec4 out_view;         // v (surface -> eye), metallic
 layout(location = 3) out vec4 out_base_color;   // base colour, 1
-layout(location = 4) out vec4 out_specular_f0;  // specular F0 of the dielectric part, 1
+layout(location = 4) out vec4 out_specular_f0;  // specular F0 of the dielectric part, its F90
 layout(location = 5) out vec4 out_emissive;     // emissive, 1
 layout(location = 6) out vec4 out_tangent;      // the tangent frame's t, its handedness (the layers')
 
@@ -19,7 +19,7 @@ void main() {
     out_normal = vec4(n, s.roughness);
     out_view = vec4(normalize(u_camera_position - surface_position()), s.metallic);
     out_base_color = vec4(s.base_color, 1.0);
-    out_specular_f0 = vec4(s.specular_f0, 1.0);
+    out_specular_f0 = vec4(s.specular_f0, s.specular_f90);
     out_emissive = vec4(s.emissive, 1.0);
     out_tangent = vec4(tangent_frame(n)[0], v_tangent.w < 0.0 ? -1.0 : 1.0);
 #ifdef HAS_ANISOTROPY
