@@ -19,6 +19,12 @@ The subpackages, by concern (a lower layer never imports a higher one):
 ``ibl`` (environments and the bake) < ``render`` (the forward renderer) < ``accuracy``
 (ground truth, twins, metrics, chart, auto quality) < ``frontends`` (CLI, API, batch, pytest
 plugin, editor). ``shaders/`` mirrors it: ``common/``, ``ibl/``, ``render/``, ``accuracy/``.
+
+Two names the code uses throughout: "the lecture" is Learn OpenGL's PBR chapters by Joey de
+Vries (Theory, Lighting, Diffuse irradiance, Specular IBL), the split sum alight starts from
+(``docs/explanation/shading-model.md``); "the conventions" are ``docs/conventions.md``
+(coordinates, the equirect mapping, the probe view, the material model, the BRDF, the ground
+truth).
 """
 
 __version__ = "0.1.0"

@@ -4,7 +4,7 @@ Prints the figures and writes results/anisotropy.md and results/anisotropy.csv; 
     .venv/bin/python benchmarks/bench_anisotropy.py            # every shared 2:1 map (~30 min on 2 loaded cores)
     .venv/bin/python benchmarks/bench_anisotropy.py --quick    # royal_esplanade and venice_sunset
 
-Error: the probe view (CONVENTIONS.md; the tangent is the probe's, docs/layers.md) rendered by
+Error: the probe view (docs/conventions.md; the tangent is the probe's, docs/layers.md) rendered by
 the GPU at the `medium` bake with the default IBL model, against the exact texel sum of
 docs/layer_anisotropy.md (alight.accuracy.ground_truth.anisotropic_ground_truth_terms) over the
 map reduced by 4, as sum |render - truth| / sum |truth| over the disk and RGB. Cases: roughness

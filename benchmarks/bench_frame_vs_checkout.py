@@ -1,6 +1,6 @@
 """One frame of the material ball without layers, counted in CPU instructions by callgrind, in
 this checkout and in another checkout (its own virtualenv): "a material without layers costs what
-it costs on main" (issue 11), with everything that differs between the two (Python side, passes,
+it costs on main", with everything that differs between the two (Python side, passes,
 shaders) included. Prints the counts; not a test.
 
     git worktree add /tmp/alight_main main

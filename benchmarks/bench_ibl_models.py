@@ -1,13 +1,13 @@
-"""Every IBL model of app/core/ibl_models.py against CONVENTIONS.md's ground truth, and its frame cost.
+"""Every IBL model of app/core/ibl_models.py against docs/conventions.md's ground truth, and its frame cost.
 Prints the figures and writes results/ibl_models.csv and results/ibl_models.md; not a test.
 
     python benchmarks/bench_ibl_models.py            # every shared 2:1 map, every preset (~10 min on 2 cores)
     python benchmarks/bench_ibl_models.py --quick    # two maps, three presets, two roughness values
 
-Error: the probe view (CONVENTIONS.md) rendered by the GPU at the `medium` bake, against the exact
+Error: the probe view (docs/conventions.md) rendered by the GPU at the `medium` bake, against the exact
 texel sum of app/accuracy/ground_truth.py over the map reduced by 2 (alight.accuracy.converged.downsample_equirect),
 as sum |render - truth| / sum |truth| over the disk and RGB (relative mean absolute error).
-The goal of issue 4: at most half the lecture's error for every preset at r >= 0.3 on every
+The goal: at most half the lecture's error for every preset at r >= 0.3 on every
 shared map (spot1Lux aside: its truth is near zero over most of the ball), at no more than 10%
 more frame time. The frame time is the material ball at 1280x720 with 3 point lights and the
 environment as background (`ForwardRenderer.render` + `ctx.finish()`, no read-back), median of repeats,
@@ -159,7 +159,7 @@ def main(argv=None):
     from alight.exchange.presets import list_presets, load_preset
 
     envs = shared_environments()
-    # The models are the BRDF's: presets with layers (the transmissive ones since issue 11) are
+    # The models are the BRDF's: presets with layers (the transmissive ones) are
     # measured by their layer's benchmark (bench_transmission.py).
     presets = [p for p in list_presets() if not load_preset(p).layers()]
     roughnesses = ROUGHNESS

@@ -5,7 +5,7 @@ results/layer_errors.csv and results/layer_errors.md. Not a test.
     python benchmarks/bench_layer_errors.py            # every shared map (~30 min on 2 loaded cores)
     python benchmarks/bench_layer_errors.py --quick    # royal_esplanade and quarry_01 only
 
-Error: the probe view (CONVENTIONS.md) rendered by the GPU at the `medium` bake with the default
+Error: the probe view (docs/conventions.md) rendered by the GPU at the `medium` bake with the default
 IBL model (alight), against `alight reference` (the GPU texel sum of the layered BRDF; the map at
 level 0, or 1 where reference.py's choose_env_level allows), as sum |render - truth| /
 sum |truth| over the disk and RGB. Each layered case is printed beside the same material

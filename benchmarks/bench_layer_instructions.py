@@ -1,4 +1,4 @@
-"""What each glTF layer (issue 11) costs per frame, counted in CPU instructions by valgrind's
+"""What each glTF layer costs per frame, counted in CPU instructions by valgrind's
 callgrind: on llvmpipe the shaders run on the CPU, and an instruction count, unlike a time, does
 not move with the load other jobs put on a shared machine. Prints the figures; not a test.
 

@@ -1,4 +1,4 @@
-"""What the glTF layers (issue 11) cost per frame: a material without layers against the same
+"""What the glTF layers cost per frame: a material without layers against the same
 material drawn by another revision's shaders (it must cost what it cost before the layers, within
 3%), and each layer's own frame cost.
 

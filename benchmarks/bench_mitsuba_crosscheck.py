@@ -7,7 +7,7 @@ shadows and inter-reflection, a near-Lambertian material. Prints; asserts nothin
 
 Mitsuba: scalar_rgb, its path integrator (max_depth 9), a two-sided stock `diffuse` BSDF of
 reflectance 0.7, a box pixel filter, the same camera (vertical fov, look-at). alight: base 0.7,
-metallic 0, specular_f0 0, roughness 1 (CONVENTIONS.md's BRDF is then Lambert but for the
+metallic 0, specular_f0 0, roughness 1 (docs/conventions.md's BRDF is then Lambert but for the
 Fresnel-Schlick term (1 - v.h)^5, which moves the albedo by well under 1% at these angles),
 max 9 vertices. A constant environment needs no agreement on the equirect mapping. Reported:
 binned 4x4 relMAE between the two, the same between two seeds of alight's (the noise floor),

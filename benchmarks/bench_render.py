@@ -306,7 +306,7 @@ def bench_ground_truth_curve(envs, roughnesses, size=32, factor=2, suffix=""):
     from alight.core.scene import Scene
     from alight.render.renderer import ForwardRenderer
 
-    section(f"Probe error vs the ground truth of CONVENTIONS.md (app/accuracy/ground_truth.py), quality 'medium', "
+    section(f"Probe error vs the ground truth of docs/conventions.md (app/accuracy/ground_truth.py), quality 'medium', "
             f"probe {size}x{size}, in %")
     print(f"The ground truth sums over the environment DOWNSAMPLED BY {factor} (alight.accuracy.converged.downsample_equirect, "
           f"e.g. 1024x512 -> {1024 // factor}x{512 // factor}) to keep it fast; the GPU bakes the full map. "
@@ -373,7 +373,7 @@ def _plot(rows, path, size, factor):
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("sum|render - ground truth| / sum|ground truth|  (%)")
     axes[-1].legend(fontsize=8, loc="upper right")
-    fig.suptitle(f"alight probe ({size}x{size}, quality medium) vs CONVENTIONS.md ground truth "
+    fig.suptitle(f"alight probe ({size}x{size}, quality medium) vs docs/conventions.md ground truth "
                  f"(env downsampled x{factor} for the reference)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

@@ -1,4 +1,4 @@
-"""Large output sizes (issue 10, item 15): peak memory of `alight render` at each size, and what
+"""Large output sizes: peak memory of `alight render` at each size, and what
 drawing in tiles costs against one pass. Prints what it measured; asserts nothing.
 
     .venv/bin/python benchmarks/bench_tiles.py                 # 1024 .. 16384 (minutes: 16384 is 268 Mpixel)

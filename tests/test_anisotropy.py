@@ -1,5 +1,5 @@
 """KHR_materials_anisotropy (docs/layer_anisotropy.md): the GLSL terms against their numpy twins,
-the exact BRDF's limits (strength 0 is CONVENTIONS.md's BRDF; a white metal never reflects more
+the exact BRDF's limits (strength 0 is docs/conventions.md's BRDF; a white metal never reflects more
 than it receives), and the exact answer on the GPU against numpy."""
 
 from __future__ import annotations
@@ -230,7 +230,7 @@ def test_a_zero_strength_part_drawn_with_the_layer_compiled_in_changes_nothing(s
     # A mesh whose parts mix an anisotropic material with a plain one compiles HAS_ANISOTROPY for
     # both; the plain part then runs the layer's code at strength 0 (punctual lights, the compact
     # sources and the environment). It must match the same part drawn without the layer within
-    # 0.2% (issue 11's zero-strength bound).
+    # 0.2% (the layers' zero-strength bound).
     import dataclasses
 
     from alight.core.mesh import FileMaterial, Mesh, sphere

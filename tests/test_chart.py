@@ -68,7 +68,7 @@ def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
     assert judged == set(IBL_MODELS) == furnace_only
     quick = sweep(quick=True)
     assert len(quick) < len(settings) and {s.ibl_model for s in quick} == set(IBL_MODELS)
-    # a row per layer of issue 11, at medium with the default model, in both sweeps
+    # a row per material layer, at medium with the default model, in both sweeps
     from alight.accuracy.chart import LAYER_ROWS
 
     for sw in (settings, quick):

@@ -1,6 +1,6 @@
 """End-to-end tests of the ``alight`` command line (``python -m alight ...``) through subprocesses.
 
-Success paths check the written images against CONVENTIONS.md's output rules; bad input must
+Success paths check the written images against docs/conventions.md's output rules; bad input must
 give exit status 2, exactly one ``alight: error:`` line naming the file or option, no traceback,
 and nothing written (not even a temporary file). GL renders are kept at 64x64 and low quality.
 """
@@ -83,7 +83,7 @@ def read(path: Path, fmt=None) -> tuple[np.ndarray, "oiio.ImageSpec"]:
 
 
 def probe_disk(w: int) -> np.ndarray:
-    """CONVENTIONS.md's probe view: pixel (i, j) is on the sphere iff x*x + y*y < 1."""
+    """docs/conventions.md's probe view: pixel (i, j) is on the sphere iff x*x + y*y < 1."""
     j, i = np.mgrid[0:w, 0:w]
     x = 2.0 * (i + 0.5) / w - 1.0
     y = 1.0 - 2.0 * (j + 0.5) / w
@@ -279,7 +279,7 @@ def test_bake_writes_all_maps(tmp_path):
 
 
 def test_a_flat_mesh_seen_edge_on_is_said(out_dir):
-    """The default camera (on +Z, CONVENTIONS.md) sees a y = 0 plane edge-on: one warning says so
+    """The default camera (on +Z, docs/conventions.md) sees a y = 0 plane edge-on: one warning says so
     and names the way out; from above (--elevation) it shows, without the warning."""
     plane = SHARED_DATA / "bad" / "singlevn.obj"
     edge_on = render(out_dir / "edge_on.png", "--mesh", plane)

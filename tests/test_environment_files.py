@@ -1,4 +1,4 @@
-"""Environment files in every legal layout (issue 10, item 13) and huge texels (item 14).
+"""Environment files in every legal layout, and huge texels.
 
 Each test writes its own files: Radiance pictures in all eight orientations (literal-run RLE
 scanlines, placed by the definition in Radiance's resolu.c), OpenEXR files with display and data

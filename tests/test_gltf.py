@@ -1,4 +1,4 @@
-"""glTF 2.0 as the specification says (issue 10): each feature is tested by equivalence, a small
+"""glTF 2.0 as the specification says: each feature is tested by equivalence, a small
 file that uses it against one that does not, rendered linear (no tone mapping) within 1% relMAE;
 plus coverage, unlit, refusals and warnings. The tests write their own files (tests/gltf_builder.py).
 """

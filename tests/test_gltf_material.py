@@ -83,7 +83,7 @@ def edge_materials() -> list[Material]:
 
 def layered_materials() -> list[Material]:
     """Each layer alone, every layer at once, an ior apart from the specular colour, and random
-    layered materials (issue 11's extensions)."""
+    layered materials (the layers' extensions)."""
     rng = np.random.default_rng(11)
     out = [
         Material(clearcoat=1.0, clearcoat_roughness=0.03, name="clearcoat"),

@@ -1,4 +1,4 @@
-"""alight.accuracy.ground_truth: CONVENTIONS.md's exact IBL texel sum, checked against analytic values and an
+"""alight.accuracy.ground_truth: docs/conventions.md's exact IBL texel sum, checked against analytic values and an
 independent Monte Carlo estimate."""
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ def _frame(n):
 
 
 def _brdf_cos(n, v, l, base, metallic, roughness, specular_f0):
-    """f(l, v) max(n.l, 0) of CONVENTIONS.md, straight from alight.core.shading's twins: (S, 3)."""
+    """f(l, v) max(n.l, 0) of docs/conventions.md, straight from alight.core.shading's twins: (S, 3)."""
     f0 = f0_of(np.asarray(base, float), metallic, np.asarray(specular_f0, float))
     nl = l @ n
     nv = max(float(n @ v), 1e-4)
@@ -81,7 +81,7 @@ def esplanade(shared_data):
 # --- (a) the white furnace ------------------------------------------------------------------
 
 def test_furnace_albedo_at_normal_incidence():
-    """CONVENTIONS.md: 0.99995 at n.v = 1, r = 1 (the 1 - 5e-5 is the Fresnel term (1 - v.h)^5
+    """docs/conventions.md: 0.99995 at n.v = 1, r = 1 (the 1 - 5e-5 is the Fresnel term (1 - v.h)^5
     taking energy from the diffuse lobe and giving less back to the F0 = 0 specular lobe)."""
     rad = constant_environment(1.0, 256).radiance  # 256x128
     out = reflectance_ground_truth(rad, _normal_at(1.0), (0.0, 0.0, 1.0), roughness=1.0, **WHITE_LAMBERT)
@@ -93,7 +93,7 @@ def test_furnace_albedo_at_normal_incidence():
 def test_furnace_albedo_at_grazing():
     """'Grazing' is the limit n.v -> 0, which the sum evaluates at n.v = 1e-4 (the shaders'
     MIN_N_DOT_V clamp; the value changes by < 1e-5 between n.v = 1e-3 and 1e-4). An independent
-    dense quadrature of the same BRDF gives 0.99157 there (r = 1), CONVENTIONS.md's 0.992."""
+    dense quadrature of the same BRDF gives 0.99157 there (r = 1), docs/conventions.md's 0.992."""
     rad = constant_environment(1.0, 256).radiance
     for nv in (1e-4, 0.0):  # exactly 0 is clamped to 1e-4 too
         out = reflectance_ground_truth(rad, _normal_at(nv), (0.0, 0.0, 1.0), roughness=1.0, **WHITE_LAMBERT)

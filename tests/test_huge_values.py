@@ -1,4 +1,4 @@
-"""Finite but huge values (issue 10, item 14): nothing downstream of the loader overflows.
+"""Finite but huge values: nothing downstream of the loader overflows.
 
 The loader clamps texels to RADIANCE_MAX (tests/test_environment_files.py). Here: a map holding
 texels at that clamp bakes (every quality, both irradiance methods, the compact-source path)

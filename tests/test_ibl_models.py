@@ -1,4 +1,4 @@
-"""The IBL models of app/core/ibl_models.py against CONVENTIONS.md's ground truth, through their numpy
+"""The IBL models of app/core/ibl_models.py against docs/conventions.md's ground truth, through their numpy
 twins (alight.accuracy.converged.ibl_converged: each model with converged maps, so only the model's own
 approximation is measured, not the bake's sampling). The maps are reduced by 4 (256x128) to keep
 this fast; both sides of every comparison use the same reduced map.
@@ -26,7 +26,7 @@ from alight.ibl.environment import constant_environment, load_environment
 PROBE = 24
 _maps: dict = {}
 # The models are about the BRDF's reflection: "water" here is the opaque low-F0 dielectric the
-# water preset was before it became transmissive (issue 11; its transmission has its own tests,
+# water preset was before it became transmissive (its transmission has its own tests,
 # tests/test_transmission.py).
 OPAQUE = {"water": Material(base_color=(0.02, 0.03, 0.05), roughness=0.05, specular_f0=(0.02, 0.02, 0.02), name="water")}
 

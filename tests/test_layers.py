@@ -1,4 +1,4 @@
-"""The layers' shared plumbing (issue 11): the material fields, the ior rule, preset files, the
+"""The layers' shared plumbing: the material fields, the ior rule, preset files, the
 API and CLI, the compile-time defines, and the exact layered BRDF's base against the ground
 truth's own. Each layer's shading has its own tests (test_clearcoat.py, ...)."""
 
@@ -207,7 +207,7 @@ def test_a_material_without_layers_renders_exactly_as_its_zero_strength_twin():
 
 def test_layered_sum_of_a_base_material_equals_the_ground_truth(shared_data):
     """The exact layered BRDF (alight.core.layers.stack) on a material without layers is
-    CONVENTIONS.md's BRDF: its texel sum equals the S1..S4 ground truth."""
+    docs/conventions.md's BRDF: its texel sum equals the S1..S4 ground truth."""
     from alight.accuracy.ground_truth import layered_ground_truth, probe_points, reflectance_ground_truth
     from alight.ibl.environment import load_environment
 

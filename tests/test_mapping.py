@@ -1,4 +1,4 @@
-"""The equirectangular mapping, the environment rotation and the probe view against CONVENTIONS.md,
+"""The equirectangular mapping, the environment rotation and the probe view against docs/conventions.md,
 in numpy and through the whole GPU path (bake -> cube -> forward pass -> read-back)."""
 
 import numpy as np

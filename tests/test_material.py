@@ -65,7 +65,7 @@ def _one_line_error(excinfo, *parts: str) -> str:
 
 def test_preset_names_follow_the_table_and_match_the_files():
     assert PRESET_NAMES == tuple(TABLE)
-    # The table's rows first; the layers' presets (issue 11) after them.
+    # The table's rows first; the layers' presets after them.
     assert list_presets()[:len(TABLE)] == list(TABLE)
 
 

@@ -94,7 +94,7 @@ def test_mirror_sphere_shows_the_environment_as_the_render_does(royal):
 def test_integrating_sphere_sums_every_bounce():
     # Inside a closed sphere whose wall emits 1 and reflects a fraction a, the radiance is
     # 1 / (1 - a) everywhere (the integrating sphere). With base 0.5 and F0 0 the albedo is
-    # 0.5 to within 0.5% (CONVENTIONS.md: F = (1 - v.h)^5 still reflects a little), so 2.0.
+    # 0.5 to within 0.5% (docs/conventions.md: F = (1 - v.h)^5 still reflects a little), so 2.0.
     material = Material(base_color=(0.5, 0.5, 0.5), metallic=0.0, roughness=1.0, specular_f0=(0.0, 0.0, 0.0),
                         emissive=(1.0, 1.0, 1.0))
     camera = Camera(position=(0.0, 0.0, 0.0), target=(0.0, 0.0, -1.0), fov_y_deg=60.0, near=0.01)

@@ -1,4 +1,4 @@
-"""alight reference (app/accuracy/reference.py): CONVENTIONS.md's ground truth on the GPU, against analytic
+"""alight reference (app/accuracy/reference.py): docs/conventions.md's ground truth on the GPU, against analytic
 values, the numpy ground truth (app/accuracy/ground_truth.py) and the real-time punctual path."""
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ def _points(ref, radiance, normals, views, material, env_level=0):
 
 
 def test_white_furnace_at_normal_incidence(ref):
-    # CONVENTIONS.md: base 1, metallic 0, specular_f0 0 under radiance 1 has albedo 0.99995 at
+    # docs/conventions.md: base 1, metallic 0, specular_f0 0 under radiance 1 has albedo 0.99995 at
     # n.v = 1, r = 1. Tolerance 1e-3: the texel sum is a midpoint rule in theta, off by about
     # (pi/H)^2/24 = 1.6e-6 at H = 512, plus float32 rounding; measured 0.999953 (3e-6 off).
     # A full 1024x512 map needs 16 dispatches: llvmpipe cut a single one short at 65535 loop
@@ -189,7 +189,7 @@ def test_automatic_env_level(royal, shared_data):
 
 def test_mesh_view_orientation(ref):
     # Light from one side only: the sphere seen from +Z is bright on that side of the image
-    # (+Y up: top rows; +X: right columns; u = 0.75 is +X in CONVENTIONS.md's mapping). Near
+    # (+Y up: top rows; +X: right columns; u = 0.75 is +X in docs/conventions.md's mapping). Near
     # Lambert, E/pi = (1 + n.y)/2 under the upper-half sky: the outer thirds of the disk differ by
     # about 4x (measured 73.2 vs 18.5); a flipped image would give the inverse ratio.
     m = Material(roughness=1.0, **WHITE)

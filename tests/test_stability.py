@@ -1,4 +1,4 @@
-"""Stability: where the methods fail, and what is expected of each failure case (issue 4).
+"""Stability: where the methods fail, and what is expected of each failure case.
 
 tests/test_robustness.py checks that nothing is NaN at the parameter extremes; tests/
 test_white_furnace.py checks the furnace at the default quality for the lecture's metal;
@@ -544,7 +544,7 @@ def test_white_furnace_metal_never_above_one(furnace, model, multiple_scattering
 @pytest.mark.parametrize("model", list(IBL_MODELS))
 @pytest.mark.parametrize("f0", [0.04, 0.0], ids=["F0=0.04", "F0=0"])
 def test_white_furnace_dielectric(furnace, model, f0):
-    """A white dielectric (base colour 1) under radiance 1. CONVENTIONS.md's BRDF itself is not
+    """A white dielectric (base colour 1) under radiance 1. docs/conventions.md's BRDF itself is not
     energy-conserving here: kd = 1 - F(v.h) per direction lets the diffuse keep what the specular
     also reflects at grazing. At r = 0 its albedo is exactly
         F0 + (1 - F0) Fc(n.v) + (1 - F0)(1 - C(n.v))

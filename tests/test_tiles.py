@@ -1,4 +1,4 @@
-"""Output sizes one framebuffer cannot hold (issue 10, item 15): tiles with the same pixels.
+"""Output sizes one framebuffer cannot hold: tiles with the same pixels.
 
 The plan (alight.render.tiles) is checked as arithmetic at every size the CLI accepts; the GL
 side by equivalence: an image drawn in small forced tiles against the same image in one pass,

@@ -1,6 +1,6 @@
 """docs/anisotropy_compare.png: KHR_materials_anisotropy looked at.
 
-Top row: brushed_aluminium in the probe view (CONVENTIONS.md) under royal_esplanade: the exact
+Top row: brushed_aluminium in the probe view (docs/conventions.md) under royal_esplanade: the exact
 answer (docs/layer_anisotropy.md, summed in numpy over the map reduced by 4), alight's stretched
 lookup, the round lookup and the Khronos sample viewer's bent normal (the last two through
 anisotropy.glsl's ANISOTROPY_LOOKUP, as benchmarks/bench_anisotropy.py selects them). Below:

@@ -1,6 +1,6 @@
 """Fit the `stretched` IBL model's lobe table (app/core/stretched_lobe.json) in lobe space.
 
-The real specular lobe seen from v (CONVENTIONS.md's BRDF, k = r^2/2: its F0-scaled part
+The real specular lobe seen from v (docs/conventions.md's BRDF, k = r^2/2: its F0-scaled part
 (1 - Fc) D G / (4 n.v) and its bias part Fc D G / (4 n.v), over l) is not the round lobe the
 prefiltered map holds (the prefilter assumes n = v = R): it is narrower across the plane of
 incidence, reaches further toward n, and has heavier tails. For each (n.v, roughness) cell and
@@ -86,7 +86,7 @@ class Grid:
 
 
 def true_lobe(l, n_dot_v: float, alpha: float, part: str):
-    """CONVENTIONS.md's specular lobe times n.l over l (n = +z, v in the xz plane), without F0:
+    """docs/conventions.md's specular lobe times n.l over l (n = +z, v in the xz plane), without F0:
     D G1(n.l) G1(n.v) / (4 n.v) times (1 - Fc) (part A) or Fc (part B); k = alpha / 2."""
     v = np.array([np.sqrt(max(1 - n_dot_v ** 2, 0.0)), 0.0, n_dot_v])
     nl = l[..., 2]

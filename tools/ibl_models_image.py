@@ -3,7 +3,7 @@ by side on the probe view, with each model's relative error against the truth in
 
     .venv/bin/python tools/ibl_models_image.py     # needs matplotlib (pip install matplotlib)
 
-The truth is `alight reference` on the GPU (CONVENTIONS.md's texel sum over the map reduced by 2,
+The truth is `alight reference` on the GPU (docs/conventions.md's texel sum over the map reduced by 2,
 --env-level 1); the models are `alight render --ibl ...` at the medium bake. Every figure in the
 titles is measured by this script when it runs.
 """

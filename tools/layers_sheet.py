@@ -1,4 +1,4 @@
-"""Renders docs/layers.jpg, the material layers' contact sheet (issue 11): every preset on the
+"""Renders docs/layers.jpg, the material layers' contact sheet: every preset on the
 material ball, ClearCoatTest beside Khronos' reference screenshot, and the Khronos Compare*
 models of the material extensions (each pair: without the feature on the left, with it on the
 right), all under royal_esplanade_1k.

@@ -1,4 +1,4 @@
-"""Renders docs/transmission.png: the transmission layer's contact sheet (issue 11).
+"""Renders docs/transmission.png: the transmission layer's contact sheet.
 
 Row 1-2: the transmissive presets (water, plastic_glass_low, glass_high_ruby, diamond) and a
 thin-walled glass beside plastic_high (opaque, for contrast), in the built-in studio and under

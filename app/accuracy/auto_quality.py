@@ -39,7 +39,7 @@ ROUGHNESS_POINTS = (0.0, 0.15, 0.25, 0.5, 0.75, 1.0)
 ARCHETYPES = ("dielectric", "metal")   # grey 0.8 dielectric (F0 0.04), gold
 # Measured but left out of the predictions, with the reason.
 EXCLUDED = {"spot1Lux.hdr": "one spot on black: the converged value is ~0 over most of the probe, "
-                            "so a relative error means little (as issue 4 says of its ground truth)"}
+                            "so a relative error means little (as the ground truth's definition says)"}
 
 
 def _lut_of(q: BakeQuality, like: BakeQuality) -> BakeQuality:

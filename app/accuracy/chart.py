@@ -1,4 +1,4 @@
-"""``alight chart``: what each bit of IBL accuracy costs (issue 4, "The chart").
+"""``alight chart``: what each bit of IBL accuracy costs.
 
 One factor at a time around the ``medium`` bake quality (a full cartesian product would not be
 tractable), plus every IBL model of ``app/core/ibl_models.py`` and multiple scattering on and off:
@@ -9,7 +9,7 @@ tractable), plus every IBL model of ``app/core/ibl_models.py`` and multiple scat
     FIS            filtered importance sampling off
     LUT            BRDF LUT size; BRDF LUT sample count
     IBL model      every entry of IBL_MODELS
-    layer          one row per layer of issue 11 (``LAYER_ROWS``): the error of the presets
+    layer          one row per material layer (``LAYER_ROWS``): the error of the presets
                    that use the layer against the layer's exact answer, the layer's own white
                    furnace (``LAYER_FURNACE``) and the ball's frame time with the layer on
     MS             multiple-scattering compensation on, for every model: judged by the white
@@ -21,7 +21,7 @@ a layer counts in that layer's row only.
 
 For each setting and environment: the bake time (the environment's passes, warm; the LUT is
 cached on disk and timed apart, cold), the frame time (a fixed scene: the material ball at
-``frame_size``, median of a few) and the error of the probe view against CONVENTIONS.md's ground
+``frame_size``, median of a few) and the error of the probe view against docs/conventions.md's ground
 truth (``alight.accuracy.reference`` on the GPU) over the presets x roughness values: relMAE in linear
 radiance and FLIP on the tone-mapped images (``alight.accuracy.metrics``).
 
@@ -67,7 +67,7 @@ FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
 FURNACE_TRUTH_WIDTH = 256
 FURNACE_TRUTH_FROM = 0.25
 QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet", "brushed_aluminium")   # the last four: the layers' rows
-# Layers with a row of their own (issue 11), the material of their white furnace (radiance 1:
+# Layers with a row of their own, the material of their white furnace (radiance 1:
 # what the layer reflects and transmits must not exceed 1, and at roughness 0 it is exactly 1)
 # and the preset drawn for their frame time.
 LAYER_ROWS = ("clearcoat", "sheen", "anisotropy", "transmission")
@@ -86,7 +86,7 @@ LAYER_FURNACE = {
 LAYER_FRAME_PRESET = {"clearcoat": "car_paint", "sheen": "velvet", "anisotropy": "brushed_aluminium",
                       "transmission": "water"}
 # Environments left out of the summary columns (still in chart_cases.csv): spot1Lux's truth is
-# near zero over most of the ball, where a relative error means little (issue 4).
+# near zero over most of the ball, where a relative error means little.
 SUMMARY_EXCLUDED = ("spot1Lux",)
 # n.v bins of the error map.
 NV_BINS = 10
@@ -184,7 +184,7 @@ class ReferenceTerms:
     levels: dict = field(default_factory=dict)   # roughness -> level summed
 
     def combine(self, material, roughness: float) -> np.ndarray:
-        """(S, S, 4) linear RGBA of CONVENTIONS.md's probe view for ``material``."""
+        """(S, S, 4) linear RGBA of docs/conventions.md's probe view for ``material``."""
         i = min(range(len(self.roughness)), key=lambda j: abs(self.roughness[j] - roughness))
         if abs(self.roughness[i] - roughness) > 1e-9:
             raise ValueError(f"roughness {roughness} was not summed")
@@ -440,7 +440,7 @@ def _furnace(renderer, setting: Setting, maps, size: int) -> list[tuple[float, f
 
 
 def furnace_truth(ref_renderer, size: int) -> list[tuple[float, float, float, float]]:
-    """CONVENTIONS.md's ground truth of the white furnace (metal, F0 = 1, radiance 1): per
+    """docs/conventions.md's ground truth of the white furnace (metal, F0 = 1, radiance 1): per
     roughness >= FURNACE_TRUTH_FROM, (r, mean, min, max) over the probe's pixels. It is below 1:
     the single-scattering BRDF loses the energy of the rays that bounce more than once."""
     from alight.ibl.environment import constant_environment

@@ -1,6 +1,6 @@
 """The converged split sum: what the GPU bake's sampling loops tend to with infinite samples.
 
-These numpy references sum exactly over the texels of an equirect map (CONVENTIONS.md's
+These numpy references sum exactly over the texels of an equirect map (docs/conventions.md's
 mapping and solid angles, via ``alight.core.shading.texel_directions``) instead of sampling, and they
 integrate the BRDF LUT by a deterministic quadrature instead of Hammersley points. Tests and
 the accuracy tools compare the GPU's baked irradiance map, prefiltered mip chain and BRDF LUT
@@ -547,7 +547,7 @@ def downsample_equirect(radiance, factor: int) -> np.ndarray:
     return box_reduce(radiance, int(factor))
 
 
-# --- transmission (docs/transmission.md) --------------------------------------------------
+# --- transmission (docs/layer_transmission.md) --------------------------------------------------
 
 def prefilter_kernel_mean_cosine(roughness, n_u: int = 4096):
     """The mean cosine between l and the lookup direction d of the prefiltered map's kernel at a
@@ -583,7 +583,7 @@ def roughness_for_mean_cosine(mean_cosine, steps: int = 40):
 def transmission_lut_converged(n_dot_v, roughness, ior, n_u: int = 256, n_phi: int = 64):
     """Numpy twin of ``ibl/transmission_lut.comp``: the refracted lobe of KHR_materials_volume's
     BTDF (v outside, index 1; l inside, index ``ior``) at one (n.v, roughness, ior) each, as
-    three numbers the forward pass reads (docs/transmission.md, "Real-time"):
+    three numbers the forward pass reads (docs/layer_transmission.md, "Real-time"):
 
     - E: the integral of btdf (1 - Fc(v.h)) |n.l| over l (transmitted = (1 - m) t c T (1 - F0) E L
       under a constant environment L). Drawing h with pdf D(h)(n.h) and l = refract(-v, h, 1/ior),

@@ -1,11 +1,11 @@
-"""The exact image-based-lighting answer of CONVENTIONS.md ("Ground truth for image-based lighting").
+"""The exact image-based-lighting answer of docs/conventions.md ("Ground truth for image-based lighting").
 
     L_o(n, v) = emissive + sum over the environment's texels t of f(l_t, v) L(l_t) max(n.l_t, 0) dOmega_t
 
-with f exactly CONVENTIONS.md's Cook-Torrance BRDF: a = r^2, D = GGX, G = Schlick-GGX with
+with f exactly docs/conventions.md's Cook-Torrance BRDF: a = r^2, D = GGX, G = Schlick-GGX with
 k = r^2/2 (the IBL k), F = Fresnel-Schlick at v.h *per light direction*, kd = (1 - F)(1 - metallic),
 f = kd base/pi + D F G / (4 n.l n.v), F0 = mix(specular_f0, base, metallic). Texel directions and
-solid angles are CONVENTIONS.md's (``alight.core.shading.texel_directions``): nothing is sampled, so the
+solid angles are docs/conventions.md's (``alight.core.shading.texel_directions``): nothing is sampled, so the
 answer is deterministic and is what every IBL approximation (the split sum, the GPU bake) is
 measured against.
 
@@ -38,7 +38,7 @@ Guards:
 - |l + v| is floored at 1e-7 (l = -v only happens for n.v < 0, where n.l > 0 can still hold).
 
 Rotation and intensity: radiance arriving from world direction d is intensity times the map's
-radiance in R_y(-deg) d (CONVENTIONS.md), so the map texel with map-space direction m lights
+radiance in R_y(-deg) d (docs/conventions.md), so the map texel with map-space direction m lights
 the world direction R_y(+deg) m = ``rotate_world_to_map(m, -deg)``; the texel sum runs over the
 rotated texel directions with unchanged solid angles.
 
@@ -209,7 +209,7 @@ def ground_truth_terms(radiance, normals, views, roughness, rotation_deg: float 
 
 def transmission_terms(radiance, normals, views, roughness, ior: float = 1.5, thin: bool = True,
                        rotation_deg: float = 0.0, intensity: float = 1.0) -> np.ndarray:
-    """The transmitted light's texel sum S_T (docs/transmission.md) for each point: (R, P, 3).
+    """The transmitted light's texel sum S_T (docs/layer_transmission.md) for each point: (R, P, 3).
 
         S_T = sum over texels with n.l < 0 of btdf(l, v) (1 - Fc(v.h)) |n.l| W
 
@@ -306,7 +306,7 @@ def check_transmission_lobe(roughness: float, ior: float) -> None:
 
 def transmission_combine(reflection: np.ndarray | tuple, s_t: np.ndarray, base_color, metallic, specular_f0,
                          transmission: float, attenuation=(1.0, 1.0, 1.0)) -> np.ndarray:
-    """L_o with transmission (docs/transmission.md): the reflected part with its diffuse scaled by
+    """L_o with transmission (docs/layer_transmission.md): the reflected part with its diffuse scaled by
     (1 - transmission), plus (1 - m) t c T (1 - F0) S_T. ``reflection`` is ``GroundTruthTerms.combine
     (..., parts=True)``'s (diffuse, specular); ``s_t`` one roughness's (P, 3) of
     :func:`transmission_terms`; ``attenuation`` the Beer-Lambert transmittance T (RGB)."""
@@ -322,9 +322,9 @@ def transmission_combine(reflection: np.ndarray | tuple, s_t: np.ndarray, base_c
 def reflectance_ground_truth(radiance, normals, views, base_color, metallic, roughness, specular_f0,
                              emissive=(0.0, 0.0, 0.0), rotation_deg: float = 0.0,
                              intensity: float = 1.0) -> np.ndarray:
-    """CONVENTIONS.md's exact IBL answer L_o(n, v) for each point: (P, 3) float64.
+    """docs/conventions.md's exact IBL answer L_o(n, v) for each point: (P, 3) float64.
 
-    ``radiance``: (H, 2H, 3) equirect map (CONVENTIONS.md mapping); ``normals`` (P, 3);
+    ``radiance``: (H, 2H, 3) equirect map (docs/conventions.md mapping); ``normals`` (P, 3);
     ``views`` (3,) or (P, 3), pointing from the surface to the eye; one material (roughness
     >= MIN_ROUGHNESS, else ValueError). ``rotation_deg`` and ``intensity`` as the renderer's
     env_rotation_deg and env_intensity.
@@ -466,7 +466,7 @@ def probe_points(width: int):
 
 def probe_ground_truth(radiance, width: int, material, rotation_deg: float = 0.0, intensity: float = 1.0,
                        roughness=None) -> np.ndarray:
-    """CONVENTIONS.md's probe view rendered exactly: (W, W, 3) float64, row 0 at the top.
+    """docs/conventions.md's probe view rendered exactly: (W, W, 3) float64, row 0 at the top.
 
     v = (0, 0, 1), n from ``alight.core.shading.probe_normals``, zeros outside the disk. ``material`` is
     an ``alight.core.material.Material`` (or anything with its fields); ``roughness`` overrides its

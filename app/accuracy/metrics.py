@@ -1,4 +1,4 @@
-"""Error measures between a test image and a reference (issue 4, "Error measures").
+"""Error measures between a test image and a reference.
 
     relative_mae: sum |test - ref| / sum |ref| over the covered pixels (alpha > 0) and RGB, in
                   linear radiance (the figure the accuracy tables quote)

@@ -1,11 +1,11 @@
-"""A path tracer for whole scenes: CONVENTIONS.md's BRDF with visibility and inter-reflection.
+"""A path tracer for whole scenes: docs/conventions.md's BRDF with visibility and inter-reflection.
 
 ``alight reference`` sums the environment per pixel with no occlusion: exact on a convex mesh,
 blind to a corner, a bowl or a box on a floor. This module traces the same scene (the camera,
 environment, lights and material factors of ``alight render``) with Intel's Embree
 (``embreex``) for the rays and numpy for the rest:
 
-    f = kd base/pi + D F G / (4 (n.l)(n.v)),  kd = (1 - F)(1 - metallic)    (CONVENTIONS.md)
+    f = kd base/pi + D F G / (4 (n.l)(n.v)),  kd = (1 - F)(1 - metallic)    (docs/conventions.md)
     D: GGX (Walter et al. 2007), alpha = r^2; G: Smith with Schlick-GGX, k = r^2/2 for the
     environment and for light bouncing between surfaces (the ground truth's k), k = (r+1)^2/8
     for punctual lights (as the renderer and ``alight reference``); F: Schlick at v.h per direction.
@@ -20,7 +20,7 @@ from the third on. Every number comes from one ``numpy.random.Generator(PCG64(se
 fixed order: the same seed gives the same image to the bit on the same machine.
 
 The environment is piecewise constant over its texels, looked up at the nearest texel, as the
-exact reference sums it (CONVENTIONS.md's mapping and rotation); background pixels show the
+exact reference sums it (docs/conventions.md's mapping and rotation); background pixels show the
 environment along the camera ray, alpha is the covered fraction of the pixel's samples.
 Not modelled (refused or said in one warning line): the layers (clearcoat, sheen, anisotropy,
 transmission), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
@@ -87,7 +87,7 @@ def _import_embree():
     return rtcore_scene, TriangleMesh
 
 
-# --- the BRDF (CONVENTIONS.md), vectorised over paths ------------------------------------------
+# --- the BRDF (docs/conventions.md), vectorised over paths ------------------------------------------
 
 def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
@@ -98,7 +98,7 @@ def _normalize(v):
 
 
 def brdf_cos(n, v, l, base, metallic, roughness, f0):
-    """CONVENTIONS.md's f(l, v) (n.l) with the ground truth's k = r^2/2; (N, 3). n, v, l: (N, 3)
+    """docs/conventions.md's f(l, v) (n.l) with the ground truth's k = r^2/2; (N, 3). n, v, l: (N, 3)
     unit vectors; base, f0: (N, 3); metallic, roughness: (N,). n.v is floored at MIN_N_DOT_V and
     |l + v| at 1e-7, as the exact reference does."""
     n_dot_l = _dot(n, l)
@@ -176,7 +176,7 @@ def sample_brdf(n, v, roughness, p_spec, xi):
 # --- the environment: lookup and importance sampling ---------------------------------------------
 
 class EnvironmentSampler:
-    """An equirect map (H, W, 3) as CONVENTIONS.md maps it, piecewise constant per texel, turned
+    """An equirect map (H, W, 3) as docs/conventions.md maps it, piecewise constant per texel, turned
     by ``rotation_deg`` and scaled by ``intensity``; texels drawn in proportion to luminance x
     solid angle (plus 1% of a uniform choice, so no lit direction has pdf 0)."""
 
@@ -199,7 +199,7 @@ class EnvironmentSampler:
         self.cdf[-1] = 1.0
 
     def _to_map(self, d):
-        # CONVENTIONS.md: light from world d is the map's radiance in R_y(-deg) d.
+        # docs/conventions.md: light from world d is the map's radiance in R_y(-deg) d.
         c, s = self.c, -self.s
         return np.stack([c * d[:, 0] + s * d[:, 2], d[:, 1], -s * d[:, 0] + c * d[:, 2]], axis=1)
 

@@ -1,15 +1,15 @@
-"""``alight reference``: CONVENTIONS.md's ground truth computed on the GPU, per pixel.
+"""``alight reference``: docs/conventions.md's ground truth computed on the GPU, per pixel.
 
     L_o(n, v) = emissive + sum over the environment's texels of f(l, v) L(l) max(n.l, 0) dOmega
                 + the punctual lights (punctual.glsl's punctual_light, k = (r+1)^2/8)
 
-f is exactly CONVENTIONS.md's BRDF with k = r^2/2 and F per direction at v.h
-(``shaders/reference/ground_truth.glsl``: ``brdf_ground_truth``, ``ground_truth_rows``). There
+f is exactly docs/conventions.md's BRDF with k = r^2/2 and F per direction at v.h
+(``shaders/accuracy/ground_truth.glsl``: ``brdf_ground_truth``, ``ground_truth_rows``). There
 is no occlusion and nothing is sampled: it is the numpy ground truth of ``app/accuracy/ground_truth.py``,
 evaluated in float32 on the GPU (each environment row is summed on its own, then added to the
 total).
 
-    probe view: a G-buffer filled in numpy (CONVENTIONS.md's exact per-pixel normals, v = +Z)
+    probe view: a G-buffer filled in numpy (docs/conventions.md's exact per-pixel normals, v = +Z)
     mesh view:  render/pbr.vert + render/gbuffer.frag -> float G-buffer (position, n, v,
                 base colour, metallic, roughness, specular F0, emissive; the mesh's texture maps
                 apply, as in the forward pass)
@@ -132,7 +132,7 @@ def env_level_radiance(radiance: np.ndarray, level: int) -> np.ndarray:
 
 
 def probe_gbuffer(size: int, material) -> dict[str, np.ndarray]:
-    """CONVENTIONS.md's probe view as G-buffer arrays (size, size, 4), row 0 at the top."""
+    """docs/conventions.md's probe view as G-buffer arrays (size, size, 4), row 0 at the top."""
     normals, inside = probe_normals(int(size))
     g = {name: np.zeros((size, size, 4), np.float32) for name in GBUFFER}
     g["position"][..., :3] = normals

@@ -4,7 +4,7 @@
     bowl:    a thick open bowl (a lathed profile), its opening toward +Y
     product: a capsule standing on a wide ground plane
 
-Each is one material-less mesh (CONVENTIONS.md: +Y up, counter-clockwise front faces, the
+Each is one material-less mesh (docs/conventions.md: +Y up, counter-clockwise front faces, the
 default camera on +Z looks at it): the material comes from the command line. Written as OBJ
 with normals by trimesh: flat faces carry their face normal (vertices are not shared across a
 crease), curved ones trimesh's smooth vertex normals.

@@ -5,7 +5,7 @@ Each function has a GLSL function of the same name; ``tests/test_glsl_twins.py``
 Everything broadcasts over leading array dimensions, vectors in the last axis. ``v`` points from
 the surface to the eye (outside, index of refraction 1), ``l`` toward where the light comes from:
 for transmitted light it lies behind the surface, n.l < 0. The full definition, and how it is
-measured, is ``docs/transmission.md``.
+measured, is ``docs/layer_transmission.md``.
 
 - Thin-walled (``thickness`` 0, KHR_materials_transmission, "Transmission BTDF"): the reflection
   lobe mirrored through the surface plane, D(h) G / (4 |n.l| n.v) with h = normalize(v + l'),
@@ -16,7 +16,7 @@ measured, is ``docs/transmission.md``.
   Integrated over l with |n.l| it gives 1 - F for a smooth surface: the ior^2 of entering and
   the 1/ior^2 of leaving the medium cancel, so it carries the environment's radiance as is.
 
-G is CONVENTIONS.md's Schlick-GGX Smith term (the volume extension: "the same terms for G and D
+G is docs/conventions.md's Schlick-GGX Smith term (the volume extension: "the same terms for G and D
 as the microfacet BRDF"), with |n.l| for the light side, and the caller's k.
 """
 

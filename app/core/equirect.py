@@ -1,4 +1,4 @@
-"""Area-weighted box reduction of equirectangular maps (CONVENTIONS.md's mapping).
+"""Area-weighted box reduction of equirectangular maps (docs/conventions.md's mapping).
 
 Shared by the environment-file reader (``alight.exchange.environment_files``, strip by strip),
 the converged twins and the GPU reference's ``--env-level``.

@@ -1,4 +1,4 @@
-"""The material state (CONVENTIONS.md, material model), its validation, and the F0 table's names
+"""The material state (docs/conventions.md, material model), its validation, and the F0 table's names
 (the preset files are read and written by ``alight.exchange.presets``).
 
 Everything a user can hand us (a preset file, a CLI option, a GUI edit) passes through
@@ -20,7 +20,7 @@ from alight.errors import AlightError
 Vec3 = tuple[float, float, float]
 
 
-# The layers beyond the lecture's BRDF (issue 11), each with the fields that belong to it, named
+# The layers beyond the lecture's BRDF, each with the fields that belong to it, named
 # after the glTF extension's parameters in snake case. Every default is glTF's, and is the
 # value at which the layer is off: such a material shades exactly as the base model does.
 LAYERS: dict[str, tuple[str, ...]] = {

@@ -3,7 +3,7 @@
 The built-in meshes (``sphere``, ``cube``, ``plane``), normals and tangents, and the closed-mesh
 test live here; files are read by ``alight.exchange.meshes``.
 
-Conventions: world space is right-handed, +Y up (``../shared/CONVENTIONS.md``); faces are
+Conventions: world space is right-handed, +Y up (``docs/conventions.md``); faces are
 counter-clockwise seen from the front; uvs follow OpenGL (v = 0 is the image's bottom row)
 while texture arrays keep PIL's order (row 0 = top row), so a texel is found at
 ``row = (1 - v) * H``.

@@ -82,7 +82,7 @@ def fit_distance(center, radius: float, fov_y_deg: float, aspect: float, directi
 
 def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float = 1.0,
                  direction=(0.0, 0.0, 1.0), margin: float = 1.3, corners=None) -> Camera:
-    """A camera on ``direction`` from ``center`` (default +Z, CONVENTIONS.md) that fits a sphere
+    """A camera on ``direction`` from ``center`` (default +Z, docs/conventions.md) that fits a sphere
     of ``radius`` in the narrower of the two fields of view, or the bounding box's ``corners``
     (8, 3) where they need less distance (``fit_distance``)."""
     d = np.asarray(direction, dtype=np.float64)

@@ -3,7 +3,7 @@
 Each function here has a GLSL function of the same name; the tests evaluate both on the same
 inputs and compare. Everything broadcasts over leading array dimensions; vectors live in the
 last axis. Conventions (coordinates, the equirectangular mapping, the probe view, the BRDF) are
-those of ``../shared/CONVENTIONS.md``.
+those of ``docs/conventions.md``.
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ def F_SchlickRoughness(n_dot_v, f0, roughness):
 
 
 def f0_of(base_color, metallic, specular_f0):
-    """F0 = mix(specular_f0, base_color, metallic) (CONVENTIONS.md, material model)."""
+    """F0 = mix(specular_f0, base_color, metallic) (docs/conventions.md, material model)."""
     m = np.asarray(metallic, dtype=np.float64)[..., None]
     return np.asarray(specular_f0) * (1.0 - m) + np.asarray(base_color) * m
 
@@ -109,7 +109,7 @@ def importance_sample_ggx_tangent(xi, roughness):
 # --- environment mapping (equirect.glsl) ------------------------------------------------
 
 def direction_to_equirect_uv(d):
-    """CONVENTIONS.md: u = 0.5 + atan2(d.x, -d.z)/(2 pi), v = acos(d.y)/pi (v = 0 at the top row)."""
+    """docs/conventions.md: u = 0.5 + atan2(d.x, -d.z)/(2 pi), v = acos(d.y)/pi (v = 0 at the top row)."""
     d = np.asarray(d, dtype=np.float64)
     u = 0.5 + np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * PI)
     v = np.arccos(np.clip(d[..., 1], -1.0, 1.0)) / PI
@@ -147,7 +147,7 @@ def texel_directions(height, width):
 # --- the probe view ---------------------------------------------------------------------
 
 def probe_normals(width):
-    """Per-pixel normals (W, W, 3) and the inside mask (W, W) of CONVENTIONS.md's probe view."""
+    """Per-pixel normals (W, W, 3) and the inside mask (W, W) of docs/conventions.md's probe view."""
     c = (np.arange(width) + 0.5) / width
     x = 2.0 * c[None, :] - 1.0
     y = 1.0 - 2.0 * c[:, None]

@@ -52,7 +52,7 @@ SUPPORTED = {
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_transmission",
     "KHR_materials_volume",
 }
-# The layers' textures alight draws (issue 11): FileMaterial slot -> (extension, textureInfo key).
+# The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
     "clearcoat": ("KHR_materials_clearcoat", "clearcoatTexture"),
     "clearcoat_roughness": ("KHR_materials_clearcoat", "clearcoatRoughnessTexture"),

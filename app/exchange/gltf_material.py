@@ -17,7 +17,7 @@ engines that know the extensions shade the same dielectric reflectance. The ior 
 alight.core.material makes a grey F0 other than 0.04 an ior of its own: water's 0.02 is ior
 1.33, written as such.
 
-The layers (issue 11; docs/layers.md) are the extensions' factors, one to one:
+The layers (docs/layers.md) are the extensions' factors, one to one:
 
     transmission          = KHR_materials_transmission.transmissionFactor
     thickness             = KHR_materials_volume.thicknessFactor

@@ -60,7 +60,7 @@ def check_output_path(path: str | os.PathLike, suffixes=IMAGE_SUFFIXES) -> Path:
 def write_image(path: str | os.PathLike, pixels, linear: bool) -> None:
     """Write an image atomically through OpenImageIO.
 
-    ``linear``: float32 RGBA radiance for .exr (CONVENTIONS.md). Otherwise uint8 sRGB for .png.
+    ``linear``: float32 RGBA radiance for .exr (docs/conventions.md). Otherwise uint8 sRGB for .png.
     Rows are top first.
     """
     import numpy as np

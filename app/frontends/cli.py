@@ -82,7 +82,7 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
                         "a glTF file's KHR_lights_punctual lights are used")
     g.add_argument("--no-file-lights", action="store_true", help="ignore the lights a glTF file brings")
     g.add_argument("--view", choices=("camera", "probe"), default="camera",
-                   help="camera: the mesh framed by a camera on +Z; probe: CONVENTIONS.md's analysis view "
+                   help="camera: the mesh framed by a camera on +Z; probe: docs/conventions.md's analysis view "
                         "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)")
     _add_material_options(p)
 
@@ -214,7 +214,7 @@ def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:
                         f"(default: {DEFAULT_IBL_MODEL})")
     g.add_argument("--multiple-scattering", action="store_true",
                    help="add the energy that single scattering loses on rough surfaces (Fdez-Aguera 2019): "
-                        "a white furnace then gives 1, but the result leaves CONVENTIONS.md's single-scattering truth")
+                        "a white furnace then gives 1, but the result leaves docs/conventions.md's single-scattering truth")
 
 
 # A value that starts with '-' and is a number or comma-separated numbers (-0.18,0,0; -1e-3; -inf)
@@ -235,7 +235,7 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):
         self.exit(2, f"alight: error: {' '.join(message.split())} (see '{self.prog} --help')\n")
 
-# ---- alight edit (issue 3: the interactive editor; everything else lives in app/frontends/editor/) ----
+# ---- alight edit (the interactive editor; everything else lives in app/frontends/editor/) ----
 
 def _add_edit_parser(sub) -> None:
     e = sub.add_parser("edit", help="open the interactive material editor (needs a display)",
@@ -328,7 +328,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "the probe view never blends pixels)")
     d.add_argument("--out", required=True, metavar="FILE.png|FILE.exr",
                    help=".png: 8-bit sRGB after exposure and tone mapping; .exr: linear float32 RGBA radiance, "
-                        "alpha 1 on the surface (CONVENTIONS.md)")
+                        "alpha 1 on the surface (docs/conventions.md)")
     d.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer and time per step")
     d.add_argument("--shadows", choices=("auto", "on", "off"), default="auto",
                    help="shadow maps for the lights and the environment's suns: auto draws them only where "
@@ -379,8 +379,8 @@ def build_parser() -> argparse.ArgumentParser:
     bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
     # --- end alight batch ---------------------------------------------------------------------
     # --- alight reference (app/accuracy/reference.py) --------------------------------------------------
-    rf = sub.add_parser("reference", help="the exact IBL ground truth (CONVENTIONS.md) on the GPU, as linear EXR",
-                        description="Compute CONVENTIONS.md's ground truth per pixel on the GPU: the sum over "
+    rf = sub.add_parser("reference", help="the exact IBL ground truth (docs/conventions.md) on the GPU, as linear EXR",
+                        description="Compute docs/conventions.md's ground truth per pixel on the GPU: the sum over "
                                     "every texel of the environment of f(l, v) L(l) max(n.l, 0) dOmega (k = r^2/2, "
                                     "F per direction at v.h), plus emission and the punctual lights (k = (r+1)^2/8), "
                                     "no occlusion. Roughness below 0.1 is refused when an environment is used. "
@@ -410,7 +410,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "the map is >= 1024 wide and no compact source holds >= 10%% of its power, else 0 "
                          "(default: auto)")
     rd.add_argument("--out", required=True, metavar="FILE.exr",
-                    help="linear float32 RGBA radiance, alpha 1 on the surface (CONVENTIONS.md); .exr only")
+                    help="linear float32 RGBA radiance, alpha 1 on the surface (docs/conventions.md); .exr only")
     rd.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer, the level and the times")
     # --- end alight reference -----------------------------------------------------------------
     # --- alight compare / alight chart (app/accuracy/metrics.py, app/accuracy/chart.py) -----------------------
@@ -598,7 +598,7 @@ def _render(args) -> int:
     camera = _camera(args, mesh, width / height)
     if camera is None and mesh is not None:
         normal = mesh.flat_normal()
-        if normal is not None and abs(normal[2]) < 0.02:   # the default camera's view is -Z (CONVENTIONS.md)
+        if normal is not None and abs(normal[2]) < 0.02:   # the default camera's view is -Z (docs/conventions.md)
             _warn([f"{args.mesh}: the mesh is flat and the default camera (on +Z) sees it edge-on, so it "
                    f"may not show; --elevation 30 (or --orbit) looks at it from another side"])
     env = None if args.no_ibl else load_environment(args.env)

@@ -2,7 +2,7 @@
 
 Every environment is an (H, W, 3) float32, C-contiguous array of linear scene-referred RGB
 radiance with W == 2*H, in [0, RADIANCE_MAX] (1e10), row 0 at the top (+Y); the mapping between
-texels and directions is CONVENTIONS.md's (see ``alight.core.shading.direction_to_equirect_uv``).
+texels and directions is docs/conventions.md's (see ``alight.core.shading.direction_to_equirect_uv``).
 
 Files are read by ``alight.exchange.environment_files`` (oriented as the file says, the display
 window as the picture, the first part with R, G, B; in strips, repaired, box-reduced when wider
@@ -109,7 +109,7 @@ def constant_environment(value=1.0, width: int = 64) -> Environment:
     return Environment(rad, "constant", [])
 
 
-# The studio, one table. Directions are world directions (CONVENTIONS.md: +Y up, the camera on
+# The studio, one table. Directions are world directions (docs/conventions.md: +Y up, the camera on
 # +Z looking toward -Z at the subject at the origin). Angles in degrees; radiance linear RGB.
 # Each soft box is a rectangle centred on `dir`, `half` = (half-width, half-height) measured as
 # angles in the plane of its own frame (right = up_hint x dir, up = dir x right), with

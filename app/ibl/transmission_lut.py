@@ -1,6 +1,6 @@
 """The transmission LUT: the refracted lobe of KHR_materials_volume's BTDF as a 3D table over
 (n.v, roughness, ior), baked once by ``shaders/ibl/transmission_lut.comp`` and kept in the user's
-cache directory like the BRDF LUT (docs/transmission.md, "Real-time").
+cache directory like the BRDF LUT (docs/layer_transmission.md, "Real-time").
 
 Channels: E (the lobe's energy), bend (its mean direction: the sine of its angle from -n over
 the view's sine), roughness (the prefiltered roughness with the same mean cosine). The numpy twin is

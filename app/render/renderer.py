@@ -779,7 +779,7 @@ class ForwardRenderer:
                     else:
                         srgb[:, t.x:t.x + t.width] = block
             if linear is not None and scene.view == "probe":
-                linear[linear[:, :, 3] == 0.0] = 0.0  # CONVENTIONS.md: probe background radiance is 0
+                linear[linear[:, :, 3] == 0.0] = 0.0  # docs/conventions.md: probe background radiance is 0
             yield Strip(tiles[0].y, Frame(linear, srgb))
 
     def _tiled_targets(self, width: int, height: int, aa: str, samples: int,
@@ -1110,7 +1110,7 @@ class ForwardRenderer:
         spreads = np.zeros(MAX_SUNS, np.float32)
         for i, sun in enumerate(suns):
             spreads[i] = sun.spread
-            # The map texel in direction m lights world direction R_y(+deg) m (CONVENTIONS.md).
+            # The map texel in direction m lights world direction R_y(+deg) m (docs/conventions.md).
             directions[i] = rotate_world_to_map(sun.direction, -scene.env_rotation_deg)
             powers[i] = np.asarray(sun.power) * scene.env_intensity
         scale = np.zeros(MAX_GRID_STEPS, np.float32)

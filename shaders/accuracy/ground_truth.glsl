@@ -1,12 +1,12 @@
-// CONVENTIONS.md's ground truth for image-based lighting as a finite sum over the texels of an
+// docs/conventions.md's ground truth for image-based lighting as a finite sum over the texels of an
 // equirect map (numpy twin: app/accuracy/ground_truth.py):
 //     L_o(n, v) = emissive + sum_t f(l_t, v) L(l_t) max(n.l_t, 0) dOmega_t
 // with k = r^2/2 (the IBL k) and F (so kd) per direction at v.h. Nothing is sampled. A
 // material's layers (docs/layers.md) enter through the same functions as in shading, with
-// CONVENTIONS.md's exact choices (punctual = false, spread 0; common/layers.glsl).
+// docs/conventions.md's exact choices (punctual = false, spread 0; common/layers.glsl).
 #include "common/shading.glsl"
 
-// f(l, v) max(n.l, 0) of CONVENTIONS.md, built from brdf.glsl's terms. n_dot_v is already
+// f(l, v) max(n.l, 0) of docs/conventions.md, built from brdf.glsl's terms. n_dot_v is already
 // clamped to MIN_N_DOT_V (as app/accuracy/ground_truth.py does); h is the geometric half vector, with
 // |l + v| floored at 1e-7 (l = -v).
 vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l) {
@@ -46,7 +46,7 @@ layout(std430, binding = 2) readonly buffer EquirectColumns {
 
 // The texel sum over rows [row_begin, row_end) of level `level` of an equirect texture
 // (W x H at that level). n and v are in the map's frame (rotate them with rotate_world_to_map
-// first). Texel (col, row) looks along its centre's direction (CONVENTIONS.md's mapping) and
+// first). Texel (col, row) looks along its centre's direction (docs/conventions.md's mapping) and
 // covers dOmega = (2 pi/W)(pi/H) sin(theta). Each row is summed on its own and then added to
 // the total, so float32 rounding grows with W + H rather than W * H.
 vec3 ground_truth_rows(sampler2D env, int level, int row_begin, int row_end, Surface s, vec3 n, vec3 v) {

@@ -1,5 +1,5 @@
 #version 450 core
-// alight reference (app/accuracy/reference.py): CONVENTIONS.md's ground truth at every G-buffer pixel.
+// alight reference (app/accuracy/reference.py): docs/conventions.md's ground truth at every G-buffer pixel.
 // One dispatch sums the environment rows [u_row_begin, u_row_end) into the accumulator; the
 // first one (u_first) starts it from emission plus the punctual lights (punctual.glsl's
 // punctual_light, k = (r+1)^2/8, no occlusion). Pixels the G-buffer marks empty stay 0.

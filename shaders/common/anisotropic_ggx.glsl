@@ -21,7 +21,7 @@ float D_GGX_anisotropic(float t_dot_h, float b_dot_h, float n_dot_h, float alpha
 // The alpha a direction x sees: the lobe's alpha projected on x's azimuth (Heitz 2014,
 // "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs", sec. 5.3). Smith
 // masking of an anisotropic lobe is the isotropic masking at this alpha, so the base's
-// Schlick-GGX G (CONVENTIONS.md) carries over unchanged. At x = n the azimuth is undefined and
+// Schlick-GGX G (docs/conventions.md) carries over unchanged. At x = n the azimuth is undefined and
 // G1 = 1 whatever alpha: alpha_b is returned.
 float projected_alpha(float t_dot_x, float b_dot_x, float alpha_t, float alpha_b) {
     float sin2 = t_dot_x * t_dot_x + b_dot_x * b_dot_x;

@@ -18,7 +18,7 @@
 #endif
 
 // D G F / (4 n.l n.v) with the lobe stretched along s.anisotropy_direction. punctual: the
-// roughness floored at MIN_PUNCTUAL_ROUGHNESS and k_direct; otherwise CONVENTIONS.md's k_ibl,
+// roughness floored at MIN_PUNCTUAL_ROUGHNESS and k_direct; otherwise docs/conventions.md's k_ibl,
 // and a compact source's angular spread widens both axes (as sun_light widens the round lobe).
 vec3 anisotropic_specular(Surface s, vec3 n, vec3 v, vec3 l, vec3 F, bool punctual, float spread) {
     float n_dot_l = max(dot(n, l), 1e-8);

@@ -1,5 +1,5 @@
 // The Cook-Torrance terms of the seed lecture, one function per term (after Filament's brdf.fs).
-// Numpy twins: app/core/shading.py (same names). Conventions: ../shared/CONVENTIONS.md.
+// Numpy twins: app/core/shading.py (same names). Conventions: docs/conventions.md.
 
 const float PI = 3.14159265358979323846;
 

@@ -1,6 +1,6 @@
 // The transmission BTDF, one function per term (after Filament's brdf.fs): thin-walled
 // (KHR_materials_transmission) and refracting (KHR_materials_volume), with Beer-Lambert
-// attenuation. Numpy twins: app/core/btdf.py (same names). Definition: docs/transmission.md.
+// attenuation. Numpy twins: app/core/btdf.py (same names). Definition: docs/layer_transmission.md.
 // v points to the eye (outside, index 1); l toward the light, behind the surface (n.l < 0).
 // Needs common/brdf.glsl.
 

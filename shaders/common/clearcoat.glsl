@@ -19,7 +19,7 @@ float clearcoat_base_weight(Surface s, vec3 v) {
 }
 
 // The coat's lobe D G / (4 n_c.l n_c.v) times n_c.l, without Fresnel: GGX (Walter et al. 2007)
-// with Schlick-GGX masking (CONVENTIONS.md's terms), the punctual or the IBL k.
+// with Schlick-GGX masking (docs/conventions.md's terms), the punctual or the IBL k.
 float clearcoat_lobe(Surface s, vec3 v, vec3 l, bool punctual, float spread) {
     vec3 n = s.clearcoat_normal;
     float n_dot_l = dot(n, l);

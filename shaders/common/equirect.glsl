@@ -1,4 +1,4 @@
-// The equirectangular mapping and environment rotation of CONVENTIONS.md.
+// The equirectangular mapping and environment rotation of docs/conventions.md.
 // Numpy twins: app/core/shading.py.
 
 // u = 0.5 + atan2(d.x, -d.z)/(2 pi) left to right; v = acos(d.y)/pi, v = 0 at the top row (+Y).

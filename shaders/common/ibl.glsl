@@ -1,5 +1,5 @@
 // Image-based lighting: the seed lecture's split sum (Karis 2013) and the models that improve on
-// it, measured against CONVENTIONS.md's ground truth (app/core/ibl_models.py lists them).
+// it, measured against docs/conventions.md's ground truth (app/core/ibl_models.py lists them).
 // Maps are baked in the environment map's own frame; lookups rotate world directions into it.
 // Compact bright sources (the sun) are not in the irradiance and prefiltered maps (app/ibl/sun.py):
 // every model adds them here, exactly, in world space.

@@ -1,6 +1,6 @@
-// How the glTF layers of issue 11 stack on the base BRDF (docs/layers.md), as the Khronos
+// How the glTF layers stack on the base BRDF (docs/layers.md), as the Khronos
 // extensions and the glTF spec's appendix B layer them:
-//     base   = Cook-Torrance (CONVENTIONS.md); its diffuse lobe shares with the transmission BTDF
+//     base   = Cook-Torrance (docs/conventions.md); its diffuse lobe shares with the transmission BTDF
 //              (KHR_materials_transmission, KHR_materials_volume) and its specular lobe may be
 //              anisotropic (KHR_materials_anisotropy)
 //     sheen  = sheen BRDF + base * sheen albedo scaling     (KHR_materials_sheen)
@@ -12,7 +12,7 @@
 // without a layer compiles without it (app/core/layers/__init__.py: layer_defines).
 //
 // "punctual" selects the punctual lights' choices (k = (r+1)^2/8, roughness floored at
-// MIN_PUNCTUAL_ROUGHNESS, as punctual.glsl); false is CONVENTIONS.md's exact BRDF (k = r^2/2),
+// MIN_PUNCTUAL_ROUGHNESS, as punctual.glsl); false is docs/conventions.md's exact BRDF (k = r^2/2),
 // used for the compact sources of ibl.glsl (their angular "spread" widens the lobes) and for
 // the ground truth (spread 0).
 

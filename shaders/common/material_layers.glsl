@@ -1,4 +1,4 @@
-// The layers' material inputs (issue 11, docs/layers.md): the factors as uniforms
+// The layers' material inputs (docs/layers.md): the factors as uniforms
 // (app/render/renderer.py: _set_material), each under its layer's HAS_* define, and
 // apply_material_layers, which writes them into a Surface. Shared by the forward pass
 // (common/mesh_material.glsl, render/probe.frag) and the reference (accuracy/reference.comp).
@@ -55,7 +55,7 @@ void apply_material_layers(inout Surface s, vec3 n, vec3 t, vec3 b) {
 #endif
 }
 
-// The probe view's tangent frame (CONVENTIONS.md's probe has no mesh): the direction of
+// The probe view's tangent frame (docs/conventions.md's probe has no mesh): the direction of
 // increasing longitude about +Y, as the built-in sphere's u (app/core/mesh.py: sphere), so the
 // probe and the sphere agree; at the poles, where longitude has no direction, +X.
 void probe_tangent_frame(vec3 n, out vec3 t, out vec3 b) {

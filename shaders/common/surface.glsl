@@ -1,4 +1,4 @@
-// The material model of CONVENTIONS.md at one shading point, with the glTF layers of issue 11
+// The material model of docs/conventions.md at one shading point, with the glTF layers
 // (docs/layers.md). A layer's fields exist only when its HAS_* define is set
 // (app/core/layers/__init__.py: layer_defines), so a material without layers compiles to the
 // base model alone and pays nothing for them.

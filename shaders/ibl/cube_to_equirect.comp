@@ -1,5 +1,5 @@
 #version 450 core
-// Samples one mip of a cube into an equirectangular image (CONVENTIONS.md's mapping), so that
+// Samples one mip of a cube into an equirectangular image (docs/conventions.md's mapping), so that
 // baked maps can be looked at and compared with the source map.
 #include "common/brdf.glsl"
 #include "common/equirect.glsl"

@@ -1,6 +1,6 @@
 #version 450 core
 // The refracted lobe of KHR_materials_volume's BTDF over n.v (x), roughness (y) and the ior
-// (z = (1 - 1/ior) / IOR_AXIS_MAX, common/transmission_lut.glsl), at texel centres, k = r^2/2 (docs/transmission.md, "Real-time"):
+// (z = (1 - 1/ior) / IOR_AXIS_MAX, common/transmission_lut.glsl), at texel centres, k = r^2/2 (docs/layer_transmission.md, "Real-time"):
 //   R: E, the lobe's energy: the integral of btdf (1 - Fc(v.h)) |n.l| over l;
 //   G: bend, the sine of its mean direction's angle from -n (leaning toward -v's tangential
 //      part) over the view's sine: 1/ior for a smooth surface; a ratio so that it vanishes

@@ -1,7 +1,7 @@
 #version 450 core
 // What lies behind the object (common/background.glsl), drawn on the far plane after the
 // surfaces, so the depth test keeps it to the pixels they left uncovered.
-// Alpha is 0 everywhere here: only surfaces count as hits (CONVENTIONS.md, image outputs).
+// Alpha is 0 everywhere here: only surfaces count as hits (docs/conventions.md, image outputs).
 #include "common/brdf.glsl"
 #include "common/background.glsl"
 #include "common/output_encoding.glsl"

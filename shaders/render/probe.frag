@@ -1,5 +1,5 @@
 #version 450 core
-// The probe view of CONVENTIONS.md: a unit sphere, orthographic, filling a square image, with
+// The probe view of docs/conventions.md: a unit sphere, orthographic, filling a square image, with
 // the exact normal n = (x, y, sqrt(1 - x^2 - y^2)) per pixel and v = (0, 0, 1).
 #include "common/shading.glsl"
 #include "common/material_layers.glsl"

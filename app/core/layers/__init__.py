@@ -1,4 +1,4 @@
-"""The glTF layers beyond the lecture's BRDF (issue 11): which a material uses, the shader
+"""The glTF layers beyond the lecture's BRDF: which a material uses, the shader
 defines that compile them in, and their numpy twins.
 
 One module per layer mirrors its GLSL file (``shaders/common/<layer>.glsl``), function by

@@ -57,7 +57,7 @@ def anisotropy_direction(m, n, t, b):
 
 def anisotropic_specular(m, p, F, punctual: bool = False, spread: float = 0.0) -> np.ndarray:
     """The stretched lobe D G F / (4 n.l n.v) (P, T, 3) for the pairs ``p`` (their t, b: the
-    tangent frame before the rotation); F (P, T, 3). The defaults are CONVENTIONS.md's exact
+    tangent frame before the rotation); F (P, T, 3). The defaults are docs/conventions.md's exact
     choices (k_ibl, no floor), what the ground truth sums."""
     direction, bitangent = anisotropy_direction(m, p.n, p.t, p.b)
     nl = np.maximum(p.n_dot_l, 1e-8)

@@ -5,7 +5,7 @@ definition: docs/layer_clearcoat.md).
     F_c(x) = 0.04 + 0.96 (1 - x)^5                 (the coat's ior 1.5; Schlick 1994)
 
 The scalar functions take dot products (any broadcasting shapes); ``clearcoat_base_weight`` and
-``clearcoat_light`` take a material and ``alight.core.layers.stack.Pairs`` and give CONVENTIONS.md's
+``clearcoat_light`` take a material and ``alight.core.layers.stack.Pairs`` and give docs/conventions.md's
 exact choices (k = r^2/2, no floor beyond MIN_PUNCTUAL_ROUGHNESS), which the ground truth sums.
 """
 

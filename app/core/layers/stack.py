@@ -1,7 +1,7 @@
 """The exact layered BRDF, pair by pair: the numpy twin of ``accuracy/ground_truth.glsl``'s
 ``brdf_ground_truth`` and ``common/layers.glsl``'s ``layered_light`` (docs/layers.md).
 
-    base   = CONVENTIONS.md's Cook-Torrance, k = r^2/2, F per direction at v.h; its diffuse lobe
+    base   = docs/conventions.md's Cook-Torrance, k = r^2/2, F per direction at v.h; its diffuse lobe
              scaled by 1 - transmission, plus the transmitted part (transmission.py); its
              specular lobe anisotropic where the material says so (anisotropy.py)
     sheen  = sheen BRDF + base * sheen albedo scaling                         (sheen.py)
@@ -94,7 +94,7 @@ class Pairs:
 
 
 def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
-    """The base's f(l, v) max(n.l, 0) (P, T, 3), CONVENTIONS.md's BRDF with the IBL k; with
+    """The base's f(l, v) max(n.l, 0) (P, T, 3), docs/conventions.md's BRDF with the IBL k; with
     transmission, the diffuse lobe scaled by 1 - transmission and the transmitted part added."""
     nl = p.n_dot_l
     lit = nl > 0.0
@@ -126,7 +126,7 @@ def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
 
 def layered_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
     """The whole material's f(l, v) |n.l| (P, T, 3): the base with its layers over it
-    (common/layers.glsl: layered_light, with CONVENTIONS.md's exact choices)."""
+    (common/layers.glsl: layered_light, with docs/conventions.md's exact choices)."""
     f = base_brdf_cos(m, p)
     used = m.layers()
     if "sheen" in used:

@@ -13,7 +13,7 @@ from alight.core.scene import Camera
 @dataclass
 class OrbitCamera:
     target: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    yaw_deg: float = 0.0       # 0: on +Z looking toward -Z (CONVENTIONS.md's default camera)
+    yaw_deg: float = 0.0       # 0: on +Z looking toward -Z (docs/conventions.md's default camera)
     pitch_deg: float = 0.0
     distance: float = 4.0
     fov_y_deg: float = 35.0

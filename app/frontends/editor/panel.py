@@ -132,7 +132,7 @@ class Panel:
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0_srgb))
             imgui.end_table()
-        # Base colour is stored linear (CONVENTIONS.md) and shown sRGB, as artists pick colours.
+        # Base colour is stored linear (docs/conventions.md) and shown sRGB, as artists pick colours.
         changed, col = imgui.color_edit3("base colour (sRGB)", _srgb(m.base_color))
         if changed:
             m = dataclasses.replace(m, base_color=_linear(col))
@@ -201,7 +201,7 @@ class Panel:
                 s.fail(exc)
 
     def _layers(self, s, m):
-        """A collapsible section per layer (issue 11), open where the material uses the layer:
+        """A collapsible section per layer, open where the material uses the layer:
         the open state follows the material whenever another one is loaded (a preset, a file,
         revert), and the artist's clicks otherwise."""
         from imgui_bundle import imgui

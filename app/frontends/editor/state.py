@@ -30,7 +30,7 @@ SCALAR_LAYER_FIELDS = tuple(f for f in LAYER_FIELDS if f not in VECTOR_LAYER_FIE
 
 
 def default_lights() -> list[Light]:
-    """Three lights, so the default view exercises the punctual path (issue 3's benchmark scene)."""
+    """Three lights, so the default view exercises the punctual path (the editor's benchmark scene)."""
     return [Light("point", (2.0, 3.0, 4.0), (1.0, 0.95, 0.9), 10.0),
             Light("point", (-3.0, 1.0, 2.0), (0.6, 0.7, 1.0), 6.0),
             Light("directional", (-0.3, -1.0, -0.5), (1.0, 1.0, 1.0), 1.0)]
