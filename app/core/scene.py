@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 VIEWS = ("camera", "probe")
 # The display curves, in tonemapping.glsl's TONEMAP_* order: 'aces' is Hill's fit (alight's
 # default, as before), 'aces-hill' the same by the Sample Viewer's name; 'neutral' is Khronos PBR
-# Neutral. docs/files_notes.md says which peer uses which by default.
+# Neutral. docs/guides/users-files.md says which peer uses which by default.
 TONEMAPS = ("none", "aces", "neutral", "aces-narkowicz", "aces-hill", "aces-hill-exposure-boost", "agx")
 BACKGROUNDS = ("env", "blur", "color", "transparent")
 LIGHT_KINDS = ("point", "directional", "spot")

@@ -12,7 +12,7 @@ the minified area isotropic filtering blurs at least N-fold along the minor axis
 mip level at least log2(N) too coarse: 1 for a mesh seen face-on, magnified or mostly at mild
 slants (under one mip level of blur, where the pictures differ by a fraction of a level), 8 for
 a textured floor seen at a grazing angle. Before, every texture had 8, which on llvmpipe costs
-a frame of DamagedHelmet 2-5x (docs/speed_notes.md; llvmpipe draws any level above 1 alike).
+a frame of DamagedHelmet 2-5x (docs/performance-assets.md; llvmpipe draws any level above 1 alike).
 """
 
 from __future__ import annotations

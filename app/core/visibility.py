@@ -1,7 +1,7 @@
 """Per-vertex visibility for still previews: ambient occlusion, bent normals and one diffuse bounce.
 
 For every vertex of a mesh part, cosine-weighted rays over the hemisphere of its normal are cast
-against the whole mesh with Intel Embree (``embreex``; 2-core figures in docs/occl_notes.md). Each
+against the whole mesh with Intel Embree (``embreex``; 2-core figures in docs/explanation/occlusion.md). Each
 vertex gets
 - ``visibility`` V: the cosine-weighted unoccluded fraction, (1/pi) * integral of V(l) (n.l) dl,
   the ambient occlusion of the diffuse term;

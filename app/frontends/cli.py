@@ -385,7 +385,7 @@ def build_parser() -> argparse.ArgumentParser:
                                     "F per direction at v.h), plus emission and the punctual lights (k = (r+1)^2/8), "
                                     "no occlusion. Roughness below 0.1 is refused when an environment is used. "
                                     "--integrator path (the default for a mesh file) path-traces the scene instead, "
-                                    "with the same BRDF, shadows and inter-reflection (docs/ptrace_notes.md).")
+                                    "with the same BRDF, shadows and inter-reflection (docs/explanation/path-traced-reference.md).")
     _add_scene_options(rf)
     _add_camera_options(rf)
     rd = rf.add_argument_group("reference")

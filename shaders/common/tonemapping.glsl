@@ -2,7 +2,7 @@
 
 // TONEMAP_NONE, TONEMAP_ACES, ...: app/core/shader_names.py Tonemap, generated from app/core/scene.py's
 // TONEMAPS: the Khronos glTF Sample Viewer's curves by their names there, and AgX
-// (docs/files_notes.md says which peer uses which).
+// (docs/guides/users-files.md says which peer uses which).
 
 // Exposed radiance is limited to this before a curve: both curves are white (to 1/255) far
 // below it, so no pixel changes, and the ACES fit's v*v stays finite in float32 (a 1e30 texel,
