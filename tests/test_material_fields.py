@@ -35,7 +35,7 @@ CASES: dict[str, tuple[object, dict]] = {
     "ior": (2.5, {}),
     "clearcoat": (1.0, {"base_color": _DARK}),
     "clearcoat_roughness": (0.8, {"base_color": _DARK, "clearcoat": 1.0}),
-    "sheen_color": ((1.0, 1.0, 1.0), {"base_color": _DARK}),
+    "sheen_color": ((1.0, 1.0, 1.0), {"base_color": _DARK, "sheen_roughness": 0.5}),
     "sheen_roughness": (0.9, {"base_color": _DARK, "sheen_color": (1.0, 1.0, 1.0)}),
     "anisotropy_strength": (1.0, {"metallic": 1.0, "roughness": 0.4}),
     "anisotropy_rotation": (1.2, {"metallic": 1.0, "roughness": 0.4, "anisotropy_strength": 1.0}),
