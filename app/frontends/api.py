@@ -143,7 +143,9 @@ class Renderer:
                      texture_set: str | os.PathLike | Iterable[str | os.PathLike] | None = None,
                      use_file_materials: bool | None = None, **fields) -> "Renderer":
         """A Material, a preset name, a preset .json or a .gltf/.glb file (its first material
-        with its maps); keyword fields (``roughness=0.3``) on top.
+        with its maps); keyword fields (``roughness=0.3``) on top: any name of
+        ``alight.core.material_fields.NAMES`` (the fields of ``alight render``'s material flags
+        and of a batch spec's materials; colours as (R, G, B) linear), and ``name``.
 
         ``texture_set``: a folder of maps, or a list of files, assigned to slots by their names
         (alight.exchange.texture_sets; the assignment is kept in ``last_texture_set``).
@@ -156,8 +158,13 @@ class Renderer:
         A material given here replaces a mesh file's own materials unless ``use_file_materials``
         is True. Errors: AlightError of one line (a bad slot, a missing file).
         """
+        from alight.core.material_fields import NAMES
         from alight.core.texture_maps import map_factors
         from alight.exchange.material_files import load_material_file
+
+        for key in fields:
+            if key not in NAMES and key != "name":
+                raise AlightError(f"set_material: unknown field {key!r} (the fields: {', '.join(NAMES)}, name)")
         from alight.exchange.texture_sets import apply_map, assign_files, assign_folder, load_map_images
 
         current = self.scene.texture_maps

@@ -135,8 +135,20 @@ def _material_label(m: Any, source: Path) -> str:
         unknown = set(m) - MATERIAL_FIELDS - {"name", "preset", "from", "texture_set", "maps"}
         if unknown:
             raise AlightError(f"{source}: material {m!r}: unknown field {sorted(unknown)[0]!r}")
-        return str(m.get("name") or m.get("preset") or Path(str(m.get("from", "material"))).stem)
+        label = str(m.get("name") or m.get("preset") or Path(str(m.get("from", "material"))).stem)
+        _check_fields(m, f"{source}: material {label!r}")
+        return label
     raise AlightError(f"{source}: material {m!r} is not a name, a file or a table")
+
+
+def _check_fields(m: dict, source: str) -> None:
+    """The spec's field values checked against the model's ranges before anything renders (the
+    same check the worker's Renderer.set_material applies), so a bad value stops the plan."""
+    from alight.core.material import Material, with_overrides
+
+    given = {k: (tuple(v) if isinstance(v, list) else v) for k, v in m.items() if k in MATERIAL_FIELDS}
+    if given:
+        with_overrides(Material(), source, **given)
 
 
 def _material_inputs(m: Any, base: Path) -> tuple[Any, list[str]]:

@@ -12,10 +12,12 @@ import time
 from pathlib import Path
 from typing import Any
 
+from alight.core.material_fields import NAMES
 from alight.errors import AlightError
 
-# The material fields a spec may set on top of a preset.
-MATERIAL_FIELDS = {"base_color", "metallic", "roughness", "specular_f0", "emissive"}
+# The material fields a spec may set on top of a preset: every field of alight.core.material_fields,
+# the same as alight render's flags and Renderer.set_material's keywords.
+MATERIAL_FIELDS = frozenset(NAMES)
 
 
 _WORKER: dict[str, Any] = {}

@@ -15,6 +15,7 @@ import sys
 import time
 
 from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
+from alight.core.material_fields import FIELDS
 from alight.errors import AlightError
 from alight.frontends.options import build_look
 
@@ -161,36 +162,17 @@ def _add_material_options(p: argparse.ArgumentParser) -> None:
                    help="one texture map (repeatable, after --texture-set): SLOT is base_color, metallic_roughness, "
                         "metallic, roughness, normal, emissive, occlusion, or normal_dx (a DirectX normal map, "
                         "green flipped), gloss (inverted into roughness), orm/arm (R occlusion, G rough, B metal)")
-    m.add_argument("--base-color", metavar="R,G,B", help="linear base colour in [0,1]; the F0 of metals")
-    m.add_argument("--metallic", type=_number("--metallic", 0.0, 1.0), metavar="X", help="0 dielectric .. 1 metal")
-    m.add_argument("--roughness", type=_number("--roughness", 0.0, 1.0), metavar="X",
-                   help="perceptual roughness r in [0,1]; alpha = r^2")
-    m.add_argument("--specular-f0", metavar="X|R,G,B", help="F0 of the dielectric part, linear (default 0.04)")
-    m.add_argument("--emissive", metavar="R,G,B", help="linear emitted radiance, >= 0")
-    m.add_argument("--ior", type=_number("--ior", 1.0), metavar="X",
-                   help="index of refraction (KHR_materials_ior); given alone it sets --specular-f0 to "
-                        "((ior-1)/(ior+1))^2, and --specular-f0 alone sets it (docs/layers.md)")
     y = p.add_argument_group("material layers (glTF extensions; each is off at its default, docs/layers.md)")
-    y.add_argument("--clearcoat", type=_number("--clearcoat", 0.0, 1.0), metavar="X",
-                   help="KHR_materials_clearcoat: the coat's weight in [0,1] (default 0: no coat)")
-    y.add_argument("--clearcoat-roughness", type=_number("--clearcoat-roughness", 0.0, 1.0), metavar="X",
-                   help="the coat's perceptual roughness in [0,1] (default 0)")
-    y.add_argument("--sheen-color", metavar="R,G,B",
-                   help="KHR_materials_sheen: linear sheen colour in [0,1] (default 0: no sheen)")
-    y.add_argument("--sheen-roughness", type=_number("--sheen-roughness", 0.0, 1.0), metavar="X",
-                   help="the sheen's perceptual roughness in [0,1] (default 0)")
-    y.add_argument("--anisotropy-strength", type=_number("--anisotropy-strength", 0.0, 1.0), metavar="X",
-                   help="KHR_materials_anisotropy: strength in [0,1] (default 0: isotropic)")
-    y.add_argument("--anisotropy-rotation", type=_number("--anisotropy-rotation"), metavar="RAD",
-                   help="the stretch's direction, radians counter-clockwise from the tangent (default 0)")
-    y.add_argument("--transmission", type=_number("--transmission", 0.0, 1.0), metavar="X",
-                   help="KHR_materials_transmission: the transmitted fraction in [0,1] (default 0: opaque)")
-    y.add_argument("--thickness", type=_number("--thickness", 0.0), metavar="X",
-                   help="KHR_materials_volume: thickness in mesh units, >= 0 (default 0: thin-walled)")
-    y.add_argument("--attenuation-color", metavar="R,G,B",
-                   help="the volume's colour after --attenuation-distance, linear in [0,1] (default 1,1,1)")
-    y.add_argument("--attenuation-distance", type=_number("--attenuation-distance"), metavar="X",
-                   help="distance at which light reaches --attenuation-color, > 0 (default: none)")
+    for field in FIELDS:   # alight.core.material_fields: the same fields as batch specs and the API
+        group = m if field.layer is None else y
+        if field.kind == "color":   # parsed (R,G,B or one grey) and range-checked by options.build_look
+            group.add_argument(field.flag, metavar=field.metavar, help=field.help)
+        elif field.low_open or math.isinf(field.low):   # an open low end: build_look says "must be > 0"
+            group.add_argument(field.flag, type=_number(field.flag), metavar=field.metavar, help=field.help)
+        else:
+            high = None if math.isinf(field.high) else field.high
+            group.add_argument(field.flag, type=_number(field.flag, field.low, high), metavar=field.metavar,
+                               help=field.help)
 
 
 def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:

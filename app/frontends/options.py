@@ -21,6 +21,7 @@ def build_look(args, report=None, index: int = 0):
     (their factors set to 1, glTF's convention), then the field flags. ``report``: called with
     each line of the texture set's assignment and each warning (None: printed to stderr)."""
     from alight.core.material import Material, parse_color, with_overrides
+    from alight.core.material_fields import FIELDS
     from alight.core.texture_maps import map_factors
     from alight.exchange.material_files import load_material_file
     from alight.exchange.texture_sets import apply_map, assign_folder, parse_map_option
@@ -50,34 +51,20 @@ def build_look(args, report=None, index: int = 0):
         maps, slots = apply_map(maps or TextureMaps(), name, path, f"--map {text}")
         loaded.update(slots)
     base = with_overrides(base, **map_factors(loaded)) if loaded else base
-    overrides = {
-        "base_color": parse_color(args.base_color, "--base-color") if args.base_color else None,
-        "metallic": args.metallic,
-        "roughness": args.roughness,
-        "specular_f0": parse_color(args.specular_f0, "--specular-f0") if args.specular_f0 else None,
-        "emissive": parse_color(args.emissive, "--emissive") if args.emissive else None,
-        "ior": args.ior,
-        "clearcoat": args.clearcoat,
-        "clearcoat_roughness": args.clearcoat_roughness,
-        "sheen_color": parse_color(args.sheen_color, "--sheen-color") if args.sheen_color else None,
-        "sheen_roughness": args.sheen_roughness,
-        "anisotropy_strength": args.anisotropy_strength,
-        "anisotropy_rotation": args.anisotropy_rotation,
-        "transmission": args.transmission,
-        "thickness": args.thickness,
-        "attenuation_color": parse_color(args.attenuation_color, "--attenuation-color")
-        if args.attenuation_color else None,
-        "attenuation_distance": args.attenuation_distance,
-    }
-    overrides = {k: v for k, v in overrides.items() if v is not None}
-    if "base_color" in overrides and max(overrides["base_color"]) > 1.0:
-        raise AlightError(f"--base-color: {args.base_color} has a component above 1")
-    for field in ("specular_f0", "sheen_color", "attenuation_color"):
-        if field in overrides and max(overrides[field]) > 1.0:
-            option = "--" + field.replace("_", "-")
-            raise AlightError(f"{option}: {getattr(args, field)} has a component above 1")
-    if "attenuation_distance" in overrides and overrides["attenuation_distance"] <= 0.0:
-        raise AlightError(f"--attenuation-distance: {args.attenuation_distance:g} must be > 0")
+    overrides = {}
+    for field in FIELDS:   # alight.core.material_fields: every flag of cli._add_material_options
+        text = getattr(args, field.name, None)
+        if text is None or text == "":   # an empty colour flag is not given (as before the registry)
+            continue
+        if field.kind == "color":
+            value = parse_color(text, field.flag)
+            if max(value) > field.high:
+                raise AlightError(f"{field.flag}: {text} has a component above {field.high:g}")
+        else:
+            value = text
+            if field.low_open and value <= field.low:
+                raise AlightError(f"{field.flag}: {value:g} must be > {field.low:g}")
+        overrides[field.name] = value
     return with_overrides(base, **overrides), overrides, (maps if maps is not None and maps.paths() else None)
 
 
