@@ -66,7 +66,8 @@ class _Size(tuple):
 def _add_scene_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("scene")
     g.add_argument("--mesh", default="sphere",
-                   help="sphere, cube, plane, or a mesh file (.obj .gltf .glb .ply .stl) (default: sphere)")
+                   help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh file "
+                        "(.obj .gltf .glb .ply .stl) (default: sphere)")
     g.add_argument("--env", default="studio",
                    help="'studio' (built in) or an equirectangular .hdr/.exr map, 2:1 (default: studio)")
     g.add_argument("--env-rotation", type=_number("--env-rotation"), default=0.0, metavar="DEG",
@@ -88,7 +89,7 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
 
 
 def _add_camera_options(p: argparse.ArgumentParser) -> None:
-    c = p.add_argument_group("camera (default: the mesh framed from +Z)")
+    c = p.add_argument_group("camera (default: the mesh framed from +Z; a built-in preview mesh from its 3/4 view)")
     c.add_argument("--camera", default="auto", metavar="auto|gltf[:N]",
                    help="auto: frame the mesh (with the flags below); gltf[:N]: the glTF file's camera N "
                         "(default 0), placed by its node (default: auto)")
@@ -352,7 +353,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "the field flags on top) as glTF 2.0: a material-only .gltf, or --mesh with "
                                    "the material as .glb. A dielectric F0 other than 0.04 is written with "
                                    "KHR_materials_ior (and KHR_materials_specular when coloured).")
-    e.add_argument("--mesh", help="sphere, cube, plane, or a mesh file (default: none for .gltf, a material only; "
+    e.add_argument("--mesh", help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh "
+                                  "file (default: none for .gltf, a material only; "
                                   "sphere for .glb); written with UVs, tangents and the maps")
     e.add_argument("--material-from", metavar="FILE.gltf|FILE.glb",
                    help="start from this glTF file's material instead of a preset")
@@ -596,7 +598,7 @@ def _render(args) -> int:
             lights = list(mesh.lights)
     width, height = _camera_size(args, mesh, width, height)
     camera = _camera(args, mesh, width / height)
-    if camera is None and mesh is not None:
+    if camera is None and mesh is not None and getattr(mesh, "view", None) is None:   # a built-in has its own view
         normal = mesh.flat_normal()
         if normal is not None and abs(normal[2]) < 0.02:   # the default camera's view is -Z (docs/conventions.md)
             _warn([f"{args.mesh}: the mesh is flat and the default camera (on +Z) sees it edge-on, so it "
@@ -881,11 +883,11 @@ def _reference(args) -> int:
         if not 0 <= level <= 8:
             raise AlightError(f"--env-level: {level} is out of range [0, 8]")
     material, overrides, texture_maps = build_look(args)
-    from alight.core.mesh import BUILTIN_MESHES
+    from alight.core.mesh import CONVEX_BUILTINS
 
     integrator = args.integrator
-    if integrator == "auto":
-        integrator = "path" if args.view == "camera" and args.mesh not in BUILTIN_MESHES else "exact"
+    if integrator == "auto":   # a concave built-in (the shader ball's groove) shadows itself: paths
+        integrator = "path" if args.view == "camera" and args.mesh not in CONVEX_BUILTINS else "exact"
     if integrator == "path":
         for option, value, low in (("--samples", args.samples, 1), ("--max-bounces", args.max_bounces, 1)):
             if value < low:

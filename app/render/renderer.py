@@ -1003,6 +1003,11 @@ class ForwardRenderer:
         if scene.mesh is None:
             return Camera()
         center, radius = scene.mesh.bounding_sphere()
+        view = getattr(scene.mesh, "view", None)
+        if view is not None:   # a built-in's 3/4 view (Mesh.view)
+            from alight.core.scene import orbit_camera
+
+            return orbit_camera(center, max(radius, 1e-6), aspect, view[0], view[1], corners=scene.mesh.corners())
         return frame_camera(center, max(radius, 1e-6), aspect=aspect, corners=scene.mesh.corners())
 
     @staticmethod

@@ -434,6 +434,9 @@ class EditorWindow:
             if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
                 self.orbit.restored, self._framed_mesh = False, self.state.mesh
             else:
+                view = getattr(self.state.mesh, "view", None)
+                if view is not None:   # a built-in preview mesh: from its 3/4 view (Mesh.view)
+                    self.orbit.yaw_deg, self.orbit.pitch_deg = float(view[0]), float(view[1])
                 self.frame_mesh()   # a new mesh: frame it once
         if 0 in self.size:    # minimised
             return None
