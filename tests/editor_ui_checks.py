@@ -432,6 +432,26 @@ def test_open_mesh_typed(ctx):
     ctx.item_close("**/Environment")
 
 
+def test_preview_mesh_combo_picks_the_shader_ball(ctx):
+    """The 'preview mesh' combo loads a built-in and frames it from its 3/4 view: the shader
+    ball's pedestal and groove change the view, and the camera looks down on it."""
+    win = editor()
+    s = win.state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("preview mesh/sphere")
+    assert s.mesh_spec == "sphere", s.error
+    before = view(ctx).astype(np.float64)
+    ctx.combo_click("preview mesh/shader_ball")
+    assert s.mesh_spec == "shader_ball", s.error
+    after = view(ctx).astype(np.float64)
+    assert np.abs(after - before).mean() > 2.0, np.abs(after - before).mean()
+    assert (win.orbit.yaw_deg, win.orbit.pitch_deg) == s.mesh.view == (35.0, 25.0)
+    ctx.combo_click("preview mesh/sphere")
+    assert s.mesh_spec == "sphere"
+    ctx.item_close("**/Environment")
+
+
 def test_field_of_view_aa_and_render_scale(ctx):
     win = editor()
     ctx.set_ref("alight")
