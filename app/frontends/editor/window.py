@@ -152,6 +152,9 @@ class EditorWindow:
         from alight.frontends.editor.panel import Panel
 
         self.shader_watcher = ShaderWatcher(self.renderer.shaders.root)
+        from alight.frontends.editor.hot_reload import FileWatcher
+
+        self.file_watcher = FileWatcher()   # maps and the environment file changed on disk
 
         self.panel = Panel()
 
@@ -293,6 +296,14 @@ class EditorWindow:
         else:
             self.state.error, self.state.message = "", "shaders reloaded"
             self._drawn_key = None   # redraw with the new programs
+
+    def check_files(self) -> None:
+        """Hot reload of the maps and the environment: what the watcher thread saw change is
+        decoded again (a new image is uploaded, a new environment baked)."""
+        changed = self.file_watcher.take_changed()
+        if changed and self.state.reload_files(changed):
+            self._drawn_key = None
+        self.file_watcher.watch(self.state.watched_files())
 
     # --- rendering ----------------------------------------------------------------------------
 
@@ -528,6 +539,7 @@ class EditorWindow:
             self.panel.draw(self)
         self._camera_input()
         self.check_shaders()
+        self.check_files()
         self.history.settle(self.state.look, self.imgui.is_any_item_active())
         self.state.sync_map_images()   # undo/redo may bring back a map not decoded now
 
@@ -606,6 +618,7 @@ class EditorWindow:
         return bool(self.glfw.window_should_close(self.window))
 
     def close(self) -> None:
+        self.file_watcher.stop()
         for targets in self._target_cache.values():
             targets.release()
         self._target_cache.clear()
