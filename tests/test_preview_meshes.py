@@ -78,3 +78,16 @@ def test_render_fills_the_frame_from_three_quarters(name, tmp_path):
         assert alpha.sum() < 0.92 * box, f"{name}: its outline fills its bounding box (seen square on)"
     # And taller than a sliver: a flat mesh seen edge-on would be a line.
     assert np.ptp(rows) > 0.3 * alpha.shape[0]
+
+
+def test_explicit_orbit_and_elevation_still_give_the_front_view(tmp_path):
+    """`--orbit 0 --elevation 0` is the view from +Z as before: the cube square on, its outline
+    filling its bounding box, where the default (its 3/4 view) does not."""
+    out = tmp_path / "front.png"
+    proc = subprocess.run([sys.executable, "-m", "alight", "render", "--mesh", "cube", "--orbit", "0", "--elevation",
+                           "0", "--size", "96", "--quality", "low", "--background", "transparent", "--out", str(out)],
+                          cwd=REPO, env=dict(os.environ), capture_output=True, text=True, timeout=180)
+    assert proc.returncode == 0, proc.stderr
+    alpha = np.asarray(Image.open(out).convert("RGBA"))[..., 3] > 128
+    rows, cols = np.nonzero(alpha)
+    assert alpha.sum() > 0.97 * (np.ptp(rows) + 1) * (np.ptp(cols) + 1)

@@ -93,10 +93,12 @@ def _add_camera_options(p: argparse.ArgumentParser) -> None:
     c.add_argument("--camera", default="auto", metavar="auto|gltf[:N]",
                    help="auto: frame the mesh (with the flags below); gltf[:N]: the glTF file's camera N "
                         "(default 0), placed by its node (default: auto)")
-    c.add_argument("--orbit", type=_number("--orbit"), default=0.0, metavar="DEG",
-                   help="turn the camera about +Y from +Z by DEG degrees, right-handed (default: 0)")
-    c.add_argument("--elevation", type=_number("--elevation", -90.0, 90.0), default=0.0, metavar="DEG",
-                   help="raise the camera by DEG degrees (default: 0)")
+    # None: not given (a built-in preview mesh keeps its 3/4 view; given, either is from +Z).
+    c.add_argument("--orbit", type=_number("--orbit"), default=None, metavar="DEG",
+                   help="turn the camera about +Y from +Z by DEG degrees, right-handed (default: 0; a built-in "
+                        "preview mesh without --orbit and --elevation: its 3/4 view)")
+    c.add_argument("--elevation", type=_number("--elevation", -90.0, 90.0), default=None, metavar="DEG",
+                   help="raise the camera by DEG degrees (default: 0, or as --orbit says)")
     c.add_argument("--distance", type=_number("--distance", 1e-6), default=None, metavar="X",
                    help="the camera's distance from the target (default: what frames the mesh)")
     c.add_argument("--fov", type=_number("--fov", 1.0, 179.0), default=None, metavar="DEG",
@@ -111,7 +113,7 @@ def _camera(args, mesh, aspect: float):
     from alight.core.scene import orbit_camera
 
     spec = args.camera
-    flags = {"--orbit": args.orbit != 0.0, "--elevation": args.elevation != 0.0,
+    flags = {"--orbit": args.orbit is not None, "--elevation": args.elevation is not None,
              "--distance": args.distance is not None, "--target": args.target is not None}
     if spec == "auto":
         if not any(flags.values()) and args.fov is None:
@@ -129,7 +131,10 @@ def _camera(args, mesh, aspect: float):
         if target is not None:   # the file's coordinates, where the mesh was moved from (Mesh.origin)
             target = tuple(t - o for t, o in zip(target, getattr(mesh, "origin", (0.0, 0.0, 0.0))))
         centre, radius = mesh.bounding_sphere()
-        return orbit_camera(centre, radius, aspect, args.orbit, args.elevation, args.distance,
+        orbit, elevation = args.orbit, args.elevation
+        if orbit is None and elevation is None and getattr(mesh, "view", None) is not None:
+            orbit, elevation = mesh.view   # --distance, --fov or --target alone keep a built-in's view
+        return orbit_camera(centre, radius, aspect, orbit or 0.0, elevation or 0.0, args.distance,
                             35.0 if args.fov is None else args.fov, target, corners=mesh.corners())
     kind, _, index = spec.partition(":")
     if kind != "gltf":
