@@ -15,6 +15,7 @@ from PIL import Image
 
 from alight.core.mesh import BUILTIN_MESHES, is_closed
 from alight.exchange.meshes import load_mesh
+from test_gltf_material import validate  # noqa: F401  (the Khronos validator fixture)
 
 REPO = Path(__file__).resolve().parents[1]
 CLOSED = {"sphere": True, "cube": True, "plane": False, "shader_ball": True, "rounded_cube": True, "drape": False}
@@ -91,3 +92,16 @@ def test_explicit_orbit_and_elevation_still_give_the_front_view(tmp_path):
     alpha = np.asarray(Image.open(out).convert("RGBA"))[..., 3] > 128
     rows, cols = np.nonzero(alpha)
     assert alpha.sum() > 0.97 * (np.ptp(rows) + 1) * (np.ptp(cols) + 1)
+
+
+@pytest.mark.parametrize("name", ["shader_ball", "rounded_cube", "drape"])
+def test_the_new_meshes_export_validator_clean(name, tmp_path, validate):
+    """`alight export --mesh NAME` writes a .glb with their uvs and tangents that the Khronos
+    validator passes with no error and no warning."""
+    out = tmp_path / f"{name}.glb"
+    proc = subprocess.run([sys.executable, "-m", "alight", "export", "--preset", "gold", "--mesh", name,
+                           "--out", str(out)], cwd=REPO, env=dict(os.environ), capture_output=True, text=True,
+                          timeout=180)
+    assert proc.returncode == 0, proc.stderr
+    (report,) = validate(out)
+    assert (report["errors"], report["warnings"]) == (0, 0), report
