@@ -432,6 +432,26 @@ def test_open_mesh_typed(ctx):
     ctx.item_close("**/Environment")
 
 
+def test_preview_mesh_combo_picks_the_shader_ball(ctx):
+    """The 'preview mesh' combo loads a built-in and frames it from its 3/4 view: the shader
+    ball's pedestal and groove change the view, and the camera looks down on it."""
+    win = editor()
+    s = win.state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("preview mesh/sphere")
+    assert s.mesh_spec == "sphere", s.error
+    before = view(ctx).astype(np.float64)
+    ctx.combo_click("preview mesh/shader_ball")
+    assert s.mesh_spec == "shader_ball", s.error
+    after = view(ctx).astype(np.float64)
+    assert np.abs(after - before).mean() > 2.0, np.abs(after - before).mean()
+    assert (win.orbit.yaw_deg, win.orbit.pitch_deg) == s.mesh.view == (35.0, 25.0)
+    ctx.combo_click("preview mesh/sphere")
+    assert s.mesh_spec == "sphere"
+    ctx.item_close("**/Environment")
+
+
 def test_field_of_view_aa_and_render_scale(ctx):
     win = editor()
     ctx.set_ref("alight")
@@ -486,6 +506,65 @@ def test_base_colour_map_typed_load_and_clear(ctx):
     ctx.item_click("texture maps/base_color/clear")
     assert "base_color" not in s.texture_maps.paths()
     np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), white, atol=0.5)
+
+
+def _until(ctx, done, limit_s: float) -> float:
+    """Frames until ``done()`` (the seconds it took), failing after ``limit_s``."""
+    import time
+
+    start = time.monotonic()
+    while not done():
+        assert time.monotonic() - start < limit_s, f"not within {limit_s} s"
+        ctx.yield_()
+    return time.monotonic() - start
+
+
+def _write_atomically(path: str, pixels: np.ndarray) -> None:
+    """As image editors and exporters save: a new file renamed over the old one."""
+    import OpenImageIO as oiio
+
+    temp = path + ".tmp" + os.path.splitext(path)[1]
+    assert oiio.ImageBuf(pixels).write(temp)
+    os.replace(temp, path)
+
+
+def test_hot_reload_of_a_map_and_the_environment(ctx):
+    """A map file rewritten on disk while the editor runs is drawn anew within a second, and so
+    is an environment file (then baked again)."""
+    s = editor().state
+    path = os.path.join(OUT, "hot.png")
+    _write_atomically(path, np.full((16, 16, 3), (230, 20, 20), np.uint8))
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_click("texture maps/base_color/##armed")
+    ctx.item_input_value("**/map file", path)
+    ctx.item_click("**/load##typed")
+    assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
+    red = ball(view(ctx)).mean(axis=0)
+    assert red[0] > 2 * red[2], red
+    before = s.map_images[path]
+    _write_atomically(path, np.full((16, 16, 3), (20, 20, 230), np.uint8))
+    seconds = _until(ctx, lambda: s.map_images.get(path) is not before, 1.0)
+    blue = ball(view(ctx)).mean(axis=0)
+    assert blue[2] > 2 * blue[0], (blue, red)
+    print(f"hot reload: the map was reloaded {seconds:.2f} s after the rewrite")
+    ctx.item_click("texture maps/base_color/clear")
+    # The environment: a uniform warm sky, then a uniform cold one.
+    env = os.path.join(OUT, "hot.hdr")
+    _write_atomically(env, np.full((32, 64, 3), (1.0, 0.6, 0.3), np.float32))
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/env file", env)
+    ctx.item_click("**/open env")
+    assert s.env_spec == env, (s.env_spec, s.error)
+    warm = ball(view(ctx)).mean(axis=0)
+    old_env = s.env
+    _write_atomically(env, np.full((32, 64, 3), (0.3, 0.6, 1.0), np.float32))
+    seconds = _until(ctx, lambda: s.env is not old_env, 1.0)
+    cold = ball(view(ctx)).mean(axis=0)
+    assert cold[2] > cold[0] + 20 and warm[0] > warm[2] + 20, (warm, cold)
+    print(f"hot reload: the environment was reloaded {seconds:.2f} s after the rewrite")
+    ctx.item_click("**/studio")
+    ctx.item_close("**/Environment")
 
 
 def test_anisotropy_and_sheen_sections(ctx):

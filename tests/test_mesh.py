@@ -72,7 +72,7 @@ def test_builtin_is_valid_and_ccw(builder):
 
 
 def test_builtins_by_name():
-    assert BUILTIN_MESHES == ("sphere", "cube", "plane")
+    assert BUILTIN_MESHES == ("sphere", "cube", "plane", "shader_ball", "rounded_cube", "drape")
     for name in BUILTIN_MESHES:
         assert load_mesh(name).source == name
 

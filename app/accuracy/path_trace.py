@@ -382,15 +382,14 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
     if settings.samples < 1:
         raise AlightError(f"--samples: {settings.samples} must be at least 1")
     t0 = time.perf_counter()
-    from alight.core.scene import frame_camera
+    from alight.core.scene import default_camera
 
     geom, warnings = scene_geometry(scene)
     rays = _Rays(geom)
     if scene.camera is not None:
         camera = scene.camera
-    else:
-        centre, radius = scene.mesh.bounding_sphere()
-        camera = frame_camera(centre, max(radius, 1e-6), aspect=width / height, corners=scene.mesh.corners())
+    else:   # as the renderer frames it (a built-in from its 3/4 view)
+        camera = default_camera(scene.mesh, width / height)
     env = None
     if radiance is not None and scene.ibl_enabled and scene.env_intensity > 0.0:
         env = EnvironmentSampler(radiance, scene.env_rotation_deg, scene.env_intensity)

@@ -1,6 +1,7 @@
 """Meshes as plain numpy arrays ready for GPU buffers (no GL here: the renderer uploads them).
 
-The built-in meshes (``sphere``, ``cube``, ``plane``), normals and tangents, and the closed-mesh
+The built-in meshes (``sphere``, ``cube``, ``plane``; the other preview meshes are
+``alight.core.preview_meshes``'s), normals and tangents, and the closed-mesh
 test live here; files are read by ``alight.exchange.meshes``.
 
 Conventions: world space is right-handed, +Y up (``docs/conventions.md``); faces are
@@ -16,7 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-BUILTIN_MESHES = ("sphere", "cube", "plane")
+# The built-in preview meshes, by the name --mesh and the editor's list take.
+BUILTIN_MESHES = ("sphere", "cube", "plane", "shader_ball", "rounded_cube", "drape")
+# Those that cannot shadow or reflect onto themselves (convex, or flat): a reference needs no paths.
+CONVEX_BUILTINS = ("sphere", "cube", "plane", "rounded_cube")
 WRAP_MODES = ("repeat", "clamp_to_edge", "mirrored_repeat")   # glTF 2.0 sampler.wrapS/T (10497, 33071, 33648)
 ALPHA_MODES = ("OPAQUE", "MASK", "BLEND")                      # glTF 2.0 material.alphaMode
 
@@ -202,6 +206,10 @@ class Mesh:
     # this (float64). A model far from its origin (1e6) is moved near it before positions become
     # float32, whose spacing there (0.06) faceted a unit sphere and broke its reflections.
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    # The direction a built-in is best seen from, (orbit, elevation) in degrees as
+    # alight.core.scene.orbit_camera takes them: a 3/4 view, so a cube is not a square and a
+    # plane not an edge. None: from +Z, the default camera (docs/conventions.md).
+    view: tuple[float, float] | None = None
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space min and max corners over all parts."""
@@ -351,6 +359,9 @@ def compute_tangents(positions, normals, uvs, indices) -> np.ndarray:
 
 # --- built-in meshes -----------------------------------------------------------------------
 
+THREE_QUARTER = (35.0, 25.0)   # Mesh.view: turned 35 degrees, raised 25 (an object with depth)
+FROM_ABOVE = (30.0, 45.0)      # Mesh.view: a flat or nearly flat object, seen from above at an angle
+
 def _part(name: str, positions, normals, uvs, tangents, indices) -> MeshPart:
     return MeshPart(
         name=name,
@@ -421,12 +432,12 @@ def _quads(faces, half: float, offset: bool) -> tuple[np.ndarray, ...]:
 
 def cube(size: float = 2.0) -> Mesh:
     """Axis-aligned cube centred at the origin: 24 vertices, flat normals, a full uv square per face."""
-    return Mesh([_part("cube", *_quads(_CUBE_FACES, size / 2.0, True))], "cube")
+    return Mesh([_part("cube", *_quads(_CUBE_FACES, size / 2.0, True))], "cube", view=THREE_QUARTER)
 
 
 def plane(size: float = 2.0) -> Mesh:
     """Square in the XZ plane facing +Y; u along +X, v along -Z."""
-    return Mesh([_part("plane", *_quads([((0, 1, 0), (1, 0, 0))], size / 2.0, False))], "plane")
+    return Mesh([_part("plane", *_quads([((0, 1, 0), (1, 0, 0))], size / 2.0, False))], "plane", view=FROM_ABOVE)
 
 
 # --- topology ------------------------------------------------------------------------------

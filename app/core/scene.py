@@ -94,6 +94,16 @@ def frame_camera(center, radius: float, fov_y_deg: float = 35.0, aspect: float =
                   near=max(distance - radius * 1.5, distance * 1e-3), far=distance + radius * 4.0)
 
 
+def default_camera(mesh, aspect: float) -> Camera:
+    """The camera a scene without one gets: the mesh framed from +Z (docs/conventions.md), or a
+    built-in preview mesh from its own 3/4 view (``Mesh.view``: orbit, elevation in degrees)."""
+    center, radius = mesh.bounding_sphere()
+    view = getattr(mesh, "view", None)
+    if view is not None:
+        return orbit_camera(center, max(radius, 1e-6), aspect, view[0], view[1], corners=mesh.corners())
+    return frame_camera(center, max(radius, 1e-6), aspect=aspect, corners=mesh.corners())
+
+
 def orbit_camera(center, radius: float, aspect: float, orbit_deg: float = 0.0, elevation_deg: float = 0.0,
                  distance: float | None = None, fov_y_deg: float = 35.0, target=None, corners=None) -> Camera:
     """A camera looking at ``target`` (default: ``center``) from a direction turned ``orbit_deg``

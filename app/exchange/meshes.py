@@ -29,12 +29,15 @@ from alight.core.mesh import (
     smooth_normals,
     sphere,
 )
+from alight.core.preview_meshes import drape, rounded_cube, shader_ball
 from alight.errors import AlightError
 
 MESH_EXTENSIONS = (".obj", ".gltf", ".glb", ".ply", ".stl")
 
 
-_BUILDERS: dict[str, Callable[[], Mesh]] = {"sphere": sphere, "cube": cube, "plane": plane}
+_BUILDERS: dict[str, Callable[[], Mesh]] = {"sphere": sphere, "cube": cube, "plane": plane,
+                                            "shader_ball": shader_ball, "rounded_cube": rounded_cube,
+                                            "drape": drape}
 
 
 def _one_line(exc: BaseException) -> str:

@@ -105,7 +105,7 @@ class Renderer:
     # --- scene state ---------------------------------------------------------------------
 
     def set_mesh(self, mesh: str | os.PathLike | Mesh) -> "Renderer":
-        """'sphere', 'cube', 'plane', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
+        """'sphere', 'cube', 'plane', 'shader_ball', 'rounded_cube', 'drape', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
         What the file is drawn without is said on stderr, one ``alight: warning:`` line each, once
         per process (alight.errors.warn)."""
         self._mesh = mesh if isinstance(mesh, Mesh) else load_mesh(os.fspath(mesh))
@@ -246,7 +246,7 @@ class Renderer:
     def set_camera(self, camera: Camera | None = None, *, orbit_deg: float | None = None,
                    elevation_deg: float = 0.0, distance: float | None = None, fov_deg: float = 35.0,
                    target=None) -> "Renderer":
-        """A Camera, None (frame the mesh from +Z), or ``orbit_deg``: look at ``target`` (default:
+        """A Camera, None (frame the mesh from +Z, a built-in from its 3/4 view, Mesh.view), or ``orbit_deg``: look at ``target`` (default:
         the mesh's centre) from a direction turned that many degrees about +Y from +Z
         (right-handed), raised by ``elevation_deg``, at ``distance`` (default: framing the mesh),
         with a vertical field of view of ``fov_deg``. A mesh file's own cameras are

@@ -67,7 +67,8 @@ class _Size(tuple):
 def _add_scene_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("scene")
     g.add_argument("--mesh", default="sphere",
-                   help="sphere, cube, plane, or a mesh file (.obj .gltf .glb .ply .stl) (default: sphere)")
+                   help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh file "
+                        "(.obj .gltf .glb .ply .stl) (default: sphere)")
     g.add_argument("--env", default="studio",
                    help="'studio' (built in) or an equirectangular .hdr/.exr map, 2:1 (default: studio)")
     g.add_argument("--env-rotation", type=_number("--env-rotation"), default=0.0, metavar="DEG",
@@ -89,14 +90,16 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
 
 
 def _add_camera_options(p: argparse.ArgumentParser) -> None:
-    c = p.add_argument_group("camera (default: the mesh framed from +Z)")
+    c = p.add_argument_group("camera (default: the mesh framed from +Z; a built-in preview mesh from its 3/4 view)")
     c.add_argument("--camera", default="auto", metavar="auto|gltf[:N]",
                    help="auto: frame the mesh (with the flags below); gltf[:N]: the glTF file's camera N "
                         "(default 0), placed by its node (default: auto)")
-    c.add_argument("--orbit", type=_number("--orbit"), default=0.0, metavar="DEG",
-                   help="turn the camera about +Y from +Z by DEG degrees, right-handed (default: 0)")
-    c.add_argument("--elevation", type=_number("--elevation", -90.0, 90.0), default=0.0, metavar="DEG",
-                   help="raise the camera by DEG degrees (default: 0)")
+    # None: not given (a built-in preview mesh keeps its 3/4 view; given, either is from +Z).
+    c.add_argument("--orbit", type=_number("--orbit"), default=None, metavar="DEG",
+                   help="turn the camera about +Y from +Z by DEG degrees, right-handed (default: 0; a built-in "
+                        "preview mesh without --orbit and --elevation: its 3/4 view)")
+    c.add_argument("--elevation", type=_number("--elevation", -90.0, 90.0), default=None, metavar="DEG",
+                   help="raise the camera by DEG degrees (default: 0, or as --orbit says)")
     c.add_argument("--distance", type=_number("--distance", 1e-6), default=None, metavar="X",
                    help="the camera's distance from the target (default: what frames the mesh)")
     c.add_argument("--fov", type=_number("--fov", 1.0, 179.0), default=None, metavar="DEG",
@@ -111,7 +114,7 @@ def _camera(args, mesh, aspect: float):
     from alight.core.scene import orbit_camera
 
     spec = args.camera
-    flags = {"--orbit": args.orbit != 0.0, "--elevation": args.elevation != 0.0,
+    flags = {"--orbit": args.orbit is not None, "--elevation": args.elevation is not None,
              "--distance": args.distance is not None, "--target": args.target is not None}
     if spec == "auto":
         if not any(flags.values()) and args.fov is None:
@@ -129,7 +132,10 @@ def _camera(args, mesh, aspect: float):
         if target is not None:   # the file's coordinates, where the mesh was moved from (Mesh.origin)
             target = tuple(t - o for t, o in zip(target, getattr(mesh, "origin", (0.0, 0.0, 0.0))))
         centre, radius = mesh.bounding_sphere()
-        return orbit_camera(centre, radius, aspect, args.orbit, args.elevation, args.distance,
+        orbit, elevation = args.orbit, args.elevation
+        if orbit is None and elevation is None and getattr(mesh, "view", None) is not None:
+            orbit, elevation = mesh.view   # --distance, --fov or --target alone keep a built-in's view
+        return orbit_camera(centre, radius, aspect, orbit or 0.0, elevation or 0.0, args.distance,
                             35.0 if args.fov is None else args.fov, target, corners=mesh.corners())
     kind, _, index = spec.partition(":")
     if kind != "gltf":
@@ -334,7 +340,8 @@ def build_parser() -> argparse.ArgumentParser:
                                    "the field flags on top) as glTF 2.0: a material-only .gltf, or --mesh with "
                                    "the material as .glb. A dielectric F0 other than 0.04 is written with "
                                    "KHR_materials_ior (and KHR_materials_specular when coloured).")
-    e.add_argument("--mesh", help="sphere, cube, plane, or a mesh file (default: none for .gltf, a material only; "
+    e.add_argument("--mesh", help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh "
+                                  "file (default: none for .gltf, a material only; "
                                   "sphere for .glb); written with UVs, tangents and the maps")
     e.add_argument("--material-from", metavar="FILE.gltf|FILE.glb",
                    help="start from this glTF file's material instead of a preset")
@@ -578,7 +585,7 @@ def _render(args) -> int:
             lights = list(mesh.lights)
     width, height = _camera_size(args, mesh, width, height)
     camera = _camera(args, mesh, width / height)
-    if camera is None and mesh is not None:
+    if camera is None and mesh is not None and getattr(mesh, "view", None) is None:   # a built-in has its own view
         normal = mesh.flat_normal()
         if normal is not None and abs(normal[2]) < 0.02:   # the default camera's view is -Z (docs/conventions.md)
             _warn([f"{args.mesh}: the mesh is flat and the default camera (on +Z) sees it edge-on, so it "
@@ -863,11 +870,11 @@ def _reference(args) -> int:
         if not 0 <= level <= 8:
             raise AlightError(f"--env-level: {level} is out of range [0, 8]")
     material, overrides, texture_maps = build_look(args)
-    from alight.core.mesh import BUILTIN_MESHES
+    from alight.core.mesh import CONVEX_BUILTINS
 
     integrator = args.integrator
-    if integrator == "auto":
-        integrator = "path" if args.view == "camera" and args.mesh not in BUILTIN_MESHES else "exact"
+    if integrator == "auto":   # a concave built-in (the shader ball's groove) shadows itself: paths
+        integrator = "path" if args.view == "camera" and args.mesh not in CONVEX_BUILTINS else "exact"
     if integrator == "path":
         for option, value, low in (("--samples", args.samples, 1), ("--max-bounces", args.max_bounces, 1)):
             if value < low:

@@ -42,7 +42,7 @@ from alight.core.scene import (
     Camera,
     Display,
     Scene,
-    frame_camera,
+    default_camera,
 )
 from alight.core.shader_names import (
     MATERIAL_MAPS,
@@ -1002,8 +1002,7 @@ class ForwardRenderer:
             return scene.camera
         if scene.mesh is None:
             return Camera()
-        center, radius = scene.mesh.bounding_sphere()
-        return frame_camera(center, max(radius, 1e-6), aspect=aspect, corners=scene.mesh.corners())
+        return default_camera(scene.mesh, aspect)   # a built-in from its 3/4 view (Mesh.view)
 
     @staticmethod
     def _ibl_defines(scene: Scene) -> dict:

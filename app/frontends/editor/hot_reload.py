@@ -66,3 +66,71 @@ def rebuild(renderer, root: Path) -> str:
         return " ".join(str(exc).split())
     renderer.use_shaders(library)
     return ""
+
+
+class FileWatcher:
+    """Texture maps and the environment file reloaded when they change on disk: a daemon thread
+    stats the watched files every ``interval_s`` (mtime and size, off the render thread, so a
+    frame never waits on the file system), and the window takes what changed once a frame
+    (``take_changed``) and decodes it again. Polling rather than OS notifications: it sees a
+    file replaced by a rename (what image editors and exporters do) as well as one written in
+    place, on every platform, for a handful of files at a cost of a few stat calls a second."""
+
+    def __init__(self, interval_s: float = 0.25):
+        import threading
+
+        self.interval_s = interval_s
+        self._lock = threading.Lock()
+        self._paths: frozenset[str] = frozenset()
+        self._stamps: dict[str, tuple | None] = {}
+        self._changed: set[str] = set()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="alight-file-watcher", daemon=True)
+        self._thread.start()
+
+    @staticmethod
+    def _stamp(path: str) -> tuple | None:
+        try:
+            st = Path(path).stat()
+        except OSError:
+            return None   # gone for now (a save by rename): its return counts as a change
+        return (st.st_mtime_ns, st.st_size)
+
+    def watch(self, paths) -> None:
+        """The files to watch now (the main thread calls this each frame; cheap when unchanged).
+        A path newly watched is taken as it is now: only later changes count."""
+        paths = frozenset(p for p in paths if p)
+        if paths == self._paths:
+            return
+        with self._lock:
+            for p in paths - self._paths:
+                self._stamps[p] = self._stamp(p)
+            for p in self._paths - paths:
+                self._stamps.pop(p, None)
+                self._changed.discard(p)
+            self._paths = paths
+
+    def poll(self) -> None:
+        """One round of stat calls (the thread's loop body; tests may call it directly)."""
+        with self._lock:
+            paths = list(self._paths)
+        for p in paths:
+            stamp = self._stamp(p)
+            with self._lock:
+                if p in self._stamps and stamp != self._stamps[p]:
+                    self._stamps[p] = stamp
+                    if stamp is not None:
+                        self._changed.add(p)
+
+    def take_changed(self) -> set[str]:
+        """The watched files changed since the last call (and present now)."""
+        with self._lock:
+            out, self._changed = self._changed, set()
+        return out
+
+    def _run(self) -> None:
+        while not self._stop.wait(self.interval_s):
+            self.poll()
+
+    def stop(self) -> None:
+        self._stop.set()

@@ -10,6 +10,7 @@ import numpy as np
 
 from alight.accuracy.auto_quality import DEFAULT_ERROR_BUDGET
 from alight.core.ibl_models import IBL_MODELS
+from alight.core.mesh import BUILTIN_MESHES
 from alight.core.material import validate_material, with_overrides
 from alight.core.scene import BACKGROUNDS, TONEMAPS, Light
 from alight.core.shading import linear_to_srgb, srgb_to_linear
@@ -354,6 +355,16 @@ class Panel:
                 s.load_env("studio")
             except AlightError as exc:
                 s.fail(exc)
+        names = list(BUILTIN_MESHES)
+        current = names.index(s.mesh_spec) if s.mesh_spec in names else -1   # -1: a file, none shown
+        changed, i = imgui.combo("preview mesh", current, names)
+        if changed and 0 <= i < len(names):
+            try:
+                s.load_mesh(names[i])
+            except AlightError as exc:
+                s.fail(exc)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("a built-in mesh, framed from its 3/4 view; or type a mesh file below")
         _, self.mesh_path = imgui.input_text("mesh", self.mesh_path)
         if imgui.button("open mesh"):
             try:

@@ -147,6 +147,37 @@ class EditorState:
     def clear_map(self, slot: str) -> None:
         self.texture_maps = self.texture_maps.with_slot(slot, "")
 
+    def watched_files(self) -> set[str]:
+        """The files whose change on disk the editor reloads: every map's and the environment's."""
+        paths = set(self.texture_maps.paths().values())
+        if self.env_spec and self.env_spec != "studio":   # the watcher's thread stats it, not the frame
+            paths.add(self.env_spec)
+        return paths
+
+    def reload_files(self, paths) -> bool:
+        """Decode again the maps and the environment read from ``paths`` (changed on disk). A file
+        that does not read now (half written, broken) keeps what was drawn and sets ``error``;
+        it is tried again at its next change. Returns whether anything was reloaded."""
+        done = []
+        for slot, path in self.texture_maps.paths().items():
+            if path in paths:
+                try:
+                    self.map_images = {**self.map_images, path: load_slot_image(self.texture_maps, slot)}
+                    done.append(path)
+                except AlightError as exc:
+                    self.fail(exc)
+        if self.env_spec in paths:
+            try:
+                self.load_env(self.env_spec)
+                done.append(self.env_spec)
+            except AlightError as exc:
+                self.fail(exc)
+        if done:
+            from pathlib import Path
+
+            self.message = "reloaded " + ", ".join(sorted({Path(p).name for p in done}))
+        return bool(done)
+
     def sync_map_images(self) -> None:
         """Decode any slot's file not yet decoded (after undo/redo or a restored session); a file
         that no longer reads empties its slot and sets ``error``."""

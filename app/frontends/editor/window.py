@@ -152,6 +152,9 @@ class EditorWindow:
         from alight.frontends.editor.panel import Panel
 
         self.shader_watcher = ShaderWatcher(self.renderer.shaders.root)
+        from alight.frontends.editor.hot_reload import FileWatcher
+
+        self.file_watcher = FileWatcher()   # maps and the environment file changed on disk
 
         self.panel = Panel()
 
@@ -294,6 +297,14 @@ class EditorWindow:
             self.state.error, self.state.message = "", "shaders reloaded"
             self._drawn_key = None   # redraw with the new programs
 
+    def check_files(self) -> None:
+        """Hot reload of the maps and the environment: what the watcher thread saw change is
+        decoded again (a new image is uploaded, a new environment baked)."""
+        changed = self.file_watcher.take_changed()
+        if changed and self.state.reload_files(changed):
+            self._drawn_key = None
+        self.file_watcher.watch(self.state.watched_files())
+
     # --- rendering ----------------------------------------------------------------------------
 
     def maps(self):
@@ -434,6 +445,9 @@ class EditorWindow:
             if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
                 self.orbit.restored, self._framed_mesh = False, self.state.mesh
             else:
+                view = getattr(self.state.mesh, "view", None)
+                if view is not None:   # a built-in preview mesh: from its 3/4 view (Mesh.view)
+                    self.orbit.yaw_deg, self.orbit.pitch_deg = float(view[0]), float(view[1])
                 self.frame_mesh()   # a new mesh: frame it once
         if 0 in self.size:    # minimised
             return None
@@ -525,6 +539,7 @@ class EditorWindow:
             self.panel.draw(self)
         self._camera_input()
         self.check_shaders()
+        self.check_files()
         self.history.settle(self.state.look, self.imgui.is_any_item_active())
         self.state.sync_map_images()   # undo/redo may bring back a map not decoded now
 
@@ -603,6 +618,7 @@ class EditorWindow:
         return bool(self.glfw.window_should_close(self.window))
 
     def close(self) -> None:
+        self.file_watcher.stop()
         for targets in self._target_cache.values():
             targets.release()
         self._target_cache.clear()
