@@ -508,6 +508,34 @@ def test_base_colour_map_typed_load_and_clear(ctx):
     np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), white, atol=0.5)
 
 
+def test_texture_set_folder_typed_into_the_map_field(ctx):
+    """A folder typed into "map file" and loaded: its Substance-named maps go to their slots by
+    name (not all into the armed slot), their factors become 1, and the ball takes the red map."""
+    import OpenImageIO as oiio
+
+    s = editor().state
+    folder = os.path.join(OUT, "wood_set")
+    os.makedirs(folder, exist_ok=True)
+    red = np.zeros((16, 16, 3), np.uint8)
+    red[..., 0] = 230
+    grey = np.full((16, 16, 3), 128, np.uint8)
+    oiio.ImageBuf(red).write(os.path.join(folder, "wood_BaseColor.png"))
+    oiio.ImageBuf(grey).write(os.path.join(folder, "wood_Roughness.png"))
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    gold = ball(view(ctx)).mean(axis=0)
+    ctx.item_input_value("**/map file", folder)
+    ctx.item_click("**/load##typed")
+    paths = s.texture_maps.paths()
+    assert paths.get("base_color", "").endswith("wood_BaseColor.png"), (paths, s.error)
+    assert paths.get("roughness", "").endswith("wood_Roughness.png"), (paths, s.error)
+    assert s.material.roughness == 1.0 and tuple(s.material.base_color) == (1.0, 1.0, 1.0), s.material
+    mapped = ball(view(ctx)).mean(axis=0)
+    assert mapped[0] > 1.5 * mapped[1] and not np.allclose(mapped, gold, atol=2.0), (mapped, gold)
+    for slot in ("base_color", "roughness"):
+        s.clear_map(slot)
+
+
 def _until(ctx, done, limit_s: float) -> float:
     """Frames until ``done()`` (the seconds it took), failing after ``limit_s``."""
     import time

@@ -286,8 +286,9 @@ class Renderer:
     def set_occlusion(self, mode: Literal["auto", "on", "off"]) -> "Renderer":
         """Occlusion of the environment light by the mesh itself, with one diffuse bounce
         (alight.core.visibility: a per-vertex ray-traced bake, cached like the IBL bake): 'auto'
-        (default) bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in
-        sphere, 'off' never. Raises AlightError for another mode."""
+        bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in sphere,
+        'off' (the default, while the bake blots some models: docs/explanation/occlusion.md) never.
+        Raises AlightError for another mode."""
         if mode not in ("auto", "on", "off"):
             raise AlightError(f"occlusion: {mode!r} is not 'auto', 'on' or 'off'")
         self.scene.occlusion = mode

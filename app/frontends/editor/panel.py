@@ -330,15 +330,34 @@ class Panel:
                 imgui.text_disabled(os.path.basename(path))
             imgui.pop_id()
         _, self.map_path = imgui.input_text("map file", self.map_path)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("an image goes into the armed slot; a folder is read as a texture set by its "
+                              "files' names (NAME_BaseColor, _Normal, _Roughness, ...)")
         imgui.same_line()
         if imgui.button("load##typed") and self.map_path:
-            loader(s.armed_slot)(self.map_path)
+            if os.path.isdir(self.map_path):
+                self._load_texture_set(s, self.map_path)
+            else:
+                loader(s.armed_slot)(self.map_path)
         changed, v = imgui.drag_float2("UV tiling", list(maps.uv_scale), 0.02, -64.0, 64.0)
         if changed:
             s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=tuple(v))
         changed, v = imgui.drag_float2("UV offset", list(maps.uv_offset), 0.005, -8.0, 8.0)
         if changed:
             s.texture_maps = dataclasses.replace(s.texture_maps, uv_offset=tuple(v))
+
+    @staticmethod
+    def _load_texture_set(s, folder: str) -> None:
+        """A folder typed into the map field: its images assigned to slots by name, as a drop of
+        several files is (one undo step; the panel's message lists the assignment)."""
+        try:
+            files = sorted(os.path.join(folder, f) for f in os.listdir(folder)
+                           if os.path.splitext(f)[1].lower() in IMAGE_SUFFIXES)
+            if not files:
+                raise AlightError(f"{folder}: no image files in the folder")
+            s.open_texture_set(files)
+        except (AlightError, OSError) as exc:
+            s.fail(exc if isinstance(exc, AlightError) else AlightError(f"{folder}: {exc.strerror}"))
 
     def _environment(self, s, win) -> None:
         from imgui_bundle import imgui
