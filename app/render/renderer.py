@@ -236,7 +236,16 @@ class _GpuPart:
         key = (np.asarray(view_projection, np.float32).tobytes(), tuple(image_size), tuple(texture_size))
         if self._anisotropy_key != key:
             part = self._part
-            area, p_max, p_min = footprints(part.positions, part.uvs, part.indices, view_projection,
+            uvs = part.uvs
+            # The uvs the maps read: KHR_texture_transform's scale (gltfpack's dequantization of
+            # quantized uvs among them) multiplies the footprint. The transform that stretches
+            # the most sets it.
+            mats = [np.asarray(info.transform.gl_matrix(), np.float64) for info in self.infos.values()
+                    if info.transform is not None and info.tex_coord == 0]
+            if mats:
+                m = max(mats, key=lambda m: abs(np.linalg.det(m[:2, :2])))
+                uvs = np.asarray(uvs, np.float64) @ m[:2, :2].T + m[:2, 2]
+            area, p_max, p_min = footprints(part.positions, uvs, part.indices, view_projection,
                                             image_size, texture_size)
             self._anisotropy = anisotropy_for_view(area, p_max, p_min)
             self._anisotropy_key = key
