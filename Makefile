@@ -14,7 +14,7 @@ demo: setup
 
 # The test suite, headless (EGL; the editor's tests start their own Xvfb).
 test: setup
-	.venv/bin/python -m pytest -q
+	bash tools/run_tests.sh
 
 bench: setup
 	.venv/bin/python benchmarks/bench_render.py

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The test suite, one pytest process per test file (make test; CI). In one process, the shared
+# llvmpipe context returned zeros for every GPU test after about three quarters of the suite had
+# run (each of those files passes on its own and after its neighbours): the cause is not found
+# yet, and separate processes keep one file's GL state from reaching the next.
+# Arguments are passed to every pytest run (e.g. -x, -k NAME).
+set -u
+cd "$(dirname "$0")/.."
+failed_files=()
+for file in tests/test_*.py; do
+  .venv/bin/python -m pytest -q -p no:cacheprovider "$file" "$@"
+  rc=$?
+  # 5: no test selected in this file (with -k): not a failure.
+  if [ "$rc" -ne 0 ] && [ "$rc" -ne 5 ]; then
+    failed_files+=("$file")
+  fi
+done
+if [ ${#failed_files[@]} -gt 0 ]; then
+  echo "run_tests: failures in ${#failed_files[@]} file(s): ${failed_files[*]}" >&2
+  exit 1
+fi
+echo "run_tests: every test file passed"
