@@ -1515,7 +1515,12 @@ class ForwardRenderer:
                     # TEXCOORD_0 as the file gives it (not a TEXCOORD_1 map's uvs, nor the user
                     # maps' tiling).
                     finest = max((t.size for t in bound_maps), key=lambda wh: wh[0] * wh[1])
-                    level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
+                    if scene.mesh is not None and scene.mesh.lod_sphere is not None:
+                        # The built-in sphere: its stand-ins (the impostor's proxy, coarser levels)
+                        # have other uvs than the ball they stand for, so all take the full level.
+                        level = 8.0
+                    else:
+                        level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
                     self.last_anisotropy[part.name] = level
                     for tex in bound_maps:
                         if tex.anisotropy != level:
