@@ -154,16 +154,23 @@ def test_emissive_and_name_fields(ctx):
 
 # --- saving -----------------------------------------------------------------------------------------
 
+def _save_preset_through_panel(ctx, preset: str, roughness: float, name: str) -> str:
+    """Click ``preset``, type ``roughness`` and a preset file under OUT, press "save preset";
+    returns the file's path."""
+    path = os.path.join(OUT, name)
+    ctx.set_ref("alight")
+    ctx.item_click(f"**/{preset}")
+    ctx.item_input_value("**/roughness", roughness)
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    return path
+
+
 def test_save_preset_button_writes_the_material(ctx):
     from alight.exchange.presets import load_preset
 
     s = editor().state
-    path = os.path.join(OUT, "from_panel.json")
-    ctx.set_ref("alight")
-    ctx.item_click("**/copper")
-    ctx.item_input_value("**/roughness", 0.42)
-    ctx.item_input_value("**/preset file", path)
-    ctx.item_click("**/save preset")
+    path = _save_preset_through_panel(ctx, "copper", 0.42, "from_panel.json")
     assert os.path.isfile(path), (s.error, s.message, editor().panel.preset_path)
     assert load_preset(path) == s.material
     assert abs(json.loads(open(path, encoding="utf-8").read())["roughness"] - 0.42) < 1e-6
@@ -769,12 +776,7 @@ def test_load_preset_button(ctx):
     from alight.exchange.presets import load_preset
 
     s = editor().state
-    path = os.path.join(OUT, "to_load.json")
-    ctx.set_ref("alight")
-    ctx.item_click("**/iron")
-    ctx.item_input_value("**/roughness", 0.66)
-    ctx.item_input_value("**/preset file", path)
-    ctx.item_click("**/save preset")
+    path = _save_preset_through_panel(ctx, "iron", 0.66, "to_load.json")
     saved = load_preset(path)
     ctx.item_click("**/water")
     assert s.material != saved
