@@ -3,6 +3,8 @@ maps as bake_environment, progress after every pass, nothing left behind when st
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -36,7 +38,11 @@ def test_bake_in_steps_equals_the_bake_in_one_go(shared_data):
             a, b = getattr(whole, name), getattr(stepped, name)
             for level in levels:
                 assert np.array_equal(read_cube(r.shaders, a, level), read_cube(r.shaders, b, level)), (name, level)
-        assert set(whole.pass_seconds) == set(stepped.pass_seconds)
+        # The first bake in a process computes the BRDF LUT, later ones find it cached: the same
+        # passes either way, whichever of the two ran first.
+        def passes(bake):
+            return {re.sub(r"^brdf_lut \((baked|cached)\)$", "brdf_lut", name) for name in bake.pass_seconds}
+        assert passes(whole) == passes(stepped)
     finally:
         whole.release()
         stepped.release()
