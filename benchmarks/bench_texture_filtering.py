@@ -28,19 +28,20 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
 
+    import alight.render.gpu_mesh as gpu_mesh_module
     import alight.render.renderer as renderer_module
     from alight.core.scene import Scene
     from alight.exchange.meshes import load_mesh
     from alight.ibl.environment import load_environment
 
-    chosen_rule = renderer_module.anisotropy_for_view
+    chosen_rule = gpu_mesh_module.anisotropy_for_view
     mesh = load_mesh(str(args.model))
     r = renderer_module.ForwardRenderer()
     maps = r.bake(load_environment("studio"), "medium")
     scene = Scene(mesh=mesh)
 
     def frame(rule) -> tuple[float, np.ndarray]:
-        renderer_module.anisotropy_for_view = rule
+        gpu_mesh_module.anisotropy_for_view = rule
         for part in r._gpu_mesh(mesh):
             part._anisotropy_key = None        # choose again under this rule
         t = time.perf_counter()

@@ -69,7 +69,7 @@ def test_emissive_adds_exactly(quarry):
 def test_back_face_culling_changes_no_pixel(shared_data, monkeypatch, mesh_name):
     """Closed meshes are drawn with back faces culled; were any front face wound the wrong way,
     culling would remove it and the image would change."""
-    import alight.render.renderer as renderer_module
+    import alight.render.gpu_mesh as gpu_mesh_module
     from alight.core.mesh import is_closed
     from alight.exchange.meshes import load_mesh
 
@@ -81,7 +81,7 @@ def test_back_face_culling_changes_no_pixel(shared_data, monkeypatch, mesh_name)
     culled_mesh = load()
     assert all(is_closed(p.positions, p.indices) for p in culled_mesh.parts)
     culled = r.render(Scene(mesh=culled_mesh, lights=LIGHTS[:2]), maps, 96, 96, aa="none").linear
-    monkeypatch.setattr(renderer_module, "is_closed", lambda *a: False)
+    monkeypatch.setattr(gpu_mesh_module, "is_closed", lambda *a: False)
     both_sides = r.render(Scene(mesh=load(), lights=LIGHTS[:2]), maps, 96, 96, aa="none").linear
     np.testing.assert_allclose(culled, both_sides, atol=1e-6)
 

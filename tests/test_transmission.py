@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import alight.render.renderer as renderer_module
+import alight.render.variants as variants_module
 from alight.accuracy.converged import (
     brdf_lut_converged,
     downsample_equirect,
@@ -100,7 +100,7 @@ def test_a_zero_strength_transmission_layer_changes_nothing(monkeypatch, shared_
     r = renderer()
     base = r.render(Scene(**scene), maps, 48, 48, aa="none").linear
     forced = {"HAS_TRANSMISSION": None, "HAS_VOLUME": None}
-    monkeypatch.setattr(renderer_module, "layer_defines", lambda materials: dict(forced))
+    monkeypatch.setattr(variants_module, "layer_defines", lambda materials: dict(forced))
     layered = r.render(Scene(**scene), maps, 48, 48, aa="none").linear
     assert relative(layered[..., :3], base[..., :3]) <= 2e-3
 

@@ -253,7 +253,7 @@ class _Geometry:
 def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     """The scene's triangles and per-part material factors (as the renderer resolves them), and
     one-line warnings about what the path tracer leaves out."""
-    from alight.render.renderer import ForwardRenderer
+    from alight.render.variants import part_material
 
     mesh = scene.mesh
     warnings: list[str] = []
@@ -263,7 +263,7 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     textured = bool(getattr(scene, "texture_maps", None))
     layered = masked = False
     for index, part in enumerate(mesh.parts):
-        m, maps_apply = ForwardRenderer._part_material(scene, part)
+        m, maps_apply = part_material(scene, part)
         if m.layers():
             layered = True
         fm = part.material

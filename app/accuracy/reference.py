@@ -50,7 +50,11 @@ from alight.core.layers.stack import probe_tangents
 from alight.core.material import LAYER_FIELDS
 from alight.core.shading import probe_normals
 from alight.errors import AlightError
-from alight.render.renderer import ForwardRenderer, _rotation_cos_sin, _set, _set_material
+from alight.render.bindings import rotation_cos_sin as _rotation_cos_sin
+from alight.render.bindings import set_material as _set_material
+from alight.render.bindings import set_uniform as _set
+from alight.render.renderer import ForwardRenderer
+from alight.render.variants import part_material
 
 # Pixel-texel pairs per dispatch at most (a 256^2 probe on a 1024x512 map: ~26 dispatches).
 CHUNK_PAIRS = 1 << 28
@@ -201,7 +205,7 @@ class ReferenceRenderer:
         with different layer factors are refused (one line) rather than summed wrongly."""
         if scene.view == "probe" or scene.mesh is None:
             return scene.material
-        materials = [self.renderer._part_material(scene, part)[0] for part in scene.mesh.parts]
+        materials = [part_material(scene, part)[0] for part in scene.mesh.parts]
         distinct = {tuple(getattr(m, f) for f in ("ior", *LAYER_FIELDS)) for m in materials if m.layers()}
         if len(distinct) > 1:
             raise AlightError(f"{scene.mesh.source}: parts with different layer factors (clearcoat, sheen, ...): "
@@ -305,7 +309,7 @@ class ReferenceRenderer:
             env_tex.use(_UNIT_ENV)
         _set(prog, "u_env", _UNIT_ENV)
         columns.bind_to_storage_buffer(2)
-        self.renderer._write_lights(scene)
+        self.renderer.lights.write(scene)
         accum.bind_to_image(0, read=True, write=True)
         _set(prog, "u_size", (width, height))
         _set(prog, "u_env_enabled", bool(use_env))

@@ -91,7 +91,7 @@ def sphere_surface_point(eye, facet_point, radius: float) -> np.ndarray:
     return p - s * d
 
 
-# The impostor's proxy (alight.render.renderer ForwardRenderer._sphere_impostor): a polygon of
+# The impostor's proxy (alight.render.sphere_impostor): a polygon of
 # this many sides facing the eye, in the plane of the sphere's outline circle, around that circle
 # with this many output pixels to spare. A pixel whose samples (at most 0.53 px from its centre
 # in the standard 4x pattern) meet the sphere then has its centre inside the proxy. Few, large

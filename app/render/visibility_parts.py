@@ -70,7 +70,7 @@ class OcclusionParts:
 
     def parts_for(self, mesh, mode: str, drawn: list, make_part) -> list:
         """The GPU parts to draw for ``mesh``: its baked ones where it is wanted, else ``drawn``.
-        ``make_part(part)`` uploads a MeshPart (alight.render.renderer._GpuPart, the mesh's
+        ``make_part(part)`` uploads a MeshPart (alight.render.gpu_mesh.GpuPart, the mesh's
         textures shared)."""
         if not self.wanted(mesh, mode):
             return drawn

@@ -416,11 +416,11 @@ class EditorWindow:
     def targets(self, size=None):
         """The view's framebuffers for a size, kept for the last few sizes: the adaptive scale
         moves between neighbouring sizes, and a reallocation per change would cost frame time."""
-        from alight.render.renderer import _Targets
+        from alight.render.targets import Targets
 
         w, h = size or self.size
         key = (w, h, self.state.aa)
-        targets = self._target_cache.pop(key, None) or _Targets(self.ctx, w, h, self.state.aa, 4)
+        targets = self._target_cache.pop(key, None) or Targets(self.ctx, w, h, self.state.aa, 4)
         self._target_cache[key] = targets
         while len(self._target_cache) > TARGET_CACHE:
             self._target_cache.popitem(last=False)[1].release()
@@ -493,7 +493,7 @@ class EditorWindow:
             prog["u_image"] = 0
             self.ctx.screen.use()
             self.ctx.viewport = (0, 0) + window
-            self.renderer._fullscreen(prog)
+            self.renderer.fullscreen(prog)
             self.ctx.viewport = (0, 0) + self.size
         # The copy leaves the last used framebuffer (display_fbo) bound; imgui draws into
         # whatever is bound, and must draw into the window, never into the view's image.

@@ -1,0 +1,297 @@
+"""The GPU side of meshes: each part's buffers and vertex arrays (GpuPart), a mesh's shared
+textures (MeshTextures), the cache of uploaded meshes, the built-in sphere's stand-ins and the
+user's maps (GpuMeshes), and the full-screen triangle every full-screen pass draws."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import moderngl
+import numpy as np
+
+from alight.core.mesh import is_closed
+from alight.core.texture_footprint import anisotropy_for_view, footprints
+
+GL_SRGB8_ALPHA8 = 0x8C43
+SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color")
+
+
+class GpuPart:
+    """A mesh part's buffers, uploaded once, and what its shader variant needs to know.
+
+    The vertex buffer holds position, normal, uv and tangent, then TEXCOORD_1 and COLOR_0 only
+    when the part has them (pbr.vert's HAS_UV1, HAS_VERTEX_COLOR). Textures come from the mesh's
+    shared set (one upload per image and sampler).
+    """
+
+    def __init__(self, ctx: moderngl.Context, part, textures: "MeshTextures"):
+        columns = [part.positions, part.normals, part.uvs, part.tangents]
+        self.layout = ["3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent"]
+        self.has_uv1 = part.uvs1 is not None
+        self.has_colors = part.colors is not None
+        if self.has_uv1:
+            columns.append(part.uvs1)
+            self.layout[0] += " 2f"
+            self.layout.append("in_uv1")
+        if self.has_colors:
+            columns.append(part.colors)
+            self.layout[0] += " 4f"
+            self.layout.append("in_color")
+        # Interleaved into one array and handed to GL as it is (no hstack of float64 copies, no
+        # tobytes() copy): the CPU side peaks at one vertex buffer's bytes, then lets it go.
+        widths = [np.shape(c)[1] for c in columns]
+        vertices = np.empty((len(part.positions), sum(widths)), np.float32)
+        at = 0
+        for column, width in zip(columns, widths):
+            vertices[:, at:at + width] = column
+            at += width
+        self.vbo = ctx.buffer(vertices)
+        del vertices
+        self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32))
+        self.ctx = ctx
+        # More per-vertex buffers, (buffer, format, *names), and whether they carry the visibility
+        # bake's values (alight.render.visibility_parts: HAS_VISIBILITY).
+        self.extra_buffers: list[tuple] = []
+        self.has_visibility = False
+        # A vertex array belongs to one program: one per program this part is drawn with (the
+        # shaded pass, a debug view), made on first use.
+        self._vaos: dict[int, moderngl.VertexArray] = {}
+        self.textures: dict[str, moderngl.Texture] = {}
+        self.infos: dict = {}
+        self._part = part
+        self._closed: bool | None = None
+        self._anisotropy_key = None
+        self._anisotropy = 1.0
+        positions = np.asarray(part.positions, np.float64)
+        self.lo = positions.min(axis=0) if len(positions) else np.zeros(3)    # bounding box corners
+        self.hi = positions.max(axis=0) if len(positions) else np.zeros(3)
+        self.centre = (self.lo + self.hi) / 2.0
+        fm = part.material
+        if fm is not None:
+            for name, info in fm.textures().items():
+                self.infos[name] = info
+                self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
+
+    @property
+    def closed(self) -> bool:
+        """Whether the part is closed (alight.core.mesh.is_closed), found on first use: only a
+        part without a glTF material's doubleSided needs to know (a 4M-triangle mesh's test
+        takes seconds)."""
+        if self._closed is None:
+            self._closed = is_closed(self._part.positions, self._part.indices)
+        return self._closed
+
+    def anisotropy(self, view_projection: np.ndarray, image_size: tuple[int, int],
+                   texture_size: tuple[int, int]) -> float:
+        """The anisotropic filtering level this view of the part gains from
+        (alight.core.texture_footprint), remembered for the last view asked."""
+        key = (np.asarray(view_projection, np.float32).tobytes(), tuple(image_size), tuple(texture_size))
+        if self._anisotropy_key != key:
+            part = self._part
+            uvs = part.uvs
+            # The uvs the maps read: KHR_texture_transform's scale (gltfpack's dequantization of
+            # quantized uvs among them) multiplies the footprint. The transform that stretches
+            # the most sets it.
+            mats = [np.asarray(info.transform.gl_matrix(), np.float64) for info in self.infos.values()
+                    if info.transform is not None and info.tex_coord == 0]
+            if mats:
+                m = max(mats, key=lambda m: abs(np.linalg.det(m[:2, :2])))
+                uvs = np.asarray(uvs, np.float64) @ m[:2, :2].T + m[:2, 2]
+            area, p_max, p_min = footprints(part.positions, uvs, part.indices, view_projection,
+                                            image_size, texture_size)
+            self._anisotropy = anisotropy_for_view(area, p_max, p_min)
+            self._anisotropy_key = key
+        return self._anisotropy
+
+    def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
+        vao = self._vaos.get(id(program))
+        if vao is None:
+            vao = self._vaos[id(program)] = self.ctx.vertex_array(
+                program, [(self.vbo, *self.layout), *self.extra_buffers], self.ibo, index_element_size=4,
+                skip_errors=True)  # a debug view may not read every attribute
+        return vao
+
+    def release(self) -> None:
+        for vao in self._vaos.values():
+            vao.release()
+        self.vbo.release()
+        self.ibo.release()
+
+
+ANISOTROPIC_FILTERS = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR_MIPMAP_NEAREST,
+                        moderngl.NEAREST_MIPMAP_LINEAR, moderngl.NEAREST_MIPMAP_NEAREST)
+MIN_FILTERS = {"nearest": moderngl.NEAREST, "linear": moderngl.LINEAR,
+                "nearest_mipmap_nearest": moderngl.NEAREST_MIPMAP_NEAREST,
+                "linear_mipmap_nearest": moderngl.LINEAR_MIPMAP_NEAREST,
+                "nearest_mipmap_linear": moderngl.NEAREST_MIPMAP_LINEAR,
+                "linear_mipmap_linear": moderngl.LINEAR_MIPMAP_LINEAR}
+
+
+class MeshTextures:
+    """A mesh's textures, one per (image, colour space, sampler): parts sharing an image share
+    its upload. REPEAT and CLAMP_TO_EDGE are the texture's wrap state; MIRRORED_REPEAT is folded
+    in the shader (mesh_material.glsl), so its axis is clamped here."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._textures: dict[tuple, moderngl.Texture] = {}
+
+    def get(self, info, srgb: bool) -> moderngl.Texture:
+        sampler = info.sampler
+        key = (id(info.image), srgb, sampler)
+        tex = self._textures.get(key)
+        if tex is None:
+            tex = upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps)
+            tex.filter = (MIN_FILTERS.get(sampler.min_filter, moderngl.LINEAR_MIPMAP_LINEAR),
+                          moderngl.NEAREST if sampler.mag_filter == "nearest" else moderngl.LINEAR)
+            tex.repeat_x = sampler.wrap_s == "repeat"
+            tex.repeat_y = sampler.wrap_t == "repeat"
+            if not sampler.mipmaps or sampler.mag_filter == "nearest":
+                tex.anisotropy = 1.0
+            self._textures[key] = tex
+        return tex
+
+    def release(self) -> None:
+        for tex in self._textures.values():
+            tex.release()
+        self._textures.clear()
+
+
+def upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool, mipmaps: bool = True) -> moderngl.Texture:
+    """An RGBA uint8 image (alight.core.mesh gives RGBA) as a texture, mipmapped unless told not."""
+    image = np.asarray(image, dtype=np.uint8)
+    if image.shape[2] == 3:
+        image = np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
+    # Images arrive top row first; texture coordinate v = 0 is the bottom row (OpenGL, trimesh).
+    data = np.ascontiguousarray(image[::-1, :, :4])
+    h, w = data.shape[:2]
+    tex = ctx.texture((w, h), 4, data.tobytes(), internal_format=GL_SRGB8_ALPHA8 if srgb else None)
+    if mipmaps:
+        tex.build_mipmaps()
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        tex.anisotropy = 8.0
+    else:
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    return tex
+
+
+def release_mesh(entry) -> None:
+    for part in entry[1]:
+        part.release()
+    entry[2].release()
+
+
+class GpuMeshes:
+    """The uploaded meshes (by the mesh's id, kept while that mesh is the one asked for), the
+    built-in sphere's stand-ins (coarser levels, the impostor's proxy: alight.render.sphere_impostor)
+    and the user-loaded texture maps (Scene.texture_maps), uploaded once per decoded image."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._meshes: dict[int, tuple[object, list[GpuPart], MeshTextures]] = {}
+        # The built-in sphere's stand-ins, by the mesh's id and a key (segments, "proxy").
+        self._stand_ins: dict[tuple[int, object], tuple[object, list[GpuPart], MeshTextures]] = {}
+        # (path, sRGB) -> (image, texture)
+        self._map_textures: dict[tuple[str, bool], tuple[np.ndarray, moderngl.Texture]] = {}
+
+    def parts(self, mesh) -> list[GpuPart]:
+        """``mesh``'s parts on the GPU, uploaded on first use (a new mesh object replaces the old)."""
+        entry = self._meshes.get(id(mesh))
+        if entry is None or entry[0] is not mesh:
+            if entry is not None:
+                release_mesh(entry)
+            textures = MeshTextures(self.ctx)
+            entry = (mesh, [GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
+            self._meshes[id(mesh)] = entry
+        return entry[1]
+
+    def textures(self, mesh) -> MeshTextures:
+        """The shared textures of a mesh ``parts`` uploaded."""
+        return self._meshes[id(mesh)][2]
+
+    def stand_in(self, mesh, key, make_part) -> GpuPart:
+        """A part drawn in place of the built-in sphere ``mesh``'s own (a coarser level, the
+        impostor's proxy), kept by ``key`` while ``mesh`` is the one drawn; ``make_part`` builds
+        its MeshPart, which takes the sphere's material, name and element."""
+        for old in [k for k, e in self._stand_ins.items() if e[0] is not mesh]:   # another mesh's
+            release_mesh(self._stand_ins.pop(old))
+        entry = self._stand_ins.get((id(mesh), key))
+        if entry is None:
+            part = mesh.parts[0]
+            stand_in = dataclasses.replace(make_part(), material=part.material, name=part.name, element=part.element)
+            textures = MeshTextures(self.ctx)
+            entry = self._stand_ins[(id(mesh), key)] = (mesh, [GpuPart(self.ctx, stand_in, textures)], textures)
+        return entry[1][0]
+
+    def user_textures(self, scene) -> dict[str, moderngl.Texture]:
+        """The scene's user-loaded maps as textures by slot, uploaded on first use of an image."""
+        if scene.texture_maps is None:
+            return {}
+        out = {}
+        for slot, path in scene.texture_maps.paths().items():
+            image = scene.texture_images.get(path)
+            if image is None:
+                continue
+            key = (path, slot in SRGB_MAPS)
+            entry = self._map_textures.get(key)
+            if entry is None or entry[0] is not image:
+                if entry is not None:
+                    entry[1].release()
+                entry = self._map_textures[key] = (image, upload_image(self.ctx, image, srgb=key[1]))
+            out[slot] = entry[1]
+        return out
+
+    def forget_map_textures(self, keep_paths) -> None:
+        """Release the uploaded maps whose path is not in ``keep_paths``."""
+        for key in [k for k in self._map_textures if k[0] not in keep_paths]:
+            self._map_textures.pop(key)[1].release()
+
+    def release_meshes(self) -> None:
+        """Release every uploaded mesh and stand-in (their vertex arrays belong to programs that a
+        shader reload replaces); the user's maps stay."""
+        for entry in [*self._meshes.values(), *self._stand_ins.values()]:
+            release_mesh(entry)
+        self._meshes.clear()
+        self._stand_ins.clear()
+
+    def release(self) -> None:
+        self.forget_map_textures(())
+        self.release_meshes()
+
+
+class FullscreenDraws:
+    """The vertex arrays of full-screen passes (one triangle, no buffer), one per program, and of
+    the background's ring (alight.render.sphere_impostor), whose buffer is rewritten per draw."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._vaos: dict = {}
+        self._ring_buffer: moderngl.Buffer | None = None
+
+    def triangle(self, prog: moderngl.Program) -> None:
+        """One full-screen triangle with ``prog`` (render/fullscreen.vert, render/background.vert)."""
+        vao = self._vaos.get(id(prog))
+        if vao is None:
+            vao = self._vaos[id(prog)] = self.ctx.vertex_array(prog, [])
+        vao.render(moderngl.TRIANGLES, vertices=3)
+
+    def ring(self, prog: moderngl.Program, ring: np.ndarray) -> None:
+        """``ring``'s triangles ((n, 2) float32 NDC points) with ``prog``."""
+        if self._ring_buffer is None:
+            self._ring_buffer = self.ctx.buffer(reserve=ring.nbytes)
+        self._ring_buffer.write(ring.tobytes())
+        vao = self._vaos.get((id(prog), "ring"))
+        if vao is None:
+            vao = self._vaos[(id(prog), "ring")] = self.ctx.vertex_array(prog, [(self._ring_buffer, "2f", "in_ndc")])
+        vao.render(moderngl.TRIANGLES, vertices=len(ring))
+
+    def release_vaos(self) -> None:
+        for vao in self._vaos.values():
+            vao.release()
+        self._vaos.clear()
+
+    def release(self) -> None:
+        self.release_vaos()
+        if self._ring_buffer is not None:
+            self._ring_buffer.release()
+            self._ring_buffer = None

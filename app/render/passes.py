@@ -1,0 +1,612 @@
+"""The passes of a frame, top to bottom (the module docstring of alight.render.renderer says
+which run for which anti-aliasing mode and read-back): the scene pass (surfaces, background,
+ground, blended parts), the mesh's draws, the MSAA resolve, the SSAA reduction, the tone map.
+
+Each scene pass decides once what its draws share (the impostor, shadows, the output
+encoding, its matrices) and hands it on in a FrameContext, which the resolve after it reads:
+no draw depends on what an earlier call left in the renderer. ``r`` is the ForwardRenderer,
+whose resources (programs, meshes, tables, targets) the passes use.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from alight.core.scene import Camera, Display
+from alight.core.shader_names import MATERIAL_MAPS, BackgroundMode, Tonemap, glsl_member
+from alight.core.sphere_lod import impostor_background_ring, impostor_hole_model
+from alight.core.texture_maps import TextureMaps
+from alight.ibl.bake import QUALITY, IBLMaps
+from alight.render.bindings import (
+    UNIT_LUT,
+    UNIT_MATERIAL,
+    UNIT_RADIANCE,
+    UNIT_SCENE_BEHIND,
+    UNIT_SHADOW_ATLAS,
+    UNIT_SHADOW_DEPTH,
+    bind_background,
+    bind_ibl,
+    set_material,
+    set_uniform,
+)
+from alight.render.gpu_mesh import ANISOTROPIC_FILTERS, GpuPart
+from alight.render.ground import GroundPass
+from alight.render.sphere_impostor import impostor_placement, lod_parts, proxy_part
+from alight.render.targets import Targets, View, read_tile
+from alight.render.tiles import TilePlan, tile_matrix, tile_origin
+from alight.render.variants import (
+    background_mode,
+    blends,
+    has_blending_parts,
+    ibl_defines,
+    light_defines,
+    material_defines,
+    part_defines,
+    part_material,
+    transmissive_parts,
+    user_maps_present,
+)
+
+
+@dataclass
+class FrameContext:
+    """What one scene pass decided, for its draws and for the resolve after it."""
+
+    display: Display | None = None     # DISPLAY_OUTPUT: tone mapped as drawn (draw_display)
+    srgb_by_framebuffer: bool = False  # SRGB_BY_FRAMEBUFFER: the framebuffer encodes sRGB
+    half_output: bool = False          # HALF_FLOAT_OUTPUT: into the half-float MSAA target
+    # The built-in sphere's impostor (alight.render.sphere_impostor): the proxy's (4, 4)
+    # placement or None, and its coverage samples: 1, 4 (into Targets.single, which the fused
+    # resolve reads), 0 (a multisampled target: no impostor).
+    impostor_model: np.ndarray | None = None
+    impostor_samples: int = 1
+    shadowed: bool = False             # the pass reads the shadow maps (alight.render.shadows)
+    view_projection: np.ndarray | None = None   # the pass's (a tile's: the image's, off centre)
+    inverse_vp: np.ndarray | None = None        # its inverse: the background's rays
+    image_size: tuple[int, int] = (0, 0)        # the targets' output size (width, height)
+
+
+# --- a frame: the passes for each anti-aliasing mode, tile by tile -------------------------
+
+def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Targets, width: int, height: int,
+                 aa: str, read_linear: bool, read_srgb: bool):
+    """ForwardRenderer.render_strips's strips: each tile drawn with the passes its mode needs
+    (alight.render.renderer's docstring) and read back; yields (y0, linear, srgb)."""
+    opaque = scene.display.background != "transparent"
+    blending = has_blending_parts(scene)
+    for tiles in plan.strips():
+        rows = tiles[0].height
+        linear = np.empty((rows, width, 4), np.float32) if read_linear and not plan.single else None
+        srgb = np.empty((rows, width, 4), np.uint8) if read_srgb and not plan.single else None
+        for t in tiles:
+            view = None if plan.single else View(width, height, tile_matrix(plan, t), tile_origin(plan, t))
+            # Only the images that are read are made.
+            if aa == "msaa" and not blending:
+                frame = draw_scene(r, scene, maps, targets, targets.draw, view=view, background=False)
+                resolve(r, frame, scene, maps, targets, read_linear, read_srgb)
+            elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe" \
+                    and not scene.ground:   # (the ground darkens radiance: it blends before the tone map)
+                draw_scene(r, scene, maps, targets, targets.display_draw(), scene.display, view=view)
+            else:
+                draw_scene(r, scene, maps, targets, targets.draw, view=view)
+                if read_srgb:
+                    tonemap(r, targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
+            if read_linear:
+                block = read_tile(targets.radiance_fbo, t, "f4", np.float32)
+                if plan.single:
+                    linear = block.copy()
+                else:
+                    linear[:, t.x:t.x + t.width] = block
+            if read_srgb:
+                block = read_tile(targets.display_fbo, t, "f1", np.uint8)
+                if plan.single:
+                    srgb = block.copy()
+                else:
+                    srgb[:, t.x:t.x + t.width] = block
+        if linear is not None and scene.view == "probe":
+            linear[linear[:, :, 3] == 0.0] = 0.0  # docs/conventions.md: probe background radiance is 0
+        yield tiles[0].y, linear, srgb
+
+
+# --- the scene pass ----------------------------------------------------------------------
+
+def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.Framebuffer,
+               display: Display | None = None, view: View | None = None, background: bool = True,
+               srgb_by_framebuffer: bool = False) -> FrameContext:
+    """One scene pass into ``fbo`` (at the targets' draw size): the surfaces, and with
+    ``background`` the background, the ground and the blended parts; ``display``: written tone
+    mapped (DISPLAY_OUTPUT). Returns what it decided, for the resolve."""
+    ctx = r.ctx
+    frame = FrameContext(display=display, srgb_by_framebuffer=srgb_by_framebuffer,
+                         half_output=targets.half and fbo is targets.draw,
+                         image_size=(targets.width, targets.height))
+    width, height = targets.draw_size
+    scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
+    view = view or View(targets.width, targets.height)
+    aspect = view.width / view.height
+    # The probe's own camera is orthographic; its backdrop is drawn as the default camera sees it.
+    camera = Camera() if scene.view == "probe" else r.camera_for(scene, aspect)
+    # The built-in sphere as an impostor: with one coverage sample a pixel into a single-sample
+    # target, with 4 into the fused resolve's single-sample stand-in for the multisampled one
+    # (its mean already taken); never into a multisampled target.
+    view_projection = camera.view_projection(aspect)
+    impostor = impostor_placement(r.meshes, scene, camera, (view.width, view.height), view_projection) \
+        if r.sphere_impostor else None
+    frame.impostor_model = impostor[0] if impostor else None
+    if targets.aa != "msaa":
+        frame.impostor_samples = 1
+    elif frame.impostor_model is not None and fbo is targets.draw and not background:
+        frame.impostor_samples = 4
+        fbo = targets.single()[1]
+    else:
+        frame.impostor_samples = 0
+    frame.shadowed = prepare_shadows(r, scene, maps)    # (its own framebuffer: before this pass's)
+    fbo.use()
+    ctx.viewport = (0, 0, width, height)
+    if view.matrix is not None:     # a tile: the whole image's projection, off centre
+        view_projection = (view_projection.astype(np.float64) @ view.matrix).astype(np.float32)
+    frame.view_projection = view_projection
+    frame.inverse_vp = inverse_vp = np.linalg.inv(view_projection).astype(np.float32)
+    ring = None
+    if r.background_ring and impostor and frame.impostor_samples == 1 and background \
+            and background_mode(scene, maps) != BackgroundMode.TRANSPARENT \
+            and not transmissive_parts(scene):
+        hole = impostor_hole_model(camera.position, scene.mesh.lod_sphere[0], impostor[1])
+        ring = impostor_background_ring(hole, view_projection) if hole is not None else None
+    # Colour too: the MSAA resolve tells covered samples by their alpha (render/resolve.frag),
+    # and transmissive parts read the opaque parts' coverage from it. The whole framebuffer:
+    # llvmpipe clears whole tiles lazily, and a scissored clear (the mesh's rectangle only)
+    # made a 1920x1080 4x frame 7-9% slower here, alternated in one process.
+    r.last_background_ring = ring is not None
+    # With the background's ring no depth is read or written (colour only).
+    fbo.depth_mask = ring is None
+    fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+    fbo.depth_mask = True
+    r.lights.write(scene)
+    if ring is not None:
+        # The one sphere's impostor with one sample a pixel: the background first, around a
+        # hole inside the sphere's outline (sphere_lod.impostor_background_ring), then the
+        # impostor over it. Every pixel is written once or, in the thin band between the hole
+        # and the outline, twice, and no depth buffer is cleared, tested or written: 3.5-5% of
+        # the editor's 860x720 scene pass on llvmpipe (two renderers alternated in one process).
+        ctx.disable(moderngl.DEPTH_TEST)
+        draw_background(r, frame, scene, maps, inverse_vp, ring)
+    else:
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+    if scene.view == "probe":
+        draw_probe(r, scene, maps, view.width * scale, (view.origin[0] * scale, view.origin[1] * scale))
+    elif scene.mesh is not None:
+        draw_mesh(r, frame, scene, maps, camera, view_projection, blend=False, targets=targets, fbo=fbo,
+                  pixels_per_radian=view.height * scale / 2.0 / math.tan(math.radians(camera.fov_y_deg) / 2.0),
+                  image_size=(view.width, view.height))
+        if not background:     # (the fused resolve composites the background under it)
+            draw_ground(r, frame, scene, maps, view_projection)
+    # After the surfaces: the depth test keeps the background's shading off covered pixels.
+    if background and ring is None:
+        draw_background(r, frame, scene, maps, inverse_vp)
+        if scene.view != "probe" and scene.mesh is not None:
+            draw_ground(r, frame, scene, maps, view_projection)
+        # Then what blends (alphaMode BLEND) over both, back to front (glTF 2.0 section 3.9.4).
+        # (The fused MSAA resolve, background=False, is used only for scenes with none.)
+        if scene.view != "probe" and scene.mesh is not None:
+            draw_mesh(r, frame, scene, maps, camera, view_projection, blend=True, image_size=(view.width, view.height))
+    ctx.disable(moderngl.DEPTH_TEST)
+    if display is None and background:
+        finish_radiance(r, targets)
+    return frame
+
+
+def scene_program(r, frame: FrameContext, vertex: str, fragment: str, defines: dict | None = None) -> moderngl.Program:
+    """A scene pass's program: with DISPLAY_OUTPUT and the display's uniforms where the pass
+    writes tone mapped (common/output_encoding.glsl), HALF_FLOAT_OUTPUT into half floats."""
+    display = frame.display
+    if display is None:
+        if frame.half_output:
+            defines = {**(defines or {}), "HALF_FLOAT_OUTPUT": None}
+        return r.program(vertex, fragment, defines)
+    defines = {**(defines or {}), "DISPLAY_OUTPUT": None, "TONEMAP_MODE": int(glsl_member(Tonemap, display.tonemap))}
+    if frame.srgb_by_framebuffer:
+        defines["SRGB_BY_FRAMEBUFFER"] = None
+    prog = r.program(vertex, fragment, defines)
+    set_uniform(prog, "u_exposure_scale", float(2.0 ** display.exposure))
+    return prog
+
+
+def prepare_shadows(r, scene, maps: IBLMaps | None) -> bool:
+    """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows); whether
+    this pass reads them. The casters: every part but those that blend."""
+    ground = scene.ground and scene.view != "probe" and scene.mesh is not None and bool(scene.mesh.parts)
+    if scene.view == "probe" or scene.mesh is None or not r.shadow_maps.wanted(scene, maps, receivers=ground):
+        r.shadow_maps.last_active = False
+        return False
+    gpu_parts = [g for g, part in zip(r.meshes.parts(scene.mesh), scene.mesh.parts) if not blends(scene, part)]
+
+    def draw_parts(matrix: bytes, parts) -> None:
+        prog = r.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+        prog["u_view_projection"].write(matrix)
+        for gpu_part in parts:
+            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+
+    bounds = GroundPass.ground_for(scene.mesh).bounds if ground else None
+    return r.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts, bounds)
+
+
+def draw_ground(r, frame: FrameContext, scene, maps: IBLMaps | None, view_projection: np.ndarray) -> None:
+    """Scene.ground's shadow catcher (alight.render.ground) into the bound framebuffer, after
+    the surfaces (and the background, where a pass draws one). Only where shadows are drawn:
+    a ground without them takes nothing from the background."""
+    if not (scene.ground and frame.shadowed and scene.mesh is not None):
+        return
+    if r.ground_pass is None:
+        r.ground_pass = GroundPass(r.ctx)
+    prog = scene_program(r, frame, "render/ground.vert", "render/ground.frag", {**light_defines(scene), "HAS_SHADOWS": None})
+    bind_ibl(prog, scene, maps, r.tables)
+    r.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
+    r.ground_pass.draw(prog, GroundPass.ground_for(scene.mesh), view_projection)
+
+
+def draw_background(r, frame: FrameContext, scene, maps: IBLMaps | None, inverse_vp: np.ndarray,
+                    ring: np.ndarray | None = None) -> None:
+    """The background pass: a full-screen triangle, or ``ring``'s triangles ((n, 2) NDC
+    points, sphere_lod.impostor_background_ring) where the impostor fills the rest."""
+    mode = background_mode(scene, maps)
+    if mode == BackgroundMode.TRANSPARENT:
+        return
+    defines = {"BACKGROUND_MODE": int(mode)}
+    if ring is not None:
+        defines["BACKGROUND_RING"] = None
+    prog = scene_program(r, frame, "render/background.vert", "render/background.frag", defines)
+    bind_background(prog, scene, maps, inverse_vp, mode)
+    if ring is None:
+        r.draws.triangle(prog)
+    else:
+        r.draws.ring(prog, ring)
+
+
+def draw_probe(r, scene, maps: IBLMaps | None, size: int, origin: tuple[int, int] = (0, 0)) -> None:
+    """The probe view (render/probe.frag): the material on the unit sphere, per pixel centre."""
+    defines = {**ibl_defines(scene), **r._below_grid_defines(scene, maps, [scene.material]),
+               **material_defines([scene.material])}
+    prog = r.program("render/fullscreen.vert", "render/probe.frag", defines)
+    prog["u_size"] = float(size)
+    set_uniform(prog, "u_pixel_origin", tuple(float(x) for x in origin))
+    set_material(prog, scene.material)
+    r.tables.bind_layer_luts(defines)
+    bind_ibl(prog, scene, maps, r.tables)
+    r.draws.triangle(prog)
+
+
+# --- the mesh ------------------------------------------------------------------------------
+
+def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camera, view_projection: np.ndarray,
+              blend: bool = False, targets: Targets | None = None, fbo: moderngl.Framebuffer | None = None,
+              pixels_per_radian: float = 1.0, image_size: tuple[int, int] | None = None) -> None:
+    """The parts that blend (``blend``) or the rest, each with its shader variant: the scene's
+    IBL model and debug view, plus only the features the part uses (variants.part_defines).
+    The rest is drawn as alight.render.renderer's docstring says: the opaque parts, then, where
+    any part transmits, a copy of what they left in ``fbo`` and the transmissive parts reading
+    it (TRANSMISSION_SCENE; ``pixels_per_radian``: the image's rows per radian at its centre,
+    for the copy's blur)."""
+    defines = ibl_defines(scene)
+    defines.update(light_defines(scene))
+    user_maps = user_maps_present(scene)
+    parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
+    any_maps = 0
+    for gpu_part, part in parts:
+        any_maps |= part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
+    # (through the renderer, where a test replaces it)
+    defines.update(r._below_grid_defines(scene, maps, [part_material(scene, part)[0] for _, part in parts], any_maps))
+    if scene.debug_view:
+        defines["DEBUG_VIEW"] = None
+    if frame.shadowed:
+        defines["HAS_SHADOWS"] = None
+    bound: set[int] = set()
+
+    def program_for(variant: dict) -> moderngl.Program:
+        all_defines = {**defines, **variant}
+        prog = scene_program(r, frame, "render/pbr.vert", "render/pbr.frag", all_defines)
+        if id(prog) not in bound:
+            bound.add(id(prog))
+            if scene.debug_view:
+                set_uniform(prog, "u_debug_view", int(scene.debug_view))
+                set_uniform(prog, "u_debug_mip", float(scene.debug_mip))
+            bind_ibl(prog, scene, maps, r.tables)
+            if frame.shadowed:
+                r.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
+        r.tables.bind_layer_luts(all_defines)
+        return prog
+
+    if blend:
+        draw_mesh_parts(r, frame, scene, program_for, camera, view_projection, blend=True, image_size=image_size)
+        return
+    transmissive = transmissive_parts(scene)
+    opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
+    if opaque:
+        draw_mesh_parts(r, frame, scene, program_for, camera, view_projection, blend=False, parts=opaque,
+                        image_size=image_size)
+    if not transmissive:
+        return
+    behind, behind_fbo = targets.behind()
+    r.ctx.copy_framebuffer(behind_fbo, fbo)   # the MSAA resolve too, where there is one
+    behind.build_mipmaps()
+    fbo.use()
+    behind.use(UNIT_SCENE_BEHIND)
+    if not (scene.ibl_enabled and maps is not None):
+        # The thin-walled lobe's energy is the BRDF LUT's A, which bind_ibl binds only with
+        # an environment.
+        q = QUALITY["medium"]
+        r.luts.get(q.lut_size, q.lut_samples).use(UNIT_LUT)
+
+    def transmissive_program(variant: dict) -> moderngl.Program:
+        prog = program_for({**variant, "TRANSMISSION_SCENE": None})
+        set_uniform(prog, "u_behind_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+        set_uniform(prog, "u_behind_pixels_per_radian", float(pixels_per_radian))
+        return prog
+
+    draw_mesh_parts(r, frame, scene, transmissive_program, camera, view_projection, blend=False, parts=transmissive,
+                    image_size=image_size)
+
+
+def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_projection: np.ndarray,
+                    blend: bool | None = None, parts: list[int] | None = None,
+                    image_size: tuple[int, int] | None = None) -> None:
+    """ForwardRenderer.draw_mesh_parts, within the scene pass ``frame`` (its impostor)."""
+    ctx = r.ctx
+    user_maps = user_maps_present(scene)
+    user = r.meshes.user_textures(scene)
+    tiling = scene.texture_maps or TextureMaps()
+    items = []
+    size = image_size or tuple(ctx.viewport[2:])
+    # The built-in sphere as an impostor (decided once per scene pass in draw_scene), by forward
+    # programs only; else its level or the mesh as given.
+    proxy_model = frame.impostor_model if callable(prog) and frame.impostor_samples else None
+    r.last_sphere_impostor = None
+    model = np.eye(4, dtype=np.float32)
+    if proxy_model is None:
+        drawn, sphere_radius, r.last_sphere_segments = lod_parts(r.meshes, scene.mesh, camera, size,
+                                                                 r.sphere_max_error_px)
+    else:
+        r.last_sphere_segments = None
+        drawn = [proxy_part(r.meshes, scene.mesh)]
+        sphere_radius = scene.mesh.lod_sphere[0]
+        model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns
+        r.last_sphere_impostor = frame.impostor_samples
+    if callable(prog) and sphere_radius is None and proxy_model is None:
+        drawn = occluded_parts(r, scene, drawn)
+    chosen = None if parts is None else set(parts)
+    for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
+        if (blend is None or blends(scene, part) == blend) and (chosen is None or index in chosen):
+            items.append((gpu_part, part))
+    if not items:
+        return
+    if blend:
+        eye = np.asarray(camera.position, np.float64)
+        items.sort(key=lambda item: -float(np.linalg.norm(item[0].centre - eye)))
+        ctx.enable(moderngl.BLEND)
+        # Straight alpha over what is behind; coverage accumulates in alpha (premultiplied).
+        ctx.blend_func = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+        ctx.depth_mask = False
+    prepared: set[int] = set()
+    try:
+        for gpu_part, part in items:
+            if callable(prog):
+                variant = part_defines(scene, gpu_part, part, user_maps)
+                if sphere_radius is not None:
+                    variant["SPHERE_SURFACE"] = None
+                if proxy_model is not None:
+                    variant["SPHERE_IMPOSTOR"] = frame.impostor_samples
+                program = prog(variant)
+            else:
+                program = prog
+            if id(program) not in prepared:
+                prepared.add(id(program))
+                _bind_view(program, ctx, frame, camera, view_projection, model, sphere_radius, proxy_model is not None)
+            material, maps_used = part_material(scene, part)
+            set_material(program, material)
+            _bind_part_factors(program, part.material if maps_used else None, material, maps_used, tiling)
+            if maps_used and any(info.transform is not None for info in gpu_part.infos.values()):
+                _bind_map_transforms(program, gpu_part)
+            bound_maps = []
+            for name in MATERIAL_MAPS:
+                tex = gpu_part.textures.get(name) if maps_used else user.get(name)
+                set_uniform(program, f"u_has_{name}_map", tex is not None)
+                if tex is not None:
+                    tex.use(UNIT_MATERIAL[name])
+                    if tex.filter[0] in ANISOTROPIC_FILTERS and tex.filter[1] != moderngl.NEAREST:
+                        bound_maps.append(tex)   # (a sampler's nearest magnification keeps 1: MeshTextures)
+            if bound_maps:
+                _set_anisotropy(r, scene, camera, gpu_part, part, bound_maps, size)
+            if part.element.startswith("meshes["):
+                # A glTF primitive: the file decides (the default material is single-sided).
+                cull = not (part.material is not None and part.material.double_sided)
+            else:
+                # A closed mesh's back faces are hidden: culling them halves the triangles
+                # rasterised and stops back faces drawn first from being shaded and then
+                # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
+                # behind (the shader flips n).
+                cull = gpu_part.closed
+            if cull:
+                ctx.front_face = "ccw"
+                ctx.enable(moderngl.CULL_FACE)
+            else:
+                ctx.disable(moderngl.CULL_FACE)
+            gpu_part.vao_for(program).render(moderngl.TRIANGLES)
+    finally:
+        ctx.disable(moderngl.CULL_FACE)
+        if blend:
+            ctx.disable(moderngl.BLEND)
+            ctx.depth_mask = True
+
+
+def _bind_view(program, ctx, frame: FrameContext, camera: Camera, view_projection: np.ndarray, model: np.ndarray,
+               sphere_radius: float | None, impostor: bool) -> None:
+    """pbr.vert's transforms and the camera, once per program in a draw_mesh_parts call."""
+    set_uniform(program, "u_model", model.tobytes(), write=True)
+    set_uniform(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
+    set_uniform(program, "u_view_projection", view_projection.astype(np.float32).tobytes(), write=True)
+    set_uniform(program, "u_camera_position", tuple(float(x) for x in camera.position))
+    set_uniform(program, "u_sphere_radius", float(sphere_radius or 0.0))
+    if impostor:   # (the inverse of this pass's view_projection)
+        set_uniform(program, "u_inverse_view_projection", frame.inverse_vp.tobytes(), write=True)
+        set_uniform(program, "u_viewport_size", tuple(float(x) for x in ctx.viewport[2:]))
+
+
+def _bind_part_factors(program, fm, material, maps_used: bool, tiling: TextureMaps) -> None:
+    """A part's file factors beside its material's (``fm``: its FileMaterial where its maps
+    apply, else None) and the uv tiling: a file's maps use its own uvs, the user's are tiled."""
+    set_uniform(program, "u_normal_scale", float(fm.normal_scale) if fm else 1.0)
+    set_uniform(program, "u_clearcoat_normal_scale", float(fm.clearcoat_normal_scale) if fm else 1.0)
+    set_uniform(program, "u_occlusion_strength", float(fm.occlusion_strength) if fm else 1.0)
+    set_uniform(program, "u_alpha", float(fm.alpha) if fm else 1.0)
+    set_uniform(program, "u_alpha_cutoff", float(fm.alpha_cutoff) if fm else 0.5)
+    set_uniform(program, "u_specular_factor", float(fm.specular_factor) if fm else 1.0)
+    set_uniform(program, "u_specular_f90", float(fm.specular_f90) if fm else 1.0)
+    set_uniform(program, "u_specular_color_f0", tuple(float(x) for x in fm.specular_color_f0) if fm
+                else tuple(float(x) for x in material.specular_f0))
+    set_uniform(program, "u_uv_scale", (1.0, 1.0) if maps_used else tuple(map(float, tiling.uv_scale)))
+    set_uniform(program, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
+
+
+def _bind_map_transforms(program, gpu_part: GpuPart) -> None:
+    """KHR_texture_transform's matrices, one per map slot (identity where a map has none)."""
+    transforms = np.tile(np.eye(3, dtype=np.float32), (len(MATERIAL_MAPS), 1, 1))
+    for name, info in gpu_part.infos.items():
+        if info.transform is not None:
+            transforms[MATERIAL_MAPS.index(name)] = info.transform.gl_matrix()
+    member = program.get("u_map_transform", None)
+    if member is not None:
+        # GLSL mat3 is column-major: upload the transposes. The compiler trims the array after
+        # the last slot the variant reads.
+        used = transforms.transpose(0, 2, 1)[:member.array_length]
+        member.write(np.ascontiguousarray(used, dtype=np.float32).tobytes())
+
+
+def _set_anisotropy(r, scene, camera: Camera, gpu_part: GpuPart, part, bound_maps, size) -> None:
+    """Anisotropic filtering where this view gains from it (alight.core.texture_footprint), not
+    everywhere: on llvmpipe 8x costs a textured frame 2-5x. Measured on TEXCOORD_0 as the file
+    gives it (not a TEXCOORD_1 map's uvs, nor the user maps' tiling)."""
+    finest = max((t.size for t in bound_maps), key=lambda wh: wh[0] * wh[1])
+    if scene.mesh is not None and scene.mesh.lod_sphere is not None:
+        # The built-in sphere: its stand-ins (the impostor's proxy, coarser levels) have other
+        # uvs than the ball they stand for, so all take the full level.
+        level = 8.0
+    else:
+        level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
+    r.last_anisotropy[part.name] = level
+    for tex in bound_maps:
+        if tex.anisotropy != level:
+            tex.anisotropy = level
+
+
+def occluded_parts(r, scene, drawn: list[GpuPart]) -> list[GpuPart]:
+    """The mesh's parts refined and baked with visibility where ``scene.occlusion`` wants them
+    (alight.render.visibility_parts), else ``drawn``."""
+    textures = r.meshes.textures(scene.mesh)
+    return r.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
+                                        lambda part: GpuPart(r.ctx, part, textures))
+
+
+# --- after the scene pass: resolve, reduce, tone map ------------------------------------
+
+def surface_rect(r, frame: FrameContext, scene) -> tuple[int, int, int, int] | None:
+    """(x, y, width, height) in pixels of the frame's image holding every pixel the mesh can
+    cover: the projected corners of its parts' bounding boxes, a pixel wider each way. None:
+    the whole image (the probe view, or a box reaching behind the eye)."""
+    if scene.view == "probe":
+        return None
+    if scene.mesh is None:
+        return (0, 0, 0, 0)
+    parts = r.meshes.parts(scene.mesh)
+    if not parts:
+        return (0, 0, 0, 0)
+    lo = np.min([p.lo for p in parts], axis=0)
+    hi = np.max([p.hi for p in parts], axis=0)
+    if scene.ground and frame.shadowed:     # the ground's square is drawn too (draw_ground)
+        g = GroundPass.ground_for(scene.mesh)
+        lo = np.minimum(lo, g.centre - (g.half_size, 0.0, g.half_size))
+        hi = np.maximum(hi, g.centre + (g.half_size, 0.0, g.half_size))
+    corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    clip = corners @ np.asarray(frame.view_projection, np.float64)
+    if (clip[:, 3] <= 1e-6).any():
+        return None
+    size = frame.image_size
+    pixels = (clip[:, :2] / clip[:, 3:] * 0.5 + 0.5) * np.array(size, np.float64)
+    x0, y0 = np.clip(np.floor(pixels.min(axis=0)) - 1, 0, size).astype(int)
+    x1, y1 = np.clip(np.ceil(pixels.max(axis=0)) + 1, 0, size).astype(int)
+    return (int(x0), int(y0), int(max(x1 - x0, 0)), int(max(y1 - y0, 0)))
+
+
+def resolve(r, frame: FrameContext, scene, maps: IBLMaps | None, targets: Targets, radiance: bool,
+            display: bool) -> None:
+    """render/resolve.frag: the multisampled surfaces of the scene pass ``frame`` resolved, the
+    background under them, into the radiance and/or the display image (at least one is
+    written, so a frame is complete)."""
+    radiance = radiance or not display
+    mode = background_mode(scene, maps)
+    # After the sphere's impostor the surfaces are in the single-sample stand-in, resolved already.
+    single = frame.impostor_samples == 4
+    defines = {"BACKGROUND_MODE": int(mode), "SCENE_SAMPLES": 1 if single else targets.samples}
+    scene_texture = targets.single()[0] if single else targets.color
+    if radiance:
+        defines["RADIANCE_OUTPUT"] = None
+    if display:
+        defines["DISPLAY_OUTPUT"] = 1 if radiance else 0
+        defines["TONEMAP_MODE"] = int(glsl_member(Tonemap, scene.display.tonemap))
+    w, h = targets.width, targets.height
+    rect = surface_rect(r, frame, scene)
+    if rect is None or rect == (0, 0, w, h):
+        passes = [(defines, None)]
+    else:
+        # Outside the mesh's rectangle no sample was drawn: the background alone, without
+        # reading the samples (NO_SURFACES), in up to four strips around it; then the
+        # resolve inside it. Every pixel is written once.
+        x, y, rw, rh = rect
+        strips = [(0, 0, w, y), (0, y + rh, w, h - y - rh), (0, y, x, rh), (x + rw, y, w - x - rw, rh)]
+        passes = [({**defines, "NO_SURFACES": None}, strip) for strip in strips if strip[2] > 0 and strip[3] > 0]
+        if rw > 0 and rh > 0:
+            passes.append((defines, rect))
+    targets.resolve_fbo(radiance, display).use()
+    r.ctx.viewport = (0, 0, w, h)
+    try:
+        for pass_defines, scissor in passes:
+            prog = r.program("render/background.vert", "render/resolve.frag", pass_defines)
+            # The rays of the scene pass just drawn (for a tile, the whole image's projection off centre).
+            bind_background(prog, scene, maps, frame.inverse_vp, mode)
+            scene_texture.use(UNIT_RADIANCE)
+            set_uniform(prog, "u_scene", UNIT_RADIANCE)
+            set_uniform(prog, "u_exposure_scale", float(2.0 ** scene.display.exposure))
+            set_uniform(prog, "u_opaque", scene.display.background != "transparent")
+            r.ctx.scissor = scissor
+            r.draws.triangle(prog)
+    finally:
+        r.ctx.scissor = None
+
+
+def finish_radiance(r, targets: Targets) -> None:
+    """The drawn samples into ``targets.radiance``: the MSAA blit, or the SSAA 2x2 reduction."""
+    if targets.aa == "msaa":
+        r.ctx.copy_framebuffer(targets.radiance_fbo, targets.draw)  # the resolve
+    elif targets.aa == "ssaa":
+        prog = r.program("render/fullscreen.vert", "render/downsample.frag")
+        targets.color.use(UNIT_RADIANCE)
+        prog["u_factor"] = 2
+        targets.radiance_fbo.use()
+        r.ctx.viewport = (0, 0, targets.width, targets.height)
+        r.draws.triangle(prog)
+
+
+def tonemap(r, radiance: moderngl.Texture, display: Display, fbo: moderngl.Framebuffer, opaque: bool = True) -> None:
+    """render/tonemap.frag: ``radiance`` exposed and tone mapped into ``fbo``, sRGB encoded."""
+    prog = r.program("render/fullscreen.vert", "render/tonemap.frag",
+                     {"TONEMAP_MODE": int(glsl_member(Tonemap, display.tonemap))})
+    radiance.use(UNIT_RADIANCE)
+    prog["u_exposure_scale"] = float(2.0 ** display.exposure)
+    prog["u_opaque"] = opaque
+    fbo.use()
+    r.ctx.viewport = (0, 0) + fbo.size
+    r.draws.triangle(prog)

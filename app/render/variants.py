@@ -1,0 +1,188 @@
+"""Which shader variant a draw compiles, as plain functions of a part and the scene: the
+material a part draws with (``part_material``) and the defines it owns (``material_defines``,
+as the Khronos glTF Sample Renderer's ``material.getDefines()``), a part's defines
+(``part_defines``: maps, uv sets, alpha mode, ...), and the scene's (IBL model, lights, the
+below-grid fade). The accuracy modules use the same functions, so the reference shades the
+materials the renderer draws."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import replace
+
+from alight.core.layers import layer_defines
+from alight.core.material import LAYERS, Material, with_overrides
+from alight.core.shader_names import (
+    MATERIAL_MAPS,
+    AlphaMode,
+    BackgroundMode,
+    IblModel,
+    glsl_member,
+    map_bit,
+    map_mask,
+)
+from alight.ibl.bake import IBLMaps, grid_roughness
+from alight.render.bindings import MAX_LIGHTS
+
+
+def part_material(scene, part) -> tuple[Material, bool]:
+    """The factors a mesh part draws with, and whether its file's texture maps apply: the file's
+    material (its own layer factors, then the scene's overrides) where the scene uses file
+    materials, else the scene's material."""
+    fm = part.material
+    if fm is None or not scene.use_file_materials:
+        return scene.material, False
+    base = Material(base_color=tuple(fm.base_color), metallic=float(fm.metallic),
+                    roughness=float(fm.roughness), specular_f0=tuple(fm.specular_f0),
+                    ior=fm.layers.get("ior"), emissive=tuple(fm.emissive), name=part.name)
+    layers = {k: v for k, v in fm.layers.items() if k != "ior"}
+    if layers:   # the file's own layer factors (alight.exchange.gltf_material)
+        base = replace(base, **layers)
+    if scene.material_overrides:
+        base = with_overrides(base, **scene.material_overrides)
+    return base, True
+
+
+def material_defines(materials) -> dict:
+    """The HAS_* defines of the layers the materials use, and only those (alight.core.layers)."""
+    return layer_defines(list(materials))
+
+
+def blends(scene, part) -> bool:
+    """Whether the part is drawn blended (its file's alphaMode BLEND, file materials on)."""
+    return part.material is not None and scene.use_file_materials and part.material.alpha_mode == "BLEND"
+
+
+def has_blending_parts(scene) -> bool:
+    """Whether a part blends (alphaMode BLEND): it is drawn over the background, so such a
+    frame keeps the background pass (the fused resolve composites the background last)."""
+    if scene.view == "probe" or scene.mesh is None or not scene.use_file_materials:
+        return False
+    return any(part.material is not None and part.material.alpha_mode == "BLEND" for part in scene.mesh.parts)
+
+
+def transmissive_parts(scene) -> list[int]:
+    """Indices of the mesh's parts whose material transmits (KHR_materials_transmission)."""
+    if scene.view == "probe" or scene.mesh is None:
+        return []
+    # A part that blends (alphaMode BLEND) is drawn in the blended pass, over the background,
+    # and transmits the environment only.
+    return [i for i, part in enumerate(scene.mesh.parts)
+            if "transmission" in part_material(scene, part)[0].layers() and not blends(scene, part)]
+
+
+def scene_layer_defines(scene, parts: list[int] | None = None) -> dict:
+    """The HAS_* defines of the layers any part of the scene's mesh (or those of ``parts``,
+    indices) is drawn with: a scene without layers compiles none."""
+    if scene.mesh is None:
+        return material_defines([scene.material])
+    chosen = range(len(scene.mesh.parts)) if parts is None else parts
+    return material_defines(part_material(scene, scene.mesh.parts[i])[0] for i in chosen)
+
+
+def user_maps_present(scene) -> set[str]:
+    """The slots of the user's maps (Scene.texture_maps) whose image is loaded."""
+    user = scene.texture_maps.paths() if scene.texture_maps is not None else {}
+    return {name for name, path in user.items() if path in scene.texture_images}
+
+
+def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
+    """The shader variant a part needs (pbr.frag, mesh_material.glsl): the maps it reads, their
+    uv sets, transforms and mirrored axes, vertex colours, alpha mode, unlit and the layers
+    its material uses. A part with none of these compiles to the plain opaque shader.
+    ``gpu_part``: its alight.render.gpu_mesh.GpuPart; ``user_maps``: ``user_maps_present``."""
+    fm = part.material
+    file_material = fm is not None and scene.use_file_materials
+    defines: dict = {}
+    if file_material:
+        present = set(gpu_part.textures)
+        masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
+        for name, info in gpu_part.infos.items():
+            bit = map_bit(name)
+            if info.tex_coord == 1 and gpu_part.has_uv1:
+                masks["MAP_UV1_MASK"] |= bit
+            if info.transform is not None:
+                masks["MAP_TRANSFORM_MASK"] |= bit
+            if info.sampler.wrap_s == "mirrored_repeat":
+                masks["MAP_MIRROR_S_MASK"] |= bit
+            if info.sampler.wrap_t == "mirrored_repeat":
+                masks["MAP_MIRROR_T_MASK"] |= bit
+        defines.update({k: v for k, v in masks.items() if v})
+        if masks["MAP_UV1_MASK"]:
+            defines["HAS_UV1"] = None
+        if fm.alpha_mode == "MASK":
+            defines["ALPHA_MODE"] = int(AlphaMode.MASK)
+        elif fm.alpha_mode == "BLEND":
+            defines["ALPHA_MODE"] = int(AlphaMode.BLEND)
+        if fm.unlit:
+            defines["UNLIT"] = None
+    else:
+        present = set(user_maps)
+    if gpu_part.has_colors and scene.use_file_materials:
+        defines["HAS_VERTEX_COLOR"] = None
+    if gpu_part.has_visibility:
+        defines["HAS_VISIBILITY"] = None
+    defines["MATERIAL_MAPS_MASK"] = map_mask(present & set(MATERIAL_MAPS))
+    defines.update(material_defines([part_material(scene, part)[0]]))
+    return defines
+
+
+def ibl_defines(scene) -> dict:
+    """The shader defines that pick the scene's IBL model (app/core/ibl_models.py)."""
+    defines = {"IBL_MODEL": int(glsl_member(IblModel, scene.ibl_model))}
+    if scene.multiple_scattering:
+        defines["MULTIPLE_SCATTERING"] = None
+    return defines
+
+
+def light_defines(scene) -> dict:
+    """punctual.glsl's PUNCTUAL_SPOT and PUNCTUAL_RANGE, only for scenes that have such lights."""
+    lights = scene.lights[:MAX_LIGHTS]
+    defines: dict = {}
+    if any(light.kind == "spot" for light in lights):
+        defines["PUNCTUAL_SPOT"] = None
+    if any(light.range is not None and light.kind != "directional" for light in lights):
+        defines["PUNCTUAL_RANGE"] = None
+    return defines
+
+
+# The maps that cannot change a roughness (MATERIAL_MAPS bits): any other map compiled in keeps
+# the prefiltered lookup's path below the grid (ibl.glsl IBL_BELOW_GRID).
+ROUGHNESS_FREE_MAPS = {"base_color", "normal", "emissive", "occlusion", "metallic", "specular", "specular_color"}
+
+
+def below_grid_defines(scene, maps: IBLMaps | None, materials, map_mask: int = 0) -> dict:
+    """``{"IBL_BELOW_GRID": 0}`` when no roughness the pass can shade lies below the prefiltered
+    grid's first step: the materials' roughness (and their coat's) is at or above it, no
+    compiled-in map (``map_mask``, MATERIAL_MAPS bits) can lower one, and no layer or IBL model
+    reads the maps at a roughness of its own. Else nothing: the shader keeps the fade into the
+    source cube (ibl.glsl)."""
+    if maps is None or not scene.ibl_enabled:
+        return {}
+    unsafe = {name for i, name in enumerate(MATERIAL_MAPS) if map_mask & (1 << i)} - ROUGHNESS_FREE_MAPS
+    if unsafe or map_mask >> len(MATERIAL_MAPS):
+        return {}
+    first_step = grid_roughness(0, maps.quality.prefiltered_levels)
+    if scene.ibl_model == "stretched":
+        return {}   # its fetches' roughness is the material's times a fitted factor below 1
+    for m in materials:
+        if m.layers() - {"clearcoat"}:
+            # sheen, anisotropy and transmission read the prefiltered maps at a roughness of
+            # their own (a LUT's or the stretched lobe's), which may lie below the grid
+            return {}
+        # the base layer's roughness, and the coat's when the coat is on (a layer that is off
+        # is compiled out, and its roughness field keeps glTF's default 0)
+        used = {"roughness"} | {f for layer in m.layers() for f in LAYERS[layer]}
+        for f in dataclasses.fields(m):
+            if f.name in used and f.name.endswith("roughness") and float(getattr(m, f.name)) < first_step:
+                return {}
+    return {"IBL_BELOW_GRID": 0}
+
+
+def background_mode(scene, maps: IBLMaps | None) -> BackgroundMode:
+    """common/background.glsl's BACKGROUND_MODE for the scene: an environment background without
+    an environment draws nothing."""
+    mode = glsl_member(BackgroundMode, scene.display.background)
+    if mode in (BackgroundMode.ENV, BackgroundMode.BLUR) and maps is None:
+        return BackgroundMode.TRANSPARENT
+    return mode
