@@ -176,7 +176,8 @@ class LookupTables:
 
             textures = []
             for part in lobe_table():
-                tex = self.ctx.texture((part.shape[1], part.shape[0]), 4, np.ascontiguousarray(part).tobytes(), dtype="f4")
+                data = np.ascontiguousarray(part).tobytes()
+                tex = self.ctx.texture((part.shape[1], part.shape[0]), 4, data, dtype="f4")
                 tex.repeat_x = tex.repeat_y = False
                 tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
                 textures.append(tex)
@@ -262,7 +263,8 @@ def bind_background(prog: moderngl.Program, scene, maps: IBLMaps | None, inverse
         maps.prefiltered_radiance.use(UNIT_PREFILTERED)
         # Grid A's mip for the blur roughness (half the grid step; see bake.grid_roughness).
         levels = maps.quality.prefiltered_levels
-        set_uniform(prog, "u_blur_mip", float(max(0.0, roughness_to_grid_step(scene.display.blur_roughness, levels) / 2)))
+        blur_mip = max(0.0, roughness_to_grid_step(scene.display.blur_roughness, levels) / 2)
+        set_uniform(prog, "u_blur_mip", float(blur_mip))
         set_uniform(prog, "u_inverse_view_projection", inverse_vp.tobytes(), write=True)
         set_uniform(prog, "u_env_rotation", rotation_cos_sin(scene.env_rotation_deg))
         set_uniform(prog, "u_env_intensity", float(scene.env_intensity))

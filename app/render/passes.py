@@ -244,7 +244,8 @@ def draw_ground(r, frame: FrameContext, scene, maps: IBLMaps | None, view_projec
         return
     if r.ground_pass is None:
         r.ground_pass = GroundPass(r.ctx)
-    prog = scene_program(r, frame, "render/ground.vert", "render/ground.frag", {**light_defines(scene), "HAS_SHADOWS": None})
+    defines = {**light_defines(scene), "HAS_SHADOWS": None}
+    prog = scene_program(r, frame, "render/ground.vert", "render/ground.frag", defines)
     bind_ibl(prog, scene, maps, r.tables)
     r.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
     r.ground_pass.draw(prog, GroundPass.ground_for(scene.mesh), view_projection)
