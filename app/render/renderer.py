@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 import moderngl
 import numpy as np
 
-from alight.core.gpu import ShaderLibrary, create_headless_context
+from alight.core.gpu import ShaderLibrary, create_headless_context, release_objects
 from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.layers import layer_defines
 from alight.core.material import LAYERS, Material, with_overrides
@@ -102,6 +102,7 @@ GL_FRAMEBUFFER_SRGB = 0x8DB9
 AA_MODES = ("none", "msaa", "ssaa")
 MAX_LIGHTS = 16   # punctual.glsl's MAX_LIGHTS
 MAX_GRID_STEPS = 32  # ibl.glsl's MAX_GRID_STEPS: prefiltered roughness steps (2 levels - 1)
+MAX_UPLOADED_MESHES = 8   # meshes kept on the GPU between frames (ForwardRenderer._gpu_mesh)
 # A multisampled frame read as sRGB only is drawn into half floats (half the bytes written,
 # cleared and resolved) where the tone map saturates before the clamp to half's largest value
 # could show: 65504 / 4 (one sample of four) at 2^-6 is 256, white in every tone map.
@@ -411,9 +412,7 @@ class _Targets:
             owned.extend(self._behind[::-1])
         if self._single is not None:
             owned.extend(self._single[::-1])
-        for obj in owned:
-            if obj is not None:
-                obj.release()
+        release_objects(self.ctx, *owned)
 
 
 class ForwardRenderer:
@@ -516,14 +515,23 @@ class ForwardRenderer:
             save_bake(self.bake_cache, self.shaders, env, maps)
 
     def _gpu_mesh(self, mesh, program=None) -> list[_GpuPart]:
-        entry = self._meshes.get(id(mesh))
+        entry = self._meshes.pop(id(mesh), None)
         if entry is None or entry[0] is not mesh:
             if entry is not None:
                 _release_mesh(entry)
+            # The least recently drawn meshes leave the GPU first (a long editor session or test
+            # run draws many; an evicted one uploads again when next drawn).
+            while len(self._meshes) >= MAX_UPLOADED_MESHES:
+                _release_mesh(self._meshes.pop(next(iter(self._meshes))))
             textures = _MeshTextures(self.ctx)
             entry = (mesh, [_GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
-            self._meshes[id(mesh)] = entry
+        self._meshes[id(mesh)] = entry    # last: the most recently drawn
         return entry[1]
+
+    @property
+    def meshes_uploaded(self) -> int:
+        """How many meshes are on the GPU now (at most MAX_UPLOADED_MESHES)."""
+        return len(self._meshes)
 
     def _drawn_parts(self, mesh, camera: Camera, image_size: tuple[int, int]) -> tuple[list[_GpuPart], float | None]:
         """The GPU parts a pass draws for ``mesh``, and the radius of the true sphere they stand
