@@ -45,6 +45,7 @@ import moderngl
 import numpy as np
 
 from alight.accuracy.ground_truth import MIN_ROUGHNESS
+from alight.core.gpu import release_objects
 from alight.core.layers import layer_defines
 from alight.core.layers.stack import probe_tangents
 from alight.core.material import LAYER_FIELDS
@@ -195,8 +196,7 @@ class ReferenceRenderer:
         r.draw_mesh_parts(scene, prog, camera, camera.view_projection(width / height))
         ctx.disable(moderngl.DEPTH_TEST)
         ctx.finish()
-        fbo.release()
-        depth.release()
+        release_objects(ctx, fbo, depth)
         return texs
 
     def layered_material(self, scene):

@@ -39,6 +39,22 @@ def create_headless_context() -> moderngl.Context:
         ) from None
 
 
+def release_objects(ctx: moderngl.Context, *objects) -> None:
+    """Release GL objects (None skipped), unbinding first a framebuffer among them that is bound.
+
+    moderngl keeps the bound framebuffer to restore it after creating another, reading one or
+    clearing: restoring a deleted one is GL_INVALID_OPERATION, and once the driver hands its name
+    to a new framebuffer it silently binds that one instead. Every framebuffer alight releases
+    goes through here."""
+    bound = ctx.fbo
+    if bound is not None and any(obj is bound for obj in objects):
+        # Framebuffer 0: the window's, or in a context without one, the name that is never deleted.
+        (ctx.screen or ctx.detect_framebuffer(0)).use()
+    for obj in objects:
+        if obj is not None:
+            obj.release()
+
+
 def describe(ctx: moderngl.Context) -> str:
     return f"{ctx.info['GL_RENDERER']} / OpenGL {ctx.info['GL_VERSION']}"
 

@@ -14,6 +14,7 @@ from alight.core.texture_footprint import anisotropy_for_view, footprints
 
 GL_SRGB8_ALPHA8 = 0x8C43
 SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color")
+MAX_UPLOADED_MESHES = 8   # meshes kept on the GPU between frames (GpuMeshes.parts)
 
 
 class GpuPart:
@@ -196,14 +197,22 @@ class GpuMeshes:
 
     def parts(self, mesh) -> list[GpuPart]:
         """``mesh``'s parts on the GPU, uploaded on first use (a new mesh object replaces the old)."""
-        entry = self._meshes.get(id(mesh))
+        entry = self._meshes.pop(id(mesh), None)
         if entry is None or entry[0] is not mesh:
             if entry is not None:
                 release_mesh(entry)
+            # The least recently drawn meshes leave the GPU first (a long editor session or test
+            # run draws many; an evicted one uploads again when next drawn).
+            while len(self._meshes) >= MAX_UPLOADED_MESHES:
+                release_mesh(self._meshes.pop(next(iter(self._meshes))))
             textures = MeshTextures(self.ctx)
             entry = (mesh, [GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
-            self._meshes[id(mesh)] = entry
+        self._meshes[id(mesh)] = entry    # last: the most recently drawn
         return entry[1]
+
+    def __len__(self) -> int:
+        """How many meshes are uploaded (at most MAX_UPLOADED_MESHES)."""
+        return len(self._meshes)
 
     def textures(self, mesh) -> MeshTextures:
         """The shared textures of a mesh ``parts`` uploaded."""

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from alight.core.gpu import release_objects
 from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.mesh import is_closed
 from alight.core.shading import rotate_world_to_map
@@ -225,9 +226,7 @@ class ShadowMaps:
             member.value = (float(w), float(h))
 
     def _release_atlas(self) -> None:
-        for obj in (self._fbo, self._sampler, self._atlas):
-            if obj is not None:
-                obj.release()
+        release_objects(self.ctx, self._fbo, self._sampler, self._atlas)
         self._fbo = self._sampler = self._atlas = None
         self._key = self._mesh = None
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from alight.core.gpu import release_objects
 from alight.errors import AlightError
 from alight.render.tiles import TILE_BYTES, Tile, TilePlan, framebuffer_bytes, plan_tiles, side_limit
 
@@ -118,9 +119,7 @@ class Targets:
             owned.extend(self._behind[::-1])
         if self._single is not None:
             owned.extend(self._single[::-1])
-        for obj in owned:
-            if obj is not None:
-                obj.release()
+        release_objects(self.ctx, *owned)
 
 
 _GL_LIMITS = ("GL_MAX_TEXTURE_SIZE", "GL_MAX_RENDERBUFFER_SIZE", "GL_MAX_VIEWPORT_DIMS",

@@ -22,6 +22,8 @@ import math
 import moderngl
 import numpy as np
 
+from alight.core.gpu import release_objects
+
 _COPY_VERTEX = """#version 450 core
 void main() {
     vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
@@ -130,9 +132,7 @@ class PanelImage:
         self.ctx.viewport = (0, 0, w, h)
 
     def release_image(self) -> None:
-        for obj in (self._fbo, self._texture):
-            if obj is not None:
-                obj.release()
+        release_objects(self.ctx, self._fbo, self._texture)
         self._fbo = self._texture = None
         self._key = None
 

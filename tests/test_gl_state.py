@@ -1,0 +1,51 @@
+"""What one frame leaves behind for the next: no GL error, and a bounded set of uploaded meshes.
+
+A renderer lives as long as an editor session or a test run, drawing many scenes at many sizes;
+a framebuffer released while bound used to leave moderngl restoring a deleted name
+(GL_INVALID_OPERATION, and once the name was reused, the wrong framebuffer bound), and every
+mesh ever drawn stayed on the GPU."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from alight.accuracy.reference import ReferenceRenderer
+from alight.core.material import Material
+from alight.core.mesh import cube, sphere
+from alight.core.scene import Light, Scene
+from alight.ibl.environment import load_environment
+from alight.render.gpu_mesh import MAX_UPLOADED_MESHES
+from alight.render.renderer import ForwardRenderer
+
+
+def test_frames_that_change_targets_leave_no_gl_error():
+    with ForwardRenderer(bake_cache=None) as r:
+        maps = r.bake(load_environment("studio"), "low")
+        lit_cube = Scene(mesh=cube(), lights=[Light(kind="directional", vector=(-0.3, -1.0, -0.4), intensity=3.0)],
+                         ground=True, shadows="on")
+        steps = [
+            ("probe, no anti-aliasing", lambda: r.render(Scene(view="probe"), maps, 32, 32, aa="none")),
+            ("sphere, MSAA", lambda: r.render(Scene(mesh=sphere(48, 24)), maps, 48, 32)),
+            ("reference G-buffer", lambda: ReferenceRenderer(r).render(Scene(mesh=sphere(48, 24)), None, 40, 24)),
+            ("shadowed cube on the ground", lambda: r.render(lit_cube, maps, 64, 48)),
+            ("probe again, another size", lambda: r.render(Scene(view="probe"), maps, 24, 24, aa="none")),
+            ("sphere, SSAA", lambda: r.render(Scene(mesh=sphere(48, 24)), maps, 40, 40, aa="ssaa")),
+        ]
+        assert r.ctx.error == "GL_NO_ERROR"
+        for name, step in steps:
+            step()
+            assert r.ctx.error == "GL_NO_ERROR", name
+
+
+def test_the_least_recently_drawn_meshes_leave_the_gpu_and_come_back_the_same():
+    with ForwardRenderer(bake_cache=None) as r:
+        maps = r.bake(load_environment("studio"), "low")
+        first = sphere(40, 20)
+        scene = Scene(mesh=first, material=Material(base_color=(0.8, 0.2, 0.1), roughness=0.4))
+        before = r.render(scene, maps, 32, 32).linear
+        for i in range(MAX_UPLOADED_MESHES + 4):
+            r.render(Scene(mesh=sphere(24 + i, 12)), maps, 16, 16)
+            assert len(r.meshes) <= MAX_UPLOADED_MESHES
+        after = r.render(scene, maps, 32, 32).linear    # uploaded again: the same pixels
+        assert np.array_equal(before, after)
+        assert r.ctx.error == "GL_NO_ERROR"
