@@ -494,10 +494,9 @@ def _set_anisotropy(r, scene, camera: Camera, gpu_part: GpuPart, part, bound_map
     finest = max((t.size for t in bound_maps), key=lambda wh: wh[0] * wh[1])
     if scene.mesh is not None and scene.mesh.lod_sphere is not None:
         # The built-in sphere: its stand-ins (the impostor's proxy, coarser levels) have other
-        # uvs than the ball they stand for, so all take the full level.
-        level = 8.0
-    else:
-        level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
+        # uvs than the ball they stand for, whose shading they draw: the level is the ball's.
+        gpu_part = r.meshes.parts(scene.mesh)[0]
+    level = gpu_part.anisotropy(camera.view_projection(size[0] / size[1]), size, finest)
     r.last_anisotropy[part.name] = level
     for tex in bound_maps:
         if tex.anisotropy != level:
