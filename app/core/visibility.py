@@ -50,7 +50,7 @@ DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
 DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
-BAKE_VERSION = 2
+BAKE_VERSION = 3   # 3: ray origins kept in front of their own faces
 OCCLUSION_MODES = ("auto", "on", "off")
 
 
@@ -127,6 +127,15 @@ def specular_occlusion(bent_dot_r, n_dot_r, visibility, roughness):
     return 1.0 + (so - 1.0) * t * t * (3.0 - 2.0 * t)
 
 
+def mapped_bent_normal(n, bent, vertex_normal):
+    """The bent normal for a normal-mapped shading normal ``n`` (all (N, 3) unit, one side): the
+    bake's lean of the bent normal from the vertex normal, added to n, so an open point keeps n
+    (and the normal map's relief) exactly."""
+    leaned = np.asarray(n, np.float64) + np.asarray(bent, np.float64) - np.asarray(vertex_normal, np.float64)
+    length = np.linalg.norm(leaned, axis=-1, keepdims=True)
+    return np.where(length > 1e-4, leaned / np.maximum(length, 1e-30), n)
+
+
 def combined_visibility(visibility, occlusion_texture):
     """The diffuse visibility with a glTF occlusion texture: the smaller of the two. Both estimate
     the same quantity for the same geometry (the texture is this mesh's own baked AO), so
@@ -135,16 +144,23 @@ def combined_visibility(visibility, occlusion_texture):
     return np.minimum(np.asarray(visibility, np.float64), np.asarray(occlusion_texture, np.float64))
 
 
+def occluder_visibility(bounce_weight, baked_visibility):
+    """The mean visibility of what the occluded rays hit, w / (1 - V), at most 1: w and V are
+    counted by different rays, whose noise made the ratio large where V is near 1."""
+    return np.minimum(np.asarray(bounce_weight, np.float64)
+                      / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3), 1.0)
+
+
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
                          hit_albedo, so, prefiltered):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
     and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
     (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
-    hit albedo * w / (1 - V_baked) * E(bounce)/pi."""
+    hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi."""
     v = np.asarray(visibility, np.float64)[..., None]
-    occluder = (np.minimum(hit_albedo, 1.0) * (np.asarray(bounce_weight, np.float64)
-                / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3))[..., None] * irradiance_bounce)
+    occluder = (np.minimum(hit_albedo, 1.0) * occluder_visibility(bounce_weight, baked_visibility)[..., None]
+                * irradiance_bounce)
     so = np.asarray(so, np.float64)[..., None]
     return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 
@@ -340,7 +356,22 @@ def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.
     toward = centroid / np.maximum(uses, 1) - p
     reach = np.linalg.norm(toward, axis=1, keepdims=True)
     nudge = toward / np.maximum(reach, 1e-30) * np.minimum(10.0 * eps, 0.5 * reach)
-    return (p + nudge + eps * n).astype(np.float32)
+    origin = p + nudge + eps * n
+    # The nudge points at the faces' centroid, which lies behind a curved surface's vertex (the
+    # chords of a convex patch run inside it): on a coarse mesh (the Duck: 4k triangles over a
+    # round body) it took the origin behind the vertex's own faces by more than the t ~ 0 skip
+    # covers, and every ray left through its own face as an occluder: V ~ 0 on convex patches,
+    # black blotches. So the origin is lifted along n until it is eps in front of every plane
+    # of its own faces (a refined face lies in its original triangle's plane).
+    face_normal = np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]])
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-30)
+    corner = faces.ravel()
+    fn = np.repeat(face_normal, 3, axis=0)
+    depth = np.einsum("ij,ij->i", origin[corner] - p[corner], fn)          # height over each own face
+    along = np.maximum(np.einsum("ij,ij->i", n[corner], fn), 0.1)         # how fast a lift along n gains
+    lift = np.zeros(len(p))
+    np.maximum.at(lift, corner, np.maximum(eps - depth, 0.0) / along)
+    return (origin + lift[:, None] * n).astype(np.float32)
 
 
 class _Occluders:
