@@ -52,6 +52,11 @@ DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past thi
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
 BAKE_VERSION = 3   # 3: ray origins kept in front of their own faces
 OCCLUSION_MODES = ("auto", "on", "off")
+# --occlusion auto: bake where the mesh's mean occlusion (occlusion_statistic) is above this.
+AUTO_MIN_OCCLUSION = 0.03
+AUTO_SAMPLES = 1024           # surface points of the statistic
+AUTO_RAYS = 32                # rays per point
+AUTO_MAX_VERTICES = 250_000   # auto bakes no bigger mesh (MetalRoughSpheresNoTextures' 1M triangles: 97 s)
 
 
 @dataclass
@@ -201,14 +206,58 @@ def self_occludes(parts, faces: int = 2000, vertices: int = 20000, tolerance: fl
     return False
 
 
+def occlusion_statistic(parts, samples: int = AUTO_SAMPLES, rays: int = AUTO_RAYS, seed: int = 0) -> float:
+    """The mesh's mean ambient occlusion, 1 - V averaged over its surface by area: ``samples``
+    points drawn by area (seeded), ``rays`` cosine-weighted rays each about the face normal, against
+    the whole mesh (Embree). 0 for a convex or flat mesh (nothing is cast then: ``self_occludes``);
+    about 0.2 for the corner scene. Its error is about sqrt(O(1 - O) / (samples rays)), < 0.003."""
+    if not self_occludes(parts):
+        return 0.0
+    triangles = np.concatenate([np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)]
+                                for p in parts])
+    cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    if area.sum() <= 0.0:
+        return 0.0
+    occluders = _Occluders(triangles)
+    rng = np.random.default_rng(seed)
+    pick = rng.choice(len(triangles), samples, p=area / area.sum())
+    a, b = rng.random(samples), rng.random(samples)
+    flip = a + b > 1.0
+    a, b = np.where(flip, 1.0 - a, a), np.where(flip, 1.0 - b, b)
+    t = triangles[pick]
+    points = t[:, 0] + a[:, None] * (t[:, 1] - t[:, 0]) + b[:, None] * (t[:, 2] - t[:, 0])
+    lo, hi = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
+    eps = eps_of(float(np.linalg.norm(hi - lo)) or 1.0)
+    normals = occluders.normals[pick].astype(np.float64)
+    # The side the mesh's normals say is outside (a mirrored node or clockwise winding would
+    # otherwise cast into the body), as the bake casts about the vertex normals.
+    vertex_normals = np.concatenate([np.asarray(p.normals, np.float64)[np.asarray(p.indices, np.int64)].sum(axis=1)
+                                     for p in parts])[pick]
+    normals *= np.where(np.einsum("ij,ij->i", normals, vertex_normals) < 0.0, -1.0, 1.0)[:, None]
+    hit, _, _ = occluders.hemisphere((points + eps * normals).astype(np.float32), normals.astype(np.float32),
+                                     rays, rng, eps)
+    return float((hit >= 0).mean())
+
+
 def wants_occlusion(mesh, mode: str) -> bool:
     """``mode`` 'on': bake unless the mesh is the built-in sphere; 'off': never; 'auto': where
-    the mesh occludes itself (``self_occludes``)."""
+    the mesh occludes enough of its own surface to matter (``occlusion_statistic`` above
+    AUTO_MIN_OCCLUSION; convex and flat meshes are decided without a ray)."""
     if mode not in OCCLUSION_MODES:
         raise AlightError(f"--occlusion: '{mode}' is not one of {', '.join(OCCLUSION_MODES)}")
     if mode == "off" or mesh is None or mesh.lod_sphere is not None:
         return False
-    return mode == "on" or self_occludes(mesh.parts)
+    if mode == "on":
+        return True
+    if not embree_available() or auto_too_big(mesh):
+        return self_occludes(mesh.parts)    # the caller says it draws without (visibility_parts)
+    return occlusion_statistic(mesh.parts) > AUTO_MIN_OCCLUSION
+
+
+def auto_too_big(mesh) -> bool:
+    """Whether 'auto' leaves the mesh unbaked for its size (more than AUTO_MAX_VERTICES vertices)."""
+    return sum(len(p.positions) for p in mesh.parts) > AUTO_MAX_VERTICES
 
 
 # ---- refinement ----------------------------------------------------------------------------------
