@@ -246,8 +246,12 @@ def test_cli_occlusion_flag(corner_obj, tmp_path):
         import OpenImageIO as oiio
 
         outs[mode] = oiio.ImageBuf(str(out)).get_pixels(oiio.FLOAT)
-    # The occluded corner is darker; nothing is brighter by more than the bounce can add.
-    assert outs["on"][..., :3].sum() < 0.95 * outs["off"][..., :3].sum()
+    # The occluded corner is darker on the surface (the background is the same), though the
+    # bounces give part of it back; the inner corner most.
+    surface = (outs["off"][..., 3] >= 1.0) & (outs["on"][..., 3] >= 1.0)
+    on, off = outs["on"][..., :3].sum(axis=-1)[surface], outs["off"][..., :3].sum(axis=-1)[surface]
+    assert on.sum() < 0.97 * off.sum()
+    assert (on / off).min() < 0.7
     bad = _cli("render", "--mesh", corner_obj, "--occlusion", "sometimes", "--out", tmp_path / "x.png", cache=cache)
     assert bad.returncode == 2
     assert len(bad.stderr.strip().splitlines()) == 1 and "--occlusion" in bad.stderr

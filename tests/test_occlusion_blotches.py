@@ -139,3 +139,16 @@ def test_the_new_shader_terms_match_their_numpy_twins():
     wv = np.column_stack([rng.uniform(0, 1, count), rng.uniform(0, 1, count)])
     gpu = evaluate(4, wv, shader="accuracy/evaluate_occlusion.comp")[:, 0]
     np.testing.assert_allclose(gpu, vis.occluder_visibility(wv[:, 0], wv[:, 1]), rtol=1e-5, atol=1e-6)
+    rows = np.column_stack([rng.uniform(0, 1, (count, 3)), rng.uniform(0, 1, count)])
+    gpu = evaluate(5, rows, shader="accuracy/evaluate_occlusion.comp")[:, :3]
+    np.testing.assert_allclose(gpu, vis.occluders_reflectance(rows[:, :3], rows[:, 3]), rtol=1e-4, atol=1e-6)
+
+
+def test_the_occluders_reflect_every_bounce():
+    """a V / (1 - a (1 - V)): one bounce (a V) where the occluders are open; the sum of the
+    geometric series a^k where they are closed in (V -> 0 with a V / (1 - a) per unit)."""
+    a = np.array([[0.7, 0.7, 0.7]])
+    np.testing.assert_allclose(vis.occluders_reflectance(a, np.array([1.0])), a)
+    v = np.array([0.5])
+    np.testing.assert_allclose(vis.occluders_reflectance(a, v), 0.35 / (1.0 - 0.35))
+    assert (vis.occluders_reflectance(a, np.array([0.3])) > a * 0.3).all()

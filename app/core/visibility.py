@@ -156,6 +156,16 @@ def occluder_visibility(bounce_weight, baked_visibility):
                       / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3), 1.0)
 
 
+def occluders_reflectance(hit_albedo, hit_visibility):
+    """What the occluders reflect of E/pi, every bounce: one bounce is a V_hit, the further ones a
+    geometric series assuming the occluders' occluders see alike (as Jimenez et al. 2016's
+    multi-bounce fit assumes): a V_hit / (1 - a (1 - V_hit)). hit_albedo (3,) or (N, 3),
+    hit_visibility (N,); returns (N, 3)."""
+    a = np.asarray(hit_albedo, np.float64)
+    v = np.asarray(hit_visibility, np.float64)[..., None]
+    return a * v / np.maximum(1.0 - a * (1.0 - v), 1e-3)
+
+
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
                          hit_albedo, so, prefiltered):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
@@ -164,8 +174,8 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
     hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi."""
     v = np.asarray(visibility, np.float64)[..., None]
-    occluder = (np.minimum(hit_albedo, 1.0) * occluder_visibility(bounce_weight, baked_visibility)[..., None]
-                * irradiance_bounce)
+    occluder = occluders_reflectance(np.minimum(hit_albedo, 1.0),
+                                     occluder_visibility(bounce_weight, baked_visibility)) * irradiance_bounce
     so = np.asarray(so, np.float64)[..., None]
     return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 

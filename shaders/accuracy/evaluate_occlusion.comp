@@ -15,6 +15,7 @@ const int TERM_CONE_APERTURE = 1;       // (V)
 const int TERM_SPECULAR_OCCLUSION = 2;  // (bent.r, n.r, V, roughness)
 const int TERM_MAPPED_BENT_NORMAL = 3;  // (n, bent as polar, azimuth angles about the vertex normal +Z)
 const int TERM_OCCLUDER_VISIBILITY = 4; // (bounce weight, V)
+const int TERM_OCCLUDERS_REFLECTANCE = 5; // (hit albedo rgb, hit visibility)
 
 vec3 polar_direction(float theta, float phi) {
     return vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
@@ -40,6 +41,9 @@ void main() {
             break;
         case TERM_OCCLUDER_VISIBILITY:
             o.x = occluder_visibility(a.x, a.y);
+            break;
+        case TERM_OCCLUDERS_REFLECTANCE:
+            o.xyz = occluders_reflectance(a.xyz, a.w);
             break;
     }
     u_outputs[i] = o;

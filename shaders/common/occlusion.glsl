@@ -58,6 +58,15 @@ float occluder_visibility(float bounce_weight, float baked_visibility) {
     return min(bounce_weight / max(1.0 - baked_visibility, 1e-3), 1.0);
 }
 
+// What the occluders reflect of E/pi: one bounce is albedo a times their visibility V_hit; the
+// light they receive from their own occluders (further bounces) is summed as a geometric series,
+// assuming those see as this point's occluders do (the assumption of Jimenez et al. 2016's
+// multi-bounce fit): a V_hit / (1 - a (1 - V_hit)). The path tracer's walls of albedo 0.7 were
+// ~8% brighter than one bounce.
+vec3 occluders_reflectance(vec3 hit_albedo, float hit_visibility) {
+    return hit_albedo * hit_visibility / max(1.0 - hit_albedo * (1.0 - hit_visibility), vec3(1e-3));
+}
+
 #ifdef HAS_VISIBILITY
 in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
 in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
@@ -105,7 +114,7 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     vec3 occluder = vec3(0.0);
     if (baked && v_bounce.w > 0.0) {
         vec3 hit_albedo = min(s.base_color * (1.0 - s.metallic) + specular_albedo, vec3(1.0));
-        occluder = hit_albedo * occluder_visibility(v_bounce.w, baked_visibility)
+        occluder = occluders_reflectance(hit_albedo, occluder_visibility(v_bounce.w, baked_visibility))
                    * irradiance_at(normalize(v_bounce.xyz), false);
     }
     irradiance = visibility * irradiance_at(bent, false) + (1.0 - visibility) * occluder;
