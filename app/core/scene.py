@@ -253,7 +253,7 @@ class Scene:
     texture_maps: "TextureMaps | None" = None
     texture_images: dict = field(default_factory=dict)
     # Occlusion of the environment light by the mesh itself (alight.core.visibility): 'auto'
-    # bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in sphere.
-    # Off by default: the bake blots some models black (the Duck sample, NormalTangentMirrorTest;
-    # docs/explanation/occlusion.md, "Known problems") until that is found.
+    # bakes it where the mesh occludes enough of itself, 'on' for every mesh but the built-in
+    # sphere. The still previews ('alight render', alight.Renderer) default to 'auto'; a bare
+    # Scene (the editor's moving view, batch) stays 'off', the bake being for a still view.
     occlusion: str = "off"

@@ -50,8 +50,13 @@ DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
 DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
-BAKE_VERSION = 2
+BAKE_VERSION = 3   # 3: ray origins kept in front of their own faces
 OCCLUSION_MODES = ("auto", "on", "off")
+# --occlusion auto: bake where the mesh's mean occlusion (occlusion_statistic) is above this.
+AUTO_MIN_OCCLUSION = 0.03
+AUTO_SAMPLES = 1024           # surface points of the statistic
+AUTO_RAYS = 32                # rays per point
+AUTO_MAX_VERTICES = 250_000   # auto bakes no bigger mesh (MetalRoughSpheresNoTextures' 1M triangles: 97 s)
 
 
 @dataclass
@@ -127,6 +132,15 @@ def specular_occlusion(bent_dot_r, n_dot_r, visibility, roughness):
     return 1.0 + (so - 1.0) * t * t * (3.0 - 2.0 * t)
 
 
+def mapped_bent_normal(n, bent, vertex_normal):
+    """The bent normal for a normal-mapped shading normal ``n`` (all (N, 3) unit, one side): the
+    bake's lean of the bent normal from the vertex normal, added to n, so an open point keeps n
+    (and the normal map's relief) exactly."""
+    leaned = np.asarray(n, np.float64) + np.asarray(bent, np.float64) - np.asarray(vertex_normal, np.float64)
+    length = np.linalg.norm(leaned, axis=-1, keepdims=True)
+    return np.where(length > 1e-4, leaned / np.maximum(length, 1e-30), n)
+
+
 def combined_visibility(visibility, occlusion_texture):
     """The diffuse visibility with a glTF occlusion texture: the smaller of the two. Both estimate
     the same quantity for the same geometry (the texture is this mesh's own baked AO), so
@@ -135,16 +149,33 @@ def combined_visibility(visibility, occlusion_texture):
     return np.minimum(np.asarray(visibility, np.float64), np.asarray(occlusion_texture, np.float64))
 
 
+def occluder_visibility(bounce_weight, baked_visibility):
+    """The mean visibility of what the occluded rays hit, w / (1 - V), at most 1: w and V are
+    counted by different rays, whose noise made the ratio large where V is near 1."""
+    return np.minimum(np.asarray(bounce_weight, np.float64)
+                      / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3), 1.0)
+
+
+def occluders_reflectance(hit_albedo, hit_visibility):
+    """What the occluders reflect of E/pi, every bounce: one bounce is a V_hit, the further ones a
+    geometric series assuming the occluders' occluders see alike (as Jimenez et al. 2016's
+    multi-bounce fit assumes): a V_hit / (1 - a (1 - V_hit)). hit_albedo (3,) or (N, 3),
+    hit_visibility (N,); returns (N, 3)."""
+    a = np.asarray(hit_albedo, np.float64)
+    v = np.asarray(hit_visibility, np.float64)[..., None]
+    return a * v / np.maximum(1.0 - a * (1.0 - v), 1e-3)
+
+
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
                          hit_albedo, so, prefiltered):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
     and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
     (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
-    hit albedo * w / (1 - V_baked) * E(bounce)/pi."""
+    hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi."""
     v = np.asarray(visibility, np.float64)[..., None]
-    occluder = (np.minimum(hit_albedo, 1.0) * (np.asarray(bounce_weight, np.float64)
-                / np.maximum(1.0 - np.asarray(baked_visibility, np.float64), 1e-3))[..., None] * irradiance_bounce)
+    occluder = occluders_reflectance(np.minimum(hit_albedo, 1.0),
+                                     occluder_visibility(bounce_weight, baked_visibility)) * irradiance_bounce
     so = np.asarray(so, np.float64)[..., None]
     return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 
@@ -185,14 +216,58 @@ def self_occludes(parts, faces: int = 2000, vertices: int = 20000, tolerance: fl
     return False
 
 
+def occlusion_statistic(parts, samples: int = AUTO_SAMPLES, rays: int = AUTO_RAYS, seed: int = 0) -> float:
+    """The mesh's mean ambient occlusion, 1 - V averaged over its surface by area: ``samples``
+    points drawn by area (seeded), ``rays`` cosine-weighted rays each about the face normal, against
+    the whole mesh (Embree). 0 for a convex or flat mesh (nothing is cast then: ``self_occludes``);
+    about 0.2 for the corner scene. Its error is about sqrt(O(1 - O) / (samples rays)), < 0.003."""
+    if not self_occludes(parts):
+        return 0.0
+    triangles = np.concatenate([np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)]
+                                for p in parts])
+    cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    if area.sum() <= 0.0:
+        return 0.0
+    occluders = _Occluders(triangles)
+    rng = np.random.default_rng(seed)
+    pick = rng.choice(len(triangles), samples, p=area / area.sum())
+    a, b = rng.random(samples), rng.random(samples)
+    flip = a + b > 1.0
+    a, b = np.where(flip, 1.0 - a, a), np.where(flip, 1.0 - b, b)
+    t = triangles[pick]
+    points = t[:, 0] + a[:, None] * (t[:, 1] - t[:, 0]) + b[:, None] * (t[:, 2] - t[:, 0])
+    lo, hi = triangles.reshape(-1, 3).min(axis=0), triangles.reshape(-1, 3).max(axis=0)
+    eps = eps_of(float(np.linalg.norm(hi - lo)) or 1.0)
+    normals = occluders.normals[pick].astype(np.float64)
+    # The side the mesh's normals say is outside (a mirrored node or clockwise winding would
+    # otherwise cast into the body), as the bake casts about the vertex normals.
+    vertex_normals = np.concatenate([np.asarray(p.normals, np.float64)[np.asarray(p.indices, np.int64)].sum(axis=1)
+                                     for p in parts])[pick]
+    normals *= np.where(np.einsum("ij,ij->i", normals, vertex_normals) < 0.0, -1.0, 1.0)[:, None]
+    hit, _, _ = occluders.hemisphere((points + eps * normals).astype(np.float32), normals.astype(np.float32),
+                                     rays, rng, eps)
+    return float((hit >= 0).mean())
+
+
 def wants_occlusion(mesh, mode: str) -> bool:
     """``mode`` 'on': bake unless the mesh is the built-in sphere; 'off': never; 'auto': where
-    the mesh occludes itself (``self_occludes``)."""
+    the mesh occludes enough of its own surface to matter (``occlusion_statistic`` above
+    AUTO_MIN_OCCLUSION; convex and flat meshes are decided without a ray)."""
     if mode not in OCCLUSION_MODES:
         raise AlightError(f"--occlusion: '{mode}' is not one of {', '.join(OCCLUSION_MODES)}")
     if mode == "off" or mesh is None or mesh.lod_sphere is not None:
         return False
-    return mode == "on" or self_occludes(mesh.parts)
+    if mode == "on":
+        return True
+    if not embree_available() or auto_too_big(mesh):
+        return self_occludes(mesh.parts)    # the caller says it draws without (visibility_parts)
+    return occlusion_statistic(mesh.parts) > AUTO_MIN_OCCLUSION
+
+
+def auto_too_big(mesh) -> bool:
+    """Whether 'auto' leaves the mesh unbaked for its size (more than AUTO_MAX_VERTICES vertices)."""
+    return sum(len(p.positions) for p in mesh.parts) > AUTO_MAX_VERTICES
 
 
 # ---- refinement ----------------------------------------------------------------------------------
@@ -340,7 +415,22 @@ def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.
     toward = centroid / np.maximum(uses, 1) - p
     reach = np.linalg.norm(toward, axis=1, keepdims=True)
     nudge = toward / np.maximum(reach, 1e-30) * np.minimum(10.0 * eps, 0.5 * reach)
-    return (p + nudge + eps * n).astype(np.float32)
+    origin = p + nudge + eps * n
+    # The nudge points at the faces' centroid, which lies behind a curved surface's vertex (the
+    # chords of a convex patch run inside it): on a coarse mesh (the Duck: 4k triangles over a
+    # round body) it took the origin behind the vertex's own faces by more than the t ~ 0 skip
+    # covers, and every ray left through its own face as an occluder: V ~ 0 on convex patches,
+    # black blotches. So the origin is lifted along n until it is eps in front of every plane
+    # of its own faces (a refined face lies in its original triangle's plane).
+    face_normal = np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]])
+    face_normal /= np.maximum(np.linalg.norm(face_normal, axis=1, keepdims=True), 1e-30)
+    corner = faces.ravel()
+    fn = np.repeat(face_normal, 3, axis=0)
+    depth = np.einsum("ij,ij->i", origin[corner] - p[corner], fn)          # height over each own face
+    along = np.maximum(np.einsum("ij,ij->i", n[corner], fn), 0.1)         # how fast a lift along n gains
+    lift = np.zeros(len(p))
+    np.maximum.at(lift, corner, np.maximum(eps - depth, 0.0) / along)
+    return (origin + lift[:, None] * n).astype(np.float32)
 
 
 class _Occluders:

@@ -68,7 +68,8 @@ class Renderer:
         self._mesh: Mesh | None = None
         self._env: Environment | None = _studio()
         self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
-                           display=Display(tonemap=tonemap, exposure=exposure, background=background))
+                           display=Display(tonemap=tonemap, exposure=exposure, background=background),
+                           occlusion="auto")
         self.set_display(tonemap=tonemap, exposure=exposure, background=background)
         self.set_mesh("sphere")
 
@@ -286,8 +287,9 @@ class Renderer:
     def set_occlusion(self, mode: Literal["auto", "on", "off"]) -> "Renderer":
         """Occlusion of the environment light by the mesh itself, with one diffuse bounce
         (alight.core.visibility: a per-vertex ray-traced bake, cached like the IBL bake): 'auto'
-        bakes it where the mesh can occlude itself, 'on' for every mesh but the built-in sphere,
-        'off' (the default, while the bake blots some models: docs/explanation/occlusion.md) never.
+        (the default) bakes it where the mesh occludes enough of its own surface
+        (alight.core.visibility.wants_occlusion: never the built-in sphere or a convex mesh), 'on'
+        for every mesh but the built-in sphere, 'off' never.
         Raises AlightError for another mode."""
         if mode not in ("auto", "on", "off"):
             raise AlightError(f"occlusion: {mode!r} is not 'auto', 'on' or 'off'")

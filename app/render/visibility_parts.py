@@ -3,18 +3,20 @@ and their refined parts on the GPU with the baked values as two more vertex attr
 (pbr.vert's in_visibility, in_bounce; HAS_VISIBILITY in shaders/common/occlusion.glsl).
 
 One ``OcclusionParts`` per renderer keeps, per mesh, the decision (``Scene.occlusion``: 'auto'
-bakes where the mesh occludes itself, 'on' wherever it is not the built-in sphere, 'off' never)
-and the uploaded parts; the bake itself is cached on disk with the IBL bakes (the renderer's
-``bake_cache``), keyed by the mesh's content and the bake's settings.
+bakes where the mean occlusion of the surface, ``occlusion_statistic``, is above
+AUTO_MIN_OCCLUSION and the mesh has at most AUTO_MAX_VERTICES vertices; 'on' wherever it is
+not the built-in sphere; 'off' never) and the uploaded parts; the bake itself is cached on disk
+with the IBL bakes (the renderer's ``bake_cache``), keyed by the mesh's content and the bake's
+settings.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from alight.core.visibility import (VISIBILITY_FIELDS, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
-                                    MeshVisibility, PartVisibility, bake_visibility, embree_available, refined_mesh_part,
-                                    visibility_key, wants_occlusion)
+from alight.core.visibility import (AUTO_MAX_VERTICES, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
+                                    VISIBILITY_FIELDS, MeshVisibility, PartVisibility, auto_too_big, bake_visibility,
+                                    embree_available, refined_mesh_part, visibility_key, wants_occlusion)
 from alight.errors import warn
 from alight.ibl.bake_cache import BadEntry, encode_entry
 
@@ -78,6 +80,11 @@ class OcclusionParts:
             # 'auto' never stops a render: it says once what it drew without ('on' raises).
             warn(f"{mesh.source}: rendered without occlusion of the environment light: the visibility bake "
                  f"needs embreex (pip install embreex)")
+            return drawn
+        if mode == "auto" and auto_too_big(mesh):
+            warn(f"{mesh.source}: rendered without occlusion of the environment light: "
+                 f"{sum(len(p.positions) for p in mesh.parts)} vertices are more than --occlusion auto bakes "
+                 f"({AUTO_MAX_VERTICES}); --occlusion on bakes it")
             return drawn
         entry = self._parts.get(id(mesh))
         if entry is None or entry[0] is not mesh:

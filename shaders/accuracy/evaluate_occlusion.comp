@@ -13,6 +13,13 @@ uniform int u_term;
 const int TERM_CAPS_INTERSECTION = 0;   // (cos cap 1, cos cap 2, cos distance)
 const int TERM_CONE_APERTURE = 1;       // (V)
 const int TERM_SPECULAR_OCCLUSION = 2;  // (bent.r, n.r, V, roughness)
+const int TERM_MAPPED_BENT_NORMAL = 3;  // (n, bent as polar, azimuth angles about the vertex normal +Z)
+const int TERM_OCCLUDER_VISIBILITY = 4; // (bounce weight, V)
+const int TERM_OCCLUDERS_REFLECTANCE = 5; // (hit albedo rgb, hit visibility)
+
+vec3 polar_direction(float theta, float phi) {
+    return vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
+}
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -28,6 +35,15 @@ void main() {
             break;
         case TERM_SPECULAR_OCCLUSION:
             o.x = specular_occlusion(a.x, a.y, a.z, a.w);
+            break;
+        case TERM_MAPPED_BENT_NORMAL:
+            o.xyz = mapped_bent_normal(polar_direction(a.x, a.y), polar_direction(a.z, a.w), vec3(0.0, 0.0, 1.0));
+            break;
+        case TERM_OCCLUDER_VISIBILITY:
+            o.x = occluder_visibility(a.x, a.y);
+            break;
+        case TERM_OCCLUDERS_REFLECTANCE:
+            o.xyz = occluders_reflectance(a.xyz, a.w);
             break;
     }
     u_outputs[i] = o;

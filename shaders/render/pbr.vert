@@ -22,6 +22,7 @@ layout(location = 6) in vec4 in_visibility;
 layout(location = 7) in vec4 in_bounce;
 out vec4 v_visibility;
 out vec4 v_bounce;
+out vec3 v_baked_normal;
 #endif
 
 uniform mat4 u_model;
@@ -48,6 +49,7 @@ void main() {
 #ifdef HAS_VISIBILITY
     v_visibility = vec4(u_normal_matrix * in_visibility.xyz, in_visibility.w);
     v_bounce = vec4(u_normal_matrix * in_bounce.xyz, in_bounce.w);
+    v_baked_normal = v_normal;
 #endif
     gl_Position = u_view_projection * world;
 }

@@ -1,0 +1,154 @@
+"""What blotched the Duck, NormalTangentMirrorTest and TextureSettingsTest with --occlusion, by
+equivalence: a mesh that cannot occlude itself renders with the bake as without it.
+
+- A coarse convex mesh (the Duck's kind: a round body of large flat triangles): the rays of a
+  vertex started behind the planes of its own faces and left through them, V ~ 0 on convex patches.
+- A normal-mapped plane (NormalTangentMirrorTest's tiles): the per-vertex bent normal replaced the
+  normal map in the diffuse lookup, the relief went flat.
+- The occluders' radiance w / (1 - V) (a bright ring where the occlusion texture is dark and the
+  bake saw almost nothing): at most 1.
+The test writes its own files (trimesh) and reads them with alight's loader."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("embreex")
+trimesh = pytest.importorskip("trimesh")
+
+from alight.core import visibility as vis  # noqa: E402
+from alight.core.material import Material  # noqa: E402
+from alight.core.scene import Camera, Scene  # noqa: E402
+from alight.exchange.meshes import load_mesh  # noqa: E402
+from alight.ibl.environment import studio_environment  # noqa: E402
+from tests.gpu import renderer  # noqa: E402
+
+
+def _coarse_ball(path: Path) -> Path:
+    """An icosphere of 80 faces with its exact (radial) normals, as OBJ."""
+    ball = trimesh.creation.icosphere(subdivisions=1)
+    normals = ball.vertices / np.linalg.norm(ball.vertices, axis=1, keepdims=True)
+    mesh = trimesh.Trimesh(ball.vertices, ball.faces, vertex_normals=normals, process=False)
+    path.write_text(mesh.export(file_type="obj", include_normals=True, include_texture=False))
+    return path
+
+
+def _bumpy_plane(path: Path) -> Path:
+    """A 2 x 2 plane facing +Z with a tangent-space normal map of ridges (slopes up to 45 degrees)
+    as glTF binary."""
+    from PIL import Image
+
+    size = 64
+    u = (np.arange(size) + 0.5) / size
+    slope = np.tile(np.sin(2.0 * np.pi * 4.0 * u), (size, 1))          # dh/du of the ridges
+    n = np.stack([-slope, np.zeros_like(slope), np.ones_like(slope)], axis=-1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    image = Image.fromarray(np.round((n * 0.5 + 0.5) * 255).astype(np.uint8))
+    vertices = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float64)
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float64)
+    material = trimesh.visual.material.PBRMaterial(baseColorFactor=[200, 200, 200, 255], metallicFactor=0.0,
+                                                   roughnessFactor=0.6, normalTexture=image)
+    mesh = trimesh.Trimesh(vertices, faces, vertex_normals=np.tile([0.0, 0.0, 1.0], (4, 1)), process=False,
+                           visual=trimesh.visual.TextureVisuals(uv=uv, material=material))
+    path.write_bytes(trimesh.Scene(mesh).export(file_type="glb"))
+    return path
+
+
+def _on_and_off(mesh, camera):
+    r = renderer()
+    maps = r.bake(studio_environment(256), "low")
+    images = {}
+    for mode in ("off", "on"):
+        scene = Scene(mesh=mesh, material=Material(base_color=(0.8, 0.8, 0.8), roughness=0.5), camera=camera,
+                      occlusion=mode)
+        images[mode] = r.render(scene, maps, 96, 96, aa="none", read_linear=True, read_srgb=False).linear[..., :3]
+    assert r.visibility_parts.wanted(mesh, "on")
+    return images["off"], images["on"]
+
+
+def test_a_coarse_convex_mesh_does_not_occlude_itself(tmp_path):
+    mesh = load_mesh(str(_coarse_ball(tmp_path / "ball.obj")))
+    baked = vis.bake_visibility(mesh)
+    v = np.concatenate([p.visibility for p in baked.parts])
+    # Convex: every ray reaches the sky (the old origins gave V = 0 at some vertices, mean 0.89).
+    assert v.min() > 0.97, v.min()
+    off, on = _on_and_off(mesh, Camera(position=(0.0, 0.6, 3.5)))
+    lit = off.sum(axis=-1) > 1e-3
+    assert lit.mean() > 0.2
+    relative = np.abs(on - off).sum(axis=-1)[lit] / off.sum(axis=-1)[lit]
+    assert np.percentile(relative, 99) < 0.03 and relative.mean() < 0.01, (relative.mean(), relative.max())
+
+
+def test_a_normal_map_keeps_its_relief_with_occlusion(tmp_path):
+    mesh = load_mesh(str(_bumpy_plane(tmp_path / "plane.glb")))
+    assert mesh.parts[0].material.normal_texture is not None
+    camera = Camera(position=(0.0, -1.5, 3.0), target=(0.0, 0.0, 0.0), up=(0.0, 0.0, 1.0))
+    off, on = _on_and_off(mesh, camera)
+    lit = off.sum(axis=-1) > 1e-3
+    assert lit.mean() > 0.3
+    luminance = off.sum(axis=-1)[lit]
+    assert luminance.std() / luminance.mean() > 0.05           # the ridges show
+    relative = np.abs(on - off).sum(axis=-1)[lit] / luminance
+    assert np.percentile(relative, 99) < 0.03, np.percentile(relative, 99)
+
+
+def test_the_occluders_visibility_is_at_most_one():
+    """w / (1 - V) is the mean visibility of what the occluded rays hit; w and V come from
+    different rays, so where V is near 1 their noise must not make the occluders brighter than lit."""
+    w = np.array([0.0, 0.02, 0.3, 0.5])
+    v = np.array([1.0, 0.999, 0.5, 0.2])
+    got = vis.occluder_visibility(w, v)
+    np.testing.assert_allclose(got, [0.0, 1.0, 0.6, 0.625])
+    ones = np.ones((4, 3))
+    diffuse, _ = vis.occluded_environment(np.zeros(4), v, w, ones, ones, 1.0, np.ones(4), ones)
+    assert diffuse.max() <= 1.0 + 1e-9
+
+
+def test_the_bent_normal_follows_the_normal_map():
+    rng = np.random.default_rng(1)
+    n = rng.normal(size=(50, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    n[:, 2] = np.abs(n[:, 2])
+    vertex = np.tile([0.0, 0.0, 1.0], (50, 1))
+    # Open (bent = vertex normal): the mapped normal itself.
+    np.testing.assert_allclose(vis.mapped_bent_normal(n, vertex, vertex), n, atol=1e-12)
+    # Unmapped (n = vertex normal): the baked bent normal.
+    bent = np.tile(np.array([0.3, 0.0, 0.9]) / np.linalg.norm([0.3, 0.0, 0.9]), (50, 1))
+    np.testing.assert_allclose(vis.mapped_bent_normal(vertex, bent, vertex), bent, atol=1e-12)
+
+
+def _polar(theta, phi):
+    return np.column_stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+
+
+def test_the_new_shader_terms_match_their_numpy_twins():
+    from tests.gpu import evaluate
+
+    rng = np.random.default_rng(4)
+    count = 400
+    angles = np.column_stack([rng.uniform(0, 1.5, count), rng.uniform(0, 6.3, count),
+                              rng.uniform(0, 1.5, count), rng.uniform(0, 6.3, count)])
+    gpu = evaluate(3, angles, shader="accuracy/evaluate_occlusion.comp")[:, :3]
+    vertex = np.tile([0.0, 0.0, 1.0], (count, 1))
+    want = vis.mapped_bent_normal(_polar(angles[:, 0], angles[:, 1]), _polar(angles[:, 2], angles[:, 3]), vertex)
+    np.testing.assert_allclose(gpu, want, atol=2e-5)
+    wv = np.column_stack([rng.uniform(0, 1, count), rng.uniform(0, 1, count)])
+    gpu = evaluate(4, wv, shader="accuracy/evaluate_occlusion.comp")[:, 0]
+    np.testing.assert_allclose(gpu, vis.occluder_visibility(wv[:, 0], wv[:, 1]), rtol=1e-5, atol=1e-6)
+    rows = np.column_stack([rng.uniform(0, 1, (count, 3)), rng.uniform(0, 1, count)])
+    gpu = evaluate(5, rows, shader="accuracy/evaluate_occlusion.comp")[:, :3]
+    np.testing.assert_allclose(gpu, vis.occluders_reflectance(rows[:, :3], rows[:, 3]), rtol=1e-4, atol=1e-6)
+
+
+def test_the_occluders_reflect_every_bounce():
+    """a V / (1 - a (1 - V)): one bounce (a V) where the occluders are open; the sum of the
+    geometric series a^k where they are closed in (V -> 0 with a V / (1 - a) per unit)."""
+    a = np.array([[0.7, 0.7, 0.7]])
+    np.testing.assert_allclose(vis.occluders_reflectance(a, np.array([1.0])), a)
+    v = np.array([0.5])
+    np.testing.assert_allclose(vis.occluders_reflectance(a, v), 0.35 / (1.0 - 0.35))
+    assert (vis.occluders_reflectance(a, np.array([0.3])) > a * 0.3).all()
