@@ -12,13 +12,20 @@ is exactly A's or B's pixels); the reference has no background, so B shows throu
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import types
 
 import numpy as np
 
+from alight.core.scene import Display
 from alight.errors import AlightError
 from alight.frontends.editor import compare as cmp
+
+# The time a frame gives the reference's sum at most (about one band more): the window stays
+# responsive while a reference that takes a minute on a software GL fills in.
+REFERENCE_SLICE_S = 0.05
+_NO_DISPLAY = Display()
 
 _VERTEX = """#version 450 core
 void main() {
@@ -68,7 +75,10 @@ class CompareView:
         self._a_targets = None
         self._a_key = None        # what A's image shows now
         self._a_ok = False        # whether A's image holds a picture (the reference may have failed)
-        self._ref_key = None
+        self._ref_key = None      # what the reference job sums (the scene less its display)
+        self._ref_job = None      # the reference's generator while it runs (_reference_job)
+        self._ref_linear = None   # its radiance so far
+        self.reference_progress = None   # the fraction summed while it runs (the panel shows it)
         self._out = None          # (texture, framebuffer) of the put-together image
         self._prog = self._vao = None
         self.reference_seconds = None
@@ -86,20 +96,14 @@ class CompareView:
             t = self._a_targets = _Targets(self.ctx, size[0], size[1], aa, 4)
         return t
 
-    def draw_a(self, win, scene, maps, size, moving: bool) -> None:
-        """Bring A's image up to date for this frame (only when what it shows changed)."""
+    def draw_a(self, win, scene, maps, size, moving: bool, finish: bool = False) -> None:
+        """Bring A's image up to date for this frame (only when what it shows changed). The
+        reference is summed a band of rows at a time (``REFERENCE_SLICE_S`` a frame; ``finish``:
+        to the end, for screenshots and tests)."""
         c = win.state.compare
         targets = self._targets_for(size, win.state.aa)
         if c.mode == "reference":
-            key = ("reference", win._view_key(scene, None, size), id(win.state.env))
-            if key == self._a_key:
-                return
-            if moving:   # the sum takes a second or more on a software GL: drawn when still
-                self._a_ok = False
-                return
-            self._a_ok = self._draw_reference(win, scene, targets)
-            self._a_key = key
-            self.redraws += 1
+            self._step_reference(win, scene, targets, moving, finish)
             return
         a = cmp.a_scene(c, scene)
         key = ("forward", win._view_key(a, maps, size))
@@ -109,46 +113,133 @@ class CompareView:
         self._a_key, self._a_ok = key, True
         self.redraws += 1
 
-    def _draw_reference(self, win, scene, targets) -> bool:
-        """The exact reference into A's display image; False (and the panel's error line) where
-        it cannot be drawn."""
-        problem = cmp.reference_problem(win.state)
-        if problem:
-            win.state.fail(AlightError(problem))
-            return False
-        try:
-            linear = self.reference_linear(win, scene, targets.width, targets.height)
-        except AlightError as exc:
-            win.state.fail(AlightError(f"reference compare: {exc}"))
-            return False
-        tex = self.ctx.texture((targets.width, targets.height), 4,
-                               np.ascontiguousarray(linear[::-1], np.float32).tobytes(), dtype="f4")
+    def _step_reference(self, win, scene, targets, moving: bool, finish: bool) -> None:
+        """The exact reference's job: started when what it shows changed and the view stands
+        still, advanced a slice a frame, tone mapped into A's image after each band (rows not
+        summed yet are uncovered: B shows through them)."""
+        c = win.state.compare
+        size = (targets.width, targets.height)
+        # Everything the sum depends on; not the display (exposure, tone map): those re-tone-map only.
+        key = (win._view_key(dataclasses.replace(scene, display=_NO_DISPLAY), None, size), id(win.state.env),
+               c.reference_scale)
+        if key != self._ref_key and not moving:
+            if self._ref_job is not None:
+                self._ref_job.close()
+            self._ref_key, self._ref_linear, self._a_ok = key, None, False
+            self.reference_progress = 0.0
+            problem = cmp.reference_problem(win.state)
+            if problem:
+                win.state.fail(AlightError(problem))
+                self._ref_job = None
+            else:
+                self._ref_job = self._reference_job(win, scene, targets.width, targets.height, c.reference_scale)
+        if self._ref_key != key:   # moving: A's half waits for the view to stand still
+            self._a_ok = False
+            return
+        changed = False
+        start = time.perf_counter()
+        while self._ref_job is not None:
+            try:
+                self._ref_linear, self.reference_progress = next(self._ref_job)
+                changed = True
+            except StopIteration:
+                self._ref_job, self.reference_progress = None, None
+                self.reference_seconds = time.perf_counter() - self._ref_started
+                break
+            except AlightError as exc:
+                win.state.fail(AlightError(f"reference compare: {exc}"))
+                self._ref_job, self._ref_linear, self.reference_progress = None, None, None
+                break
+            if not finish and time.perf_counter() - start >= REFERENCE_SLICE_S:
+                break
+        display_key = (key, scene.display)
+        if self._ref_linear is None:
+            self._a_ok = False
+        elif changed or self._a_key != display_key:
+            self._tonemap_reference(scene, targets)
+            self._a_key, self._a_ok = display_key, True
+            self.redraws += 1
+
+    def _reference_job(self, win, scene, width: int, height: int, scale: float):
+        """A generator: the reference of the view at ``scale`` of its pixels (at least 16 wide),
+        one band of rows per step; yields (the radiance so far (h, w, 4), top row first, alpha 0
+        where not summed yet; the fraction done)."""
+        from alight.accuracy.reference import (
+            GBUFFER,
+            ReferenceRenderer,
+            check_layer_lobes,
+            check_layer_roughness,
+            check_roughness,
+            choose_env_level,
+            env_level_radiance,
+        )
+
+        self._ref_started = time.perf_counter()
+        rw = max(16, round(width * scale))
+        rh = max(1, round(height * rw / width))
+        rr = ReferenceRenderer(self.renderer)
+        env = win.state.env
+        use_env = env is not None and scene.ibl_enabled
+        radiance = None
+        if use_env:
+            roughnesses = rr.scene_roughnesses(scene)
+            for r in roughnesses:
+                check_roughness(r)
+            check_layer_roughness(rr.layered_material(scene))
+            check_layer_lobes(rr.layered_material(scene), roughnesses)
+            # Reduced once here (the reference's own choice of level), not per band.
+            radiance = env_level_radiance(np.asarray(env.radiance, np.float32),
+                                          choose_env_level(env.radiance, roughnesses))
+        textures = rr.mesh_gbuffer(scene, rw, rh)
+        g = {}
+        for name, tex in zip(GBUFFER, textures):
+            g[name] = np.frombuffer(tex.read(), np.float32).reshape(rh, rw, 4)[::-1].copy()
+            tex.release()
+        linear = np.zeros((rh, rw, 4), np.float32)
+        covered = g["position"][..., 3] > 0.5
+        yield linear, 0.0
+        band = 1
+        y = 0
+        while y < rh:
+            while y < rh and not covered[y].any():   # rows without the mesh: nothing to sum
+                y += 1
+            if y >= rh:
+                break
+            y1 = min(rh, y + band)
+            t0 = time.perf_counter()
+            part = rr.render_gbuffer({n: g[n][y:y1] for n in GBUFFER}, scene, radiance, env_level=0)
+            linear[y:y1] = part.linear
+            linear[y:y1, :, 3] = covered[y:y1]
+            # The next band sized to the slice from this one's time.
+            spent = time.perf_counter() - t0
+            band = max(1, min(64, int(band * REFERENCE_SLICE_S / max(spent, 1e-4))))
+            y = y1
+            yield linear, y / rh
+        yield linear, 1.0
+
+    def _tonemap_reference(self, scene, targets) -> None:
+        """The reference's radiance, upscaled to A's image (nearest: each summed pixel a block),
+        tone mapped with the view's display settings; alpha the coverage."""
+        h, w = targets.height, targets.width
+        src = self._ref_linear
+        rows = np.minimum((np.arange(h) + 0.5) * src.shape[0] / h, src.shape[0] - 1).astype(int)
+        cols = np.minimum((np.arange(w) + 0.5) * src.shape[1] / w, src.shape[1] - 1).astype(int)
+        full = src[rows][:, cols]
+        tex = self.ctx.texture((w, h), 4, np.ascontiguousarray(full[::-1], np.float32).tobytes(), dtype="f4")
         try:
             self.renderer.tonemap(tex, scene.display, targets.display_fbo, opaque=False)
         finally:
             tex.release()
-        return True
-
-    def reference_linear(self, win, scene, width: int, height: int) -> np.ndarray:
-        """``alight reference``'s radiance of the view, (H, W, 4) float32, top row first, alpha the
-        coverage. Errors: AlightError (a roughness below the reference's minimum, ...)."""
-        from alight.accuracy.reference import ReferenceRenderer
-
-        env = win.state.env
-        t0 = time.perf_counter()
-        result = ReferenceRenderer(self.renderer).render(scene, None if env is None else env.radiance, width, height)
-        self.reference_seconds = time.perf_counter() - t0
-        return result.linear
 
     # --- putting the halves together -------------------------------------------------------------
 
-    def compose(self, win, scene, maps, b_targets, moving: bool):
+    def compose(self, win, scene, maps, b_targets, moving: bool, finish: bool = False):
         """A left of the divider, ``b_targets``' display image right of it, in an image of B's size.
         Returns an object with the attributes the window reads from a _Targets (display,
         display_fbo, width, height)."""
         c = win.state.compare
         size = (b_targets.width, b_targets.height)
-        self.draw_a(win, scene, maps, size, moving)
+        self.draw_a(win, scene, maps, size, moving, finish)
         if self._out is None or self._out[0].size != size:
             if self._out is not None:
                 for obj in self._out:
@@ -177,9 +268,9 @@ class CompareView:
         c = win.state.compare
         h, w = b_srgb.shape[:2]
         if c.mode == "reference":
-            targets = self._targets_for((w, h), "none")
-            self._a_key = None   # A's image is the screenshot's now
-            if not self._draw_reference(win, scene, targets):
+            targets = self._targets_for((w, h), win.state.aa)
+            self.draw_a(win, scene, maps, (w, h), False, finish=True)
+            if not self._a_ok:
                 return b_srgb
             a = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)[::-1]
             return composite_rows(a, _with_alpha(b_srgb), c.divider, b_behind_a=True)[..., :b_srgb.shape[2]]

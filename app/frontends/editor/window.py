@@ -493,7 +493,7 @@ class EditorWindow:
                 self.renderer.forget_map_textures(set(scene.texture_maps.paths().values()))
                 self._drawn_maps = scene.texture_maps
         if compare:
-            targets = self.compare_view.compose(self, scene, maps, targets, moving)
+            targets = self.compare_view.compose(self, scene, maps, targets, moving, finish=full)
         if direct:
             pass   # already in the window
         elif size == window:
