@@ -117,6 +117,12 @@ def draw_overlay(win) -> None:
     colour = imgui.get_color_u32(imgui.ImVec4(1.0, 1.0, 1.0, 0.9 if c.dragging else 0.6))
     draw.add_line(imgui.ImVec2(x, 0.0), imgui.ImVec2(x, view_h), colour, 2.0)
     a, b = half_names(win.state)
+    if c.mode == "reference":   # say what A's half shows while the sum is not there (B's pixels)
+        progress = win.compare_view.reference_progress
+        if progress is not None:
+            a += f" (summing, {progress:.0%})"
+        elif not win.compare_view.a_ready:
+            a += " (not drawn: see the panel)" if win.state.error else " (when the view stands still)"
     draw.add_text(imgui.ImVec2(max(4.0, x - 8.0 - imgui.calc_text_size(a).x), 4.0), colour, a)
     draw.add_text(imgui.ImVec2(min(view_w - 4.0 - imgui.calc_text_size(b).x, x + 8.0), 4.0), colour, b)
 

@@ -84,6 +84,11 @@ class CompareView:
         self.reference_seconds = None
         self.redraws = 0          # A's image drawn (tests read it)
 
+    @property
+    def a_ready(self) -> bool:
+        """Whether A's image holds A's picture now (the reference may be summing or refused)."""
+        return bool(self._a_ok)
+
     # --- half A -----------------------------------------------------------------------------
 
     def _targets_for(self, size, aa):
