@@ -2,12 +2,13 @@
 (the live view) right of it put together in one image, which the window shows and reads as it
 does the plain view.
 
-Only the renderer's public calls draw: ``draw_display`` for a forward half (its own ``_Targets``,
-so B's image stays B's and neither redraws when only the divider moves), ``render`` for the
-screenshot's halves, and ``tonemap`` for the reference (``ReferenceRenderer.render``'s linear
-radiance, tone mapped with the view's display settings, so both halves share one curve). The
-halves meet in one full-screen pass that fetches each pixel from A or B (no filtering: the image
-is exactly A's or B's pixels); the reference has no background, so B shows through around it.
+Only the renderer's public calls draw: ``draw_display`` for a forward half (framebuffers of its
+own, so B's image stays B's and neither redraws when only the divider moves), ``render`` for the
+screenshot's halves, and ``tonemap`` for the reference (``ReferenceRenderer.render_gbuffer``'s
+linear radiance, summed a band of rows a frame, tone mapped with the view's display settings, so
+both halves share one curve). The halves meet in one full-screen pass that fetches each pixel
+from A or B (no filtering: the image is exactly A's or B's pixels); the reference has no
+background, so B shows through around it.
 """
 
 from __future__ import annotations
@@ -70,8 +71,9 @@ def composite_rows(a: np.ndarray, b: np.ndarray, divider: float, b_behind_a: boo
 
 
 class CompareView:
-    def __init__(self, ctx, renderer):
-        self.ctx, self.renderer = ctx, renderer
+    def __init__(self, ctx, renderer, new_targets):
+        """``new_targets(size, aa)``: view framebuffers of A's own (EditorWindow.new_targets)."""
+        self.ctx, self.renderer, self.new_targets = ctx, renderer, new_targets
         self._a_targets = None
         self._a_key = None        # what A's image shows now
         self._a_ok = False        # whether A's image holds a picture (the reference may have failed)
@@ -92,13 +94,12 @@ class CompareView:
     # --- half A -----------------------------------------------------------------------------
 
     def _targets_for(self, size, aa):
-        from alight.render.renderer import _Targets   # as the window's own view targets
-
         t = self._a_targets
         if t is None or (t.width, t.height, t.aa) != (size[0], size[1], aa):
             if t is not None:
+                self.ctx.screen.use()   # never release a bound framebuffer
                 t.release()
-            t = self._a_targets = _Targets(self.ctx, size[0], size[1], aa, 4)
+            t = self._a_targets = self.new_targets(size, aa)
         return t
 
     def draw_a(self, win, scene, maps, size, moving: bool, finish: bool = False) -> None:
@@ -247,6 +248,7 @@ class CompareView:
         self.draw_a(win, scene, maps, size, moving, finish)
         if self._out is None or self._out[0].size != size:
             if self._out is not None:
+                self.ctx.screen.use()
                 for obj in self._out:
                     obj.release()
             tex = self.ctx.texture(size, 4, dtype="f1")
@@ -283,6 +285,7 @@ class CompareView:
         return composite_rows(frame.srgb[..., :b_srgb.shape[2]], b_srgb, c.divider)
 
     def release(self) -> None:
+        self.ctx.screen.use()
         if self._a_targets is not None:
             self._a_targets.release()
         for obj in (self._out or ()) + tuple(x for x in (self._vao, self._prog) if x is not None):

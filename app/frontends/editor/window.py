@@ -159,7 +159,7 @@ class EditorWindow:
         self.panel = Panel()
         from alight.frontends.editor.compare_view import CompareView
 
-        self.compare_view = CompareView(self.ctx, self.renderer)   # the A/B split view's GL side
+        self.compare_view = CompareView(self.ctx, self.renderer, self.new_targets)   # the A/B split view's GL side
 
     # --- input --------------------------------------------------------------------------------
 
@@ -433,6 +433,13 @@ class EditorWindow:
         while len(self._target_cache) > TARGET_CACHE:
             self._target_cache.popitem(last=False)[1].release()
         return targets
+
+    def new_targets(self, size, aa):
+        """Framebuffers of their own for an image of the view's kind (the compare view's half A),
+        outside the view's cache."""
+        from alight.render.renderer import _Targets
+
+        return _Targets(self.ctx, size[0], size[1], aa, 4)
 
     def _view_key(self, scene, maps, size) -> tuple:
         """Everything the view image depends on. Material, Camera, Light and Display are plain
