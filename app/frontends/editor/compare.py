@@ -179,7 +179,7 @@ def draw_section(win, presets) -> None:
         changed, v = imgui.slider_float("reference scale", c.reference_scale, 0.05, 1.0)
         if imgui.is_item_hovered():
             imgui.set_tooltip("the reference's resolution relative to the view's (each summed pixel "
-                              "a block): the exact sum costs per pixel, a minute for 4000 on a software GL")
+                              "a block): the exact sum costs per pixel, 46 s for 4400 on the sphere on llvmpipe")
         if changed:
             c.reference_scale = v
         view = win.compare_view
