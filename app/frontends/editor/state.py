@@ -19,9 +19,9 @@ from alight.core.scene import TONEMAPS, Display, Light, Scene
 from alight.core.shader_names import DATA_VIEWS, DEBUG_VIEWS
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
-from alight.frontends.editor.compare import CompareState
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.exchange.texture_sets import load_slot_image
+from alight.frontends.editor.compare import CompareState
 from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")

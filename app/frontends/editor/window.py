@@ -188,7 +188,7 @@ class EditorWindow:
         if not io.want_capture_mouse:
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
             if divider:
-                pass
+                pass   # the left button drags the compare divider
             elif imgui.is_mouse_dragging(imgui.MouseButton_.left):
                 self.orbit.orbit(dx, dy)
             elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and io.key_shift:
