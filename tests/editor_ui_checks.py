@@ -772,6 +772,143 @@ def test_ior_and_specular_f0_follow_each_other(ctx):
     assert s.material.ior > 1.5, s.material   # the ior follows the F0 typed
 
 
+# --- compare: the A/B split view (app/frontends/editor/compare.py) ----------------------------------
+
+def _halves(image: np.ndarray, divider: float) -> tuple[np.ndarray, np.ndarray]:
+    from alight.frontends.editor.compare_view import split_column
+
+    col = split_column(divider, image.shape[1])
+    return image[:, :col].astype(np.int32), image[:, col:].astype(np.int32)
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> int:
+    """The largest difference of two images of one shape (0-255)."""
+    assert a.shape == b.shape, (a.shape, b.shape)
+    return int(np.abs(a.astype(np.int32) - b.astype(np.int32)).max()) if a.size else 0
+
+
+def _ball_half(image: np.ndarray, left: bool) -> np.ndarray:
+    """The ball's pixels in the left or right half of the image (the divider at 0.5)."""
+    h, w = image.shape[:2]
+    y, x = np.mgrid[0:h, 0:w]
+    side = x < w // 2 - 2 if left else x >= w // 2 + 2
+    return image[((x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2) & side].astype(np.float64)
+
+
+def test_compare_snapshot_a_against_the_live_material_and_drag_the_divider(ctx):
+    from imgui_bundle import imgui
+
+    win = editor()
+    s = win.state
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.3)
+    copper = view(ctx)                      # the plain view, before the split
+    ctx.item_click("**/silver")
+    silver = view(ctx)
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.3)
+    ctx.item_open("**/Compare")
+    ctx.combo_click("compare/material")
+    assert s.compare.mode == "material" and not s.compare.active   # A not chosen: one view
+    ctx.item_click("**/snapshot A")
+    assert s.compare.active and s.compare.a_material == s.material, s.compare
+    assert _same(view(ctx), copper) <= 1        # the same material both sides: the plain view
+    ctx.item_click("**/silver")                 # the live material changes; A keeps copper
+    assert s.material.name == "silver" and s.compare.a_material.name == "copper"
+    split = view(ctx)
+    a, b = _halves(split, s.compare.divider)
+    assert _same(a, _halves(copper, s.compare.divider)[0]) <= 1, "A's half is not the snapshot's render"
+    assert _same(b, _halves(silver, s.compare.divider)[1]) <= 1, "B's half is not the live material's render"
+    left, right = _ball_half(split, True).mean(axis=0), _ball_half(split, False).mean(axis=0)
+    assert left[0] / left[2] > right[0] / right[2] + 0.15, (left, right)   # copper's red left, silver's grey right
+    # A left drag on the divider's line moves it (and does not orbit); elsewhere it orbits.
+    void(ctx)
+    yaw = win.orbit.yaw_deg
+    view_w = imgui.get_io().display_size.x - win.panel_width()
+    h = imgui.get_io().display_size.y
+    ctx.mouse_move_to_pos(imgui.ImVec2(s.compare.divider * view_w, h * 0.5))
+    ctx.mouse_drag_with_delta(imgui.ImVec2(-0.25 * view_w, 0))
+    assert abs(s.compare.divider - 0.25) < 0.03, s.compare.divider
+    assert win.orbit.yaw_deg == yaw, "the divider's drag orbited the camera"
+    moved = view(ctx)
+    a, b = _halves(moved, s.compare.divider)
+    assert _same(a, _halves(copper, s.compare.divider)[0]) <= 1
+    assert _same(b, _halves(silver, s.compare.divider)[1]) <= 1
+    # Between the old boundary and the new one the pixels are now silver's, not copper's.
+    from alight.frontends.editor.compare_view import split_column
+
+    w = moved.shape[1]
+    band = slice(split_column(0.27, w), split_column(0.48, w))
+    assert _same(moved[:, band], silver[:, band]) <= 1 and _same(moved[:, band], copper[:, band]) > 10
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/divider", 0.5)
+    assert s.compare.divider == 0.5
+    # A preset chosen for A instead of the snapshot.
+    ctx.combo_click("A preset/gold")
+    assert s.compare.a_material.name == "gold" and s.compare.a_label == "preset gold"
+    ctx.combo_click("compare/off")
+    assert not s.compare.active
+    assert _same(view(ctx), silver) <= 1        # off: the plain live view again
+    ctx.item_close("**/Compare")
+
+
+def test_compare_two_ibl_models(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/roughness", 0.9)
+    ctx.item_open("**/Environment")
+    ctx.combo_click("IBL model/lecture")
+    lecture = view(ctx)
+    ctx.combo_click("IBL model/alight")
+    alight = view(ctx)
+    ctx.item_close("**/Environment")
+    ctx.set_ref("alight")
+    ctx.item_open("**/Compare")
+    ctx.combo_click("compare/ibl model")
+    ctx.combo_click("A IBL model/lecture")
+    ctx.combo_click("B IBL model/alight")
+    assert (s.compare.a_ibl_model, s.ibl_model) == ("lecture", "alight")
+    split = view(ctx)
+    a, b = _halves(split, s.compare.divider)
+    assert _same(a, _halves(lecture, s.compare.divider)[0]) <= 1, "A's half is not the lecture model's render"
+    assert _same(b, _halves(alight, s.compare.divider)[1]) <= 1, "B's half is not the alight model's render"
+    assert np.abs(_ball_half(split, True).mean() - _ball_half(alight, True).mean()) > 0.2
+    ctx.combo_click("compare/off")
+    ctx.item_close("**/Compare")
+
+
+def test_compare_against_the_exact_reference(ctx):
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/roughness", 0.5)
+    live = view(ctx)
+    ctx.item_open("**/Compare")
+    ctx.combo_click("compare/reference")
+    ctx.item_input_value("**/reference scale", 0.1)   # 64 x 40 sums: seconds on a software GL
+    assert abs(s.compare.reference_scale - 0.1) < 1e-6, s.compare.reference_scale
+    split = view(ctx)                            # (the view waits for the whole sum)
+    assert editor().compare_view.reference_seconds, s.error
+    a, b = _halves(split, s.compare.divider)
+    la, lb = _halves(live, s.compare.divider)
+    assert _same(b, lb) <= 1                     # B: the live view
+    ball_a, ball_live = _ball_half(split, True), _ball_half(live, True)
+    assert _same(ball_a, ball_live) > 0, "the reference half is the live render"
+    # The split-sum forward render is within a few percent of the exact sum on a rough dielectric.
+    assert np.abs(ball_a.mean(axis=0) - ball_live.mean(axis=0)).max() < 8, (ball_a.mean(axis=0), ball_live.mean(axis=0))
+    corner = slice(0, 8)
+    assert _same(a[corner, corner], la[corner, corner]) <= 1   # around the sphere: B's background
+    # Below the reference's minimum roughness: one line in the panel, not a wrong half.
+    ctx.item_input_value("**/roughness", 0.02)
+    view(ctx)
+    assert "reference compare:" in s.error and "roughness" in s.error, s.error
+    ctx.item_input_value("**/roughness", 0.5)
+    ctx.combo_click("compare/off")
+    ctx.item_close("**/Compare")
+
+
 def test_load_preset_button(ctx):
     from alight.exchange.presets import load_preset
 

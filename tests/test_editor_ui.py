@@ -111,9 +111,19 @@ def test_set_the_view(ctx):
     ctx.item_open('**/Lights')
     ctx.item_click('**/add directional')
     ctx.item_close('**/Lights')
+    # The split view: A a snapshot of silver, B silver made rougher, the divider at 0.3.
+    ctx.set_ref('alight')
+    ctx.item_open('**/Compare')
+    ctx.combo_click('compare/material')
+    ctx.item_click('**/snapshot A')
+    ctx.item_input_value('**/divider', 0.3)
+    ctx.item_close('**/Compare')
+    ctx.item_input_value('**/roughness', 0.7)
     s = editor().state
     assert (s.env_rotation_deg, s.display.tonemap, s.display.background) == (75.0, 'neutral', 'color')
     assert s.material.name == 'silver', s.material.name
+    assert s.compare.active and abs(s.compare.divider - 0.3) < 1e-6, s.compare
+    assert abs(s.material.roughness - 0.7) < 1e-6 and s.compare.a_material.roughness != s.material.roughness
     np.save('first.npy', view(ctx))
 """
 
@@ -126,13 +136,18 @@ def test_reopened(ctx):
     assert (s.display.tonemap, s.display.exposure, s.display.background) == ('neutral', -0.5, 'color'), s.display
     assert len(s.lights) == 4 and s.lights[-1].kind == 'directional', s.lights
     assert s.material.name == 'silver', s.material.name
+    c = s.compare
+    assert (c.mode, c.a_label, c.active) == ('material', 'snapshot of silver', True) and abs(c.divider - 0.3) < 1e-6, c
+    assert c.a_material.name == 'silver' and abs(s.material.roughness - 0.7) < 1e-6, c
+    assert abs(c.a_material.roughness - s.material.roughness) > 0.1, c   # A the snapshot, B edited since
     np.save('second.npy', view(ctx))
 """
 
 
 def test_view_settings_survive_close_and_reopen(display, tmp_path):
-    """Environment rotation and intensity, tone map, exposure, background and lights set through
-    the panel come back when the editor is opened again, and the view is the same picture."""
+    """Environment rotation and intensity, tone map, exposure, background, lights and the compare
+    split (on, its divider, A's snapshot) set through the panel come back when the editor is
+    opened again, and the view is the same picture (split as it was)."""
     (tmp_path / "first.py").write_text(FIRST_RUN)
     (tmp_path / "second.py").write_text(SECOND_RUN)
     first = ui_test(tmp_path, tmp_path / "first.py", "--new", size="320x240")

@@ -91,6 +91,10 @@ class Panel:
             self._lights(s)
         if imgui.collapsing_header("Display & camera"):
             self._display(s, win)
+        if imgui.collapsing_header("Compare"):   # the A/B split view (app/frontends/editor/compare.py)
+            from alight.frontends.editor.compare import draw_section
+
+            draw_section(win, self.presets)
         if imgui.collapsing_header("Performance", imgui.TreeNodeFlags_.default_open):
             self._performance(win)
         if imgui.collapsing_header("Accuracy chart"):   # the latest 'alight chart' (app/frontends/editor/chart_view.py)

@@ -13,6 +13,7 @@ from alight.core.material import material_from_dict
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.exchange.output import write_text_atomic
+from alight.frontends.editor import compare
 from alight.paths import config_dir
 
 CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "radius")
@@ -30,7 +31,8 @@ def save_session(state, orbit) -> None:
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
                          "display": dataclasses.asdict(state.display),
-                         "lights": [dataclasses.asdict(light) for light in state.lights]}}
+                         "lights": [dataclasses.asdict(light) for light in state.lights]},
+            "compare": compare.to_dict(state.compare)}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))
@@ -74,6 +76,11 @@ def restore_session(state, orbit) -> str:
             for k, v in values.items():
                 setattr(state, k, v)
             state.display, state.lights = display, lights
+    if "compare" in data:   # the split view: on or off, the divider, what A is
+        try:
+            state.compare = compare.from_dict(data["compare"], str(path))
+        except AlightError as exc:
+            warning = " ".join(str(exc).split())
     camera = data.get("camera")
     if isinstance(camera, dict):
         try:

@@ -21,6 +21,7 @@ from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.exchange.texture_sets import load_slot_image
+from alight.frontends.editor.compare import CompareState
 from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")
@@ -59,6 +60,7 @@ class EditorState:
     use_file_materials: bool = False   # a mesh file's own materials and texture maps instead of the panel's
     debug_view: int = 0
     debug_mip: float = 0.0
+    compare: CompareState = field(default_factory=CompareState)   # the A/B split view (compare.py)
     error: str = ""          # the last error, shown in the panel until the next success
     message: str = ""        # the last success ("saved gold.json")
     warnings: int = 0        # warning lines of the last mesh or environment file opened
@@ -340,6 +342,10 @@ class EditorState:
                 if len(pair) != 2:
                     raise AlightError(f"--script: '{edit}': {key} takes U,V")
                 self.texture_maps = dataclasses.replace(self.texture_maps, **{key: pair})
+            elif key.startswith("compare"):   # compare=MODE, compare_divider=, compare_a=, ... (compare.py)
+                from alight.frontends.editor.compare import apply_edit
+
+                apply_edit(self.compare, self.material, key, value)
             elif key == "debug_mip":
                 self.debug_mip = max(0.0, _finite(value, edit))
             else:

@@ -157,6 +157,9 @@ class EditorWindow:
         self.file_watcher = FileWatcher()   # maps and the environment file changed on disk
 
         self.panel = Panel()
+        from alight.frontends.editor.compare_view import CompareView
+
+        self.compare_view = CompareView(self.ctx, self.renderer, self.new_targets)   # the A/B split view's GL side
 
     # --- input --------------------------------------------------------------------------------
 
@@ -178,10 +181,15 @@ class EditorWindow:
             self.state.fail(exc)
 
     def _camera_input(self) -> None:
+        from alight.frontends.editor.compare import handle_mouse
+
         imgui, io = self.imgui, self.imgui.get_io()
+        divider = handle_mouse(self)   # a left drag on the compare divider moves it, not the camera
         if not io.want_capture_mouse:
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
-            if imgui.is_mouse_dragging(imgui.MouseButton_.left):
+            if divider:
+                pass   # the left button drags the compare divider
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.left):
                 self.orbit.orbit(dx, dy)
             elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and io.key_shift:
                 # Shift + right drag turns the environment (as Substance's viewers do): a view's
@@ -426,6 +434,13 @@ class EditorWindow:
             self._target_cache.popitem(last=False)[1].release()
         return targets
 
+    def new_targets(self, size, aa):
+        """Framebuffers of their own for an image of the view's kind (the compare view's half A),
+        outside the view's cache."""
+        from alight.render.renderer import _Targets
+
+        return _Targets(self.ctx, size[0], size[1], aa, 4)
+
     def _view_key(self, scene, maps, size) -> tuple:
         """Everything the view image depends on. Material, Camera, Light and Display are plain
         dataclasses compared by value; the mesh and the bake by identity (they are replaced, never
@@ -464,7 +479,9 @@ class EditorWindow:
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
-        into, into_srgb = self.direct_target() if (moving and not full and size == window) else (None, False)
+        compare = self.state.compare.active   # two halves put together: never straight into the window
+        into, into_srgb = self.direct_target() if (moving and not full and size == window and not compare) \
+            else (None, False)
         # (The key deep-copies the lights: 0.3 ms a frame, not spent where every frame redraws.)
         key = self._view_key(scene, maps, size) if into is None else None
         direct = False     # drawn into the window (the renderer may not: draw_display)
@@ -482,6 +499,8 @@ class EditorWindow:
             if scene.texture_maps != self._drawn_maps:   # uploaded maps no slot uses any more
                 self.renderer.forget_map_textures(set(scene.texture_maps.paths().values()))
                 self._drawn_maps = scene.texture_maps
+        if compare:
+            targets = self.compare_view.compose(self, scene, maps, targets, moving, finish=full)
         if direct:
             pass   # already in the window
         elif size == window:
@@ -537,6 +556,9 @@ class EditorWindow:
             self._size_cache = None   # the runner polled the events
         if self.show_panel:
             self.panel.draw(self)
+        from alight.frontends.editor.compare import draw_overlay
+
+        draw_overlay(self)   # the compare divider's line and the halves' names, over the view
         self._camera_input()
         self.check_shaders()
         self.check_files()
@@ -593,7 +615,10 @@ class EditorWindow:
         scene = self.state.scene(self.orbit.camera())
         frame = self.renderer.render(scene, self.maps(), w, h, aa=self.state.aa, read_linear=False, read_srgb=True)
         alpha = scene.display.background == "transparent"
-        write_image(out, frame.srgb if alpha else frame.srgb[:, :, :3], linear=False)
+        pixels = frame.srgb if alpha else frame.srgb[:, :, :3]
+        if self.state.compare.active:   # the split view, as shown
+            pixels = self.compare_view.compose_frame(self, scene, self.maps(), pixels, self.state.aa)
+        write_image(out, pixels, linear=False)
 
     def view_pixels(self, what: str = "the view"):
         """The view without the panel at window size, top row first: uint8 (h, w, 3), sRGB."""
@@ -622,6 +647,7 @@ class EditorWindow:
         for targets in self._target_cache.values():
             targets.release()
         self._target_cache.clear()
+        self.compare_view.release()
         self._panel_image.release()
         if self.hosted:   # the runner closes imgui, the window and its context after this
             self.implot.destroy_context()

@@ -1,0 +1,299 @@
+"""The compare view's GL side: half A drawn into its own image, then A left of the divider and B
+(the live view) right of it put together in one image, which the window shows and reads as it
+does the plain view.
+
+Only the renderer's public calls draw: ``draw_display`` for a forward half (framebuffers of its
+own, so B's image stays B's and neither redraws when only the divider moves), ``render`` for the
+screenshot's halves, and ``tonemap`` for the reference (``ReferenceRenderer.render_gbuffer``'s
+linear radiance, summed a band of rows a frame, tone mapped with the view's display settings, so
+both halves share one curve). The halves meet in one full-screen pass that fetches each pixel
+from A or B (no filtering: the image is exactly A's or B's pixels); the reference has no
+background, so B shows through around it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+import types
+
+import numpy as np
+
+from alight.core.scene import Display
+from alight.errors import AlightError
+from alight.frontends.editor import compare as cmp
+
+# The time a frame gives the reference's sum at most (about one band more): the window stays
+# responsive while a reference that takes a minute on a software GL fills in.
+REFERENCE_SLICE_S = 0.05
+_NO_DISPLAY = Display()
+
+_VERTEX = """#version 450 core
+void main() {
+    vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+    gl_Position = vec4(p, 0.0, 1.0);
+}
+"""
+# Left of u_split A's pixel, else B's; where A is uncovered (the reference's background) and
+# u_a_covers is off, B's.
+_FRAGMENT = """#version 450 core
+uniform sampler2D u_a;
+uniform sampler2D u_b;
+uniform int u_split;
+uniform bool u_has_a;
+uniform bool u_b_behind_a;
+layout(location = 0) out vec4 out_color;
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    vec4 b = texelFetch(u_b, p, 0);
+    vec4 a = u_has_a ? texelFetch(u_a, p, 0) : b;
+    out_color = (p.x < u_split && !(u_b_behind_a && a.a == 0.0)) ? a : b;
+}
+"""
+
+
+def split_column(divider: float, width: int) -> int:
+    """The first column of B in an image ``width`` wide."""
+    return int(round(min(1.0, max(0.0, divider)) * width))
+
+
+def composite_rows(a: np.ndarray, b: np.ndarray, divider: float, b_behind_a: bool = False) -> np.ndarray:
+    """The numpy twin of the composite pass for images (H, W, C), top row first."""
+    out = b.copy()
+    split = split_column(divider, b.shape[1])
+    left = a[:, :split]
+    if b_behind_a and a.shape[2] == 4:
+        covered = left[..., 3:4] > 0
+        out[:, :split] = np.where(covered, left, b[:, :split])
+    else:
+        out[:, :split] = left
+    return out
+
+
+class CompareView:
+    def __init__(self, ctx, renderer, new_targets):
+        """``new_targets(size, aa)``: view framebuffers of A's own (EditorWindow.new_targets)."""
+        self.ctx, self.renderer, self.new_targets = ctx, renderer, new_targets
+        self._a_targets = None
+        self._a_key = None        # what A's image shows now
+        self._a_ok = False        # whether A's image holds a picture (the reference may have failed)
+        self._ref_key = None      # what the reference job sums (the scene less its display)
+        self._ref_job = None      # the reference's generator while it runs (_reference_job)
+        self._ref_linear = None   # its radiance so far
+        self.reference_progress = None   # the fraction summed while it runs (the panel shows it)
+        self._out = None          # (texture, framebuffer) of the put-together image
+        self._prog = self._vao = None
+        self.reference_seconds = None
+        self.redraws = 0          # A's image drawn (tests read it)
+
+    @property
+    def a_ready(self) -> bool:
+        """Whether A's image holds A's picture now (the reference may be summing or refused)."""
+        return bool(self._a_ok)
+
+    # --- half A -----------------------------------------------------------------------------
+
+    def _targets_for(self, size, aa):
+        t = self._a_targets
+        if t is None or (t.width, t.height, t.aa) != (size[0], size[1], aa):
+            if t is not None:
+                self.ctx.screen.use()   # never release a bound framebuffer
+                t.release()
+            t = self._a_targets = self.new_targets(size, aa)
+        return t
+
+    def draw_a(self, win, scene, maps, size, moving: bool, finish: bool = False) -> None:
+        """Bring A's image up to date for this frame (only when what it shows changed). The
+        reference is summed a band of rows at a time (``REFERENCE_SLICE_S`` a frame; ``finish``:
+        to the end, for screenshots and tests)."""
+        c = win.state.compare
+        targets = self._targets_for(size, win.state.aa)
+        if c.mode == "reference":
+            self._step_reference(win, scene, targets, moving, finish)
+            return
+        a = cmp.a_scene(c, scene)
+        key = ("forward", win._view_key(a, maps, size))
+        if key == self._a_key and self._a_ok:
+            return
+        self.renderer.draw_display(a, maps, targets)
+        self._a_key, self._a_ok = key, True
+        self.redraws += 1
+
+    def _step_reference(self, win, scene, targets, moving: bool, finish: bool) -> None:
+        """The exact reference's job: started when what it shows changed and the view stands
+        still, advanced a slice a frame, tone mapped into A's image after each band (rows not
+        summed yet are uncovered: B shows through them)."""
+        c = win.state.compare
+        size = (targets.width, targets.height)
+        # Everything the sum depends on; not the display (exposure, tone map): those re-tone-map only.
+        key = (win._view_key(dataclasses.replace(scene, display=_NO_DISPLAY), None, size), id(win.state.env),
+               c.reference_scale)
+        if key != self._ref_key and not moving:
+            if self._ref_job is not None:
+                self._ref_job.close()
+            self._ref_key, self._ref_linear, self._a_ok = key, None, False
+            self.reference_progress = 0.0
+            problem = cmp.reference_problem(win.state)
+            if problem:
+                win.state.fail(AlightError(problem))
+                self._ref_job = None
+            else:
+                self._ref_job = self._reference_job(win, scene, targets.width, targets.height, c.reference_scale)
+        if self._ref_key != key:   # moving: A's half waits for the view to stand still
+            self._a_ok = False
+            return
+        changed = False
+        start = time.perf_counter()
+        while self._ref_job is not None:
+            try:
+                self._ref_linear, self.reference_progress = next(self._ref_job)
+                changed = True
+            except StopIteration:
+                self._ref_job, self.reference_progress = None, None
+                self.reference_seconds = time.perf_counter() - self._ref_started
+                break
+            except AlightError as exc:
+                win.state.fail(AlightError(f"reference compare: {exc}"))
+                self._ref_job, self._ref_linear, self.reference_progress = None, None, None
+                break
+            if not finish and time.perf_counter() - start >= REFERENCE_SLICE_S:
+                break
+        display_key = (key, scene.display)
+        if self._ref_linear is None:
+            self._a_ok = False
+        elif changed or self._a_key != display_key:
+            self._tonemap_reference(scene, targets)
+            self._a_key, self._a_ok = display_key, True
+            self.redraws += 1
+
+    def _reference_job(self, win, scene, width: int, height: int, scale: float):
+        """A generator: the reference of the view at ``scale`` of its pixels (at least 16 wide),
+        one band of rows per step; yields (the radiance so far (h, w, 4), top row first, alpha 0
+        where not summed yet; the fraction done)."""
+        from alight.accuracy.reference import (
+            GBUFFER,
+            ReferenceRenderer,
+            check_layer_lobes,
+            check_layer_roughness,
+            check_roughness,
+            choose_env_level,
+            env_level_radiance,
+        )
+
+        self._ref_started = time.perf_counter()
+        rw = max(16, round(width * scale))
+        rh = max(1, round(height * rw / width))
+        rr = ReferenceRenderer(self.renderer)
+        env = win.state.env
+        use_env = env is not None and scene.ibl_enabled
+        radiance = None
+        if use_env:
+            roughnesses = rr.scene_roughnesses(scene)
+            for r in roughnesses:
+                check_roughness(r)
+            check_layer_roughness(rr.layered_material(scene))
+            check_layer_lobes(rr.layered_material(scene), roughnesses)
+            # Reduced once here (the reference's own choice of level), not per band.
+            radiance = env_level_radiance(np.asarray(env.radiance, np.float32),
+                                          choose_env_level(env.radiance, roughnesses))
+        textures = rr.mesh_gbuffer(scene, rw, rh)
+        g = {}
+        for name, tex in zip(GBUFFER, textures):
+            g[name] = np.frombuffer(tex.read(), np.float32).reshape(rh, rw, 4)[::-1].copy()
+            tex.release()
+        linear = np.zeros((rh, rw, 4), np.float32)
+        covered = g["position"][..., 3] > 0.5
+        yield linear, 0.0
+        band = 1
+        y = 0
+        while y < rh:
+            while y < rh and not covered[y].any():   # rows without the mesh: nothing to sum
+                y += 1
+            if y >= rh:
+                break
+            y1 = min(rh, y + band)
+            t0 = time.perf_counter()
+            part = rr.render_gbuffer({n: g[n][y:y1] for n in GBUFFER}, scene, radiance, env_level=0)
+            linear[y:y1] = part.linear
+            linear[y:y1, :, 3] = covered[y:y1]
+            # The next band sized to the slice from this one's time.
+            spent = time.perf_counter() - t0
+            band = max(1, min(64, int(band * REFERENCE_SLICE_S / max(spent, 1e-4))))
+            y = y1
+            yield linear, y / rh
+        yield linear, 1.0
+
+    def _tonemap_reference(self, scene, targets) -> None:
+        """The reference's radiance, upscaled to A's image (nearest: each summed pixel a block),
+        tone mapped with the view's display settings; alpha the coverage."""
+        h, w = targets.height, targets.width
+        src = self._ref_linear
+        rows = np.minimum((np.arange(h) + 0.5) * src.shape[0] / h, src.shape[0] - 1).astype(int)
+        cols = np.minimum((np.arange(w) + 0.5) * src.shape[1] / w, src.shape[1] - 1).astype(int)
+        full = src[rows][:, cols]
+        tex = self.ctx.texture((w, h), 4, np.ascontiguousarray(full[::-1], np.float32).tobytes(), dtype="f4")
+        try:
+            self.renderer.tonemap(tex, scene.display, targets.display_fbo, opaque=False)
+        finally:
+            tex.release()
+
+    # --- putting the halves together -------------------------------------------------------------
+
+    def compose(self, win, scene, maps, b_targets, moving: bool, finish: bool = False):
+        """A left of the divider, ``b_targets``' display image right of it, in an image of B's size.
+        Returns an object with the attributes the window reads from a _Targets (display,
+        display_fbo, width, height)."""
+        c = win.state.compare
+        size = (b_targets.width, b_targets.height)
+        self.draw_a(win, scene, maps, size, moving, finish)
+        if self._out is None or self._out[0].size != size:
+            if self._out is not None:
+                self.ctx.screen.use()
+                for obj in self._out:
+                    obj.release()
+            tex = self.ctx.texture(size, 4, dtype="f1")
+            self._out = (tex, self.ctx.framebuffer([tex]))
+        if self._prog is None:
+            self._prog = self.ctx.program(vertex_shader=_VERTEX, fragment_shader=_FRAGMENT)
+            self._vao = self.ctx.vertex_array(self._prog, [])
+        tex, fbo = self._out
+        self._a_targets.display.use(0)
+        b_targets.display.use(1)
+        prog = self._prog
+        prog["u_a"], prog["u_b"] = 0, 1
+        prog["u_split"] = split_column(c.divider, size[0])
+        prog["u_has_a"] = bool(self._a_ok)
+        prog["u_b_behind_a"] = c.mode == "reference"
+        fbo.use()
+        self.ctx.viewport = (0, 0) + size
+        self._vao.render(vertices=3)
+        return types.SimpleNamespace(display=tex, display_fbo=fbo, width=size[0], height=size[1])
+
+    def compose_frame(self, win, scene, maps, b_srgb: np.ndarray, aa: str) -> np.ndarray:
+        """The screenshot's split picture: B's pixels ``b_srgb`` (H, W, C) uint8, top row first,
+        with A drawn again at that size left of the divider."""
+        c = win.state.compare
+        h, w = b_srgb.shape[:2]
+        if c.mode == "reference":
+            targets = self._targets_for((w, h), win.state.aa)
+            self.draw_a(win, scene, maps, (w, h), False, finish=True)
+            if not self._a_ok:
+                return b_srgb
+            a = np.frombuffer(targets.display_fbo.read(components=4, dtype="f1"), np.uint8).reshape(h, w, 4)[::-1]
+            return composite_rows(a, _with_alpha(b_srgb), c.divider, b_behind_a=True)[..., :b_srgb.shape[2]]
+        frame = self.renderer.render(cmp.a_scene(c, scene), maps, w, h, aa=aa, read_linear=False, read_srgb=True)
+        return composite_rows(frame.srgb[..., :b_srgb.shape[2]], b_srgb, c.divider)
+
+    def release(self) -> None:
+        self.ctx.screen.use()
+        if self._a_targets is not None:
+            self._a_targets.release()
+        for obj in (self._out or ()) + tuple(x for x in (self._vao, self._prog) if x is not None):
+            obj.release()
+        self._a_targets = self._out = self._vao = self._prog = None
+
+
+def _with_alpha(image: np.ndarray) -> np.ndarray:
+    if image.shape[2] == 4:
+        return image
+    return np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
