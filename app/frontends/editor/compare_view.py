@@ -241,7 +241,7 @@ class CompareView:
 
     def compose(self, win, scene, maps, b_targets, moving: bool, finish: bool = False):
         """A left of the divider, ``b_targets``' display image right of it, in an image of B's size.
-        Returns an object with the attributes the window reads from a _Targets (display,
+        Returns an object with the attributes the window reads from a Targets (display,
         display_fbo, width, height)."""
         c = win.state.compare
         size = (b_targets.width, b_targets.height)

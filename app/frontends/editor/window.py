@@ -437,9 +437,9 @@ class EditorWindow:
     def new_targets(self, size, aa):
         """Framebuffers of their own for an image of the view's kind (the compare view's half A),
         outside the view's cache."""
-        from alight.render.renderer import _Targets
+        from alight.render.targets import Targets
 
-        return _Targets(self.ctx, size[0], size[1], aa, 4)
+        return Targets(self.ctx, size[0], size[1], aa, 4)
 
     def _view_key(self, scene, maps, size) -> tuple:
         """Everything the view image depends on. Material, Camera, Light and Display are plain
