@@ -168,26 +168,17 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
 // mirror shows a spot of the source's size and power (after Karis 2013's sphere lights; it
 // matters only where alpha is near the source's size, e.g. royal_esplanade's 2-degree lamps).
 vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, float spread) {
-    float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0) return vec3(0.0);
-    float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    LobeAngles a;
+    a.n_dot_l = dot(n, l);
+    if (a.n_dot_l <= 0.0) return vec3(0.0);
+    a.n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
-    float n_dot_h = max(dot(n, h), 0.0);
-    vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s), surface_f90(s));
-#ifdef HAS_ANISOTROPY
-    vec3 specular = anisotropic_specular(s, n, v, l, F, false, spread);
-#else
+    a.n_dot_h = max(dot(n, h), 0.0);
+    a.v_dot_h = max(dot(v, h), 0.0);
     float alpha = s.roughness * s.roughness;
     float widened = max(sqrt(sqrt(alpha * alpha + spread * spread)), MIN_PUNCTUAL_ROUGHNESS);
-    float D = D_GGX(n_dot_h, widened);
-    float G = G_Smith(n_dot_v, n_dot_l, k_ibl(max(s.roughness, MIN_PUNCTUAL_ROUGHNESS)));
-    vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
-#endif
-    vec3 kd = (1.0 - F) * (1.0 - s.metallic);
-#ifdef HAS_TRANSMISSION
-    kd *= 1.0 - s.transmission;
-#endif
-    return (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+    LobeChoice c = LobeChoice(widened, k_ibl(max(s.roughness, MIN_PUNCTUAL_ROUGHNESS)), false, spread);
+    return base_lobes(s, surface_f0(s), n, v, l, a, c);
 }
 
 // A compact source through the base and its layers (common/layers.glsl).

@@ -3,6 +3,7 @@
 #include "common/equirect.glsl"
 #include "common/surface.glsl"
 #include "common/layers.glsl"
+#include "common/base_lobes.glsl"
 #include "common/shadows.glsl"
 #include "common/ibl.glsl"
 #include "common/punctual.glsl"
