@@ -36,6 +36,7 @@ import numpy as np
 from alight.core.gpu import ShaderLibrary, create_headless_context
 from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.layers import layer_defines
+from alight.core.layers.iridescence import iridescence_uniforms
 from alight.core.material import LAYERS, Material, with_overrides
 from alight.core.mesh import MeshPart, is_closed, sphere
 from alight.core.scene import (
@@ -1659,3 +1660,5 @@ def _set_material(prog: moderngl.Program, m: Material) -> None:
     _set(prog, "u_thickness", float(m.thickness))
     _set(prog, "u_attenuation_color", tuple(float(x) for x in m.attenuation_color))
     _set(prog, "u_attenuation_distance", float(min(m.attenuation_distance, 3.0e38)))
+    for name, value in iridescence_uniforms(m).items():   # common/material_iridescence.glsl
+        _set(prog, name, value)

@@ -26,7 +26,8 @@ struct LobeChoice {
     float spread;
 };
 
-// The Fresnel of the base's specular lobe at v.h (Schlick 1994, with KHR_materials_specular's F90).
+// The Fresnel of the base's lobes at v.h (Schlick 1994, with KHR_materials_specular's F90); a
+// thin film (HAS_IRIDESCENCE, common/iridescence.glsl) mixes its own into it.
 vec3 base_fresnel(Surface s, vec3 f0, LobeAngles a) {
     return F_Schlick(a.v_dot_h, f0, surface_f90(s));
 }
@@ -42,7 +43,8 @@ vec3 base_specular_lobe(Surface s, vec3 n, vec3 v, vec3 l, LobeAngles a, LobeCho
 #endif
 }
 
-// Filament's diffuseLobe: kd Lambert, kd = (1 - F)(1 - metallic)(1 - transmission).
+// Filament's diffuseLobe: kd Lambert, kd = (1 - F)(1 - metallic)(1 - transmission); F is the
+// diffuse lobe's Fresnel (with HAS_IRIDESCENCE the film's largest channel mixed in).
 vec3 base_diffuse_lobe(Surface s, vec3 F) {
     vec3 kd = (1.0 - F) * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
@@ -54,5 +56,10 @@ vec3 base_diffuse_lobe(Surface s, vec3 F) {
 // Filament's surfaceShading without the light's colour: (diffuse + specular) n.l.
 vec3 base_lobes(Surface s, vec3 f0, vec3 n, vec3 v, vec3 l, LobeAngles a, LobeChoice c) {
     vec3 F = base_fresnel(s, f0, a);
+#ifdef HAS_IRIDESCENCE
+    return (base_diffuse_lobe(s, iridescence_diffuse_fresnel(s, F))
+            + base_specular_lobe(s, n, v, l, a, c, iridescence_specular_fresnel(s, F))) * a.n_dot_l;
+#else
     return (base_diffuse_lobe(s, F) + base_specular_lobe(s, n, v, l, a, c, F)) * a.n_dot_l;
+#endif
 }

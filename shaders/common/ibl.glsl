@@ -243,8 +243,12 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
 #endif
     vec3 irradiance = irradiance_at(n, true);
     vec3 spec_albedo = F * lut.x + surface_f90(s) * lut.y;
+    vec3 diffuse_weight = 1.0 - F;
+#ifdef HAS_IRIDESCENCE
+    iridescence_ibl_weights(s, lut, diffuse_weight, spec_albedo);
+#endif
     occlude_environment(s, n, reflect(-v, n), spec_albedo, true, irradiance, prefiltered);
-    return ibl_combine(s, surface_f0(s), 1.0 - F, spec_albedo, lut, irradiance, prefiltered);
+    return ibl_combine(s, surface_f0(s), diffuse_weight, spec_albedo, lut, irradiance, prefiltered);
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
@@ -270,9 +274,12 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
     // 1 - F0 - (F90 - F0) Fc, and the split sum's B scales by F90.
     float f90 = surface_f90(s);
     vec3 spec_albedo = f0 * lut.x + f90 * lut.y;
+    vec3 diffuse_weight = 1.0 - f0 - (f90 - f0) * diffuse_fresnel(n_dot_v);
+#ifdef HAS_IRIDESCENCE
+    iridescence_ibl_weights(s, lut, diffuse_weight, spec_albedo);
+#endif
     occlude_environment(s, n, d, spec_albedo, with_suns, irradiance, prefiltered);
-    return ibl_combine(s, f0, 1.0 - f0 - (f90 - f0) * diffuse_fresnel(n_dot_v), spec_albedo, lut,
-                       irradiance, prefiltered);
+    return ibl_combine(s, f0, diffuse_weight, spec_albedo, lut, irradiance, prefiltered);
 }
 
 // The lecture's cook_torrance_IBL: kd and F from the roughness-aware Fresnel at n.v.
