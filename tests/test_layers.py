@@ -73,7 +73,7 @@ def test_presets_load_without_layer_fields_and_keep_their_files():
     writes the same fields as before."""
     for name in list_presets():
         m = load_preset(name)
-        assert m.layers() == frozenset() or name in ("car_paint", "velvet", "brushed_aluminium", "water",
+        assert m.layers() == frozenset() or name in ("car_paint", "velvet", "brushed_aluminium", "water", "oil_film",
                                                      "plastic_glass_low", "glass_high_ruby", "diamond")
         d = m.to_dict()
         if not m.layers():
