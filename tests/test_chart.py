@@ -178,14 +178,14 @@ def test_chart_quick_end_to_end(quick_chart):
     # r = 0.25: its refracted lobe is too narrow, alight.accuracy.ground_truth.check_transmission_lobe).
     layer_rows = [r for r in judged if r["factor"] == "layer"]
     layer_preset = {"layer clearcoat": "car_paint", "layer sheen": "velvet", "layer anisotropy": "brushed_aluminium",
-                    "layer transmission": "water"}
+                    "layer transmission": "water", "layer iridescence": "oil_film"}
     assert [r["setting"] for r in layer_rows] == list(layer_preset)
     per_layer = {name: [c for c in cases if c["setting"] == name] for name in layer_preset}
     for name, preset in layer_preset.items():
         assert {c["preset"] for c in per_layer[name]} == {preset}
         assert 1 <= len(per_layer[name]) <= 3
     assert {float(c["roughness"]) for c in per_layer["layer transmission"]} == {0.5, 1.0}
-    assert len(cases) == (len(judged) - 4) * 2 * 3 + sum(len(v) for v in per_layer.values())
+    assert len(cases) == (len(judged) - len(layer_preset)) * 2 * 3 + sum(len(v) for v in per_layer.values())
     # The baseline's summary is the mean of its cases.
     base = [float(c["rel_mae"]) for c in cases if c["setting"] == rows[0]["setting"]]
     assert rows[0]["rel_mae_mean"] == pytest.approx(np.mean(base), rel=1e-4)

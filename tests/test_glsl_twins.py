@@ -186,3 +186,71 @@ def test_transmission_light(ior, thickness, punctual):
         cpu[i] = transmission_light(m, p, punctual)[0, 0]
     close(gpu, cpu, rtol=2e-3, atol=2e-5)
     assert np.isfinite(gpu).all() and (gpu >= 0).all() and np.all(gpu[:20] == 0)
+
+
+# --- KHR_materials_iridescence (common/iridescence_terms.glsl and iridescence.glsl against
+# app/core/layers/iridescence.py; the base BRDF with the film against app/core/layers/stack.py) ---
+
+IRIDESCENCE_TERMS = {"SENSITIVITY": 0, "FRESNEL": 1, "BASE_BRDF": 2, "IBL_WEIGHTS": 3}
+
+
+def evaluate_iridescence(term, inputs, material=None, outside_ior=1.0):
+    from alight.core.layers.iridescence import iridescence_uniforms
+    from alight.core.material import Material
+
+    m = material or Material()
+    uniforms = {"u_params": (outside_ior, m.metallic, m.roughness, 0.0), **iridescence_uniforms(m)}
+    return evaluate(IRIDESCENCE_TERMS[term], inputs, uniforms, shader="accuracy/evaluate_iridescence.comp",
+                    defines={"HAS_IRIDESCENCE": None})
+
+
+def test_iridescence_sensitivity():
+    from alight.core.layers import iridescence
+
+    x = np.column_stack([rng.uniform(0, 3000, 300), rng.choice([0.0, np.pi, 2 * np.pi], (300, 3))])
+    gpu = evaluate_iridescence("SENSITIVITY", x)[:, :3]
+    close(gpu, iridescence.iridescence_sensitivity(x[:, 0], x[:, 1:]), rtol=2e-4, atol=2e-5)
+
+
+@pytest.mark.parametrize("outside_ior", [1.0, 1.5])
+def test_iridescence_fresnel(outside_ior):
+    from alight.core.layers import iridescence
+
+    x = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1200, 400), rng.uniform(1.0, 2.4, 400),
+                         rng.uniform(0, 1, 400)])
+    gpu = evaluate_iridescence("FRESNEL", x, outside_ior=outside_ior)[:, :3]
+    cpu = iridescence.iridescence_fresnel(outside_ior, x[:, 2], x[:, 0], x[:, 1], np.repeat(x[:, 3:4], 3, axis=1))
+    close(gpu, cpu, rtol=2e-3, atol=2e-4)   # cos of phases up to 2e-9 * 2 pi * 2e6 * 2 * 2.4 * 1200 nm
+    assert (gpu >= 0).all() and np.isfinite(gpu).all()
+
+
+@pytest.mark.parametrize("metallic,thickness", [(0.0, 400.0), (1.0, 250.0), (0.0, 0.0)])
+def test_iridescence_base_brdf(metallic, thickness):
+    """brdf_ground_truth with the film (accuracy/ground_truth.glsl through common/base_lobes.glsl)
+    against stack.layered_brdf_cos, the numpy ground truth's BRDF."""
+    from alight.core.layers.stack import Pairs, layered_brdf_cos
+    from alight.core.material import Material
+
+    m = Material(base_color=(0.8, 0.5, 0.3), metallic=metallic, roughness=0.4, iridescence=0.8,
+                 iridescence_ior=1.4, iridescence_thickness_maximum=thickness)
+    nv = rng.uniform(0.05, 1, 200)
+    l = _light_at(rng.uniform(0.05, 1, 200), rng.uniform(0, 2 * np.pi, 200))
+    gpu = evaluate_iridescence("BASE_BRDF", np.column_stack([nv, l]), m)[:, :3]
+    cpu = np.stack([layered_brdf_cos(m, Pairs(n=np.array([[0.0, 0.0, 1.0]]), v=_view_at(nv[i:i + 1]), l=l[i:i + 1]))[0, 0]
+                    for i in range(len(nv))])
+    close(gpu, cpu, rtol=2e-3, atol=2e-5)
+
+
+def test_iridescence_ibl_weights():
+    from alight.core.layers import iridescence
+    from alight.core.material import Material
+    m = Material(roughness=0.3, iridescence=0.6, iridescence_ior=1.8, iridescence_thickness_maximum=500.0)
+    x = np.column_stack([rng.uniform(0.01, 1, 200), rng.uniform(0, 1, 200), rng.uniform(0, 0.2, 200)])
+    gpu = evaluate_iridescence("IBL_WEIGHTS", x, m)
+    film = iridescence.iridescence_fresnel_at_view(m, x[:, 0])
+    f0 = np.full((len(x), 3), 0.04)
+    dfres = 8.233601e-05 + (1 - x[:, 0]) * (0.002021979 + (1 - x[:, 0]) * (0.009310647 + (1 - x[:, 0]) * (0.007795988 + (1 - x[:, 0]) * 0.0089526)))
+    dw, spec = iridescence.iridescence_ibl_weights(film, m.iridescence, x[:, 1], x[:, 2],
+                                                   1 - f0 - (1 - f0) * dfres[:, None], f0 * x[:, 1:2] + x[:, 2:3])
+    close(gpu[:, :3], spec, rtol=2e-3, atol=2e-5)
+    close(gpu[:, 3], dw[:, 0], rtol=2e-3, atol=2e-5)

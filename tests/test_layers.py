@@ -35,7 +35,8 @@ REPO = Path(__file__).resolve().parents[1]
 ALL_LAYERS = Material(base_color=(0.6, 0.2, 0.1), roughness=0.4, ior=1.45, specular_f0=(0.05, 0.04, 0.03), transmission=0.5, thickness=0.25,
                       attenuation_color=(0.9, 0.5, 0.2), attenuation_distance=0.75, clearcoat=0.8,
                       clearcoat_roughness=0.2, sheen_color=(0.3, 0.4, 0.5), sheen_roughness=0.6,
-                      anisotropy_strength=0.7, anisotropy_rotation=1.25, name="all_layers")
+                      anisotropy_strength=0.7, anisotropy_rotation=1.25, iridescence=0.6, iridescence_ior=1.6,
+                      iridescence_thickness_minimum=80.0, iridescence_thickness_maximum=450.0, name="all_layers")
 
 
 def test_defaults_are_gltf_and_turn_every_layer_off():
@@ -73,7 +74,7 @@ def test_presets_load_without_layer_fields_and_keep_their_files():
     writes the same fields as before."""
     for name in list_presets():
         m = load_preset(name)
-        assert m.layers() == frozenset() or name in ("car_paint", "velvet", "brushed_aluminium", "water",
+        assert m.layers() == frozenset() or name in ("car_paint", "velvet", "brushed_aluminium", "water", "oil_film",
                                                      "plastic_glass_low", "glass_high_ruby", "diamond")
         d = m.to_dict()
         if not m.layers():

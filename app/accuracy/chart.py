@@ -66,11 +66,12 @@ FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
 # of its texels), from this roughness up.
 FURNACE_TRUTH_WIDTH = 256
 FURNACE_TRUTH_FROM = 0.25
-QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet", "brushed_aluminium")   # the last four: the layers' rows
+QUICK_PRESETS = ("gold", "plastic_high", "water", "car_paint", "velvet", "brushed_aluminium",
+                 "oil_film")   # from water on: the layers' rows
 # Layers with a row of their own, the material of their white furnace (radiance 1:
 # what the layer reflects and transmits must not exceed 1, and at roughness 0 it is exactly 1)
 # and the preset drawn for their frame time.
-LAYER_ROWS = ("clearcoat", "sheen", "anisotropy", "transmission")
+LAYER_ROWS = ("clearcoat", "sheen", "anisotropy", "transmission", "iridescence")
 LAYER_FURNACE = {
     # A white metal under a full coat, or under a white sheen: at most 1 (docs/layer_clearcoat.md,
     # docs/layer_sheen.md).
@@ -82,9 +83,12 @@ LAYER_FURNACE = {
                        anisotropy_rotation=1.5707963),
     # A thin white wall of ior 1 that transmits everything (docs/layer_transmission.md).
     "transmission": dict(base_color=(1.0, 1.0, 1.0), transmission=1.0, ior=1.0),
+    # A white metal under oil_film's film: F_film (A + B) <= 1 (docs/layer_iridescence.md).
+    "iridescence": dict(base_color=(1.0, 1.0, 1.0), metallic=1.0, iridescence=1.0, iridescence_ior=1.47,
+                        iridescence_thickness_maximum=380.0),
 }
 LAYER_FRAME_PRESET = {"clearcoat": "car_paint", "sheen": "velvet", "anisotropy": "brushed_aluminium",
-                      "transmission": "water"}
+                      "transmission": "water", "iridescence": "oil_film"}
 # Environments left out of the summary columns (still in chart_cases.csv): spot1Lux's truth is
 # near zero over most of the ball, where a relative error means little.
 SUMMARY_EXCLUDED = ("spot1Lux",)

@@ -453,6 +453,12 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
         prefiltered = prefiltered_converged(lighting, direction, r)
     if material is not None and "transmission" in material.layers():
         diffuse_scale = 1.0 - material.transmission
+    if material is not None and "iridescence" in material.layers():   # ibl.glsl: iridescence_ibl_weights
+        from alight.core.layers import iridescence as ir
+
+        diffuse_weight, spec_weight = ir.iridescence_ibl_weights(
+            ir.iridescence_fresnel_at_view(material, np.sum(n * v, axis=-1)), ir.iridescence_weight(material),
+            A[:, 0], B[:, 0], diffuse_weight, spec_weight)
     albedo = base * (1.0 - m) * float(diffuse_scale)
     if multiple_scattering:
         e_ss = A + B

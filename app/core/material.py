@@ -29,6 +29,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "anisotropy": ("anisotropy_strength", "anisotropy_rotation"),               # KHR_materials_anisotropy
     "transmission": ("transmission",),                                          # KHR_materials_transmission
     "volume": ("thickness", "attenuation_color", "attenuation_distance"),       # KHR_materials_volume
+    "iridescence": ("iridescence", "iridescence_ior", "iridescence_thickness_minimum",
+                    "iridescence_thickness_maximum"),                           # KHR_materials_iridescence
 }
 LAYER_FIELDS: tuple[str, ...] = tuple(f for fields in LAYERS.values() for f in fields)
 DEFAULT_IOR = 1.5  # glTF's; F0 = ((1.5 - 1) / (1.5 + 1))^2 = 0.04
@@ -97,6 +99,12 @@ class Material:
     # the tangent in the tangent plane).
     anisotropy_strength: float = 0.0
     anisotropy_rotation: float = 0.0
+    # KHR_materials_iridescence: the thin film's weight, index and thickness range (nm); without
+    # a thickness map the film is thickness_maximum thick (alight.core.layers.iridescence).
+    iridescence: float = 0.0
+    iridescence_ior: float = 1.3
+    iridescence_thickness_minimum: float = 100.0
+    iridescence_thickness_maximum: float = 400.0
 
     def __post_init__(self) -> None:
         # The ior rule (class docstring), applied once at construction; dataclasses.replace passes
@@ -122,7 +130,7 @@ class Material:
         """The layers this material uses (names of ``LAYERS``); empty: the base model alone.
 
         A layer is on when its strength is above zero: clearcoat > 0, max(sheen_color) > 0,
-        anisotropy_strength > 0, transmission > 0; volume when transmission > 0 and thickness > 0
+        anisotropy_strength > 0, iridescence > 0, transmission > 0; volume when transmission > 0 and thickness > 0
         (KHR_materials_volume acts only through transmission)."""
         used = set()
         if self.clearcoat > 0.0:
@@ -131,6 +139,8 @@ class Material:
             used.add("sheen")
         if self.anisotropy_strength > 0.0:
             used.add("anisotropy")
+        if self.iridescence > 0.0:
+            used.add("iridescence")
         if self.transmission > 0.0:
             used.add("transmission")
             if self.thickness > 0.0:
@@ -178,6 +188,8 @@ _RANGES: dict[str, tuple[float, float]] = {
     "attenuation_distance": (0.0, math.inf), "clearcoat": _UNIT, "clearcoat_roughness": _UNIT,
     "sheen_color": _UNIT, "sheen_roughness": _UNIT, "anisotropy_strength": _UNIT,
     "anisotropy_rotation": (-math.inf, math.inf),
+    "iridescence": _UNIT, "iridescence_ior": (1.0, math.inf), "iridescence_thickness_minimum": _NONNEG,
+    "iridescence_thickness_maximum": _NONNEG,
 }
 _VECTORS = ("base_color", "specular_f0", "emissive", "f0_linear", "f0_srgb", "attenuation_color", "sheen_color")
 # Fields a preset file may leave out: every layer field (the layer is then off) and the ior

@@ -52,7 +52,7 @@ class MaterialField:
 _LAYER_EXTENSION = {
     "clearcoat": "KHR_materials_clearcoat", "sheen": "KHR_materials_sheen",
     "anisotropy": "KHR_materials_anisotropy", "transmission": "KHR_materials_transmission",
-    "volume": "KHR_materials_volume",
+    "volume": "KHR_materials_volume", "iridescence": "KHR_materials_iridescence",
 }
 _BASE_EXTENSION = {"ior": "KHR_materials_ior", "specular_f0": "KHR_materials_specular"}
 
@@ -75,6 +75,10 @@ _TEXT: dict[str, tuple[str, str]] = {
     "thickness": ("X", "KHR_materials_volume: thickness in mesh units, >= 0 (default 0: thin-walled)"),
     "attenuation_color": ("R,G,B", "the volume's colour after --attenuation-distance, linear in [0,1] (default 1,1,1)"),
     "attenuation_distance": ("X", "distance at which light reaches --attenuation-color, > 0 (default: none)"),
+    "iridescence": ("X", "KHR_materials_iridescence: the thin film's weight in [0,1] (default 0: no film)"),
+    "iridescence_ior": ("X", "the thin film's index of refraction, >= 1 (default 1.3)"),
+    "iridescence_thickness_minimum": ("NM", "the film's thickness in nm where the thickness map is 0 (default 100)"),
+    "iridescence_thickness_maximum": ("NM", "the film's thickness in nm where the map is 1, and without a map (default 400)"),
 }
 # Fields whose low end is excluded (material._number refuses attenuation_distance <= 0).
 _LOW_OPEN = ("attenuation_distance",)

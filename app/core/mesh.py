@@ -94,7 +94,9 @@ TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
 # frame (2x - 1), B a factor on anisotropy_strength. KHR_materials_transmission's R multiplies
 # transmission and KHR_materials_volume's thickness G multiplies thickness (linear).
 LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness",
-                       "anisotropy", "transmission", "thickness")
+                       "anisotropy", "transmission", "thickness", "iridescence", "iridescence_thickness")
+# KHR_materials_iridescence (linear): iridescence R multiplies iridescence, iridescence_thickness G
+# mixes the film's thickness from iridescence_thickness_minimum to _maximum.
 # KHR_materials_specular's textures: specular A multiplies specularFactor, specular_color RGB
 # (sRGB) multiplies specularColorFactor, before the extension's min(..., 1) (FileMaterial).
 SPECULAR_TEXTURE_SLOTS = ("specular", "specular_color")
@@ -139,6 +141,8 @@ class FileMaterial:
     anisotropy_texture: TextureInfo | None = None
     transmission_texture: TextureInfo | None = None
     thickness_texture: TextureInfo | None = None
+    iridescence_texture: TextureInfo | None = None
+    iridescence_thickness_texture: TextureInfo | None = None
     # KHR_materials_specular with textures: specular_f0 per texel is
     # min(specular_color_f0 * specular_color, 1) * specular_factor * specular (the textures'
     # values), where specular_color_f0 = F0(ior) * specularColorFactor, not clamped.

@@ -77,7 +77,7 @@ DATA_VIEWS = frozenset({DebugView.BASE_COLOUR, DebugView.NORMAL, DebugView.ROUGH
 # MAP_*_MASK defines), and one texture unit each in this order (app/render/renderer.py).
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
                  "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy",
-                 "transmission", "thickness", "specular", "specular_color")
+                 "transmission", "thickness", "specular", "specular_color", "iridescence", "iridescence_thickness")
 
 
 def map_bit(name: str) -> int:
@@ -121,6 +121,7 @@ SHADER_OPTIONS: dict[str, str] = {
     "HAS_ANISOTROPY": "KHR_materials_anisotropy",
     "HAS_TRANSMISSION": "KHR_materials_transmission",
     "HAS_VOLUME": "KHR_materials_volume",
+    "HAS_IRIDESCENCE": "KHR_materials_iridescence",
     "TRANSMISSION_SCENE": "transmission refracts a copy of the opaque scene behind the part",
     "ANISOTROPY_LOOKUP": "how the anisotropic lobe's IBL is looked up (1: table, 2: fetches)",
     "ANISOTROPY_FETCHES": "the number of prefiltered fetches along the stretched anisotropic lobe",

@@ -29,6 +29,9 @@ The layers (docs/layers.md) are the extensions' factors, one to one:
     sheen_roughness       = KHR_materials_sheen.sheenRoughnessFactor
     anisotropy_strength   = KHR_materials_anisotropy.anisotropyStrength
     anisotropy_rotation   = KHR_materials_anisotropy.anisotropyRotation
+    iridescence           = KHR_materials_iridescence.iridescenceFactor
+    iridescence_ior       = KHR_materials_iridescence.iridescenceIor
+    iridescence_thickness_minimum, _maximum = KHR_materials_iridescence.iridescenceThicknessMinimum, _Maximum
 
 An extension is written only when one of its fields differs from its default (the layer is
 on). The factors only: a material's maps (alight.core.texture_maps) are written by
@@ -57,6 +60,7 @@ EXT_VOLUME = "KHR_materials_volume"
 EXT_CLEARCOAT = "KHR_materials_clearcoat"
 EXT_SHEEN = "KHR_materials_sheen"
 EXT_ANISOTROPY = "KHR_materials_anisotropy"
+EXT_IRIDESCENCE = "KHR_materials_iridescence"
 DEFAULT_F0 = 0.04  # ((1.5 - 1) / (1.5 + 1))^2, glTF's default dielectric
 # Each layer extension's factors: (glTF name, Material field, glTF default, components).
 LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
@@ -70,6 +74,10 @@ LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
                 ("sheenRoughnessFactor", "sheen_roughness", 0.0, 1)),
     EXT_ANISOTROPY: (("anisotropyStrength", "anisotropy_strength", 0.0, 1),
                      ("anisotropyRotation", "anisotropy_rotation", 0.0, 1)),
+    EXT_IRIDESCENCE: (("iridescenceFactor", "iridescence", 0.0, 1),
+                      ("iridescenceIor", "iridescence_ior", 1.3, 1),
+                      ("iridescenceThicknessMinimum", "iridescence_thickness_minimum", 100.0, 1),
+                      ("iridescenceThicknessMaximum", "iridescence_thickness_maximum", 400.0, 1)),
 }
 GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 

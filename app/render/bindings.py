@@ -11,6 +11,7 @@ import moderngl
 import numpy as np
 
 from alight.core.ibl_models import SUNS_AS_BAKED
+from alight.core.layers.iridescence import iridescence_uniforms
 from alight.core.material import Material
 from alight.core.shader_names import MATERIAL_MAPS, BackgroundMode, LightKind, glsl_member
 from alight.core.shading import rotate_world_to_map
@@ -85,6 +86,8 @@ def set_material(prog, m: Material) -> None:
     set_uniform(prog, "u_thickness", float(m.thickness))
     set_uniform(prog, "u_attenuation_color", tuple(float(x) for x in m.attenuation_color))
     set_uniform(prog, "u_attenuation_distance", float(min(m.attenuation_distance, 3.0e38)))
+    for name, value in iridescence_uniforms(m).items():   # common/material_iridescence.glsl
+        set_uniform(prog, name, value)
 
 
 def rotation_cos_sin(deg: float) -> tuple[float, float]:

@@ -6,7 +6,7 @@
 // docs/conventions.md's exact choices (punctual = false, spread 0; common/layers.glsl).
 #include "common/shading.glsl"
 
-// f(l, v) max(n.l, 0) of docs/conventions.md, built from brdf.glsl's terms. n_dot_v is already
+// f(l, v) max(n.l, 0) of docs/conventions.md: common/base_lobes.glsl with the exact choices. n_dot_v is already
 // clamped to MIN_N_DOT_V (as app/accuracy/ground_truth.py does); h is the geometric half vector, with
 // |l + v| floored at 1e-7 (l = -v).
 vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l) {
@@ -15,25 +15,16 @@ vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l
 #else
     vec3 f = vec3(0.0);
 #endif
-    float n_dot_l = dot(n, l);
-    if (n_dot_l > 0.0) {
+    LobeAngles a;
+    a.n_dot_l = dot(n, l);
+    if (a.n_dot_l > 0.0) {
         vec3 lv = l + v;
         vec3 h = lv / max(length(lv), 1e-7);
-        float n_dot_h = dot(n, h);
-        float v_dot_h = clamp(dot(v, h), 0.0, 1.0);
-        vec3 F = F_Schlick(v_dot_h, f0, surface_f90(s));
-        vec3 kd = (1.0 - F) * (1.0 - s.metallic);
-#ifdef HAS_TRANSMISSION
-        kd *= 1.0 - s.transmission;
-#endif
-#ifdef HAS_ANISOTROPY
-        vec3 specular = anisotropic_specular(s, n, v, l, F, false, 0.0);
-#else
-        float D = D_GGX(n_dot_h, s.roughness);
-        float G = G_Smith(n_dot_v, n_dot_l, k_ibl(s.roughness));
-        vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
-#endif
-        f += (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+        a.n_dot_v = n_dot_v;
+        a.n_dot_h = dot(n, h);
+        a.v_dot_h = clamp(dot(v, h), 0.0, 1.0);
+        LobeChoice c = LobeChoice(s.roughness, k_ibl(s.roughness), false, 0.0);
+        f += base_lobes(s, f0, n, v, l, a, c);
     }
     return layered_light(s, n, v, l, f, false, 0.0);
 }

@@ -63,6 +63,12 @@ void main() {
     s.anisotropy_strength *= min(length(tw.xyz), 1.0);
     s_map.anisotropy_strength = s.anisotropy_strength;
 #endif
+#ifdef HAS_IRIDESCENCE
+    apply_material_iridescence(s);
+    iridescence_at_view(s, n, v);
+    apply_material_iridescence(s_map);
+    iridescence_at_view(s_map, n_map, v_map);
+#endif
     vec3 sum = u_first ? layered_emission(s, v) + punctual_lights(s, n, v, position.xyz) : imageLoad(u_accum, p).rgb;
     if (u_env_enabled && u_row_end > u_row_begin) {
         sum += u_env_intensity * ground_truth_rows(u_env, 0, u_row_begin, u_row_end, s_map, n_map, v_map);

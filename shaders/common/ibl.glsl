@@ -168,26 +168,17 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
 // mirror shows a spot of the source's size and power (after Karis 2013's sphere lights; it
 // matters only where alpha is near the source's size, e.g. royal_esplanade's 2-degree lamps).
 vec3 sun_light(Surface s, vec3 n, vec3 v, vec3 l, float spread) {
-    float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0) return vec3(0.0);
-    float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    LobeAngles a;
+    a.n_dot_l = dot(n, l);
+    if (a.n_dot_l <= 0.0) return vec3(0.0);
+    a.n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
-    float n_dot_h = max(dot(n, h), 0.0);
-    vec3 F = F_Schlick(max(dot(v, h), 0.0), surface_f0(s), surface_f90(s));
-#ifdef HAS_ANISOTROPY
-    vec3 specular = anisotropic_specular(s, n, v, l, F, false, spread);
-#else
+    a.n_dot_h = max(dot(n, h), 0.0);
+    a.v_dot_h = max(dot(v, h), 0.0);
     float alpha = s.roughness * s.roughness;
     float widened = max(sqrt(sqrt(alpha * alpha + spread * spread)), MIN_PUNCTUAL_ROUGHNESS);
-    float D = D_GGX(n_dot_h, widened);
-    float G = G_Smith(n_dot_v, n_dot_l, k_ibl(max(s.roughness, MIN_PUNCTUAL_ROUGHNESS)));
-    vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
-#endif
-    vec3 kd = (1.0 - F) * (1.0 - s.metallic);
-#ifdef HAS_TRANSMISSION
-    kd *= 1.0 - s.transmission;
-#endif
-    return (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+    LobeChoice c = LobeChoice(widened, k_ibl(max(s.roughness, MIN_PUNCTUAL_ROUGHNESS)), false, spread);
+    return base_lobes(s, surface_f0(s), n, v, l, a, c);
 }
 
 // A compact source through the base and its layers (common/layers.glsl).
@@ -252,8 +243,12 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
 #endif
     vec3 irradiance = irradiance_at(n, true);
     vec3 spec_albedo = F * lut.x + surface_f90(s) * lut.y;
+    vec3 diffuse_weight = 1.0 - F;
+#ifdef HAS_IRIDESCENCE
+    iridescence_ibl_weights(s, lut, diffuse_weight, spec_albedo);
+#endif
     occlude_environment(s, n, reflect(-v, n), spec_albedo, true, irradiance, prefiltered);
-    return ibl_combine(s, surface_f0(s), 1.0 - F, spec_albedo, lut, irradiance, prefiltered);
+    return ibl_combine(s, surface_f0(s), diffuse_weight, spec_albedo, lut, irradiance, prefiltered);
 }
 
 // Karis' split as published: the LUT's A and B already hold the Fresnel, so the specular factor
@@ -279,9 +274,12 @@ vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with
     // 1 - F0 - (F90 - F0) Fc, and the split sum's B scales by F90.
     float f90 = surface_f90(s);
     vec3 spec_albedo = f0 * lut.x + f90 * lut.y;
+    vec3 diffuse_weight = 1.0 - f0 - (f90 - f0) * diffuse_fresnel(n_dot_v);
+#ifdef HAS_IRIDESCENCE
+    iridescence_ibl_weights(s, lut, diffuse_weight, spec_albedo);
+#endif
     occlude_environment(s, n, d, spec_albedo, with_suns, irradiance, prefiltered);
-    return ibl_combine(s, f0, 1.0 - f0 - (f90 - f0) * diffuse_fresnel(n_dot_v), spec_albedo, lut,
-                       irradiance, prefiltered);
+    return ibl_combine(s, f0, diffuse_weight, spec_albedo, lut, irradiance, prefiltered);
 }
 
 // The lecture's cook_torrance_IBL: kd and F from the roughness-aware Fresnel at n.v.

@@ -55,6 +55,16 @@ vec3 transmission_light(Surface s, vec3 n, vec3 v, vec3 l, bool punctual, float 
 vec3 transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns);
 #endif
 
+#ifdef HAS_IRIDESCENCE
+// The thin film's Fresnel at this view into s (once per shading point, before any light).
+void iridescence_at_view(inout Surface s, vec3 n, vec3 v);
+// The base's Fresnel F at v.h with the film mixed in: for the specular lobe, for the diffuse lobe.
+vec3 iridescence_specular_fresnel(Surface s, vec3 F);
+vec3 iridescence_diffuse_fresnel(Surface s, vec3 F);
+// The split sum's diffuse weight and specular albedo with the film mixed in (lut: A, B).
+void iridescence_ibl_weights(Surface s, vec4 lut, inout vec3 diffuse_weight, inout vec3 spec_albedo);
+#endif
+
 // ---- the stack ---------------------------------------------------------------------------
 
 // The layers over the base for one direction l; base is the base's f |n.l| (transmission included).

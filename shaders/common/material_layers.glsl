@@ -25,6 +25,8 @@ uniform vec3 u_attenuation_color;
 uniform float u_attenuation_distance;  // 3e38 stands for glTF's +inf (no attenuation)
 #endif
 
+#include "common/material_iridescence.glsl"
+
 // The layer factors at a point with shading normal n and tangent frame (t, b) (orthonormal,
 // b = cross(n, t) up to the mesh's handedness). Maps, where a layer has them, multiply these
 // factors afterwards (common/mesh_material.glsl).

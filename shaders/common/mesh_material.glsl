@@ -85,6 +85,12 @@ uniform sampler2D u_transmission_map;
 uniform bool u_has_thickness_map;             // G multiplies thickness
 uniform sampler2D u_thickness_map;
 #endif
+#ifdef HAS_IRIDESCENCE
+uniform bool u_has_iridescence_map;           // KHR_materials_iridescence: R multiplies iridescence
+uniform bool u_has_iridescence_thickness_map; // G mixes the film's thickness from the minimum to the maximum
+uniform sampler2D u_iridescence_map;
+uniform sampler2D u_iridescence_thickness_map;
+#endif
 
 // The maps compiled in, a bit each (app/core/shader_names.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
@@ -314,6 +320,14 @@ Surface material_surface(vec3 n) {
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
     mat3 frame = tangent_frame(n);
     apply_material_layers(s, n, frame[0], frame[1]);
+#endif
+#ifdef HAS_IRIDESCENCE
+    apply_material_iridescence(s);
+    if (has_map(MAP_IRIDESCENCE, u_has_iridescence_map)) s.iridescence *= sample_map(u_iridescence_map, MAP_IRIDESCENCE, 17).r;
+    if (has_map(MAP_IRIDESCENCE_THICKNESS, u_has_iridescence_thickness_map)) {
+        s.iridescence_thickness = mix(u_iridescence_thickness_minimum, u_iridescence_thickness_maximum,
+                                      sample_map(u_iridescence_thickness_map, MAP_IRIDESCENCE_THICKNESS, 18).g);
+    }
 #endif
 #ifdef HAS_ANISOTROPY
     if (has_map(MAP_ANISOTROPY, u_has_anisotropy_map)) {

@@ -26,26 +26,16 @@ vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
 #else
     vec3 transmitted = vec3(0.0);
 #endif
-    float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0) return transmitted;
-    float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
+    LobeAngles a;
+    a.n_dot_l = dot(n, l);
+    if (a.n_dot_l <= 0.0) return transmitted;
+    a.n_dot_v = max(dot(n, v), MIN_N_DOT_V);
     vec3 h = normalize(l + v);
-    float n_dot_h = max(dot(n, h), 0.0);
-    float v_dot_h = max(dot(v, h), 0.0);
+    a.n_dot_h = max(dot(n, h), 0.0);
+    a.v_dot_h = max(dot(v, h), 0.0);
     float roughness = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
-    vec3 F = F_Schlick(v_dot_h, surface_f0(s), surface_f90(s));
-    vec3 kd = (1.0 - F) * (1.0 - s.metallic);
-#ifdef HAS_TRANSMISSION
-    kd *= 1.0 - s.transmission;
-#endif
-#ifdef HAS_ANISOTROPY
-    vec3 specular = anisotropic_specular(s, n, v, l, F, true, 0.0);
-#else
-    float D = D_GGX(n_dot_h, roughness);
-    float G = G_Smith(n_dot_v, n_dot_l, k_direct(roughness));
-    vec3 specular = D * G * F / (4.0 * n_dot_l * n_dot_v);
-#endif
-    return transmitted + (kd * Fd_Lambert(s.base_color) + specular) * n_dot_l;
+    LobeChoice c = LobeChoice(roughness, k_direct(roughness), true, 0.0);
+    return transmitted + base_lobes(s, surface_f0(s), n, v, l, a, c);
 }
 
 // f(l, v) L_in (n.l) for one light: the base with the layers over it (common/layers.glsl).

@@ -3,6 +3,7 @@
 #include "common/equirect.glsl"
 #include "common/surface.glsl"
 #include "common/layers.glsl"
+#include "common/base_lobes.glsl"
 #include "common/shadows.glsl"
 #include "common/ibl.glsl"
 #include "common/punctual.glsl"
@@ -11,10 +12,14 @@
 #include "common/sheen.glsl"
 #include "common/anisotropy.glsl"
 #include "common/transmission.glsl"
+#include "common/iridescence.glsl"
 
 uniform bool u_ibl_enabled;
 
 vec3 shade(Surface s, vec3 n, vec3 v, vec3 position) {
+#ifdef HAS_IRIDESCENCE
+    iridescence_at_view(s, n, v);
+#endif
     vec3 radiance = layered_emission(s, v);
     if (u_ibl_enabled) {
         radiance += ibl_model(s, n, v);

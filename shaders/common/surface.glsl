@@ -29,6 +29,12 @@ struct Surface {
     float transmission;         // KHR_materials_transmission
     float ior;                  // KHR_materials_ior: the refraction's index
 #endif
+#ifdef HAS_IRIDESCENCE
+    float iridescence;           // KHR_materials_iridescence: the thin film's weight (0: no film)
+    float iridescence_ior;       // the film's index
+    float iridescence_thickness; // nm
+    vec3 iridescence_fresnel;    // the film's Fresnel at the view's n.v (common/iridescence.glsl)
+#endif
 #ifdef HAS_VOLUME
     float thickness;            // KHR_materials_volume, in world units at this point
     vec3 attenuation_color;
@@ -76,6 +82,12 @@ Surface surface_base(vec3 base_color, float metallic, float roughness, vec3 spec
 #ifdef HAS_TRANSMISSION
     s.transmission = 0.0;
     s.ior = 1.5;
+#endif
+#ifdef HAS_IRIDESCENCE
+    s.iridescence = 0.0;
+    s.iridescence_ior = 1.3;
+    s.iridescence_thickness = 400.0;
+    s.iridescence_fresnel = vec3(0.0);
 #endif
 #ifdef HAS_VOLUME
     s.thickness = 0.0;

@@ -28,6 +28,9 @@ void main() {
     probe_tangent_frame(n, t, b);
     apply_material_layers(s, n, t, b);
 #endif
+#ifdef HAS_IRIDESCENCE
+    apply_material_iridescence(s);
+#endif
     out_radiance = vec4(shade(s, n, vec3(0.0, 0.0, 1.0), n), 1.0);
     gl_FragDepth = 0.0;  // in front of the background, which is drawn after on the far plane
 }

@@ -3,7 +3,8 @@
 
     base   = docs/conventions.md's Cook-Torrance, k = r^2/2, F per direction at v.h; its diffuse lobe
              scaled by 1 - transmission, plus the transmitted part (transmission.py); its
-             specular lobe anisotropic where the material says so (anisotropy.py)
+             specular lobe anisotropic where the material says so (anisotropy.py), its
+             Fresnel the thin film's where it has one (iridescence.py)
     sheen  = sheen BRDF + base * sheen albedo scaling                         (sheen.py)
     coated = clearcoat BRDF + sheen * (1 - clearcoat F_c(n_c.v))              (clearcoat.py)
 
@@ -17,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alight.core.layers import anisotropy, clearcoat, sheen, transmission
+from alight.core.layers import anisotropy, clearcoat, iridescence, sheen, transmission
 from alight.core.material import Material
 from alight.core.shading import MIN_PUNCTUAL_ROUGHNESS, PI, D_GGX, F_Schlick, G1_SchlickGGX, k_ibl
 
@@ -101,7 +102,10 @@ def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
     nl_c = np.where(lit, nl, 0.0)
     f0 = np.asarray(m.f0(), np.float64)
     F = F_Schlick(p.v_dot_h, f0)                         # (P, T, 3)
-    kd = (1.0 - F) * (1.0 - m.metallic)
+    F_diffuse = F
+    if "iridescence" in m.layers():
+        F, F_diffuse = iridescence.iridescence_fresnels(m, p, F)
+    kd = (1.0 - F_diffuse) * (1.0 - m.metallic)
     if "transmission" in m.layers():
         kd = kd * (1.0 - m.transmission)
     if "anisotropy" in m.layers():
