@@ -6,7 +6,7 @@ so ``--help`` and argument errors are instant.
 
 The package holds one module per subcommand; each declares its ``Command`` (its arguments and
 its run function) and ``COMMANDS`` lists them in the order ``alight --help`` shows. What several
-subcommands share is in ``arguments`` (types, the parser, option groups) and ``camera``.
+subcommands share is in ``arguments`` (types, the parser, option groups).
 """
 
 from __future__ import annotations

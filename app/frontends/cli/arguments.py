@@ -1,6 +1,7 @@
 """What the subcommands share: the argument types, the parser class, the option groups that
 several subcommands take (scene, camera, material, bake), the ``Command`` each subcommand module
-declares, and the warning line."""
+declares, and the warning line. The flags are read into a scene by app/frontends/scene_setup.py
+(scene, camera) and app/frontends/options.py (material)."""
 
 from __future__ import annotations
 
@@ -94,6 +95,24 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
     _add_material_options(p)
 
 
+def _add_camera_options(p: argparse.ArgumentParser) -> None:
+    c = p.add_argument_group("camera (default: the mesh framed from +Z; a built-in preview mesh from its 3/4 view)")
+    c.add_argument("--camera", default="auto", metavar="auto|gltf[:N]",
+                   help="auto: frame the mesh (with the flags below); gltf[:N]: the glTF file's camera N "
+                        "(default 0), placed by its node (default: auto)")
+    # None: not given (a built-in preview mesh keeps its 3/4 view; given, either is from +Z).
+    c.add_argument("--orbit", type=_number("--orbit"), default=None, metavar="DEG",
+                   help="turn the camera about +Y from +Z by DEG degrees, right-handed (default: 0; a built-in "
+                        "preview mesh without --orbit and --elevation: its 3/4 view)")
+    c.add_argument("--elevation", type=_number("--elevation", -90.0, 90.0), default=None, metavar="DEG",
+                   help="raise the camera by DEG degrees (default: 0, or as --orbit says)")
+    c.add_argument("--distance", type=_number("--distance", 1e-6), default=None, metavar="X",
+                   help="the camera's distance from the target (default: what frames the mesh)")
+    c.add_argument("--fov", type=_number("--fov", 1.0, 179.0), default=None, metavar="DEG",
+                   help="vertical field of view in degrees (default: 35, or the glTF camera's)")
+    c.add_argument("--target", metavar="X,Y,Z", help="the point looked at (default: the mesh's bounding-box centre)")
+
+
 def _add_material_options(p: argparse.ArgumentParser) -> None:
     m = p.add_argument_group("material (flags override the preset's fields)")
     m.add_argument("--preset", metavar="NAME|PATH",
@@ -165,3 +184,8 @@ class _Parser(argparse.ArgumentParser):
 def _warn(lines) -> None:
     for line in lines:
         print(f"alight: warning: {line}", file=sys.stderr)
+
+
+def _warn_line(line: str) -> None:
+    """One warning line (scene_setup's ``report``)."""
+    _warn([line])

@@ -6,8 +6,15 @@ import sys
 import time
 
 from alight.errors import AlightError
-from alight.frontends.cli.arguments import Command, _add_scene_options, _size, _warn
-from alight.frontends.cli.camera import _add_camera_options, _camera
+from alight.frontends.cli.arguments import (
+    Command,
+    _add_camera_options,
+    _add_scene_options,
+    _size,
+    _Size,
+    _warn,
+    _warn_line,
+)
 from alight.frontends.options import build_look
 
 
@@ -35,7 +42,9 @@ def add_parser(sub) -> None:
                          "(default: 0)")
     rd.add_argument("--max-bounces", type=int, default=8, metavar="N",
                     help="--integrator path: surface vertices per path at most, 1 = direct light only (default: 8)")
-    rd.add_argument("--size", type=_size, default=(256, 256), metavar="W|WxH", help="image size (default: 256)")
+    rd.add_argument("--size", type=_size, default=_Size(256, 256, True), metavar="W|WxH",
+                    help="image size; W alone is square, or with --camera gltf the camera's aspect ratio, as in "
+                         "'alight render' (default: 256)")
     rd.add_argument("--env-level", default="auto", metavar="N|auto",
                     help="sum over the map box-reduced by 2^N (area-weighted): 4^N times faster. Level 1 "
                          "changed royal_esplanade by <= 0.015%% (worst pixel 0.1%%) at r >= 0.25, but by 0.5%% "
@@ -55,19 +64,53 @@ def run(args) -> int:
     width, height = args.size
     if args.view == "probe" and width != height:
         raise AlightError(f"--size: the probe view is square; got {width}x{height}")
-    level = None
-    if args.env_level != "auto":
-        try:
-            level = int(args.env_level)
-        except ValueError:
-            raise AlightError(f"--env-level: '{args.env_level}' is not a whole number or 'auto'") from None
-        if not 0 <= level <= 8:
-            raise AlightError(f"--env-level: {level} is out of range [0, 8]")
-    material, overrides, texture_maps = build_look(args)
+    level = _env_level(args)
+    look = build_look(args)
+    integrator = _integrator(args, level)
+
+    from alight.accuracy.reference import check_layer_roughness, check_roughness
+
+    material = look[0]
+    if not args.no_ibl and integrator == "exact":
+        check_roughness(material.roughness)   # before any file is read
+        check_layer_roughness(material)
+    setup = _scene(args, look)
+    if integrator == "path":
+        _path_trace(args, setup, out, start)
+    else:
+        _exact(args, setup, out, level, start)
+    print(out)
+    return 0
+
+
+def _scene(args, look):
+    """The scene of the flags, read as 'alight render' reads them (app/frontends/scene_setup.py);
+    the reference has no display, IBL model or shadow options of its own."""
+    from alight.frontends.scene_setup import scene_from_flags
+
+    return scene_from_flags(args, args.size, look, _warn_line)
+
+
+def _env_level(args) -> int | None:
+    """--env-level as a whole number 0..8 (None: auto)."""
+    if args.env_level == "auto":
+        return None
+    try:
+        level = int(args.env_level)
+    except ValueError:
+        raise AlightError(f"--env-level: '{args.env_level}' is not a whole number or 'auto'") from None
+    if not 0 <= level <= 8:
+        raise AlightError(f"--env-level: {level} is out of range [0, 8]")
+    return level
+
+
+def _integrator(args, level: int | None) -> str:
+    """'exact' or 'path' (--integrator auto: a concave built-in, the shader ball's groove, or a mesh
+    file shadows itself: paths), its flags checked and embreex found before any file is read."""
     from alight.core.mesh import CONVEX_BUILTINS
 
     integrator = args.integrator
-    if integrator == "auto":   # a concave built-in (the shader ball's groove) shadows itself: paths
+    if integrator == "auto":
         integrator = "path" if args.view == "camera" and args.mesh not in CONVEX_BUILTINS else "exact"
     if integrator == "path":
         for option, value, low in (("--samples", args.samples, 1), ("--max-bounces", args.max_bounces, 1)):
@@ -80,52 +123,33 @@ def run(args) -> int:
         from alight.accuracy.path_trace import _import_embree
 
         _import_embree()   # a missing install is said before any file is read
+    return integrator
 
-    from alight.accuracy.reference import check_layer_roughness, check_roughness
-    from alight.core.scene import Scene, parse_light
-    from alight.exchange.texture_sets import load_map_images
-    from alight.exchange.meshes import load_mesh
-    from alight.ibl.environment import load_environment
 
-    if not args.no_ibl and integrator == "exact":
-        check_roughness(material.roughness)   # before any file is read
-        check_layer_roughness(material)
-    lights = [parse_light(spec) for spec in args.light]
-    mesh = load_mesh(args.mesh) if args.view == "camera" else None
-    if mesh is not None:
-        _warn(mesh.warnings)
-        if not args.light and not args.no_file_lights:
-            lights = list(mesh.lights)
-    camera = _camera(args, mesh, width / height)
-    env = None if args.no_ibl else load_environment(args.env)
-    if env is not None:
-        _warn(env.warnings)
-    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None and texture_maps is None,
-                  texture_maps=texture_maps, texture_images=load_map_images(texture_maps) if texture_maps else {},
-                  material_overrides=overrides, lights=lights, camera=camera, view=args.view,
-                  env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
-                  ibl_enabled=env is not None)
-    if integrator == "path":
-        from alight.accuracy.path_trace import TraceSettings, trace
-        from alight.exchange.output import write_image
+def _path_trace(args, setup, out, start: float) -> None:
+    from alight.accuracy.path_trace import TraceSettings, trace
+    from alight.exchange.output import write_image
 
-        result = trace(scene, env.radiance if env is not None else None, width, height,
-                       TraceSettings(samples=args.samples, max_bounces=args.max_bounces, seed=args.seed))
-        _warn(result.warnings)
-        write_image(out, result.linear, linear=True)
-        if args.verbose:
-            print(f"path traced, {args.samples} samples a pixel, seed {args.seed}; total "
-                  f"{time.perf_counter() - start:.3f}s; "
-                  + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
-                  file=sys.stderr)
-        print(out)
-        return 0
+    env = setup.environment
+    result = trace(setup.scene, env.radiance if env is not None else None, setup.width, setup.height,
+                   TraceSettings(samples=args.samples, max_bounces=args.max_bounces, seed=args.seed))
+    _warn(result.warnings)
+    write_image(out, result.linear, linear=True)
+    if args.verbose:
+        print(f"path traced, {args.samples} samples a pixel, seed {args.seed}; total "
+              f"{time.perf_counter() - start:.3f}s; "
+              + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
+              file=sys.stderr)
 
+
+def _exact(args, setup, out, level: int | None, start: float) -> None:
     from alight.accuracy.reference import ReferenceRenderer
     from alight.exchange.output import write_image
 
+    env = setup.environment
     ref = ReferenceRenderer()
-    result = ref.render(scene, env.radiance if env is not None else None, width, height, env_level=level)
+    result = ref.render(setup.scene, env.radiance if env is not None else None, setup.width, setup.height,
+                        env_level=level)
     write_image(out, result.linear, linear=True)
     if args.verbose:
         from alight.core.gpu import describe
@@ -135,8 +159,6 @@ def run(args) -> int:
         print(f"{describe(ref.ctx)}\n{where}, {result.dispatches} dispatches; total "
               f"{time.perf_counter() - start:.3f}s; " + ", ".join(f"{k} {v:.3f}s" for k, v in result.seconds.items()),
               file=sys.stderr)
-    print(out)
-    return 0
 
 
 COMMAND = Command("reference", add_parser, run)

@@ -10,13 +10,14 @@ from alight.frontends.cli.arguments import (
     TONEMAP_CHOICES,
     Command,
     _add_bake_options,
+    _add_camera_options,
     _add_scene_options,
     _number,
     _size,
     _Size,
     _warn,
+    _warn_line,
 )
-from alight.frontends.cli.camera import _add_camera_options, _camera, _camera_size
 from alight.frontends.options import build_look
 
 
@@ -74,44 +75,10 @@ def run(args) -> int:
     if args.quality != "auto" and args.error_budget is not None:
         raise AlightError("--error-budget: only with --quality auto")
     _check_output_options(args, out)
-    material, overrides, texture_maps = build_look(args)
-
-    from alight.core.scene import Display, Scene, parse_light
-    from alight.exchange.texture_sets import load_map_images
-    from alight.exchange.meshes import load_mesh
-    from alight.ibl.environment import load_environment
-
-    lights = [parse_light(spec) for spec in args.light]
-    mesh = load_mesh(args.mesh) if args.view == "camera" else None
-    if mesh is not None:
-        _warn(mesh.warnings)
-        if not args.light and not args.no_file_lights:
-            lights = list(mesh.lights)
-    width, height = _camera_size(args, mesh, width, height)
-    camera = _camera(args, mesh, width / height)
-    if camera is None and mesh is not None and getattr(mesh, "view", None) is None:   # a built-in has its own view
-        normal = mesh.flat_normal()
-        if normal is not None and abs(normal[2]) < 0.02:   # the default camera's view is -Z (docs/conventions.md)
-            _warn([f"{args.mesh}: the mesh is flat and the default camera (on +Z) sees it edge-on, so it "
-                   f"may not show; --elevation 30 (or --orbit) looks at it from another side"])
-    env = None if args.no_ibl else load_environment(args.env)
-    if env is not None:
-        _warn(env.warnings)
-    display = Display(tonemap=args.tonemap or "aces", exposure=args.exposure, background=args.background)
-    if args.background_color:
-        from alight.core.material import parse_color
-
-        display.background_color = parse_color(args.background_color, "--background-color")
-    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None and texture_maps is None,
-                  texture_maps=texture_maps, texture_images=load_map_images(texture_maps) if texture_maps else {},
-                  material_overrides=overrides, lights=lights, camera=camera, view=args.view,
-                  env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
-                  ibl_enabled=env is not None, ibl_model=args.ibl,
-                  multiple_scattering=args.multiple_scattering, display=display, shadows=args.shadows,
-                  ground=args.ground, occlusion=args.occlusion)
+    setup = _scene(args, build_look(args))
+    scene, env, width, height = setup.scene, setup.environment, setup.width, setup.height
     loaded = time.perf_counter()
 
-    from alight.exchange.output import image_rows_writer
     from alight.ibl.bake import quality_named
     from alight.render.renderer import ForwardRenderer
 
@@ -125,16 +92,7 @@ def run(args) -> int:
         quality = quality_named(args.quality, args.irradiance)
     maps = renderer.bake(env, quality) if env is not None else None
     baked = time.perf_counter()
-    # Strip by strip (an image too big for one framebuffer is drawn in tiles): each band of rows
-    # is written and dropped, so memory stays bounded at any --size.
-    exr = out.suffix.lower() == ".exr"
-    channels = 4 if exr or args.background == "transparent" else 3
-    writing = 0.0
-    with image_rows_writer(out, width, height, channels, linear=exr) as put:
-        for strip in renderer.render_strips(scene, maps, width, height, aa=args.aa, read_linear=exr, read_srgb=not exr):
-            t = time.perf_counter()
-            put(strip.frame.linear if exr else strip.frame.srgb[:, :, :channels])
-            writing += time.perf_counter() - t
+    writing = _write(args, out, renderer, scene, maps, width, height)
     if args.verbose:
         from alight.core.gpu import describe
 
@@ -146,6 +104,41 @@ def run(args) -> int:
                   file=sys.stderr)
     print(out)
     return 0
+
+
+def _scene(args, look):
+    """The scene of the flags (app/frontends/scene_setup.py, as 'alight reference' reads them) with
+    render's own fields: the display, the IBL model, shadows, ground and occlusion."""
+    from alight.core.scene import Display
+    from alight.frontends.scene_setup import scene_from_flags
+
+    setup = scene_from_flags(args, args.size, look, _warn_line, ibl_model=args.ibl,
+                             multiple_scattering=args.multiple_scattering, shadows=args.shadows,
+                             ground=args.ground, occlusion=args.occlusion)
+    display = Display(tonemap=args.tonemap or "aces", exposure=args.exposure, background=args.background)
+    if args.background_color:
+        from alight.core.material import parse_color
+
+        display.background_color = parse_color(args.background_color, "--background-color")
+    setup.scene.display = display
+    return setup
+
+
+def _write(args, out, renderer, scene, maps, width: int, height: int) -> float:
+    """Render and write ``out`` strip by strip (an image too big for one framebuffer is drawn in
+    tiles): each band of rows is written and dropped, so memory stays bounded at any --size.
+    Returns the seconds spent writing."""
+    from alight.exchange.output import image_rows_writer
+
+    exr = out.suffix.lower() == ".exr"
+    channels = 4 if exr or args.background == "transparent" else 3
+    writing = 0.0
+    with image_rows_writer(out, width, height, channels, linear=exr) as put:
+        for strip in renderer.render_strips(scene, maps, width, height, aa=args.aa, read_linear=exr, read_srgb=not exr):
+            t = time.perf_counter()
+            put(strip.frame.linear if exr else strip.frame.srgb[:, :, :channels])
+            writing += time.perf_counter() - t
+    return writing
 
 
 def _check_output_options(args, out) -> None:
