@@ -318,7 +318,9 @@ class Renderer:
     def render(self, width: int | None = None, height: int | None = None, *,
                linear: bool = False) -> np.ndarray:
         """Render the scene; returns (H, W, 4) float32 linear radiance (``linear=True``) or
-        (H, W, 4) uint8 sRGB after exposure and tone mapping. Row 0 is the top."""
+        (H, W, 4) uint8 sRGB after exposure and tone mapping. Row 0 is the top. A flat mesh that
+        the default camera (set_camera(None), on +Z) sees edge-on is said in one warning line, as
+        ``alight render`` says it."""
         w, h = _size(width or self.width, height or (self.height if width is None else width))
         if self.scene.view == "probe" and w != h:
             raise AlightError(f"size: the probe view is square; got {w}x{h}")
