@@ -37,7 +37,7 @@ from alight.core.scene import (
     parse_light,
 )
 from alight.errors import AlightError, warn
-from alight.exchange.meshes import load_mesh
+from alight.frontends.scene_setup import framing_warnings, load_scene_environment, load_scene_mesh
 from alight.ibl.environment import Environment, load_environment
 
 Quality = Literal["low", "medium", "high", "auto"]
@@ -66,6 +66,7 @@ class Renderer:
         self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
         self.bakes_done = 0    # how many bakes actually ran (misses of the memory and disk caches)
         self._mesh: Mesh | None = None
+        self._framing_checked: Mesh | None = None   # the mesh framing_warnings last looked at
         self._env: Environment | None = _studio()
         self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
                            display=Display(tonemap=tonemap, exposure=exposure, background=background),
@@ -109,9 +110,12 @@ class Renderer:
         """'sphere', 'cube', 'plane', 'shader_ball', 'rounded_cube', 'drape', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
         What the file is drawn without is said on stderr, one ``alight: warning:`` line each, once
         per process (alight.errors.warn)."""
-        self._mesh = mesh if isinstance(mesh, Mesh) else load_mesh(os.fspath(mesh))
-        for line in self._mesh.warnings:
-            warn(line)
+        if isinstance(mesh, Mesh):
+            self._mesh = mesh
+            for line in mesh.warnings:
+                warn(line)
+        else:
+            self._mesh = load_scene_mesh(os.fspath(mesh), warn)
         self.scene.mesh = self._mesh
         return self
 
@@ -120,12 +124,12 @@ class Renderer:
         """'studio', an equirectangular .hdr/.exr, a loaded Environment, or None (no IBL)."""
         if env is None or isinstance(env, Environment):
             self._env = env
+            for line in env.warnings if env is not None else ():
+                warn(line)
         elif os.fspath(env) == "studio":
-            self._env = _studio()
-        else:
-            self._env = load_environment(os.fspath(env))
-        for line in self._env.warnings if self._env is not None else ():
-            warn(line)     # what was repaired or clamped (alight.errors.warn: once per process)
+            self._env = _studio()   # built in: nothing to warn about
+        else:   # what was repaired or clamped is said (alight.errors.warn: once per process)
+            self._env = load_scene_environment(os.fspath(env), warn)
         self.scene.ibl_enabled = self._env is not None
         if rotation_deg is not None:
             self.scene.env_rotation_deg = float(rotation_deg)
@@ -316,10 +320,17 @@ class Renderer:
     def render(self, width: int | None = None, height: int | None = None, *,
                linear: bool = False) -> np.ndarray:
         """Render the scene; returns (H, W, 4) float32 linear radiance (``linear=True``) or
-        (H, W, 4) uint8 sRGB after exposure and tone mapping. Row 0 is the top."""
+        (H, W, 4) uint8 sRGB after exposure and tone mapping. Row 0 is the top. A flat mesh that
+        the default camera (set_camera(None), on +Z) sees edge-on is said in one warning line, as
+        ``alight render`` says it."""
         w, h = _size(width or self.width, height or (self.height if width is None else width))
         if self.scene.view == "probe" and w != h:
             raise AlightError(f"size: the probe view is square; got {w}x{h}")
+        if self.scene.view == "camera" and self.scene.camera is None and self._framing_checked is not self._mesh:
+            self._framing_checked = self._mesh   # once per mesh: flat_normal reads every vertex
+            for line in framing_warnings(self._mesh, self._mesh.source, None,
+                                         "set_camera(orbit_deg=0, elevation_deg=30)"):
+                warn(line)   # as alight render says it (app/frontends/scene_setup.py)
         frame = self._frame(w, h, linear=linear, srgb=not linear)
         return frame.linear if linear else frame.srgb
 

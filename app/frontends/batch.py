@@ -197,32 +197,15 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
     if unknown:
         raise AlightError(f"{source}: unknown key {sorted(unknown)[0]!r} (known: {', '.join(sorted(_KEYS))})")
     base = source.resolve().parent
-    size = spec.get("size", 256)
-    size = [size, size] if isinstance(size, int) and not isinstance(size, bool) else size
-    if not (isinstance(size, list) and len(size) == 2 and all(isinstance(x, int) and 1 <= x <= 8192 for x in size)):
-        raise AlightError(f"{source}: 'size' must be an integer or [W, H], 1..8192")
-    quality = spec.get("quality", "medium")
-    if quality not in ("low", "medium", "high"):
-        raise AlightError(f"{source}: 'quality' must be low, medium or high")
+    size, quality = _size_and_quality(spec, source)
     meshes = _list(spec, "meshes", ["sphere"], source)
     envs = _list(spec, "environments", ["studio"], source)
     materials = _list(spec, "materials", ["gold"], source, (str, dict))
     cams = _list(spec, "camera_angles", [0], source, (int, float))
     env_angles = _list(spec, "environment_angles", [0], source, (int, float))
-    options = {k: spec[k] for k in ("aa", "tonemap", "background", "shadows", "ground") if k in spec}
-    if options.get("shadows", "auto") not in ("auto", "on", "off"):
-        raise AlightError(f"{source}: 'shadows' must be auto, on or off")
-    if not isinstance(options.get("ground", False), bool):
-        raise AlightError(f"{source}: 'ground' must be true or false")
+    options = _item_options(spec, source)
     out_dir = Path(out) if out is not None else base / str(spec.get("out", source.stem))
-
-    mesh_names = [Path(m).stem for m in meshes]
-    env_names = [Path(e).stem for e in envs]
-    mat_names = [_slug(_material_label(m, source)) for m in materials]
-    for what, names in (("meshes", mesh_names), ("environments", env_names), ("materials", mat_names)):
-        dup = {n for n in names if names.count(n) > 1}
-        if dup:
-            raise AlightError(f"{source}: two {what} share the name {sorted(dup)[0]!r}; output names would collide")
+    mesh_names, env_names, mat_names = _output_names(meshes, envs, materials, source)
 
     spec_deps = [str(source)]
 
@@ -246,16 +229,7 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
     frames, animations = [], []
     tt = spec.get("turntable")
     if tt is not None:
-        if not isinstance(tt, dict) or set(tt) - _TURNTABLE_KEYS:
-            raise AlightError(f"{source}: 'turntable' takes {', '.join(sorted(_TURNTABLE_KEYS))}")
-        n = tt.get("frames", 24)
-        rotate, fmt, fps = tt.get("rotate", "camera"), tt.get("format", "gif"), tt.get("fps", 12)
-        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 3600:
-            raise AlightError(f"{source}: turntable 'frames' must be an integer 1..3600")
-        if rotate not in ("camera", "environment") or fmt not in ("gif", "apng"):
-            raise AlightError(f"{source}: turntable 'rotate' is camera|environment and 'format' gif|apng")
-        if not isinstance(fps, (int, float)) or not 0 < fps <= 100:
-            raise AlightError(f"{source}: turntable 'fps' must be in (0, 100]")
+        n, rotate, fmt, fps = _turntable(tt, source)
         for mi, ei, ki in itertools.product(range(len(meshes)), range(len(envs)), range(len(materials))):
             stem = f"{mesh_names[mi]}__{env_names[ei]}__{mat_names[ki]}"
             paths = []
@@ -267,6 +241,55 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
                 paths.append(p)
             animations.append(Animation(out_dir / "turntable" / f"{stem}.{fmt}", paths, float(fps)))
     return Plan(source, out_dir, stills, frames, animations, bool(spec.get("contact_sheet", True)))
+
+
+def _size_and_quality(spec: dict, source: Path) -> tuple[list[int], str]:
+    """The spec's size ([W, H]) and bake quality, checked."""
+    size = spec.get("size", 256)
+    size = [size, size] if isinstance(size, int) and not isinstance(size, bool) else size
+    if not (isinstance(size, list) and len(size) == 2 and all(isinstance(x, int) and 1 <= x <= 8192 for x in size)):
+        raise AlightError(f"{source}: 'size' must be an integer or [W, H], 1..8192")
+    quality = spec.get("quality", "medium")
+    if quality not in ("low", "medium", "high"):
+        raise AlightError(f"{source}: 'quality' must be low, medium or high")
+    return size, quality
+
+
+def _item_options(spec: dict, source: Path) -> dict:
+    """The Item options the spec sets (aa, tonemap, background, shadows, ground), checked."""
+    options = {k: spec[k] for k in ("aa", "tonemap", "background", "shadows", "ground") if k in spec}
+    if options.get("shadows", "auto") not in ("auto", "on", "off"):
+        raise AlightError(f"{source}: 'shadows' must be auto, on or off")
+    if not isinstance(options.get("ground", False), bool):
+        raise AlightError(f"{source}: 'ground' must be true or false")
+    return options
+
+
+def _output_names(meshes: list, envs: list, materials: list, source: Path) -> tuple[list[str], list[str], list[str]]:
+    """The names of the meshes, environments and materials in output file names; two alike collide."""
+    mesh_names = [Path(m).stem for m in meshes]
+    env_names = [Path(e).stem for e in envs]
+    mat_names = [_slug(_material_label(m, source)) for m in materials]
+    for what, names in (("meshes", mesh_names), ("environments", env_names), ("materials", mat_names)):
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise AlightError(f"{source}: two {what} share the name {sorted(dup)[0]!r}; output names would collide")
+    return mesh_names, env_names, mat_names
+
+
+def _turntable(tt, source: Path) -> tuple[int, str, str, float]:
+    """The spec's [turntable] table, checked: (frames, rotate, format, fps)."""
+    if not isinstance(tt, dict) or set(tt) - _TURNTABLE_KEYS:
+        raise AlightError(f"{source}: 'turntable' takes {', '.join(sorted(_TURNTABLE_KEYS))}")
+    n = tt.get("frames", 24)
+    rotate, fmt, fps = tt.get("rotate", "camera"), tt.get("format", "gif"), tt.get("fps", 12)
+    if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 3600:
+        raise AlightError(f"{source}: turntable 'frames' must be an integer 1..3600")
+    if rotate not in ("camera", "environment") or fmt not in ("gif", "apng"):
+        raise AlightError(f"{source}: turntable 'rotate' is camera|environment and 'format' gif|apng")
+    if not isinstance(fps, (int, float)) or not 0 < fps <= 100:
+        raise AlightError(f"{source}: turntable 'fps' must be in (0, 100]")
+    return n, rotate, fmt, fps
 
 
 def _deg(x: float) -> str:

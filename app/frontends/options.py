@@ -52,7 +52,7 @@ def build_look(args, report=None, index: int = 0):
         loaded.update(slots)
     base = with_overrides(base, **map_factors(loaded)) if loaded else base
     overrides = {}
-    for field in FIELDS:   # alight.core.material_fields: every flag of cli._add_material_options
+    for field in FIELDS:   # alight.core.material_fields: every flag of cli.arguments._add_material_options
         text = getattr(args, field.name, None)
         if text is None or text == "":   # an empty colour flag is not given (as before the registry)
             continue

@@ -1,0 +1,82 @@
+"""``alight chart``: the IBL settings swept against the ground truth (app/accuracy/chart.py)."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from alight.errors import AlightError
+from alight.frontends.cli.arguments import Command
+
+
+def add_parser(sub) -> None:
+    ch = sub.add_parser("chart", help="sweep the IBL settings: bake time, frame time, error against the ground truth",
+                        description="Measure, one factor at a time around the medium quality, every IBL setting "
+                                    "(irradiance method and size, specular cube size, sample counts, filtered "
+                                    "importance sampling, LUT size and samples, every IBL model, multiple "
+                                    "scattering judged by the white furnace) against the GPU ground truth on the "
+                                    "presets x roughness x environments. Writes CSVs and PNG charts (app/accuracy/chart.py).")
+    ch.add_argument("--quick", action="store_true",
+                    help="a small sweep: royal_esplanade only, 3 presets, 3 roughness values, a few settings")
+    ch.add_argument("--env", action="append", metavar="MAP",
+                    help="an environment (repeatable; default: every 2:1 map in ../shared/data/env, else studio)")
+    ch.add_argument("--presets", metavar="A,B,...", help="presets to measure (default: all; --quick: gold, "
+                                                          "plastic_high, water)")
+    ch.add_argument("--size", type=int, default=32, metavar="N", help="probe size for the errors (default: 32)")
+    ch.add_argument("--out", default="alight-chart", metavar="DIR", help="output folder (default: alight-chart)")
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from alight.accuracy.chart import (
+        QUICK_PRESETS,
+        QUICK_ROUGHNESS,
+        ChartConfig,
+        default_env_dir,
+        equirect_envs,
+        run_chart,
+        sweep,
+    )
+    from alight.exchange.presets import list_presets
+
+    if args.size < 8 or args.size > 256:
+        raise AlightError(f"--size: {args.size} must be from 8 to 256")
+    if args.env:
+        envs = list(args.env)
+    else:
+        env_dir = default_env_dir()
+        if env_dir is None:
+            envs = ["studio"]
+        else:
+            envs, skipped = equirect_envs(env_dir)
+            for line in [] if args.quick else skipped:
+                print(f"alight chart: skipped {line}", file=sys.stderr)
+            if args.quick:
+                pick = [e for e in envs if "royal_esplanade" in e]
+                envs = pick or envs[:1] or ["studio"]
+    presets = list(QUICK_PRESETS) if args.quick else list_presets()
+    if args.presets:
+        presets = [p.strip() for p in args.presets.split(",") if p.strip()]
+    config = ChartConfig(envs=envs, presets=presets, size=args.size,
+                         roughness=QUICK_ROUGHNESS if args.quick else ChartConfig.__dataclass_fields__["roughness"].default,
+                         frame_size=(320, 180) if args.quick else (1280, 720),
+                         frame_repeats=3 if args.quick else 7, settings=sweep(args.quick))
+    start = time.perf_counter()
+    results = run_chart(config, args.out)
+    out = Path(args.out)
+    print(f"{len(results)} settings x {len(envs)} environment(s) in {time.perf_counter() - start:.0f} s")
+    print(f"{'setting':34s} {'bake ms':>8s} {'frame ms':>9s} {'relMAE %':>9s} {'max %':>7s} {'FLIP':>6s} "
+          f"{'furnace r=1':>11s}")
+    for res in results:
+        fr = [f[1] for f in res.furnace if f[0] == 1.0]
+        print(f"{res.setting.name:34s} {res.bake_median * 1000:8.0f} {res.frame_seconds * 1000:9.1f} "
+              f"{res.rel_mean * 100:9.2f} {res.rel_max * 100:7.1f} {res.flip_mean:6.3f} "
+              f"{fr[0] if fr else float('nan'):11.3f}")
+    for name in ("chart.csv", "chart_cases.csv", "furnace.csv", "error_map.csv", "chart.png", "error_map.png"):
+        if (out / name).exists():
+            print(out / name)
+    return 0
+
+
+COMMAND = Command("chart", add_parser, run)

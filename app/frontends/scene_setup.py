@@ -1,0 +1,166 @@
+"""The scene the front ends describe, set up one way for all of them.
+
+``alight render`` and ``alight reference`` build their Scene from the same flags with
+``scene_from_flags`` (so the same flags give the same scene, the same image size and the same
+warnings); the Python API (``alight.Renderer``, and through it ``alight batch``) loads its mesh
+with ``load_scene_mesh`` and says ``framing_warnings`` before it renders. What the picture is
+drawn without (a mesh file's repairs, an environment's clamps, a flat mesh seen edge-on, a glTF
+camera whose aspect ratio is not the image's) goes to ``report`` one line at a time, as it is
+found: the CLI prints ``alight: warning: ...`` lines, the API says each once per process.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+from alight.errors import AlightError
+
+Report = Callable[[str], None]
+
+
+@dataclass
+class SceneSetup:
+    """A scene ready to render: the Scene, the environment it is lit by (None: --no-ibl) and
+    the image size in pixels (a glTF camera's aspect ratio may have set the height)."""
+
+    scene: object          # alight.core.scene.Scene (imported lazily: --help needs no numpy)
+    environment: object    # alight.ibl.environment.Environment | None
+    width: int
+    height: int
+
+
+def scene_from_flags(args, size: tuple[int, int], look, report: Report, **fields) -> SceneSetup:
+    """The scene of the scene, camera and material flags (the groups of
+    app/frontends/cli/arguments.py). ``look``: options.build_look's
+    (material, overrides, maps); ``size``: --size's (W, H), W alone (``one_side``) letting a
+    glTF camera set H; ``fields``: the Scene fields only one command has (render's display,
+    IBL model, shadows, ...). Errors: AlightError of one line (a bad light, camera or file)."""
+    from alight.core.scene import Scene, parse_light
+    from alight.exchange.texture_sets import load_map_images
+
+    material, overrides, texture_maps = look
+    lights = [parse_light(spec) for spec in args.light]
+    mesh = load_scene_mesh(args.mesh, report) if args.view == "camera" else None
+    if mesh is not None and not args.light and not args.no_file_lights:
+        lights = list(mesh.lights)
+    width, height = camera_size(args, mesh, *size, report)
+    camera = flag_camera(args, mesh, width / height)
+    for line in framing_warnings(mesh, args.mesh, camera):
+        report(line)
+    env = None if args.no_ibl else load_scene_environment(args.env, report)
+    scene = Scene(mesh=mesh, material=material, use_file_materials=args.preset is None and texture_maps is None,
+                  texture_maps=texture_maps, texture_images=load_map_images(texture_maps) if texture_maps else {},
+                  material_overrides=overrides, lights=lights, camera=camera, view=args.view,
+                  env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
+                  ibl_enabled=env is not None, **fields)
+    return SceneSetup(scene, env, width, height)
+
+
+def load_scene_mesh(spec: str, report: Report):
+    """A built-in or a mesh file (alight.exchange.meshes.load_mesh), its warnings reported."""
+    from alight.exchange.meshes import load_mesh
+
+    mesh = load_mesh(spec)
+    for line in mesh.warnings:
+        report(line)
+    return mesh
+
+
+def load_scene_environment(spec: str, report: Report):
+    """'studio' or an equirectangular map (alight.ibl.environment.load_environment), its warnings reported."""
+    from alight.ibl.environment import load_environment
+
+    env = load_environment(spec)
+    for line in env.warnings:
+        report(line)
+    return env
+
+
+def framing_warnings(mesh, name: str, camera, way_out: str = "--elevation 30 (or --orbit)") -> list[str]:
+    """The default camera (camera None, on +Z looking down -Z: docs/conventions.md) sees a flat
+    mesh edge-on, so it may not show; a built-in has its own 3/4 view (Mesh.view). ``way_out``:
+    how this front end turns the camera."""
+    if camera is not None or mesh is None or getattr(mesh, "view", None) is not None:
+        return []
+    normal = mesh.flat_normal()
+    if normal is None or abs(normal[2]) >= 0.02:
+        return []
+    return [f"{name}: the mesh is flat and the default camera (on +Z) sees it edge-on, so it "
+            f"may not show; {way_out} looks at it from another side"]
+
+
+def flag_camera(args, mesh, aspect: float):
+    """The Camera --camera and the camera flags ask for (None: the renderer frames the mesh)."""
+    from dataclasses import replace
+
+    from alight.core.scene import orbit_camera
+
+    spec = args.camera
+    flags = {"--orbit": args.orbit is not None, "--elevation": args.elevation is not None,
+             "--distance": args.distance is not None, "--target": args.target is not None}
+    if spec == "auto":
+        if not any(flags.values()) and args.fov is None:
+            return None
+        target = None
+        if args.target is not None:
+            try:
+                target = tuple(float(x) for x in args.target.split(","))
+            except ValueError:
+                target = ()
+            if len(target) != 3 or not all(math.isfinite(x) for x in target):
+                raise AlightError(f"--target: '{args.target}' is not three comma-separated numbers")
+        if mesh is None:
+            raise AlightError("--orbit/--elevation/--distance/--fov/--target: only with --view camera")
+        if target is not None:   # the file's coordinates, where the mesh was moved from (Mesh.origin)
+            target = tuple(t - o for t, o in zip(target, getattr(mesh, "origin", (0.0, 0.0, 0.0))))
+        centre, radius = mesh.bounding_sphere()
+        orbit, elevation = args.orbit, args.elevation
+        if orbit is None and elevation is None and getattr(mesh, "view", None) is not None:
+            orbit, elevation = mesh.view   # --distance, --fov or --target alone keep a built-in's view
+        return orbit_camera(centre, radius, aspect, orbit or 0.0, elevation or 0.0, args.distance,
+                            35.0 if args.fov is None else args.fov, target, corners=mesh.corners())
+    kind, _, index = spec.partition(":")
+    if kind != "gltf":
+        raise AlightError(f"--camera: '{spec}' is not auto, gltf or gltf:N")
+    used = [name for name, on in flags.items() if on]
+    if used:
+        raise AlightError(f"{used[0]}: not with --camera {spec} (the file's camera is placed by its node)")
+    try:
+        n = int(index) if index else 0
+    except ValueError:
+        raise AlightError(f"--camera: '{spec}': N must be a whole number") from None
+    cameras = getattr(mesh, "cameras", []) if mesh is not None else []
+    if not cameras:
+        raise AlightError(f"--camera: {args.mesh}: the file has no camera")
+    if not 0 <= n < len(cameras):
+        raise AlightError(f"--camera: {args.mesh}: camera {n} does not exist (the file has {len(cameras)})")
+    camera = cameras[n]
+    return camera if args.fov is None else replace(camera, fov_y_deg=args.fov)
+
+
+def camera_size(args, mesh, width: int, height: int, report: Report) -> tuple[int, int]:
+    """The image size for --camera gltf: a --size of one side takes the camera's aspect ratio
+    (glTF's perspective.aspectRatio, or xmag/ymag), as viewers do; a size that does not match
+    it is kept and reported (the vertical field of view is the camera's, so the sides are cut or
+    widened)."""
+    if args.camera == "auto" or mesh is None:
+        return width, height
+    from alight.exchange.camera_aspect import gltf_camera_aspects
+
+    kind, _, index = args.camera.partition(":")
+    try:
+        aspect = gltf_camera_aspects(args.mesh)[int(index) if index else 0]
+    except (IndexError, ValueError):
+        return width, height        # flag_camera says what is wrong with the spec
+    if aspect is None:
+        return width, height
+    if getattr(args.size, "one_side", False):
+        return width, max(1, round(width / aspect))
+    if abs(width / height - aspect) > 0.5 / height * aspect + 1e-9:
+        side = "cut off" if width / height < aspect else "widened beyond the camera's frame"
+        report(f"--camera {args.camera}: {args.mesh}'s camera has aspect ratio {aspect:.4g} but --size "
+               f"{width}x{height} is {width / height:.4g}: the image's sides are {side}; give --size {width} "
+               f"to take the camera's aspect")
+    return width, height
