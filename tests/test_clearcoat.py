@@ -87,7 +87,7 @@ def test_zero_strength_coat_compiled_in_changes_nothing(monkeypatch, shared_data
     """With HAS_CLEARCOAT forced on and clearcoat 0 the image is the base's within 0.2%
     (forward pass with point lights and the environment, and the reference)."""
     import alight.accuracy.reference as reference
-    import alight.render.renderer as forward
+    import alight.render.variants as forward
     from alight.accuracy.reference import ReferenceRenderer
 
     r = renderer()

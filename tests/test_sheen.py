@@ -111,7 +111,7 @@ def test_white_furnace_render_never_exceeds_one(model, sheen_roughness):
 
 def test_zero_strength_sheen_compiled_in_changes_nothing(monkeypatch, shared_data):
     import alight.accuracy.reference as reference
-    import alight.render.renderer as forward
+    import alight.render.variants as forward
     from alight.accuracy.reference import ReferenceRenderer
 
     r = renderer()

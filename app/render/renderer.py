@@ -50,7 +50,7 @@ from alight.render.ground import GroundPass
 from alight.render.passes import FrameContext
 from alight.render.shadows import ShadowMaps
 from alight.render.targets import HALF_FLOAT_MAX, HALF_FLOAT_MIN_EXPOSURE, Targets, tiled_targets
-from alight.render.tiles import TilePlan
+from alight.render.tiles import TILE_BYTES, TilePlan
 from alight.render.visibility_parts import OcclusionParts
 
 __all__ = ["AA_MODES", "ForwardRenderer", "Frame", "GL_FRAMEBUFFER_SRGB", "HALF_FLOAT_MAX",
@@ -268,8 +268,9 @@ class ForwardRenderer:
         def forget() -> None:
             self._targets = None
 
+        # (TILE_BYTES read here, at each call: a test lowers it on this module)
         return tiled_targets(self.ctx, width, height, aa, samples, tile,
-                             lambda w, h: self._targets_for(w, h, aa, samples, half), forget)
+                             lambda w, h: self._targets_for(w, h, aa, samples, half), forget, TILE_BYTES)
 
     def _targets_for(self, width: int, height: int, aa: str, samples: int, half: bool = False) -> Targets:
         """The framebuffers for one tile, kept while the size and mode stay."""

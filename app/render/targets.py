@@ -128,12 +128,11 @@ _GL_LIMITS = ("GL_MAX_TEXTURE_SIZE", "GL_MAX_RENDERBUFFER_SIZE", "GL_MAX_VIEWPOR
 
 def tiled_targets(ctx: moderngl.Context, width: int, height: int, aa: str, samples: int,
                   tile: tuple[int, int] | None, make: Callable[[int, int], Targets],
-                  forget: Callable[[], None]) -> tuple[TilePlan, Targets]:
+                  forget: Callable[[], None], budget: int = TILE_BYTES) -> tuple[TilePlan, Targets]:
     """The tile plan for this size and the framebuffers of one tile (``make(tile_width,
     tile_height)``). Where the GL refuses them (out of memory, an incomplete framebuffer), tiles
     a quarter the size are tried (``forget`` drops what the refused attempt left); at 16x16 an
-    AlightError says so in one line."""
-    budget = TILE_BYTES
+    AlightError says so in one line. ``budget``: the bytes one tile's framebuffers may take."""
     limits = {key: ctx.info.get(key) for key in _GL_LIMITS}
     while True:
         plan = plan_tiles(width, height, side_limit(limits, aa), framebuffer_bytes(aa, samples), budget, tile=tile)
