@@ -174,7 +174,10 @@ def test_save_preset_button_writes_the_material(ctx):
     assert os.path.isfile(path), (s.error, s.message, editor().panel.preset_path)
     assert load_preset(path) == s.material
     assert abs(json.loads(open(path, encoding="utf-8").read())["roughness"] - 0.42) < 1e-6
-    assert s.message == f"saved {path}"
+    assert s.message.startswith(f"saved {path} and to the library: "), s.message
+    from alight.frontends.editor.library import library_dir   # a saved material is in the library too
+
+    assert (library_dir() / "from_panel.glb").is_file() and "from_panel" in [e.name for e in editor().panel.library.entries]
 
 
 def test_export_gltf_button_writes_a_gltf(ctx):
@@ -782,3 +785,109 @@ def test_load_preset_button(ctx):
     assert s.material != saved
     ctx.item_click("**/load preset")
     assert s.material == saved, (s.material, s.error)
+
+
+# --- the library: saved materials with thumbnails, the presets' thumbnails ------------------------
+
+def _same_material(a, b) -> bool:
+    """Field by field within float32 rounding (a glTF file holds float32 and derives F0 from ior)."""
+    import dataclasses
+
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, str) or x == y:
+            continue
+        if not np.allclose(np.asarray(x, np.float64), np.asarray(y, np.float64), rtol=1e-6, atol=1e-6):
+            return False
+    return True
+
+
+def _capture(ctx, name: str) -> np.ndarray:
+    """The whole window as the engine captures it (panel and view, as shown): uint8 (h, w, 4)."""
+    import OpenImageIO as oiio
+    from imgui_bundle.immapp.testing import capture
+
+    path = os.path.join(OUT, name)
+    capture(ctx, path)
+    return oiio.ImageBuf(path).get_pixels(oiio.UINT8)
+
+
+def _wait_for_thumbnails(ctx, frames: int = 2000) -> None:
+    """Frames until no thumbnail the panel asked for is still to be made."""
+    thumbs = editor().thumbnails
+    for _ in range(frames):
+        ctx.yield_()
+        if not thumbs.pending():
+            return
+    raise AssertionError(f"{thumbs.pending()} thumbnails still pending after {frames} frames")
+
+
+def _icon_pixels(ctx, shot: np.ndarray, ref: str) -> np.ndarray:
+    """The thumbnail drawn left of a list row (a preset's or a library entry's), from a capture."""
+    from alight.frontends.editor.library_panel import ICON
+
+    rect = ctx.item_info(ref).rect_full
+    y0 = int(rect.min.y + (rect.max.y - rect.min.y - ICON) / 2)
+    x1 = int(rect.min.x) - 2
+    return shot[y0 + 4:y0 + ICON - 4, x1 - ICON + 4:x1 - 4, :3].astype(np.float64)
+
+
+def test_presets_show_rendered_thumbnails(ctx):
+    """Each F0 preset's row shows its rendered ball (cached as a PNG under its content key):
+    copper's thumbnail is red over blue where silver's is grey, in the files and on screen."""
+    import OpenImageIO as oiio
+
+    from alight.core.texture_maps import TextureMaps
+    from alight.frontends.editor.thumbnails import thumbnail_dir
+
+    win = editor()
+    ctx.set_ref("alight")
+    _wait_for_thumbnails(ctx)
+    presets = {name: m for name, m, *_ in win.panel.presets}
+    def centre(name):
+        file = thumbnail_dir() / f"{win.thumbnails.key(presets[name], TextureMaps())}.png"
+        assert file.is_file(), file
+        px = oiio.ImageBuf(str(file)).get_pixels(oiio.UINT8).astype(np.float64)
+        return px[24:40, 24:40, :3].mean(axis=(0, 1))
+    copper, silver = centre("copper"), centre("silver")
+    assert copper[0] / copper[2] > 1.15 * silver[0] / silver[2], (copper, silver)
+    shot = _capture(ctx, "thumbnails.png")
+    on_screen = {name: _icon_pixels(ctx, shot, f"**/{name}").mean(axis=(0, 1)) for name in ("copper", "silver")}
+    c, g = on_screen["copper"], on_screen["silver"]
+    assert c[0] / max(c[2], 1) > 1.15 * g[0] / max(g[2], 1), on_screen
+    assert np.ptp(_icon_pixels(ctx, shot, "**/copper").mean(axis=2)) > 20, "a flat swatch, not a rendered ball"
+
+
+def test_library_save_thumbnail_and_click_applies_undoably(ctx):
+    """'save to library' writes NAME.glb into the library folder; the entry appears with its
+    thumbnail; clicking it after another preset applies it (the same view), Ctrl+Z goes back."""
+    from alight.exchange.material_files import load_material_file
+    from alight.frontends.editor.library import library_dir
+
+    s, win = editor().state, editor()
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.3)
+    ctx.item_input_value("**/metallic", 0.5)
+    saved = s.material
+    shown = ball(view(ctx)).mean(axis=0)
+    ctx.item_input_value("**/library name", "ui copper")
+    ctx.item_click("**/save to library")
+    path = library_dir() / "ui_copper.glb"
+    assert path.is_file(), (s.error, s.message)
+    assert str(path) in s.message, s.message
+    assert _same_material(load_material_file(str(path))[0], saved)
+    ctx.yield_(2)
+    names = [e.name for e in win.panel.library.entries]
+    assert "ui_copper" in names, names
+    ctx.item_click("**/silver")
+    assert s.material.name == "silver"
+    ctx.item_click("**/ui_copper##library")
+    assert _same_material(s.material, saved), s.material
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), shown, atol=0.5)
+    _wait_for_thumbnails(ctx)
+    icon = _icon_pixels(ctx, _capture(ctx, "library.png"), "**/ui_copper##library").mean(axis=(0, 1))
+    assert icon[0] > icon[2] + 10, icon   # copper's ball, not the grey placeholder
+    void(ctx)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.name == "silver", s.material

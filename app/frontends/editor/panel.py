@@ -19,6 +19,7 @@ from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.exchange.presets import list_presets, load_preset
 from alight.frontends.editor.file_browser import FileBrowser
+from alight.frontends.editor.library_panel import ICON, LibraryPanel
 from alight.frontends.editor.state import DEBUG_VIEWS
 from alight.ibl.bake import QUALITY
 
@@ -61,6 +62,7 @@ class Panel:
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
+        self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -115,7 +117,7 @@ class Panel:
         if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
             # The names' column as wide as the longest name and its swatch: the F0 columns take the rest.
             longest = max((name for name, *_ in self.presets), key=len, default="preset")
-            name_width = imgui.calc_text_size(longest).x + 14 + imgui.get_style().item_spacing.x
+            name_width = imgui.calc_text_size(longest).x + ICON + imgui.get_style().item_spacing.x
             imgui.table_setup_column("preset", imgui.TableColumnFlags_.width_fixed, name_width)
             imgui.table_setup_column("F0 linear")
             imgui.table_setup_column("F0 sRGB")
@@ -123,16 +125,17 @@ class Panel:
             for name, preset, f0, f0_srgb in self.presets:
                 imgui.table_next_row()
                 imgui.table_next_column()
-                imgui.color_button(f"##sw{name}", imgui.ImVec4(*f0_srgb, 1.0), 0, imgui.ImVec2(14, 14))
+                self.library.icon(win, f"##sw{name}", preset, fallback_rgb=f0_srgb)   # its thumbnail
                 imgui.same_line()
                 # Highlighted: the preset the material is now (none once any field is edited).
-                if imgui.selectable(name, m == preset)[0]:
+                if imgui.selectable(name, m == preset, 0, imgui.ImVec2(0, ICON))[0]:
                     m = picked = preset
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0))
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0_srgb))
             imgui.end_table()
+        self.library.draw(s, win)   # saved materials; a click is applied after the write-back below
         # Base colour is stored linear (docs/conventions.md) and shown sRGB, as artists pick colours.
         changed, col = imgui.color_edit3("base colour (sRGB)", _srgb(m.base_color))
         if changed:
@@ -167,6 +170,7 @@ class Panel:
                 s.material = validate_material(m, "panel")
             except AlightError as exc:
                 s.fail(exc)
+        self.library.apply_click(s)
         if imgui.tree_node_ex("texture maps", imgui.TreeNodeFlags_.default_open):
             self._texture_maps(s)
             imgui.tree_pop()
@@ -187,6 +191,10 @@ class Panel:
                 s.error, s.message = "", f"saved {self.preset_path}"
             except AlightError as exc:
                 s.fail(exc)
+            else:   # a saved material is in the library too, under the file's name
+                self.library.save(s, self.preset_path)
+                if not s.error:
+                    s.message = f"saved {self.preset_path} and {s.message.removeprefix('saved ')}"
         imgui.same_line()
         if imgui.button("load preset"):
             s.open_file(self.preset_path)

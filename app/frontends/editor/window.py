@@ -157,6 +157,9 @@ class EditorWindow:
         self.file_watcher = FileWatcher()   # maps and the environment file changed on disk
 
         self.panel = Panel()
+        from alight.frontends.editor.thumbnails import Thumbnails
+
+        self.thumbnails = Thumbnails(self.ctx, self.renderer)   # the presets' and library's, a few a frame
 
     # --- input --------------------------------------------------------------------------------
 
@@ -547,6 +550,7 @@ class EditorWindow:
         """The view into the window's back buffer (under the panel), and a slice of a pending bake."""
         self.render_view()
         self.advance_bake()
+        self.thumbnails.step()
 
     def begin_imgui_frame(self) -> None:
         """imgui's input and new frame (after poll_events)."""
@@ -623,6 +627,7 @@ class EditorWindow:
             targets.release()
         self._target_cache.clear()
         self._panel_image.release()
+        self.thumbnails.release()
         if self.hosted:   # the runner closes imgui, the window and its context after this
             self.implot.destroy_context()
             self.renderer.release()
