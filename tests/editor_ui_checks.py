@@ -891,3 +891,41 @@ def test_library_save_thumbnail_and_click_applies_undoably(ctx):
     void(ctx)
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
     assert s.material.name == "silver", s.material
+
+
+# --- a transparent background over a checkerboard --------------------------------------------------
+
+def _checker_levels(corner: np.ndarray) -> tuple[float, float]:
+    """The fractions of a corner's pixels at the checkerboard's light and dark grey."""
+    v = corner.astype(np.int32)
+    grey = (v.max(axis=2) - v.min(axis=2)) <= 2
+    light = (grey & (np.abs(v[:, :, 0] - 204) <= 2)).mean()
+    dark = (grey & (np.abs(v[:, :, 0] - 153) <= 2)).mean()
+    return float(light), float(dark)
+
+
+def test_transparent_background_shows_a_checkerboard(ctx):
+    """With the transparent background the window shows the view over light and dark grey
+    squares (8 px) where nothing covers it, the ball opaque over them; the env background none."""
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    void(ctx)
+    w, h = win.view_area()
+    middle = (slice(h // 2 - 4, h // 2 + 4), slice(w // 2 - 4, w // 2 + 4))
+    over_env = _capture(ctx, "over_env.png")[middle][:, :, :3].mean(axis=(0, 1))
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/transparent")
+    ctx.item_close("**/Environment")
+    void(ctx)
+    shot = _capture(ctx, "checker.png")[:, :, :3]
+    light, dark = _checker_levels(shot[:32, :32])
+    assert light > 0.3 and dark > 0.3, (light, dark, shot[:2, :10, 0])
+    row = shot[2, :32, 0].astype(np.int32)
+    assert abs(row[:8].mean() - row[8:16].mean()) > 40, row   # the squares alternate every 8 px
+    np.testing.assert_allclose(shot[middle].mean(axis=(0, 1)), over_env, atol=2)   # the ball: opaque over it
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+    light, dark = _checker_levels(_capture(ctx, "no_checker.png")[:32, :32, :3])
+    assert light + dark < 0.5, (light, dark)

@@ -40,6 +40,7 @@ PANEL_WIDTH = 420
 TARGET_FPS = 30.0
 ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP = 0.25, 1.0 / 16.0
 TARGET_CACHE = 4   # view framebuffers kept, by size
+CHECKER_SQUARE = 8.0   # pixels a side of the checkerboard under a transparent background
 
 
 class EditorWindow:
@@ -467,7 +468,10 @@ class EditorWindow:
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
-        into, into_srgb = self.direct_target() if (moving and not full and size == window) else (None, False)
+        # A transparent background is shown over a checkerboard, so never drawn straight in.
+        checker = scene.display.background == "transparent" and not full
+        into, into_srgb = self.direct_target() if (moving and not full and size == window and not checker) \
+            else (None, False)
         # (The key deep-copies the lights: 0.3 ms a frame, not spent where every frame redraws.)
         key = self._view_key(scene, maps, size) if into is None else None
         direct = False     # drawn into the window (the renderer may not: draw_display)
@@ -487,6 +491,8 @@ class EditorWindow:
                 self._drawn_maps = scene.texture_maps
         if direct:
             pass   # already in the window
+        elif checker:
+            self._show_over_checker(targets, window)
         elif size == window:
             self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
         else:
@@ -502,6 +508,20 @@ class EditorWindow:
         # whatever is bound, and must draw into the window, never into the view's image.
         self.ctx.screen.use()
         return targets
+
+    def _show_over_checker(self, targets, window) -> None:
+        """The view image over a checkerboard (render/checker.frag), stretched to the view area:
+        what a transparent background shows in the window (the files keep the real alpha)."""
+        prog = self.renderer.program("render/fullscreen.vert", "render/checker.frag")
+        targets.display.filter = (self._linear, self._linear)
+        targets.display.use(0)
+        prog["u_image"] = 0
+        prog["u_square"] = CHECKER_SQUARE
+        prog["u_origin"] = (0.0, 0.0)
+        self.ctx.screen.use()
+        self.ctx.viewport = (0, 0) + window
+        self.renderer._fullscreen(prog)
+        self.ctx.viewport = (0, 0) + self.size
 
     def frame(self) -> None:
         self.draw()
