@@ -929,3 +929,53 @@ def test_transparent_background_shows_a_checkerboard(ctx):
     ctx.item_close("**/Environment")
     light, dark = _checker_levels(_capture(ctx, "no_checker.png")[:32, :32, :3])
     assert light + dark < 0.5, (light, dark)
+
+
+# --- screenshots at a chosen size ------------------------------------------------------------------
+
+def _shoot(ctx, frames: int = 3000) -> str:
+    """Click the screenshot button; the new PNG once the window has written it."""
+    names = set(os.listdir("."))
+    ctx.item_click("**/screenshot (F12)")
+    for _ in range(frames):
+        ctx.yield_()
+        new = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-") and n.endswith(".png")]
+        if new and editor().screenshot_job is None:
+            return new[0]
+    raise AssertionError(f"no screenshot written: {editor().state.error}")
+
+
+def test_screenshot_at_a_chosen_size(ctx):
+    """Unchecking 'at the view's size' and typing a size: the button writes a PNG that size (the
+    view's framing, the copper ball in the middle), and the panel's message names the file;
+    with the transparent background it is RGBA, clear around the ball. Sides clamp to 16384."""
+    import OpenImageIO as oiio
+
+    win, s = editor(), editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_open("**/Display & camera")
+    ctx.item_uncheck("**/###shot_view_size")
+    ctx.item_input_value("screenshot size/$$0", 1000)
+    ctx.item_input_value("screenshot size/$$1", 300)
+    name = _shoot(ctx)
+    image = oiio.ImageBuf(name).get_pixels(oiio.UINT8)
+    assert image.shape == (300, 1000, 3), image.shape
+    assert s.message == f"wrote {os.path.abspath(name)} (1000x300)", s.message
+    centre = image[140:160, 490:510].astype(np.float64).mean(axis=(0, 1))
+    assert centre[0] > centre[2] + 20, centre
+    ctx.item_close("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/transparent")
+    ctx.item_close("**/Environment")
+    ctx.item_open("**/Display & camera")
+    image = oiio.ImageBuf(_shoot(ctx)).get_pixels(oiio.UINT8)
+    assert image.shape == (300, 1000, 4) and image[150, 500, 3] == 255 and image[:4, :4, 3].max() == 0, image.shape
+    ctx.item_input_value("screenshot size/$$0", 20000)
+    assert win.screenshot_size.width == 16384, win.screenshot_size
+    ctx.item_check("**/###shot_view_size")
+    assert win.screenshot_size.size(win.view_area()) == win.view_area()
+    ctx.item_close("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")

@@ -497,9 +497,9 @@ class Panel:
         _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)
         if imgui.button("frame mesh (F)"):
             win.frame_mesh()
-        imgui.same_line()
-        if imgui.button("screenshot (F12)"):
-            win.screenshot_request = win.next_screenshot_name()   # the window writes it after the frame
+        from alight.frontends.editor.screenshot import draw_controls
+
+        draw_controls(win)   # size, the button (F12), progress
         imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
         imgui.text_disabled("turn the environment: Shift + right drag")
 

@@ -146,6 +146,10 @@ class EditorWindow:
 
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
+        from alight.frontends.editor.screenshot import ScreenshotSize
+
+        self.screenshot_size = ScreenshotSize()   # the view's or a chosen size (the panel's)
+        self.screenshot_job = None     # the PNG being written, a few strips a frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
         self.adaptive_scale = 0.5      # the adaptive motion scale now (see adapt_motion_scale)
         self._was_moving = False
@@ -530,13 +534,14 @@ class EditorWindow:
 
     def after_swap(self) -> None:
         """After the frame is shown: the screenshot asked for during it, the frame time."""
-        if self.screenshot_request:
+        if self.screenshot_request and self.screenshot_job is None:
             path, self.screenshot_request = self.screenshot_request, ""
             try:
-                self.save_view(path)
-                self.state.error, self.state.message = "", f"wrote {path}"
+                self.screenshot_job = self.start_save_view(path)
             except AlightError as exc:
                 self.state.fail(exc)
+        if self.screenshot_job is not None:
+            self._advance_screenshot()
         now = time.perf_counter()
         if self._last_swap is not None:
             self.frame_times.append(now - self._last_swap)
@@ -605,19 +610,41 @@ class EditorWindow:
         pixels = self.view_pixels(what=str(out))
         write_image(out, pixels, linear=False)
 
-    def save_view(self, path: str) -> None:
+    def start_save_view(self, path: str):
         """F12 and the panel's button: the view as it is framed (the area left of the panel, at
-        full resolution whatever the render and motion scales), drawn again by the renderer's
-        offline path; RGBA with the coverage as alpha when the background is transparent."""
-        from alight.exchange.output import check_output_path, write_image
+        full resolution whatever the render and motion scales, or the size chosen in the panel),
+        drawn again by the renderer's offline path; RGBA with the coverage as alpha when the
+        background is transparent. Returns the screenshot.ScreenshotJob that writes it."""
+        from alight.frontends.editor.screenshot import ScreenshotJob
 
-        out = check_output_path(path, (".png",))
         self.finish_bake()
-        w, h = self.view_area()
+        size = self.screenshot_size.size(self.view_area())
         scene = self.state.scene(self.orbit.camera())
-        frame = self.renderer.render(scene, self.maps(), w, h, aa=self.state.aa, read_linear=False, read_srgb=True)
-        alpha = scene.display.background == "transparent"
-        write_image(out, frame.srgb if alpha else frame.srgb[:, :, :3], linear=False)
+        return ScreenshotJob(self.renderer, scene, self.maps(), size, self.state.aa, path)
+
+    def _advance_screenshot(self) -> None:
+        """A few strips of the screenshot being written; the panel's message says when it is."""
+        job = self.screenshot_job
+        try:
+            done = job.step()
+        except AlightError as exc:
+            self.state.fail(exc)
+            done = True
+        finally:
+            self.ctx.screen.use()
+        if done:
+            self.screenshot_job = None
+            if os.path.isfile(job.path) and job.rows == job.height:
+                self.state.error, self.state.message = "", f"wrote {job.path} ({job.width}x{job.height})"
+
+    def save_view(self, path: str) -> None:
+        """``start_save_view`` run to the end now."""
+        job = self.start_save_view(path)
+        try:
+            while not job.step(float("inf")):
+                pass
+        finally:
+            self.ctx.screen.use()
 
     def view_pixels(self, what: str = "the view"):
         """The view without the panel at window size, top row first: uint8 (h, w, 3), sRGB."""
