@@ -979,3 +979,15 @@ def test_screenshot_at_a_chosen_size(ctx):
     ctx.item_open("**/Environment")
     ctx.combo_click("background/env")
     ctx.item_close("**/Environment")
+
+
+def test_typed_values_are_kept_without_float_noise(ctx):
+    """A value typed into a float widget is kept as typed (0.6, not float32's 0.6000000238...),
+    in the state and in the preset file saved."""
+    import re
+
+    s = editor().state
+    path = _save_preset_through_panel(ctx, "gold", 0.6, "tidy.json")
+    assert s.material.roughness == 0.6, repr(s.material.roughness)
+    text = open(path, encoding="utf-8").read()
+    assert re.search(r'"roughness": 0\.6\b', text) and "0.6000000" not in text, text

@@ -122,6 +122,8 @@ def test_the_editor_takes_renders_scene_options(display, tmp_path):
     assert np.abs(rotated - default).mean() > 1.0
     probe = edit("--view", "probe", "--screenshot", str(tmp_path / "p.png"))
     assert probe.returncode == 2 and probe.stderr.count("\n") == 1 and not (tmp_path / "p.png").exists()
+    helped = edit("--help")   # ... and not offered: the editor's help has no --view
+    assert helped.returncode == 0 and "--view" not in helped.stdout and "probe" not in helped.stdout, helped.stdout
 
 
 def test_window_checks_in_a_fresh_process(display):

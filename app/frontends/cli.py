@@ -64,7 +64,8 @@ class _Size(tuple):
         return size
 
 
-def _add_scene_options(p: argparse.ArgumentParser) -> None:
+def _add_scene_options(p: argparse.ArgumentParser, views: bool = True) -> None:
+    """``views``: offer --view (the editor draws the camera view only, and does not offer it)."""
     g = p.add_argument_group("scene")
     g.add_argument("--mesh", default="sphere",
                    help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh file "
@@ -83,9 +84,11 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
                         "W/sr-like, divided by distance squared; directional is irradiance). Without --light, "
                         "a glTF file's KHR_lights_punctual lights are used")
     g.add_argument("--no-file-lights", action="store_true", help="ignore the lights a glTF file brings")
+    # Taken but not offered where only the camera view is drawn (the editor refuses probe in a line).
     g.add_argument("--view", choices=("camera", "probe"), default="camera",
                    help="camera: the mesh framed by a camera on +Z; probe: docs/conventions.md's analysis view "
-                        "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)")
+                        "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)"
+                   if views else argparse.SUPPRESS)
     _add_material_options(p)
 
 
@@ -229,7 +232,7 @@ def _add_edit_parser(sub) -> None:
     e = sub.add_parser("edit", help="open the interactive material editor (needs a display)",
                        description="The material editor: a window with a live preview and a panel. "
                                    "Drop .hdr/.exr, mesh or preset .json files on it.")
-    _add_scene_options(e)
+    _add_scene_options(e, views=False)
     e.add_argument("--quality", choices=QUALITIES + ("auto",), default="medium",
                    help="bake quality; auto: the cheapest measured bake within 2%% for the environment and "
                         "the kind of material, shown in the panel (default: medium)")

@@ -39,6 +39,27 @@ def _edited(m, **fields):
         return dataclasses.replace(m, **fields)
 
 
+def _short_float(x):
+    """A widget's float32 as the shortest decimal that reads back as it (0.6, not 0.6000000238)."""
+    return float(str(np.float32(x))) if np.isfinite(x) else x
+
+
+def tidy_edit(old, new):
+    """``new`` with each field that differs from ``old`` rounded as ``_short_float`` (imgui's
+    widgets are float32: typed 0.6 comes back 0.6000000238418579, and presets and sessions
+    saved it so); fields not edited keep their exact values."""
+    changes = {}
+    for f in dataclasses.fields(new):
+        a, b = getattr(old, f.name), getattr(new, f.name)
+        if a == b or isinstance(b, (str, bool)):
+            continue
+        if isinstance(b, float):
+            changes[f.name] = _short_float(b)
+        elif isinstance(b, tuple) and all(isinstance(x, float) for x in b):
+            changes[f.name] = tuple(_short_float(x) for x in b)
+    return dataclasses.replace(new, **changes) if changes else new
+
+
 def _linear(c) -> tuple[float, float, float]:
     return tuple(float(x) for x in np.clip(srgb_to_linear(np.asarray(c, np.float64)), 0.0, 1.0))
 
@@ -167,7 +188,7 @@ class Panel:
             s.material = s.saved_material = picked
         elif m != s.material:
             try:
-                s.material = validate_material(m, "panel")
+                s.material = validate_material(tidy_edit(s.material, m), "panel")
             except AlightError as exc:
                 s.fail(exc)
         self.library.apply_click(s)

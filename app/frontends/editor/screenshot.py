@@ -63,6 +63,10 @@ class ScreenshotJob:
                     return True
                 self._put(strip.frame.srgb[:, :, :self.channels])
                 self.rows += len(strip.frame.srgb)
+                if self.rows >= self.height:   # the last strip: the file is whole now
+                    self._strips.close()
+                    self._writer.__exit__(None, None, None)
+                    return True
                 if time.perf_counter() - start >= budget_s:
                     return False
         except BaseException:
