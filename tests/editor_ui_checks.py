@@ -991,3 +991,19 @@ def test_typed_values_are_kept_without_float_noise(ctx):
     assert s.material.roughness == 0.6, repr(s.material.roughness)
     text = open(path, encoding="utf-8").read()
     assert re.search(r'"roughness": 0\.6\b', text) and "0.6000000" not in text, text
+
+
+def test_an_error_line_does_not_move_the_panel(ctx):
+    """The status row at the panel's top keeps its height: a long error replacing a message
+    leaves every control where it was (the next click lands where the artist aimed)."""
+    s = editor().state
+    _save_preset_through_panel(ctx, "gold", 0.5, "before_error.json")
+    assert s.message and not s.error, (s.message, s.error)
+    ctx.item_input_value("**/preset file", os.path.join(OUT, "no_such_preset_" * 8 + ".json"))
+    ctx.yield_(2)
+    before = ctx.item_info("**/load preset").rect_full.min.y
+    ctx.item_click("**/load preset")
+    ctx.yield_(2)
+    assert s.error and editor().panel.shown_error == s.error, s.error
+    after = ctx.item_info("**/load preset").rect_full.min.y
+    assert after == before, (before, after, s.error)

@@ -97,15 +97,7 @@ class Panel:
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse)
         self.shown_error = s.error
-        if s.error:
-            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), "error:")
-            imgui.same_line()
-            imgui.text_wrapped(s.error)
-        elif s.message:
-            imgui.text_disabled(s.message)
-        if win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
-            fraction, label = win.bake_progress
-            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
+        self._status_line(s, win)
         if imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
             self._material(s, win)
         if imgui.collapsing_header("Environment"):
@@ -123,6 +115,28 @@ class Panel:
             self.chart_view.draw()
         imgui.end()
         self.browser.draw()
+
+    @staticmethod
+    def _status_line(s, win) -> None:
+        """One row of a fixed height at the top: the error, else the bake's progress, else the
+        last message, else nothing; so the rows below never move when one appears or goes. A
+        long line is cut at the panel's edge; hovering it shows it whole."""
+        from imgui_bundle import imgui
+
+        top = imgui.get_cursor_pos_y()
+        if s.error:
+            imgui.align_text_to_frame_padding()
+            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), f"error: {s.error}")
+        elif win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
+            fraction, label = win.bake_progress
+            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
+        elif s.message:
+            imgui.align_text_to_frame_padding()
+            imgui.text_disabled(s.message)
+        if (s.error or s.message) and imgui.is_item_hovered():
+            imgui.set_tooltip(s.error or s.message)
+        # Always the height of one framed row, whatever was drawn.
+        imgui.set_cursor_pos_y(top + imgui.get_frame_height_with_spacing())
 
     # --- sections -------------------------------------------------------------------------------
 
