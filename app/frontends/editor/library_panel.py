@@ -67,7 +67,6 @@ class LibraryPanel:
         for line in self.problems:
             imgui.text_disabled(line)
         _, self.name = imgui.input_text("library name", self.name)
-        imgui.same_line()
         if imgui.button("save to library"):
             self.save(s, self.name)
         imgui.tree_pop()

@@ -34,7 +34,8 @@ from alight.ibl.bake import QUALITY
 BAKE_SLICE_S = 0.03
 # The panel is a side bar on the window's right (at most half the window): the view is the
 # rest, so the panel never covers the mesh, and the view starts at the framebuffer's origin.
-PANEL_WIDTH = 420
+# 480 at 1280x720 (420 cut the labels of the widest rows there).
+PANEL_WIDTH = 480
 # Adaptive resolution while the camera moves: the view's scale follows the frame time toward
 # this rate, in steps (a new size reallocates the view's targets), between these bounds.
 TARGET_FPS = 30.0
