@@ -1007,3 +1007,17 @@ def test_an_error_line_does_not_move_the_panel(ctx):
     assert s.error and editor().panel.shown_error == s.error, s.error
     after = ctx.item_info("**/load preset").rect_full.min.y
     assert after == before, (before, after, s.error)
+
+
+def test_ctrl_a_selects_a_text_field(ctx):
+    """Ctrl+A in a text field selects all of it: what is typed next replaces the text."""
+    from imgui_bundle import imgui
+
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/preset file", "some_long_name.json")
+    ctx.item_click("**/preset file")
+    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.a)
+    ctx.key_chars("material.json")
+    ctx.key_press(imgui.Key.enter)
+    ctx.yield_(2)
+    assert editor().panel.preset_path == "material.json", editor().panel.preset_path

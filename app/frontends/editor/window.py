@@ -87,6 +87,7 @@ class EditorWindow:
             # screenshots and benchmarks keep none, so they never depend on the last session.
             imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
             self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
+            glfw.set_key_callback(self.window, self._key_callback)   # keys as the layout labels them (keys.py)
             self._native_imgui = self._start_native_imgui(imgui)
         from alight.frontends.editor.panel_image import PanelImage
 
@@ -185,6 +186,13 @@ class EditorWindow:
             self.state.open_texture_set(images)
         except Exception as exc:   # one line in the panel, never a traceback
             self.state.fail(exc)
+
+    def _key_callback(self, window, key, scancode, action, mods) -> None:
+        """glfw's key event to imgui with the key the layout prints (keys.translate_key)."""
+        from alight.frontends.editor.keys import translate_key
+
+        name = self.glfw.get_key_name(key, scancode) if key != self.glfw.KEY_UNKNOWN else None
+        self.impl.keyboard_callback(window, translate_key(key, name), scancode, action, mods)
 
     def _camera_input(self) -> None:
         imgui, io = self.imgui, self.imgui.get_io()
