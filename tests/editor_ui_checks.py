@@ -812,14 +812,19 @@ def _capture(ctx, name: str) -> np.ndarray:
     return oiio.ImageBuf(path).get_pixels(oiio.UINT8)
 
 
-def _wait_for_thumbnails(ctx, frames: int = 2000) -> None:
-    """Frames until no thumbnail the panel asked for is still to be made."""
+def _wait_for_thumbnails(ctx, seconds: float = 400.0) -> None:
+    """Frames until no thumbnail the panel asked for is still to be made (each is an 'alight
+    render' in a child process; on a loaded machine a layered material's takes many seconds)."""
+    import time
+
     thumbs = editor().thumbnails
-    for _ in range(frames):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
         ctx.yield_()
         if not thumbs.pending():
+            assert not thumbs.failures(), thumbs.failures()
             return
-    raise AssertionError(f"{thumbs.pending()} thumbnails still pending after {frames} frames")
+    raise AssertionError(f"{thumbs.pending()} thumbnails still pending after {seconds} s")
 
 
 def _icon_pixels(ctx, shot: np.ndarray, ref: str) -> np.ndarray:

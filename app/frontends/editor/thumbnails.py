@@ -1,16 +1,23 @@
 """Thumbnails of materials (the F0 table's presets, the library's entries) for the panel.
 
-Each is the material on the built-in sphere under the built-in studio (its own 'low' bake,
-whatever the view shows, so a thumbnail depends on the material alone), rendered once by the
-editor's ForwardRenderer and kept as a PNG in the user's cache folder under the material's
-content key (``library.content_key``): the next start only reads the files. The panel asks
-for a texture id each frame (``texture_id``: no GL, None until ready); the window renders what
-was asked for in ``step`` after the view, one thumbnail a frame at most and none in the first
-frames, so a long list never stalls the editor (the studio's bake for them runs in slices too).
+Each is the material on the built-in sphere under the built-in studio, as ``alight render
+--preset FILE --size 64 --quality low`` draws it, kept as a PNG in the user's cache folder under
+the material's content key (``library.content_key``): the next start only reads the files.
+
+They are rendered by that command in a child process, one at a time, driven by a thread of
+their own: a layered material (transmission, sheen, anisotropy ...) needs its own shader
+variant, and compiling one took 12-19 s on this 2-core llvmpipe machine under load, a freeze
+of the editor had its own GL context done it. The panel asks for a texture id each frame
+(``texture_id``: no GL, None until ready); the window's ``step`` (after the view) uploads the
+PNGs that are ready, none in the first frames and a few milliseconds' worth a frame.
 """
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -21,8 +28,9 @@ from alight.frontends.editor.library import content_key
 
 THUMB_SIZE = 64          # pixels a side, rendered and cached (drawn smaller in the list)
 START_AFTER_FRAMES = 2   # the editor's first frames draw the view alone
-FRAME_BUDGET_S = 0.015   # what step() spends a frame at most, beyond one render or bake slice
-THUMB_VERSION = "1"      # part of the cache key: a change to how thumbnails look renders them anew
+FRAME_BUDGET_S = 0.01    # what step() spends a frame reading and uploading ready thumbnails
+THUMB_VERSION = "2"      # part of the cache key: a change to how thumbnails look renders them anew
+RENDER_TIMEOUT_S = 600   # one child render at most (a shader variant compiled on a loaded machine)
 
 
 def thumbnail_dir() -> Path:
@@ -32,15 +40,18 @@ def thumbnail_dir() -> Path:
 
 
 class Thumbnails:
-    def __init__(self, ctx, renderer):
-        self.ctx, self.renderer = ctx, renderer
+    def __init__(self, ctx, renderer=None):
+        self.ctx = ctx
         self._keys: dict = {}          # (material, maps) -> content key (hashing map files once)
         self._textures: dict = {}      # content key -> moderngl.Texture
         self._wanted: dict = {}        # content key -> (material, maps), in the order asked
         self._failed: dict = {}        # content key -> the error line (not retried)
         self._frames = 0
-        self._env = self._ibl = self._mesh = None
-        self._bake = None              # the studio's bake in progress (a generator)
+        self._lock = threading.Lock()
+        self._queue: list = []         # (key, material, maps) for the worker, in order
+        self._queued: set = set()
+        self._worker = None
+        self._stop = threading.Event()
         self.rendered = 0              # thumbnails rendered (not read from the cache) so far
         self.loaded = 0                # thumbnails read from the cache so far
 
@@ -49,10 +60,6 @@ class Thumbnails:
         if k not in self._keys:
             self._keys[k] = content_key(material, maps, f"thumbnail {THUMB_VERSION} {THUMB_SIZE}")
         return self._keys[k]
-
-    def forget(self, material, maps) -> None:
-        """Hash the maps' files again next time (a map changed on disk)."""
-        self._keys.pop((material, maps), None)
 
     def texture_id(self, material, maps) -> int | None:
         """The GL name of the thumbnail's texture, or None until it is ready (then it is queued)."""
@@ -67,84 +74,83 @@ class Thumbnails:
     def pending(self) -> int:
         return len(self._wanted)
 
+    def failures(self) -> list[str]:
+        return list(self._failed.values())
+
     def step(self, budget_s: float = FRAME_BUDGET_S) -> None:
-        """Make the thumbnails asked for (GL context current): read cached ones while the budget
-        lasts, render at most one. Leaves the window's framebuffer bound."""
+        """Upload the thumbnails asked for whose PNG is in the cache (GL context current), while
+        the budget lasts; hand the others to the worker thread. Binds nothing else."""
         self._frames += 1
         if self._frames <= START_AFTER_FRAMES or not self._wanted:
             return
         start = time.perf_counter()
-        try:
-            while self._wanted and time.perf_counter() - start < budget_s:
-                key, (material, maps) = next(iter(self._wanted.items()))
-                file = thumbnail_dir() / f"{key}.png"
-                pixels = _read(file)
-                if pixels is None:
-                    if not self._studio_ready():
-                        return
-                    try:
-                        pixels = self._render(material, maps)
-                    except AlightError as exc:
-                        self._failed[key] = " ".join(str(exc).split())
-                        del self._wanted[key]
-                        continue
-                    self._write(file, pixels)
-                    self.rendered += 1
-                else:
-                    self.loaded += 1
-                self._textures[key] = self.ctx.texture((THUMB_SIZE, THUMB_SIZE), 4, np.ascontiguousarray(pixels).tobytes())
+        for key, (material, maps) in list(self._wanted.items()):
+            if time.perf_counter() - start >= budget_s:
+                return
+            with self._lock:
+                failed = self._failed.get(key)
+            if failed is not None:
                 del self._wanted[key]
-        finally:
-            self.ctx.screen.use()
-            self.ctx.viewport = (0, 0) + tuple(self.ctx.screen.size)
+                continue
+            pixels = _read(thumbnail_dir() / f"{key}.png")
+            if pixels is None:
+                self._ask(key, material, maps)
+                continue
+            self.loaded += key not in self._queued
+            self._textures[key] = self.ctx.texture((THUMB_SIZE, THUMB_SIZE), 4, np.ascontiguousarray(pixels).tobytes())
+            del self._wanted[key]
 
-    def _studio_ready(self) -> bool:
-        """The built-in studio's 'low' bake, a slice a call: True once it is done."""
-        if self._ibl is not None:
-            return True
-        if self._bake is None:
-            from alight.exchange.meshes import load_mesh
-            from alight.ibl.environment import load_environment
+    def _ask(self, key, material, maps) -> None:
+        with self._lock:
+            if key in self._queued:
+                return
+            self._queued.add(key)
+            self._queue.append((key, material, maps))
+        if self._worker is None:
+            self._worker = threading.Thread(target=self._work, name="alight-thumbnails", daemon=True)
+            self._worker.start()
 
-            self._env, self._mesh = load_environment("studio"), load_mesh("sphere")
-            self._bake = self.renderer.bake_steps(self._env, "low")
-        try:
-            next(self._bake)
-            return False
-        except StopIteration as done:
-            self._ibl, self._bake = done.value, None
-            return True
-
-    def _render(self, material, maps):
-        """uint8 (THUMB_SIZE, THUMB_SIZE, 4) sRGB, top row first: the material on the sphere."""
-        from alight.core.scene import Scene
-        from alight.exchange.texture_sets import load_map_images
-        from alight.frontends.editor.state import default_lights
-
-        scene = Scene(mesh=self._mesh, material=material, use_file_materials=False, lights=default_lights(),
-                      texture_maps=maps, texture_images=load_map_images(maps) if maps.paths() else {},
-                      shadows="off")
-        frame = self.renderer.render(scene, self._ibl, THUMB_SIZE, THUMB_SIZE, aa="none",
-                                     read_linear=False, read_srgb=True)
-        return frame.srgb
-
-    @staticmethod
-    def _write(file: Path, pixels) -> None:
-        """Into the cache; a cache that cannot be written only costs a render next time."""
-        from alight.exchange.output import write_image
-
-        try:
-            file.parent.mkdir(parents=True, exist_ok=True)
-            write_image(file, pixels, linear=False)
-        except (AlightError, OSError):
-            pass
+    def _work(self) -> None:
+        while not self._stop.is_set():
+            with self._lock:
+                job = self._queue.pop(0) if self._queue else None
+            if job is None:
+                self._stop.wait(0.1)
+                continue
+            key, material, maps = job
+            try:
+                render_thumbnail(material, maps, thumbnail_dir() / f"{key}.png")
+                self.rendered += 1
+            except AlightError as exc:
+                with self._lock:
+                    self._failed[key] = " ".join(str(exc).split())
 
     def release(self) -> None:
+        self._stop.set()
         for texture in self._textures.values():
             texture.release()
         self._textures.clear()
-        if self._bake is not None:
-            self._bake.close()
+
+
+def render_thumbnail(material, maps, out: Path) -> None:
+    """``alight render`` of the material (written to a scratch preset: .json, or .glb with its
+    maps) on the sphere, THUMB_SIZE square, into ``out`` (written atomically by the command).
+    Errors: AlightError with the command's last line."""
+    from alight.exchange.material_files import save_material_file
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="alight-thumb-") as scratch:
+        preset = Path(scratch) / ("material.glb" if maps.paths() else "material.json")
+        save_material_file(material, preset, maps)
+        try:
+            done = subprocess.run([sys.executable, "-m", "alight", "render", "--preset", str(preset),
+                                   "--size", str(THUMB_SIZE), "--quality", "low", "--out", str(out)],
+                                  capture_output=True, text=True, timeout=RENDER_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            raise AlightError(f"{out.name}: the thumbnail's render took over {RENDER_TIMEOUT_S} s") from None
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
+        raise AlightError(f"thumbnail of '{material.name}': {last}")
 
 
 def _read(file: Path):
@@ -158,6 +164,8 @@ def _read(file: Path):
         pixels = buf.get_pixels(oiio.UINT8)
     except Exception:   # a damaged cache file: rendered again
         return None
-    if pixels is None or pixels.shape != (THUMB_SIZE, THUMB_SIZE, 4):
+    if pixels is None or pixels.shape[:2] != (THUMB_SIZE, THUMB_SIZE) or pixels.shape[2] not in (3, 4):
         return None
+    if pixels.shape[2] == 3:   # alight render's opaque PNG: RGB
+        pixels = np.concatenate([pixels, np.full(pixels.shape[:2] + (1,), 255, np.uint8)], axis=2)
     return pixels

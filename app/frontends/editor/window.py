@@ -166,7 +166,7 @@ class EditorWindow:
         self.panel = Panel()
         from alight.frontends.editor.thumbnails import Thumbnails
 
-        self.thumbnails = Thumbnails(self.ctx, self.renderer)   # the presets' and library's, a few a frame
+        self.thumbnails = Thumbnails(self.ctx)   # the presets' and library's, a few a frame
 
     # --- input --------------------------------------------------------------------------------
 
