@@ -21,7 +21,7 @@ def ui_test(tmp_path: Path, file: Path, *args: str, size: str = "640x400") -> su
     env = dict(os.environ, ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"),
                ALIGHT_DATA_DIR=str(tmp_path / "data"), ALIGHT_UI_TEST_OUT=str(tmp_path))
     return subprocess.run([sys.executable, "-m", "alight", "edit", "--size", size, *args, "--ui-test", str(file)],
-                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=1200)
 
 
 def test_every_panel_check_passes_through_the_test_engine(display, tmp_path):

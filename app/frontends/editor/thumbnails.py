@@ -1,11 +1,12 @@
 """Thumbnails of materials (the F0 table's presets, the library's entries) for the panel.
 
-Each is the material on the built-in sphere under the built-in studio, as ``alight render
---preset FILE --size 64 --quality low`` draws it, kept as a PNG in the user's cache folder under
-the material's content key (``library.content_key``): the next start only reads the files.
+Each is the material on the built-in sphere under the built-in studio (its own 'low' bake,
+whatever the view shows, so a thumbnail depends on the material alone), kept as a PNG in the
+user's cache folder under the material's content key (``library.content_key``): the next start
+only reads the files.
 
-They are rendered by that command in a child process, one at a time, driven by a thread of
-their own: a layered material (transmission, sheen, anisotropy ...) needs its own shader
+They are rendered by one child process (thumbnail_worker.py), a job at a time, driven by a
+thread of their own: a layered material (transmission, sheen, anisotropy ...) needs its own shader
 variant, and compiling one took 12-19 s on this 2-core llvmpipe machine under load, a freeze
 of the editor had its own GL context done it. The panel asks for a texture id each frame
 (``texture_id``: no GL, None until ready); the window's ``step`` (after the view) uploads the
@@ -30,7 +31,6 @@ THUMB_SIZE = 64          # pixels a side, rendered and cached (drawn smaller in 
 START_AFTER_FRAMES = 2   # the editor's first frames draw the view alone
 FRAME_BUDGET_S = 0.01    # what step() spends a frame reading and uploading ready thumbnails
 THUMB_VERSION = "2"      # part of the cache key: a change to how thumbnails look renders them anew
-RENDER_TIMEOUT_S = 600   # one child render at most (a shader variant compiled on a loaded machine)
 
 
 def thumbnail_dir() -> Path:
@@ -111,19 +111,31 @@ class Thumbnails:
             self._worker.start()
 
     def _work(self) -> None:
-        while not self._stop.is_set():
-            with self._lock:
-                job = self._queue.pop(0) if self._queue else None
-            if job is None:
-                self._stop.wait(0.1)
-                continue
-            key, material, maps = job
-            try:
-                render_thumbnail(material, maps, thumbnail_dir() / f"{key}.png")
-                self.rendered += 1
-            except AlightError as exc:
+        """The worker thread: jobs to the render process (thumbnail_worker.py), one at a time."""
+        process = None
+        try:
+            while not self._stop.is_set():
                 with self._lock:
-                    self._failed[key] = " ".join(str(exc).split())
+                    job = self._queue.pop(0) if self._queue else None
+                if job is None:
+                    self._stop.wait(0.1)
+                    continue
+                key, material, maps = job
+                try:
+                    if process is None or process.poll() is not None:
+                        process = _start_worker()
+                    render_thumbnail(process, material, maps, thumbnail_dir() / f"{key}.png")
+                    self.rendered += 1
+                except AlightError as exc:
+                    with self._lock:
+                        self._failed[key] = " ".join(str(exc).split())
+        finally:
+            if process is not None and process.poll() is None:
+                process.stdin.close()
+                try:
+                    process.wait(timeout=5)
+                except subprocess.TimeoutExpired:
+                    process.kill()
 
     def release(self) -> None:
         self._stop.set()
@@ -132,25 +144,29 @@ class Thumbnails:
         self._textures.clear()
 
 
-def render_thumbnail(material, maps, out: Path) -> None:
-    """``alight render`` of the material (written to a scratch preset: .json, or .glb with its
-    maps) on the sphere, THUMB_SIZE square, into ``out`` (written atomically by the command).
-    Errors: AlightError with the command's last line."""
+def _start_worker():
+    return subprocess.Popen([sys.executable, "-m", "alight.frontends.editor.thumbnail_worker"],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                            text=True, bufsize=1)
+
+
+def render_thumbnail(process, material, maps, out: Path) -> None:
+    """The material (written to a scratch file: .json, or .glb with its maps) rendered by the
+    worker process into ``out``. Errors: AlightError with the worker's line."""
     from alight.exchange.material_files import save_material_file
 
     out.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="alight-thumb-") as scratch:
-        preset = Path(scratch) / ("material.glb" if maps.paths() else "material.json")
-        save_material_file(material, preset, maps)
+        source = Path(scratch) / ("material.glb" if maps.paths() else "material.json")
+        save_material_file(material, source, maps)
         try:
-            done = subprocess.run([sys.executable, "-m", "alight", "render", "--preset", str(preset),
-                                   "--size", str(THUMB_SIZE), "--quality", "low", "--out", str(out)],
-                                  capture_output=True, text=True, timeout=RENDER_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            raise AlightError(f"{out.name}: the thumbnail's render took over {RENDER_TIMEOUT_S} s") from None
-    if done.returncode != 0:
-        last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
-        raise AlightError(f"thumbnail of '{material.name}': {last}")
+            process.stdin.write(f"{source}\t{out}\n")
+            process.stdin.flush()
+            answer = process.stdout.readline().strip()
+        except (OSError, ValueError):
+            answer = ""
+    if answer != "ok":
+        raise AlightError(f"thumbnail of '{material.name}': {answer or 'the render process ended'}")
 
 
 def _read(file: Path):
