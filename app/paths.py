@@ -46,3 +46,14 @@ def config_dir() -> Path:
     import platformdirs
 
     return Path(platformdirs.user_config_dir("alight", appauthor=False))
+
+
+def data_dir() -> Path:
+    """What the user keeps (the editor's material library): ``ALIGHT_DATA_DIR``, else the
+    platform's user data folder (``~/.local/share/alight`` on Linux, honouring XDG_DATA_HOME)."""
+    explicit = os.environ.get("ALIGHT_DATA_DIR")
+    if explicit:
+        return Path(explicit)
+    import platformdirs
+
+    return Path(platformdirs.user_data_dir("alight", appauthor=False))

@@ -30,9 +30,10 @@ def shared_data() -> Path:
 @pytest.fixture(scope="session", autouse=True)
 def _private_cache_and_config(tmp_path_factory):
     """Keep the tests' caches and the editor's session away from the user's own folders."""
-    old = {k: os.environ.get(k) for k in ("ALIGHT_CACHE_DIR", "ALIGHT_CONFIG_DIR")}
+    old = {k: os.environ.get(k) for k in ("ALIGHT_CACHE_DIR", "ALIGHT_CONFIG_DIR", "ALIGHT_DATA_DIR")}
     os.environ["ALIGHT_CACHE_DIR"] = str(tmp_path_factory.mktemp("alight-cache"))
     os.environ["ALIGHT_CONFIG_DIR"] = str(tmp_path_factory.mktemp("alight-config"))
+    os.environ["ALIGHT_DATA_DIR"] = str(tmp_path_factory.mktemp("alight-data"))   # the editor's library
     yield
     for k, v in old.items():
         if v is None:

@@ -174,7 +174,10 @@ def test_save_preset_button_writes_the_material(ctx):
     assert os.path.isfile(path), (s.error, s.message, editor().panel.preset_path)
     assert load_preset(path) == s.material
     assert abs(json.loads(open(path, encoding="utf-8").read())["roughness"] - 0.42) < 1e-6
-    assert s.message == f"saved {path}"
+    assert s.message.startswith(f"saved {path} and to the library: "), s.message
+    from alight.frontends.editor.library import library_dir   # a saved material is in the library too
+
+    assert (library_dir() / "from_panel.glb").is_file() and "from_panel" in [e.name for e in editor().panel.library.entries]
 
 
 def test_export_gltf_button_writes_a_gltf(ctx):
@@ -919,3 +922,249 @@ def test_load_preset_button(ctx):
     assert s.material != saved
     ctx.item_click("**/load preset")
     assert s.material == saved, (s.material, s.error)
+
+
+# --- the library: saved materials with thumbnails, the presets' thumbnails ------------------------
+
+def _same_material(a, b) -> bool:
+    """Field by field within float32 rounding (a glTF file holds float32 and derives F0 from ior)."""
+    import dataclasses
+
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, str) or x == y:
+            continue
+        if not np.allclose(np.asarray(x, np.float64), np.asarray(y, np.float64), rtol=1e-6, atol=1e-6):
+            return False
+    return True
+
+
+def _capture(ctx, name: str) -> np.ndarray:
+    """The whole window as the engine captures it (panel and view, as shown): uint8 (h, w, 4)."""
+    import OpenImageIO as oiio
+    from imgui_bundle.immapp.testing import capture
+
+    path = os.path.join(OUT, name)
+    capture(ctx, path)
+    return oiio.ImageBuf(path).get_pixels(oiio.UINT8)
+
+
+def _wait_for_thumbnails(ctx, seconds: float = 400.0) -> None:
+    """Frames until no thumbnail the panel asked for is still to be made (each is an 'alight
+    render' in a child process; on a loaded machine a layered material's takes many seconds)."""
+    import time
+
+    thumbs = editor().thumbnails
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        ctx.yield_()
+        if not thumbs.pending():
+            assert not thumbs.failures(), thumbs.failures()
+            return
+    raise AssertionError(f"{thumbs.pending()} thumbnails still pending after {seconds} s")
+
+
+def _icon_pixels(ctx, shot: np.ndarray, ref: str) -> np.ndarray:
+    """The thumbnail drawn left of a list row (a preset's or a library entry's), from a capture."""
+    from alight.frontends.editor.library_panel import ICON
+
+    rect = ctx.item_info(ref).rect_full
+    y0 = int(rect.min.y + (rect.max.y - rect.min.y - ICON) / 2)
+    x1 = int(rect.min.x) - 2
+    return shot[y0 + 4:y0 + ICON - 4, x1 - ICON + 4:x1 - 4, :3].astype(np.float64)
+
+
+def test_presets_show_rendered_thumbnails(ctx):
+    """Each F0 preset's row shows its rendered ball (cached as a PNG under its content key):
+    copper's thumbnail is red over blue where silver's is grey, in the files and on screen."""
+    import OpenImageIO as oiio
+
+    from alight.core.texture_maps import TextureMaps
+    from alight.frontends.editor.thumbnails import thumbnail_dir
+
+    win = editor()
+    ctx.set_ref("alight")
+    _wait_for_thumbnails(ctx)
+    presets = {name: m for name, m, *_ in win.panel.presets}
+    def centre(name):
+        file = thumbnail_dir() / f"{win.thumbnails.key(presets[name], TextureMaps())}.png"
+        assert file.is_file(), file
+        px = oiio.ImageBuf(str(file)).get_pixels(oiio.UINT8).astype(np.float64)
+        return px[24:40, 24:40, :3].mean(axis=(0, 1))
+    copper, silver = centre("copper"), centre("silver")
+    assert copper[0] / copper[2] > 1.15 * silver[0] / silver[2], (copper, silver)
+    ctx.item_make_visible("**/copper", 0)   # earlier checks leave the panel scrolled down
+    ctx.item_make_visible("**/silver", 0)
+    shot = _capture(ctx, "thumbnails.png")
+    on_screen = {name: _icon_pixels(ctx, shot, f"**/{name}").mean(axis=(0, 1)) for name in ("copper", "silver")}
+    c, g = on_screen["copper"], on_screen["silver"]
+    assert c[0] / max(c[2], 1) > 1.15 * g[0] / max(g[2], 1), on_screen
+    assert np.ptp(_icon_pixels(ctx, shot, "**/copper").mean(axis=2)) > 20, "a flat swatch, not a rendered ball"
+
+
+def test_library_save_thumbnail_and_click_applies_undoably(ctx):
+    """'save to library' writes NAME.glb into the library folder; the entry appears with its
+    thumbnail; clicking it after another preset applies it (the same view), Ctrl+Z goes back."""
+    from alight.exchange.material_files import load_material_file
+    from alight.frontends.editor.library import library_dir
+
+    s, win = editor().state, editor()
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.3)
+    ctx.item_input_value("**/metallic", 0.5)
+    saved = s.material
+    shown = ball(view(ctx)).mean(axis=0)
+    ctx.item_input_value("**/library name", "ui copper")
+    ctx.item_click("**/save to library")
+    path = library_dir() / "ui_copper.glb"
+    assert path.is_file(), (s.error, s.message)
+    assert str(path) in s.message, s.message
+    assert _same_material(load_material_file(str(path))[0], saved)
+    ctx.yield_(2)
+    names = [e.name for e in win.panel.library.entries]
+    assert "ui_copper" in names, names
+    ctx.item_click("**/silver")
+    assert s.material.name == "silver"
+    ctx.item_click("**/ui_copper##library")
+    assert _same_material(s.material, saved), s.material
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), shown, atol=0.5)
+    _wait_for_thumbnails(ctx)
+    ctx.item_make_visible("**/ui_copper##library", 0)
+    icon = _icon_pixels(ctx, _capture(ctx, "library.png"), "**/ui_copper##library").mean(axis=(0, 1))
+    assert icon[0] > icon[2] + 10, icon   # copper's ball, not the grey placeholder
+    void(ctx)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.name == "silver", s.material
+
+
+# --- a transparent background over a checkerboard --------------------------------------------------
+
+def _checker_levels(corner: np.ndarray) -> tuple[float, float]:
+    """The fractions of a corner's pixels at the checkerboard's light and dark grey."""
+    v = corner.astype(np.int32)
+    grey = (v.max(axis=2) - v.min(axis=2)) <= 2
+    light = (grey & (np.abs(v[:, :, 0] - 204) <= 2)).mean()
+    dark = (grey & (np.abs(v[:, :, 0] - 153) <= 2)).mean()
+    return float(light), float(dark)
+
+
+def test_transparent_background_shows_a_checkerboard(ctx):
+    """With the transparent background the window shows the view over light and dark grey
+    squares (8 px) where nothing covers it, the ball opaque over them; the env background none."""
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    void(ctx)
+    w, h = win.view_area()
+    middle = (slice(h // 2 - 4, h // 2 + 4), slice(w // 2 - 4, w // 2 + 4))
+    over_env = _capture(ctx, "over_env.png")[middle][:, :, :3].mean(axis=(0, 1))
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/transparent")
+    ctx.item_close("**/Environment")
+    void(ctx)
+    shot = _capture(ctx, "checker.png")[:, :, :3]
+    light, dark = _checker_levels(shot[:32, :32])
+    assert light > 0.3 and dark > 0.3, (light, dark, shot[:2, :10, 0])
+    row = shot[2, :32, 0].astype(np.int32)
+    assert abs(row[:8].mean() - row[8:16].mean()) > 40, row   # the squares alternate every 8 px
+    np.testing.assert_allclose(shot[middle].mean(axis=(0, 1)), over_env, atol=2)   # the ball: opaque over it
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+    light, dark = _checker_levels(_capture(ctx, "no_checker.png")[:32, :32, :3])
+    assert light + dark < 0.5, (light, dark)
+
+
+# --- screenshots at a chosen size ------------------------------------------------------------------
+
+def _shoot(ctx, frames: int = 3000) -> str:
+    """Click the screenshot button; the new PNG once the window has written it."""
+    names = set(os.listdir("."))
+    ctx.item_click("**/screenshot (F12)")
+    for _ in range(frames):
+        ctx.yield_()
+        new = [n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-") and n.endswith(".png")]
+        if new and editor().screenshot_job is None:
+            return new[0]
+    raise AssertionError(f"no screenshot written: {editor().state.error}")
+
+
+def test_screenshot_at_a_chosen_size(ctx):
+    """Unchecking 'at the view's size' and typing a size: the button writes a PNG that size (the
+    view's framing, the copper ball in the middle), and the panel's message names the file;
+    with the transparent background it is RGBA, clear around the ball. Sides clamp to 16384."""
+    import OpenImageIO as oiio
+
+    win, s = editor(), editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    h = view(ctx).shape[0]   # the view at window size: the same vertical field of view, centred
+    middle = view(ctx)[h // 2 - 3:h // 2 + 3, view(ctx).shape[1] // 2 - 3:view(ctx).shape[1] // 2 + 3]
+    ctx.item_open("**/Display & camera")
+    ctx.item_uncheck("**/###shot_view_size")
+    ctx.item_input_value("screenshot size/$$0", 1000)
+    ctx.item_input_value("screenshot size/$$1", 300)
+    name = _shoot(ctx)
+    image = oiio.ImageBuf(name).get_pixels(oiio.UINT8)
+    assert image.shape == (300, 1000, 3), image.shape
+    assert s.message == f"wrote {os.path.abspath(name)} (1000x300)", s.message
+    centre = image[148:152, 498:502].astype(np.float64).mean(axis=(0, 1))
+    np.testing.assert_allclose(centre, middle.reshape(-1, 3).mean(axis=0), atol=16)   # the view's centre
+    ctx.item_close("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/transparent")
+    ctx.item_close("**/Environment")
+    ctx.item_open("**/Display & camera")
+    image = oiio.ImageBuf(_shoot(ctx)).get_pixels(oiio.UINT8)
+    assert image.shape == (300, 1000, 4) and image[150, 500, 3] == 255 and image[:4, :4, 3].max() == 0, image.shape
+    ctx.item_input_value("screenshot size/$$0", 20000)
+    assert win.screenshot_size.width == 16384, win.screenshot_size
+    ctx.item_check("**/###shot_view_size")
+    assert win.screenshot_size.size(win.view_area()) == win.view_area()
+    ctx.item_close("**/Display & camera")
+    ctx.item_open("**/Environment")
+    ctx.combo_click("background/env")
+    ctx.item_close("**/Environment")
+
+
+def test_typed_values_are_kept_without_float_noise(ctx):
+    """A value typed into a float widget is kept as typed (0.6, not float32's 0.6000000238...),
+    in the state and in the preset file saved."""
+    import re
+
+    s = editor().state
+    path = _save_preset_through_panel(ctx, "gold", 0.6, "tidy.json")
+    assert s.material.roughness == 0.6, repr(s.material.roughness)
+    text = open(path, encoding="utf-8").read()
+    assert re.search(r'"roughness": 0\.6\b', text) and "0.6000000" not in text, text
+
+
+def test_an_error_line_does_not_move_the_panel(ctx):
+    """The status row at the panel's top keeps its height: a long error replacing a message
+    leaves every control where it was (the next click lands where the artist aimed)."""
+    s = editor().state
+    _save_preset_through_panel(ctx, "gold", 0.5, "before_error.json")
+    assert s.message and not s.error, (s.message, s.error)
+    ctx.item_input_value("**/preset file", os.path.join(OUT, "no_such_preset_" * 8 + ".json"))
+    ctx.yield_(2)
+    before = ctx.item_info("**/load preset").rect_full.min.y
+    ctx.item_click("**/load preset")
+    ctx.yield_(2)
+    assert s.error and editor().panel.shown_error == s.error, s.error
+    after = ctx.item_info("**/load preset").rect_full.min.y
+    assert after == before, (before, after, s.error)
+
+
+def test_ctrl_a_selects_a_text_field(ctx):
+    """Ctrl+A in a text field selects all of it: what is typed next replaces the text."""
+    from imgui_bundle import imgui
+
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/preset file", "some_long_name.json")
+    ctx.item_click("**/preset file")
+    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.a)
+    ctx.key_chars("material.json")
+    ctx.key_press(imgui.Key.enter)
+    ctx.yield_(2)
+    assert editor().panel.preset_path == "material.json", editor().panel.preset_path

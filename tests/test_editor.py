@@ -122,6 +122,8 @@ def test_the_editor_takes_renders_scene_options(display, tmp_path):
     assert np.abs(rotated - default).mean() > 1.0
     probe = edit("--view", "probe", "--screenshot", str(tmp_path / "p.png"))
     assert probe.returncode == 2 and probe.stderr.count("\n") == 1 and not (tmp_path / "p.png").exists()
+    helped = edit("--help")   # ... and not offered: the editor's help has no --view
+    assert helped.returncode == 0 and "--view" not in helped.stdout and "probe" not in helped.stdout, helped.stdout
 
 
 def test_window_checks_in_a_fresh_process(display):
@@ -218,3 +220,21 @@ def test_a_dropped_file_says_what_it_is_drawn_without(tmp_path, capfd):
     assert state.open_file(str(tmp_path / "tri3.obj"))
     assert state.message == "opened tri3.obj (1 warning on stderr)"
     assert "mtllib 'absent.mtl' not found" in capfd.readouterr().err
+
+
+def test_keys_are_translated_by_the_layouts_character():
+    """The editor's own loop hands imgui the key the layout prints (app/frontends/editor/keys.py):
+    on AZERTY the key at Q's place prints 'a', and Ctrl+A must reach imgui as A."""
+    import glfw
+
+    from alight.frontends.editor.keys import translate_key
+
+    assert translate_key(glfw.KEY_Q, "a") == glfw.KEY_A and translate_key(glfw.KEY_A, "q") == glfw.KEY_Q
+    assert translate_key(glfw.KEY_SEMICOLON, "m") == glfw.KEY_M and translate_key(glfw.KEY_Z, "y") == glfw.KEY_Y
+    assert translate_key(glfw.KEY_1, "&") == glfw.KEY_1 and translate_key(glfw.KEY_MINUS, "-") == glfw.KEY_MINUS
+    assert translate_key(glfw.KEY_KP_1, "1") == glfw.KEY_KP_1   # the keypad keeps its codes
+    assert translate_key(glfw.KEY_F1, None) == glfw.KEY_F1 and translate_key(glfw.KEY_ENTER, None) == glfw.KEY_ENTER
+    for c in "abcxyz0123456789`-=[]\\,;'./":   # every code as glfw.h numbers it
+        expected = getattr(glfw, f"KEY_{c.upper()}", None) if c.isalnum() else None
+        if expected is not None:
+            assert translate_key(glfw.KEY_SPACE, c) == expected, c

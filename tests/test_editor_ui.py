@@ -19,9 +19,9 @@ REPO = Path(__file__).resolve().parents[1]
 
 def ui_test(tmp_path: Path, file: Path, *args: str, size: str = "640x400") -> subprocess.CompletedProcess:
     env = dict(os.environ, ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"),
-               ALIGHT_UI_TEST_OUT=str(tmp_path))
+               ALIGHT_DATA_DIR=str(tmp_path / "data"), ALIGHT_UI_TEST_OUT=str(tmp_path))
     return subprocess.run([sys.executable, "-m", "alight", "edit", "--size", size, *args, "--ui-test", str(file)],
-                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=1200)
 
 
 def test_every_panel_check_passes_through_the_test_engine(display, tmp_path):
@@ -35,7 +35,7 @@ def test_every_panel_check_passes_through_the_test_engine(display, tmp_path):
     assert list(tmp_path.glob("alight-screenshot-*.png"))
     # The session is saved at the end, as after a normal close: the last material clicked.
     session = json.loads((tmp_path / "config" / "editor-session.json").read_text())
-    assert session["material"]["name"] == "iron", session   # the last material (the load preset check)
+    assert session["material"]["name"] == "gold", session   # the last material (the error-line check's)
 
 
 def test_failures_exit_1_with_their_message_and_the_view_is_the_editors(display, tmp_path):

@@ -70,7 +70,8 @@ class _Size(tuple):
         return size
 
 
-def _add_scene_options(p: argparse.ArgumentParser) -> None:
+def _add_scene_options(p: argparse.ArgumentParser, views: bool = True) -> None:
+    """``views``: offer --view (the editor draws the camera view only, and does not offer it)."""
     g = p.add_argument_group("scene")
     g.add_argument("--mesh", default="sphere",
                    help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh file "
@@ -89,9 +90,11 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
                         "W/sr-like, divided by distance squared; directional is irradiance). Without --light, "
                         "a glTF file's KHR_lights_punctual lights are used")
     g.add_argument("--no-file-lights", action="store_true", help="ignore the lights a glTF file brings")
+    # Taken but not offered where only the camera view is drawn (the editor refuses probe in a line).
     g.add_argument("--view", choices=("camera", "probe"), default="camera",
                    help="camera: the mesh framed by a camera on +Z; probe: docs/conventions.md's analysis view "
-                        "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)")
+                        "(a unit sphere, orthographic, exact per-pixel normals, no anti-aliasing)"
+                   if views else argparse.SUPPRESS)
     _add_material_options(p)
 
 

@@ -10,7 +10,7 @@ def add_parser(sub) -> None:
     e = sub.add_parser("edit", help="open the interactive material editor (needs a display)",
                        description="The material editor: a window with a live preview and a panel. "
                                    "Drop .hdr/.exr, mesh or preset .json files on it.")
-    _add_scene_options(e)
+    _add_scene_options(e, views=False)
     e.add_argument("--quality", choices=QUALITIES + ("auto",), default="medium",
                    help="bake quality; auto: the cheapest measured bake within 2%% for the environment and "
                         "the kind of material, shown in the panel (default: medium)")

@@ -19,6 +19,7 @@ from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.exchange.presets import list_presets, load_preset
 from alight.frontends.editor.file_browser import FileBrowser
+from alight.frontends.editor.library_panel import ICON, LibraryPanel
 from alight.frontends.editor.state import DEBUG_VIEWS
 from alight.ibl.bake import QUALITY
 
@@ -36,6 +37,27 @@ def _edited(m, **fields):
         return with_overrides(m, "panel", **fields)
     except AlightError:
         return dataclasses.replace(m, **fields)
+
+
+def _short_float(x):
+    """A widget's float32 as the shortest decimal that reads back as it (0.6, not 0.6000000238)."""
+    return float(str(np.float32(x))) if np.isfinite(x) else x
+
+
+def tidy_edit(old, new):
+    """``new`` with each field that differs from ``old`` rounded as ``_short_float`` (imgui's
+    widgets are float32: typed 0.6 comes back 0.6000000238418579, and presets and sessions
+    saved it so); fields not edited keep their exact values."""
+    changes = {}
+    for f in dataclasses.fields(new):
+        a, b = getattr(old, f.name), getattr(new, f.name)
+        if a == b or isinstance(b, (str, bool)):
+            continue
+        if isinstance(b, float):
+            changes[f.name] = _short_float(b)
+        elif isinstance(b, tuple) and all(isinstance(x, float) for x in b):
+            changes[f.name] = tuple(_short_float(x) for x in b)
+    return dataclasses.replace(new, **changes) if changes else new
 
 
 def _linear(c) -> tuple[float, float, float]:
@@ -61,6 +83,7 @@ class Panel:
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
+        self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -74,15 +97,7 @@ class Panel:
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse)
         self.shown_error = s.error
-        if s.error:
-            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), "error:")
-            imgui.same_line()
-            imgui.text_wrapped(s.error)
-        elif s.message:
-            imgui.text_disabled(s.message)
-        if win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
-            fraction, label = win.bake_progress
-            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
+        self._status_line(s, win)
         if imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
             self._material(s, win)
         if imgui.collapsing_header("Environment"):
@@ -105,6 +120,28 @@ class Panel:
         imgui.end()
         self.browser.draw()
 
+    @staticmethod
+    def _status_line(s, win) -> None:
+        """One row of a fixed height at the top: the error, else the bake's progress, else the
+        last message, else nothing; so the rows below never move when one appears or goes. A
+        long line is cut at the panel's edge; hovering it shows it whole."""
+        from imgui_bundle import imgui
+
+        top = imgui.get_cursor_pos_y()
+        if s.error:
+            imgui.align_text_to_frame_padding()
+            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), f"error: {s.error}")
+        elif win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
+            fraction, label = win.bake_progress
+            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
+        elif s.message:
+            imgui.align_text_to_frame_padding()
+            imgui.text_disabled(s.message)
+        if (s.error or s.message) and imgui.is_item_hovered():
+            imgui.set_tooltip(s.error or s.message)
+        # Always the height of one framed row, whatever was drawn.
+        imgui.set_cursor_pos_y(top + imgui.get_frame_height_with_spacing())
+
     # --- sections -------------------------------------------------------------------------------
 
     def _material(self, s, win) -> None:
@@ -119,7 +156,7 @@ class Panel:
         if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
             # The names' column as wide as the longest name and its swatch: the F0 columns take the rest.
             longest = max((name for name, *_ in self.presets), key=len, default="preset")
-            name_width = imgui.calc_text_size(longest).x + 14 + imgui.get_style().item_spacing.x
+            name_width = imgui.calc_text_size(longest).x + ICON + imgui.get_style().item_spacing.x
             imgui.table_setup_column("preset", imgui.TableColumnFlags_.width_fixed, name_width)
             imgui.table_setup_column("F0 linear")
             imgui.table_setup_column("F0 sRGB")
@@ -127,16 +164,17 @@ class Panel:
             for name, preset, f0, f0_srgb in self.presets:
                 imgui.table_next_row()
                 imgui.table_next_column()
-                imgui.color_button(f"##sw{name}", imgui.ImVec4(*f0_srgb, 1.0), 0, imgui.ImVec2(14, 14))
+                self.library.icon(win, f"##sw{name}", preset, fallback_rgb=f0_srgb)   # its thumbnail
                 imgui.same_line()
                 # Highlighted: the preset the material is now (none once any field is edited).
-                if imgui.selectable(name, m == preset)[0]:
+                if imgui.selectable(name, m == preset, 0, imgui.ImVec2(0, ICON))[0]:
                     m = picked = preset
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0))
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0_srgb))
             imgui.end_table()
+        self.library.draw(s, win)   # saved materials; a click is applied after the write-back below
         # Base colour is stored linear (docs/conventions.md) and shown sRGB, as artists pick colours.
         changed, col = imgui.color_edit3("base colour (sRGB)", _srgb(m.base_color))
         if changed:
@@ -168,9 +206,10 @@ class Panel:
             s.material = s.saved_material = picked
         elif m != s.material:
             try:
-                s.material = validate_material(m, "panel")
+                s.material = validate_material(tidy_edit(s.material, m), "panel")
             except AlightError as exc:
                 s.fail(exc)
+        self.library.apply_click(s)
         if imgui.tree_node_ex("texture maps", imgui.TreeNodeFlags_.default_open):
             self._texture_maps(s)
             imgui.tree_pop()
@@ -191,6 +230,10 @@ class Panel:
                 s.error, s.message = "", f"saved {self.preset_path}"
             except AlightError as exc:
                 s.fail(exc)
+            else:   # a saved material is in the library too, under the file's name
+                self.library.save(s, self.preset_path)
+                if not s.error:
+                    s.message = f"saved {self.preset_path} and {s.message.removeprefix('saved ')}"
         imgui.same_line()
         if imgui.button("load preset"):
             s.open_file(self.preset_path)
@@ -493,9 +536,9 @@ class Panel:
         _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)
         if imgui.button("frame mesh (F)"):
             win.frame_mesh()
-        imgui.same_line()
-        if imgui.button("screenshot (F12)"):
-            win.screenshot_request = win.next_screenshot_name()   # the window writes it after the frame
+        from alight.frontends.editor.screenshot import draw_controls
+
+        draw_controls(win)   # size, the button (F12), progress
         imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
         imgui.text_disabled("turn the environment: Shift + right drag")
 

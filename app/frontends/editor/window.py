@@ -34,12 +34,14 @@ from alight.ibl.bake import QUALITY
 BAKE_SLICE_S = 0.03
 # The panel is a side bar on the window's right (at most half the window): the view is the
 # rest, so the panel never covers the mesh, and the view starts at the framebuffer's origin.
-PANEL_WIDTH = 420
+# 480 at 1280x720 (420 cut the labels of the widest rows there).
+PANEL_WIDTH = 480
 # Adaptive resolution while the camera moves: the view's scale follows the frame time toward
 # this rate, in steps (a new size reallocates the view's targets), between these bounds.
 TARGET_FPS = 30.0
 ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP = 0.25, 1.0 / 16.0
 TARGET_CACHE = 4   # view framebuffers kept, by size
+CHECKER_SQUARE = 8.0   # pixels a side of the checkerboard under a transparent background
 
 
 class EditorWindow:
@@ -85,6 +87,7 @@ class EditorWindow:
             # screenshots and benchmarks keep none, so they never depend on the last session.
             imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
             self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
+            glfw.set_key_callback(self.window, self._key_callback)   # keys as the layout labels them (keys.py)
             self._native_imgui = self._start_native_imgui(imgui)
         from alight.frontends.editor.panel_image import PanelImage
 
@@ -145,6 +148,10 @@ class EditorWindow:
 
         self._linear = moderngl.LINEAR
         self.screenshot_request = ""   # set by the panel's button or F12; written after the frame
+        from alight.frontends.editor.screenshot import ScreenshotSize
+
+        self.screenshot_size = ScreenshotSize()   # the view's or a chosen size (the panel's)
+        self.screenshot_job = None     # the PNG being written, a few strips a frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
         self.adaptive_scale = 0.5      # the adaptive motion scale now (see adapt_motion_scale)
         self._was_moving = False
@@ -158,8 +165,10 @@ class EditorWindow:
 
         self.panel = Panel()
         from alight.frontends.editor.compare_view import CompareView
+        from alight.frontends.editor.thumbnails import Thumbnails
 
         self.compare_view = CompareView(self.ctx, self.renderer, self.new_targets)   # the A/B split view's GL side
+        self.thumbnails = Thumbnails(self.ctx)   # the presets' and library's, a few a frame
 
     # --- input --------------------------------------------------------------------------------
 
@@ -179,6 +188,13 @@ class EditorWindow:
             self.state.open_texture_set(images)
         except Exception as exc:   # one line in the panel, never a traceback
             self.state.fail(exc)
+
+    def _key_callback(self, window, key, scancode, action, mods) -> None:
+        """glfw's key event to imgui with the key the layout prints (keys.translate_key)."""
+        from alight.frontends.editor.keys import translate_key
+
+        name = self.glfw.get_key_name(key, scancode) if key != self.glfw.KEY_UNKNOWN else None
+        self.impl.keyboard_callback(window, translate_key(key, name), scancode, action, mods)
 
     def _camera_input(self) -> None:
         from alight.frontends.editor.compare import handle_mouse
@@ -480,7 +496,10 @@ class EditorWindow:
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
         compare = self.state.compare.active   # two halves put together: never straight into the window
-        into, into_srgb = self.direct_target() if (moving and not full and size == window and not compare) \
+        # A transparent background is shown over a checkerboard, so never drawn straight in.
+        checker = scene.display.background == "transparent" and not full
+        into, into_srgb = self.direct_target() if (moving and not full and size == window and not compare
+                                                   and not checker) \
             else (None, False)
         # (The key deep-copies the lights: 0.3 ms a frame, not spent where every frame redraws.)
         key = self._view_key(scene, maps, size) if into is None else None
@@ -503,6 +522,8 @@ class EditorWindow:
             targets = self.compare_view.compose(self, scene, maps, targets, moving, finish=full)
         if direct:
             pass   # already in the window
+        elif checker:
+            self._show_over_checker(targets, window)
         elif size == window:
             self.ctx.copy_framebuffer(self.ctx.screen, targets.display_fbo)
         else:
@@ -519,6 +540,20 @@ class EditorWindow:
         self.ctx.screen.use()
         return targets
 
+    def _show_over_checker(self, targets, window) -> None:
+        """The view image over a checkerboard (render/checker.frag), stretched to the view area:
+        what a transparent background shows in the window (the files keep the real alpha)."""
+        prog = self.renderer.program("render/fullscreen.vert", "render/checker.frag")
+        targets.display.filter = (self._linear, self._linear)
+        targets.display.use(0)
+        prog["u_image"] = 0
+        prog["u_square"] = CHECKER_SQUARE
+        prog["u_origin"] = (0.0, 0.0)
+        self.ctx.screen.use()
+        self.ctx.viewport = (0, 0) + window
+        self.renderer.fullscreen(prog)
+        self.ctx.viewport = (0, 0) + self.size
+
     def frame(self) -> None:
         self.draw()
         self.glfw.swap_buffers(self.window)
@@ -526,13 +561,14 @@ class EditorWindow:
 
     def after_swap(self) -> None:
         """After the frame is shown: the screenshot asked for during it, the frame time."""
-        if self.screenshot_request:
+        if self.screenshot_request and self.screenshot_job is None:
             path, self.screenshot_request = self.screenshot_request, ""
             try:
-                self.save_view(path)
-                self.state.error, self.state.message = "", f"wrote {path}"
+                self.screenshot_job = self.start_save_view(path)
             except AlightError as exc:
                 self.state.fail(exc)
+        if self.screenshot_job is not None:
+            self._advance_screenshot()
         now = time.perf_counter()
         if self._last_swap is not None:
             self.frame_times.append(now - self._last_swap)
@@ -569,6 +605,7 @@ class EditorWindow:
         """The view into the window's back buffer (under the panel), and a slice of a pending bake."""
         self.render_view()
         self.advance_bake()
+        self.thumbnails.step()
 
     def begin_imgui_frame(self) -> None:
         """imgui's input and new frame (after poll_events)."""
@@ -603,22 +640,52 @@ class EditorWindow:
         pixels = self.view_pixels(what=str(out))
         write_image(out, pixels, linear=False)
 
-    def save_view(self, path: str) -> None:
+    def start_save_view(self, path: str):
         """F12 and the panel's button: the view as it is framed (the area left of the panel, at
-        full resolution whatever the render and motion scales), drawn again by the renderer's
-        offline path; RGBA with the coverage as alpha when the background is transparent."""
-        from alight.exchange.output import check_output_path, write_image
+        full resolution whatever the render and motion scales, or the size chosen in the panel),
+        drawn again by the renderer's offline path; RGBA with the coverage as alpha when the
+        background is transparent. Returns the screenshot.ScreenshotJob that writes it."""
+        from alight.frontends.editor.screenshot import ScreenshotJob
 
-        out = check_output_path(path, (".png",))
         self.finish_bake()
-        w, h = self.view_area()
+        size = self.screenshot_size.size(self.view_area())
         scene = self.state.scene(self.orbit.camera())
-        frame = self.renderer.render(scene, self.maps(), w, h, aa=self.state.aa, read_linear=False, read_srgb=True)
-        alpha = scene.display.background == "transparent"
-        pixels = frame.srgb if alpha else frame.srgb[:, :, :3]
-        if self.state.compare.active:   # the split view, as shown
-            pixels = self.compare_view.compose_frame(self, scene, self.maps(), pixels, self.state.aa)
-        write_image(out, pixels, linear=False)
+        if self.state.compare.active:   # the split view, as shown: its halves put together whole
+            from alight.frontends.editor.screenshot import WholeScreenshotJob
+
+            maps, aa = self.maps(), self.state.aa
+
+            def pixels():
+                frame = self.renderer.render(scene, maps, size[0], size[1], aa=aa, read_linear=False, read_srgb=True)
+                b = frame.srgb if scene.display.background == "transparent" else frame.srgb[:, :, :3]
+                return self.compare_view.compose_frame(self, scene, maps, b, aa)
+
+            return WholeScreenshotJob(pixels, size, path)
+        return ScreenshotJob(self.renderer, scene, self.maps(), size, self.state.aa, path)
+
+    def _advance_screenshot(self) -> None:
+        """A few strips of the screenshot being written; the panel's message says when it is."""
+        job = self.screenshot_job
+        try:
+            done = job.step()
+        except AlightError as exc:
+            self.state.fail(exc)
+            done = True
+        finally:
+            self.ctx.screen.use()
+        if done:
+            self.screenshot_job = None
+            if os.path.isfile(job.path) and job.rows == job.height:
+                self.state.error, self.state.message = "", f"wrote {job.path} ({job.width}x{job.height})"
+
+    def save_view(self, path: str) -> None:
+        """``start_save_view`` run to the end now."""
+        job = self.start_save_view(path)
+        try:
+            while not job.step(float("inf")):
+                pass
+        finally:
+            self.ctx.screen.use()
 
     def view_pixels(self, what: str = "the view"):
         """The view without the panel at window size, top row first: uint8 (h, w, 3), sRGB."""
@@ -649,6 +716,7 @@ class EditorWindow:
         self._target_cache.clear()
         self.compare_view.release()
         self._panel_image.release()
+        self.thumbnails.release()
         if self.hosted:   # the runner closes imgui, the window and its context after this
             self.implot.destroy_context()
             self.renderer.release()

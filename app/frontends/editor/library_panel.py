@@ -1,0 +1,95 @@
+"""The panel's library: the saved materials with their thumbnails, a click applies one (an undo
+step, as a preset click), 'save to library'; and the thumbnails beside the F0 table's presets.
+imgui only: the files are library.py's, the thumbnails' GL is thumbnails.py's (the window's)."""
+
+from __future__ import annotations
+
+import time
+
+from alight.core.texture_maps import TextureMaps
+from alight.errors import AlightError
+from alight.frontends.editor import library
+
+ICON = 24              # a thumbnail's side in the list, pixels
+RESCAN_S = 0.5         # how often the library folder is looked at for new or removed entries
+_NO_MAPS = TextureMaps()
+
+
+class LibraryPanel:
+    def __init__(self):
+        self.name = "my_material"          # the 'library name' field
+        self.entries: list[library.Entry] = []
+        self.problems: list[str] = []
+        self._stamp = None
+        self._scanned = -1e9
+        self.clicked = None               # the entry clicked this frame, applied by apply_click
+
+    def rescan(self, force: bool = False) -> None:
+        now = time.monotonic()
+        if not force and now - self._scanned < RESCAN_S:
+            return
+        self._scanned = now
+        stamp = library.folder_stamp()
+        if force or stamp != self._stamp:
+            self._stamp = stamp
+            self.entries, self.problems = library.list_entries()
+
+    def icon(self, win, label: str, material, maps=_NO_MAPS, fallback_rgb=None) -> None:
+        """The thumbnail, or (until it is rendered) a swatch of ``fallback_rgb`` the same size."""
+        from imgui_bundle import imgui
+
+        thumbs = getattr(win, "thumbnails", None)
+        texture = thumbs.texture_id(material, maps) if thumbs is not None else None
+        if texture is not None:
+            imgui.image(imgui.ImTextureRef(texture), imgui.ImVec2(ICON, ICON))
+        else:
+            imgui.color_button(label, imgui.ImVec4(*(fallback_rgb or (0.3, 0.3, 0.3)), 1.0),
+                               imgui.ColorEditFlags_.no_tooltip, imgui.ImVec2(ICON, ICON))
+
+    def draw(self, s, win) -> None:
+        """The library section, under the F0 table. A click is kept in ``clicked``: the panel's
+        material widgets write their copy back after this, and ``apply_click`` comes after them."""
+        from imgui_bundle import imgui
+
+        self.rescan()
+        if not imgui.tree_node_ex("library", imgui.TreeNodeFlags_.default_open):
+            return
+        for entry in self.entries:
+            self.icon(win, f"##lib_icon_{entry.name}", entry.material, entry.maps)
+            imgui.same_line()
+            current = s.material == entry.material and s.texture_maps == entry.maps
+            if imgui.selectable(f"{entry.name}##library", current, 0, imgui.ImVec2(0, ICON))[0]:
+                self.clicked = entry
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(entry.path)
+        if not self.entries:
+            imgui.text_disabled("empty: 'save to library' or 'save preset' adds the material")
+        for line in self.problems:
+            imgui.text_disabled(line)
+        _, self.name = imgui.input_text("library name", self.name)
+        if imgui.button("save to library"):
+            self.save(s, self.name)
+        imgui.tree_pop()
+
+    def apply_click(self, s) -> None:
+        """The entry clicked this frame becomes the material, with its maps (one undo step, as a
+        preset click; 'revert' goes back to it)."""
+        entry, self.clicked = self.clicked, None
+        if entry is None:
+            return
+        try:
+            s.load_material(entry.path)
+            s.error, s.message = "", f"applied {entry.name} from the library"
+        except AlightError as exc:
+            s.fail(exc)
+
+    def save(self, s, name: str) -> None:
+        """The material and its maps into the library as NAME.glb; the panel's message says where."""
+        try:
+            path = library.save_entry(s.material, s.texture_maps, name)
+        except AlightError as exc:
+            s.fail(exc)
+            return
+        s.saved_material = s.material
+        s.error, s.message = "", f"saved to the library: {path}"
+        self.rescan(force=True)
