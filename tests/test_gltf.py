@@ -499,7 +499,7 @@ def test_points_and_unknown_extensions_warn_once(tmp_path):
     g = _flat_plane(tmp_path / "w.glb", pbrMetallicRoughness={})
     pts = g.accessor(np.zeros((4, 3)) + [0, 0, 0.1])
     g.mesh([{"attributes": {"POSITION": pts}, "mode": 0}, {"attributes": {"POSITION": pts}, "mode": 0}])
-    g.use("KHR_materials_iridescence", "KHR_materials_dispersion")   # not drawn by alight
+    g.use("KHR_materials_iridescence", "KHR_materials_volume_scatter")   # not drawn by alight
     run = _cli("--mesh", str(g.save(tmp_path / "w.glb")), "--out", str(tmp_path / "w.png"))
     assert run.returncode == 0, run.stderr
     lines = [x for x in run.stderr.splitlines() if x.startswith("alight: warning:")]

@@ -43,6 +43,7 @@ CASES: dict[str, tuple[object, dict]] = {
     "thickness": (1.0, {k: v for k, v in _VOLUME.items() if k != "thickness"}),
     "attenuation_color": ((1.0, 0.2, 0.2), {k: v for k, v in _VOLUME.items() if k != "attenuation_color"}),
     "attenuation_distance": (0.3, {k: v for k, v in _VOLUME.items() if k != "attenuation_distance"}),
+    "dispersion": (10.0, {"transmission": 1.0, "thickness": 1.0, "ior": 3.0, "roughness": 0.2}),
 }
 _SETTINGS = ["--size", "32", "--quality", "low", "--aa", "none"]
 _SPEC_SETTINGS = {"size": 32, "quality": "low", "aa": "none"}

@@ -29,6 +29,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "anisotropy": ("anisotropy_strength", "anisotropy_rotation"),               # KHR_materials_anisotropy
     "transmission": ("transmission",),                                          # KHR_materials_transmission
     "volume": ("thickness", "attenuation_color", "attenuation_distance"),       # KHR_materials_volume
+    "dispersion": ("dispersion",),                                              # KHR_materials_dispersion
 }
 LAYER_FIELDS: tuple[str, ...] = tuple(f for fields in LAYERS.values() for f in fields)
 DEFAULT_IOR = 1.5  # glTF's; F0 = ((1.5 - 1) / (1.5 + 1))^2 = 0.04
@@ -87,6 +88,8 @@ class Material:
     thickness: float = 0.0
     attenuation_color: Vec3 = (1.0, 1.0, 1.0)
     attenuation_distance: float = math.inf
+    # KHR_materials_dispersion: 20 / Abbe number (0: none); spreads the volume's ior per channel.
+    dispersion: float = 0.0
     # KHR_materials_clearcoat: the coat's weight and perceptual roughness.
     clearcoat: float = 0.0
     clearcoat_roughness: float = 0.0
@@ -123,7 +126,8 @@ class Material:
 
         A layer is on when its strength is above zero: clearcoat > 0, max(sheen_color) > 0,
         anisotropy_strength > 0, transmission > 0; volume when transmission > 0 and thickness > 0
-        (KHR_materials_volume acts only through transmission)."""
+        (KHR_materials_volume acts only through transmission); dispersion when the volume is on
+        and dispersion > 0 (KHR_materials_dispersion acts only on a volume's refraction)."""
         used = set()
         if self.clearcoat > 0.0:
             used.add("clearcoat")
@@ -135,6 +139,8 @@ class Material:
             used.add("transmission")
             if self.thickness > 0.0:
                 used.add("volume")
+                if self.dispersion > 0.0:
+                    used.add("dispersion")
         return frozenset(used)
 
     def to_dict(self) -> dict[str, Any]:
@@ -177,7 +183,7 @@ _RANGES: dict[str, tuple[float, float]] = {
     "ior": (1.0, math.inf), "transmission": _UNIT, "thickness": _NONNEG, "attenuation_color": _UNIT,
     "attenuation_distance": (0.0, math.inf), "clearcoat": _UNIT, "clearcoat_roughness": _UNIT,
     "sheen_color": _UNIT, "sheen_roughness": _UNIT, "anisotropy_strength": _UNIT,
-    "anisotropy_rotation": (-math.inf, math.inf),
+    "anisotropy_rotation": (-math.inf, math.inf), "dispersion": _NONNEG,
 }
 _VECTORS = ("base_color", "specular_f0", "emissive", "f0_linear", "f0_srgb", "attenuation_color", "sheen_color")
 # Fields a preset file may leave out: every layer field (the layer is then off) and the ior

@@ -50,7 +50,7 @@ SUPPORTED = {
     "KHR_materials_specular", "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_texture_webp",
     "KHR_draco_mesh_compression",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_transmission",
-    "KHR_materials_volume",
+    "KHR_materials_volume", "KHR_materials_dispersion",
 }
 # The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {

@@ -23,6 +23,7 @@ The layers (docs/layers.md) are the extensions' factors, one to one:
     thickness             = KHR_materials_volume.thicknessFactor
     attenuation_color     = KHR_materials_volume.attenuationColor
     attenuation_distance  = KHR_materials_volume.attenuationDistance (absent: +inf)
+    dispersion            = KHR_materials_dispersion.dispersion
     clearcoat             = KHR_materials_clearcoat.clearcoatFactor
     clearcoat_roughness   = KHR_materials_clearcoat.clearcoatRoughnessFactor
     sheen_color           = KHR_materials_sheen.sheenColorFactor
@@ -57,6 +58,7 @@ EXT_VOLUME = "KHR_materials_volume"
 EXT_CLEARCOAT = "KHR_materials_clearcoat"
 EXT_SHEEN = "KHR_materials_sheen"
 EXT_ANISOTROPY = "KHR_materials_anisotropy"
+EXT_DISPERSION = "KHR_materials_dispersion"
 DEFAULT_F0 = 0.04  # ((1.5 - 1) / (1.5 + 1))^2, glTF's default dielectric
 # Each layer extension's factors: (glTF name, Material field, glTF default, components).
 LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
@@ -70,6 +72,7 @@ LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
                 ("sheenRoughnessFactor", "sheen_roughness", 0.0, 1)),
     EXT_ANISOTROPY: (("anisotropyStrength", "anisotropy_strength", 0.0, 1),
                      ("anisotropyRotation", "anisotropy_rotation", 0.0, 1)),
+    EXT_DISPERSION: (("dispersion", "dispersion", 0.0, 1),),
 }
 GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 

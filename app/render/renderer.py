@@ -1659,3 +1659,4 @@ def _set_material(prog: moderngl.Program, m: Material) -> None:
     _set(prog, "u_thickness", float(m.thickness))
     _set(prog, "u_attenuation_color", tuple(float(x) for x in m.attenuation_color))
     _set(prog, "u_attenuation_distance", float(min(m.attenuation_distance, 3.0e38)))
+    _set(prog, "u_dispersion", float(m.dispersion))

@@ -24,6 +24,9 @@ uniform float u_thickness;
 uniform vec3 u_attenuation_color;
 uniform float u_attenuation_distance;  // 3e38 stands for glTF's +inf (no attenuation)
 #endif
+#ifdef HAS_DISPERSION
+uniform float u_dispersion;
+#endif
 
 // The layer factors at a point with shading normal n and tangent frame (t, b) (orthonormal,
 // b = cross(n, t) up to the mesh's handedness). Maps, where a layer has them, multiply these
@@ -52,6 +55,9 @@ void apply_material_layers(inout Surface s, vec3 n, vec3 t, vec3 b) {
     s.thickness = u_thickness;
     s.attenuation_color = u_attenuation_color;
     s.attenuation_distance = u_attenuation_distance;
+#endif
+#ifdef HAS_DISPERSION
+    s.dispersion = u_dispersion;
 #endif
 }
 

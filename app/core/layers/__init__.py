@@ -24,6 +24,7 @@ LAYER_DEFINES: dict[str, str] = {
     "anisotropy": "HAS_ANISOTROPY",
     "transmission": "HAS_TRANSMISSION",
     "volume": "HAS_VOLUME",
+    "dispersion": "HAS_DISPERSION",
 }
 assert set(LAYER_DEFINES) == set(LAYERS)
 
