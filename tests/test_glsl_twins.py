@@ -120,13 +120,15 @@ def test_spot_and_range_attenuation():
 # app/core/btdf.py and app/core/layers/transmission.py) -------------------------------------
 
 TRANSMISSION_TERMS = {"BTDF_THIN": 0, "BTDF_REFRACTION": 1, "BEER_LAMBERT": 2, "TRANSMISSION_LIGHT": 3,
-                      "DISPERSION_IORS": 4}
+                      "DISPERSION_IORS": 4, "DIFFUSE_BTDF_COS": 5, "DIFFUSE_TRANSMISSION_LIGHT": 6}
 
 
-def evaluate_transmission(term, inputs, uniforms=None, dispersion=False):
+def evaluate_transmission(term, inputs, uniforms=None, dispersion=False, diffuse=False):
     defines = {"HAS_TRANSMISSION": None, "HAS_VOLUME": None}
     if dispersion:
         defines["HAS_DISPERSION"] = None
+    if diffuse:
+        defines["HAS_DIFFUSE_TRANSMISSION"] = None
     return evaluate(TRANSMISSION_TERMS[term], inputs, uniforms, shader="accuracy/evaluate_transmission.comp",
                     defines=defines)
 
@@ -233,3 +235,38 @@ def test_dispersed_transmission_light(ior, thickness, dispersion, punctual):
         np.testing.assert_allclose(cpu[:, 1], plain[:, 1], rtol=1e-12)
     else:
         np.testing.assert_allclose(cpu, plain, rtol=1e-12)
+
+
+# --- KHR_materials_diffuse_transmission (common/diffuse_transmission_terms.glsl and
+# diffuse_transmission.glsl against app/core/layers/diffuse_transmission.py) ---------------------
+
+def test_diffuse_btdf_cos():
+    from alight.core.layers.diffuse_transmission import diffuse_btdf_cos
+
+    x = np.column_stack([rng.uniform(0, 1, (300, 3)), rng.uniform(-1, 1, 300)])
+    gpu = evaluate_transmission("DIFFUSE_BTDF_COS", x)[:, :3]
+    close(gpu, np.array([diffuse_btdf_cos(c, nl) for c, nl in zip(x[:, :3], x[:, 3])]))
+    assert np.all(gpu[x[:, 3] >= 0] == 0)
+
+
+@pytest.mark.parametrize("thickness", [0.0, 0.8])
+def test_diffuse_transmission_light(thickness):
+    from alight.core.layers.diffuse_transmission import diffuse_transmission_light, front_weight
+    from alight.core.layers.stack import Pairs
+    from alight.core.material import Material
+
+    x = np.column_stack([-rng.uniform(0.02, 1, 300), rng.uniform(0.02, 1, 300), rng.uniform(0.05, 1, 300),
+                         rng.uniform(0, 2 * np.pi, 300)])
+    x[:20, 0] *= -1   # some lights in front: no transmitted light there
+    params = (1.5, thickness, 0.25, 0.7)
+    gpu = evaluate_transmission("DIFFUSE_TRANSMISSION_LIGHT", x, {"u_params": params}, diffuse=True)
+    cpu = np.empty((len(x), 3))
+    for i, (nl, nv, t, phi) in enumerate(x):
+        m = Material(base_color=(0.9, 0.6, 0.3), metallic=0.25, roughness=0.4, specular_f0=(0.05, 0.04, 0.03), ior=1.5,
+                     transmission=t, thickness=thickness, attenuation_color=(1.0, 0.8, 0.5), attenuation_distance=0.7,
+                     diffuse_transmission=0.7, diffuse_transmission_color=(0.2, 0.9, 0.6))
+        p = Pairs(n=np.array([[0.0, 0.0, 1.0]]), v=_view_at(np.array([nv])), l=_light_at(np.array([nl]), np.array([phi])))
+        cpu[i] = diffuse_transmission_light(m, p)[0, 0]
+    close(gpu[:, :3], cpu, rtol=2e-4, atol=1e-6)
+    close(gpu[:, 3], np.full(len(x), front_weight(m)))
+    assert np.all(gpu[:20, :3] == 0) and (gpu[20:, 1] > 0).all()

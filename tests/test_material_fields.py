@@ -43,6 +43,8 @@ CASES: dict[str, tuple[object, dict]] = {
     "thickness": (1.0, {k: v for k, v in _VOLUME.items() if k != "thickness"}),
     "attenuation_color": ((1.0, 0.2, 0.2), {k: v for k, v in _VOLUME.items() if k != "attenuation_color"}),
     "attenuation_distance": (0.3, {k: v for k, v in _VOLUME.items() if k != "attenuation_distance"}),
+    "diffuse_transmission": (1.0, {"base_color": (0.9, 0.2, 0.1), "diffuse_transmission_color": (0.1, 0.2, 0.9)}),
+    "diffuse_transmission_color": ((0.1, 0.2, 0.9), {"base_color": (0.9, 0.2, 0.1), "diffuse_transmission": 1.0}),
     "dispersion": (10.0, {"transmission": 1.0, "thickness": 1.0, "ior": 3.0, "roughness": 0.2}),
 }
 _SETTINGS = ["--size", "32", "--quality", "low", "--aa", "none"]

@@ -30,6 +30,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "transmission": ("transmission",),                                          # KHR_materials_transmission
     "volume": ("thickness", "attenuation_color", "attenuation_distance"),       # KHR_materials_volume
     "dispersion": ("dispersion",),                                              # KHR_materials_dispersion
+    "diffuse_transmission": ("diffuse_transmission", "diffuse_transmission_color"),  # KHR_materials_diffuse_transmission
 }
 LAYER_FIELDS: tuple[str, ...] = tuple(f for fields in LAYERS.values() for f in fields)
 DEFAULT_IOR = 1.5  # glTF's; F0 = ((1.5 - 1) / (1.5 + 1))^2 = 0.04
@@ -90,6 +91,10 @@ class Material:
     attenuation_distance: float = math.inf
     # KHR_materials_dispersion: 20 / Abbe number (0: none); spreads the volume's ior per channel.
     dispersion: float = 0.0
+    # KHR_materials_diffuse_transmission: the share of the diffuse lobe that leaves through the
+    # back side (a Lambertian BTDF) and its linear colour.
+    diffuse_transmission: float = 0.0
+    diffuse_transmission_color: Vec3 = (1.0, 1.0, 1.0)
     # KHR_materials_clearcoat: the coat's weight and perceptual roughness.
     clearcoat: float = 0.0
     clearcoat_roughness: float = 0.0
@@ -127,7 +132,8 @@ class Material:
         A layer is on when its strength is above zero: clearcoat > 0, max(sheen_color) > 0,
         anisotropy_strength > 0, transmission > 0; volume when transmission > 0 and thickness > 0
         (KHR_materials_volume acts only through transmission); dispersion when the volume is on
-        and dispersion > 0 (KHR_materials_dispersion acts only on a volume's refraction)."""
+        and dispersion > 0 (KHR_materials_dispersion acts only on a volume's refraction);
+        diffuse_transmission when diffuse_transmission > 0."""
         used = set()
         if self.clearcoat > 0.0:
             used.add("clearcoat")
@@ -135,6 +141,8 @@ class Material:
             used.add("sheen")
         if self.anisotropy_strength > 0.0:
             used.add("anisotropy")
+        if self.diffuse_transmission > 0.0:
+            used.add("diffuse_transmission")
         if self.transmission > 0.0:
             used.add("transmission")
             if self.thickness > 0.0:
@@ -184,8 +192,10 @@ _RANGES: dict[str, tuple[float, float]] = {
     "attenuation_distance": (0.0, math.inf), "clearcoat": _UNIT, "clearcoat_roughness": _UNIT,
     "sheen_color": _UNIT, "sheen_roughness": _UNIT, "anisotropy_strength": _UNIT,
     "anisotropy_rotation": (-math.inf, math.inf), "dispersion": _NONNEG,
+    "diffuse_transmission": _UNIT, "diffuse_transmission_color": _UNIT,
 }
-_VECTORS = ("base_color", "specular_f0", "emissive", "f0_linear", "f0_srgb", "attenuation_color", "sheen_color")
+_VECTORS = ("base_color", "specular_f0", "emissive", "f0_linear", "f0_srgb", "attenuation_color", "sheen_color",
+            "diffuse_transmission_color")
 # Fields a preset file may leave out: every layer field (the layer is then off) and the ior
 # (then derived from specular_f0); specular_f0 may be left out when the ior is given.
 _MAY_OMIT = ("ior", *LAYER_FIELDS)

@@ -53,6 +53,7 @@ _LAYER_EXTENSION = {
     "clearcoat": "KHR_materials_clearcoat", "sheen": "KHR_materials_sheen",
     "anisotropy": "KHR_materials_anisotropy", "transmission": "KHR_materials_transmission",
     "volume": "KHR_materials_volume", "dispersion": "KHR_materials_dispersion",
+    "diffuse_transmission": "KHR_materials_diffuse_transmission",
 }
 _BASE_EXTENSION = {"ior": "KHR_materials_ior", "specular_f0": "KHR_materials_specular"}
 
@@ -75,6 +76,8 @@ _TEXT: dict[str, tuple[str, str]] = {
     "thickness": ("X", "KHR_materials_volume: thickness in mesh units, >= 0 (default 0: thin-walled)"),
     "attenuation_color": ("R,G,B", "the volume's colour after --attenuation-distance, linear in [0,1] (default 1,1,1)"),
     "attenuation_distance": ("X", "distance at which light reaches --attenuation-color, > 0 (default: none)"),
+    "diffuse_transmission": ("X", "KHR_materials_diffuse_transmission: the diffuse share leaving through the back side, in [0,1] (default 0: none)"),
+    "diffuse_transmission_color": ("R,G,B", "the diffusely transmitted light's linear colour in [0,1] (default 1,1,1)"),
     "dispersion": ("X", "KHR_materials_dispersion: 20 / Abbe number, >= 0, spreads a volume's ior per channel (default 0: none)"),
 }
 # Fields whose low end is excluded (material._number refuses attenuation_distance <= 0).

@@ -51,6 +51,7 @@ SUPPORTED = {
     "KHR_draco_mesh_compression",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_transmission",
     "KHR_materials_volume", "KHR_materials_dispersion",
+    "KHR_materials_diffuse_transmission",
 }
 # The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {

@@ -24,6 +24,8 @@ The layers (docs/layers.md) are the extensions' factors, one to one:
     attenuation_color     = KHR_materials_volume.attenuationColor
     attenuation_distance  = KHR_materials_volume.attenuationDistance (absent: +inf)
     dispersion            = KHR_materials_dispersion.dispersion
+    diffuse_transmission  = KHR_materials_diffuse_transmission.diffuseTransmissionFactor
+    diffuse_transmission_color = KHR_materials_diffuse_transmission.diffuseTransmissionColorFactor
     clearcoat             = KHR_materials_clearcoat.clearcoatFactor
     clearcoat_roughness   = KHR_materials_clearcoat.clearcoatRoughnessFactor
     sheen_color           = KHR_materials_sheen.sheenColorFactor
@@ -59,6 +61,7 @@ EXT_CLEARCOAT = "KHR_materials_clearcoat"
 EXT_SHEEN = "KHR_materials_sheen"
 EXT_ANISOTROPY = "KHR_materials_anisotropy"
 EXT_DISPERSION = "KHR_materials_dispersion"
+EXT_DIFFUSE_TRANSMISSION = "KHR_materials_diffuse_transmission"
 DEFAULT_F0 = 0.04  # ((1.5 - 1) / (1.5 + 1))^2, glTF's default dielectric
 # Each layer extension's factors: (glTF name, Material field, glTF default, components).
 LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
@@ -73,6 +76,8 @@ LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
     EXT_ANISOTROPY: (("anisotropyStrength", "anisotropy_strength", 0.0, 1),
                      ("anisotropyRotation", "anisotropy_rotation", 0.0, 1)),
     EXT_DISPERSION: (("dispersion", "dispersion", 0.0, 1),),
+    EXT_DIFFUSE_TRANSMISSION: (("diffuseTransmissionFactor", "diffuse_transmission", 0.0, 1),
+                               ("diffuseTransmissionColorFactor", "diffuse_transmission_color", (1.0, 1.0, 1.0), 3)),
 }
 GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 

@@ -1660,3 +1660,5 @@ def _set_material(prog: moderngl.Program, m: Material) -> None:
     _set(prog, "u_attenuation_color", tuple(float(x) for x in m.attenuation_color))
     _set(prog, "u_attenuation_distance", float(min(m.attenuation_distance, 3.0e38)))
     _set(prog, "u_dispersion", float(m.dispersion))
+    _set(prog, "u_diffuse_transmission", float(m.diffuse_transmission))
+    _set(prog, "u_diffuse_transmission_color", tuple(float(x) for x in m.diffuse_transmission_color))

@@ -19,6 +19,8 @@ const int TERM_BTDF_REFRACTION = 1;
 const int TERM_BEER_LAMBERT = 2;
 const int TERM_TRANSMISSION_LIGHT = 3;
 const int TERM_DISPERSION_IORS = 4;
+const int TERM_DIFFUSE_BTDF_COS = 5;
+const int TERM_DIFFUSE_TRANSMISSION_LIGHT = 6;
 
 // Unit v and l about n = +Z: v in the xz plane at n.v; l at n.l (< 0: behind) and azimuth phi.
 vec3 view_at(float n_dot_v) {
@@ -70,6 +72,26 @@ void main() {
             // a = (ior, dispersion).
             o.xyz = dispersion_iors(a.x, a.y);
             break;
+        case TERM_DIFFUSE_BTDF_COS:
+            // a = (colour, n.l).
+            o.xyz = diffuse_btdf_cos(a.xyz, a.w);
+            break;
+#ifdef HAS_DIFFUSE_TRANSMISSION
+        case TERM_DIFFUSE_TRANSMISSION_LIGHT: {
+            // a = (n.l, n.v, transmission, phi); u_params = (ior, thickness, metallic, diffuse_transmission).
+            Surface s = surface_base(vec3(0.9, 0.6, 0.3), u_params.z, 0.4, vec3(0.05, 0.04, 0.03), vec3(0.0), 1.0);
+            s.transmission = a.z;
+            s.ior = u_params.x;
+            s.thickness = u_params.y;
+            s.attenuation_color = vec3(1.0, 0.8, 0.5);
+            s.attenuation_distance = 0.7;
+            s.diffuse_transmission = u_params.w;
+            s.diffuse_transmission_color = vec3(0.2, 0.9, 0.6);
+            o.xyz = diffuse_transmission_light(s, n, view_at(a.y), light_at(a.x, a.w));
+            o.w = diffuse_transmission_front_weight(s);
+            break;
+        }
+#endif
     }
     u_outputs[i] = o;
 }

@@ -15,6 +15,9 @@ vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l
 #else
     vec3 f = vec3(0.0);
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    f += diffuse_transmission_light(s, n, v, l);
+#endif
     float n_dot_l = dot(n, l);
     if (n_dot_l > 0.0) {
         vec3 lv = l + v;
@@ -25,6 +28,9 @@ vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l
         vec3 kd = (1.0 - F) * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
         kd *= 1.0 - s.transmission;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+        kd *= diffuse_transmission_front_weight(s);
 #endif
 #ifdef HAS_ANISOTROPY
         vec3 specular = anisotropic_specular(s, n, v, l, F, false, 0.0);

@@ -55,6 +55,15 @@ vec3 transmission_light(Surface s, vec3 n, vec3 v, vec3 l, bool punctual, float 
 vec3 transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns);
 #endif
 
+#ifdef HAS_DIFFUSE_TRANSMISSION
+// What the base's front diffuse lobe keeps (1 - diffuse_transmission; common/diffuse_transmission.glsl).
+float diffuse_transmission_front_weight(Surface s);
+// The diffusely transmitted light for one direction l behind the surface, times |n.l|.
+vec3 diffuse_transmission_light(Surface s, vec3 n, vec3 v, vec3 l);
+// The diffusely transmitted environment (the irradiance about -n).
+vec3 diffuse_transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns);
+#endif
+
 // ---- the stack ---------------------------------------------------------------------------
 
 // The layers over the base for one direction l; base is the base's f |n.l| (transmission included).
@@ -74,6 +83,9 @@ vec3 layered_ibl(Surface s, vec3 n, vec3 v, vec3 base, bool with_suns) {
     vec3 radiance = base;
 #ifdef HAS_TRANSMISSION
     radiance += transmission_ibl(s, n, v, with_suns);
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    radiance += diffuse_transmission_ibl(s, n, v, with_suns);
 #endif
 #ifdef HAS_SHEEN
     radiance = radiance * sheen_base_weight_ibl(s, n, v) + sheen_ibl(s, n, v, with_suns);

@@ -27,6 +27,10 @@ uniform float u_attenuation_distance;  // 3e38 stands for glTF's +inf (no attenu
 #ifdef HAS_DISPERSION
 uniform float u_dispersion;
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+uniform float u_diffuse_transmission;
+uniform vec3 u_diffuse_transmission_color;
+#endif
 
 // The layer factors at a point with shading normal n and tangent frame (t, b) (orthonormal,
 // b = cross(n, t) up to the mesh's handedness). Maps, where a layer has them, multiply these
@@ -58,6 +62,10 @@ void apply_material_layers(inout Surface s, vec3 n, vec3 t, vec3 b) {
 #endif
 #ifdef HAS_DISPERSION
     s.dispersion = u_dispersion;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    s.diffuse_transmission = u_diffuse_transmission;
+    s.diffuse_transmission_color = u_diffuse_transmission_color;
 #endif
 }
 

@@ -26,6 +26,9 @@ vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
 #else
     vec3 transmitted = vec3(0.0);
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    transmitted += diffuse_transmission_light(s, n, v, l);
+#endif
     float n_dot_l = dot(n, l);
     if (n_dot_l <= 0.0) return transmitted;
     float n_dot_v = max(dot(n, v), MIN_N_DOT_V);
@@ -37,6 +40,9 @@ vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
     vec3 kd = (1.0 - F) * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
     kd *= 1.0 - s.transmission;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    kd *= diffuse_transmission_front_weight(s);
 #endif
 #ifdef HAS_ANISOTROPY
     vec3 specular = anisotropic_specular(s, n, v, l, F, true, 0.0);

@@ -11,6 +11,7 @@
 #include "common/sheen.glsl"
 #include "common/anisotropy.glsl"
 #include "common/transmission.glsl"
+#include "common/diffuse_transmission.glsl"
 
 uniform bool u_ibl_enabled;
 

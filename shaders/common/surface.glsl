@@ -37,6 +37,10 @@ struct Surface {
 #ifdef HAS_DISPERSION
     float dispersion;           // KHR_materials_dispersion: 20 / Abbe number
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    float diffuse_transmission;       // KHR_materials_diffuse_transmission
+    vec3 diffuse_transmission_color;  // linear
+#endif
 };
 
 // F0 = mix(specular_f0, base_color, metallic).
@@ -87,6 +91,10 @@ Surface surface_base(vec3 base_color, float metallic, float roughness, vec3 spec
 #endif
 #ifdef HAS_DISPERSION
     s.dispersion = 0.0;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    s.diffuse_transmission = 0.0;
+    s.diffuse_transmission_color = vec3(1.0);
 #endif
     return s;
 }

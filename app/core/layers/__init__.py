@@ -25,6 +25,7 @@ LAYER_DEFINES: dict[str, str] = {
     "transmission": "HAS_TRANSMISSION",
     "volume": "HAS_VOLUME",
     "dispersion": "HAS_DISPERSION",
+    "diffuse_transmission": "HAS_DIFFUSE_TRANSMISSION",
 }
 assert set(LAYER_DEFINES) == set(LAYERS)
 
