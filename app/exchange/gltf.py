@@ -394,6 +394,11 @@ class _Reader:
             "normal": m.normalTexture, "emissive": m.emissiveTexture, "occlusion": m.occlusionTexture,
         }
         infos = {}
+        unread = ext.get("KHR_materials_diffuse_transmission")
+        for key in ("diffuseTransmissionTexture", "diffuseTransmissionColorTexture"):
+            if isinstance(unread, dict) and key in unread:   # the factors are drawn, not these maps yet
+                self.warn(f"unread:{key}", f"{where}.extensions.KHR_materials_diffuse_transmission.{key}: "
+                                           "not read; rendered with the factor alone")
         for slot, (name, key) in LAYER_TEXTURES.items():
             layer_info = (ext.get(name) or {}).get(key) if isinstance(ext.get(name), dict) else None
             if isinstance(layer_info, dict):
