@@ -35,7 +35,8 @@ REPO = Path(__file__).resolve().parents[1]
 ALL_LAYERS = Material(base_color=(0.6, 0.2, 0.1), roughness=0.4, ior=1.45, specular_f0=(0.05, 0.04, 0.03), transmission=0.5, thickness=0.25,
                       attenuation_color=(0.9, 0.5, 0.2), attenuation_distance=0.75, clearcoat=0.8,
                       clearcoat_roughness=0.2, sheen_color=(0.3, 0.4, 0.5), sheen_roughness=0.6,
-                      anisotropy_strength=0.7, anisotropy_rotation=1.25, name="all_layers")
+                      anisotropy_strength=0.7, anisotropy_rotation=1.25, dispersion=0.4, diffuse_transmission=0.3,
+                      diffuse_transmission_color=(0.7, 0.9, 0.4), name="all_layers")
 
 
 def test_defaults_are_gltf_and_turn_every_layer_off():
@@ -45,10 +46,12 @@ def test_defaults_are_gltf_and_turn_every_layer_off():
     assert (m.transmission, m.thickness, m.attenuation_color, m.attenuation_distance) == (0.0, 0.0, (1.0,) * 3, math.inf)
     assert (m.clearcoat, m.clearcoat_roughness, m.sheen_color, m.sheen_roughness) == (0.0, 0.0, (0.0,) * 3, 0.0)
     assert (m.anisotropy_strength, m.anisotropy_rotation) == (0.0, 0.0)
+    assert (m.dispersion, m.diffuse_transmission, m.diffuse_transmission_color) == (0.0, 0.0, (1.0,) * 3)
     assert ALL_LAYERS.layers() == frozenset(LAYERS)
     # A layer's secondary fields alone do not turn it on.
     assert Material(clearcoat_roughness=0.5, sheen_roughness=0.5, anisotropy_rotation=1.0, thickness=1.0).layers() == frozenset()
     assert Material(thickness=1.0, transmission=0.1).layers() == {"transmission", "volume"}
+    assert Material(dispersion=1.0, transmission=0.1).layers() == {"transmission"}   # dispersion needs a volume
 
 
 def test_the_ior_rule():
