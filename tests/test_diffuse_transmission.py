@@ -183,3 +183,16 @@ def test_probe_against_the_exact_answer(shared_data):
     error = relative(got[inside], truth)
     print(f"diffuse transmission 0.5 vs truth: {error * 100:.2f}%; the truth moves {relative(plain, truth) * 100:.2f}% with it")
     assert error <= PROBE_BOUND
+
+
+def test_its_textures_are_warned_about_in_one_line(tmp_path):
+    """The two textures are not read yet: a file with them says so once, and draws the factor."""
+    from alight.exchange.meshes import load_mesh
+
+    path = _sphere_file(tmp_path / "t.glb", {"diffuseTransmissionFactor": 0.5,
+                                             "diffuseTransmissionTexture": {"index": 0},
+                                             "diffuseTransmissionColorTexture": {"index": 0}})
+    mesh = load_mesh(str(path))
+    lines = [w for w in mesh.warnings if "KHR_materials_diffuse_transmission" in w]
+    assert len(lines) == 2 and all("not read" in w for w in lines)
+    assert mesh.parts[0].material.layers["diffuse_transmission"] == 0.5
