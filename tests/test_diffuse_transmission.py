@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-import alight.render.renderer as renderer_module
+import alight.render.variants as variants   # the layer defines a draw compiles (material_defines)
 from alight.accuracy.converged import downsample_equirect
 from alight.accuracy.ground_truth import layered_ground_truth, probe_points
 from alight.core import shading
@@ -56,7 +56,7 @@ def test_a_zero_diffuse_transmission_compiled_in_changes_nothing(monkeypatch, sh
                  mesh=sphere() if view == "camera" else None)
     r = renderer()
     base = r.render(Scene(**scene), maps, 48, 48, aa="none").linear
-    monkeypatch.setattr(renderer_module, "layer_defines", lambda materials: {"HAS_DIFFUSE_TRANSMISSION": None})
+    monkeypatch.setattr(variants, "layer_defines", lambda materials: {"HAS_DIFFUSE_TRANSMISSION": None})
     layered = r.render(Scene(**scene), maps, 48, 48, aa="none").linear
     np.testing.assert_allclose(layered[..., :3], base[..., :3], rtol=2e-6, atol=1e-7)
 

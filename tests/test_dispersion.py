@@ -11,7 +11,7 @@ import struct
 import numpy as np
 import pytest
 
-import alight.render.renderer as renderer_module
+import alight.render.variants as variants   # the layer defines a draw compiles (material_defines)
 from alight.accuracy.converged import downsample_equirect
 from alight.accuracy.ground_truth import (
     dispersion_transmission_terms,
@@ -77,7 +77,7 @@ def test_a_zero_dispersion_compiled_in_changes_nothing(monkeypatch, shared_data,
     r = renderer()
     base = r.render(Scene(**scene), maps, 48, 48, aa="none").linear
     forced = {"HAS_TRANSMISSION": None, "HAS_VOLUME": None, "HAS_DISPERSION": None}
-    monkeypatch.setattr(renderer_module, "layer_defines", lambda materials: dict(forced))
+    monkeypatch.setattr(variants, "layer_defines", lambda materials: dict(forced))
     layered = r.render(Scene(**scene), maps, 48, 48, aa="none").linear
     np.testing.assert_allclose(layered[..., :3], base[..., :3], rtol=2e-6, atol=1e-7)
 
