@@ -119,12 +119,18 @@ def test_spot_and_range_attenuation():
 # --- the transmission BTDF and layer (common/btdf.glsl and transmission.glsl against
 # app/core/btdf.py and app/core/layers/transmission.py) -------------------------------------
 
-TRANSMISSION_TERMS = {"BTDF_THIN": 0, "BTDF_REFRACTION": 1, "BEER_LAMBERT": 2, "TRANSMISSION_LIGHT": 3}
+TRANSMISSION_TERMS = {"BTDF_THIN": 0, "BTDF_REFRACTION": 1, "BEER_LAMBERT": 2, "TRANSMISSION_LIGHT": 3,
+                      "DISPERSION_IORS": 4, "DIFFUSE_BTDF_COS": 5, "DIFFUSE_TRANSMISSION_LIGHT": 6}
 
 
-def evaluate_transmission(term, inputs, uniforms=None):
+def evaluate_transmission(term, inputs, uniforms=None, dispersion=False, diffuse=False):
+    defines = {"HAS_TRANSMISSION": None, "HAS_VOLUME": None}
+    if dispersion:
+        defines["HAS_DISPERSION"] = None
+    if diffuse:
+        defines["HAS_DIFFUSE_TRANSMISSION"] = None
     return evaluate(TRANSMISSION_TERMS[term], inputs, uniforms, shader="accuracy/evaluate_transmission.comp",
-                    defines={"HAS_TRANSMISSION": None, "HAS_VOLUME": None})
+                    defines=defines)
 
 
 def _view_at(n_dot_v):
@@ -254,3 +260,81 @@ def test_iridescence_ibl_weights():
                                                    1 - f0 - (1 - f0) * dfres[:, None], f0 * x[:, 1:2] + x[:, 2:3])
     close(gpu[:, :3], spec, rtol=2e-3, atol=2e-5)
     close(gpu[:, 3], dw[:, 0], rtol=2e-3, atol=2e-5)
+
+
+# --- KHR_materials_dispersion (common/dispersion_terms.glsl and transmission.glsl against
+# app/core/layers/dispersion.py and transmission.py) ------------------------------------------
+
+def test_dispersion_iors():
+    from alight.core.layers.dispersion import dispersion_iors
+
+    x = np.column_stack([rng.uniform(1.0, 3.0, 200), rng.uniform(0.0, 2.0, 200)])
+    gpu = evaluate_transmission("DISPERSION_IORS", x, dispersion=True)[:, :3]
+    close(gpu, np.array([dispersion_iors(ior, d) for ior, d in x]), rtol=1e-6)
+    # Abbe number 40 (dispersion 0.5) at ior 1.5: n_F - n_C = 0.5 / 40 = 0.0125, centred on n_d.
+    np.testing.assert_allclose(dispersion_iors(1.5, 0.5), [1.49375, 1.5, 1.50625])
+
+
+@pytest.mark.parametrize("ior,thickness,dispersion", [(1.5, 1.0, 1.0), (2.4, 0.3, 3.0), (1.5, 0.0, 2.0)])
+@pytest.mark.parametrize("punctual", [False, True])
+def test_dispersed_transmission_light(ior, thickness, dispersion, punctual):
+    """transmission_light with HAS_DISPERSION: each channel at its own index (a thin wall: none)."""
+    from alight.core.layers.stack import Pairs
+    from alight.core.layers.transmission import transmission_light
+    from alight.core.material import Material
+
+    x = np.column_stack([-rng.uniform(0.02, 1, 300), rng.uniform(0.02, 1, 300), rng.uniform(0.05, 1, 300),
+                         rng.uniform(0, 2 * np.pi, 300)])
+    params = (ior, thickness, 0.25, float(punctual))
+    gpu = evaluate_transmission("TRANSMISSION_LIGHT", x, {"u_params": params, "u_dispersion_factor": dispersion},
+                                dispersion=True)[:, :3]
+    cpu = np.empty_like(gpu, dtype=np.float64)
+    plain = np.empty_like(cpu)
+    for i, (nl, nv, r, phi) in enumerate(x):
+        m = Material(base_color=(0.9, 0.6, 0.3), metallic=0.25, roughness=r, specular_f0=(0.05, 0.04, 0.03), ior=ior,
+                     transmission=0.8, thickness=thickness, attenuation_color=(1.0, 0.8, 0.5), attenuation_distance=0.7,
+                     dispersion=dispersion)
+        p = Pairs(n=np.array([[0.0, 0.0, 1.0]]), v=_view_at(np.array([nv])), l=_light_at(np.array([nl]), np.array([phi])))
+        cpu[i] = transmission_light(m, p, punctual)[0, 0]
+        plain[i] = transmission_light(Material(**{**m.__dict__, "dispersion": 0.0}), p, punctual)[0, 0]
+    close(gpu, cpu, rtol=2e-3, atol=2e-5)
+    if thickness > 0.0:   # the channels really refract apart (red and blue differ from undispersed)
+        assert np.abs(cpu[:, 0] - plain[:, 0]).max() > 1e-3 and np.abs(cpu[:, 2] - plain[:, 2]).max() > 1e-3
+        np.testing.assert_allclose(cpu[:, 1], plain[:, 1], rtol=1e-12)
+    else:
+        np.testing.assert_allclose(cpu, plain, rtol=1e-12)
+
+
+# --- KHR_materials_diffuse_transmission (common/diffuse_transmission_terms.glsl and
+# diffuse_transmission.glsl against app/core/layers/diffuse_transmission.py) ---------------------
+
+def test_diffuse_btdf_cos():
+    from alight.core.layers.diffuse_transmission import diffuse_btdf_cos
+
+    x = np.column_stack([rng.uniform(0, 1, (300, 3)), rng.uniform(-1, 1, 300)])
+    gpu = evaluate_transmission("DIFFUSE_BTDF_COS", x)[:, :3]
+    close(gpu, np.array([diffuse_btdf_cos(c, nl) for c, nl in zip(x[:, :3], x[:, 3])]))
+    assert np.all(gpu[x[:, 3] >= 0] == 0)
+
+
+@pytest.mark.parametrize("thickness", [0.0, 0.8])
+def test_diffuse_transmission_light(thickness):
+    from alight.core.layers.diffuse_transmission import diffuse_transmission_light, front_weight
+    from alight.core.layers.stack import Pairs
+    from alight.core.material import Material
+
+    x = np.column_stack([-rng.uniform(0.02, 1, 300), rng.uniform(0.02, 1, 300), rng.uniform(0.05, 1, 300),
+                         rng.uniform(0, 2 * np.pi, 300)])
+    x[:20, 0] *= -1   # some lights in front: no transmitted light there
+    params = (1.5, thickness, 0.25, 0.7)
+    gpu = evaluate_transmission("DIFFUSE_TRANSMISSION_LIGHT", x, {"u_params": params}, diffuse=True)
+    cpu = np.empty((len(x), 3))
+    for i, (nl, nv, t, phi) in enumerate(x):
+        m = Material(base_color=(0.9, 0.6, 0.3), metallic=0.25, roughness=0.4, specular_f0=(0.05, 0.04, 0.03), ior=1.5,
+                     transmission=t, thickness=thickness, attenuation_color=(1.0, 0.8, 0.5), attenuation_distance=0.7,
+                     diffuse_transmission=0.7, diffuse_transmission_color=(0.2, 0.9, 0.6))
+        p = Pairs(n=np.array([[0.0, 0.0, 1.0]]), v=_view_at(np.array([nv])), l=_light_at(np.array([nl]), np.array([phi])))
+        cpu[i] = diffuse_transmission_light(m, p)[0, 0]
+    close(gpu[:, :3], cpu, rtol=2e-4, atol=1e-6)
+    close(gpu[:, 3], np.full(len(x), front_weight(m)))
+    assert np.all(gpu[:20, :3] == 0) and (gpu[20:, 1] > 0).all()

@@ -103,7 +103,7 @@ def test_zero_weight_compiled_in_changes_nothing(monkeypatch, shared_data):
     """With HAS_IRIDESCENCE forced on, weight 0 is the base (forward pass and reference) to
     float rounding, and a film of thickness 0 is no film either."""
     import alight.accuracy.reference as reference
-    import alight.render.renderer as forward
+    import alight.render.variants as forward   # the layer defines a draw compiles (material_defines)
     from alight.accuracy.reference import ReferenceRenderer
 
     r = renderer()

@@ -36,7 +36,8 @@ ALL_LAYERS = Material(base_color=(0.6, 0.2, 0.1), roughness=0.4, ior=1.45, specu
                       attenuation_color=(0.9, 0.5, 0.2), attenuation_distance=0.75, clearcoat=0.8,
                       clearcoat_roughness=0.2, sheen_color=(0.3, 0.4, 0.5), sheen_roughness=0.6,
                       anisotropy_strength=0.7, anisotropy_rotation=1.25, iridescence=0.6, iridescence_ior=1.6,
-                      iridescence_thickness_minimum=80.0, iridescence_thickness_maximum=450.0, name="all_layers")
+                      iridescence_thickness_minimum=80.0, iridescence_thickness_maximum=450.0, dispersion=0.4,
+                      diffuse_transmission=0.3, diffuse_transmission_color=(0.7, 0.9, 0.4), name="all_layers")
 
 
 def test_defaults_are_gltf_and_turn_every_layer_off():
@@ -46,10 +47,12 @@ def test_defaults_are_gltf_and_turn_every_layer_off():
     assert (m.transmission, m.thickness, m.attenuation_color, m.attenuation_distance) == (0.0, 0.0, (1.0,) * 3, math.inf)
     assert (m.clearcoat, m.clearcoat_roughness, m.sheen_color, m.sheen_roughness) == (0.0, 0.0, (0.0,) * 3, 0.0)
     assert (m.anisotropy_strength, m.anisotropy_rotation) == (0.0, 0.0)
+    assert (m.dispersion, m.diffuse_transmission, m.diffuse_transmission_color) == (0.0, 0.0, (1.0,) * 3)
     assert ALL_LAYERS.layers() == frozenset(LAYERS)
     # A layer's secondary fields alone do not turn it on.
     assert Material(clearcoat_roughness=0.5, sheen_roughness=0.5, anisotropy_rotation=1.0, thickness=1.0).layers() == frozenset()
     assert Material(thickness=1.0, transmission=0.1).layers() == {"transmission", "volume"}
+    assert Material(dispersion=1.0, transmission=0.1).layers() == {"transmission"}   # dispersion needs a volume
 
 
 def test_the_ior_rule():

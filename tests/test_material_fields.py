@@ -47,6 +47,9 @@ CASES: dict[str, tuple[object, dict]] = {
     "iridescence_ior": (2.0, {"base_color": _DARK, "iridescence": 1.0}),
     "iridescence_thickness_minimum": (300.0, {"base_color": _DARK, "iridescence": 1.0}),
     "iridescence_thickness_maximum": (250.0, {"base_color": _DARK, "iridescence": 1.0, "iridescence_ior": 1.8}),
+    "diffuse_transmission": (1.0, {"base_color": (0.9, 0.2, 0.1), "diffuse_transmission_color": (0.1, 0.2, 0.9)}),
+    "diffuse_transmission_color": ((0.1, 0.2, 0.9), {"base_color": (0.9, 0.2, 0.1), "diffuse_transmission": 1.0}),
+    "dispersion": (10.0, {"transmission": 1.0, "thickness": 1.0, "ior": 3.0, "roughness": 0.2}),
 }
 # Fields that change the picture only through a map (the thickness map's G mixes minimum and
 # maximum; without one the film is the maximum thick): both front ends must still agree.

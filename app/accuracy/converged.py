@@ -705,11 +705,25 @@ def transmission_environment_converged(material, radiance, normals, view) -> np.
     the BTDF with the rest of the layered BRDF, ``ibl_converged``)."""
     from alight.core.btdf import beer_lambert
 
+    import dataclasses
+
+    from alight.core.layers.dispersion import channel_iors
+
     m = material
     n = _unit_rows(normals)
     v = np.broadcast_to(_unit_rows(view), n.shape)
-    direction, rough, energy = transmitted_lobe_converged(m, n, v)
     weight = (1.0 - m.metallic) * m.transmission * np.asarray(m.base_color) * (1.0 - np.asarray(m.f0()))
     if "volume" in m.layers():
         weight = weight * beer_lambert(m.attenuation_color, m.attenuation_distance, m.thickness)
-    return weight * energy[:, None] * prefiltered_converged_varying(np.asarray(radiance, np.float32), direction, rough)
+    env = np.asarray(radiance, np.float32)
+
+    def gathered(mc):
+        direction, rough, energy = transmitted_lobe_converged(mc, n, v)
+        return energy[:, None] * prefiltered_converged_varying(env, direction, rough)
+
+    iors = channel_iors(m)
+    if iors[0] == iors[2]:
+        return weight * gathered(m)
+    # KHR_materials_dispersion (transmission.glsl: dispersed_radiance): a lobe per channel.
+    channels = [gathered(dataclasses.replace(m, ior=float(iors[c])))[:, c] for c in range(3)]
+    return weight * np.stack(channels, -1)

@@ -289,6 +289,20 @@ def transmission_terms(radiance, normals, views, roughness, ior: float = 1.5, th
     return out
 
 
+def dispersion_transmission_terms(radiance, normals, views, roughness, ior: float, dispersion: float,
+                                  rotation_deg: float = 0.0, intensity: float = 1.0) -> np.ndarray:
+    """KHR_materials_dispersion's S_T (R, P, 3) (docs/layer_dispersion.md): channel c of
+    :func:`transmission_terms` for the refracting BTDF at that channel's index
+    (``alight.core.layers.dispersion.dispersion_iors``). Combine with
+    :func:`transmission_combine` as the undispersed S_T."""
+    from alight.core.layers.dispersion import dispersion_iors
+
+    iors = dispersion_iors(ior, dispersion)
+    sums = [transmission_terms(radiance, normals, views, roughness, float(iors[c]), False, rotation_deg,
+                               intensity)[..., c] for c in range(3)]
+    return np.stack(sums, -1)
+
+
 def check_transmission_lobe(roughness: float, ior: float) -> None:
     """The refracting lobe spans about alpha (ior - 1) / (2 ior) of the reflected lobe's alpha (at
     normal incidence, a facet tilted by theta bends the refracted ray by theta (1 - 1/ior), the

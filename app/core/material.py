@@ -31,6 +31,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "volume": ("thickness", "attenuation_color", "attenuation_distance"),       # KHR_materials_volume
     "iridescence": ("iridescence", "iridescence_ior", "iridescence_thickness_minimum",
                     "iridescence_thickness_maximum"),                           # KHR_materials_iridescence
+    "dispersion": ("dispersion",),                                              # KHR_materials_dispersion
+    "diffuse_transmission": ("diffuse_transmission", "diffuse_transmission_color"),  # KHR_materials_diffuse_transmission
 }
 LAYER_FIELDS: tuple[str, ...] = tuple(f for fields in LAYERS.values() for f in fields)
 DEFAULT_IOR = 1.5  # glTF's; F0 = ((1.5 - 1) / (1.5 + 1))^2 = 0.04
@@ -89,6 +91,12 @@ class Material:
     thickness: float = 0.0
     attenuation_color: Vec3 = (1.0, 1.0, 1.0)
     attenuation_distance: float = math.inf
+    # KHR_materials_dispersion: 20 / Abbe number (0: none); spreads the volume's ior per channel.
+    dispersion: float = 0.0
+    # KHR_materials_diffuse_transmission: the share of the diffuse lobe that leaves through the
+    # back side (a Lambertian BTDF) and its linear colour.
+    diffuse_transmission: float = 0.0
+    diffuse_transmission_color: Vec3 = (1.0, 1.0, 1.0)
     # KHR_materials_clearcoat: the coat's weight and perceptual roughness.
     clearcoat: float = 0.0
     clearcoat_roughness: float = 0.0
@@ -131,7 +139,9 @@ class Material:
 
         A layer is on when its strength is above zero: clearcoat > 0, max(sheen_color) > 0,
         anisotropy_strength > 0, iridescence > 0, transmission > 0; volume when transmission > 0 and thickness > 0
-        (KHR_materials_volume acts only through transmission)."""
+        (KHR_materials_volume acts only through transmission); dispersion when the volume is on
+        and dispersion > 0 (KHR_materials_dispersion acts only on a volume's refraction);
+        diffuse_transmission when diffuse_transmission > 0."""
         used = set()
         if self.clearcoat > 0.0:
             used.add("clearcoat")
@@ -141,10 +151,14 @@ class Material:
             used.add("anisotropy")
         if self.iridescence > 0.0:
             used.add("iridescence")
+        if self.diffuse_transmission > 0.0:
+            used.add("diffuse_transmission")
         if self.transmission > 0.0:
             used.add("transmission")
             if self.thickness > 0.0:
                 used.add("volume")
+                if self.dispersion > 0.0:
+                    used.add("dispersion")
         return frozenset(used)
 
     def to_dict(self) -> dict[str, Any]:
@@ -189,9 +203,11 @@ _RANGES: dict[str, tuple[float, float]] = {
     "sheen_color": _UNIT, "sheen_roughness": _UNIT, "anisotropy_strength": _UNIT,
     "anisotropy_rotation": (-math.inf, math.inf),
     "iridescence": _UNIT, "iridescence_ior": (1.0, math.inf), "iridescence_thickness_minimum": _NONNEG,
-    "iridescence_thickness_maximum": _NONNEG,
+    "iridescence_thickness_maximum": _NONNEG, "dispersion": _NONNEG,
+    "diffuse_transmission": _UNIT, "diffuse_transmission_color": _UNIT,
 }
-_VECTORS = ("base_color", "specular_f0", "emissive", "f0_linear", "f0_srgb", "attenuation_color", "sheen_color")
+_VECTORS = ("base_color", "specular_f0", "emissive", "f0_linear", "f0_srgb", "attenuation_color", "sheen_color",
+            "diffuse_transmission_color")
 # Fields a preset file may leave out: every layer field (the layer is then off) and the ior
 # (then derived from specular_f0); specular_f0 may be left out when the ior is given.
 _MAY_OMIT = ("ior", *LAYER_FIELDS)

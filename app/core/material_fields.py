@@ -53,6 +53,7 @@ _LAYER_EXTENSION = {
     "clearcoat": "KHR_materials_clearcoat", "sheen": "KHR_materials_sheen",
     "anisotropy": "KHR_materials_anisotropy", "transmission": "KHR_materials_transmission",
     "volume": "KHR_materials_volume", "iridescence": "KHR_materials_iridescence",
+    "dispersion": "KHR_materials_dispersion", "diffuse_transmission": "KHR_materials_diffuse_transmission",
 }
 _BASE_EXTENSION = {"ior": "KHR_materials_ior", "specular_f0": "KHR_materials_specular"}
 
@@ -79,6 +80,9 @@ _TEXT: dict[str, tuple[str, str]] = {
     "iridescence_ior": ("X", "the thin film's index of refraction, >= 1 (default 1.3)"),
     "iridescence_thickness_minimum": ("NM", "the film's thickness in nm where the thickness map is 0 (default 100)"),
     "iridescence_thickness_maximum": ("NM", "the film's thickness in nm where the map is 1, and without a map (default 400)"),
+    "diffuse_transmission": ("X", "KHR_materials_diffuse_transmission: the diffuse share leaving through the back side, in [0,1] (default 0: none)"),
+    "diffuse_transmission_color": ("R,G,B", "the diffusely transmitted light's linear colour in [0,1] (default 1,1,1)"),
+    "dispersion": ("X", "KHR_materials_dispersion: 20 / Abbe number, >= 0, spreads a volume's ior per channel (default 0: none)"),
 }
 # Fields whose low end is excluded (material._number refuses attenuation_distance <= 0).
 _LOW_OPEN = ("attenuation_distance",)

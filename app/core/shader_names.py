@@ -122,6 +122,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "HAS_TRANSMISSION": "KHR_materials_transmission",
     "HAS_VOLUME": "KHR_materials_volume",
     "HAS_IRIDESCENCE": "KHR_materials_iridescence",
+    "HAS_DISPERSION": "KHR_materials_dispersion",
+    "HAS_DIFFUSE_TRANSMISSION": "KHR_materials_diffuse_transmission",
     "TRANSMISSION_SCENE": "transmission refracts a copy of the opaque scene behind the part",
     "ANISOTROPY_LOOKUP": "how the anisotropic lobe's IBL is looked up (1: table, 2: fetches)",
     "ANISOTROPY_FETCHES": "the number of prefiltered fetches along the stretched anisotropic lobe",

@@ -50,7 +50,8 @@ SUPPORTED = {
     "KHR_materials_specular", "KHR_mesh_quantization", "KHR_lights_punctual", "EXT_texture_webp",
     "KHR_draco_mesh_compression",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_transmission",
-    "KHR_materials_volume", "KHR_materials_iridescence",
+    "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_dispersion",
+    "KHR_materials_diffuse_transmission",
 }
 # The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
@@ -395,6 +396,11 @@ class _Reader:
             "normal": m.normalTexture, "emissive": m.emissiveTexture, "occlusion": m.occlusionTexture,
         }
         infos = {}
+        unread = ext.get("KHR_materials_diffuse_transmission")
+        for key in ("diffuseTransmissionTexture", "diffuseTransmissionColorTexture"):
+            if isinstance(unread, dict) and key in unread:   # the factors are drawn, not these maps yet
+                self.warn(f"unread:{key}", f"{where}.extensions.KHR_materials_diffuse_transmission.{key}: "
+                                           "not read; rendered with the factor alone")
         for slot, (name, key) in LAYER_TEXTURES.items():
             layer_info = (ext.get(name) or {}).get(key) if isinstance(ext.get(name), dict) else None
             if isinstance(layer_info, dict):

@@ -23,6 +23,9 @@ The layers (docs/layers.md) are the extensions' factors, one to one:
     thickness             = KHR_materials_volume.thicknessFactor
     attenuation_color     = KHR_materials_volume.attenuationColor
     attenuation_distance  = KHR_materials_volume.attenuationDistance (absent: +inf)
+    dispersion            = KHR_materials_dispersion.dispersion
+    diffuse_transmission  = KHR_materials_diffuse_transmission.diffuseTransmissionFactor
+    diffuse_transmission_color = KHR_materials_diffuse_transmission.diffuseTransmissionColorFactor
     clearcoat             = KHR_materials_clearcoat.clearcoatFactor
     clearcoat_roughness   = KHR_materials_clearcoat.clearcoatRoughnessFactor
     sheen_color           = KHR_materials_sheen.sheenColorFactor
@@ -61,6 +64,8 @@ EXT_CLEARCOAT = "KHR_materials_clearcoat"
 EXT_SHEEN = "KHR_materials_sheen"
 EXT_ANISOTROPY = "KHR_materials_anisotropy"
 EXT_IRIDESCENCE = "KHR_materials_iridescence"
+EXT_DISPERSION = "KHR_materials_dispersion"
+EXT_DIFFUSE_TRANSMISSION = "KHR_materials_diffuse_transmission"
 DEFAULT_F0 = 0.04  # ((1.5 - 1) / (1.5 + 1))^2, glTF's default dielectric
 # Each layer extension's factors: (glTF name, Material field, glTF default, components).
 LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
@@ -78,6 +83,9 @@ LAYER_EXTENSIONS: dict[str, tuple[tuple[str, str, Any, int], ...]] = {
                       ("iridescenceIor", "iridescence_ior", 1.3, 1),
                       ("iridescenceThicknessMinimum", "iridescence_thickness_minimum", 100.0, 1),
                       ("iridescenceThicknessMaximum", "iridescence_thickness_maximum", 400.0, 1)),
+    EXT_DISPERSION: (("dispersion", "dispersion", 0.0, 1),),
+    EXT_DIFFUSE_TRANSMISSION: (("diffuseTransmissionFactor", "diffuse_transmission", 0.0, 1),
+                               ("diffuseTransmissionColorFactor", "diffuse_transmission_color", (1.0, 1.0, 1.0), 3)),
 }
 GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 

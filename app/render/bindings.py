@@ -86,6 +86,9 @@ def set_material(prog, m: Material) -> None:
     set_uniform(prog, "u_thickness", float(m.thickness))
     set_uniform(prog, "u_attenuation_color", tuple(float(x) for x in m.attenuation_color))
     set_uniform(prog, "u_attenuation_distance", float(min(m.attenuation_distance, 3.0e38)))
+    set_uniform(prog, "u_dispersion", float(m.dispersion))
+    set_uniform(prog, "u_diffuse_transmission", float(m.diffuse_transmission))
+    set_uniform(prog, "u_diffuse_transmission_color", tuple(float(x) for x in m.diffuse_transmission_color))
     for name, value in iridescence_uniforms(m).items():   # common/material_iridescence.glsl
         set_uniform(prog, name, value)
 

@@ -1,6 +1,6 @@
 #version 450 core
 // Evaluates one transmission function per row of inputs (tests/gpu.py's evaluate, with
-// shader="accuracy/evaluate_transmission.comp" and HAS_TRANSMISSION, HAS_VOLUME defined), for
+// shader="accuracy/evaluate_transmission.comp" and HAS_TRANSMISSION, HAS_VOLUME (HAS_DISPERSION) defined), for
 // tests/test_glsl_twins.py to compare with the numpy twins (app/core/btdf.py,
 // app/core/layers/transmission.py). Not used for rendering.
 #include "common/shading.glsl"
@@ -12,11 +12,15 @@ uniform int u_count;
 uniform int u_term;
 uniform vec4 u_params;   // per-term constants
 uniform float u_spread;  // TERM_TRANSMISSION_LIGHT: a compact source's angular radius
+uniform float u_dispersion_factor;  // TERM_TRANSMISSION_LIGHT with HAS_DISPERSION: the dispersion
 
 const int TERM_BTDF_THIN = 0;
 const int TERM_BTDF_REFRACTION = 1;
 const int TERM_BEER_LAMBERT = 2;
 const int TERM_TRANSMISSION_LIGHT = 3;
+const int TERM_DISPERSION_IORS = 4;
+const int TERM_DIFFUSE_BTDF_COS = 5;
+const int TERM_DIFFUSE_TRANSMISSION_LIGHT = 6;
 
 // Unit v and l about n = +Z: v in the xz plane at n.v; l at n.l (< 0: behind) and azimuth phi.
 vec3 view_at(float n_dot_v) {
@@ -58,9 +62,36 @@ void main() {
             s.thickness = u_params.y;
             s.attenuation_color = vec3(1.0, 0.8, 0.5);
             s.attenuation_distance = 0.7;
+#ifdef HAS_DISPERSION
+            s.dispersion = u_dispersion_factor;
+#endif
             o.xyz = transmission_light(s, n, view_at(a.y), light_at(a.x, a.w), u_params.w > 0.5, u_spread);
             break;
         }
+        case TERM_DISPERSION_IORS:
+            // a = (ior, dispersion).
+            o.xyz = dispersion_iors(a.x, a.y);
+            break;
+        case TERM_DIFFUSE_BTDF_COS:
+            // a = (colour, n.l).
+            o.xyz = diffuse_btdf_cos(a.xyz, a.w);
+            break;
+#ifdef HAS_DIFFUSE_TRANSMISSION
+        case TERM_DIFFUSE_TRANSMISSION_LIGHT: {
+            // a = (n.l, n.v, transmission, phi); u_params = (ior, thickness, metallic, diffuse_transmission).
+            Surface s = surface_base(vec3(0.9, 0.6, 0.3), u_params.z, 0.4, vec3(0.05, 0.04, 0.03), vec3(0.0), 1.0);
+            s.transmission = a.z;
+            s.ior = u_params.x;
+            s.thickness = u_params.y;
+            s.attenuation_color = vec3(1.0, 0.8, 0.5);
+            s.attenuation_distance = 0.7;
+            s.diffuse_transmission = u_params.w;
+            s.diffuse_transmission_color = vec3(0.2, 0.9, 0.6);
+            o.xyz = diffuse_transmission_light(s, n, view_at(a.y), light_at(a.x, a.w));
+            o.w = diffuse_transmission_front_weight(s);
+            break;
+        }
+#endif
     }
     u_outputs[i] = o;
 }

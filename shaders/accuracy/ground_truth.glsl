@@ -15,6 +15,9 @@ vec3 brdf_ground_truth(Surface s, vec3 f0, vec3 n, vec3 v, float n_dot_v, vec3 l
 #else
     vec3 f = vec3(0.0);
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    f += diffuse_transmission_light(s, n, v, l);
+#endif
     LobeAngles a;
     a.n_dot_l = dot(n, l);
     if (a.n_dot_l > 0.0) {

@@ -47,7 +47,7 @@ void main() {
     // The environment is summed in the map's frame: a copy of the surface with its layers'
     // directions (coat normal, tangent frame) in that frame too.
     Surface s_map = s;
-#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME) || defined(HAS_DIFFUSE_TRANSMISSION)
     // The layers' factors are the scene material's (app/accuracy/reference.py), about the
     // G-buffer's frame.
     vec4 tw = texelFetch(u_g_tangent, p, 0);

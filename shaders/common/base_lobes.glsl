@@ -43,12 +43,15 @@ vec3 base_specular_lobe(Surface s, vec3 n, vec3 v, vec3 l, LobeAngles a, LobeCho
 #endif
 }
 
-// Filament's diffuseLobe: kd Lambert, kd = (1 - F)(1 - metallic)(1 - transmission); F is the
-// diffuse lobe's Fresnel (with HAS_IRIDESCENCE the film's largest channel mixed in).
+// Filament's diffuseLobe: kd Lambert, kd = (1 - F)(1 - metallic)(1 - transmission)(1 - diffuse_transmission);
+// F is the diffuse lobe's Fresnel (with HAS_IRIDESCENCE the film's largest channel mixed in).
 vec3 base_diffuse_lobe(Surface s, vec3 F) {
     vec3 kd = (1.0 - F) * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
     kd *= 1.0 - s.transmission;   // the rest of the diffuse lobe is transmitted (transmission.glsl)
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    kd *= diffuse_transmission_front_weight(s);   // the rest leaves through the back (diffuse_transmission.glsl)
 #endif
     return kd * Fd_Lambert(s.base_color);
 }

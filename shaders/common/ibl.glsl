@@ -188,6 +188,9 @@ vec3 sun_layered(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
 #else
     vec3 transmitted = vec3(0.0);
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    transmitted += diffuse_transmission_light(s, n, v, l);
+#endif
     return layered_light(s, n, v, l, transmitted + sun_light(s, n, v, l, spread), false, spread) * power;
 }
 
@@ -214,6 +217,9 @@ vec3 ibl_combine(Surface s, vec3 f0, vec3 diffuse_weight, vec3 spec_weight, vec4
     vec3 albedo = s.base_color * (1.0 - s.metallic);
 #ifdef HAS_TRANSMISSION
     albedo *= 1.0 - s.transmission;   // the rest of the diffuse lobe is transmitted (transmission.glsl)
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    albedo *= diffuse_transmission_front_weight(s);   // the rest leaves through the back (diffuse_transmission.glsl)
 #endif
 #ifdef MULTIPLE_SCATTERING
     float e_ss = lut.x + lut.y;

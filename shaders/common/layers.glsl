@@ -65,6 +65,15 @@ vec3 iridescence_diffuse_fresnel(Surface s, vec3 F);
 void iridescence_ibl_weights(Surface s, vec4 lut, inout vec3 diffuse_weight, inout vec3 spec_albedo);
 #endif
 
+#ifdef HAS_DIFFUSE_TRANSMISSION
+// What the base's front diffuse lobe keeps (1 - diffuse_transmission; common/diffuse_transmission.glsl).
+float diffuse_transmission_front_weight(Surface s);
+// The diffusely transmitted light for one direction l behind the surface, times |n.l|.
+vec3 diffuse_transmission_light(Surface s, vec3 n, vec3 v, vec3 l);
+// The diffusely transmitted environment (the irradiance about -n).
+vec3 diffuse_transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns);
+#endif
+
 // ---- the stack ---------------------------------------------------------------------------
 
 // The layers over the base for one direction l; base is the base's f |n.l| (transmission included).
@@ -84,6 +93,9 @@ vec3 layered_ibl(Surface s, vec3 n, vec3 v, vec3 base, bool with_suns) {
     vec3 radiance = base;
 #ifdef HAS_TRANSMISSION
     radiance += transmission_ibl(s, n, v, with_suns);
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    radiance += diffuse_transmission_ibl(s, n, v, with_suns);
 #endif
 #ifdef HAS_SHEEN
     radiance = radiance * sheen_base_weight_ibl(s, n, v) + sheen_ibl(s, n, v, with_suns);

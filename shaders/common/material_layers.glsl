@@ -24,6 +24,13 @@ uniform float u_thickness;
 uniform vec3 u_attenuation_color;
 uniform float u_attenuation_distance;  // 3e38 stands for glTF's +inf (no attenuation)
 #endif
+#ifdef HAS_DISPERSION
+uniform float u_dispersion;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+uniform float u_diffuse_transmission;
+uniform vec3 u_diffuse_transmission_color;
+#endif
 
 #include "common/material_iridescence.glsl"
 
@@ -54,6 +61,13 @@ void apply_material_layers(inout Surface s, vec3 n, vec3 t, vec3 b) {
     s.thickness = u_thickness;
     s.attenuation_color = u_attenuation_color;
     s.attenuation_distance = u_attenuation_distance;
+#endif
+#ifdef HAS_DISPERSION
+    s.dispersion = u_dispersion;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    s.diffuse_transmission = u_diffuse_transmission;
+    s.diffuse_transmission_color = u_diffuse_transmission_color;
 #endif
 }
 

@@ -317,7 +317,7 @@ Surface material_surface(vec3 n) {
     if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
     s.metallic = clamp(s.metallic, 0.0, 1.0);
-#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME) || defined(HAS_DIFFUSE_TRANSMISSION)
     mat3 frame = tangent_frame(n);
     apply_material_layers(s, n, frame[0], frame[1]);
 #endif

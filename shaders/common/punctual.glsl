@@ -26,6 +26,9 @@ vec3 punctual_base(Surface s, vec3 n, vec3 v, vec3 l) {
 #else
     vec3 transmitted = vec3(0.0);
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    transmitted += diffuse_transmission_light(s, n, v, l);
+#endif
     LobeAngles a;
     a.n_dot_l = dot(n, l);
     if (a.n_dot_l <= 0.0) return transmitted;

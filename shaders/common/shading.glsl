@@ -13,6 +13,7 @@
 #include "common/anisotropy.glsl"
 #include "common/transmission.glsl"
 #include "common/iridescence.glsl"
+#include "common/diffuse_transmission.glsl"
 
 uniform bool u_ibl_enabled;
 

@@ -40,6 +40,13 @@ struct Surface {
     vec3 attenuation_color;
     float attenuation_distance; // +inf (a huge number) for none
 #endif
+#ifdef HAS_DISPERSION
+    float dispersion;           // KHR_materials_dispersion: 20 / Abbe number
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    float diffuse_transmission;       // KHR_materials_diffuse_transmission
+    vec3 diffuse_transmission_color;  // linear
+#endif
 };
 
 // F0 = mix(specular_f0, base_color, metallic).
@@ -93,6 +100,13 @@ Surface surface_base(vec3 base_color, float metallic, float roughness, vec3 spec
     s.thickness = 0.0;
     s.attenuation_color = vec3(1.0);
     s.attenuation_distance = 3.0e38;
+#endif
+#ifdef HAS_DISPERSION
+    s.dispersion = 0.0;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    s.diffuse_transmission = 0.0;
+    s.diffuse_transmission_color = vec3(1.0);
 #endif
     return s;
 }

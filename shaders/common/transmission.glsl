@@ -2,9 +2,11 @@
 // microfacet BTDF, thin-walled or refracting into a volume with Beer-Lambert attenuation
 // (common/layers.glsl declares these hooks; the definition is docs/layer_transmission.md).
 // Numpy twins: app/core/layers/transmission.py (transmission_light) and
-// app/accuracy/converged.py (transmission_ibl_converged).
+// app/accuracy/converged.py (transmission_ibl_converged). KHR_materials_dispersion (HAS_DISPERSION)
+// refracts each colour channel at its own index (transmitted_btdf, dispersed_radiance).
 #include "common/btdf.glsl"
 #include "common/transmission_lut.glsl"
+#include "common/dispersion_terms.glsl"
 #ifdef HAS_TRANSMISSION
 
 #ifdef HAS_VOLUME
@@ -52,6 +54,28 @@ float widened_transmission_roughness(Surface s, float roughness, float spread) {
     return min(sqrt(widened_alpha), 1.0);
 }
 
+// (1 - F(v.h)) btdf at index `ior` for l behind the surface (the Fresnel at the BTDF's own half
+// vector; F0 stays the material's).
+vec3 transmitted_btdf_at(Surface s, vec3 n, vec3 v, vec3 l, float roughness, float k, float ior) {
+    float v_dot_h;
+    float btdf = transmission_btdf(n, v, l, roughness, k, ior, thin_walled(s), v_dot_h);
+    return (1.0 - F_Schlick(v_dot_h, surface_f0(s), surface_f90(s))) * btdf;
+}
+
+// (1 - F) btdf per channel: with KHR_materials_dispersion each channel at its own index
+// (common/dispersion_terms.glsl; a thin wall bends nothing, so it has no dispersion).
+vec3 transmitted_btdf(Surface s, vec3 n, vec3 v, vec3 l, float roughness, float k) {
+#ifdef HAS_DISPERSION
+    if (!thin_walled(s) && s.dispersion > 0.0) {
+        vec3 iors = dispersion_iors(s.ior, s.dispersion);
+        return vec3(transmitted_btdf_at(s, n, v, l, roughness, k, iors.r).r,
+                    transmitted_btdf_at(s, n, v, l, roughness, k, iors.g).g,
+                    transmitted_btdf_at(s, n, v, l, roughness, k, iors.b).b);
+    }
+#endif
+    return transmitted_btdf_at(s, n, v, l, roughness, k, s.ior);
+}
+
 // The transmitted part of the base for one direction l behind the surface, times |n.l|:
 // (1 - metallic) t T base (1 - F(v.h)) btdf; 0 for l in front (the diffuse lobe's share,
 // 1 - transmission, is applied by the base). punctual: k = (r+1)^2/8 and the roughness floor.
@@ -61,10 +85,7 @@ vec3 transmission_light(Surface s, vec3 n, vec3 v, vec3 l, bool punctual, float 
     float roughness = punctual ? max(s.roughness, MIN_PUNCTUAL_ROUGHNESS) : s.roughness;
     float k = punctual ? k_direct(roughness) : k_ibl(roughness);
     if (spread > 0.0) roughness = max(widened_transmission_roughness(s, s.roughness, spread), MIN_PUNCTUAL_ROUGHNESS);
-    float v_dot_h;
-    float btdf = transmission_btdf(n, v, l, roughness, k, s.ior, thin_walled(s), v_dot_h);
-    vec3 F = F_Schlick(v_dot_h, surface_f0(s), surface_f90(s));
-    return transmission_weight(s) * s.base_color * (1.0 - F) * (btdf * -n_dot_l);
+    return transmission_weight(s) * s.base_color * transmitted_btdf(s, n, v, l, roughness, k) * -n_dot_l;
 }
 
 // ---- image-based light ---------------------------------------------------------------------
@@ -145,18 +166,45 @@ TransmittedLobe transmitted_lobe(Surface s, vec3 n, vec3 v) {
 #endif
 }
 
-vec3 transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns) {
+// The lobe's energy times what it gathers (the environment, or with scene_only the opaque scene
+// behind alone).
+vec3 gathered_radiance(Surface s, vec3 n, vec3 v, bool with_suns, bool scene_only) {
     TransmittedLobe lobe = transmitted_lobe(s, n, v);
+#ifdef TRANSMISSION_SCENE
+    if (scene_only) return lobe.energy * scene_behind(lobe.direction * volume_path(s), lobe.roughness).rgb;
+#endif
+    return lobe.energy * behind_radiance(lobe, s, with_suns);
+}
+
+// gathered_radiance per channel: with KHR_materials_dispersion each channel's lobe refracts at
+// its own index (the Sample Viewer's three rays); a thin wall has one lobe.
+vec3 dispersed_radiance(Surface s, vec3 n, vec3 v, bool with_suns, bool scene_only) {
+#ifdef HAS_DISPERSION
+    if (!thin_walled(s) && s.dispersion > 0.0) {
+        vec3 iors = dispersion_iors(s.ior, s.dispersion);
+        Surface channel = s;
+        vec3 radiance;
+        channel.ior = iors.r;
+        radiance.r = gathered_radiance(channel, n, v, with_suns, scene_only).r;
+        channel.ior = iors.g;
+        radiance.g = gathered_radiance(channel, n, v, with_suns, scene_only).g;
+        channel.ior = iors.b;
+        radiance.b = gathered_radiance(channel, n, v, with_suns, scene_only).b;
+        return radiance;
+    }
+#endif
+    return gathered_radiance(s, n, v, with_suns, scene_only);
+}
+
+vec3 transmission_ibl(Surface s, vec3 n, vec3 v, bool with_suns) {
     vec3 f0 = surface_f0(s);
-    return transmission_weight(s) * s.base_color * (1.0 - f0) * lobe.energy * behind_radiance(lobe, s, with_suns);
+    return transmission_weight(s) * s.base_color * (1.0 - f0) * dispersed_radiance(s, n, v, with_suns, false);
 }
 
 #ifdef TRANSMISSION_SCENE
 // Without an environment (IBL off) the opaque scene behind still shows through.
 vec3 transmission_scene_only(Surface s, vec3 n, vec3 v) {
-    TransmittedLobe lobe = transmitted_lobe(s, n, v);
-    vec3 scene = scene_behind(lobe.direction * volume_path(s), lobe.roughness).rgb;
-    return transmission_weight(s) * s.base_color * (1.0 - surface_f0(s)) * lobe.energy * scene;
+    return transmission_weight(s) * s.base_color * (1.0 - surface_f0(s)) * dispersed_radiance(s, n, v, false, true);
 }
 #endif
 

@@ -23,7 +23,7 @@ void main() {
     if (r2 >= 1.0) discard;
     vec3 n = vec3(xy, sqrt(1.0 - r2));
     Surface s = surface_base(u_base_color, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);
-#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME)
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME) || defined(HAS_DIFFUSE_TRANSMISSION)
     vec3 t, b;
     probe_tangent_frame(n, t, b);
     apply_material_layers(s, n, t, b);

@@ -25,6 +25,8 @@ LAYER_DEFINES: dict[str, str] = {
     "transmission": "HAS_TRANSMISSION",
     "volume": "HAS_VOLUME",
     "iridescence": "HAS_IRIDESCENCE",
+    "dispersion": "HAS_DISPERSION",
+    "diffuse_transmission": "HAS_DIFFUSE_TRANSMISSION",
 }
 assert set(LAYER_DEFINES) == set(LAYERS)
 

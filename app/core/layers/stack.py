@@ -2,7 +2,8 @@
 ``brdf_ground_truth`` and ``common/layers.glsl``'s ``layered_light`` (docs/layers.md).
 
     base   = docs/conventions.md's Cook-Torrance, k = r^2/2, F per direction at v.h; its diffuse lobe
-             scaled by 1 - transmission, plus the transmitted part (transmission.py); its
+             scaled by 1 - transmission, plus the transmitted part (transmission.py), and by
+             1 - diffuse_transmission, plus the back lobe (diffuse_transmission.py); its
              specular lobe anisotropic where the material says so (anisotropy.py), its
              Fresnel the thin film's where it has one (iridescence.py)
     sheen  = sheen BRDF + base * sheen albedo scaling                         (sheen.py)
@@ -18,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alight.core.layers import anisotropy, clearcoat, iridescence, sheen, transmission
+from alight.core.layers import anisotropy, clearcoat, diffuse_transmission, iridescence, sheen, transmission
 from alight.core.material import Material
 from alight.core.shading import MIN_PUNCTUAL_ROUGHNESS, PI, D_GGX, F_Schlick, G1_SchlickGGX, k_ibl
 
@@ -108,6 +109,8 @@ def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
     kd = (1.0 - F_diffuse) * (1.0 - m.metallic)
     if "transmission" in m.layers():
         kd = kd * (1.0 - m.transmission)
+    if "diffuse_transmission" in m.layers():
+        kd = kd * diffuse_transmission.front_weight(m)
     if "anisotropy" in m.layers():
         specular_cos = anisotropy.anisotropic_specular(m, p, F, spread=p.spread) * nl_c[..., None]
     else:
@@ -125,6 +128,8 @@ def base_brdf_cos(m: Material, p: Pairs) -> np.ndarray:
     f = np.where(lit[..., None], f, 0.0)
     if "transmission" in m.layers():
         f = f + transmission.transmission_light(m, p)
+    if "diffuse_transmission" in m.layers():
+        f = f + diffuse_transmission.diffuse_transmission_light(m, p)
     return f
 
 
