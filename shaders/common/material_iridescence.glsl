@@ -1,5 +1,5 @@
-// KHR_materials_iridescence's material inputs: the factors as uniforms (app/render/renderer.py:
-// _set_material, from alight.core.layers.iridescence.iridescence_uniforms) and
+// KHR_materials_iridescence's material inputs: the factors as uniforms (app/render/bindings.py:
+// set_material, from alight.core.layers.iridescence.iridescence_uniforms) and
 // apply_material_iridescence, which writes them into a Surface; the maps multiply them
 // afterwards (common/mesh_material.glsl). Shared by the forward pass and the reference.
 #ifdef HAS_IRIDESCENCE

@@ -1,5 +1,5 @@
 // The layers' material inputs (docs/layers.md): the factors as uniforms
-// (app/render/renderer.py: _set_material), each under its layer's HAS_* define, and
+// (app/render/bindings.py: set_material), each under its layer's HAS_* define, and
 // apply_material_layers, which writes them into a Surface. Shared by the forward pass
 // (common/mesh_material.glsl, render/probe.frag) and the reference (accuracy/reference.comp).
 
