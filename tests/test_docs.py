@@ -119,3 +119,11 @@ def test_the_shaders_readme_lists_every_shader():
     for folder, files in on_disk.items():
         assert listed[folder] == files, (f"shaders/README.md, {folder}/: not listed {sorted(files - listed[folder])}, "
                                          f"no such file {sorted(listed[folder] - files)}")
+
+
+def test_the_readme_links_every_page_of_the_site():
+    """The front page is the way in: every page of docs/ is one link from it."""
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    linked = {target.split("#")[0] for target in LINK.findall(readme)}
+    pages = {p.relative_to(REPO).as_posix() for p in (REPO / "docs").rglob("*.md")}
+    assert pages - linked == set(), "README.md does not link: " + ", ".join(sorted(pages - linked))
