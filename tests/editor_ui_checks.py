@@ -664,6 +664,69 @@ def test_transmission_and_volume_sections(ctx):
     assert s.material.transmission == 0.0 and s.material.thickness == 0.0
 
 
+def test_iridescence_dispersion_and_diffuse_transmission_sections(ctx):
+    """The sections made from the material-field registry (app/frontends/editor/layer_rows.py):
+    each edit through its widget changes the ball and is one undo step."""
+    s = editor().state
+
+    def changed(before, what):
+        after = view(ctx).astype(np.float64)
+        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
+        return after
+
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.3)
+    plain = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_iridescence")
+    ctx.item_input_value("**/iridescence", 1.0)
+    assert s.material.iridescence == 1.0 and "iridescence" in s.material.layers(), s.material
+    filmed = changed(plain, "iridescence")
+    ctx.item_input_value("**/iridescence thickness maximum", 250.0)   # a drag, in nm
+    assert s.material.iridescence_thickness_maximum == 250.0, s.material
+    changed(filmed, "iridescence thickness maximum")
+    # Each edit one undo step: Ctrl+Z twice takes the film off, and the ball is copper again.
+    void(ctx)
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.iridescence == 1.0 and s.material.iridescence_thickness_maximum == 400.0, s.material
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
+    assert s.material.iridescence == 0.0, s.material
+    np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), ball(plain).mean(axis=0), atol=0.5)
+    ctx.item_close("**/###layer_iridescence")
+    # Diffuse transmission: a red diffuse ball lets blue light through from behind.
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("base colour (sRGB)/##Y", 40)
+    ctx.item_input_value("base colour (sRGB)/##Z", 40)
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_diffuse_transmission")
+    ctx.item_input_value("**/diffuse transmission", 1.0)
+    ctx.item_input_value("###layer_diffuse_transmission/diffuse transmission colour (sRGB)/##X", 20)
+    assert s.material.diffuse_transmission == 1.0 and s.material.diffuse_transmission_color[0] < 0.01, s.material
+    changed(image, "diffuse transmission")
+    ctx.item_close("**/###layer_diffuse_transmission")
+    # Dispersion acts on a volume's refraction: transmission, thickness and a high ior first,
+    # through white (plastic_high's dark blue hides the fringes: 0.15 at 10 in one run).
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/roughness", 0.2)
+    for component in "XYZ":
+        ctx.item_input_value(f"base colour (sRGB)/##{component}", 255)
+    ctx.item_input_value("**/ior", 3.0)
+    ctx.item_open("**/###layer_transmission")
+    ctx.item_input_value("**/transmission", 1.0)
+    ctx.item_close("**/###layer_transmission")
+    ctx.item_open("**/###layer_volume")
+    ctx.item_input_value("**/thickness", 1.0)
+    ctx.item_close("**/###layer_volume")
+    image = view(ctx).astype(np.float64)
+    ctx.item_open("**/###layer_dispersion")
+    ctx.item_input_value("**/dispersion", 20.0)   # Abbe number 1: the fringes at the horizon's edge
+    assert s.material.dispersion == 20.0 and "dispersion" in s.material.layers(), s.material
+    changed(image, "dispersion")
+    ctx.item_close("**/###layer_dispersion")
+    ctx.item_click("**/revert")
+    assert s.material.dispersion == 0.0 and s.material.transmission == 0.0
+
+
 def test_bake_quality_combo(ctx):
     win = editor()
     ctx.set_ref("alight")

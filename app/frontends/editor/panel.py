@@ -19,11 +19,13 @@ from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.exchange.presets import list_presets, load_preset
 from alight.frontends.editor.file_browser import FileBrowser
+from alight.frontends.editor.layer_rows import FINITE_START, SECTIONS, LayerRow
 from alight.frontends.editor.library_panel import ICON, LibraryPanel
 from alight.frontends.editor.state import DEBUG_VIEWS
 from alight.ibl.bake import QUALITY
 
 AA_CHOICES = ("none", "msaa")
+_DRAG_MAX = 1e9   # imgui's bound for a drag whose range is open above (an inf bound is not safe in imgui)
 
 
 def _srgb(c) -> list[float]:
@@ -62,6 +64,37 @@ def tidy_edit(old, new):
 
 def _linear(c) -> tuple[float, float, float]:
     return tuple(float(x) for x in np.clip(srgb_to_linear(np.asarray(c, np.float64)), 0.0, 1.0))
+
+
+def layer_row(row: LayerRow, m):
+    """Draw one layer field's widget (layer_rows.py says which) with the field's help as its
+    tooltip; returns ``m`` with the edit, clamped to the field's range."""
+    from imgui_bundle import imgui
+
+    value = getattr(m, row.field)
+    if row.widget == "color":
+        changed, col = imgui.color_edit3(row.label, _srgb(value))
+        new = _linear(col)
+    elif row.widget == "angle":
+        changed, new = imgui.slider_angle(row.label, value, -180.0, 180.0)
+    elif row.widget == "slider":
+        changed, new = imgui.slider_float(row.label, value, row.low, row.high, row.fmt)
+    else:
+        if row.switch:   # the field's infinite default is 'off': a checkbox, then the drag when on
+            changed, on = imgui.checkbox(row.switch, value != float("inf"))
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(row.help)
+            if changed:
+                return dataclasses.replace(m, **{row.field: FINITE_START if on else float("inf")})
+            if not on:
+                return m
+        # imgui clamps a drag to a finite range only; an open end is clamped here.
+        changed, new = imgui.drag_float(row.label, value, row.speed, row.low,
+                                        row.high if np.isfinite(row.high) else _DRAG_MAX, row.fmt)
+        new = min(max(new, row.low), row.high)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip(row.help)
+    return dataclasses.replace(m, **{row.field: new}) if changed else m
 
 
 class Panel:
@@ -249,89 +282,27 @@ class Panel:
                 s.fail(exc)
 
     def _layers(self, s, m):
-        """A collapsible section per layer, open where the material uses the layer:
-        the open state follows the material whenever another one is loaded (a preset, a file,
-        revert), and the artist's clicks otherwise."""
+        """A collapsible section per layer of the material-field registry (layer_rows.py), open
+        where the material uses the layer: the open state follows the material whenever another
+        one is loaded (a preset, a file, revert), and the artist's clicks otherwise."""
         from imgui_bundle import imgui
 
         reset = s.saved_material is not self._sections_for
         self._sections_for = s.saved_material
         used = m.layers()
-        for title, layer, draw in (("Clearcoat", "clearcoat", self._clearcoat), ("Sheen", "sheen", self._sheen),
-                                   ("Anisotropy", "anisotropy", self._anisotropy),
-                                   ("Transmission", "transmission", self._transmission),
-                                   ("Volume", "volume", self._volume)):
+        for section in SECTIONS:
             if reset:
-                imgui.set_next_item_open(layer in used, imgui.Cond_.always)
-            if imgui.tree_node_ex(f"{title}{' (on)' if layer in used else ''}###layer_{layer}"):
-                m = draw(m)
+                imgui.set_next_item_open(section.layer in used, imgui.Cond_.always)
+            opened = imgui.tree_node_ex(f"{section.title}{' (on)' if section.layer in used else ''}"
+                                        f"###layer_{section.layer}")
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(section.extension)
+            if opened:
+                if section.note:
+                    imgui.text_disabled(section.note)
+                for row in section.rows:
+                    m = layer_row(row, m)
                 imgui.tree_pop()
-        return m
-
-    @staticmethod
-    def _clearcoat(m):
-        from imgui_bundle import imgui
-
-        changed, v = imgui.slider_float("clearcoat", m.clearcoat, 0.0, 1.0)
-        if changed:
-            m = dataclasses.replace(m, clearcoat=v)
-        changed, v = imgui.slider_float("clearcoat roughness", m.clearcoat_roughness, 0.0, 1.0)
-        if changed:
-            m = dataclasses.replace(m, clearcoat_roughness=v)
-        return m
-
-    @staticmethod
-    def _sheen(m):
-        from imgui_bundle import imgui
-
-        changed, col = imgui.color_edit3("sheen colour (sRGB)", _srgb(m.sheen_color))
-        if changed:
-            m = dataclasses.replace(m, sheen_color=_linear(col))
-        changed, v = imgui.slider_float("sheen roughness", m.sheen_roughness, 0.0, 1.0)
-        if changed:
-            m = dataclasses.replace(m, sheen_roughness=v)
-        return m
-
-    @staticmethod
-    def _anisotropy(m):
-        from imgui_bundle import imgui
-
-        changed, v = imgui.slider_float("anisotropy strength", m.anisotropy_strength, 0.0, 1.0)
-        if changed:
-            m = dataclasses.replace(m, anisotropy_strength=v)
-        changed, v = imgui.slider_angle("anisotropy rotation", m.anisotropy_rotation, -180.0, 180.0)
-        if changed:
-            m = dataclasses.replace(m, anisotropy_rotation=v)
-        return m
-
-    @staticmethod
-    def _transmission(m):
-        from imgui_bundle import imgui
-
-        changed, v = imgui.slider_float("transmission", m.transmission, 0.0, 1.0)
-        if changed:
-            m = dataclasses.replace(m, transmission=v)
-        return m
-
-    @staticmethod
-    def _volume(m):
-        from imgui_bundle import imgui
-
-        imgui.text_disabled("acts through transmission; thickness 0 is thin-walled")
-        changed, v = imgui.drag_float("thickness", m.thickness, 0.005, 0.0, 100.0)
-        if changed:
-            m = dataclasses.replace(m, thickness=max(v, 0.0))
-        changed, col = imgui.color_edit3("attenuation colour (sRGB)", _srgb(m.attenuation_color))
-        if changed:
-            m = dataclasses.replace(m, attenuation_color=_linear(col))
-        finite = m.attenuation_distance != float("inf")
-        changed, finite_now = imgui.checkbox("attenuate", finite)
-        if changed:
-            m = dataclasses.replace(m, attenuation_distance=1.0 if finite_now else float("inf"))
-        if finite_now and not changed:
-            changed, v = imgui.drag_float("attenuation distance", m.attenuation_distance, 0.01, 1e-3, 1e4)
-            if changed:
-                m = dataclasses.replace(m, attenuation_distance=max(v, 1e-3))
         return m
 
     def _browse(self, label: str, suffixes: tuple[str, ...], on_pick) -> None:

@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
-from alight.core.material import LAYER_FIELDS, Material, validate_material, with_overrides
+from alight.core.material import Material, validate_material, with_overrides
+from alight.core.material_fields import FIELDS
 from alight.core.scene import TONEMAPS, Display, Light, Scene
 from alight.core.shader_names import DATA_VIEWS, DEBUG_VIEWS
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
@@ -26,8 +27,9 @@ from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
-VECTOR_LAYER_FIELDS = ("sheen_color", "attenuation_color")
-SCALAR_LAYER_FIELDS = tuple(f for f in LAYER_FIELDS if f not in VECTOR_LAYER_FIELDS)
+# From the registry, so a layer added there is a --script key too (a colour as R,G,B).
+VECTOR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "color")
+SCALAR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "number")
 
 
 def default_lights() -> list[Light]:
@@ -284,7 +286,7 @@ class EditorState:
 
     def apply_edit(self, edit: str) -> None:
         """``field=value``: roughness / metallic / ior and the layers' numbers (clearcoat, ...),
-        base_color / emissive / specular_f0 / sheen_color / attenuation_color (R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
+        base_color / emissive / specular_f0 and the layers' colours (sheen_color, ...: R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
         env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), quality;
         map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
         uv_offset (U,V)."""
