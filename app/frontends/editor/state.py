@@ -286,7 +286,8 @@ class EditorState:
 
     def apply_edit(self, edit: str) -> None:
         """``field=value``: roughness / metallic / ior and the layers' numbers (clearcoat, ...),
-        base_color / emissive / specular_f0 and the layers' colours (sheen_color, ...: R,G,B linear), preset / open / mesh / env (a name or path), exposure, tonemap,
+        base_color / emissive / specular_f0 and the layers' colours (sheen_color, ...: R,G,B linear),
+        preset / open / mesh / env (a name or path), exposure, tonemap,
         env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), quality;
         map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
         uv_offset (U,V)."""
