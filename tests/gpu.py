@@ -14,6 +14,27 @@ def renderer() -> ForwardRenderer:
     return ForwardRenderer()
 
 
+def bake(env, quality: str = "medium"):
+    """The shared renderer's bake of ``env`` (the renderer keeps it per environment and quality)."""
+    return renderer().bake(env, quality)
+
+
+def probe(material, maps, width: int = 32, **scene):
+    """The probe view of ``material`` (docs/conventions.md): linear RGB (width, width, 3), the
+    mask of pixels on the sphere and their normals (alight.core.shading.probe_normals)."""
+    from alight.core import shading
+    from alight.core.scene import Scene
+
+    n, inside = shading.probe_normals(width)
+    image = renderer().render(Scene(material=material, view="probe", **scene), maps, width, width).linear
+    return image[..., :3], inside, n
+
+
+def relative(a, b) -> float:
+    """Relative mean absolute error of ``a`` against ``b`` (sums over every element)."""
+    return float(np.abs(a - b).sum() / np.abs(b).sum())
+
+
 TERMS = {name: i for i, name in enumerate([
     "D_GGX", "G1", "G_SMITH", "F_SCHLICK", "F_SCHLICK_ROUGHNESS", "DIRECTION_TO_EQUIRECT",
     "EQUIRECT_TO_DIRECTION", "ROTATE_WORLD_TO_MAP", "HAMMERSLEY", "IMPORTANCE_SAMPLE_GGX", "ACES",

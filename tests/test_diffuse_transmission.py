@@ -19,30 +19,13 @@ from alight.core.mesh import sphere
 from alight.core.scene import Light, Scene
 from alight.ibl.environment import constant_environment, load_environment
 from tests.gltf_builder import USHORT, Gltf
-from tests.gpu import renderer
+from tests.gpu import bake as maps_for
+from tests.gpu import probe, relative, renderer
 
 WIDTH = 32
 # A leaf-like sheet: green, half of its diffuse light leaves through the back, yellow-green.
 LEAF = Material(base_color=(0.25, 0.5, 0.1), roughness=0.5, diffuse_transmission=0.5,
                 diffuse_transmission_color=(0.6, 0.9, 0.2))
-_maps: dict = {}
-
-
-def maps_for(env, quality="medium"):
-    key = (env.content_hash, quality)
-    if key not in _maps:
-        _maps[key] = renderer().bake(env, quality)
-    return _maps[key]
-
-
-def probe(material, maps, width=WIDTH, **scene):
-    n, inside = shading.probe_normals(width)
-    image = renderer().render(Scene(material=material, view="probe", **scene), maps, width, width).linear
-    return image[..., :3], inside, n
-
-
-def relative(a, b):
-    return float(np.abs(a - b).sum() / np.abs(b).sum())
 
 
 # --- zero strength ------------------------------------------------------------------------------

@@ -20,7 +20,6 @@ from alight.accuracy.ground_truth import (
     probe_points,
     transmission_combine,
 )
-from alight.core import shading
 from alight.core.btdf import beer_lambert
 from alight.core.equirect import box_reduce
 from alight.core.layers.dispersion import abbe_number, dispersion_iors
@@ -28,30 +27,12 @@ from alight.core.material import Material
 from alight.core.mesh import sphere
 from alight.core.scene import Light, Scene
 from alight.ibl.environment import constant_environment, load_environment
-from tests.gpu import renderer
+from tests.gpu import bake as maps_for
+from tests.gpu import probe, relative, renderer
 
-WIDTH = 32
 # A dense flint glass: ior 1.7, Abbe number 20 (dispersion 1); the red and blue indices 1.6825, 1.7175.
 FLINT = Material(base_color=(0.95, 0.95, 0.95), roughness=0.35, transmission=1.0, ior=1.7, thickness=0.5,
                  attenuation_color=(0.9, 0.8, 0.7), attenuation_distance=2.0, dispersion=1.0)
-_maps: dict = {}
-
-
-def maps_for(env, quality="medium"):
-    key = (env.content_hash, quality)
-    if key not in _maps:
-        _maps[key] = renderer().bake(env, quality)
-    return _maps[key]
-
-
-def probe(material, maps, width=WIDTH, **scene):
-    n, inside = shading.probe_normals(width)
-    image = renderer().render(Scene(material=material, view="probe", **scene), maps, width, width).linear
-    return image[..., :3], inside, n
-
-
-def relative(a, b):
-    return float(np.abs(a - b).sum() / np.abs(b).sum())
 
 
 def test_the_layer_is_on_only_with_a_volume():

@@ -23,37 +23,18 @@ from alight.accuracy.ground_truth import (
     transmission_combine,
     transmission_terms,
 )
-from alight.core import shading
 from alight.core.btdf import beer_lambert
 from alight.core.equirect import box_reduce
 from alight.core.material import Material
 from alight.core.mesh import sphere
 from alight.core.scene import Display, Light, Scene
 from alight.ibl.environment import constant_environment, load_environment
-from tests.gpu import renderer
+from tests.gpu import bake as maps_for
+from tests.gpu import probe, relative, renderer
 
-WIDTH = 32
 THIN = Material(base_color=(0.9, 0.85, 0.8), roughness=0.3, transmission=1.0, ior=1.45)
 VOLUME = Material(base_color=(0.9, 0.85, 0.8), roughness=0.3, transmission=1.0, ior=1.5, thickness=0.5,
                   attenuation_color=(0.8, 0.6, 0.4), attenuation_distance=1.0)
-_maps: dict = {}
-
-
-def maps_for(env, quality="medium"):
-    key = (env.content_hash, quality)
-    if key not in _maps:
-        _maps[key] = renderer().bake(env, quality)
-    return _maps[key]
-
-
-def probe(material, maps, width=WIDTH, **scene):
-    n, inside = shading.probe_normals(width)
-    image = renderer().render(Scene(material=material, view="probe", **scene), maps, width, width).linear
-    return image[..., :3], inside, n
-
-
-def relative(a, b):
-    return float(np.abs(a - b).sum() / np.abs(b).sum())
 
 
 # --- the furnace and zero strength -------------------------------------------------------------
