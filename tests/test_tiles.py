@@ -232,14 +232,14 @@ def test_framebuffers_the_gl_refuses_give_smaller_tiles(maps, monkeypatch):
 
 
 def test_cli_writes_tiled_images_strip_by_strip(tmp_path):
-    """alight render through the tiled path (TILE_BYTES made tiny, in a process of its own) writes
+    """alight render through the tiled path (tile_bytes made tiny, in a process of its own) writes
     the same PNG and EXR as one pass, band by band."""
     assert len(plan_tiles(96, 64, 16384, framebuffer_bytes("msaa", 4), 30 * 1024).strips()) > 2
     outs = {}
     for tiled, ext in itertools.product((False, True), ("png", "exr")):
         out = tmp_path / f"{'tiled' if tiled else 'one'}.{ext}"
         code = ("import sys, alight.render.renderer as r\n"
-                + ("r.TILE_BYTES = 30 * 1024\n" if tiled else "")
+                + ("r.ForwardRenderer.tile_bytes = 30 * 1024\n" if tiled else "")
                 + "from alight.frontends.cli import main\n"
                 + f"sys.exit(main(['render', '--size', '96x64', '--quality', 'low', '--out', {str(out)!r}]))")
         proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True,

@@ -87,6 +87,10 @@ class ForwardRenderer:
     that ran, ``bakes_loaded`` those read from the disk cache.
     """
 
+    #: the most bytes one tile's framebuffers may take (alight.render.tiles); larger images are
+    #: drawn in tiles. A class attribute so that a test (or a caller short of GPU memory) lowers it.
+    tile_bytes: int = TILE_BYTES
+
     def __init__(self, ctx: moderngl.Context | None = None, shaders: ShaderLibrary | None = None,
                  bake_cache: BakeCache | None | str = "default"):
         self.ctx = ctx or create_headless_context()
@@ -247,7 +251,7 @@ class ForwardRenderer:
                       tile: tuple[int, int] | None = None) -> Iterator[Strip]:
         """``render`` strip by strip, top first (alight.render.tiles): each Strip holds a band of
         whole rows, drawn as one or more tiles, so a caller that writes and drops each one holds
-        one strip's pixels at a time. A size within the GL limits and TILE_BYTES is one strip."""
+        one strip's pixels at a time. A size within the GL limits and ``tile_bytes`` is one strip."""
         if scene.view == "probe":
             aa = "none"  # the probe view's normals are exact per pixel centre: no blending
         if aa == "msaa":
@@ -268,9 +272,8 @@ class ForwardRenderer:
         def forget() -> None:
             self._targets = None
 
-        # (TILE_BYTES read here, at each call: a test lowers it on this module)
         return tiled_targets(self.ctx, width, height, aa, samples, tile,
-                             lambda w, h: self._targets_for(w, h, aa, samples, half), forget, TILE_BYTES)
+                             lambda w, h: self._targets_for(w, h, aa, samples, half), forget, self.tile_bytes)
 
     def _targets_for(self, width: int, height: int, aa: str, samples: int, half: bool = False) -> Targets:
         """The framebuffers for one tile, kept while the size and mode stay."""
