@@ -1,4 +1,5 @@
-"""What one frame leaves behind for the next: no GL error, and a bounded set of uploaded meshes.
+"""What one frame leaves behind for the next: no GL error, a bounded set of uploaded meshes and
+(in the editor) of bakes.
 
 A renderer lives as long as an editor session or a test run, drawing many scenes at many sizes;
 a framebuffer released while bound used to leave moderngl restoring a deleted name
@@ -48,4 +49,27 @@ def test_the_least_recently_drawn_meshes_leave_the_gpu_and_come_back_the_same():
             assert len(r.meshes) <= MAX_UPLOADED_MESHES
         after = r.render(scene, maps, 32, 32).linear    # uploaded again: the same pixels
         assert np.array_equal(before, after)
+        assert r.ctx.error == "GL_NO_ERROR"
+
+
+def test_bakes_beyond_max_bakes_leave_the_gpu_and_load_back_from_the_disk_cache(tmp_path):
+    """An editor visiting environment after environment keeps the last ``max_bakes`` bakes on the
+    GPU; an older one asked for again is read from the disk cache, not baked, and lights the
+    same pixels."""
+    from alight.ibl.bake_cache import BakeCache
+    from alight.ibl.environment import constant_environment
+
+    with ForwardRenderer(bake_cache=BakeCache(tmp_path)) as r:
+        r.max_bakes = 2
+        envs = [load_environment("studio")] + [constant_environment(v, 32) for v in (0.5, 2.0)]
+        scene = Scene(mesh=sphere(40, 20), material=Material(base_color=(0.8, 0.2, 0.1), roughness=0.4))
+        first = r.bake(envs[0], "low")
+        before = r.render(scene, first, 32, 32).linear
+        for env in envs[1:]:
+            r.bake(env, "low")
+        assert len(r._bakes) == 2 and r.bakes_run == 3
+        assert type(first.irradiance.mglo).__name__ == "InvalidObject"    # released (moderngl's mark)
+        again = r.bake(envs[0], "low")
+        assert r.bakes_run == 3 and r.bakes_loaded == 1
+        assert np.array_equal(before, r.render(scene, again, 32, 32).linear)
         assert r.ctx.error == "GL_NO_ERROR"

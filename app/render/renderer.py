@@ -90,6 +90,9 @@ class ForwardRenderer:
     #: the most bytes one tile's framebuffers may take (alight.render.tiles); larger images are
     #: drawn in tiles. A class attribute so that a test (or a caller short of GPU memory) lowers it.
     tile_bytes: int = TILE_BYTES
+    #: how many bakes stay in memory (None: all). The editor, visiting environment after
+    #: environment, bounds it; the API and batch keep every bake, since callers hold their maps.
+    max_bakes: int | None = None
 
     def __init__(self, ctx: moderngl.Context | None = None, shaders: ShaderLibrary | None = None,
                  bake_cache: BakeCache | None | str = "default"):
@@ -138,7 +141,7 @@ class ForwardRenderer:
             if maps is None:
                 maps = bake_environment(self.ctx, self.shaders, env, q, self.luts)
                 self._keep_bake(env, maps)
-            self._bakes[key] = maps
+            self._remember_bake(key, maps)
         return self._bakes[key]
 
     def bake_steps(self, env, quality: BakeQuality | str = "medium"):
@@ -152,8 +155,17 @@ class ForwardRenderer:
             if maps is None:
                 maps = yield from bake_steps(self.ctx, self.shaders, env, q, self.luts)
                 self._keep_bake(env, maps)
-            self._bakes[key] = maps
+            self._remember_bake(key, maps)
         return self._bakes[key]
+
+    def _remember_bake(self, key: tuple, maps: IBLMaps) -> None:
+        """Keep a bake in memory; beyond ``max_bakes`` the oldest leaves the GPU (its maps are
+        released: a caller must not hold maps older than the last ``max_bakes`` bakes). It stays
+        in the disk cache, so asking for it again loads it rather than baking."""
+        self._bakes[key] = maps
+        while self.max_bakes is not None and len(self._bakes) > max(1, self.max_bakes):
+            oldest = next(iter(self._bakes))
+            self._bakes.pop(oldest).release()
 
     def _load_bake(self, env, q: BakeQuality) -> IBLMaps | None:
         if self.bake_cache is None:

@@ -73,6 +73,10 @@ class EditorWindow:
             self._open_window(glfw, size, title)
         self.ctx = moderngl.create_context(require=450)
         self.renderer = ForwardRenderer(self.ctx)
+        # A session that visits environment after environment would keep every bake on the GPU:
+        # the last few stay (the one shown and a step or two back), older ones reload from the
+        # disk cache. The window holds no maps older than the one shown.
+        self.renderer.max_bakes = 4
         # Whether the window has the depth buffer a scene pass needs (render_view draws into it).
         self._screen_depth = self._depth_bits() >= 16
         self._screen_srgb = self._screen_depth and self._screen_encodes_srgb()
