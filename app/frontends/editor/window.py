@@ -338,7 +338,8 @@ class EditorWindow:
     def maps(self):
         """The maps in use. A new environment or quality starts a bake that ``advance_bake`` runs
         a slice at a time between frames; until it completes the previous maps stay in use (the
-        ForwardRenderer caches bakes, so going back to an environment costs nothing)."""
+        ForwardRenderer keeps the last few bakes, so going back to an environment costs nothing,
+        and loads older ones from the disk cache)."""
         s = self.state
         if s.env is None:
             return None
