@@ -218,7 +218,7 @@ def layer_reference(ref_renderer, radiance: np.ndarray, size: int, material, rou
         try:   # a lobe the texel sum cannot integrate has no reference, and so no case
             check_roughness(r)
             check_layer_roughness(replace(material, roughness=r))
-            if "volume" in material.layers():
+            if {"transmission", "volume"} <= material.layers():
                 check_transmission_lobe(r, material.ior)
         except (AlightError, ValueError):
             continue
