@@ -76,6 +76,23 @@ def test_the_sweep_is_one_factor_at_a_time_and_covers_the_method_space():
         assert all(s.ibl_model == settings[0].ibl_model for s in sw if s.layer)
 
 
+def test_each_layered_preset_counts_in_one_layer_row():
+    """A preset with layers is judged in exactly one layer row, the last of LAYER_ROWS it uses (a
+    dispersive glass in the dispersion row, not also in the transmission row), and every layer
+    row has a preset, a furnace material that uses the layer and a frame preset."""
+    from alight.accuracy.chart import LAYER_FRAME_PRESET, LAYER_FURNACE, QUICK_PRESETS, layer_row
+    from alight.core.material import Material
+    from alight.exchange.presets import list_presets, load_preset
+
+    rows = {name: layer_row(load_preset(name)) for name in list_presets()}
+    assert rows["flint_glass"] == "dispersion" and rows["water"] == "transmission" and rows["leaf"] == \
+        "diffuse_transmission" and rows["gold"] == ""
+    for layer in LAYER_ROWS:
+        assert layer in Material(**LAYER_FURNACE[layer]).layers(), layer
+        assert layer_row(load_preset(LAYER_FRAME_PRESET[layer])) == layer
+        assert any(rows[p] == layer for p in QUICK_PRESETS), layer
+
+
 def test_pareto_frontier():
     pts = [(1.0, 10.0), (2.0, 5.0), (3.0, 6.0), (4.0, 1.0), (2.0, 5.0), (math.nan, 0.1), (5.0, 1.0)]
     assert pareto(pts) == [True, True, False, True, True, False, False]
@@ -162,7 +179,11 @@ def test_chart_quick_end_to_end(quick_chart):
     assert [r["setting"] for r in rows] == [s.name for s in sweep(quick=True)]
     for r in rows:
         assert r["bake_ms"] > 0 and r["frame_ms"] > 0 and r["lut_cold_ms"] > 0
-        assert 0.0 < r["furnace_min"] <= r["furnace_mean"] <= r["furnace_max"] <= 1.05
+        # (The diffuse transmission's furnace is a white dielectric, whose BRDF exceeds 1 toward
+        # grazing view at low roughness with or without the layer: docs/conventions.md. That the
+        # layer adds nothing there is tests/test_diffuse_transmission.py's furnace test.)
+        bound = 1.5 if r["setting"] == "layer diffuse_transmission" else 1.05
+        assert 0.0 < r["furnace_min"] <= r["furnace_mean"] <= r["furnace_max"] <= bound, r["setting"]
         if r["multiple_scattering"]:
             assert math.isnan(r["rel_mae_mean"]) and math.isnan(r["flip_mean"])   # kept out of the truth
         else:
@@ -178,13 +199,17 @@ def test_chart_quick_end_to_end(quick_chart):
     # r = 0.25: its refracted lobe is too narrow, alight.accuracy.ground_truth.check_transmission_lobe).
     layer_rows = [r for r in judged if r["factor"] == "layer"]
     layer_preset = {"layer clearcoat": "car_paint", "layer sheen": "velvet", "layer anisotropy": "brushed_aluminium",
-                    "layer transmission": "water", "layer iridescence": "oil_film"}
+                    "layer transmission": "water", "layer iridescence": "oil_film", "layer dispersion": "flint_glass",
+                    "layer diffuse_transmission": "leaf"}
     assert [r["setting"] for r in layer_rows] == list(layer_preset)
     per_layer = {name: [c for c in cases if c["setting"] == name] for name in layer_preset}
     for name, preset in layer_preset.items():
         assert {c["preset"] for c in per_layer[name]} == {preset}
         assert 1 <= len(per_layer[name]) <= 3
     assert {float(c["roughness"]) for c in per_layer["layer transmission"]} == {0.5, 1.0}
+    # flint_glass's ior 1.7 bends more than water's 1.33: its refracted lobe at r = 0.25 is wide enough.
+    assert {float(c["roughness"]) for c in per_layer["layer dispersion"]} == {0.25, 0.5, 1.0}
+    assert {float(c["roughness"]) for c in per_layer["layer diffuse_transmission"]} == {0.25, 0.5, 1.0}
     assert len(cases) == (len(judged) - len(layer_preset)) * 2 * 3 + sum(len(v) for v in per_layer.values())
     # The baseline's summary is the mean of its cases.
     base = [float(c["rel_mae"]) for c in cases if c["setting"] == rows[0]["setting"]]
@@ -195,6 +220,9 @@ def test_chart_quick_end_to_end(quick_chart):
     # (A layer's row is not a mirror at r = 0: anisotropy stretches it.)
     mirror = [float(r["mean"]) for r in furnace if float(r["roughness"]) == 0.0 and not r["setting"].startswith("layer ")]
     assert mirror and all(abs(v - 1.0) < 0.01 for v in mirror)
+    # The layers at r = 1 (every lobe wide): at most 1, the diffuse transmission's sheet too.
+    rough = {r["setting"]: float(r["max"]) for r in furnace if float(r["roughness"]) == 1.0 and r["setting"].startswith("layer ")}
+    assert len(rough) == len(LAYER_ROWS) and all(v <= 1.0 + 1e-3 for v in rough.values()), rough
     truth = [r for r in furnace if r["setting"] == "ground truth"]
     assert truth and all(0.0 < float(r["mean"]) <= 1.0 for r in truth)
     import OpenImageIO as oiio

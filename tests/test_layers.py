@@ -78,7 +78,8 @@ def test_presets_load_without_layer_fields_and_keep_their_files():
     for name in list_presets():
         m = load_preset(name)
         assert m.layers() == frozenset() or name in ("car_paint", "velvet", "brushed_aluminium", "water", "oil_film",
-                                                     "plastic_glass_low", "glass_high_ruby", "diamond")
+                                                     "plastic_glass_low", "glass_high_ruby", "diamond", "flint_glass",
+                                                     "leaf")
         d = m.to_dict()
         if not m.layers():
             assert set(d) == {"name", "base_color", "metallic", "roughness", "specular_f0", "emissive"}

@@ -97,7 +97,7 @@ def check_layer_lobes(material, roughnesses) -> None:
     (alight.accuracy.ground_truth.check_transmission_lobe; docs/layer_transmission.md)."""
     from alight.accuracy.ground_truth import check_transmission_lobe
 
-    if "volume" not in material.layers():
+    if not {"transmission", "volume"} <= material.layers():   # a diffuse transmission's volume refracts nothing
         return
     for r in roughnesses:
         try:

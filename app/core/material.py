@@ -138,9 +138,12 @@ class Material:
         """The layers this material uses (names of ``LAYERS``); empty: the base model alone.
 
         A layer is on when its strength is above zero: clearcoat > 0, max(sheen_color) > 0,
-        anisotropy_strength > 0, iridescence > 0, transmission > 0; volume when transmission > 0 and thickness > 0
-        (KHR_materials_volume acts only through transmission); dispersion when the volume is on
-        and dispersion > 0 (KHR_materials_dispersion acts only on a volume's refraction);
+        anisotropy_strength > 0, iridescence > 0, transmission > 0; volume when thickness > 0 and
+        transmission > 0 or diffuse_transmission > 0 (KHR_materials_volume acts through the light
+        that crosses the surface: KHR_materials_diffuse_transmission's "combined with
+        KHR_materials_volume" section, its Beer-Lambert attenuation on the diffusely transmitted
+        light as the Khronos Sample Viewer applies it); dispersion when transmission and the volume
+        are on and dispersion > 0 (KHR_materials_dispersion acts only on a volume's refraction);
         diffuse_transmission when diffuse_transmission > 0."""
         used = set()
         if self.clearcoat > 0.0:
@@ -153,12 +156,12 @@ class Material:
             used.add("iridescence")
         if self.diffuse_transmission > 0.0:
             used.add("diffuse_transmission")
+        if self.thickness > 0.0 and (self.transmission > 0.0 or self.diffuse_transmission > 0.0):
+            used.add("volume")
         if self.transmission > 0.0:
             used.add("transmission")
-            if self.thickness > 0.0:
-                used.add("volume")
-                if self.dispersion > 0.0:
-                    used.add("dispersion")
+            if self.thickness > 0.0 and self.dispersion > 0.0:
+                used.add("dispersion")
         return frozenset(used)
 
     def to_dict(self) -> dict[str, Any]:

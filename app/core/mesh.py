@@ -94,9 +94,15 @@ TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occl
 # frame (2x - 1), B a factor on anisotropy_strength. KHR_materials_transmission's R multiplies
 # transmission and KHR_materials_volume's thickness G multiplies thickness (linear).
 LAYER_TEXTURE_SLOTS = ("clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness",
-                       "anisotropy", "transmission", "thickness", "iridescence", "iridescence_thickness")
+                       "anisotropy", "transmission", "thickness", "iridescence", "iridescence_thickness",
+                       "diffuse_transmission")
 # KHR_materials_iridescence (linear): iridescence R multiplies iridescence, iridescence_thickness G
 # mixes the film's thickness from iridescence_thickness_minimum to _maximum.
+# KHR_materials_diffuse_transmission's two textures packed in one (one sampler unit: the fragment
+# shader with every layer and map on needs 32 of llvmpipe's 32 otherwise 33;
+# alight.exchange.packed_textures): A (linear) multiplies diffuse_transmission (the
+# diffuseTransmissionTexture's A), RGB (sRGB) multiplies diffuse_transmission_color (the
+# diffuseTransmissionColorTexture's RGB).
 # KHR_materials_specular's textures: specular A multiplies specularFactor, specular_color RGB
 # (sRGB) multiplies specularColorFactor, before the extension's min(..., 1) (FileMaterial).
 SPECULAR_TEXTURE_SLOTS = ("specular", "specular_color")
@@ -143,6 +149,7 @@ class FileMaterial:
     thickness_texture: TextureInfo | None = None
     iridescence_texture: TextureInfo | None = None
     iridescence_thickness_texture: TextureInfo | None = None
+    diffuse_transmission_texture: TextureInfo | None = None   # packed: RGB colour (sRGB), A strength
     # KHR_materials_specular with textures: specular_f0 per texel is
     # min(specular_color_f0 * specular_color, 1) * specular_factor * specular (the textures'
     # values), where specular_color_f0 = F0(ior) * specularColorFactor, not clamped.

@@ -77,7 +77,8 @@ DATA_VIEWS = frozenset({DebugView.BASE_COLOUR, DebugView.NORMAL, DebugView.ROUGH
 # MAP_*_MASK defines), and one texture unit each in this order (app/render/renderer.py).
 MATERIAL_MAPS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion", "metallic", "roughness",
                  "clearcoat", "clearcoat_roughness", "clearcoat_normal", "sheen_color", "sheen_roughness", "anisotropy",
-                 "transmission", "thickness", "specular", "specular_color", "iridescence", "iridescence_thickness")
+                 "transmission", "thickness", "specular", "specular_color", "iridescence", "iridescence_thickness",
+                 "diffuse_transmission")
 
 
 def map_bit(name: str) -> int:

@@ -43,6 +43,7 @@ from alight.core.mesh import (
 from alight.core.scene import Camera, Light
 from alight.errors import AlightError
 from alight.exchange.gltf_accessors import Accessors, fail, meshopt_available, read_uri
+from alight.exchange.packed_textures import pack_diffuse_transmission
 
 # Extensions alight renders as their specifications say.
 SUPPORTED = {
@@ -65,6 +66,8 @@ LAYER_TEXTURES = {
     "thickness": ("KHR_materials_volume", "thicknessTexture"),
     "iridescence": ("KHR_materials_iridescence", "iridescenceTexture"),
     "iridescence_thickness": ("KHR_materials_iridescence", "iridescenceThicknessTexture"),
+    "diffuse_transmission": ("KHR_materials_diffuse_transmission", "diffuseTransmissionTexture"),
+    "diffuse_transmission_color": ("KHR_materials_diffuse_transmission", "diffuseTransmissionColorTexture"),
     "specular": ("KHR_materials_specular", "specularTexture"),
     "specular_color": ("KHR_materials_specular", "specularColorTexture"),
 }
@@ -396,11 +399,6 @@ class _Reader:
             "normal": m.normalTexture, "emissive": m.emissiveTexture, "occlusion": m.occlusionTexture,
         }
         infos = {}
-        unread = ext.get("KHR_materials_diffuse_transmission")
-        for key in ("diffuseTransmissionTexture", "diffuseTransmissionColorTexture"):
-            if isinstance(unread, dict) and key in unread:   # the factors are drawn, not these maps yet
-                self.warn(f"unread:{key}", f"{where}.extensions.KHR_materials_diffuse_transmission.{key}: "
-                                           "not read; rendered with the factor alone")
         for slot, (name, key) in LAYER_TEXTURES.items():
             layer_info = (ext.get(name) or {}).get(key) if isinstance(ext.get(name), dict) else None
             if isinstance(layer_info, dict):
@@ -430,6 +428,13 @@ class _Reader:
                 continue
             info.image = self._images[image_index]
             textures[f"{slot}_texture"] = info
+        if "diffuse_transmission_color_texture" in textures or "diffuse_transmission_texture" in textures:
+            # one texture holds both (alight.exchange.packed_textures)
+            packed, note = pack_diffuse_transmission(textures.pop("diffuse_transmission_texture", None),
+                                                     textures.pop("diffuse_transmission_color_texture", None))
+            textures["diffuse_transmission_texture"] = packed
+            if note:
+                self.warn(f"packed:{index}", f"{where}.{_json_slot('diffuse_transmission')}: {note}")
         fm = FileMaterial(
             base_color=tuple(float(x) for x in factors.base_color),  # type: ignore[arg-type]
             metallic=float(factors.metallic), roughness=float(factors.roughness),

@@ -194,7 +194,7 @@ class LookupTables:
         """The tables a compiled-in layer reads (the sheen LUT, the transmission LUT)."""
         if "HAS_SHEEN" in defines:
             self.luts.sheen().use(UNIT_SHEEN_LUT)
-        if "HAS_VOLUME" in defines:
+        if "HAS_VOLUME" in defines and "HAS_TRANSMISSION" in defines:   # (a diffuse transmission's volume reads none)
             self.transmission_lut().use(UNIT_TRANSMISSION_LUT)
 
     def release(self) -> None:

@@ -13,7 +13,8 @@ from alight.core.mesh import is_closed
 from alight.core.texture_footprint import anisotropy_for_view, footprints
 
 GL_SRGB8_ALPHA8 = 0x8C43
-SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color")
+SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color", "diffuse_transmission")
+# (diffuse_transmission packs its RGB colour, sRGB, with its A strength: GL_SRGB8_ALPHA8 leaves A linear.)
 MAX_UPLOADED_MESHES = 8   # meshes kept on the GPU between frames (GpuMeshes.parts)
 
 

@@ -91,6 +91,12 @@ uniform bool u_has_iridescence_thickness_map; // G mixes the film's thickness fr
 uniform sampler2D u_iridescence_map;
 uniform sampler2D u_iridescence_thickness_map;
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+// KHR_materials_diffuse_transmission's two textures in one (alight.exchange.packed_textures):
+// A multiplies diffuse_transmission, RGB (sRGB) multiplies diffuse_transmission_color.
+uniform bool u_has_diffuse_transmission_map;
+uniform sampler2D u_diffuse_transmission_map;
+#endif
 
 // The maps compiled in, a bit each (app/core/shader_names.py MATERIAL_MAPS order). llvmpipe runs both
 // sides of a branch, so a map's fetch costs even where u_has_*_map is false; the forward pass
@@ -367,6 +373,13 @@ Surface material_surface(vec3 n) {
 #endif
 #ifdef HAS_VOLUME
     if (has_map(MAP_THICKNESS, u_has_thickness_map)) s.thickness *= sample_map(u_thickness_map, MAP_THICKNESS, 14).g;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    if (has_map(MAP_DIFFUSE_TRANSMISSION, u_has_diffuse_transmission_map)) {
+        vec4 texel = sample_map(u_diffuse_transmission_map, MAP_DIFFUSE_TRANSMISSION, 19);
+        s.diffuse_transmission *= texel.a;
+        s.diffuse_transmission_color *= texel.rgb;
+    }
 #endif
     return s;
 }

@@ -21,7 +21,7 @@ def add_parser(sub) -> None:
     ch.add_argument("--env", action="append", metavar="MAP",
                     help="an environment (repeatable; default: every 2:1 map in ../shared/data/env, else studio)")
     ch.add_argument("--presets", metavar="A,B,...", help="presets to measure (default: all; --quick: gold, "
-                                                          "plastic_high, water)")
+                                                          "plastic_high and one preset per layer)")
     ch.add_argument("--size", type=int, default=32, metavar="N", help="probe size for the errors (default: 32)")
     ch.add_argument("--out", default="alight-chart", metavar="DIR", help="output folder (default: alight-chart)")
 

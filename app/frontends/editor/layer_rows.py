@@ -20,7 +20,7 @@ from alight.core.material_fields import FIELDS, MaterialField
 # What the registry cannot say: the line under a section's title (a layer that acts only
 # through another), and the checkbox of a field whose default is infinite.
 _NOTES = {
-    "volume": "acts through transmission; thickness 0 is thin-walled",
+    "volume": "acts through transmission or diffuse transmission; thickness 0 is thin-walled",
     "dispersion": "acts through a volume's refraction (transmission, thickness > 0)",
 }
 _SWITCH_LABELS = {"attenuation_distance": "attenuate"}
