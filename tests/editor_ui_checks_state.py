@@ -2,7 +2,7 @@
 ImGui Test Engine: run by tests/test_editor_ui_state.py as ``alight edit --new --ui-test
 tests/editor_ui_checks_state.py`` (a real window under Xvfb); not collected by pytest.
 
-A preset click replaces the maps; the status row stays in view whatever the scroll and tells an
+The controls stay put while thumbnails arrive; a preset click replaces the maps; the status row stays in view whatever the scroll and tells an
 error from a success by colour; a success replaces an old error; a texture set names the
 material; the 'texture set' row takes a folder or several files; 'open mesh' confirms, and the
 mesh field shows the mesh restored from the last session (``reopened_mesh_field_shows_the_path``,
@@ -95,6 +95,28 @@ def colour_pixels(band: np.ndarray, rgb) -> int:
     return int((np.abs(band.astype(np.int32) - np.asarray(rgb)).max(axis=2) <= 40).sum())
 
 
+# --- the controls stay put ---------------------------------------------------------------------------
+
+def test_the_controls_stay_put_while_thumbnails_arrive(ctx):
+    """First, with the thumbnail cache empty: each preset's rendered thumbnail replacing its
+    swatch leaves every control below the table where it was (a swatch was a framed colour
+    button, 3 px taller in its row than the image, so each arrival moved them up)."""
+    import time
+
+    thumbs = editor().thumbnails
+    ctx.set_ref("alight")
+    ctx.yield_(2)
+    before = content_y(ctx, "**/export glTF")
+    assert thumbs.pending(), "no thumbnail left to arrive: the cache was not empty"
+    start = time.monotonic()
+    while thumbs.pending():
+        assert time.monotonic() - start < 400, thumbs.pending()
+        ctx.yield_()
+        assert content_y(ctx, "**/export glTF") == before, (content_y(ctx, "**/export glTF"), before)
+    ctx.yield_(2)
+    assert content_y(ctx, "**/export glTF") == before, (content_y(ctx, "**/export glTF"), before)
+
+
 # --- 1: a preset is a whole material ----------------------------------------------------------------
 
 def test_a_preset_click_replaces_the_texture_maps(ctx):
@@ -166,7 +188,7 @@ def test_the_status_row_stays_in_view_when_the_panel_is_scrolled(ctx):
     band = status_band(ctx, capture(ctx, "status_scrolled_error.png"))
     assert colour_pixels(band, ERROR_RGB) > 20 and colour_pixels(band, MESSAGE_RGB) == 0, \
         (colour_pixels(band, ERROR_RGB), colour_pixels(band, MESSAGE_RGB))
-    assert content_y(ctx, "**/export glTF") == before
+    assert content_y(ctx, "**/export glTF") == before, (content_y(ctx, "**/export glTF"), before)
     ctx.scroll_to_top("//alight")
     for header in ("Environment", "Lights", "Display & camera", "Compare", "Accuracy chart"):
         ctx.item_close(f"**/{header}")

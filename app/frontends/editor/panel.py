@@ -353,13 +353,14 @@ class Panel:
             imgui.set_tooltip("a folder of maps, or image files separated by ';' (or drop them on the view "
                               "together): each goes to its slot by its name (NAME_BaseColor, _Normal, "
                               "_Roughness, _Metallic, _AO, _ORM, ...); the material takes the set's name")
-        imgui.same_line()
         if imgui.button("load set") and self.set_path.strip():
             self._load_texture_set(s, self.set_path)
         imgui.same_line()
         if imgui.button("browse set"):   # any image of the set: its folder is loaded
             self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,
                               lambda path: self._load_texture_set(s, os.path.dirname(path)))
+        imgui.same_line()
+        imgui.text_disabled("a folder, files split by ';', or a drop")
         for slot in MAP_SLOTS:
             imgui.push_id(slot)
             if imgui.radio_button("##armed", s.armed_slot == slot):
