@@ -2,11 +2,12 @@
 ImGui Test Engine: run by tests/test_editor_ui_state.py as ``alight edit --new --ui-test
 tests/editor_ui_checks_state.py`` (a real window under Xvfb); not collected by pytest.
 
-The controls stay put while thumbnails arrive; a preset click replaces the maps; the status row stays in view whatever the scroll and tells an
-error from a success by colour; a success replaces an old error; a texture set names the
-material; the 'texture set' row takes a folder or several files; 'open mesh' confirms, and the
-mesh field shows the mesh restored from the last session (``reopened_mesh_field_shows_the_path``,
-run by the runner in a second editor). The last check leaves a mesh file open for that."""
+The controls stay put while thumbnails arrive; a preset click replaces the maps; the status row
+stays in view whatever the scroll and tells an error from a success by colour; a success
+replaces an old error; a texture set names the material; the 'texture set' row takes a folder
+or several files; 'open mesh' confirms, and the mesh field shows the mesh restored from the
+last session (``reopened_mesh_field_shows_the_path``, run by the runner in a second editor).
+The last check leaves a mesh file open for that."""
 
 from __future__ import annotations
 
