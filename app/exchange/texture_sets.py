@@ -198,6 +198,42 @@ def assign_files(paths, base: TextureMaps | None = None) -> TextureSet:
     return TextureSet(maps, [files[p] for p in sorted(files)])
 
 
+def set_name(paths, folder: str | os.PathLike = "") -> str:
+    """A texture set's name, for the material it makes: ``folder``'s name when the set is a
+    folder, else the stem its map files share once the map names and resolutions are dropped
+    (``Wood049`` from Wood049_2K_Color.png and Wood049_2K_NormalGL.png), else the files' folder's
+    name; '' when there is none."""
+    if folder:
+        return Path(os.path.abspath(folder)).name
+    stems = []
+    for p in paths:
+        found = role_of(p)
+        if found is None:
+            continue
+        tokens = [t for t in re.split(r"[^A-Za-z0-9]+", Path(p).stem) if t]
+        while len(tokens) > 1 and _RESOLUTION.match(tokens[-1].lower()):
+            tokens.pop()
+        for k in range(min(len(tokens), 3), 0, -1):   # the recognised name, as role_of matched it
+            if "".join(tokens[-k:]).lower() == found[1]:
+                tokens = tokens[:-k]
+                break
+        else:   # written without a separator ('RockBaseColor'): the name cut off the last token
+            tokens[-1] = tokens[-1][:-len(found[1])]
+            tokens = [t for t in tokens if t]
+        while tokens and _RESOLUTION.match(tokens[-1].lower()):
+            tokens.pop()
+        stems.append(tokens)
+    common = []
+    for group in zip(*stems) if stems else ():
+        if len(set(group)) > 1:
+            break
+        common.append(group[0])
+    if common:
+        return "_".join(common)
+    parents = {Path(os.path.abspath(p)).parent.name for p in paths}
+    return parents.pop() if len(parents) == 1 else ""
+
+
 def assign_folder(folder: str | os.PathLike, base: TextureMaps | None = None) -> TextureSet:
     """Every image file directly in ``folder`` (not its subfolders), assigned by ``assign_files``.
     A missing folder, or one without an image of a known name, is an AlightError naming it."""

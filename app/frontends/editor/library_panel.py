@@ -35,7 +35,9 @@ class LibraryPanel:
             self.entries, self.problems = library.list_entries()
 
     def icon(self, win, label: str, material, maps=_NO_MAPS, fallback_rgb=None) -> None:
-        """The thumbnail, or (until it is rendered) a swatch of ``fallback_rgb`` the same size."""
+        """The thumbnail, or (until it is rendered) a swatch of ``fallback_rgb`` the same size.
+        The swatch is painted, not a colour button: a framed item lowers the row's text by the
+        frame padding, so each arriving thumbnail moved every control below it up 3 px."""
         from imgui_bundle import imgui
 
         thumbs = getattr(win, "thumbnails", None)
@@ -43,8 +45,11 @@ class LibraryPanel:
         if texture is not None:
             imgui.image(imgui.ImTextureRef(texture), imgui.ImVec2(ICON, ICON))
         else:
-            imgui.color_button(label, imgui.ImVec4(*(fallback_rgb or (0.3, 0.3, 0.3)), 1.0),
-                               imgui.ColorEditFlags_.no_tooltip, imgui.ImVec2(ICON, ICON))
+            pos = imgui.get_cursor_screen_pos()
+            imgui.dummy(imgui.ImVec2(ICON, ICON))
+            imgui.get_window_draw_list().add_rect_filled(
+                pos, imgui.ImVec2(pos.x + ICON, pos.y + ICON),
+                imgui.get_color_u32(imgui.ImVec4(*(fallback_rgb or (0.3, 0.3, 0.3)), 1.0)))
 
     def draw(self, s, win) -> None:
         """The library section, under the F0 table. A click is kept in ``clicked``: the panel's

@@ -25,6 +25,9 @@ from alight.frontends.editor.state import DEBUG_VIEWS
 from alight.ibl.bake import QUALITY
 
 AA_CHOICES = ("none", "msaa")
+# The status row's colours: an error, a success (a message); bright on the dark theme, told apart.
+ERROR_RGBA = (1.0, 0.35, 0.3, 1.0)
+MESSAGE_RGBA = (0.45, 0.85, 0.45, 1.0)
 _DRAG_MAX = 1e9   # imgui's bound for a drag whose range is open above (an inf bound is not safe in imgui)
 
 
@@ -113,6 +116,8 @@ class Panel:
         self.preset_path = "material.json"
         self.gltf_path = "material.gltf"
         self.map_path = ""
+        self.set_path = ""      # the 'texture set' field: a folder, or image files separated by ';'
+        self._specs_shown = (None, None)   # the mesh and environment the path fields were last set from
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
@@ -127,10 +132,12 @@ class Panel:
         width = win.panel_width()
         imgui.set_next_window_pos(imgui.ImVec2(display.x - width, 0), imgui.Cond_.always)
         imgui.set_next_window_size(imgui.ImVec2(width, display.y), imgui.Cond_.always)
+        # The status row is the window's menu bar: it stays in view whatever the panel's scroll.
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
-                    | imgui.WindowFlags_.no_collapse)
+                    | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
         self.shown_error = s.error
         self._status_line(s, win)
+        self._follow_loaded(s)
         if imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
             self._material(s, win)
         if imgui.collapsing_header("Environment"):
@@ -155,25 +162,36 @@ class Panel:
 
     @staticmethod
     def _status_line(s, win) -> None:
-        """One row of a fixed height at the top: the error, else the bake's progress, else the
-        last message, else nothing; so the rows below never move when one appears or goes. A
-        long line is cut at the panel's edge; hovering it shows it whole."""
+        """The panel's menu bar, one row of a fixed height that never scrolls: the error (red),
+        else the bake's progress, else the last message (green), else nothing; so a save or an
+        error is seen wherever the panel is scrolled, and the rows below never move when one
+        appears or goes. A long line is cut at the panel's edge; hovering it shows it whole."""
         from imgui_bundle import imgui
 
-        top = imgui.get_cursor_pos_y()
+        if not imgui.begin_menu_bar():
+            return
         if s.error:
-            imgui.align_text_to_frame_padding()
-            imgui.text_colored(imgui.ImVec4(1.0, 0.35, 0.3, 1.0), f"error: {s.error}")
+            imgui.text_colored(imgui.ImVec4(*ERROR_RGBA), f"error: {s.error}")
         elif win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
             fraction, label = win.bake_progress
             imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
         elif s.message:
-            imgui.align_text_to_frame_padding()
-            imgui.text_disabled(s.message)
+            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), s.message)
         if (s.error or s.message) and imgui.is_item_hovered():
             imgui.set_tooltip(s.error or s.message)
-        # Always the height of one framed row, whatever was drawn.
-        imgui.set_cursor_pos_y(top + imgui.get_frame_height_with_spacing())
+        imgui.end_menu_bar()
+
+    def _follow_loaded(self, s) -> None:
+        """The mesh and env path fields show the file loaded (a restored session, a drop), not
+        what was typed before it; a built-in mesh or the studio leaves the field as it is."""
+        specs = (s.mesh_spec, s.env_spec)
+        if specs == self._specs_shown:
+            return
+        if s.mesh_spec != self._specs_shown[0] and s.mesh_spec not in BUILTIN_MESHES:
+            self.mesh_path = s.mesh_spec
+        if s.env_spec != self._specs_shown[1] and s.env_spec != "studio":
+            self.env_path = s.env_spec
+        self._specs_shown = specs
 
     # --- sections -------------------------------------------------------------------------------
 
@@ -199,8 +217,8 @@ class Panel:
                 imgui.table_next_column()
                 self.library.icon(win, f"##sw{name}", preset, fallback_rgb=f0_srgb)   # its thumbnail
                 imgui.same_line()
-                # Highlighted: the preset the material is now (none once any field is edited).
-                if imgui.selectable(name, m == preset, 0, imgui.ImVec2(0, ICON))[0]:
+                # Highlighted: the preset the material is now (none once any field is edited or a map loaded).
+                if imgui.selectable(name, m == preset and not s.texture_maps.paths(), 0, imgui.ImVec2(0, ICON))[0]:
                     m = picked = preset
                 imgui.table_next_column()
                 imgui.text(" ".join(f"{x:.2f}" for x in f0))
@@ -234,9 +252,10 @@ class Panel:
         changed, name = imgui.input_text("name", m.name)
         if changed and name.strip() and name.isprintable():
             m = dataclasses.replace(m, name=name)
+            s.typed_name = name   # a texture set loaded later keeps it
         m = self._layers(s, m)
-        if picked is not None and m is picked:   # a click and no other edit: the preset as it is
-            s.material = s.saved_material = picked
+        if picked is not None and m is picked:   # a click and no other edit: the preset, without maps
+            s.apply_preset(picked)
         elif m != s.material:
             try:
                 s.material = validate_material(tidy_edit(s.material, m), "panel")
@@ -328,6 +347,20 @@ class Panel:
         maps = s.texture_maps
         if s.use_file_materials:
             imgui.text_disabled("parts with a material of their own use the file's maps")
+        # A whole set at once, each file to its slot by its name (as a drop of several files).
+        _, self.set_path = imgui.input_text("texture set", self.set_path)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("a folder of maps, or image files separated by ';' (or drop them on the view "
+                              "together): each goes to its slot by its name (NAME_BaseColor, _Normal, "
+                              "_Roughness, _Metallic, _AO, _ORM, ...); the material takes the set's name")
+        if imgui.button("load set") and self.set_path.strip():
+            self._load_texture_set(s, self.set_path)
+        imgui.same_line()
+        if imgui.button("browse set"):   # any image of the set: its folder is loaded
+            self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,
+                              lambda path: self._load_texture_set(s, os.path.dirname(path)))
+        imgui.same_line()
+        imgui.text_disabled("a folder, files split by ';', or a drop")
         for slot in MAP_SLOTS:
             imgui.push_id(slot)
             if imgui.radio_button("##armed", s.armed_slot == slot):
@@ -365,17 +398,27 @@ class Panel:
             s.texture_maps = dataclasses.replace(s.texture_maps, uv_offset=tuple(v))
 
     @staticmethod
-    def _load_texture_set(s, folder: str) -> None:
-        """A folder typed into the map field: its images assigned to slots by name, as a drop of
-        several files is (one undo step; the panel's message lists the assignment)."""
+    def _load_texture_set(s, text: str) -> None:
+        """A folder, or image files separated by ';' (the 'texture set' field; a folder typed
+        into 'map file' too): the images assigned to slots by name, as a drop of several files
+        is (one undo step; the panel's message lists the assignment)."""
+        entries = [p.strip() for p in text.split(";") if p.strip()]
+        folder = entries[0] if len(entries) == 1 and os.path.isdir(entries[0]) else ""
         try:
-            files = sorted(os.path.join(folder, f) for f in os.listdir(folder)
-                           if os.path.splitext(f)[1].lower() in IMAGE_SUFFIXES)
-            if not files:
-                raise AlightError(f"{folder}: no image files in the folder")
-            s.open_texture_set(files)
+            if folder:
+                files = sorted(os.path.join(folder, f) for f in os.listdir(folder)
+                               if os.path.splitext(f)[1].lower() in IMAGE_SUFFIXES)
+                if not files:
+                    raise AlightError(f"{folder}: no image files in the folder")
+            else:
+                files = entries
+                for path in files:
+                    if not os.path.isfile(path):
+                        raise AlightError(f"{path}: texture set: no such file (a folder, or image files "
+                                          f"separated by ';')")
+            s.open_texture_set(files, folder)
         except (AlightError, OSError) as exc:
-            s.fail(exc if isinstance(exc, AlightError) else AlightError(f"{folder}: {exc.strerror}"))
+            s.fail(exc if isinstance(exc, AlightError) else AlightError(f"{text}: {exc.strerror}"))
 
     def _environment(self, s, win) -> None:
         from imgui_bundle import imgui
@@ -390,6 +433,7 @@ class Panel:
         if imgui.button("studio"):
             try:
                 s.load_env("studio")
+                s.error, s.message = "", "environment: studio"
             except AlightError as exc:
                 s.fail(exc)
         names = list(BUILTIN_MESHES)
@@ -398,6 +442,7 @@ class Panel:
         if changed and 0 <= i < len(names):
             try:
                 s.load_mesh(names[i])
+                s.error, s.message = "", f"mesh: {names[i]}"
             except AlightError as exc:
                 s.fail(exc)
         if imgui.is_item_hovered():
@@ -406,6 +451,8 @@ class Panel:
         if imgui.button("open mesh"):
             try:
                 s.load_mesh(self.mesh_path)
+                warned = f" ({s.warnings} warning{'s' if s.warnings > 1 else ''} on stderr)" if s.warnings else ""
+                s.error, s.message = "", f"opened mesh {self.mesh_path}{warned}"
             except AlightError as exc:
                 s.fail(exc)
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)

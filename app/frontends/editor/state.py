@@ -65,6 +65,7 @@ class EditorState:
     compare: CompareState = field(default_factory=CompareState)   # the A/B split view (compare.py)
     error: str = ""          # the last error, shown in the panel until the next success
     message: str = ""        # the last success ("saved gold.json")
+    typed_name: str = ""     # the material name the artist typed last: a texture set loaded keeps it
     warnings: int = 0        # warning lines of the last mesh or environment file opened
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
     mesh: object = None
@@ -162,7 +163,7 @@ class EditorState:
         """Decode again the maps and the environment read from ``paths`` (changed on disk). A file
         that does not read now (half written, broken) keeps what was drawn and sets ``error``;
         it is tried again at its next change. Returns whether anything was reloaded."""
-        done = []
+        done, failed = [], False
         for slot, path in self.texture_maps.paths().items():
             if path in paths:
                 try:
@@ -170,15 +171,19 @@ class EditorState:
                     done.append(path)
                 except AlightError as exc:
                     self.fail(exc)
+                    failed = True
         if self.env_spec in paths:
             try:
                 self.load_env(self.env_spec)
                 done.append(self.env_spec)
             except AlightError as exc:
                 self.fail(exc)
+                failed = True
         if done:
             from pathlib import Path
 
+            if not failed:   # the file that failed to read before reads now: its error goes
+                self.error = ""
             self.message = "reloaded " + ", ".join(sorted({Path(p).name for p in done}))
         return bool(done)
 
@@ -201,6 +206,13 @@ class EditorState:
                 except AlightError as exc:
                     self.texture_maps = self.texture_maps.with_slot(slot, "")
                     self.fail(exc)
+
+    def apply_preset(self, preset: Material) -> None:
+        """A preset of the F0 table: a whole material, so its factors and no maps (maps loaded
+        before would multiply its factors); 'revert' goes back to it. One undo step (History)."""
+        self.material = self.saved_material = preset
+        self.texture_maps = TextureMaps()
+        self.error, self.message = "", f"applied {preset.name}"
 
     def load_material(self, name_or_path: str) -> None:
         """A preset (.json: factors; .gltf/.glb: factors and maps, alight.exchange.material_files)."""
@@ -230,12 +242,14 @@ class EditorState:
 
         export_gltf(self.material, path, self.texture_maps, self.mesh)
 
-    def open_texture_set(self, paths) -> list[str]:
-        """Image files dropped together, assigned to slots by their names
-        (alight.exchange.texture_sets); the loaded slots' factors become 1 (glTF's convention;
-        one undo step). Returns the assignment's lines, also shown as the panel's message."""
+    def open_texture_set(self, paths, folder: str = "") -> list[str]:
+        """Image files dropped together (or ``folder``'s), assigned to slots by their names
+        (alight.exchange.texture_sets); the loaded slots' factors become 1 (glTF's convention)
+        and the material is named after the set (the folder's name, else the files' common
+        stem) unless its name is one the artist typed; one undo step. Returns the assignment's
+        lines, also shown as the panel's message."""
         from alight.core.texture_maps import map_factors
-        from alight.exchange.texture_sets import assign_files, load_map_images
+        from alight.exchange.texture_sets import assign_files, load_map_images, set_name
 
         found = assign_files(paths, self.texture_maps)
         if not found.slots:
@@ -245,6 +259,9 @@ class EditorState:
         self.map_images = images
         self.texture_maps = found.maps
         self.material = with_overrides(self.material, **map_factors(found.slots))
+        name = set_name(paths, folder)
+        if name and name.isprintable() and self.material.name != self.typed_name:
+            self.material = dataclasses.replace(self.material, name=name)
         self.error, self.message = "", "texture set: " + "; ".join(found.lines())
         return found.lines()
 
