@@ -24,6 +24,7 @@ import moderngl
 import numpy as np
 
 from alight.core.gpu import release_objects
+from alight.errors import warn
 from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.mesh import is_closed
 from alight.core.shading import rotate_world_to_map
@@ -36,6 +37,10 @@ from alight.core.shadow_fit import (
 )
 
 SHADOW_MODES = ("auto", "on", "off")
+# A depth map stops light or lets it all through: a part that lets at least this share through
+# (alight.render.visibility_parts.light_through: transmission, a blended part's 1 - alpha) casts
+# nothing, one below casts as opaque; either way the error is the smaller of t and 1 - t.
+CASTER_MAX_THROUGH = 0.5
 MAX_SHADOW_VIEWS = 16      # shaders/common/shadows.glsl's MAX_SHADOW_VIEWS
 MAX_SHADOW_LIGHTS = 16     # punctual.glsl's MAX_LIGHTS
 MAX_SHADOW_SUNS = 4        # suns.glsl's MAX_SUNS
@@ -168,7 +173,7 @@ class ShadowMaps:
             return False
         suns = _shadowed_suns(scene, maps)
         centre, radius = bounds if bounds is not None else scene.mesh.bounding_sphere()
-        key = (id(scene.mesh), bool(scene.use_file_materials), tuple(_light_key(x) for x in scene.lights),
+        key = (id(scene.mesh), bool(scene.use_file_materials), tuple(id(g) for g in gpu_parts), tuple(_light_key(x) for x in scene.lights),
                tuple((tuple(np.round(s.direction, 9)), round(float(s.spread), 9)) for s in suns),
                float(scene.env_rotation_deg) if suns else 0.0, tuple(np.round(centre, 9)), round(float(radius), 9))
         if key == self._key and self._atlas is not None and self._mesh is scene.mesh:
@@ -245,6 +250,21 @@ class ShadowMaps:
     def release(self) -> None:
         self._release_atlas()
         self._self_shadowing.clear()
+
+
+def casters(scene) -> list[bool]:
+    """Per part of ``scene.mesh``, whether it casts into the shadow maps (CASTER_MAX_THROUGH);
+    says once in a warning line which parts cast nothing because they let light through."""
+    from alight.render.visibility_parts import light_through
+
+    through = light_through(scene) or (0.0,) * len(scene.mesh.parts)
+    cast = [t < CASTER_MAX_THROUGH for t in through]
+    skipped = [p.name or str(i) for i, (p, c) in enumerate(zip(scene.mesh.parts, cast)) if not c]
+    if skipped:
+        warn(f"{scene.mesh.source}: part(s) {', '.join(skipped)} cast no shadow: they let at least "
+             f"{CASTER_MAX_THROUGH:g} of the light through (transmission or alpha blending), which a shadow map "
+             f"cannot weigh")
+    return cast
 
 
 def _shadowed_suns(scene, maps) -> list:
