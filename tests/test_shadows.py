@@ -384,3 +384,75 @@ def test_api_set_shadows():
             r.set_shadows("sometimes")
         with pytest.raises(AlightError, match="occlusion: 'x'"):
             r.set_shadows(occlusion="x")
+
+
+def test_ground_views_are_as_wide_as_the_casters():
+    """On --ground the sun's and a directional light's views cover the model across the light
+    (its shadow lies in its own footprint there) and reach the ground only in depth."""
+    from alight.core.ground import ground_under
+    from alight.ibl.sun import Sun
+    from alight.render.shadows import RESOLUTION, plan_views
+
+    mesh = cube()
+    lo, hi = mesh.bounds()
+    centre, radius = mesh.bounding_sphere()
+    ground = ground_under(lo, hi, centre, radius)
+    low_sun = Sun(direction=np.array([0.0, np.sin(np.radians(10.0)), -np.cos(np.radians(10.0))]),
+                  power=np.ones(3), fraction=0.5, texels=10, spread=0.004)
+    plan = plan_views([Light(kind="directional", vector=(0.3, -0.2, 0.9))], [low_sun], *ground.bounds,
+                      casters=(centre, radius))
+    travel = [np.array([0.3, -0.2, 0.9]), -low_sun.direction]      # where each source's light goes
+    for view, d in zip(plan.views, travel):
+        assert view.texel == pytest.approx(2.0 * radius * 1.02 / view.resolution)
+        assert view.resolution == RESOLUTION["directional"]
+        # the ground's rim down the light, where the longest shadow fades out, lies inside the
+        # view's depth range (the rim toward the light lies before the casters: nothing shadows it)
+        away = np.array([d[0], 0.0, d[2]]) / np.hypot(d[0], d[2])
+        depth = (view.matrix @ np.append(ground.centre + ground.fade * away, 1.0))[2]
+        assert -1.0 <= depth <= 1.0
+
+
+def test_ground_shadow_of_a_low_sun_matches_traced_visibility():
+    """A cube on --ground under a map's sun 10 degrees high (0.5 degrees wide), seen from above:
+    the ground's shadow (alpha over a transparent background, divided by the sun's share of the
+    ground's light) against the hidden share of the sun's disk from Embree shadow rays. With the
+    sun's view as wide as the ground's sphere a texel was stretched along the light into streaks."""
+    pytest.importorskip("embreex", reason="the traced visibility needs embreex (pip install 'alight[reference]')")
+    from alight.accuracy.path_trace import _Rays, scene_geometry
+    from alight.core.shading import rotate_world_to_map
+    from alight.ibl.environment import Environment
+    from alight.render.shadows import SPREAD_TO_RADIUS
+
+    toward = np.array([0.6, np.sin(np.radians(10.0)), -0.8])
+    toward[[0, 2]] *= np.cos(np.radians(10.0)) / np.hypot(0.6, 0.8)
+    env = Environment(radiance=synthetic_sun_map(toward, radiance=4.0e4, radius_deg=0.5, size=1024),
+                      name="low sun", warnings=[])
+    r = renderer()
+    maps = r.bake(env, "low")
+    sun = maps.suns[0]
+    size = 384
+    scene = Scene(mesh=cube(), ground=True, camera=top_view(), display=Display(background="transparent"))
+    alpha = r.render(scene, maps, size, size).linear[..., 3].astype(np.float64)
+    x, z = pixel_world_xz(size)
+    y0 = float(cube().bounds()[0][1])
+    pts = np.stack([x, np.full_like(x, y0 + 1e-4), z], axis=-1).reshape(-1, 3)
+    rays = _Rays(scene_geometry(scene)[0])
+    d0 = np.asarray(rotate_world_to_map(np.asarray(sun.direction, float), 0.0))
+    a = np.cross(d0, (0.0, 1.0, 0.0))
+    a /= np.linalg.norm(a)
+    b = np.cross(d0, a)
+    disk = np.tan(sun.spread * SPREAD_TO_RADIUS)
+    hidden = np.zeros(len(pts))
+    for k in range(32):
+        rho, phi = np.sqrt((k + 0.5) / 32), k * 2.39996323
+        d = d0 + disk * rho * (np.cos(phi) * a + np.sin(phi) * b)
+        hidden += rays.blocked(pts, np.broadcast_to(d / np.linalg.norm(d), pts.shape), np.full(len(pts), np.inf))
+    hidden = (hidden / 32).reshape(size, size)
+    ground = ~_dilate((np.abs(x) <= 1.0) & (np.abs(z) <= 1.0), 2) & (np.hypot(x, z) < 2.5)
+    share = np.median(alpha[ground & (hidden > 0.999)])
+    estimate = alpha / share
+    penumbra = ground & (hidden > 0.02) & (hidden < 0.98)
+    assert penumbra.sum() > 100
+    # now 0.056 and 0.00027; with the views as wide as the ground 0.090 and 0.00074
+    assert np.abs(estimate - hidden)[penumbra].mean() < 0.075
+    assert np.abs(estimate - hidden)[ground].mean() < 0.0005

@@ -22,8 +22,11 @@ fixed order: the same seed gives the same image to the bit on the same machine.
 The environment is piecewise constant over its texels, looked up at the nearest texel, as the
 exact reference sums it (docs/conventions.md's mapping and rotation); background pixels show the
 environment along the camera ray, alpha is the covered fraction of the pixel's samples.
-Not modelled (refused or said in one warning line): the layers (clearcoat, sheen, anisotropy,
-transmission), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
+Transmission (KHR_materials_transmission's factor) is a thin wall: the share t (1 - metallic) of
+what meets it goes straight on, chosen with that probability, shadow rays carry the product of
+the walls' shares (no refraction, no Fresnel loss on the way through; alight's shadows and bake
+weigh parts the same way, alight.render.visibility_parts.light_through).
+Not modelled (refused or said in one warning line): the other layers (clearcoat, sheen, anisotropy), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
 """
 
 from __future__ import annotations
@@ -258,14 +261,17 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     mesh = scene.mesh
     warnings: list[str] = []
     corners, normals, mats, table = [], [], [], {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0",
-                                                                           "emissive")}
+                                                                           "emissive", "through")}
     # The user's maps (--map, --texture-set) are left out as a file's are.
     textured = bool(getattr(scene, "texture_maps", None))
     layered = masked = False
     for index, part in enumerate(mesh.parts):
         m, maps_apply = part_material(scene, part)
-        if m.layers():
+        if m.layers() - {"transmission"}:
             layered = True
+        # KHR_materials_transmission as a thin wall: the share t (1 - metallic) goes straight on
+        # (no refraction, no Fresnel loss), the rest meets the base BRDF.
+        table["through"].append(float(m.transmission) * (1.0 - float(m.metallic)))
         fm = part.material
         if maps_apply and fm is not None:
             textured |= bool(fm.textures())
@@ -287,8 +293,9 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
         table["specular_f0"].append(m.specular_f0)
         table["emissive"].append(m.emissive)
     if layered:
-        raise AlightError(f"{mesh.source}: the path tracer has the base BRDF only (no clearcoat, sheen, anisotropy, "
-                          "transmission); use the exact reference (--integrator exact) for layered materials")
+        raise AlightError(f"{mesh.source}: the path tracer has the base BRDF only (no clearcoat, sheen, anisotropy; "
+                          "transmission as a thin wall); use the exact reference (--integrator exact) for layered "
+                          "materials")
     if textured:
         warnings.append(f"{mesh.source}: the path tracer applies the material factors only (no texture maps or "
                         "vertex colours)")
@@ -331,6 +338,25 @@ class _Rays:
             return np.zeros(0, bool)
         prim, t, _, _ = self.hit(origins, dirs)
         return (prim >= 0) & (t < dists)
+
+    def transmittance(self, origins, dirs, dists, through, eps: float, walls: int = 8):
+        """The share of light that reaches each origin from its distance along dir: 0 behind an
+        opaque triangle, the product of ``through`` (per triangle) of the thin walls crossed."""
+        out = np.ones(len(origins))
+        todo = np.arange(len(origins))
+        o, left = np.array(origins, np.float64), np.array(dists, np.float64)
+        for _ in range(walls):
+            if len(todo) == 0:
+                break
+            prim, t, _, _ = self.hit(o[todo], dirs[todo])
+            hit = (prim >= 0) & (t < left[todo])
+            out[todo[hit]] *= through[prim[hit]]
+            go = hit & (out[todo] > 0.0)
+            todo, t = todo[go], t[go]
+            o[todo] = o[todo] + dirs[todo] * (t + eps)[:, None]
+            left[todo] -= t + eps
+        out[todo] = 0.0     # more walls than counted: dark
+        return out
 
 
 def _camera_rays(camera, aspect, width, height, pix, rng, jitter):
@@ -401,6 +427,14 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
     cover = np.zeros(npix)
     eps = 1e-5 * geom.scale
     tb = geom.table
+    clear_parts = bool((tb["through"] > 0.0).any())
+    through_of_triangle = tb["through"][geom.material]
+
+    def shadow(origins, dirs, dists):
+        """1 where the light is seen, 0 behind an opaque triangle, the thin walls' product between."""
+        if not clear_parts:
+            return (~rays.blocked(origins, dirs, dists)).astype(np.float64)
+        return rays.transmittance(origins, dirs, dists, through_of_triangle, eps)
     # One dimension of the environment's and of the BRDF's samples is stratified over a pixel's
     # samples (sample s in [s, s + 1) / N, shifted per pixel and per strategy: Cranley-Patterson
     # rotation): it divides the noise of a compact sun by about 2 at 256 samples.
@@ -431,7 +465,9 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                 else:
                     pb = prev_pdf[miss]
                     pe = env.pdf(d)
-                    w = pb * pb / np.maximum(pb * pb + pe * pe, 1e-300)
+                    seen = np.isinf(pb)     # a camera ray through thin walls: no other strategy
+                    pb = np.where(seen, 1.0, pb)
+                    w = np.where(seen, 1.0, pb * pb / np.maximum(pb * pb + pe * pe, 1e-300))
                 radiance_sum[alive[miss]] += throughput[miss] * L * w[:, None]
             keep = ~miss
             alive, prim, dist, bu, bv = alive[keep], prim[keep], dist[keep], bu[keep], bv[keep]
@@ -447,6 +483,19 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
             ng = np.where(back[:, None], -ng, ng)
             n = np.where(back[:, None], -n, n)
             m = geom.material[prim]
+            if clear_parts:
+                # a thin wall: the share it lets through goes straight on (chosen with that probability)
+                on = rng.random(len(alive)) < tb["through"][m]
+                if on.any():
+                    nxt = np.flatnonzero(on)
+                    passing = (alive[nxt], p[nxt] + direction[nxt] * eps, direction[nxt], throughput[nxt],
+                               None if prev_pdf is None else prev_pdf[keep][nxt])
+                    stay = ~on
+                    alive, prim, dist, bu, bv, p, n, ng, v, m = (x[stay] for x in (alive, prim, dist, bu, bv, p, n, ng,
+                                                                                  v, m))
+                    origin, direction, throughput = origin[stay], direction[stay], throughput[stay]
+                else:
+                    passing = None
             base, metal, rough, f0 = tb["base"][m], tb["metallic"][m], tb["roughness"][m], tb["f0"][m]
             radiance_sum[alive] += throughput * tb["emissive"][m]
             p_off = p + ng * eps
@@ -459,12 +508,14 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                 xi[:, 0] = stratified(xi[:, 0], 0, alive)
                 l, L, pe = env.sample(xi)
                 ok = (_dot(ng, l) > 0.0) & (_dot(n, l) > 0.0)
+                seen = np.ones(len(alive))
                 if settings.visibility and ok.any():
                     sub = np.flatnonzero(ok)
-                    ok[sub] &= ~rays.blocked(p_off[sub], l[sub], np.full(len(sub), np.inf))
+                    seen[sub] = shadow(p_off[sub], l[sub], np.full(len(sub), np.inf))
+                    ok &= seen > 0.0
                 if ok.any():
                     sub = np.flatnonzero(ok)
-                    f = brdf_cos(n[sub], v[sub], l[sub], base[sub], metal[sub], rough[sub], f0[sub])
+                    f = seen[sub, None] * brdf_cos(n[sub], v[sub], l[sub], base[sub], metal[sub], rough[sub], f0[sub])
                     pb = brdf_pdf(n[sub], v[sub], l[sub], rough[sub], p_spec[sub])
                     # power heuristic: (f L / pe) pe^2 / (pe^2 + pb^2), where a BRDF sample follows;
                     # at a path's last vertex the environment sample is the only strategy
@@ -477,12 +528,14 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
             for light in scene.lights:
                 l, Li, ldist = _light_terms(light, p)
                 ok = (_dot(ng, l) > 0.0) & (_dot(n, l) > 0.0) & (Li.max(axis=1) > 0.0)
+                seen = np.ones(len(alive))
                 if settings.visibility and ok.any():
                     sub = np.flatnonzero(ok)
-                    ok[sub] &= ~rays.blocked(p_off[sub], l[sub], ldist[sub] - 2.0 * eps)
+                    seen[sub] = shadow(p_off[sub], l[sub], ldist[sub] - 2.0 * eps)
+                    ok &= seen > 0.0
                 if ok.any():
                     sub = np.flatnonzero(ok)
-                    radiance_sum[alive[sub]] += throughput[sub] * punctual_light(
+                    radiance_sum[alive[sub]] += seen[sub, None] * throughput[sub] * punctual_light(
                         n[sub], v[sub], l[sub], base[sub], metal[sub], np.maximum(rough[sub], MIN_PUNCTUAL_ROUGHNESS),
                         tb["specular_f0"][m[sub]], Li[sub])
             if last:
@@ -502,6 +555,11 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                 ok &= survive
             ok &= throughput.max(axis=1) > 0.0
             alive, origin, direction, throughput, prev_pdf = alive[ok], p_off[ok], l[ok], throughput[ok], pb[ok]
+            if clear_parts and passing is not None:
+                a_, o_, d_, t_, pp_ = passing
+                alive, origin, direction, throughput = (np.concatenate([x, y]) for x, y in
+                                                        ((alive, a_), (origin, o_), (direction, d_), (throughput, t_)))
+                prev_pdf = np.concatenate([prev_pdf, pp_ if pp_ is not None else np.full(len(a_), np.inf)])
             if len(alive) == 0:
                 break
         np.add.at(accum, pix, radiance_sum)

@@ -80,10 +80,14 @@ def perspective(fov_deg: float, near: float, far: float) -> np.ndarray:
     return m
 
 
-def directional_view(direction, centre, radius: float, resolution: int, angular_radius: float = 0.0) -> ShadowView:
+def directional_view(direction, centre, radius: float, resolution: int, angular_radius: float = 0.0,
+                     receivers=None) -> ShadowView:
     """An orthographic view along ``direction`` (where light travels) holding the sphere
-    (``centre``, ``radius``), its centre snapped to whole texels in the light's plane.
-    ``angular_radius``: the source's (radians; 0 for a delta light)."""
+    (``centre``, ``radius``) of the casters, its centre snapped to whole texels in the light's
+    plane. ``angular_radius``: the source's (radians; 0 for a delta light). ``receivers``:
+    (centre, radius) of a sphere of surfaces that only take the shadow (the ground): the view's
+    depth range reaches them, its width does not, since a directional light puts the casters'
+    shadow inside their own footprint across the light; a receiver outside the map is lit."""
     d = np.asarray(direction, np.float64)
     d = d / np.linalg.norm(d)
     radius = max(float(radius), 1e-6) * 1.02     # a little room for the PCF kernel at the rim
@@ -96,6 +100,9 @@ def directional_view(direction, centre, radius: float, resolution: int, angular_
     distance = 2.0 * radius
     eye = snapped - d * distance
     near, far = distance - radius, distance + radius
+    if receivers is not None:
+        r_centre, r_radius = receivers
+        far = max(far, float(np.dot(np.asarray(r_centre, np.float64) - eye, d)) + float(r_radius) * 1.02)
     matrix = orthographic(radius, near, far) @ look_at(eye, d, (0.0, 1.0, 0.0))
     return ShadowView(matrix, KIND_ORTHO, near, far, texel, math.tan(angular_radius), resolution)
 

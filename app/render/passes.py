@@ -35,6 +35,8 @@ from alight.render.bindings import (
 )
 from alight.render.gpu_mesh import ANISOTROPIC_FILTERS, GpuPart
 from alight.render.ground import GroundPass
+from alight.render.shadows import casters as shadow_casters
+from alight.render.visibility_parts import light_through
 from alight.render.sphere_impostor import impostor_placement, lod_parts, proxy_part
 from alight.render.targets import Targets, View, read_tile
 from alight.render.tiles import TilePlan, tile_matrix, tile_origin
@@ -219,12 +221,14 @@ def scene_program(r, frame: FrameContext, vertex: str, fragment: str, defines: d
 
 def prepare_shadows(r, scene, maps: IBLMaps | None) -> bool:
     """The shadow maps for ``scene``, drawn where out of date (alight.render.shadows); whether
-    this pass reads them. The casters: every part but those that blend."""
+    this pass reads them. The casters: every part but those that blend or let light through
+    (alight.render.shadows.casters)."""
     ground = scene.ground and scene.view != "probe" and scene.mesh is not None and bool(scene.mesh.parts)
     if scene.view == "probe" or scene.mesh is None or not r.shadow_maps.wanted(scene, maps, receivers=ground):
         r.shadow_maps.last_active = False
         return False
-    gpu_parts = [g for g, part in zip(r.meshes.parts(scene.mesh), scene.mesh.parts) if not blends(scene, part)]
+    gpu_parts = [g for g, part, cast in zip(r.meshes.parts(scene.mesh), scene.mesh.parts, shadow_casters(scene))
+                 if cast and not blends(scene, part)]
 
     def draw_parts(matrix: bytes, parts) -> None:
         prog = r.program("render/shadow_depth.vert", "render/shadow_depth.frag")
@@ -508,7 +512,7 @@ def occluded_parts(r, scene, drawn: list[GpuPart]) -> list[GpuPart]:
     (alight.render.visibility_parts), else ``drawn``."""
     textures = r.meshes.textures(scene.mesh)
     return r.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
-                                        lambda part: GpuPart(r.ctx, part, textures))
+                                        lambda part: GpuPart(r.ctx, part, textures), light_through(scene))
 
 
 # --- after the scene pass: resolve, reduce, tone map ------------------------------------

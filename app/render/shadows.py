@@ -24,6 +24,7 @@ import moderngl
 import numpy as np
 
 from alight.core.gpu import release_objects
+from alight.errors import warn
 from alight.core.ibl_models import SUNS_AS_BAKED
 from alight.core.mesh import is_closed
 from alight.core.shading import rotate_world_to_map
@@ -36,12 +37,18 @@ from alight.core.shadow_fit import (
 )
 
 SHADOW_MODES = ("auto", "on", "off")
+# A depth map stops light or lets it all through: a part that lets at least this share through
+# (alight.render.visibility_parts.light_through: transmission, a blended part's 1 - alpha) casts
+# nothing, one below casts as opaque; either way the error is the smaller of t and 1 - t.
+CASTER_MAX_THROUGH = 0.5
 MAX_SHADOW_VIEWS = 16      # shaders/common/shadows.glsl's MAX_SHADOW_VIEWS
 MAX_SHADOW_LIGHTS = 16     # punctual.glsl's MAX_LIGHTS
 MAX_SHADOW_SUNS = 4        # suns.glsl's MAX_SUNS
-# Texels along a view's side. Orthographic views cover the whole scene; a point light's faces
-# cover a quarter of its sphere each; a sun's shadow is soft (PCSS), so it needs fewer texels.
-RESOLUTION = {"directional": 2048, "sun": 1024, "spot": 1024, "point": 512}
+# Texels along a view's side. Orthographic views cover the casters; a point light's faces
+# cover a quarter of its sphere each. A sun's shadow is soft (PCSS), but a low sun stretches a
+# texel along the ground by 1 / sin(elevation) (5.7 at quarry_01's 10 degrees): at 1024 the
+# helmet's ground shadow showed texel-wide streaks along the light (benchmarks/bench_ground_shadow.py).
+RESOLUTION = {"directional": 2048, "sun": 2048, "spot": 1024, "point": 512}
 # The source's RMS angular spread (alight.ibl.sun.Sun.spread) as a disk's radius: a uniform
 # disk of radius R has RMS angle R / sqrt(2).
 SPREAD_TO_RADIUS = math.sqrt(2.0)
@@ -77,16 +84,25 @@ def pack(sizes: list[int], max_width: int = 4096) -> tuple[list[tuple[int, int, 
     return rects, (max(width, 1), max(y + row, 1))
 
 
-def plan_views(lights, suns, centre, radius: float, env_rotation_deg: float = 0.0) -> ShadowPlan:
+def plan_views(lights, suns, centre, radius: float, env_rotation_deg: float = 0.0, casters=None) -> ShadowPlan:
     """The views for ``lights`` (alight.core.scene.Light) and ``suns`` (alight.ibl.sun.Sun, in the
     map's frame: turned into the world by ``env_rotation_deg`` as the renderer turns them),
     covering the sphere (``centre``, ``radius``), at most MAX_SHADOW_VIEWS of them (sources past
-    that are left unshadowed)."""
+    that are left unshadowed). ``casters``: (centre, radius) of the casters where that sphere
+    also holds receivers that cast nothing (the ground): the orthographic views are only as wide
+    as the casters (shadow_fit.directional_view), so the ground costs them no resolution."""
+    receivers = None
+    if casters is not None:
+        receivers = (centre, radius)
+        ortho_centre, ortho_radius = casters
+    else:
+        ortho_centre, ortho_radius = centre, radius
     views: list[ShadowView] = []
     light_first: list[int] = []
     for light in lights[:MAX_SHADOW_LIGHTS]:
         if light.kind == "directional":
-            made = [directional_view(light.vector, centre, radius, RESOLUTION["directional"])]
+            made = [directional_view(light.vector, ortho_centre, ortho_radius, RESOLUTION["directional"],
+                                     receivers=receivers)]
         elif light.kind == "spot":
             made = [spot_view(light.vector, light.direction, light.outer_cone_deg, centre, radius, RESOLUTION["spot"])]
         else:
@@ -103,8 +119,8 @@ def plan_views(lights, suns, centre, radius: float, env_rotation_deg: float = 0.
             continue
         toward = rotate_world_to_map(np.asarray(sun.direction, np.float64), -env_rotation_deg)
         sun_view.append(len(views))
-        views.append(directional_view(-np.asarray(toward, np.float64), centre, radius, RESOLUTION["sun"],
-                                      angular_radius=float(sun.spread) * SPREAD_TO_RADIUS))
+        views.append(directional_view(-np.asarray(toward, np.float64), ortho_centre, ortho_radius, RESOLUTION["sun"],
+                                      angular_radius=float(sun.spread) * SPREAD_TO_RADIUS, receivers=receivers))
     rects, atlas = pack([v.resolution for v in views])
     return ShadowPlan(tuple(views), tuple(light_first), tuple(sun_view), tuple(rects), atlas)
 
@@ -157,12 +173,13 @@ class ShadowMaps:
             return False
         suns = _shadowed_suns(scene, maps)
         centre, radius = bounds if bounds is not None else scene.mesh.bounding_sphere()
-        key = (id(scene.mesh), bool(scene.use_file_materials), tuple(_light_key(x) for x in scene.lights),
+        key = (id(scene.mesh), bool(scene.use_file_materials), tuple(id(g) for g in gpu_parts), tuple(_light_key(x) for x in scene.lights),
                tuple((tuple(np.round(s.direction, 9)), round(float(s.spread), 9)) for s in suns),
                float(scene.env_rotation_deg) if suns else 0.0, tuple(np.round(centre, 9)), round(float(radius), 9))
         if key == self._key and self._atlas is not None and self._mesh is scene.mesh:
             return True
-        plan = plan_views(scene.lights, suns, centre, radius, scene.env_rotation_deg)
+        casters = scene.mesh.bounding_sphere() if receivers else None
+        plan = plan_views(scene.lights, suns, centre, radius, scene.env_rotation_deg, casters)
         if not plan.views:
             self.last_active = False
             return False
@@ -233,6 +250,21 @@ class ShadowMaps:
     def release(self) -> None:
         self._release_atlas()
         self._self_shadowing.clear()
+
+
+def casters(scene) -> list[bool]:
+    """Per part of ``scene.mesh``, whether it casts into the shadow maps (CASTER_MAX_THROUGH);
+    says once in a warning line which parts cast nothing because they let light through."""
+    from alight.render.visibility_parts import light_through
+
+    through = light_through(scene) or (0.0,) * len(scene.mesh.parts)
+    cast = [t < CASTER_MAX_THROUGH for t in through]
+    skipped = [p.name or str(i) for i, (p, c) in enumerate(zip(scene.mesh.parts, cast)) if not c]
+    if skipped:
+        warn(f"{scene.mesh.source}: part(s) {', '.join(skipped)} cast no shadow: they let at least "
+             f"{CASTER_MAX_THROUGH:g} of the light through (transmission or alpha blending), which a shadow map "
+             f"cannot weigh")
+    return cast
 
 
 def _shadowed_suns(scene, maps) -> list:

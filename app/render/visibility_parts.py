@@ -21,11 +21,29 @@ from alight.errors import warn
 from alight.ibl.bake_cache import BadEntry, encode_entry
 
 
+def light_through(scene) -> tuple[float, ...] | None:
+    """Per part of ``scene.mesh``, the share of light it lets through to what lies behind it (the
+    bake's and the shadow maps' casters): transmission (KHR_materials_transmission's factor) times
+    (1 - metallic), or 1 - alpha for a part drawn blended; None where every part is opaque.
+    The factors only: a transmission texture is not read (one number per part)."""
+    from alight.render.variants import blends, part_material
+
+    values = []
+    for part in scene.mesh.parts:
+        m, _ = part_material(scene, part)
+        t = float(m.transmission) * (1.0 - float(m.metallic))
+        if blends(scene, part):
+            t = max(t, 1.0 - float(part.material.alpha))
+        values.append(min(max(t, 0.0), 1.0))
+    return tuple(values) if any(v > 0.0 for v in values) else None
+
+
 def cached_visibility(mesh, cache=None, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
-                      max_vertices: int = DEFAULT_MAX_VERTICES) -> MeshVisibility:
+                      max_vertices: int = DEFAULT_MAX_VERTICES, light_through=None) -> MeshVisibility:
     """``bake_visibility``, through ``cache`` (an ``alight.ibl.bake_cache.BakeCache``; None: no
-    cache) keyed by the mesh's content and the bake settings (``visibility_key``)."""
-    key, description = visibility_key(mesh, rays, edge_fraction, max_vertices)
+    cache) keyed by the mesh's content, the parts' ``light_through`` and the bake settings
+    (``visibility_key``)."""
+    key, description = visibility_key(mesh, rays, edge_fraction, max_vertices, light_through)
     if cache is not None:
         arrays = cache.load(key, description, "visibility bake")
         if arrays is not None:
@@ -39,7 +57,7 @@ def cached_visibility(mesh, cache=None, rays: int = DEFAULT_RAYS, edge_fraction:
                 return MeshVisibility(parts, from_cache=True)
             except BadEntry as exc:
                 cache.reject(key, "visibility bake", str(exc))
-    result = bake_visibility(mesh, rays, edge_fraction, max_vertices)
+    result = bake_visibility(mesh, rays, edge_fraction, max_vertices, light_through=light_through)
     if cache is not None:
         arrays = {f"{i}.{f}": getattr(p, f) for i, p in enumerate(result.parts) for f in VISIBILITY_FIELDS
                   if getattr(p, f) is not None}
@@ -70,10 +88,10 @@ class OcclusionParts:
             entry = self._wanted[(id(mesh), mode)] = (mesh, wants_occlusion(mesh, mode))
         return entry[1]
 
-    def parts_for(self, mesh, mode: str, drawn: list, make_part) -> list:
+    def parts_for(self, mesh, mode: str, drawn: list, make_part, through=None) -> list:
         """The GPU parts to draw for ``mesh``: its baked ones where it is wanted, else ``drawn``.
         ``make_part(part)`` uploads a MeshPart (alight.render.gpu_mesh.GpuPart, the mesh's
-        textures shared)."""
+        textures shared); ``through``: the parts' light_through (None: all opaque)."""
         if not self.wanted(mesh, mode):
             return drawn
         if mode == "auto" and not embree_available():
@@ -87,10 +105,10 @@ class OcclusionParts:
                  f"({AUTO_MAX_VERTICES}); --occlusion on bakes it")
             return drawn
         entry = self._parts.get(id(mesh))
-        if entry is None or entry[0] is not mesh:
+        if entry is None or entry[0] is not mesh or entry[2] != through:
             if entry is not None:
                 self._release(entry[1])
-            baked = cached_visibility(mesh, self.cache, self.rays, self.edge_fraction, self.max_vertices)
+            baked = cached_visibility(mesh, self.cache, self.rays, self.edge_fraction, self.max_vertices, through)
             if baked.from_cache:
                 self.bakes_loaded += 1
             else:
@@ -103,7 +121,7 @@ class OcclusionParts:
                 g.extra_buffers.append((buffer, "4f 4f", "in_visibility", "in_bounce"))
                 g.has_visibility = True
                 gpu.append(g)
-            entry = self._parts[id(mesh)] = (mesh, gpu)
+            entry = self._parts[id(mesh)] = (mesh, gpu, through)
         return entry[1]
 
     @staticmethod
@@ -114,7 +132,7 @@ class OcclusionParts:
             g.release()
 
     def release(self) -> None:
-        for _, parts in self._parts.values():
+        for _, parts, _ in self._parts.values():
             self._release(parts)
         self._parts.clear()
         self._wanted.clear()
