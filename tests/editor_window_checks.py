@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import time
 from pathlib import Path
 
 import numpy as np
@@ -422,16 +423,30 @@ def test_kept_panel_pixels_are_the_panel_drawn_anew(window):
     is drawn straight in."""
     kept = window._panel_image
     window.finish_bake()
+    # A thumbnail that arrives changes the panel's draw data between the frames compared: let
+    # them all arrive first (they render in a child process, seconds under load).
+    deadline = time.monotonic() + 120
+    window.frame()
+    while window.thumbnails.pending() and time.monotonic() < deadline:
+        window.frame()
+    assert not window.thumbnails.pending(), f"{window.thumbnails.pending()} thumbnails still pending after 120 s"
     for _ in range(20):     # (the first frames rasterise glyphs into imgui's atlas: texture updates)
         window.frame()
         if kept.reused:
             break
-    reused = kept.reused
-    assert reused > 0
-    copied = _drawn_with(window)
-    assert kept.reused == reused + 1                    # the same draw data: copied
-    drawn = _drawn_with(window, keep_panel_pixels=False)
-    window.glfw.swap_buffers(window.window)
+    assert kept.reused > 0
+    # The panel's text can still change between two frames (its frame-time readout): a pair
+    # whose draw data changed in between is drawn again, up to 5 times; a copy that differs from
+    # the panel drawn anew fails every time.
+    for _ in range(5):
+        reused = kept.reused
+        copied = _drawn_with(window)
+        copied_again = kept.reused == reused + 1           # the same draw data: copied
+        drawn = _drawn_with(window, keep_panel_pixels=False)
+        window.glfw.swap_buffers(window.window)
+        if copied_again and np.array_equal(copied, drawn):
+            break
+    assert copied_again
     np.testing.assert_array_equal(copied, drawn)
     assert copied[:, window.view_area()[0]:].std() > 5.0
 
