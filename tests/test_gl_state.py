@@ -73,3 +73,34 @@ def test_bakes_beyond_max_bakes_leave_the_gpu_and_load_back_from_the_disk_cache(
         assert r.bakes_run == 3 and r.bakes_loaded == 1
         assert np.array_equal(before, r.render(scene, again, 32, 32).linear)
         assert r.ctx.error == "GL_NO_ERROR"
+
+
+def test_an_older_renderer_draws_in_its_own_context_after_a_newer_one_was_made():
+    """Every ForwardRenderer() makes an EGL context of its own, and making one makes it current:
+    the older renderer's next bake and frame must still go to its own context, with its own
+    programs (they went to the newer one's, where the same names are other programs or none:
+    GL_INVALID_OPERATION in glUseProgram, and black maps, late in one test process)."""
+    from alight.ibl.bake import read_cube
+    from alight.ibl.environment import constant_environment
+
+    first, env = constant_environment(2.0, 32), constant_environment(0.5, 32)
+    scene = Scene(mesh=sphere(40, 20), material=Material(base_color=(0.8, 0.2, 0.1), roughness=0.4))
+    with ForwardRenderer(bake_cache=None) as alone:
+        alone_maps = alone.bake(env, "low")
+        expected_irradiance = read_cube(alone.shaders, alone_maps.irradiance)[..., :3]
+        expected = alone.render(scene, alone_maps, 32, 32).linear
+    older = ForwardRenderer(bake_cache=None)
+    try:
+        older.render(scene, older.bake(first, "low"), 32, 32)   # its programs exist, in its context
+        with ForwardRenderer(bake_cache=None) as newer:
+            newer.render(Scene(view="probe"), newer.bake(first, "low"), 16, 16)
+            maps = older.bake(env, "low")
+            irradiance = read_cube(older.shaders, maps.irradiance)[..., :3]
+            frame = older.render(scene, maps, 32, 32).linear
+            assert older.ctx.error == "GL_NO_ERROR"
+        assert abs(irradiance.mean() - 0.5) < 0.01      # a constant L: E/pi = L, not black
+        np.testing.assert_array_equal(irradiance, expected_irradiance)
+        np.testing.assert_array_equal(frame, expected)
+        np.testing.assert_array_equal(older.render(scene, maps, 32, 32).linear, expected)  # and after
+    finally:
+        older.release()

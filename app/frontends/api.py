@@ -90,9 +90,7 @@ class Renderer:
         r, self._renderer = self._renderer, None
         if r is not None:
             with _keep_current_context():
-                r.ctx.__enter__()
-                r.release()
-                r.ctx.release()
+                r.release()     # its own context too (alight.render.renderer)
 
     @property
     def is_open(self) -> bool:

@@ -96,6 +96,11 @@ class ForwardRenderer:
 
     def __init__(self, ctx: moderngl.Context | None = None, shaders: ShaderLibrary | None = None,
                  bake_cache: BakeCache | None | str = "default"):
+        # A renderer that makes its own context makes it current where it starts work: every
+        # ForwardRenderer() is an EGL context of its own, and creating one makes it current, so
+        # an older renderer's calls would go to the newer one's context (other programs under the
+        # same names: GL_INVALID_OPERATION and black maps). A context given is the caller's to manage.
+        self._owns_context = ctx is None
         self.ctx = ctx or create_headless_context()
         self.shaders = shaders or ShaderLibrary(self.ctx)
         self.tables = LookupTables(self.ctx, self.shaders)   # LUTs and lobe tables (alight.render.bindings)
@@ -133,7 +138,14 @@ class ForwardRenderer:
 
     # --- resources -----------------------------------------------------------------------
 
+    def make_current(self) -> None:
+        """Make this renderer's own context current (the entry points do); a context given to the
+        constructor is left to its owner."""
+        if self._owns_context:
+            self.ctx.__enter__()    # eglMakeCurrent; the same context again costs next to nothing
+
     def bake(self, env, quality: BakeQuality | str = "medium") -> IBLMaps:
+        self.make_current()
         q = QUALITY[quality] if isinstance(quality, str) else quality
         key = (env.content_hash, q)
         if key not in self._bakes:
@@ -148,6 +160,7 @@ class ForwardRenderer:
         """``bake`` in steps (alight.ibl.bake.bake_steps): yields (fraction, label) between GPU passes
         and returns the maps, cached as ``bake`` caches them (a cached bake yields nothing, one
         on disk is loaded in the first step)."""
+        self.make_current()
         q = QUALITY[quality] if isinstance(quality, str) else quality
         key = (env.content_hash, q)
         if key not in self._bakes:
@@ -211,6 +224,10 @@ class ForwardRenderer:
         self.meshes.forget_map_textures(keep_paths)
 
     def release(self) -> None:
+        """Release every GL object the renderer made, and its context if it made that too."""
+        if self._owns_context and isinstance(self.ctx.mglo, moderngl.mgl.InvalidObject):
+            return      # released already
+        self.make_current()
         for maps in self._bakes.values():
             maps.release()
         self._bakes.clear()
@@ -228,6 +245,8 @@ class ForwardRenderer:
         self.tables.release()
         self.draws.release()
         self.shaders.reload()
+        if self._owns_context:
+            self.ctx.release()
 
     def __enter__(self) -> "ForwardRenderer":
         return self
@@ -264,6 +283,7 @@ class ForwardRenderer:
         """``render`` strip by strip, top first (alight.render.tiles): each Strip holds a band of
         whole rows, drawn as one or more tiles, so a caller that writes and drops each one holds
         one strip's pixels at a time. A size within the GL limits and ``tile_bytes`` is one strip."""
+        self.make_current()
         if scene.view == "probe":
             aa = "none"  # the probe view's normals are exact per pixel centre: no blending
         if aa == "msaa":
@@ -278,6 +298,7 @@ class ForwardRenderer:
         for y0, linear, srgb in passes.frame_strips(self, scene, maps, plan, targets, width, height, aa,
                                                     read_linear, read_srgb):
             yield Strip(y0, Frame(linear, srgb))
+            self.make_current()     # the caller may have drawn with another renderer in between
 
     def _tiled_targets(self, width: int, height: int, aa: str, samples: int,
                        tile: tuple[int, int] | None, half: bool = False) -> tuple[TilePlan, Targets]:
