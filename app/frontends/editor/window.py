@@ -23,6 +23,7 @@ import os
 import time
 
 from alight.core.gpu import ShaderCompileError
+from alight.frontends.editor.variant_warmup import draw_view
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.frontends.editor.camera import OrbitCamera
@@ -169,6 +170,9 @@ class EditorWindow:
 
         self.compare_view = CompareView(self.ctx, self.renderer, self.new_targets)   # the A/B split view's GL side
         self.thumbnails = Thumbnails(self.ctx)   # the presets' and library's, a few a frame
+        from alight.frontends.editor.variant_warmup import VariantWarmup
+
+        self.variant_warmup = VariantWarmup()   # new shader variants compiled in a process of their own
 
     # --- input --------------------------------------------------------------------------------
 
@@ -504,9 +508,12 @@ class EditorWindow:
         # (The key deep-copies the lights: 0.3 ms a frame, not spent where every frame redraws.)
         key = self._view_key(scene, maps, size) if into is None else None
         direct = False     # drawn into the window (the renderer may not: draw_display)
+        if self.variant_warmup.step():   # a new variant compiled in the warm-up process: draw it now
+            self._drawn_key = None
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
-                drawn_into = self.renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
+                # (a variant not compiled yet: the last picture's scene meanwhile, variant_warmup.py)
+                drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
                 direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
@@ -715,6 +722,7 @@ class EditorWindow:
             targets.release()
         self._target_cache.clear()
         self.compare_view.release()
+        self.variant_warmup.close()
         self._panel_image.release()
         self.thumbnails.release()
         if self.hosted:   # the runner closes imgui, the window and its context after this
