@@ -123,9 +123,11 @@ def draw_overlay(win) -> None:
             a += f" (summing, {progress:.0%})"
         elif not win.compare_view.a_ready:
             a += " (not drawn: see the panel)" if win.state.error else " (when the view stands still)"
-    for text, left in ((a, max(4.0, x - 8.0 - imgui.calc_text_size(a).x)),
-                       (b, min(view_w - 4.0 - imgui.calc_text_size(b).x, x + 8.0))):
-        label(draw, imgui, text, left, 4.0)
+    a_left = x - 8.0 - imgui.calc_text_size(a).x
+    # A's name where it fits left of the divider, else a row lower (never over B's)
+    a_top = 4.0 if a_left >= 4.0 else 4.0 + imgui.get_text_line_height() + 2 * LABEL_PAD + 2.0
+    label(draw, imgui, a, max(4.0, a_left), a_top)
+    label(draw, imgui, b, min(view_w - 4.0 - imgui.calc_text_size(b).x, x + 8.0), 4.0)
 
 
 # The halves' names on a solid box: readable over any picture (a checkerboard, a white ball).

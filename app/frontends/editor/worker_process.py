@@ -31,6 +31,8 @@ import threading
 import time
 from pathlib import Path
 
+CHILD_NICENESS = 10
+
 
 class WorkerProcess:
     """The parent's handle on one child process ``python -m MODULE`` (started on the first job,
@@ -179,6 +181,10 @@ def serve(handle) -> int:
     """The child's loop: ``handle(job, progress, superseded)`` for each job, ``job`` unpickled,
     ``progress(fraction)`` to report, ``superseded()`` True once a newer job waits (the handler
     may then stop early and return False: answered ``cancelled``). Any exception is the job's one-line error."""
+    try:   # the editor's frames first: a child that sums or compiles takes what they leave of the cores
+        os.nice(CHILD_NICENESS)
+    except OSError:
+        pass
     jobs = _Jobs()
     while True:
         item = jobs.next()
