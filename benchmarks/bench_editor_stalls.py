@@ -116,7 +116,7 @@ def run(side: str, what: str, args) -> dict:
     env = dict(os.environ)
     if side == "before":
         env["PYTHONPATH"] = args.base + os.pathsep + env.get("PYTHONPATH", "")
-    with tempfile.TemporaryDirectory(prefix="alight-bench-stalls-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="alight-bench-stalls-", ignore_cleanup_errors=True) as tmp:
         env["MESA_SHADER_CACHE_DIR"] = os.path.join(tmp, "mesa")
         env["ALIGHT_CACHE_DIR"] = os.path.join(tmp, "cache")
         cmd = [sys.executable, os.path.abspath(__file__), "--child", what, "--size", args.size,

@@ -124,7 +124,8 @@ def test_the_reference_fills_in_while_frames_go_on_and_reopening_reuses_it(ctx):
     ctx.item_input_value("**/roughness", 0.5)
     ctx.yield_(2)
     assert cv.a_ready and cv.reference_progress is None, (cv.a_ready, cv.reference_progress)
-    assert (cv.reference_jobs, cv.reference_cache_hits) == (jobs + 1, hits + 1), (cv.reference_jobs, cv.reference_cache_hits)
+    counts = (cv.reference_jobs, cv.reference_cache_hits)
+    assert counts == (jobs + 1, hits + 1), counts
     assert same(shown(ctx), first) <= 1
     ctx.combo_click("compare/off")
     ctx.item_close("**/Compare")

@@ -5,10 +5,10 @@ does the plain view.
 Only the renderer's public calls draw: ``draw_display`` for a forward half (framebuffers of its
 own, so B's image stays B's and neither redraws when only the divider moves), ``render`` for the
 screenshot's halves, and ``tonemap`` for the reference (``ReferenceRenderer.render_gbuffer``'s
-linear radiance, summed by a process of its own, reference_worker.py, and tone mapped here with
-the view's display settings, so both halves share one curve). The halves meet in one full-screen pass that fetches each pixel
-from A or B (no filtering: the image is exactly A's or B's pixels); the reference has no
-background, so B shows through around it.
+linear radiance, summed by a process of its own, reference_worker.py, and tone mapped here
+with the view's display settings, so both halves share one curve). The halves meet in one
+full-screen pass that fetches each pixel from A or B (no filtering: the image is exactly A's
+or B's pixels); the reference has no background, so B shows through around it.
 """
 
 from __future__ import annotations

@@ -19,6 +19,8 @@ without this module.
 
 from __future__ import annotations
 
+import dataclasses
+import os
 import pickle
 import sys
 from dataclasses import dataclass
@@ -26,12 +28,14 @@ from dataclasses import dataclass
 
 @dataclass
 class WarmupJob:
-    scene: object          # alight.core.scene.Scene, as the view draws it
-    env: object            # the environment (alight.ibl.environment.Environment) or None
+    scene: object          # alight.core.scene.Scene, as the view draws it (mesh None: the last one sent)
+    env: object            # the environment (alight.ibl.environment.Environment), None: the last one sent
     quality: object        # the bake's alight.ibl.bake.BakeQuality (None without an environment)
     size: tuple            # the view's (width, height)
     aa: str                # the view's anti-aliasing
     out: str               # where the child writes the keys it compiled (a pickle)
+    mesh_token: int = 0    # which mesh and environment these are (0: none): each is sent once, then named by token
+    env_token: int = 0
 
 
 class VariantWarmup:
@@ -45,6 +49,8 @@ class VariantWarmup:
         self._warm: set = set()    # program keys the child compiled (or that may compile here)
         self.jobs = 0              # warm-ups asked of the child (tests read it)
         self.held = 0              # draws held back for a program not compiled yet
+        self._sent = (None, None)  # the tokens of the mesh and environment the child has
+        self._holds = None
 
     @property
     def pending(self) -> bool:
@@ -64,9 +70,16 @@ class VariantWarmup:
         if self._worker is None:
             self._worker = WorkerProcess("alight.frontends.editor.variant_warmup")
         out = self._worker.scratch_file(f"keys-{self.jobs}.pickle")
-        job = WarmupJob(scene=scene, env=win.state.env if maps is not None else None,
+        env = win.state.env if maps is not None else None
+        # A mesh or environment of millions of values is pickled once (in this frame), not per job.
+        mesh_token, env_token = (0 if x is None else id(x) for x in (scene.mesh, env))
+        send_mesh, send_env = mesh_token != self._sent[0], env_token != self._sent[1]
+        self._sent = (mesh_token, env_token)
+        self._holds = (scene.mesh, env)   # so neither id is reused while the child names it
+        job = WarmupJob(scene=scene if send_mesh else dataclasses.replace(scene, mesh=None),
+                        env=env if send_env else None,
                         quality=maps.quality if maps is not None else None, size=tuple(size),
-                        aa=win.state.aa, out=str(out))
+                        aa=win.state.aa, out=str(out), mesh_token=mesh_token, env_token=env_token)
         self._job_id, self._job_trigger, self._out = self._worker.submit(job), exc.key, out
         self.jobs += 1
 
@@ -84,6 +97,8 @@ class VariantWarmup:
                 except (OSError, pickle.UnpicklingError, EOFError):
                     pass
                 self._out.unlink(missing_ok=True)
+            else:   # the child may have restarted: send the mesh and environment again
+                self._sent = (None, None)
             # Whatever the child managed, the key that started the job compiles now (a failed or
             # partial warm-up must never keep the view on the old picture).
             self._warm.add(self._job_trigger)
@@ -120,8 +135,6 @@ def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
         warmup.request(win, exc, scene, maps, (targets.width, targets.height))
     finally:
         renderer.shaders.gate = None
-    import dataclasses
-
     old = dataclasses.replace(old, camera=scene.camera)
     return renderer.draw_display(old, maps, targets, into=into, into_encodes_srgb=into_srgb), False
 
@@ -135,21 +148,31 @@ def main() -> int:
 
     renderer = ForwardRenderer()
     targets = {}
+    have = {"mesh": (None, None), "env": (None, None)}   # token -> the object last sent
+
+    def kept(name, token, sent):
+        if sent is not None:
+            have[name] = (token, sent)
+        elif have[name][0] != token:
+            raise RuntimeError(f"the {name} named {token} was never sent")
+        return have[name][1]
 
     def handle(job: WarmupJob, progress, superseded) -> bool:
-        maps = renderer.bake(job.env, job.quality) if job.env is not None and job.quality is not None else None
+        scene = job.scene
+        if job.mesh_token:   # (0: no mesh, or no environment)
+            scene = dataclasses.replace(scene, mesh=kept("mesh", job.mesh_token, scene.mesh))
+        env = kept("env", job.env_token, job.env) if job.env_token else None
+        maps = renderer.bake(env, job.quality) if env is not None and job.quality is not None else None
         key = (job.size, job.aa)
         if key not in targets:
             for t in targets.values():
                 t.release()
             targets.clear()
             targets[key] = Targets(renderer.ctx, job.size[0], job.size[1], job.aa, 4)
-        renderer.draw_display(job.scene, maps, targets[key])
+        renderer.draw_display(scene, maps, targets[key])
         renderer.ctx.finish()   # the first draw's code generation happens by here
         with open(job.out + ".tmp", "wb") as f:
             pickle.dump(renderer.shaders.compiled_keys(), f)
-        import os
-
         os.replace(job.out + ".tmp", job.out)
         return True
 
