@@ -23,7 +23,10 @@ import dataclasses
 import os
 import pickle
 import sys
+import time
 from dataclasses import dataclass
+
+CACHE_SETTLE_S = 0.3
 
 
 @dataclass
@@ -171,12 +174,16 @@ def main() -> int:
             targets[key] = Targets(renderer.ctx, job.size[0], job.size[1], job.aa, 4)
         renderer.draw_display(scene, maps, targets[key])
         renderer.ctx.finish()   # the first draw's code generation happens by here
+        # Mesa writes its shader disk cache from a thread of its own: a moment for the entries
+        # to be on disk when the editor compiles the same programs.
+        time.sleep(CACHE_SETTLE_S)
         with open(job.out + ".tmp", "wb") as f:
             pickle.dump(renderer.shaders.compiled_keys(), f)
         os.replace(job.out + ".tmp", job.out)
         return True
 
-    return serve(handle)
+    # Not below the editor's priority: the view waits for this job (the old picture shows).
+    return serve(handle, niceness=0)
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ import threading
 import time
 from pathlib import Path
 
+# A long job (the reference's sum) runs below the editor's priority: the frames first.
 CHILD_NICENESS = 10
 
 
@@ -177,12 +178,13 @@ def answer(job_id, word: str, text: str = "") -> None:
     print(f"{job_id}\t{word}\t{' '.join(str(text).split())}", flush=True)
 
 
-def serve(handle) -> int:
+def serve(handle, niceness: int = CHILD_NICENESS) -> int:
     """The child's loop: ``handle(job, progress, superseded)`` for each job, ``job`` unpickled,
     ``progress(fraction)`` to report, ``superseded()`` True once a newer job waits (the handler
     may then stop early and return False: answered ``cancelled``). Any exception is the job's one-line error."""
-    try:   # the editor's frames first: a child that sums or compiles takes what they leave of the cores
-        os.nice(CHILD_NICENESS)
+    try:   # the editor's frames first: a child that sums takes what they leave of the cores
+        if niceness:
+            os.nice(niceness)
     except OSError:
         pass
     jobs = _Jobs()
