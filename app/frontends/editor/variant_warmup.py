@@ -53,6 +53,7 @@ class VariantWarmup:
         self.jobs = 0              # warm-ups asked of the child (tests read it)
         self.held = 0              # draws held back for a program not compiled yet
         self._sent = (None, None)  # the tokens of the mesh and environment the child has
+        self.showing_old = False   # the view's last draw was the last complete picture's scene
         self._holds = None
 
     @property
@@ -87,7 +88,8 @@ class VariantWarmup:
         self.jobs += 1
 
     def step(self) -> bool:
-        """Take the child's answers; True when a job ended this call (the view then draws again)."""
+        """Take the child's answers; True when a job ended this call and the view shows the old
+        picture (the view then draws again; one drawn whole since, by a screenshot, needs not)."""
         if self._worker is None or self._job_id is None:
             return False
         for job_id, word, _text in self._worker.answers():
@@ -106,7 +108,7 @@ class VariantWarmup:
             # partial warm-up must never keep the view on the old picture).
             self._warm.add(self._job_trigger)
             self._job_id = self._job_trigger = None
-            return True
+            return self.showing_old
         return False
 
     def close(self) -> None:
@@ -126,19 +128,20 @@ def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
     if not gated or old is None:   # (nothing drawn yet: no old picture to keep)
         drawn = renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
         warmup._warm.update(renderer.shaders.compiled_keys())
-        win._last_complete_scene = scene
+        win._last_complete_scene, warmup.showing_old = scene, False
         return drawn, True
     renderer.shaders.gate = warmup.gate
     try:
         drawn = renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
         warmup._warm.update(renderer.shaders.compiled_keys())
-        win._last_complete_scene = scene
+        win._last_complete_scene, warmup.showing_old = scene, False
         return drawn, True
     except ProgramPending as exc:
         warmup.request(win, exc, scene, maps, (targets.width, targets.height))
     finally:
         renderer.shaders.gate = None
     old = dataclasses.replace(old, camera=scene.camera)
+    warmup.showing_old = True
     return renderer.draw_display(old, maps, targets, into=into, into_encodes_srgb=into_srgb), False
 
 
