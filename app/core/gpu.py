@@ -164,16 +164,38 @@ def first_error_line(log: str) -> str:
     return " ".join(log.split())[:300]
 
 
+class ProgramPending(Exception):
+    """A program the library's ``gate`` held back (not compiled yet): the caller draws something
+    else meanwhile. ``key``: the program's key (``ShaderLibrary.program_key``)."""
+
+    def __init__(self, key: tuple):
+        super().__init__(f"program not compiled yet: {key[1]} + {key[2]}")
+        self.key = key
+
+
 class ShaderLibrary:
     """Compiles programs from ``shaders/`` on demand and keeps them until ``reload``.
 
     Programs are keyed by their stage files and defines, so asking twice costs nothing.
+    ``gate``: None (compile whatever is asked), or a function of a program's key that says
+    whether it may be compiled now; where it says no, ``program`` raises ProgramPending (the
+    editor compiles new variants in a process of its own first: a software GL's first draw of a
+    variant takes seconds, and the driver's shader cache then makes it fast here).
     """
 
     def __init__(self, ctx: moderngl.Context, root: Path | None = None):
         self.ctx = ctx
         self.root = root or shader_dir()
         self._programs: dict[tuple, moderngl.Program | moderngl.ComputeShader] = {}
+        self.gate = None
+
+    @staticmethod
+    def program_key(vertex: str, fragment: str, defines: dict[str, object] | None = None) -> tuple:
+        return ("program", vertex, fragment, tuple(sorted((defines or {}).items())))
+
+    def compiled_keys(self) -> list[tuple]:
+        """The keys of the programs compiled so far."""
+        return [k for k in self._programs if k[0] == "program"]
 
     def _compile(self, key, build):
         if key not in self._programs:
@@ -182,7 +204,9 @@ class ShaderLibrary:
 
     def program(self, vertex: str, fragment: str, defines: dict[str, object] | None = None) -> moderngl.Program:
         defines = defines or {}
-        key = ("program", vertex, fragment, tuple(sorted(defines.items())))
+        key = self.program_key(vertex, fragment, defines)
+        if self.gate is not None and key not in self._programs and not self.gate(key):
+            raise ProgramPending(key)
 
         def build():
             vs = load_source(vertex, defines, self.root)

@@ -123,8 +123,26 @@ def draw_overlay(win) -> None:
             a += f" (summing, {progress:.0%})"
         elif not win.compare_view.a_ready:
             a += " (not drawn: see the panel)" if win.state.error else " (when the view stands still)"
-    draw.add_text(imgui.ImVec2(max(4.0, x - 8.0 - imgui.calc_text_size(a).x), 4.0), colour, a)
-    draw.add_text(imgui.ImVec2(min(view_w - 4.0 - imgui.calc_text_size(b).x, x + 8.0), 4.0), colour, b)
+    a_left = x - 8.0 - imgui.calc_text_size(a).x
+    # A's name where it fits left of the divider, else a row lower (never over B's)
+    a_top = 4.0 if a_left >= 4.0 else 4.0 + imgui.get_text_line_height() + 2 * LABEL_PAD + 2.0
+    label(draw, imgui, a, max(4.0, a_left), a_top)
+    label(draw, imgui, b, min(view_w - 4.0 - imgui.calc_text_size(b).x, x + 8.0), 4.0)
+
+
+# The halves' names on a solid box: readable over any picture (a checkerboard, a white ball).
+LABEL_PAD = 3.0
+LABEL_BOX = (0.08, 0.08, 0.08, 0.85)
+LABEL_TEXT = (1.0, 1.0, 1.0, 1.0)
+
+
+def label(draw, imgui, text: str, x: float, y: float) -> None:
+    """``text`` at (x, y) (window pixels) over a dark box LABEL_PAD wider each side."""
+    size = imgui.calc_text_size(text)
+    draw.add_rect_filled(imgui.ImVec2(x - LABEL_PAD, y - LABEL_PAD),
+                         imgui.ImVec2(x + size.x + LABEL_PAD, y + size.y + LABEL_PAD),
+                         imgui.get_color_u32(imgui.ImVec4(*LABEL_BOX)), 3.0)
+    draw.add_text(imgui.ImVec2(x, y), imgui.get_color_u32(imgui.ImVec4(*LABEL_TEXT)), text)
 
 
 def half_names(state) -> tuple[str, str]:

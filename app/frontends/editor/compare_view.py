@@ -5,10 +5,10 @@ does the plain view.
 Only the renderer's public calls draw: ``draw_display`` for a forward half (framebuffers of its
 own, so B's image stays B's and neither redraws when only the divider moves), ``render`` for the
 screenshot's halves, and ``tonemap`` for the reference (``ReferenceRenderer.render_gbuffer``'s
-linear radiance, summed a band of rows a frame, tone mapped with the view's display settings, so
-both halves share one curve). The halves meet in one full-screen pass that fetches each pixel
-from A or B (no filtering: the image is exactly A's or B's pixels); the reference has no
-background, so B shows through around it.
+linear radiance, summed by a process of its own, reference_worker.py, and tone mapped here
+with the view's display settings, so both halves share one curve). The halves meet in one
+full-screen pass that fetches each pixel from A or B (no filtering: the image is exactly A's
+or B's pixels); the reference has no background, so B shows through around it.
 """
 
 from __future__ import annotations
@@ -23,9 +23,14 @@ from alight.core.scene import Display
 from alight.errors import AlightError
 from alight.frontends.editor import compare as cmp
 
-# The time a frame gives the reference's sum at most (about one band more): the window stays
-# responsive while a reference that takes a minute on a software GL fills in.
-REFERENCE_SLICE_S = 0.05
+# The reference is summed by a process of its own (reference_worker.py): the frame only tone
+# maps the rows summed so far, at most this often while the sum runs (a few ms at 800x720).
+REFERENCE_SHOW_S = 0.25
+# What a screenshot or a test (``finish``) waits for a sum at most.
+REFERENCE_WAIT_S = 1200.0
+# Finished references kept, by everything they depend on: closing and reopening compare, or
+# going back to a view summed before, shows it at once.
+REFERENCE_CACHE = 8
 _NO_DISPLAY = Display()
 
 _VERTEX = """#version 450 core
@@ -78,8 +83,16 @@ class CompareView:
         self._a_key = None        # what A's image shows now
         self._a_ok = False        # whether A's image holds a picture (the reference may have failed)
         self._ref_key = None      # what the reference job sums (the scene less its display)
-        self._ref_job = None      # the reference's generator while it runs (_reference_job)
+        self._ref_job_id = None   # the reference process's job while it sums (_start_reference)
         self._ref_linear = None   # its radiance so far
+        self._ref_out = None      # the .npy the process writes the rows into
+        self._ref_shown = 0.0     # when the rows were last tone mapped into A's image
+        self._ref_holds = None
+        # (key, radiance, holds), the last used last (the keys hold dataclasses that do not hash)
+        self._ref_cache: list = []
+        self._worker = None       # the reference process (worker_process.WorkerProcess), started on first use
+        self.reference_jobs = 0   # sums asked of the process (tests read it)
+        self.reference_cache_hits = 0   # references shown from the cache
         self.reference_progress = None   # the fraction summed while it runs (the panel shows it)
         self._out = None          # (texture, framebuffer) of the put-together image
         self._prog = self._vao = None
@@ -104,8 +117,8 @@ class CompareView:
 
     def draw_a(self, win, scene, maps, size, moving: bool, finish: bool = False) -> None:
         """Bring A's image up to date for this frame (only when what it shows changed). The
-        reference is summed a band of rows at a time (``REFERENCE_SLICE_S`` a frame; ``finish``:
-        to the end, for screenshots and tests)."""
+        reference is summed by a process of its own (``finish``: waits for it to end, for
+        screenshots and tests)."""
         c = win.state.compare
         targets = self._targets_for(size, win.state.aa)
         if c.mode == "reference":
@@ -120,108 +133,101 @@ class CompareView:
         self.redraws += 1
 
     def _step_reference(self, win, scene, targets, moving: bool, finish: bool) -> None:
-        """The exact reference's job: started when what it shows changed and the view stands
-        still, advanced a slice a frame, tone mapped into A's image after each band (rows not
-        summed yet are uncovered: B shows through them)."""
+        """The exact reference: taken from the cache when this view was summed before, else
+        asked of the reference process (reference_worker.py) when what it shows changed and the
+        view stands still; the rows it has summed are tone mapped into A's image every
+        ``REFERENCE_SHOW_S`` (rows not summed yet are uncovered: B shows through them). The frame
+        never waits for the sum but with ``finish``."""
         c = win.state.compare
         size = (targets.width, targets.height)
         # Everything the sum depends on; not the display (exposure, tone map): those re-tone-map only.
         key = (win._view_key(dataclasses.replace(scene, display=_NO_DISPLAY), None, size), id(win.state.env),
                c.reference_scale)
+        changed = self._take_answers(win)
         if key != self._ref_key and not moving:
-            if self._ref_job is not None:
-                self._ref_job.close()
+            if self._ref_job_id is not None:   # the sum of what the view showed before stops
+                self._worker.submit(None)
             self._ref_key, self._ref_linear, self._a_ok = key, None, False
-            self.reference_progress = 0.0
+            self._ref_job_id, self.reference_progress = None, None
+            cached = next((entry for entry in self._ref_cache if entry[0] == key), None)
             problem = cmp.reference_problem(win.state)
-            if problem:
+            if cached is not None:
+                self._ref_cache.remove(cached)
+                self._ref_cache.append(cached)
+                self._ref_linear, changed = cached[1], True
+                self.reference_cache_hits += 1
+            elif problem:
                 win.state.fail(AlightError(problem))
-                self._ref_job = None
             else:
-                self._ref_job = self._reference_job(win, scene, targets.width, targets.height, c.reference_scale)
+                self._start_reference(win, scene, size, c.reference_scale, key)
         if self._ref_key != key:   # moving: A's half waits for the view to stand still
             self._a_ok = False
             return
-        changed = False
-        start = time.perf_counter()
-        while self._ref_job is not None:
-            try:
-                self._ref_linear, self.reference_progress = next(self._ref_job)
-                changed = True
-            except StopIteration:
-                self._ref_job, self.reference_progress = None, None
-                self.reference_seconds = time.perf_counter() - self._ref_started
-                break
-            except AlightError as exc:
-                win.state.fail(AlightError(f"reference compare: {exc}"))
-                self._ref_job, self._ref_linear, self.reference_progress = None, None, None
-                break
-            if not finish and time.perf_counter() - start >= REFERENCE_SLICE_S:
-                break
+        if finish and self._ref_job_id is not None:
+            changed |= self._take_answers(win, wait=True)
         display_key = (key, scene.display)
+        now = time.perf_counter()
         if self._ref_linear is None:
             self._a_ok = False
-        elif changed or self._a_key != display_key:
+        elif (changed and (self._ref_job_id is None or now - self._ref_shown >= REFERENCE_SHOW_S)) \
+                or self._a_key != display_key:
             self._tonemap_reference(scene, targets)
-            self._a_key, self._a_ok = display_key, True
+            self._a_key, self._a_ok, self._ref_shown = display_key, True, now
             self.redraws += 1
 
-    def _reference_job(self, win, scene, width: int, height: int, scale: float):
-        """A generator: the reference of the view at ``scale`` of its pixels (at least 16 wide),
-        one band of rows per step; yields (the radiance so far (h, w, 4), top row first, alpha 0
-        where not summed yet; the fraction done)."""
-        from alight.accuracy.reference import (
-            GBUFFER,
-            ReferenceRenderer,
-            check_layer_lobes,
-            check_layer_roughness,
-            check_roughness,
-            choose_env_level,
-            env_level_radiance,
-        )
+    def _start_reference(self, win, scene, size, scale, key) -> None:
+        from alight.frontends.editor.reference_worker import ReferenceJob
+        from alight.frontends.editor.worker_process import WorkerProcess
 
-        self._ref_started = time.perf_counter()
-        rw = max(16, round(width * scale))
-        rh = max(1, round(height * rw / width))
-        rr = ReferenceRenderer(self.renderer)
-        env = win.state.env
-        use_env = env is not None and scene.ibl_enabled
-        radiance = None
-        if use_env:
-            roughnesses = rr.scene_roughnesses(scene)
-            for r in roughnesses:
-                check_roughness(r)
-            check_layer_roughness(rr.layered_material(scene))
-            check_layer_lobes(rr.layered_material(scene), roughnesses)
-            # Reduced once here (the reference's own choice of level), not per band.
-            radiance = env_level_radiance(np.asarray(env.radiance, np.float32),
-                                          choose_env_level(env.radiance, roughnesses))
-        textures = rr.mesh_gbuffer(scene, rw, rh)
-        g = {}
-        for name, tex in zip(GBUFFER, textures):
-            g[name] = np.frombuffer(tex.read(), np.float32).reshape(rh, rw, 4)[::-1].copy()
-            tex.release()
-        linear = np.zeros((rh, rw, 4), np.float32)
-        covered = g["position"][..., 3] > 0.5
-        yield linear, 0.0
-        band = 1
-        y = 0
-        while y < rh:
-            while y < rh and not covered[y].any():   # rows without the mesh: nothing to sum
-                y += 1
-            if y >= rh:
-                break
-            y1 = min(rh, y + band)
-            t0 = time.perf_counter()
-            part = rr.render_gbuffer({n: g[n][y:y1] for n in GBUFFER}, scene, radiance, env_level=0)
-            linear[y:y1] = part.linear
-            linear[y:y1, :, 3] = covered[y:y1]
-            # The next band sized to the slice from this one's time.
-            spent = time.perf_counter() - t0
-            band = max(1, min(64, int(band * REFERENCE_SLICE_S / max(spent, 1e-4))))
-            y = y1
-            yield linear, y / rh
-        yield linear, 1.0
+        if self._worker is None:
+            self._worker = WorkerProcess("alight.frontends.editor.reference_worker")
+        self._ref_out = self._worker.scratch_file(f"reference-{len(self._ref_cache)}-{self.reference_jobs}.npy")
+        self._ref_out.unlink(missing_ok=True)
+        # The scene without the maps' images it does not read (the reference shades factors).
+        job = ReferenceJob(scene=scene, env=win.state.env, width=size[0], height=size[1], scale=scale,
+                           out=str(self._ref_out))
+        self._ref_job_id = self._worker.submit(job)
+        self._ref_started, self.reference_progress = time.perf_counter(), 0.0
+        # The cache holds the mesh and environment the key names by id, so neither id is reused.
+        self._ref_holds = (win.state.mesh, win.state.env)
+        self.reference_jobs += 1
+
+    def _take_answers(self, win, wait: bool = False) -> bool:
+        """The reference process's lines about the current job; whether new rows came."""
+        if self._worker is None:
+            return False
+        if wait:
+            lines = self._worker.wait(self._ref_job_id, REFERENCE_WAIT_S)
+        else:
+            lines = self._worker.answers()
+        changed = False
+        for job_id, word, text in lines:
+            if job_id != self._ref_job_id:
+                continue   # a job superseded since
+            if word == "progress":
+                self.reference_progress = float(text)
+                changed |= self._read_rows()
+            elif word == "done":
+                changed |= self._read_rows()
+                self._ref_job_id, self.reference_progress = None, None
+                self.reference_seconds = time.perf_counter() - self._ref_started
+                if self._ref_linear is not None:
+                    self._ref_cache.append((self._ref_key, self._ref_linear, self._ref_holds))
+                    del self._ref_cache[:-REFERENCE_CACHE]
+                self._ref_out.unlink(missing_ok=True)
+            else:   # error, cancelled: nothing more comes for this job
+                self._ref_job_id, self._ref_linear, self.reference_progress = None, None, None
+                self._a_ok = False
+                if word == "error":
+                    win.state.fail(AlightError(f"reference compare: {text}"))
+        return changed
+
+    def _read_rows(self) -> bool:
+        try:
+            self._ref_linear = np.load(self._ref_out, mmap_mode="r").copy()
+        except (OSError, ValueError):   # not written yet
+            return False
+        return True
 
     def _tonemap_reference(self, scene, targets) -> None:
         """The reference's radiance, upscaled to A's image (nearest: each summed pixel a block),
@@ -285,6 +291,9 @@ class CompareView:
         return composite_rows(frame.srgb[..., :b_srgb.shape[2]], b_srgb, c.divider)
 
     def release(self) -> None:
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
         self.ctx.screen.use()
         if self._a_targets is not None:
             self._a_targets.release()

@@ -23,6 +23,7 @@ import os
 import time
 
 from alight.core.gpu import ShaderCompileError
+from alight.frontends.editor.variant_warmup import draw_view
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
 from alight.frontends.editor.camera import OrbitCamera
@@ -92,6 +93,7 @@ class EditorWindow:
             imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
             self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
             glfw.set_key_callback(self.window, self._key_callback)   # keys as the layout labels them (keys.py)
+            glfw.set_cursor_pos_callback(self.window, self._cursor_callback)   # each motion where it was
             self._native_imgui = self._start_native_imgui(imgui)
         from alight.frontends.editor.panel_image import PanelImage
 
@@ -173,6 +175,9 @@ class EditorWindow:
 
         self.compare_view = CompareView(self.ctx, self.renderer, self.new_targets)   # the A/B split view's GL side
         self.thumbnails = Thumbnails(self.ctx)   # the presets' and library's, a few a frame
+        from alight.frontends.editor.variant_warmup import VariantWarmup
+
+        self.variant_warmup = VariantWarmup()   # new shader variants compiled in a process of their own
 
     # --- input --------------------------------------------------------------------------------
 
@@ -200,6 +205,22 @@ class EditorWindow:
         name = self.glfw.get_key_name(key, scancode) if key != self.glfw.KEY_UNKNOWN else None
         self.impl.keyboard_callback(window, translate_key(key, name), scancode, action, mods)
 
+    def _cursor_callback(self, window, x, y) -> None:
+        """The motion's own position. (imgui_bundle's Python backend asks glfw for the cursor's
+        position now: after a long frame every queued motion then lands where the mouse is at
+        the end, the press and the release at one point, and the drag between them is lost.)"""
+        if self.glfw.get_window_attrib(window, self.glfw.FOCUSED):
+            self.imgui.get_io().add_mouse_pos_event(float(x), float(y))
+        else:
+            self.imgui.get_io().add_mouse_pos_event(-1.0, -1.0)
+
+    def _released_drag(self, button) -> bool:
+        """A drag whose last motion and release came in one frame, as the events queued during a
+        long frame do (imgui then sees the button up already): that motion still counts."""
+        io = self.imgui.get_io()
+        return self.imgui.is_mouse_released(button) and \
+            abs(io.mouse_delta.x) + abs(io.mouse_delta.y) >= io.mouse_drag_threshold
+
     def _camera_input(self) -> None:
         from alight.frontends.editor.compare import handle_mouse
 
@@ -209,15 +230,17 @@ class EditorWindow:
             dx, dy = io.mouse_delta.x, io.mouse_delta.y
             if divider:
                 pass   # the left button drags the compare divider
-            elif imgui.is_mouse_dragging(imgui.MouseButton_.left):
+            elif imgui.is_mouse_dragging(imgui.MouseButton_.left) or self._released_drag(imgui.MouseButton_.left):
                 self.orbit.orbit(dx, dy)
-            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) and io.key_shift:
+            elif (imgui.is_mouse_dragging(imgui.MouseButton_.right) or self._released_drag(imgui.MouseButton_.right)) \
+                    and io.key_shift:
                 # Shift + right drag turns the environment (as Substance's viewers do): a view's
                 # width of drag is a full turn, the lighting follows the hand.
                 s = self.state
                 turned = s.env_rotation_deg + dx * 360.0 / max(1, self._sizes()[1][0] - self.panel_width())
                 s.env_rotation_deg = (turned + 180.0) % 360.0 - 180.0
-            elif imgui.is_mouse_dragging(imgui.MouseButton_.right) or imgui.is_mouse_dragging(imgui.MouseButton_.middle):
+            elif any(imgui.is_mouse_dragging(b) or self._released_drag(b)
+                     for b in (imgui.MouseButton_.right, imgui.MouseButton_.middle)):
                 self.orbit.pan(dx, dy, self.size[1])
             if io.mouse_wheel:
                 self.orbit.zoom(io.mouse_wheel)
@@ -509,9 +532,12 @@ class EditorWindow:
         # (The key deep-copies the lights: 0.3 ms a frame, not spent where every frame redraws.)
         key = self._view_key(scene, maps, size) if into is None else None
         direct = False     # drawn into the window (the renderer may not: draw_display)
+        if self.variant_warmup.step():   # a new variant compiled in the warm-up process: draw it now
+            self._drawn_key = None
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
-                drawn_into = self.renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
+                # (a variant not compiled yet: the last picture's scene meanwhile, variant_warmup.py)
+                drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
                 direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
@@ -720,6 +746,7 @@ class EditorWindow:
             targets.release()
         self._target_cache.clear()
         self.compare_view.release()
+        self.variant_warmup.close()
         self._panel_image.release()
         self.thumbnails.release()
         if self.hosted:   # the runner closes imgui, the window and its context after this

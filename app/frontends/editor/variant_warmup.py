@@ -1,0 +1,193 @@
+"""New shader variants compiled away from the editor's frames.
+
+A layer switched on or a map loaded needs a shader variant the editor has not compiled. On
+llvmpipe the program's link is the small part (0.1-0.4 s here) and the first draw the large one
+(0.8-7 s: llvmpipe generates the fragment code for the draw's state then); Mesa keeps both in
+its shader disk cache, after which the same compile and first draw take a few tens of ms.
+GPU drivers keep such a cache too (NVIDIA's GLCache), and a GPU's link is what costs there.
+
+So the view's draw runs with the shader library's ``gate`` (alight.core.gpu.ShaderLibrary): a
+program not compiled yet raises ProgramPending instead of compiling. The window then draws the
+last picture's scene (its programs all compiled) with the current camera, and this module asks
+its child process (``python -m alight.frontends.editor.variant_warmup``, its own EGL context)
+to draw the new scene once, the same way (the same size, anti-aliasing and bake quality): that
+compiles the new programs into the driver's cache and reports their keys. Those keys pass the
+gate afterwards, and the view draws the new picture, its compile now a cache read. Where the
+child cannot help (it fails, or the driver keeps no cache) the compile happens in the frame, as
+without this module.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import pickle
+import sys
+import time
+from dataclasses import dataclass
+
+CACHE_SETTLE_S = 0.3
+
+
+@dataclass
+class WarmupJob:
+    scene: object          # alight.core.scene.Scene, as the view draws it (mesh None: the last one sent)
+    env: object            # the environment (alight.ibl.environment.Environment), None: the last one sent
+    quality: object        # the bake's alight.ibl.bake.BakeQuality (None without an environment)
+    size: tuple            # the view's (width, height)
+    aa: str                # the view's anti-aliasing
+    out: str               # where the child writes the keys it compiled (a pickle)
+    mesh_token: int = 0    # which mesh and environment these are (0: none): each is sent once, then named by token
+    env_token: int = 0
+
+
+class VariantWarmup:
+    """The parent's side: ``gate`` for the view's draws, ``request`` when one was held back,
+    ``step`` each frame. ``pending``: a draw waits for the child now."""
+
+    def __init__(self):
+        self._worker = None
+        self._job_id = None
+        self._job_trigger = None   # the key that started the job
+        self._warm: set = set()    # program keys the child compiled (or that may compile here)
+        self.jobs = 0              # warm-ups asked of the child (tests read it)
+        self.held = 0              # draws held back for a program not compiled yet
+        self._sent = (None, None)  # the tokens of the mesh and environment the child has
+        self.showing_old = False   # the view's last draw was the last complete picture's scene
+        self._holds = None
+
+    @property
+    def pending(self) -> bool:
+        return self._job_id is not None
+
+    def gate(self, key) -> bool:
+        return key in self._warm
+
+    def request(self, win, exc, scene, maps, size) -> None:
+        """A draw of ``scene`` was held back for ``exc.key``: start the child's draw of it
+        (unless one runs: the draw after it asks again for what it did not compile)."""
+        self.held += 1
+        if self._job_id is not None:
+            return
+        from alight.frontends.editor.worker_process import WorkerProcess
+
+        if self._worker is None:
+            self._worker = WorkerProcess("alight.frontends.editor.variant_warmup")
+        out = self._worker.scratch_file(f"keys-{self.jobs}.pickle")
+        env = win.state.env if maps is not None else None
+        # A mesh or environment of millions of values is pickled once (in this frame), not per job.
+        mesh_token, env_token = (0 if x is None else id(x) for x in (scene.mesh, env))
+        send_mesh, send_env = mesh_token != self._sent[0], env_token != self._sent[1]
+        self._sent = (mesh_token, env_token)
+        self._holds = (scene.mesh, env)   # so neither id is reused while the child names it
+        job = WarmupJob(scene=scene if send_mesh else dataclasses.replace(scene, mesh=None),
+                        env=env if send_env else None,
+                        quality=maps.quality if maps is not None else None, size=tuple(size),
+                        aa=win.state.aa, out=str(out), mesh_token=mesh_token, env_token=env_token)
+        self._job_id, self._job_trigger, self._out = self._worker.submit(job), exc.key, out
+        self.jobs += 1
+
+    def step(self) -> bool:
+        """Take the child's answers; True when a job ended this call and the view shows the old
+        picture (the view then draws again; one drawn whole since, by a screenshot, needs not)."""
+        if self._worker is None or self._job_id is None:
+            return False
+        for job_id, word, _text in self._worker.answers():
+            if job_id != self._job_id or word == "progress":
+                continue
+            if word == "done":
+                try:
+                    with open(self._out, "rb") as f:
+                        self._warm.update(pickle.load(f))
+                except (OSError, pickle.UnpicklingError, EOFError):
+                    pass
+                self._out.unlink(missing_ok=True)
+            else:   # the child may have restarted: send the mesh and environment again
+                self._sent = (None, None)
+            # Whatever the child managed, the key that started the job compiles now (a failed or
+            # partial warm-up must never keep the view on the old picture).
+            self._warm.add(self._job_trigger)
+            self._job_id = self._job_trigger = None
+            return self.showing_old
+        return False
+
+    def close(self) -> None:
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
+
+
+def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
+    """``renderer.draw_display`` of the view, with the gate when ``gated``: a program not
+    compiled yet is handed to the child and the last complete picture's scene is drawn instead
+    (with this frame's camera). Returns (the framebuffer drawn into, whether it is ``scene``)."""
+    from alight.core.gpu import ProgramPending
+
+    renderer, warmup = win.renderer, win.variant_warmup
+    old = getattr(win, "_last_complete_scene", None)
+    if not gated or old is None:   # (nothing drawn yet: no old picture to keep)
+        drawn = renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
+        warmup._warm.update(renderer.shaders.compiled_keys())
+        win._last_complete_scene, warmup.showing_old = scene, False
+        return drawn, True
+    renderer.shaders.gate = warmup.gate
+    try:
+        drawn = renderer.draw_display(scene, maps, targets, into=into, into_encodes_srgb=into_srgb)
+        warmup._warm.update(renderer.shaders.compiled_keys())
+        win._last_complete_scene, warmup.showing_old = scene, False
+        return drawn, True
+    except ProgramPending as exc:
+        warmup.request(win, exc, scene, maps, (targets.width, targets.height))
+    finally:
+        renderer.shaders.gate = None
+    old = dataclasses.replace(old, camera=scene.camera)
+    warmup.showing_old = True
+    return renderer.draw_display(old, maps, targets, into=into, into_encodes_srgb=into_srgb), False
+
+
+# --- the child process ---------------------------------------------------------------------------
+
+def main() -> int:
+    from alight.frontends.editor.worker_process import serve
+    from alight.render.renderer import ForwardRenderer
+    from alight.render.targets import Targets
+
+    renderer = ForwardRenderer()
+    targets = {}
+    have = {"mesh": (None, None), "env": (None, None)}   # token -> the object last sent
+
+    def kept(name, token, sent):
+        if sent is not None:
+            have[name] = (token, sent)
+        elif have[name][0] != token:
+            raise RuntimeError(f"the {name} named {token} was never sent")
+        return have[name][1]
+
+    def handle(job: WarmupJob, progress, superseded) -> bool:
+        scene = job.scene
+        if job.mesh_token:   # (0: no mesh, or no environment)
+            scene = dataclasses.replace(scene, mesh=kept("mesh", job.mesh_token, scene.mesh))
+        env = kept("env", job.env_token, job.env) if job.env_token else None
+        maps = renderer.bake(env, job.quality) if env is not None and job.quality is not None else None
+        key = (job.size, job.aa)
+        if key not in targets:
+            for t in targets.values():
+                t.release()
+            targets.clear()
+            targets[key] = Targets(renderer.ctx, job.size[0], job.size[1], job.aa, 4)
+        renderer.draw_display(scene, maps, targets[key])
+        renderer.ctx.finish()   # the first draw's code generation happens by here
+        # Mesa writes its shader disk cache from a thread of its own: a moment for the entries
+        # to be on disk when the editor compiles the same programs.
+        time.sleep(CACHE_SETTLE_S)
+        with open(job.out + ".tmp", "wb") as f:
+            pickle.dump(renderer.shaders.compiled_keys(), f)
+        os.replace(job.out + ".tmp", job.out)
+        return True
+
+    # Not below the editor's priority: the view waits for this job (the old picture shows).
+    return serve(handle, niceness=0)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

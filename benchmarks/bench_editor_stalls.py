@@ -1,0 +1,165 @@
+"""The editor's frame times while the compare view's exact reference sums, and while a new
+shader variant (a layer switched on) compiles: this checkout against another one, the two
+alternated (before, after, before, after ...), each run a fresh process. Not a test.
+
+    git archive main | tar -x -C /tmp/base_src && mkdir /tmp/base && ln -s /tmp/base_src/app /tmp/base/alight
+    xvfb-run -a -s "-screen 0 1920x1080x24" .venv/bin/python benchmarks/bench_editor_stalls.py --base /tmp/base
+
+``--base``: a folder whose ``alight`` is the other checkout's app/ (put first on PYTHONPATH for
+the "before" runs). Each run is an EditorWindow (its own loop, the panel, 800x720 by default)
+on the built-in sphere in the built-in studio:
+
+- reference: plastic_high at roughness 0.5, compare 'reference' at ``--scale``; frames are timed
+  (``win.frame()`` then ``ctx.finish()``) from the switch until A's half is whole; then compare
+  off for 10 frames and on again: the frames until A's half is whole again.
+- variant: gold, 20 frames, then clearcoat 1.0 (set on the state); frames timed until the view
+  shows the clearcoat picture and 10 more. Each run has an empty Mesa shader cache of its own
+  (MESA_SHADER_CACHE_DIR), as a first switch on a new machine.
+
+Prints one line a run and, a side, the median and range over its runs of the median and the
+longest frame.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _window(size):
+    from alight.exchange.presets import load_preset
+    from alight.frontends.editor.state import EditorState
+    from alight.frontends.editor.window import EditorWindow
+
+    state = EditorState()
+    state.material = state.saved_material = load_preset("plastic_high")
+    state.load_mesh("sphere")
+    state.load_env("studio")
+    win = EditorWindow(state, size)
+    win.finish_bake()
+    for _ in range(10):
+        win.frame()
+    return state, win
+
+
+def _timed_frame(win) -> float:
+    t0 = time.perf_counter()
+    win.frame()
+    win.ctx.finish()
+    return time.perf_counter() - t0
+
+
+def child_reference(size, scale: float, limit_s: float) -> dict:
+    from alight.frontends.editor.compare import CompareState
+
+    state, win = _window(size)
+    state.material = dataclasses.replace(state.material, roughness=0.5)
+    for _ in range(3):
+        win.frame()
+    try:
+        state.compare = CompareState(mode="reference", reference_scale=scale)
+        times, start = [], time.perf_counter()
+        while time.perf_counter() - start < limit_s:
+            times.append(_timed_frame(win))
+            if win.compare_view.a_ready and win.compare_view.reference_progress is None:
+                break
+        whole = time.perf_counter() - start
+        state.compare = CompareState(mode="off", reference_scale=scale)
+        for _ in range(10):
+            win.frame()
+        state.compare = CompareState(mode="reference", reference_scale=scale)
+        again, start = [], time.perf_counter()
+        while time.perf_counter() - start < limit_s:
+            again.append(_timed_frame(win))
+            if win.compare_view.a_ready and win.compare_view.reference_progress is None:
+                break
+        return {"frames": len(times), "median_ms": 1000 * statistics.median(times), "max_ms": 1000 * max(times),
+                "whole_s": whole, "reopen_frames": len(again), "reopen_s": sum(again)}
+    finally:
+        win.close()
+
+
+def child_variant(size) -> dict:
+    state, win = _window(size)
+    from alight.exchange.presets import load_preset
+
+    state.material = load_preset("gold")
+    try:
+        for _ in range(20):
+            win.frame()
+        steady = [_timed_frame(win) for _ in range(5)]
+        state.material = dataclasses.replace(state.material, clearcoat=1.0)
+        times, start, shown, after = [], time.perf_counter(), None, 0
+        warm = getattr(win, "variant_warmup", None)
+        while time.perf_counter() - start < 300 and after < 10:
+            times.append(_timed_frame(win))
+            done = warm is None or (not warm.pending and win._last_complete_scene.material == state.material)
+            if shown is None and done:
+                shown = time.perf_counter() - start
+            after += shown is not None
+        return {"frames": len(times), "steady_ms": 1000 * statistics.median(steady),
+                "median_ms": 1000 * statistics.median(times), "max_ms": 1000 * max(times), "shown_s": shown}
+    finally:
+        win.close()
+
+
+def run(side: str, what: str, args) -> dict:
+    env = dict(os.environ)
+    if side == "before":
+        env["PYTHONPATH"] = args.base + os.pathsep + env.get("PYTHONPATH", "")
+    with tempfile.TemporaryDirectory(prefix="alight-bench-stalls-", ignore_cleanup_errors=True) as tmp:
+        env["MESA_SHADER_CACHE_DIR"] = os.path.join(tmp, "mesa")
+        env["ALIGHT_CACHE_DIR"] = os.path.join(tmp, "cache")
+        cmd = [sys.executable, os.path.abspath(__file__), "--child", what, "--size", args.size,
+               "--scale", str(args.scale), "--limit", str(args.limit)]
+        out = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=tmp)
+    if out.returncode != 0:
+        raise SystemExit(f"{side} {what}: {out.stderr[-2000:]}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--base", help="a folder whose 'alight' is the other checkout's app/")
+    ap.add_argument("--what", choices=("reference", "variant", "both"), default="both")
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--size", default="800x720")
+    ap.add_argument("--scale", type=float, default=0.25)
+    ap.add_argument("--limit", type=float, default=600.0, help="seconds a reference run waits at most")
+    ap.add_argument("--child", choices=("reference", "variant"))
+    args = ap.parse_args()
+    size = tuple(int(v) for v in args.size.split("x"))
+    if args.child == "reference":
+        print(json.dumps(child_reference(size, args.scale, args.limit)))
+        return
+    if args.child == "variant":
+        print(json.dumps(child_variant(size)))
+        return
+    if not args.base:
+        raise SystemExit("--base is required (the 'before' checkout)")
+    whats = ("reference", "variant") if args.what == "both" else (args.what,)
+    for what in whats:
+        results = {"before": [], "after": []}
+        for r in range(args.rounds):
+            for side in ("before", "after"):
+                res = run(side, what, args)
+                results[side].append(res)
+                print(f"{what} round {r + 1} {side}: " + ", ".join(
+                    f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in res.items()), flush=True)
+        for side, runs in results.items():
+            for field in ("median_ms", "max_ms"):
+                xs = [x[field] for x in runs]
+                print(f"{what} {side} {field}: median {statistics.median(xs):.1f} (range {min(xs):.1f}-{max(xs):.1f})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,33 @@
+"""The editor's slow work (the compare view's exact reference, new shader variants) kept away
+from its frames, through its real UI: ``alight edit --ui-test tests/editor_ui_checks_speed.py``
+under Xvfb (the Dear ImGui Test Engine operates the panel)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from test_editor import display  # noqa: F401  (the Xvfb fixture)
+from test_editor_ui import ui_test
+
+REPO = Path(__file__).resolve().parents[1]
+CHECKS = REPO / "tests" / "editor_ui_checks_speed.py"
+
+
+def test_every_speed_check_passes_through_the_test_engine(display, tmp_path):
+    result = ui_test(tmp_path, CHECKS, "--new")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]
+    assert f"{len(checks)} passed, 0 failed" in result.stdout, result.stdout
+
+
+def test_a_drag_made_during_a_busy_frame_turns_the_camera(display):
+    """Real X events (XTest) queued while no frame polls, as during a long frame: the press, the
+    motions and the release all count (tests/editor_x_events_speed.py)."""
+    import os
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, str(REPO / "tests" / "editor_x_events_speed.py")], cwd=REPO,
+                            env=dict(os.environ, DISPLAY=display), capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: turned"), result.stdout
