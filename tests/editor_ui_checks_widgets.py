@@ -118,16 +118,24 @@ def test_slider_values_read_beside_their_handle(ctx):
     assert editor().state.material.roughness == 0.5
     r = ctx.item_info("**/roughness").rect_full
     pixels = _panel_pixels(ctx)
+    from PIL import Image
+
+    Image.fromarray(pixels).save(os.path.join(OUT, "panel_sliders.png"))   # to look at
     # The frame only (the label right of it is outside): the slider is the item's left part.
     frame_w = r.max.x - r.min.x - imgui.get_style().item_inner_spacing.x - imgui.calc_text_size("roughness").x
-    box = pixels[int(r.min.y) + 2:int(r.max.y) - 2, int(r.min.x) + 2:int(r.min.x + frame_w) - 2].astype(np.int32)
-    blue = (box[..., 2] - box[..., 0] > 25)
-    cols = np.flatnonzero(blue.any(axis=0))
-    assert cols.size, "no handle found in the roughness slider"
+    box = pixels[int(r.min.y):int(r.max.y), int(r.min.x) + 2:int(r.min.x + frame_w) - 2].astype(np.int32)
+    # The handle: the columns that differ from the frame's colour in the rows above the digits
+    # (the handle spans the frame's height; the digits its middle). Any theme's colours.
+    top = box[2:5]
+    background = np.median(top.reshape(-1, 3), axis=0)
+    cols = np.flatnonzero((np.abs(top - background).max(axis=2) > 8).any(axis=0))
+    assert cols.size, f"no handle found in the roughness slider at {r.min.x:.0f},{r.min.y:.0f}"
     width = cols.max() - cols.min() + 1
     assert width <= 6, f"the handle is {width} px wide over the digits"
-    handle = _luminance(box[blue]).mean()
-    text = _luminance(box[(box.min(axis=2) > 200)]).mean()   # the white digits
+    handle = _luminance(top[:, cols].reshape(-1, 3)).mean()
+    on_handle = box[:, cols.min():cols.max() + 1].reshape(-1, 3)
+    text = _luminance(on_handle).max()   # the digits' pixels where they cross the handle
+    assert text > handle, "no digit drawn across the handle"
     contrast = (text + 0.05) / (handle + 0.05)
     assert contrast >= 4.5, f"digits on the handle: contrast {contrast:.1f}:1"
 
