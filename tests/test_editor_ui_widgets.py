@@ -42,3 +42,45 @@ def test_ctrl_a_and_escape_with_real_x_key_events(display, tmp_path):
                             capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     assert "own loop: 0 failures in 20 Ctrl+A tries and 1 Escape" in result.stdout, result.stdout
+
+
+def test_a_chord_released_in_one_poll_keeps_its_modifier():
+    """keys.KeyEvents: Ctrl down, A down, Ctrl up, A up arriving in one poll (a slow frame) reach
+    imgui as two frames, A pressed with Ctrl held; characters keep their place."""
+    import glfw
+
+    from alight.frontends.editor.keys import KeyEvents
+
+    q = KeyEvents()
+    for key, action in ((glfw.KEY_LEFT_CONTROL, glfw.PRESS), (glfw.KEY_A, glfw.PRESS),
+                        (glfw.KEY_LEFT_CONTROL, glfw.RELEASE), (glfw.KEY_A, glfw.RELEASE)):
+        q.key(key, 0, action, 0)
+    q.char(ord("m"))
+    first, second = q.take_frame(), q.take_frame()
+    assert [e[1:4:2] for e in first] == [(glfw.KEY_LEFT_CONTROL, glfw.PRESS), (glfw.KEY_A, glfw.PRESS)]
+    assert [e[1:4:2] for e in second[:2]] == [(glfw.KEY_LEFT_CONTROL, glfw.RELEASE), (glfw.KEY_A, glfw.RELEASE)]
+    assert second[2] == ("char", ord("m")) and q.take_frame() == []
+    # Typing without a modifier is not held back: a frame takes it all.
+    for c in "ab":
+        q.key(glfw.KEY_A + ord(c) - ord("a"), 0, glfw.PRESS, 0)
+        q.char(ord(c))
+        q.key(glfw.KEY_A + ord(c) - ord("a"), 0, glfw.RELEASE, 0)
+    assert len(q.take_frame()) == 6
+
+
+def test_lights_turn_as_the_environment_does():
+    """env_turn: the environment's rotation is right-handed about +Y (+90 carries +X to -Z,
+    docs/conventions.md); a light turned by the same angle follows a feature of the map."""
+    import numpy as np
+
+    from alight.core.scene import Light
+    from alight.frontends.editor.env_turn import rotate_y, turn_lights, wrapped_delta
+
+    np.testing.assert_allclose(rotate_y((1.0, 0.0, 0.0), 90.0), (0.0, 0.0, -1.0), atol=1e-12)
+    np.testing.assert_allclose(rotate_y((0.0, 2.0, 0.0), 37.0), (0.0, 2.0, 0.0), atol=1e-12)
+    spot = Light("spot", (0.0, 3.0, 3.0), direction=(0.0, -0.7071, -0.7071))
+    turned = turn_lights([spot], 180.0)[0]
+    np.testing.assert_allclose(turned.vector, (0.0, 3.0, -3.0), atol=1e-12)
+    np.testing.assert_allclose(turned.direction, (0.0, -0.7071, 0.7071), atol=1e-12)
+    assert turned.inner_cone_deg == spot.inner_cone_deg and spot.vector == (0.0, 3.0, 3.0)
+    assert wrapped_delta(179.0, -179.0) == 2.0 and wrapped_delta(-179.0, 179.0) == -2.0
