@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Installs what alight needs on a Debian machine, skipping what is already there:
 #   Debian: Mesa's EGL and software OpenGL (headless renders), Xvfb and XTest (the editor's window tests);
+#     xdotool (real X key events for the editor's own loop: tests/test_editor_ui_widgets.py);
 #   Python: a virtual environment in .venv with alight installed from this checkout (not editable).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1 libgl1 xvfb xauth libxtst6)
+packages=(libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1 libgl1 xvfb xauth libxtst6 xdotool)
 missing=()
 for pkg in "${packages[@]}"; do
   dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")

@@ -27,3 +27,47 @@ def translate_key(key: int, name: str | None) -> int:
     if "0" <= c <= "9":
         return KEY_0 + ord(c) - ord("0")
     return _PUNCTUATION.get(c, key)
+
+
+# glfw.h's modifier keys: left/right shift, control, alt, super.
+MODIFIER_KEYS = frozenset((340, 341, 342, 343, 344, 345, 346, 347))
+PRESS, RELEASE = 1, 0
+
+
+class KeyEvents:
+    """glfw's key and character events, handed to imgui a frame's worth at a time.
+
+    imgui applies every queued event of a frame before the widgets read them (its trickling
+    splits a frame only where one key changes twice), so a chord released as a keyboard or
+    xdotool releases it, Ctrl up before A up, reached it as "A down, Ctrl up" in one frame when
+    both came in one poll (a slow frame): the text field saw a plain 'a' and Ctrl+A did nothing
+    (1 in 4 tries under Xvfb). Here a modifier that changes after a key went down in the same
+    frame waits for the next frame, so the key is seen with the modifiers it was pressed with.
+    Events keep their order (characters too, queued beside the keys). Pure: ``deliver`` is
+    handed each event as ``("key", key, scancode, action, mods)`` or ``("char", codepoint)``.
+    """
+
+    def __init__(self):
+        self.pending: list[tuple] = []
+
+    def key(self, key: int, scancode: int, action: int, mods: int) -> None:
+        self.pending.append(("key", key, scancode, action, mods))
+
+    def char(self, codepoint: int) -> None:
+        self.pending.append(("char", codepoint))
+
+    def take_frame(self) -> list[tuple]:
+        """The events for this frame: all pending ones up to a modifier change that follows a
+        non-modifier key's press among them; the rest stay for the next frame."""
+        pressed = False
+        for i, event in enumerate(self.pending):
+            if event[0] != "key":
+                continue
+            if event[1] in MODIFIER_KEYS:
+                if pressed:
+                    taken, self.pending = self.pending[:i], self.pending[i:]
+                    return taken
+            elif event[3] != RELEASE:   # a press or its repeat
+                pressed = True
+        taken, self.pending = self.pending, []
+        return taken

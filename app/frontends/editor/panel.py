@@ -28,6 +28,10 @@ AA_CHOICES = ("none", "msaa")
 # The status row's colours: an error, a success (a message); bright on the dark theme, told apart.
 ERROR_RGBA = (1.0, 0.35, 0.3, 1.0)
 MESSAGE_RGBA = (0.45, 0.85, 0.45, 1.0)
+# A slider's handle: imgui's is 12 px of opaque blue under the value's centred digits, which it
+# hid (0.5 put it over the 5). A thin, half-transparent one leaves the digits readable.
+SLIDER_GRAB_PX, SLIDER_GRAB_ALPHA = 4.0, 0.45
+LONGEST_LIGHT_LABEL = "direction (light travels)"
 _DRAG_MAX = 1e9   # imgui's bound for a drag whose range is open above (an inf bound is not safe in imgui)
 
 
@@ -100,6 +104,18 @@ def layer_row(row: LayerRow, m):
     return dataclasses.replace(m, **{row.field: new}) if changed else m
 
 
+def close_popup_on_escape() -> None:
+    """Escape closes the open popup (the colour picker, a combo's list). imgui does so only with
+    keyboard navigation on (io.ConfigFlags NavEnableKeyboard), which the editor's own loop leaves
+    off: with it, imgui keeps the keyboard after any click in the panel, and F, F12 and Ctrl+Z
+    would reach the view only after a click on it. A modal (a file dialog) stays."""
+    from imgui_bundle import imgui
+
+    every = imgui.PopupFlags_.any_popup_id | imgui.PopupFlags_.any_popup_level
+    if imgui.is_key_pressed(imgui.Key.escape, False) and imgui.is_popup_open("", every):
+        imgui.internal.close_popups_except_modals()
+
+
 class Panel:
     def __init__(self):
         # The F0 table, read once: (name, material, linear F0, sRGB F0).
@@ -132,6 +148,10 @@ class Panel:
         width = win.panel_width()
         imgui.set_next_window_pos(imgui.ImVec2(display.x - width, 0), imgui.Cond_.always)
         imgui.set_next_window_size(imgui.ImVec2(width, display.y), imgui.Cond_.always)
+        imgui.push_style_var(imgui.StyleVar_.grab_min_size, SLIDER_GRAB_PX)
+        for col in (imgui.Col_.slider_grab, imgui.Col_.slider_grab_active):
+            c = imgui.get_style_color_vec4(col)
+            imgui.push_style_color(col, imgui.ImVec4(c.x, c.y, c.z, SLIDER_GRAB_ALPHA))
         # The status row is the window's menu bar: it stays in view whatever the panel's scroll.
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
@@ -158,7 +178,10 @@ class Panel:
             self.chart_view = getattr(self, "chart_view", None) or ChartView()
             self.chart_view.draw()
         imgui.end()
+        imgui.pop_style_color(2)
+        imgui.pop_style_var()
         self.browser.draw()
+        close_popup_on_escape()
 
     @staticmethod
     def _status_line(s, win) -> None:
@@ -459,6 +482,10 @@ class Panel:
         if imgui.is_item_hovered():
             imgui.set_tooltip("or Shift + right drag in the view")
         imgui.text_disabled("turn the environment: Shift + right drag in the view")
+        _, s.lights_follow_env = imgui.checkbox("lights turn with the environment", s.lights_follow_env)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("the drag and the rotation slider turn every light about the vertical axis "
+                              "by the same angle, so a key light stays on the environment's sun")
         _, s.env_intensity = imgui.slider_float("intensity", s.env_intensity, 0.0, 4.0)
         d = s.display
         changed, i = imgui.combo("background", BACKGROUNDS.index(d.background), BACKGROUNDS)
@@ -488,6 +515,8 @@ class Panel:
         from imgui_bundle import imgui
 
         _, s.ibl_enabled = imgui.checkbox("image-based lighting", s.ibl_enabled)
+        # The fields narrower here, so the longest label ends at the panel's edge, not past it.
+        imgui.push_item_width(-(imgui.calc_text_size(LONGEST_LIGHT_LABEL).x + imgui.get_style().item_inner_spacing.x))
         remove = None
         # Lights are replaced, not mutated, so the renderer's "lights changed?" check stays honest.
         for i, light in enumerate(s.lights):
@@ -517,6 +546,7 @@ class Panel:
             if light != s.lights[i]:
                 s.lights[i] = light
             imgui.pop_id()
+        imgui.pop_item_width()
         if remove is not None:
             del s.lights[remove]
         if imgui.button("add point"):
@@ -557,6 +587,9 @@ class Panel:
         from alight.frontends.editor.screenshot import draw_controls
 
         draw_controls(win)   # size, the button (F12), progress
+        from alight.frontends.editor import turntable
+
+        turntable.draw_controls(win)   # frames, file, the button (T), progress
         imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
         imgui.text_disabled("turn the environment: Shift + right drag")
 

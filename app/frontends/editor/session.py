@@ -18,7 +18,8 @@ from alight.paths import config_dir
 
 CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "radius")
 # The view's settings kept beside the material and camera (with the display and the lights).
-SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering")
+SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering",
+                  "lights_follow_env")
 
 
 def session_path() -> Path:
@@ -119,7 +120,8 @@ def _read_settings(data: dict):
               "env_intensity": max(0.0, number(data["env_intensity"], "env_intensity")),
               "ibl_enabled": bool(data["ibl_enabled"]),
               "ibl_model": choice(data["ibl_model"], tuple(IBL_MODELS), "ibl_model"),
-              "multiple_scattering": bool(data["multiple_scattering"])}
+              "multiple_scattering": bool(data["multiple_scattering"]),
+              "lights_follow_env": bool(data.get("lights_follow_env", False))}   # (older sessions lack it)
     d = data["display"]
     display = Display(tonemap=choice(d["tonemap"], TONEMAPS, "tonemap"), exposure=number(d["exposure"], "exposure"),
                       background=choice(d["background"], BACKGROUNDS, "background"),

@@ -54,6 +54,7 @@ class EditorState:
     ibl_model: str = DEFAULT_IBL_MODEL     # app/core/ibl_models.py
     multiple_scattering: bool = False
     env_rotation_deg: float = 0.0
+    lights_follow_env: bool = False   # turning the environment turns the lights with it (env_turn.py)
     env_intensity: float = 1.0
     aa: str = "none"
     render_scale: float = 1.0     # the view's resolution relative to the window

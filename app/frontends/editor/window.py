@@ -92,7 +92,12 @@ class EditorWindow:
             # screenshots and benchmarks keep none, so they never depend on the last session.
             imgui.get_io().set_ini_filename(str(ini_path) if ini_path else "")
             self.impl = GlfwRenderer(self.window)   # input; and the Python renderer, where the native one cannot start
-            glfw.set_key_callback(self.window, self._key_callback)   # keys as the layout labels them (keys.py)
+            # Keys as the layout labels them, a frame's worth at a time (keys.py: KeyEvents).
+            from alight.frontends.editor.keys import KeyEvents
+
+            self.key_events = KeyEvents()
+            glfw.set_key_callback(self.window, self._key_callback)
+            glfw.set_char_callback(self.window, lambda _w, c: self.key_events.char(c))
             glfw.set_cursor_pos_callback(self.window, self._cursor_callback)   # each motion where it was
             self._native_imgui = self._start_native_imgui(imgui)
         from alight.frontends.editor.panel_image import PanelImage
@@ -158,6 +163,11 @@ class EditorWindow:
 
         self.screenshot_size = ScreenshotSize()   # the view's or a chosen size (the panel's)
         self.screenshot_job = None     # the PNG being written, a few strips a frame
+        from alight.frontends.editor.turntable import TurntableSettings
+
+        self.turntable = TurntableSettings()   # the panel's frames and file (turntable.py)
+        self.turntable_request = False  # set by the panel's button or T; started after the frame
+        self.turntable_job = None       # the turntable being drawn, a few frames a frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
         self.adaptive_scale = 0.5      # the adaptive motion scale now (see adapt_motion_scale)
         self._was_moving = False
@@ -199,11 +209,21 @@ class EditorWindow:
             self.state.fail(exc)
 
     def _key_callback(self, window, key, scancode, action, mods) -> None:
-        """glfw's key event to imgui with the key the layout prints (keys.translate_key)."""
+        """glfw's key event, with the key the layout prints (keys.translate_key), queued for
+        imgui (``_deliver_keys``)."""
         from alight.frontends.editor.keys import translate_key
 
         name = self.glfw.get_key_name(key, scancode) if key != self.glfw.KEY_UNKNOWN else None
-        self.impl.keyboard_callback(window, translate_key(key, name), scancode, action, mods)
+        self.key_events.key(translate_key(key, name), scancode, action, mods)
+
+    def _deliver_keys(self) -> None:
+        """This frame's key and character events to imgui, in order (keys.KeyEvents says why
+        not all of them)."""
+        for event in self.key_events.take_frame():
+            if event[0] == "key":
+                self.impl.keyboard_callback(self.window, *event[1:])
+            else:
+                self.impl.char_callback(self.window, event[1])
 
     def _cursor_callback(self, window, x, y) -> None:
         """The motion's own position. (imgui_bundle's Python backend asks glfw for the cursor's
@@ -249,9 +269,22 @@ class EditorWindow:
                 self.frame_mesh()
             if imgui.is_key_pressed(imgui.Key.f12):
                 self.screenshot_request = self.next_screenshot_name()
+            if imgui.is_key_pressed(imgui.Key.t) and not io.key_ctrl:
+                self.turntable_request = True
             if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
                 s = self.state
                 s.look = self.history.redo(s.look) if io.key_shift else self.history.undo(s.look)
+
+    def _turn_lights_with_env(self) -> None:
+        """Where the panel's box says so, the lights turn by the angle the environment turned
+        since the last frame, whatever turned it (the drag, the slider: env_turn.py). The first
+        frame only notes the rotation (a restored session's lights are already where they were)."""
+        from alight.frontends.editor.env_turn import turn_lights, wrapped_delta
+
+        s = self.state
+        last, self._env_rotation_seen = getattr(self, "_env_rotation_seen", None), s.env_rotation_deg
+        if s.lights_follow_env and last is not None and last != s.env_rotation_deg:
+            s.lights = turn_lights(s.lights, wrapped_delta(last, s.env_rotation_deg))
 
     def frame_mesh(self) -> None:
         if self.state.mesh is not None:
@@ -310,6 +343,8 @@ class EditorWindow:
         """GLFW's events; the window's sizes are read again after them (_sizes)."""
         self.glfw.poll_events()
         self._size_cache = None
+        if not self.hosted:
+            self._deliver_keys()
 
     def _sizes(self) -> tuple[tuple[int, int], tuple[int, int]]:
         """(framebuffer size, window size), read once between polls: each is a round trip to the X
@@ -600,6 +635,7 @@ class EditorWindow:
                 self.state.fail(exc)
         if self.screenshot_job is not None:
             self._advance_screenshot()
+        self._advance_turntable()
         now = time.perf_counter()
         if self._last_swap is not None:
             self.frame_times.append(now - self._last_swap)
@@ -627,6 +663,7 @@ class EditorWindow:
 
         draw_overlay(self)   # the compare divider's line and the halves' names, over the view
         self._camera_input()
+        self._turn_lights_with_env()
         self.check_shaders()
         self.check_files()
         self.history.settle(self.state.look, self.imgui.is_any_item_active())
@@ -709,6 +746,44 @@ class EditorWindow:
             if os.path.isfile(job.path) and job.rows == job.height:
                 self.state.error, self.state.message = "", f"wrote {job.path} ({job.width}x{job.height})"
 
+    def start_turntable(self):
+        """The panel's turntable: the view's camera orbiting once about the vertical axis
+        (turntable.py), at the view's size, the scene as it is now."""
+        from alight.frontends.editor.turntable import TurntableJob, orbit_cameras
+
+        self.finish_bake()
+        t = self.turntable
+        cameras = orbit_cameras(self.orbit, t.frames)
+        scene = self.state.scene(cameras[0])
+        channels = 4 if scene.display.background == "transparent" else 3
+        return TurntableJob(self.renderer, lambda camera: dataclasses.replace(scene, camera=camera), cameras,
+                            self.maps(), self.view_area(), self.state.aa, t.path, channels)
+
+    def _advance_turntable(self) -> None:
+        """Start the turntable asked for, or draw a few more of its frames; the panel's message
+        names the files once they are whole."""
+        if self.turntable_request and self.turntable_job is None:
+            self.turntable_request = False
+            try:
+                self.turntable_job = self.start_turntable()
+            except AlightError as exc:
+                self.state.fail(exc)
+        job = self.turntable_job
+        if job is None:
+            return
+        try:
+            done = job.step()
+        except AlightError as exc:
+            self.state.fail(exc)
+            done = True
+        finally:
+            self.ctx.screen.use()
+        if done:
+            self.turntable_job = None
+            if job.rows == job.height:
+                where = job.path if job.webp else f"{job.finals[0]} ... {job.finals[-1].name}"
+                self.state.error, self.state.message = "", f"wrote {where} ({job.done} frames, {job.width}x{job.height})"
+
     def save_view(self, path: str) -> None:
         """``start_save_view`` run to the end now."""
         job = self.start_save_view(path)
@@ -742,6 +817,8 @@ class EditorWindow:
 
     def close(self) -> None:
         self.file_watcher.stop()
+        if self.turntable_job is not None:   # unfinished: its temporary files go
+            self.turntable_job.cancel()
         for targets in self._target_cache.values():
             targets.release()
         self._target_cache.clear()

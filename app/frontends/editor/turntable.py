@@ -1,0 +1,159 @@
+"""Turntables from the editor: N frames of the view with the camera orbiting once about the
+vertical axis through its target, as numbered PNGs or one animated WebP.
+
+Why the camera orbits (and the environment and lights stay put): the mesh is seen from every
+side with the lighting the artist set up, as the orbit (left drag) shows it, and frame 0 is the
+view itself. Turning the environment instead shows a sphere's reflections moving but never the
+mesh's back; the artist gets that one by dragging with Shift.
+
+Drawn off the frame loop as the screenshots are (screenshot.py): a few frames each editor
+frame, so the window keeps drawing and the panel shows the progress. Each frame is the
+screenshot of that camera (the renderer's offline path at the view's size). The files appear
+only whole: the PNGs are written under temporary names and renamed once all are drawn, the
+WebP (lossless, through imageio's Pillow plugin) is written to a temporary file and renamed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from alight.errors import AlightError
+
+SUFFIXES = (".png", ".webp")
+MAX_FRAMES = 720
+STEP_BUDGET_S = 0.05   # time a frame gives the turntable, beyond one of its frames
+FRAME_MS = 40          # the WebP's frame time (25 frames a second)
+
+
+@dataclass
+class TurntableSettings:
+    """The panel's choice: how many frames, and where (``NAME.png``: NAME_000.png ...;
+    ``NAME.webp``: one animated file)."""
+
+    frames: int = 36
+    path: str = "turntable.webp"
+
+
+def frame_paths(path: str, frames: int) -> list[Path]:
+    """The files a turntable writes: ``path`` itself for .webp, else NAME_000.png, NAME_001.png, ..."""
+    p = Path(path)
+    if p.suffix.lower() == ".webp":
+        return [p]
+    digits = max(3, len(str(frames - 1)))
+    return [p.with_name(f"{p.stem}_{i:0{digits}d}{p.suffix}") for i in range(frames)]
+
+
+def orbit_cameras(orbit, frames: int) -> list:
+    """``frames`` cameras one turn about the vertical axis through ``orbit``'s target, the first
+    the orbit's own (alight.core.scene.Camera)."""
+    return [dataclasses.replace(orbit, yaw_deg=orbit.yaw_deg + 360.0 * i / frames).camera()
+            for i in range(frames)]
+
+
+class TurntableJob:
+    """A turntable being drawn a frame or a few at a time (``step``), with ScreenshotJob's
+    interface. ``scene_for(camera)`` gives the scene for a camera (the editor's, at the start).
+    Errors: AlightError of one line naming the file (bad path, frame count, a write that
+    failed); nothing is left under the final names."""
+
+    def __init__(self, renderer, scene_for, cameras, maps, size: tuple[int, int], aa: str, path: str,
+                 channels: int = 3):
+        from alight.exchange.output import check_output_path
+
+        if not 2 <= len(cameras) <= MAX_FRAMES:
+            raise AlightError(f"{path}: a turntable has 2 to {MAX_FRAMES} frames, not {len(cameras)}")
+        out = check_output_path(path, SUFFIXES).resolve()
+        self.path = str(out)
+        self.webp = out.suffix.lower() == ".webp"
+        self.finals = frame_paths(self.path, len(cameras))
+        self.width, self.height = size
+        self._render = lambda camera: renderer.render(scene_for(camera), maps, size[0], size[1], aa=aa,
+                                                      read_linear=False, read_srgb=True).srgb
+        self._cameras = cameras
+        self._temps: list[Path] = []    # the PNGs drawn so far, under temporary names
+        self._frames: list = []         # the WebP's frames drawn so far
+        self.done = 0
+        self.channels = channels   # 4 (RGBA, coverage as alpha) where the background is transparent
+
+    @property
+    def rows(self) -> int:   # (the window's "is it whole" check reads a screenshot job's rows)
+        return self.height if self.done == len(self._cameras) else 0
+
+    def step(self, budget_s: float = STEP_BUDGET_S) -> bool:
+        """Draw frames for about ``budget_s`` (at least one); True once the files are whole."""
+        start = time.perf_counter()
+        try:
+            while self.done < len(self._cameras):
+                pixels = self._render(self._cameras[self.done])
+                self._keep(pixels[:, :, :self.channels])
+                self.done += 1
+                if self.done < len(self._cameras) and time.perf_counter() - start >= budget_s:
+                    return False
+            self._finish()
+            return True
+        except BaseException:
+            self.cancel()
+            raise
+
+    def _keep(self, pixels) -> None:
+        if self.webp:
+            self._frames.append(pixels.copy())
+            return
+        from alight.exchange.output import write_image
+
+        final = self.finals[self.done]
+        temp = final.with_name(f".{final.stem}.tmp{os.getpid()}{final.suffix}")
+        self._temps.append(temp)
+        write_image(temp, pixels, linear=False)
+
+    def _finish(self) -> None:
+        if self.webp:
+            import imageio.v3 as iio
+
+            from alight.exchange.output import atomic_path
+
+            try:
+                with atomic_path(self.path) as temp:
+                    iio.imwrite(temp, self._frames, plugin="pillow", extension=".webp", lossless=True,
+                                duration=FRAME_MS, loop=0)
+            except (OSError, ValueError) as exc:
+                raise AlightError(f"{self.path}: cannot write the turntable ({' '.join(str(exc).split())})") from None
+            self._frames = []
+            return
+        for temp, final in zip(self._temps, self.finals):
+            os.replace(temp, final)
+        self._temps = []
+
+    def cancel(self) -> None:
+        for temp in self._temps:
+            with contextlib.suppress(FileNotFoundError):
+                temp.unlink()
+        self._temps, self._frames = [], []
+
+    def progress(self) -> str:
+        return f"turntable {os.path.basename(self.path)}: frame {self.done} of {len(self._cameras)}"
+
+
+def draw_controls(win) -> None:
+    """The panel's turntable row: frames, the file, the button, the job's progress."""
+    from imgui_bundle import imgui
+
+    t = win.turntable
+    changed, n = imgui.input_int("turntable frames", t.frames)
+    if changed:
+        t.frames = max(2, min(MAX_FRAMES, n))
+    _, t.path = imgui.input_text("turntable file", t.path)
+    if imgui.is_item_hovered():
+        imgui.set_tooltip("NAME.webp: one animated WebP (lossless); NAME.png: NAME_000.png, NAME_001.png, ...; "
+                          "the camera orbits once about the vertical axis, at the view's size")
+    if imgui.button("turntable (T)"):
+        win.turntable_request = True   # the window starts it after the frame
+    job = getattr(win, "turntable_job", None)
+    if job is not None:
+        imgui.same_line()
+        imgui.text_disabled(job.progress())
