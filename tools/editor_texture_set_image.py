@@ -14,7 +14,10 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from imgui_bundle import imgui
 from imgui_bundle.immapp.testing import capture
+
+from alight.frontends.editor.ui_test import editor
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 
@@ -40,6 +43,9 @@ def test_texture_set_picture(ctx):
     ctx.item_click("**/plastic_high")
     ctx.item_input_value("**/texture set", folder)
     ctx.item_click("**/load set")
-    ctx.mouse_move_to_pos(__import__("imgui_bundle").imgui.ImVec2(200, 600))
+    state = editor().state
+    # The picture is of the set loaded: three slots filled and the material named after the folder.
+    assert len(state.texture_maps.paths()) == 3 and state.material.name == "oak_planks", (state.texture_maps, state.error)
+    ctx.mouse_move_to_pos(imgui.ImVec2(200, 600))
     ctx.yield_(3)
     capture(ctx, str(DOCS / "editor_texture_set.png"))
