@@ -110,3 +110,65 @@ def test_the_reference_half_is_for_the_sphere_only():
     assert compare.reference_problem(state) == ""
     state.mesh_spec = "shader_ball"
     assert "sphere" in compare.reference_problem(state)
+
+
+def _material_plane(path):
+    """A glTF plane with a material of its own (red), so the editor ticks 'own materials'."""
+    from tests.gltf_builder import FLOAT, UINT, Gltf, grid_plane
+
+    g = Gltf()
+    pos, nor, _, idx = grid_plane(2, 2.0)
+    mat = g.material(pbrMetallicRoughness={"baseColorFactor": [1.0, 0.0, 0.0, 1.0]})
+    g.mesh([{"attributes": {"POSITION": g.accessor(pos, FLOAT, bounds=True), "NORMAL": g.accessor(nor)},
+             "indices": g.accessor(idx.reshape(-1), UINT), "material": mat}])
+    return g.save(path)
+
+
+def test_a_snapshot_keeps_its_maps_and_a_preset_has_none(tmp_path):
+    """Compare's A is the snapshot with the maps it was taken with: B's later maps (or none) never
+    reach it; a preset for A has no maps; A is drawn on every part even where B shows a mesh
+    file's own materials."""
+    from PIL import Image
+
+    brown = tmp_path / "wood_BaseColor.png"
+    Image.fromarray(np.full((8, 8, 3), (120, 70, 30), np.uint8)).save(brown)
+    state = EditorState()
+    state.material = load_preset("silver")
+    state.open_texture_set([str(brown)])
+    assert state.texture_maps.paths() == {"base_color": str(brown)}
+    state.apply_edit("compare=material")
+    state.apply_edit("compare_a=snapshot")
+    state.apply_preset(load_preset("gold"))      # B: gold, its maps cleared
+    assert state.texture_maps.paths() == {}
+    a = compare.a_scene(state.compare, state.scene(None))
+    assert a.texture_maps.paths() == {"base_color": str(brown)} and str(brown) in a.texture_images
+    state.open_texture_set([str(brown)])         # B has maps again; a preset for A has none
+    state.apply_edit("compare_a=gold")
+    a = compare.a_scene(state.compare, state.scene(None))
+    assert a.material.name == "gold" and a.texture_maps.paths() == {} and not a.use_file_materials
+
+
+def test_a_snapshots_maps_and_the_own_materials_box_survive_the_session(tmp_path, monkeypatch):
+    from PIL import Image
+
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
+    brown = tmp_path / "wood_BaseColor.png"
+    Image.fromarray(np.full((8, 8, 3), (120, 70, 30), np.uint8)).save(brown)
+    plane = _material_plane(tmp_path / "red_plane.gltf")
+    state = EditorState()
+    state.load_mesh(str(plane))
+    assert state.use_file_materials               # the file has a material: ticked on loading
+    state.use_file_materials = False              # the artist unticks it
+    state.open_texture_set([str(brown)])
+    state.apply_edit("compare=material")
+    state.apply_edit("compare_a=snapshot")
+    save_session(state, OrbitCamera())
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert not fresh.use_file_materials           # as left, not as the mesh's default
+    assert fresh.compare.a_texture_maps.paths() == {"base_color": str(brown)}
+    np.testing.assert_array_equal(fresh.compare.a_texture_images[str(brown)],
+                                  state.compare.a_texture_images[str(brown)])

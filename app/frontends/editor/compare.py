@@ -19,10 +19,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from alight.core.ibl_models import IBL_MODELS
 from alight.core.material import Material
+from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 
 MODES = ("off", "material", "ibl model", "reference")
@@ -38,6 +39,10 @@ class CompareState:
     divider: float = 0.5              # where the halves meet, as a fraction of the view's width
     a_material: Material | None = None   # mode 'material': A's material (None: not chosen yet)
     a_label: str = ""                 # what A's material is ("snapshot of gold", "preset copper")
+    # A's maps: a snapshot keeps the maps it was taken with (their decoded images too, so B's
+    # later maps never reach A); a preset has none.
+    a_texture_maps: TextureMaps = field(default_factory=TextureMaps)
+    a_texture_images: dict = field(default_factory=dict)   # path -> decoded image (not saved)
     a_ibl_model: str = "lecture"      # mode 'ibl model': A's model
     reference_scale: float = 0.25     # mode 'reference': the sum's pixels per view pixel, each way
     dragging: bool = False            # the divider is held by the mouse now (not saved)
@@ -52,7 +57,9 @@ def a_scene(compare: CompareState, scene):
     """The Scene half A draws: ``scene`` (B's) with A's material or A's IBL model. (The reference
     half is not a forward render; compare_view.py draws it.)"""
     if compare.mode == "material" and compare.a_material is not None:
-        return dataclasses.replace(scene, material=compare.a_material)
+        # A is a material, shown on every part even where B shows a mesh file's own materials.
+        return dataclasses.replace(scene, material=compare.a_material, texture_maps=compare.a_texture_maps,
+                                   texture_images=compare.a_texture_images, use_file_materials=False)
     if compare.mode == "ibl model":
         return dataclasses.replace(scene, ibl_model=compare.a_ibl_model)
     return scene
@@ -157,6 +164,18 @@ def half_names(state) -> tuple[str, str]:
     return "", ""
 
 
+def take_snapshot(c: CompareState, state) -> None:
+    """A becomes the material being edited as it is now, with its maps (EditorState)."""
+    c.a_material, c.a_label = state.material, f"snapshot of {state.material.name}"
+    c.a_texture_maps, c.a_texture_images = state.texture_maps, dict(state.map_images)
+
+
+def set_preset(c: CompareState, material: Material, name: str) -> None:
+    """A becomes a preset: its factors, no maps (as a preset click does to B)."""
+    c.a_material, c.a_label = material, f"preset {name}"
+    c.a_texture_maps, c.a_texture_images = TextureMaps(), {}
+
+
 # --- the panel's section ----------------------------------------------------------------------
 
 def draw_section(win, presets) -> None:
@@ -170,7 +189,7 @@ def draw_section(win, presets) -> None:
         c.mode = MODES[i]
     if c.mode == "material":
         if imgui.button("snapshot A"):
-            c.a_material, c.a_label = s.material, f"snapshot of {s.material.name}"
+            take_snapshot(c, s)
         if imgui.is_item_hovered():
             imgui.set_tooltip("A keeps the material as it is now; edit on, B follows the panel")
         names = [name for name, *_ in presets]
@@ -179,7 +198,7 @@ def draw_section(win, presets) -> None:
         imgui.set_next_item_width(-80)
         changed, k = imgui.combo("A preset", current, names)
         if changed and 0 <= k < len(presets):
-            c.a_material, c.a_label = presets[k][1], f"preset {presets[k][0]}"
+            set_preset(c, presets[k][1], presets[k][0])
         if c.a_material is None:
             imgui.text_disabled("A: press 'snapshot A' or pick a preset")
     elif c.mode == "ibl model":
@@ -219,7 +238,8 @@ def draw_section(win, presets) -> None:
 def to_dict(c: CompareState) -> dict:
     return {"mode": c.mode, "divider": c.divider, "a_label": c.a_label, "a_ibl_model": c.a_ibl_model,
             "reference_scale": c.reference_scale,
-            "a_material": None if c.a_material is None else c.a_material.to_dict()}
+            "a_material": None if c.a_material is None else c.a_material.to_dict(),
+            "a_texture_maps": c.a_texture_maps.to_dict()}
 
 
 def from_dict(data, source: str) -> CompareState:
@@ -239,13 +259,30 @@ def from_dict(data, source: str) -> CompareState:
     scale = data.get("reference_scale", 0.25)
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0.0 < scale <= 1.0:
         raise AlightError(f"{source}: compare: reference_scale is not a number in (0, 1]")
+    maps = TextureMaps.from_dict(data.get("a_texture_maps") or {}, f"{source}: compare: a_texture_maps")
     return CompareState(mode=mode, divider=min(1.0, max(0.0, float(divider))), a_ibl_model=model,
                         reference_scale=float(scale),
                         a_material=None if material is None else material_from_dict(material, f"{source}: compare"),
-                        a_label=str(data.get("a_label", "")))
+                        a_label=str(data.get("a_label", "")), a_texture_maps=maps,
+                        a_texture_images=_map_images(maps, source))
 
 
-def apply_edit(c: CompareState, material: Material, key: str, value: str) -> None:
+def _map_images(maps: TextureMaps, source: str) -> dict:
+    """A restored snapshot's images, decoded again; a file gone since is one warning and A
+    goes without that map."""
+    from alight.errors import warn
+    from alight.exchange.texture_sets import load_slot_image
+
+    images = {}
+    for slot, path in maps.paths().items():
+        try:
+            images[path] = load_slot_image(maps, slot)
+        except AlightError as exc:
+            warn(f"{source}: compare: A's {slot} map: {exc}; A is drawn without it")
+    return images
+
+
+def apply_edit(c: CompareState, state, key: str, value: str) -> None:
     """``--script``: compare=MODE, compare_divider=F, compare_a=snapshot|PRESET, compare_a_ibl_model=NAME."""
     from alight.exchange.presets import load_preset
 
@@ -260,9 +297,9 @@ def apply_edit(c: CompareState, material: Material, key: str, value: str) -> Non
         c.divider = min(1.0, max(0.0, x))
     elif key == "compare_a":
         if value == "snapshot":
-            c.a_material, c.a_label = material, f"snapshot of {material.name}"
+            take_snapshot(c, state)
         else:
-            c.a_material, c.a_label = load_preset(value), f"preset {value}"
+            set_preset(c, load_preset(value), value)
     elif key == "compare_reference_scale":
         x = float(value)
         if not 0.0 < x <= 1.0:

@@ -31,6 +31,7 @@ def save_session(state, orbit) -> None:
             "texture_maps": state.texture_maps.to_dict(),
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
+                         "use_file_materials": state.use_file_materials,
                          "display": dataclasses.asdict(state.display),
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
             "compare": compare.to_dict(state.compare)}
@@ -77,6 +78,11 @@ def restore_session(state, orbit) -> str:
             for k, v in values.items():
                 setattr(state, k, v)
             state.display, state.lights = display, lights
+            # The mesh file's own materials, as the artist left the box (loading the mesh ticked it
+            # wherever the file has materials); older sessions lack it: the mesh's default stays.
+            own = settings.get("use_file_materials")
+            if isinstance(own, bool) and state.mesh is not None:
+                state.use_file_materials = own and any(part.material is not None for part in state.mesh.parts)
     if "compare" in data:   # the split view: on or off, the divider, what A is
         try:
             state.compare = compare.from_dict(data["compare"], str(path))

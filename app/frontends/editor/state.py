@@ -366,7 +366,7 @@ class EditorState:
             elif key.startswith("compare"):   # compare=MODE, compare_divider=, compare_a=, ... (compare.py)
                 from alight.frontends.editor.compare import apply_edit
 
-                apply_edit(self.compare, self.material, key, value)
+                apply_edit(self.compare, self, key, value)
             elif key == "debug_mip":
                 self.debug_mip = max(0.0, _finite(value, edit))
             else:

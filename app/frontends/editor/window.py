@@ -582,7 +582,9 @@ class EditorWindow:
                 (key or self._view_key(scene, maps, size), targets)
             self.redraws += 1
             if scene.texture_maps != self._drawn_maps:   # uploaded maps no slot uses any more
-                self.renderer.forget_map_textures(set(scene.texture_maps.paths().values()))
+                # (compare's A keeps the maps of its snapshot)
+                keep = set(scene.texture_maps.paths().values()) | set(self.state.compare.a_texture_maps.paths().values())
+                self.renderer.forget_map_textures(keep)
                 self._drawn_maps = scene.texture_maps
         if compare:
             targets = self.compare_view.compose(self, scene, maps, targets, moving, finish=full)
