@@ -255,6 +255,88 @@ def test_a_texture_set_names_the_material_undoably(ctx):
     assert s.texture_maps.paths() and s.material.name == "my oak", (s.material.name, s.error)
 
 
+def test_revert_after_an_undone_preset_click_is_the_look_before_it(ctx):
+    """Silver clicked over a wood set, then Ctrl+Z: 'revert' after a tweak returns to the wood
+    look (factors and maps), not to the silver the artist took back; after a preset click it
+    returns to the preset, without maps."""
+    s = editor().state
+    files = wood_set(os.path.join(OUT, "wood_revert"))
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/texture set", os.path.dirname(files["base_color"]))
+    ctx.item_click("**/load set")
+    start = s.look
+    assert start[1].paths() == files, (start, s.error)
+    wood = ball(view(ctx))
+    ctx.item_click("**/silver")
+    undo(ctx)
+    assert s.look == start, s.look
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/roughness", 0.4)
+    ctx.item_click("**/revert")
+    assert s.look == start, s.look
+    np.testing.assert_allclose(ball(view(ctx)), wood, atol=1)
+    ctx.item_click("**/silver")
+    silver = s.look
+    ctx.item_input_value("**/roughness", 0.7)
+    ctx.item_click("**/revert")
+    assert s.look == silver and not s.texture_maps.paths(), s.look
+
+
+def _left_of_divider(image: np.ndarray, divider: float) -> np.ndarray:
+    from alight.frontends.editor.compare_view import split_column
+
+    return image[:, :split_column(divider, image.shape[1])].astype(np.int32)
+
+
+def test_compare_a_keeps_the_maps_of_its_snapshot(ctx):
+    """'snapshot A' over a wood set keeps the wood maps in A while B changes (a preset click on
+    B cleared them from A too); 'A preset' is the preset's factors without maps, even while B
+    has maps."""
+    s = editor().state
+    folder = os.path.dirname(wood_set(os.path.join(OUT, "wood_compare"))["base_color"])
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    gold = view(ctx)
+    ctx.item_click("**/silver")
+    ctx.item_input_value("**/texture set", folder)
+    ctx.item_click("**/load set")
+    wood = view(ctx)
+    ctx.item_open("**/Compare")
+    ctx.combo_click("compare/material")
+    ctx.item_click("**/snapshot A")
+    ctx.item_click("**/silver")             # B: plain silver; A stays the wood snapshot
+    assert not s.texture_maps.paths()
+    divider = s.compare.divider
+    a = _left_of_divider(view(ctx), divider)
+    assert np.abs(a - _left_of_divider(wood, divider)).max() <= 1, "A lost its snapshot's maps"
+    ctx.item_input_value("**/texture set", folder)   # B with maps; A a preset
+    ctx.item_click("**/load set")
+    ctx.combo_click("A preset/gold")
+    a = _left_of_divider(view(ctx), divider)
+    assert np.abs(a - _left_of_divider(gold, divider)).max() <= 1, "A preset gold drew B's maps"
+    ctx.combo_click("compare/off")
+    ctx.item_close("**/Compare")
+
+
+def test_the_library_name_follows_the_material(ctx):
+    """A texture set names the material, and 'save to library' names the entry after it
+    (the field showed 'my_material'); a name typed in the field wins."""
+    s = editor().state
+    folder = os.path.join(OUT, "walnut")
+    wood_set(folder, "walnut")
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_input_value("**/texture set", folder)
+    ctx.item_click("**/load set")
+    assert s.material.name == "walnut", s.material.name
+    ctx.item_click("**/save to library")
+    assert s.message.endswith("walnut.glb"), (s.message, s.error)
+    ctx.item_input_value("**/library name", "walnut dark")
+    ctx.item_click("**/save to library")
+    assert s.message.endswith("walnut_dark.glb"), (s.message, s.error)
+
+
 def test_the_texture_set_row_takes_a_folder_or_several_files(ctx):
     """The 'texture set' row: a folder, or files separated by ';', each to its slot by its name
     (not all to the armed slot); files with no folder of their own name give their common stem.

@@ -343,9 +343,18 @@ def _own_loop_checks(tries: int = 20) -> int:
     window_id = subprocess.run(["xdotool", "search", "--onlyvisible", "--pid", str(os.getpid())], capture_output=True,
                                text=True, check=True).stdout.split()[0]
 
+    last_click = [0.0]
+
     def click_at(x, y):
-        """The pointer to the window's (x, y), then a left click."""
+        """The pointer to the window's (x, y), then a left click: a single one. (A click within
+        imgui's double-click time of the last, at the same place, selects a word, and the
+        highlight is there before Ctrl+A: on a quiet machine the tries came that fast.)"""
+        import time
+
+        while time.monotonic() - last_click[0] < 1.5 * imgui.get_io().mouse_double_click_time:
+            win.frame()
         xdo("mousemove", "--window", window_id, str(int(x)), str(int(y)), "click", "1")
+        last_click[0] = time.monotonic()
 
     failures = 0
     panel = win.panel.library

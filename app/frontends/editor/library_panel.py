@@ -17,7 +17,9 @@ _NO_MAPS = TextureMaps()
 
 class LibraryPanel:
     def __init__(self):
-        self.name = "my_material"          # the 'library name' field
+        # The 'library name' field: '' follows the material's name (a preset's, a texture set's,
+        # one typed in 'name'); a name typed here is kept until the entry is saved.
+        self.name = ""
         self.entries: list[library.Entry] = []
         self.problems: list[str] = []
         self._stamp = None
@@ -71,9 +73,11 @@ class LibraryPanel:
             imgui.text_disabled("empty: 'save to library' or 'save preset' adds the material")
         for line in self.problems:
             imgui.text_disabled(line)
-        _, self.name = imgui.input_text("library name", self.name)
+        changed, typed = imgui.input_text("library name", self.name or s.material.name)
+        if changed:
+            self.name = typed
         if imgui.button("save to library"):
-            self.save(s, self.name)
+            self.save(s, self.name or s.material.name)
         imgui.tree_pop()
 
     def apply_click(self, s) -> None:
@@ -95,6 +99,7 @@ class LibraryPanel:
         except AlightError as exc:
             s.fail(exc)
             return
-        s.saved_material = s.material
+        s.mark_saved()
+        self.name = ""
         s.error, s.message = "", f"saved to the library: {path}"
         self.rescan(force=True)

@@ -201,7 +201,14 @@ class Panel:
         elif s.message:
             imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), s.message)
         if (s.error or s.message) and imgui.is_item_hovered():
-            imgui.set_tooltip(s.error or s.message)
+            # The line whole, wrapped to the window's width (a set's assignment outgrew it).
+            width = imgui.get_io().display_size.x
+            imgui.set_next_window_pos(imgui.ImVec2(0.0, imgui.get_item_rect_max().y + 2.0))
+            imgui.begin_tooltip()
+            imgui.push_text_wrap_pos(width - 2.0 * imgui.get_style().window_padding.x)
+            imgui.text_unformatted(s.error or s.message)
+            imgui.pop_text_wrap_pos()
+            imgui.end_tooltip()
         imgui.end_menu_bar()
 
     def _follow_loaded(self, s) -> None:
@@ -291,13 +298,13 @@ class Panel:
         imgui.text_disabled(f"F0 = {' '.join(f'{x:.3f}' for x in s.material.f0())}   "
                             f"undo {len(win.history.undo_stack)}  redo {len(win.history.redo_stack)}")
         if imgui.button("revert"):
-            s.material = s.saved_material
+            s.revert()
         imgui.same_line()
         if imgui.button("undo"):
-            s.look = win.history.undo(s.look)
+            s.step_history(win.history)
         imgui.same_line()
         if imgui.button("redo"):
-            s.look = win.history.redo(s.look)
+            s.step_history(win.history, redo=True)
         _, self.preset_path = imgui.input_text("preset file", self.preset_path)
         if imgui.button("save preset"):
             try:
@@ -381,7 +388,7 @@ class Panel:
         imgui.same_line()
         if imgui.button("browse set"):   # any image of the set: its folder is loaded
             self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,
-                              lambda path: self._load_texture_set(s, os.path.dirname(path)))
+                              lambda path: self._browsed_set(s, os.path.dirname(path)))
         imgui.same_line()
         imgui.text_disabled("a folder, files split by ';', or a drop")
         for slot in MAP_SLOTS:
@@ -419,6 +426,11 @@ class Panel:
         changed, v = imgui.drag_float2("UV offset", list(maps.uv_offset), 0.005, -8.0, 8.0)
         if changed:
             s.texture_maps = dataclasses.replace(s.texture_maps, uv_offset=tuple(v))
+
+    def _browsed_set(self, s, folder: str) -> None:
+        """The folder of the map picked in 'browse set': loaded, and shown in the field."""
+        self.set_path = folder
+        self._load_texture_set(s, folder)
 
     @staticmethod
     def _load_texture_set(s, text: str) -> None:

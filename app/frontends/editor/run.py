@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 
@@ -22,7 +23,7 @@ def build_state(args) -> EditorState:
                         adaptive_motion=args.motion_scale is None)
     material, _, maps = build_look(args)
     state.material = state.saved_material = material
-    _start_maps(state, maps)
+    _start_maps(state, maps, args)
     state.load_mesh(args.mesh)
     state.load_env(args.env)
     if args.no_ibl:
@@ -103,13 +104,19 @@ def _imgui_ini():
     return config_dir() / "imgui.ini"
 
 
-def _start_maps(state: EditorState, maps) -> None:
-    """--texture-set, --map and a .gltf --preset's maps, as 'alight render' draws them."""
+def _start_maps(state: EditorState, maps, args) -> None:
+    """--texture-set, --map and a .gltf --preset's maps, as 'alight render' draws them; a
+    --texture-set without --preset names the material after the set, as the panel's row does."""
     if maps is not None:
-        from alight.exchange.texture_sets import load_map_images
+        from alight.exchange.texture_sets import load_map_images, set_name
 
         state.map_images = load_map_images(maps)
-        state.texture_maps = maps
+        state.texture_maps = state.saved_texture_maps = maps
+        texture_set = getattr(args, "texture_set", None)
+        if texture_set and args.preset is None:
+            name = set_name([], texture_set)
+            if name and name.isprintable():
+                state.material = state.saved_material = dataclasses.replace(state.material, name=name)
 
 
 def _no_scene_options(args) -> bool:

@@ -46,7 +46,8 @@ class EditorState:
     material: Material = field(default_factory=Material)
     texture_maps: TextureMaps = field(default_factory=TextureMaps)   # user-loaded maps, UV tiling
     armed_slot: str = "base_color"     # the texture slot a dropped image file fills
-    saved_material: Material = field(default_factory=Material)   # what 'revert' goes back to
+    saved_material: Material = field(default_factory=Material)   # what 'revert' goes back to ...
+    saved_texture_maps: TextureMaps = field(default_factory=TextureMaps)   # ... with these maps
     quality: str = "medium"
     display: Display = field(default_factory=Display)
     lights: list[Light] = field(default_factory=default_lights)
@@ -208,12 +209,36 @@ class EditorState:
                     self.texture_maps = self.texture_maps.with_slot(slot, "")
                     self.fail(exc)
 
+    def mark_saved(self) -> None:
+        """The look now is what 'revert' goes back to (after a save)."""
+        self.saved_material, self.saved_texture_maps = self.material, self.texture_maps
+
+    def revert(self) -> None:
+        """Back to the material and maps last applied, loaded or saved (a preset, a library
+        entry, a file); an undo step like any edit."""
+        self.material, self.texture_maps = self.saved_material, self.saved_texture_maps
+        self.sync_map_images()
+        self.error, self.message = "", f"reverted to {self.material.name}"
+
+    def step_history(self, history, redo: bool = False) -> None:
+        """Undo (or redo) one step. Stepping away from the look 'revert' goes back to takes
+        'revert' along: after a preset click is undone, 'revert' returns to the look before the
+        click, not to the preset the artist took back."""
+        leaving_saved = self.look == (self.saved_material, self.saved_texture_maps)
+        self.look = history.redo(self.look) if redo else history.undo(self.look)
+        self.sync_map_images()
+        if leaving_saved:
+            self.saved_material, self.saved_texture_maps = self.look
+
     def apply_preset(self, preset: Material) -> None:
         """A preset of the F0 table: a whole material, so its factors and no maps (maps loaded
         before would multiply its factors); 'revert' goes back to it. One undo step (History)."""
         self.material = self.saved_material = preset
-        self.texture_maps = TextureMaps()
+        self.texture_maps = self.saved_texture_maps = TextureMaps()
         self.error, self.message = "", f"applied {preset.name}"
+        if self.use_file_materials:   # a click on a preset is to see it: on every part of the mesh
+            self.use_file_materials = False
+            self.message += " (the mesh file's own materials unticked)"
 
     def load_material(self, name_or_path: str) -> None:
         """A preset (.json: factors; .gltf/.glb: factors and maps, alight.exchange.material_files)."""
@@ -224,7 +249,7 @@ class EditorState:
         images = load_map_images(maps)   # read first: a bad map changes nothing
         self._say(warnings)
         self.material = self.saved_material = m
-        self.texture_maps = dataclasses.replace(maps)
+        self.texture_maps = self.saved_texture_maps = dataclasses.replace(maps)
         self.map_images = images
 
     def save_material(self, path: str) -> None:
@@ -234,7 +259,7 @@ class EditorState:
         from alight.exchange.material_files import is_gltf, save_material_file
 
         save_material_file(self.material, path, self.texture_maps, mesh=self.mesh if is_gltf(path) else None)
-        self.saved_material = self.material
+        self.mark_saved()
 
     def export_gltf(self, path: str) -> None:
         """The edited material, its maps and the mesh (UVs, tangents) as .gltf or .glb

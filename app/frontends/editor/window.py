@@ -273,7 +273,7 @@ class EditorWindow:
                 self.turntable_request = True
             if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
                 s = self.state
-                s.look = self.history.redo(s.look) if io.key_shift else self.history.undo(s.look)
+                s.step_history(self.history, redo=io.key_shift)
 
     def _turn_lights_with_env(self) -> None:
         """Where the panel's box says so, the lights turn by the angle the environment turned
