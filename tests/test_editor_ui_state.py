@@ -47,3 +47,24 @@ def test_a_texture_sets_name():
     assert set_name(["/m/RockBaseColor.png", "/m/RockNormal.png"]) == "Rock"
     assert set_name(["/sets/tiles/basecolor.png", "/sets/tiles/normal.png"]) == "tiles"   # no stem: the folder
     assert set_name(["/a/x_BaseColor.png", "/b/y_Normal.png"]) == ""   # neither
+
+
+def test_a_texture_set_on_the_command_line_names_the_material(display, tmp_path):
+    """`alight edit --texture-set DIR` names the material after the folder, as the panel's row
+    does (it was 'default'); with --preset the preset's name stays."""
+    import numpy as np
+    from PIL import Image
+
+    folder = tmp_path / "walnut"
+    folder.mkdir()
+    Image.fromarray(np.full((8, 8, 3), (120, 70, 30), np.uint8)).save(folder / "walnut_BaseColor.png")
+    check = tmp_path / "named.py"
+    check.write_text("from alight.frontends.editor.ui_test import editor\n"
+                     "def test_named(ctx):\n"
+                     "    s = editor().state\n"
+                     "    assert s.texture_maps.paths(), s.texture_maps\n"
+                     "    print('NAME=' + s.material.name)\n")
+    for extra, name in (((), "walnut"), (("--preset", "gold"), "gold")):
+        result = ui_test(tmp_path, check, "--new", "--texture-set", str(folder), *extra)
+        assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+        assert f"NAME={name}" in result.stdout, result.stdout
