@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import sys
+import time
 
 import numpy as np
 
@@ -302,7 +303,7 @@ def _own_loop_checks(tries: int = 20) -> int:
 
     rects = {}
     # Where the widgets are, read as imgui lays them out (an observer: the call is passed on as is).
-    for name in ("input_text", "color_edit3"):
+    for name in ("input_text", "color_edit3", "slider_float"):
         def spy(label, *args, _f=getattr(imgui, name), **kwargs):
             result = _f(label, *args, **kwargs)
             rects[label] = (imgui.get_item_rect_min().x, imgui.get_item_rect_min().y,
@@ -389,8 +390,25 @@ def _own_loop_checks(tries: int = 20) -> int:
     elif imgui.is_popup_open("", every):
         failures += 1
         print("escape: the colour picker is still open")
+    # A fast Ctrl+click on the roughness slider (Ctrl down, click, Ctrl up in one xdotool call):
+    # the slider opens for typing and keeps its value; a plain click would set it where it landed.
+    import dataclasses
+
+    for i in range(6):
+        state.material = dataclasses.replace(state.material, roughness=0.3)   # (the scene set up)
+        win.frame()
+        rx0, ry0, rx1, ry1 = rects["roughness"]
+        while time.monotonic() - last_click[0] < 1.5 * imgui.get_io().mouse_double_click_time:
+            win.frame()
+        xdo("mousemove", "--window", window_id, str(int(rx0 + 0.85 * (rx1 - rx0))), str(int((ry0 + ry1) / 2)),
+            "keydown", "ctrl", "click", "1", "keyup", "ctrl")
+        last_click[0] = time.monotonic()
+        if abs(state.material.roughness - 0.3) > 1e-6:
+            failures += 1
+            print(f"ctrl+click try {i}: the slider took the click (roughness {state.material.roughness:.3f})")
+        xdo("key", "Escape")
     win.close()
-    print(f"own loop: {failures} failures in {tries} Ctrl+A tries and 1 Escape")
+    print(f"own loop: {failures} failures in {tries} Ctrl+A tries, 1 Escape and 6 Ctrl+clicks")
     return failures
 
 

@@ -99,6 +99,9 @@ class EditorWindow:
             glfw.set_key_callback(self.window, self._key_callback)
             glfw.set_char_callback(self.window, lambda _w, c: self.key_events.char(c))
             glfw.set_cursor_pos_callback(self.window, self._cursor_callback)   # each motion where it was
+            # Buttons and the wheel through the same queue, so a Ctrl+click keeps its order.
+            glfw.set_mouse_button_callback(self.window, lambda _w, b, a, m: self.key_events.button(b, a, m))
+            glfw.set_scroll_callback(self.window, lambda _w, dx, dy: self.key_events.scroll(dx, dy))
             self._native_imgui = self._start_native_imgui(imgui)
         from alight.frontends.editor.panel_image import PanelImage
 
@@ -219,20 +222,28 @@ class EditorWindow:
     def _deliver_keys(self) -> None:
         """This frame's key and character events to imgui, in order (keys.KeyEvents says why
         not all of them)."""
+        io = self.imgui.get_io()
         for event in self.key_events.take_frame():
-            if event[0] == "key":
+            kind = event[0]
+            if kind == "key":
                 self.impl.keyboard_callback(self.window, *event[1:])
-            else:
+            elif kind == "char":
                 self.impl.char_callback(self.window, event[1])
+            elif kind == "button":
+                self.impl.mouse_button_callback(self.window, *event[1:])
+            elif kind == "cursor":
+                io.add_mouse_pos_event(float(event[1]), float(event[2]))
+            else:
+                self.impl.scroll_callback(self.window, *event[1:])
 
     def _cursor_callback(self, window, x, y) -> None:
         """The motion's own position. (imgui_bundle's Python backend asks glfw for the cursor's
         position now: after a long frame every queued motion then lands where the mouse is at
         the end, the press and the release at one point, and the drag between them is lost.)"""
         if self.glfw.get_window_attrib(window, self.glfw.FOCUSED):
-            self.imgui.get_io().add_mouse_pos_event(float(x), float(y))
+            self.key_events.cursor(x, y)
         else:
-            self.imgui.get_io().add_mouse_pos_event(-1.0, -1.0)
+            self.key_events.cursor(-1.0, -1.0)
 
     def _released_drag(self, button) -> bool:
         """A drag whose last motion and release came in one frame, as the events queued during a
