@@ -457,18 +457,27 @@ class _Occluders:
         chunk = max(1, 262_144 // rays)
         for s0 in range(0, count, chunk):
             n = normals[s0:s0 + chunk]
-            t, b = _frame(n)
-            angle = rng.uniform(0.0, 2.0 * math.pi, len(n))
-            c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-            t, b = c * t + s * b, c * b - s * t
-            frame = np.stack([t, b, n], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
-            d = np.ascontiguousarray((local @ frame).reshape(-1, 3))         # (C * R, 3)
-            o = np.ascontiguousarray(np.repeat(origins[s0:s0 + chunk], rays, axis=0))
+            d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
             prim, u, v = _cast(self.scene, o, d, self.normals, eps)
             hit[s0:s0 + chunk] = prim.reshape(len(n), rays)
             uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
             open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
         return hit, uv, open_sum
+
+
+def _chunk_rays(local: np.ndarray, origins: np.ndarray, normals: np.ndarray, rng) -> tuple[np.ndarray, np.ndarray]:
+    """The rays of a chunk of origins: ``local`` (R, 3) directions about +Z turned onto each normal
+    in a frame spun by a random angle per origin (one ``rng.uniform`` draw of len(origins): the same
+    sequence wherever it is called, so a bake stays reproducible), as (C * R, 3) directions and
+    (C * R, 3) origins."""
+    t, b = _frame(normals)
+    angle = rng.uniform(0.0, 2.0 * math.pi, len(normals))
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    t, b = c * t + s * b, c * b - s * t
+    frame = np.stack([t, b, normals], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
+    d = np.ascontiguousarray((local @ frame).reshape(-1, 3))
+    o = np.ascontiguousarray(np.repeat(origins, len(local), axis=0))
+    return d, o
 
 
 def _free_rays(occluders, see_through, through_of_triangle, origins, normals, rays: int, rng, eps: float):
@@ -486,13 +495,7 @@ def _free_rays(occluders, see_through, through_of_triangle, origins, normals, ra
     chunk = max(1, 262_144 // rays)
     for s0 in range(0, count, chunk):
         n = normals[s0:s0 + chunk]
-        t, b = _frame(n)
-        angle = rng.uniform(0.0, 2.0 * math.pi, len(n))
-        c, s_ = np.cos(angle)[:, None], np.sin(angle)[:, None]
-        t, b = c * t + s_ * b, c * b - s_ * t
-        frame = np.stack([t, b, n], axis=1).astype(np.float32)
-        d = np.ascontiguousarray((local @ frame).reshape(-1, 3))
-        o = np.ascontiguousarray(np.repeat(origins[s0:s0 + chunk], rays, axis=0))
+        d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
         w = np.ones(len(d))
         if occluders is not None:
             prim, _, _ = _cast(occluders.scene, o, d, occluders.normals, eps)

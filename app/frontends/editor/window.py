@@ -744,17 +744,21 @@ class EditorWindow:
             return WholeScreenshotJob(pixels, size, path)
         return ScreenshotJob(self.renderer, scene, self.maps(), size, self.state.aa, path)
 
+    def _step_job(self, job) -> bool:
+        """One step of a screenshot or turntable job; True once it is done or failed (the error
+        in the panel). The jobs draw into their own targets: the window's framebuffer is bound again."""
+        try:
+            return job.step()
+        except AlightError as exc:
+            self.state.fail(exc)
+            return True
+        finally:
+            self.ctx.screen.use()
+
     def _advance_screenshot(self) -> None:
         """A few strips of the screenshot being written; the panel's message says when it is."""
         job = self.screenshot_job
-        try:
-            done = job.step()
-        except AlightError as exc:
-            self.state.fail(exc)
-            done = True
-        finally:
-            self.ctx.screen.use()
-        if done:
+        if self._step_job(job):
             self.screenshot_job = None
             if os.path.isfile(job.path) and job.rows == job.height:
                 self.state.error, self.state.message = "", f"wrote {job.path} ({job.width}x{job.height})"
@@ -784,14 +788,7 @@ class EditorWindow:
         job = self.turntable_job
         if job is None:
             return
-        try:
-            done = job.step()
-        except AlightError as exc:
-            self.state.fail(exc)
-            done = True
-        finally:
-            self.ctx.screen.use()
-        if done:
+        if self._step_job(job):
             self.turntable_job = None
             if job.rows == job.height:
                 where = job.path if job.webp else f"{job.finals[0]} ... {job.finals[-1].name}"
