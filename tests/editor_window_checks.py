@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import time
 from pathlib import Path
 
 import numpy as np
@@ -425,10 +424,8 @@ def test_kept_panel_pixels_are_the_panel_drawn_anew(window):
     window.finish_bake()
     # A thumbnail that arrives changes the panel's draw data between the frames compared: let
     # them all arrive first (they render in a child process, seconds under load).
-    deadline = time.monotonic() + 120
     window.frame()
-    while window.thumbnails.pending() and time.monotonic() < deadline:
-        window.frame()
+    window.wait_for_thumbnails(120.0)
     assert not window.thumbnails.pending(), f"{window.thumbnails.pending()} thumbnails still pending after 120 s"
     for _ in range(20):     # (the first frames rasterise glyphs into imgui's atlas: texture updates)
         window.frame()

@@ -169,6 +169,9 @@ def test_a_snapshots_maps_and_the_own_materials_box_survive_the_session(tmp_path
     fresh = EditorState()
     assert restore_session(fresh, OrbitCamera()) == ""
     assert not fresh.use_file_materials           # as left, not as the mesh's default
+    fresh.texture_maps = dataclasses.replace(fresh.texture_maps, base_color="")
+    fresh.revert()                                # back to the restored material with its maps
+    assert fresh.texture_maps.paths() == {"base_color": str(brown)}
     assert fresh.compare.a_texture_maps.paths() == {"base_color": str(brown)}
     np.testing.assert_array_equal(fresh.compare.a_texture_images[str(brown)],
                                   state.compare.a_texture_images[str(brown)])

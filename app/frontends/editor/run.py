@@ -22,8 +22,9 @@ def build_state(args) -> EditorState:
     state = EditorState(quality=args.quality, aa=args.aa, motion_scale=args.motion_scale or 0.5,
                         adaptive_motion=args.motion_scale is None)
     material, _, maps = build_look(args)
-    state.material = state.saved_material = material
+    state.material = material
     _start_maps(state, maps, args)
+    state.mark_saved()   # what 'revert' goes back to: the material and maps it started with
     state.load_mesh(args.mesh)
     state.load_env(args.env)
     if args.no_ibl:
@@ -111,12 +112,12 @@ def _start_maps(state: EditorState, maps, args) -> None:
         from alight.exchange.texture_sets import load_map_images, set_name
 
         state.map_images = load_map_images(maps)
-        state.texture_maps = state.saved_texture_maps = maps
+        state.texture_maps = maps
         texture_set = getattr(args, "texture_set", None)
         if texture_set and args.preset is None:
             name = set_name([], texture_set)
             if name and name.isprintable():
-                state.material = state.saved_material = dataclasses.replace(state.material, name=name)
+                state.material = dataclasses.replace(state.material, name=name)
 
 
 def _no_scene_options(args) -> bool:
@@ -141,10 +142,7 @@ def _benchmark(win, frames: int) -> int:
     # The presets' thumbnails render in a child process on a first start (cached after): on two
     # cores it takes the frames' CPU. The phases time the editor once it is done; how long it
     # took is printed.
-    start, thumbs = time.perf_counter(), getattr(win, "thumbnails", None)
-    while thumbs is not None and thumbs.pending() and time.perf_counter() - start < 300.0:
-        win.frame()
-    print(f"background work before timing (the presets' thumbnails): {time.perf_counter() - start:.1f} s")
+    print(f"background work before timing (the presets' thumbnails): {win.wait_for_thumbnails(300.0):.1f} s")
     w, h = win.size
     print(f"editor benchmark {w}x{h}, material ball, IBL, {len(state.lights)} lights, panel, aa={state.aa}")
 

@@ -53,7 +53,7 @@ def restore_session(state, orbit) -> str:
     except (OSError, ValueError, KeyError, TypeError, AlightError) as exc:
         return f"{path}: last session not restored ({' '.join(str(exc).split())})"
     warning = ""
-    state.material = state.saved_material = material
+    state.material = material
     # Each map is read again; one that no longer reads (moved, broken since) is left empty.
     state.texture_maps = TextureMaps(uv_scale=maps.uv_scale, uv_offset=maps.uv_offset,
                                      normal_dx=maps.normal_dx, roughness_gloss=maps.roughness_gloss)
@@ -62,6 +62,7 @@ def restore_session(state, orbit) -> str:
             state.set_map(slot, map_path, factor_to_1=False)
         except AlightError as exc:
             warning = str(exc)
+    state.mark_saved()   # 'revert' goes back to the restored material with its maps
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
         if isinstance(spec, str):
             try:

@@ -744,6 +744,14 @@ class EditorWindow:
             return WholeScreenshotJob(pixels, size, path)
         return ScreenshotJob(self.renderer, scene, self.maps(), size, self.state.aa, path)
 
+    def wait_for_thumbnails(self, timeout_s: float) -> float:
+        """Draw frames until every thumbnail asked for has arrived (they render in a child
+        process: seconds on a first start), at most ``timeout_s``; returns the seconds waited."""
+        start = time.perf_counter()
+        while self.thumbnails.pending() and time.perf_counter() - start < timeout_s:
+            self.frame()
+        return time.perf_counter() - start
+
     def _step_job(self, job) -> bool:
         """One step of a screenshot or turntable job; True once it is done or failed (the error
         in the panel). The jobs draw into their own targets: the window's framebuffer is bound again."""
