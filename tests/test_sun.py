@@ -35,6 +35,23 @@ def test_extracts_a_synthetic_sun_and_conserves_power():
     assert without.max() <= 0.5 + 1e-6          # the hole is filled with the surrounding sky
 
 
+@pytest.mark.parametrize("size", [1024, 2048])
+def test_a_flat_disc_as_wide_as_the_cone_is_one_whole_sun(size):
+    """A disc of equal texels exactly SUN_RADIUS_DEG wide (as awkward_8198x4099.exr has): one
+    source, centred on the disc, holding the whole disc at every resolution. Before, the cone
+    started on the first brightest texel, on the disc's edge, and cut the disc into four
+    sources whose share changed with the resolution; a ring starting at the disc's edge counted
+    edge texels as sky."""
+    from alight.ibl.sun import SUN_RADIUS_DEG
+
+    env, d, sun_power = synthetic_sun([0.0, 0.42, -0.9], radiance=500.0, radius_deg=SUN_RADIUS_DEG, size=size)
+    without, suns = extract_suns(env)
+    assert len(suns) == 1
+    assert np.degrees(np.arccos(np.clip(suns[0].direction @ d, -1, 1))) < 180.0 / (size // 2)
+    np.testing.assert_allclose(suns[0].power, sun_power, rtol=5e-3)
+    np.testing.assert_allclose(power(without) + suns[0].power, power(env), rtol=1e-5)
+
+
 @pytest.mark.parametrize("name", ["venice_sunset_1k.hdr", "newport_loft.hdr", "blouberg_sunrise_2_1k.hdr"])
 def test_leaves_broad_light_alone(shared_data, name):
     env = load_environment(str(shared_data / "env" / name))

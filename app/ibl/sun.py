@@ -98,6 +98,39 @@ def _remove(radiance: np.ndarray, lum: np.ndarray, sun: "Sun", r0: int, cone: np
     return sun
 
 
+_FLAT_TOP = 1.0 - 1e-3   # texels this close to the brightest are its equals
+_EDGE_TEXELS = 1.5
+
+
+def _cone_at(band: np.ndarray, band_dirs: np.ndarray, band_omega: np.ndarray, direction: np.ndarray,
+             edge_texels: float, height: int):
+    """The cone of SUN_RADIUS_DEG around ``direction`` within a band of rows of a map ``height``
+    texels tall: (its mask, the excess radiance over the ring's sky inside it, that excess's power
+    (3,), the excess-weighted centroid direction (3,)); None where no ring texel lies in the band
+    to measure the sky.
+
+    The cone and the ring reach ``edge_texels`` further: for a flat-topped source (a hard-edged
+    disc) of radius SUN_RADIUS_DEG, _EDGE_TEXELS, so that it is taken whole at any resolution,
+    with the texels its edge touches (with a cone of
+    exactly its radius, the ring counted the edge texels of awkward_8198x4099.exr's 3-degree disc
+    as sky and 12% of the disc stayed in the sampled map, a different share at each resolution)."""
+    edge = edge_texels * 180.0 / height
+    cos_to = band_dirs @ direction.astype(np.float32)
+    cone = cos_to > np.cos(np.radians(SUN_RADIUS_DEG + edge))
+    ring = ((cos_to <= np.cos(np.radians(SUN_RING_DEG[0] + edge)))
+            & (cos_to > np.cos(np.radians(SUN_RING_DEG[1] + edge))))
+    if not ring.any() or not cone.any():
+        return None
+    fill = (band[ring] * band_omega[ring, None]).sum(axis=0) / max(float(band_omega[ring].sum()), 1e-30)
+    excess = np.maximum(band[cone] - fill, 0.0)
+    power = (excess * band_omega[cone, None]).sum(axis=0)
+    weights = excess.mean(axis=1) * band_omega[cone]
+    centroid = (band_dirs[cone] * weights[:, None]).sum(axis=0, dtype=np.float64)
+    norm = float(np.linalg.norm(centroid))
+    centroid = centroid / norm if norm > 0.0 else direction
+    return cone, excess, power, centroid
+
+
 def _find_sun(radiance: np.ndarray, lum: np.ndarray, total: float):
     """The brightest compact source of ``radiance`` (``lum``: its mean over RGB) as (Sun, its
     first row, its cone mask over the rows from there, the excess radiance inside the cone);
@@ -107,26 +140,31 @@ def _find_sun(radiance: np.ndarray, lum: np.ndarray, total: float):
         return None
     omega_rows = _omega(h, w)
     peak = np.unravel_index(np.argmax(lum), lum.shape)
-    # Only the rows within the ring's reach of the peak can hold the cone or the ring.
-    reach = int(np.ceil(np.radians(SUN_RING_DEG[1]) / np.pi * h)) + 1
+    # The cone is centred on the brightest texels: on the one brightest texel of a real sun, but on
+    # the middle of a flat top (equal texels, as a rendered disc or a clipped photo has), whose
+    # first brightest texel lies on its edge. A cone centred there cut awkward_8198x4099.exr's
+    # disc into four sources that changed with the map's resolution.
+    reach = int(np.ceil(np.radians(SUN_RING_DEG[1] + 2.0 * SUN_RADIUS_DEG) / np.pi * h + 2 * _EDGE_TEXELS)) + 1
     r0, r1 = max(0, peak[0] - reach), min(h, peak[0] + reach + 1)
     band, band_dirs = radiance[r0:r1], _band_directions(r0, r1, h, w)
     band_omega = np.broadcast_to(omega_rows[r0:r1, None], band.shape[:2])
     to_peak = band_dirs[peak[0] - r0, peak[1]]
-    cos_to_peak = band_dirs[..., 0] * to_peak[0] + band_dirs[..., 1] * to_peak[1] + band_dirs[..., 2] * to_peak[2]
-    cone = cos_to_peak > np.cos(np.radians(SUN_RADIUS_DEG))
-    ring = (cos_to_peak <= np.cos(np.radians(SUN_RING_DEG[0]))) & (cos_to_peak > np.cos(np.radians(SUN_RING_DEG[1])))
-    if not ring.any():   # no sky around the peak to measure: nothing is compact at this resolution
+    # a source that fits the cone fits within its diameter of any of its texels
+    near_peak = band_dirs @ to_peak > np.cos(np.radians(2.0 * SUN_RADIUS_DEG))
+    top = near_peak & (lum[r0:r1] >= lum[peak] * _FLAT_TOP)
+    direction = (band_dirs[top] * band_omega[top, None]).sum(axis=0, dtype=np.float64)
+    direction = direction / np.linalg.norm(direction)
+    # A flat top has a hard edge, whose texels are the same disc's partial cover: the cone takes
+    # them too. A real sun's one brightest texel and soft falloff keep the cone as it was.
+    edge_texels = _EDGE_TEXELS if int(top.sum()) > 1 else 0.0
+    found = _cone_at(band, band_dirs, band_omega, direction, edge_texels, h)
+    if found is None:
         return None
-    fill = (band[ring] * band_omega[ring, None]).sum(axis=0) / max(float(band_omega[ring].sum()), 1e-30)
-    excess = np.maximum(band[cone] - fill, 0.0)
-    power = (excess * band_omega[cone, None]).sum(axis=0)
+    cone, excess, power, direction = found
     fraction = float(power.mean()) / total
     if fraction < SUN_MIN_POWER_FRACTION:
         return None
     weights = excess.mean(axis=1) * band_omega[cone]
-    direction = (band_dirs[cone] * weights[:, None]).sum(axis=0)
-    direction = direction / np.linalg.norm(direction)
     angle = np.arccos(np.clip(np.einsum("ij,j->i", band_dirs[cone], direction), -1.0, 1.0))
     spread = float(np.sqrt((weights * angle * angle).sum() / max(float(weights.sum()), 1e-30)))
     sun = Sun(direction.astype(np.float64), power.astype(np.float64), fraction, int(cone.sum()), spread)
