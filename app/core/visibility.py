@@ -142,6 +142,21 @@ def specular_occlusion(bent_dot_r, n_dot_r, visibility, roughness):
     return 1.0 + (so - 1.0) * t * t * (3.0 - 2.0 * t)
 
 
+def cone_roughness(visibility):
+    """The perceptual roughness whose prefiltered lobe is as wide as the visibility cone: the
+    inverse of ``specular_occlusion``'s lobe aperture cos a = 0.1^(alpha^2) (alpha = roughness^2)
+    at the cone's cos a = sqrt(1 - V) (``cone_aperture_cos``); at most 1."""
+    alpha2 = np.log(np.maximum(cone_aperture_cos(visibility), 1e-4)) / math.log(0.1)
+    return np.minimum(np.sqrt(np.sqrt(alpha2)), 1.0)
+
+
+def cone_blend(visibility):
+    """The weight of E(bent)/pi against the prefiltered radiance in the visible cone's mean
+    radiance: smoothstep(0.6, 0.95, V): 1 at an open point (exact there), 0 for a narrow cone."""
+    t = np.clip((np.asarray(visibility, np.float64) - 0.6) / 0.35, 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
 def mapped_bent_normal(n, bent, vertex_normal):
     """The bent normal for a normal-mapped shading normal ``n`` (all (N, 3) unit, one side): the
     bake's lean of the bent normal from the vertex normal, added to n, so an open point keeps n
@@ -190,13 +205,16 @@ def suns_on_occluders(hit_albedo, hit_visibility, first, second):
 
 
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
-                         hit_albedo, so, prefiltered, sun_first=None, sun_second=None):
+                         hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
     and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
     (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
     hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi, plus, with ``sun_first`` and
-    ``sun_second`` (N, 3) (sum_k P_k B1_k and B2_k of bake_sun_bounce), ``suns_on_occluders``."""
+    ``sun_second`` (N, 3) (sum_k P_k B1_k and B2_k of bake_sun_bounce), ``suns_on_occluders``.
+    ``cone_radiance`` (N, 3): the prefiltered radiance at the bent normal and ``cone_roughness``
+    (default: irradiance_bent, as a uniform environment has it); what V multiplies is its mix with
+    E(bent)/pi by ``cone_blend`` (occlusion.glsl's visible_cone_radiance)."""
     v = np.asarray(visibility, np.float64)[..., None]
     albedo = np.minimum(hit_albedo, 1.0)
     hit_visibility = occluder_visibility(bounce_weight, baked_visibility)
@@ -204,7 +222,11 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     if sun_first is not None:
         occluder = occluder + suns_on_occluders(albedo, hit_visibility, sun_first, sun_second)
     so = np.asarray(so, np.float64)[..., None]
-    return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
+    bent = np.asarray(irradiance_bent, np.float64)
+    cone = bent if cone_radiance is None else np.asarray(cone_radiance, np.float64)
+    blend = cone_blend(visibility)[..., None]
+    visible = cone + (bent - cone) * blend
+    return v * visible + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 
 
 # ---- which meshes need it -----------------------------------------------------------------------

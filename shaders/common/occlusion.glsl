@@ -75,6 +75,30 @@ vec3 suns_on_occluders(vec3 hit_albedo, float hit_visibility, vec3 first, vec3 s
            + hit_albedo * hit_albedo * second / max(1.0 - hit_albedo * (1.0 - hit_visibility), vec3(1e-3));
 }
 
+// The roughness whose prefiltered lobe is as wide as the visibility cone: the inverse of
+// specular_occlusion's lobe aperture cos a = 0.1^(alpha^2), alpha = roughness^2, at the cone's
+// cos a = sqrt(1 - V); at most 1.
+float cone_roughness(float visibility) {
+    float alpha2 = log(max(cone_aperture_cos(visibility), 1e-4)) / log(0.1);
+    return min(sqrt(sqrt(alpha2)), 1.0);
+}
+
+// How much of the visible cone's mean radiance is taken as E(bent)/pi: 0 for a narrow cone (the
+// prefiltered lobe), 1 for an open point (the hemisphere's cosine mean, exact there).
+float cone_blend(float visibility) {
+    return smoothstep(0.6, 0.95, visibility);
+}
+
+// The cosine-weighted mean radiance over the visibility cone (V of it is what reaches the
+// point): E(bent)/pi means the whole hemisphere around the bent normal, which under a sky
+// brighter at the horizon than overhead lit a bowl's floor, seeing only the sky overhead, 26-37%
+// too bright (newport_loft, quarry_01, against the path tracer's direct light); the prefiltered
+// radiance at cone_roughness is the mean over a lobe as wide as the cone.
+vec3 visible_cone_radiance(vec3 bent, float visibility) {
+    vec3 cone = prefiltered_radiance_at(bent, cone_roughness(visibility), false);
+    return mix(cone, irradiance_at(bent, false), cone_blend(visibility));
+}
+
 #ifdef HAS_VISIBILITY
 in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
 in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
@@ -121,7 +145,7 @@ float combined_visibility(Surface s, vec3 n) {
 // hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo taken as this surface's
 // (diffuse plus specular: a rough metal's walls light each other too).
 // Plus the suns' light on the occluders (in their own shadows, baked: suns_on_occluders).
-// Diffuse: V E(bent)/pi + (1 - V) times that; specular: the prefiltered radiance for the share of
+// Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
 // the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
 // The compact sources' direct light (with_suns) stays unoccluded here (shadows are theirs).
 void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool with_suns,
@@ -142,7 +166,7 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
         occluder += suns_on_occluders(hit_albedo, hit_visibility, suns_weighted(v_sun_bounce),
                                       suns_weighted(v_sun_bounce2));
     }
-    irradiance = visibility * irradiance_at(bent, false) + (1.0 - visibility) * occluder;
+    irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
     if (with_suns) irradiance += suns_irradiance_over_pi(n);
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
     prefiltered = so * prefiltered + (1.0 - so) * occluder;
