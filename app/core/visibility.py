@@ -33,8 +33,9 @@ anyway, so the picture without occlusion is unchanged. Baked once per mesh conte
 IBL bake (alight.render.visibility_parts.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
-``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility`` and
-``occluded_environment`` here (tests/test_occlusion.py holds them equal).
+``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
+``cone_blend``, ``suns_on_occluders`` and ``occluded_environment`` here (tests/test_occlusion.py,
+test_occlusion_cone.py and test_occlusion_suns.py hold them equal).
 """
 
 from __future__ import annotations
