@@ -1,6 +1,9 @@
 """The visibility bake (app/core/visibility.py) against the path tracer (app/accuracy/path_trace.py):
-the corner, the bowl (app/accuracy/scenes.py) and DamagedHelmet's geometry under the maps of
-../shared/data/env, alight with --occlusion off and on, binned 4x4 linear relMAE
+the corner, the bowl, the product (a capsule on a ground plane that is part of the mesh;
+app/accuracy/scenes.py) and DamagedHelmet's geometry under the maps of ../shared/data/env, alight
+with --occlusion off, on without the suns' light on the occluders (the bake's sun pass off:
+alight.render.visibility_parts.OcclusionParts.sun_bounce, the render before it existed) and on,
+binned 4x4 linear relMAE
 (app/accuracy/binned.py, as `alight compare --bin 4`); and the cost: bake time, frame time off/on
 alternated A B A B. Prints a table and writes benchmarks/results/occlusion.md; asserts nothing.
 
@@ -26,8 +29,8 @@ HERE = Path(__file__).resolve().parent
 DATA = HERE.parent.parent / "shared" / "data"
 ENV_DIR = DATA / "env"
 HELMET = DATA / "models" / "DamagedHelmet" / "DamagedHelmet.gltf"
-SCENES = ("corner", "bowl", "helmet")
-VIEWS = {"corner": (30.0, 25.0), "bowl": (0.0, 45.0), "helmet": (30.0, 10.0)}   # (orbit, elevation)
+SCENES = ("corner", "bowl", "product", "helmet")
+VIEWS = {"corner": (30.0, 25.0), "bowl": (0.0, 45.0), "product": (20.0, 20.0), "helmet": (30.0, 10.0)}   # (orbit, elevation)
 GREY = dict(base_color=(0.7, 0.7, 0.7), metallic=0.0, roughness=0.5)
 
 
@@ -77,8 +80,9 @@ def reference(folder: Path, name: str, mesh, env_name: str, env, size: int, samp
 
 def measure(folder: Path, size: int, samples: int, repeats: int, maps: list[str], scenes: list[str]) -> None:
     from alight.accuracy.binned import binned_relative_mae
-    from alight.core.visibility import bake_visibility, occlusion_statistic
+    from alight.core.visibility import bake_sun_bounce, bake_visibility, occlusion_statistic
     from alight.ibl.environment import load_environment
+    from alight.render.bindings import sun_world_directions
     from alight.render.renderer import ForwardRenderer
 
     folder.mkdir(parents=True, exist_ok=True)
@@ -97,12 +101,15 @@ def measure(folder: Path, size: int, samples: int, repeats: int, maps: list[str]
         for name in scenes:
             ref = reference(folder, name, meshes[name], env_name, env, size, samples)
             errors = {}
-            for mode in ("off", "on"):
+            for label, mode, sun_bounce in (("off", "off", True), ("no sun bounce", "on", False), ("on", "on", True)):
+                renderer.visibility_parts.sun_bounce = sun_bounce
                 img = renderer.render(scene_for(meshes[name], name, size, mode), maps_, size, size,
                                       read_linear=True, read_srgb=False).linear
-                errors[mode] = 100.0 * binned_relative_mae(img, ref, 4)
-            rows.append((name, env_name, errors["off"], errors["on"]))
-            print(f"{name:8s} {env_name:28s} off {errors['off']:5.1f}%  on {errors['on']:5.1f}%", flush=True)
+                errors[label] = 100.0 * binned_relative_mae(img, ref, 4)
+            renderer.visibility_parts.sun_bounce = True
+            rows.append((name, env_name, errors["off"], errors["no sun bounce"], errors["on"]))
+            print(f"{name:8s} {env_name:28s} off {errors['off']:5.1f}%  on without the suns' bounce "
+                  f"{errors['no sun bounce']:5.1f}%  on {errors['on']:5.1f}%", flush=True)
     stats = {name: occlusion_statistic(meshes[name].parts) for name in scenes}
     # Cost: the bake (no disk cache) and frames alternated off/on, per scene.
     env = load_environment(str(ENV_DIR / maps[0]))
@@ -112,6 +119,13 @@ def measure(folder: Path, size: int, samples: int, repeats: int, maps: list[str]
     for name in scenes:
         bake_s = [bake_visibility(meshes[name]).seconds for _ in range(2)]
         pair = {m: scene_for(meshes[name], name, frame, m) for m in ("off", "on")}
+        directions = sun_world_directions(pair["on"], maps_)
+        baked = bake_visibility(meshes[name])
+        sun_s = []
+        for _ in range(2):
+            start = time.perf_counter()
+            bake_sun_bounce(baked.parts, directions)
+            sun_s.append(time.perf_counter() - start)
         for m in ("off", "on"):   # warm: programs compiled, bake done
             renderer.render(pair[m], maps_, frame, frame)
         times = {"off": [], "on": []}
@@ -121,7 +135,8 @@ def measure(folder: Path, size: int, samples: int, repeats: int, maps: list[str]
                 renderer.render(pair[m], maps_, frame, frame)
                 times[m].append(time.perf_counter() - start)
         med = {m: float(np.median(v)) for m, v in times.items()}
-        cost.append(f"- {name}: bake {bake_s[0]:.2f} s, {bake_s[1]:.2f} s; frame {frame}x{frame} ({maps[0]}), "
+        cost.append(f"- {name}: bake {bake_s[0]:.2f} s, {bake_s[1]:.2f} s; the sun pass ({len(directions)} "
+                    f"sun) {sun_s[0]:.2f} s, {sun_s[1]:.2f} s; frame {frame}x{frame} ({maps[0]}), "
                     f"alternated A B x{repeats}, median off {med['off'] * 1e3:.1f} ms, on {med['on'] * 1e3:.1f} ms "
                     f"(ratio {med['on'] / med['off']:.2f}; off {min(times['off']) * 1e3:.1f}-"
                     f"{max(times['off']) * 1e3:.1f} ms, on {min(times['on']) * 1e3:.1f}-{max(times['on']) * 1e3:.1f} ms)")
@@ -130,8 +145,9 @@ def measure(folder: Path, size: int, samples: int, repeats: int, maps: list[str]
              f"{size}x{size} px; references: app/accuracy/path_trace.py, {samples} samples a pixel, seed 0, "
              "8 bounces; binned 4x4 linear relMAE; alight: medium bake, default IBL model, MSAA; grey dielectric "
              "(0.7, roughness 0.5) on every part.", "",
-             "| scene | environment | occlusion off % | occlusion on % |", "|---|---|---|---|"]
-    lines += [f"| {a} | {b} | {c:.1f} | {d:.1f} |" for a, b, c, d in rows]
+             "| scene | environment | occlusion off % | on, no sun bounce (before) % | occlusion on % |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {a} | {b} | {c:.1f} | {d:.1f} | {e:.1f} |" for a, b, c, d, e in rows]
     lines += ["", "occlusion statistic (auto bakes above 0.03): "
               + ", ".join(f"{n} {v:.3f}" for n, v in stats.items()), "", "Cost:", *cost]
     print("\n".join(lines))

@@ -1,11 +1,11 @@
 """What --occlusion costs a frame: DamagedHelmet (the grey material of bench_occlusion.py), 256x256,
-blouberg_sunrise_2, the medium bake; frames alternated in one run: occlusion off, on with the
-refinement as it was (every edge where V or the bent normal changed was split: INTERPOLATION_TEST
-off), and on as now (a split kept only where the edge's linear interpolation misses the
-midpoint). Wall time and this process's CPU time (llvmpipe's threads included: steadier than
-the wall clock on a shared machine), medians and ranges; the refined meshes' sizes.
+quarry_01 (a map with a sun: its shadow map and the bake's sun pass both at work), the medium
+bake; frames alternated in one run: occlusion off, on without the suns' light on the occluders
+(OcclusionParts.sun_bounce off: the render before the sun pass), and on as now. Wall time and
+this process's CPU time (llvmpipe's threads included: steadier than the wall clock on a shared
+machine), medians and ranges; the refined meshes' sizes; the sun pass's own time.
 
-    .venv/bin/python benchmarks/bench_occlusion_cost.py [--rounds 9] [--size 256]
+    .venv/bin/python benchmarks/bench_occlusion_cost.py [--rounds 9] [--size 256] [--env NAME]
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=9)
     ap.add_argument("--size", type=int, default=256)
-    ap.add_argument("--env", default="blouberg_sunrise_2_1k.hdr")
+    ap.add_argument("--env", default="quarry_01_1k.hdr")
     args = ap.parse_args(argv)
     os.environ.setdefault("ALIGHT_CACHE_DIR", tempfile.mkdtemp(prefix="alight-bench-cache-"))
 
@@ -47,20 +47,28 @@ def main(argv=None) -> int:
     r.visibility_parts.cache = None
     maps = r.bake(env, "medium")
     conditions = {}
-    for name, test in (("off", None), ("on, every split", False), ("on, splits kept", True)):
+    for name, sun_bounce in (("off", True), ("on, no sun pass", False), ("on (now)", True)):
         copy = dataclasses.replace(mesh, parts=[dataclasses.replace(p) for p in mesh.parts])
-        scene = scene_for(copy, "helmet", size, "off" if test is None else "on")
-        if test is not None:
-            vis.INTERPOLATION_TEST = test
+        scene = scene_for(copy, "helmet", size, "off" if name == "off" else "on")
+        r.visibility_parts.sun_bounce = sun_bounce
         r.render(scene, maps, size, size)          # the bake (if any), programs compiled
         r.render(scene, maps, size, size)
-        vis.INTERPOLATION_TEST = True
-        conditions[name] = (copy, scene)
-    baked = {name: _refined_triangles(r, copy) for name, (copy, _) in conditions.items()}
+        conditions[name] = (copy, scene, sun_bounce)
+    from alight.render.bindings import sun_world_directions
+
+    baked_now = r.visibility_parts._parts[id(conditions["on (now)"][0])][3]
+    directions = sun_world_directions(conditions["on (now)"][1], maps)
+    sun_seconds = []
+    for _ in range(2):
+        t0 = time.perf_counter()
+        vis.bake_sun_bounce(baked_now.parts, directions)
+        sun_seconds.append(time.perf_counter() - t0)
+    baked = {name: _refined_triangles(r, copy) for name, (copy, _, _) in conditions.items()}
     wall = {n: [] for n in conditions}
     cpu = {n: [] for n in conditions}
     for _ in range(args.rounds):
-        for name, (_, scene) in conditions.items():
+        for name, (_, scene, sun_bounce) in conditions.items():
+            r.visibility_parts.sun_bounce = sun_bounce
             t0, c0 = time.perf_counter(), time.process_time()
             r.render(scene, maps, size, size)
             wall[name].append(time.perf_counter() - t0)
@@ -74,6 +82,8 @@ def main(argv=None) -> int:
         print(f"| {name} | {baked[name]} | {np.median(w):.1f} [{w.min():.1f}-{w.max():.1f}] | "
               f"{np.median(w) / np.median(np.array(wall['off']) * 1e3):.2f} | {np.median(c):.1f} [{c.min():.1f}-{c.max():.1f}] | "
               f"{np.median(c) / np.median(np.array(cpu['off']) * 1e3):.2f} |")
+    print(f"the sun pass ({len(directions)} sun, {sum(len(p.positions) for p in baked_now.parts)} vertices): "
+          f"{sun_seconds[0]:.2f} s, {sun_seconds[1]:.2f} s")
     return 0
 
 

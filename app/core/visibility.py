@@ -17,6 +17,14 @@ vertex gets
   bands are linear in the direction). It replaces the sky in the occluded directions of both the
   diffuse and the specular lobe. The hit's albedo is taken to be the shading point's, diffuse
   plus specular (one material per scene, as the test scenes and most product shots).
+- the suns' bounce (``bake_sun_bounce``, a second pass keyed by the suns' directions too): what
+  the occluders receive from each compact source of the environment (app/ibl/sun.py), which the
+  bounce above leaves out (E there is the map without its suns). For every bounce ray that hits,
+  a shadow ray from the hit point toward sun k gives the hit's own visibility of it; the vertex
+  keeps, per sun, that light's mean over its hitting rays (B1) and the same for the light the
+  hits get from their own sunlit occluders (B2, from B1 at the hits: no more rays), so the
+  occluders' radiance is sum_k P_k (a B1_k + a^2 B2_k + ...) (P_k the sun's power: the shader's
+  u_sun_power, so the environment's intensity needs no new pass).
 
 A per-vertex bake needs vertices where the occlusion changes, and no more (llvmpipe pays per
 small triangle): the part's edges are split to a coarse size first, then again where V changes
@@ -25,8 +33,9 @@ anyway, so the picture without occlusion is unchanged. Baked once per mesh conte
 IBL bake (alight.render.visibility_parts.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
-``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility`` and
-``occluded_environment`` here (tests/test_occlusion.py holds them equal).
+``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
+``cone_blend``, ``suns_on_occluders`` and ``occluded_environment`` here (tests/test_occlusion.py,
+test_occlusion_cone.py and test_occlusion_suns.py hold them equal).
 """
 
 from __future__ import annotations
@@ -134,6 +143,21 @@ def specular_occlusion(bent_dot_r, n_dot_r, visibility, roughness):
     return 1.0 + (so - 1.0) * t * t * (3.0 - 2.0 * t)
 
 
+def cone_roughness(visibility):
+    """The perceptual roughness whose prefiltered lobe is as wide as the visibility cone: the
+    inverse of ``specular_occlusion``'s lobe aperture cos a = 0.1^(alpha^2) (alpha = roughness^2)
+    at the cone's cos a = sqrt(1 - V) (``cone_aperture_cos``); at most 1."""
+    alpha2 = np.log(np.maximum(cone_aperture_cos(visibility), 1e-4)) / math.log(0.1)
+    return np.minimum(np.sqrt(np.sqrt(alpha2)), 1.0)
+
+
+def cone_blend(visibility):
+    """The weight of E(bent)/pi against the prefiltered radiance in the visible cone's mean
+    radiance: smoothstep(0.6, 0.95, V): 1 at an open point (exact there), 0 for a narrow cone."""
+    t = np.clip((np.asarray(visibility, np.float64) - 0.6) / 0.35, 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
 def mapped_bent_normal(n, bent, vertex_normal):
     """The bent normal for a normal-mapped shading normal ``n`` (all (N, 3) unit, one side): the
     bake's lean of the bent normal from the vertex normal, added to n, so an open point keeps n
@@ -168,18 +192,42 @@ def occluders_reflectance(hit_albedo, hit_visibility):
     return a * v / np.maximum(1.0 - a * (1.0 - v), 1e-3)
 
 
+def suns_on_occluders(hit_albedo, hit_visibility, first, second):
+    """What the occluders shine of the suns' light, per unit power: a B1 (direct on them) + a^2 B2
+    (from their own sunlit occluders), the further bounces as the tail of the same geometric
+    series as ``occluders_reflectance``: a B1 + a^2 B2 / (1 - a (1 - V_hit)). hit_albedo (3,) or
+    (N, 3), hit_visibility (N,), first and second (N,) or (N, 3) (sum_k P_k B_k); returns (N, 3)."""
+    a = np.asarray(hit_albedo, np.float64)
+    v = np.asarray(hit_visibility, np.float64)[..., None]
+    b1, b2 = (np.asarray(b, np.float64) for b in (first, second))
+    b1 = b1[..., None] if b1.ndim == 1 else b1
+    b2 = b2[..., None] if b2.ndim == 1 else b2
+    return a * b1 + a * a * b2 / np.maximum(1.0 - a * (1.0 - v), 1e-3)
+
+
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
-                         hit_albedo, so, prefiltered):
+                         hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
     and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
     (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
-    hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi."""
+    hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi, plus, with ``sun_first`` and
+    ``sun_second`` (N, 3) (sum_k P_k B1_k and B2_k of bake_sun_bounce), ``suns_on_occluders``.
+    ``cone_radiance`` (N, 3): the prefiltered radiance at the bent normal and ``cone_roughness``
+    (default: irradiance_bent, as a uniform environment has it); what V multiplies is its mix with
+    E(bent)/pi by ``cone_blend`` (occlusion.glsl's visible_cone_radiance)."""
     v = np.asarray(visibility, np.float64)[..., None]
-    occluder = occluders_reflectance(np.minimum(hit_albedo, 1.0),
-                                     occluder_visibility(bounce_weight, baked_visibility)) * irradiance_bounce
+    albedo = np.minimum(hit_albedo, 1.0)
+    hit_visibility = occluder_visibility(bounce_weight, baked_visibility)
+    occluder = occluders_reflectance(albedo, hit_visibility) * irradiance_bounce
+    if sun_first is not None:
+        occluder = occluder + suns_on_occluders(albedo, hit_visibility, sun_first, sun_second)
     so = np.asarray(so, np.float64)[..., None]
-    return v * irradiance_bent + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
+    bent = np.asarray(irradiance_bent, np.float64)
+    cone = bent if cone_radiance is None else np.asarray(cone_radiance, np.float64)
+    blend = cone_blend(visibility)[..., None]
+    visible = cone + (bent - cone) * blend
+    return v * visible + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 
 
 # ---- which meshes need it -----------------------------------------------------------------------
@@ -636,6 +684,116 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
             bounce_direction=bounce_dir[a:b].astype(np.float32),
             bounce_weight=bounce_weight[a:b].astype(np.float32)))
     return MeshVisibility(parts, seconds=time.perf_counter() - start, rays=int(cast))
+
+
+# ---- the suns on the occluders ------------------------------------------------------------------
+
+MAX_SUNS = 4          # shaders/common/suns.glsl's MAX_SUNS: one vec4 per vertex holds them
+SUN_BOUNCE_VERSION = 2   # 2: the second bounce (B2)
+
+
+def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
+                    seed: int = 0, light_through=None) -> list[np.ndarray]:
+    """Per part of a bake (``bake_visibility``'s refined parts, world space), (N, 8) float32: the
+    light each compact source k of ``directions`` ((K, 3) unit world directions toward the suns,
+    K <= MAX_SUNS; the rest 0) puts on what the vertex's ``bounce_rays`` cosine-weighted rays hit
+    (the occluders), over the sun's power, as two bounces:
+    - columns 0..3, B1_k: the mean over the rays that hit of S_k(hit) max(n_hit.l_k, 0) / pi,
+      n_hit the hit face's normal turned toward the ray, S_k the hit's visibility of sun k (a
+      shadow ray toward it, stopped by an opaque part, passing ``light_through`` of a see-through
+      one, as the bake's V): the suns' E/pi on the occluders, direct;
+    - columns 4..7, B2_k: the mean over the same hits of h(hit) B1_k(hit), h the share of a
+      vertex's rays that hit, B1 interpolated at the hit from its triangle's vertices: the light
+      the occluders get from their own sunlit occluders, over their albedo.
+    An occluder of albedo a then shines a (B1 + a B2 + ...) P_k (P_k the sun's power, radiance
+    integrated over its disk: the shader's u_sun_power, so the environment's intensity needs no
+    new pass). 0 for a vertex none of whose rays hit. Seeded; each sun a delta light (its spread
+    is not sampled)."""
+    directions = np.asarray(directions, np.float64).reshape(-1, 3)[:MAX_SUNS]
+    out = [np.zeros((len(p.positions), 2 * MAX_SUNS), np.float32) for p in parts]
+    if not len(directions) or not parts:
+        return out
+    positions = np.concatenate([p.positions for p in parts]).astype(np.float64)
+    lo, hi = positions.min(axis=0), positions.max(axis=0)
+    eps = eps_of(float(np.linalg.norm(hi - lo)) or 1.0)
+    offsets = np.cumsum([0] + [len(p.positions) for p in parts])
+    faces = [np.asarray(p.indices, np.int64).reshape(-1, 3) for p in parts]
+    all_f = np.concatenate([f + o for f, o in zip(faces, offsets[:-1])])
+    all_n = np.concatenate([p.normals for p in parts]).astype(np.float64)
+    all_n /= np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
+    refined = _Occluders(positions[all_f])
+    through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
+    part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
+    clear = through > 0.0
+    opaque_tri = ~clear[part_of_triangle]
+    blockers = _Occluders(positions[all_f[opaque_tri]]) if opaque_tri.any() else None
+    see_through = _Occluders(positions[all_f[~opaque_tri]]) if clear.any() else None
+    through_of_see_through = through[part_of_triangle[~opaque_tri]]
+    origins = np.concatenate([_origins(positions[a:b], all_n[a:b], f, eps)
+                              for f, a, b in zip(faces, offsets[:-1], offsets[1:])])
+    rng = np.random.default_rng(seed)
+    local = cosine_directions(bounce_rays).astype(np.float32)
+    count = len(positions)
+    total = np.zeros((count, MAX_SUNS), np.float64)
+    hits = np.zeros(count, np.int64)
+    kept = []                       # per chunk: the hitting rays' vertex, triangle and barycentrics
+    chunk = max(1, 262_144 // bounce_rays)
+    for s0 in range(0, count, chunk):
+        n = all_n[s0:s0 + chunk].astype(np.float32)
+        d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
+        prim, u, v = _cast(refined.scene, o, d, refined.normals, eps)
+        ray = np.nonzero(prim >= 0)[0]
+        if not len(ray):
+            continue
+        tri = refined.triangles[prim[ray]].astype(np.float64)
+        point = tri[:, 0] + u[ray, None] * (tri[:, 1] - tri[:, 0]) + v[ray, None] * (tri[:, 2] - tri[:, 0])
+        face_n = refined.normals[prim[ray]].astype(np.float64)
+        face_n *= np.where(np.einsum("ij,ij->i", face_n, d[ray]) > 0.0, -1.0, 1.0)[:, None]   # the side seen
+        vertex = s0 + ray // bounce_rays
+        hits += np.bincount(vertex, minlength=count)
+        kept.append((vertex, prim[ray], u[ray], v[ray]))
+        start = (point + 2.0 * eps * face_n).astype(np.float32)
+        for k, l in enumerate(directions):
+            cos = face_n @ l
+            lit = np.nonzero(cos > 0.0)[0]
+            if not len(lit):
+                continue
+            o2 = np.ascontiguousarray(start[lit])
+            d2 = np.ascontiguousarray(np.broadcast_to(l.astype(np.float32), (len(lit), 3)))
+            shadow = np.ones(len(lit))
+            if blockers is not None:
+                p2, _, _ = _cast(blockers.scene, o2, d2, blockers.normals, eps)
+                shadow = (p2 < 0).astype(np.float64)
+            if see_through is not None:
+                p3, _, _ = _cast(see_through.scene, o2, d2, see_through.normals, eps)
+                shadow = shadow * np.where(p3 < 0, 1.0, through_of_see_through[np.maximum(p3, 0)])
+            total[:, k] += np.bincount(vertex[lit], shadow * cos[lit] / math.pi, minlength=count)
+    first = total / np.maximum(hits, 1)[:, None]                       # B1 per vertex
+    carried = first * (hits / bounce_rays)[:, None]                    # h B1: what a vertex passes on
+    second = np.zeros_like(first)
+    for vertex, prim, u, v in kept:
+        w = np.column_stack([1.0 - u - v, u, v]).astype(np.float64)
+        at_hit = np.einsum("hk,hkc->hc", w, carried[all_f[prim]])
+        for k in range(MAX_SUNS):
+            second[:, k] += np.bincount(vertex, at_hit[:, k], minlength=count)
+    second /= np.maximum(hits, 1)[:, None]
+    both = np.column_stack([first, second]).astype(np.float32)
+    return [both[a:b] for a, b in zip(offsets[:-1], offsets[1:])]
+
+
+def sun_bounce_key(visibility_key_: str, directions, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
+                   light_through=None) -> tuple[str, dict]:
+    """The cache key of ``bake_sun_bounce`` over the bake ``visibility_key_`` for the suns'
+    world ``directions`` (rounded to 1e-5: an environment's rotation or another map is another
+    key; its intensity and the suns' powers are not in it, the shader multiplies them in)."""
+    description = {"what": "sun-bounce", "version": SUN_BOUNCE_VERSION, "visibility": visibility_key_,
+                   "directions": [[round(float(x), 5) for x in d] for d in
+                                  np.asarray(directions, np.float64).reshape(-1, 3)[:MAX_SUNS]],
+                   "bounce_rays": bounce_rays}
+    if light_through is not None and any(float(t) > 0.0 for t in light_through):
+        description["light_through"] = [round(float(t), 6) for t in light_through]
+    text = json.dumps(description, sort_keys=True)
+    return "alight-sun-bounce-" + hashlib.sha256(text.encode()).hexdigest(), description
 
 
 # ---- the cache ----------------------------------------------------------------------------------

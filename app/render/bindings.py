@@ -238,6 +238,16 @@ def bind_ibl(program: moderngl.Program, scene, maps: IBLMaps | None, tables: Loo
     write_suns(program, scene, maps)
 
 
+def sun_world_directions(scene, maps: IBLMaps | None) -> np.ndarray:
+    """(K, 3) world directions toward the compact sources the bake left out of ``maps`` (K <=
+    MAX_SUNS; (0, 3) without maps): the map texel in direction m lights world direction
+    R_y(+deg) m (docs/conventions.md)."""
+    if maps is None or not maps.suns:
+        return np.zeros((0, 3))
+    return np.array([rotate_world_to_map(sun.direction, -scene.env_rotation_deg) for sun in maps.suns[:MAX_SUNS]],
+                    np.float64).reshape(-1, 3)
+
+
 def write_suns(program: moderngl.Program, scene, maps: IBLMaps) -> None:
     """The compact sources the bake left out of the maps, in world space (ibl.glsl adds them)."""
     suns = maps.suns[:MAX_SUNS]
@@ -246,9 +256,8 @@ def write_suns(program: moderngl.Program, scene, maps: IBLMaps) -> None:
     spreads = np.zeros(MAX_SUNS, np.float32)
     for i, sun in enumerate(suns):
         spreads[i] = sun.spread
-        # The map texel in direction m lights world direction R_y(+deg) m (docs/conventions.md).
-        directions[i] = rotate_world_to_map(sun.direction, -scene.env_rotation_deg)
         powers[i] = np.asarray(sun.power) * scene.env_intensity
+    directions[:len(suns)] = sun_world_directions(scene, maps)
     scale = np.zeros(MAX_GRID_STEPS, np.float32)
     scale[:len(maps.sun_prefilter_scale)] = maps.sun_prefilter_scale[:MAX_GRID_STEPS]
     set_uniform(program, "u_sun_count", len(suns))

@@ -32,6 +32,7 @@ from alight.render.bindings import (
     bind_ibl,
     set_material,
     set_uniform,
+    sun_world_directions,
 )
 from alight.render.gpu_mesh import ANISOTROPIC_FILTERS, GpuPart
 from alight.render.ground import GroundPass
@@ -70,6 +71,7 @@ class FrameContext:
     view_projection: np.ndarray | None = None   # the pass's (a tile's: the image's, off centre)
     inverse_vp: np.ndarray | None = None        # its inverse: the background's rays
     image_size: tuple[int, int] = (0, 0)        # the targets' output size (width, height)
+    sun_directions: np.ndarray | None = None    # (K, 3) world: the compact sources (the bake's sun bounce)
 
 
 # --- a frame: the passes for each anti-aliasing mode, tile by tile -------------------------
@@ -125,7 +127,7 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
     ctx = r.ctx
     frame = FrameContext(display=display, srgb_by_framebuffer=srgb_by_framebuffer,
                          half_output=targets.half and fbo is targets.draw,
-                         image_size=(targets.width, targets.height))
+                         image_size=(targets.width, targets.height), sun_directions=sun_world_directions(scene, maps))
     width, height = targets.draw_size
     scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
     view = view or View(targets.width, targets.height)
@@ -382,7 +384,7 @@ def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_pr
         model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns
         r.last_sphere_impostor = frame.impostor_samples
     if callable(prog) and sphere_radius is None and proxy_model is None:
-        drawn = occluded_parts(r, scene, drawn)
+        drawn = occluded_parts(r, scene, drawn, frame.sun_directions)
     chosen = None if parts is None else set(parts)
     for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
         if (blend is None or blends(scene, part) == blend) and (chosen is None or index in chosen):
@@ -507,12 +509,14 @@ def _set_anisotropy(r, scene, camera: Camera, gpu_part: GpuPart, part, bound_map
             tex.anisotropy = level
 
 
-def occluded_parts(r, scene, drawn: list[GpuPart]) -> list[GpuPart]:
+def occluded_parts(r, scene, drawn: list[GpuPart], sun_directions=None) -> list[GpuPart]:
     """The mesh's parts refined and baked with visibility where ``scene.occlusion`` wants them
-    (alight.render.visibility_parts), else ``drawn``."""
+    (alight.render.visibility_parts), else ``drawn``; ``sun_directions``: (K, 3) world, the
+    compact sources whose light on the occluders the bake adds (None: none)."""
     textures = r.meshes.textures(scene.mesh)
     return r.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
-                                        lambda part: GpuPart(r.ctx, part, textures), light_through(scene))
+                                        lambda part: GpuPart(r.ctx, part, textures), light_through(scene),
+                                        sun_directions)
 
 
 # --- after the scene pass: resolve, reduce, tone map ------------------------------------

@@ -16,6 +16,8 @@ const int TERM_SPECULAR_OCCLUSION = 2;  // (bent.r, n.r, V, roughness)
 const int TERM_MAPPED_BENT_NORMAL = 3;  // (n, bent as polar, azimuth angles about the vertex normal +Z)
 const int TERM_OCCLUDER_VISIBILITY = 4; // (bounce weight, V)
 const int TERM_OCCLUDERS_REFLECTANCE = 5; // (hit albedo rgb, hit visibility)
+const int TERM_SUNS_ON_OCCLUDERS = 6;     // (hit albedo rgb, hit visibility; first = 1, second = 1)
+const int TERM_CONE = 7;                  // (V): cone_roughness, cone_blend
 
 vec3 polar_direction(float theta, float phi) {
     return vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
@@ -44,6 +46,13 @@ void main() {
             break;
         case TERM_OCCLUDERS_REFLECTANCE:
             o.xyz = occluders_reflectance(a.xyz, a.w);
+            break;
+        case TERM_SUNS_ON_OCCLUDERS:
+            o.xyz = suns_on_occluders(a.xyz, a.w, vec3(1.0), vec3(1.0));
+            break;
+        case TERM_CONE:
+            o.x = cone_roughness(a.x);
+            o.y = cone_blend(a.x);
             break;
     }
     u_outputs[i] = o;

@@ -67,10 +67,53 @@ vec3 occluders_reflectance(vec3 hit_albedo, float hit_visibility) {
     return hit_albedo * hit_visibility / max(1.0 - hit_albedo * (1.0 - hit_visibility), vec3(1e-3));
 }
 
+// What the occluders shine of the suns' light (first: sum_k P_k B1_k, the suns' E/pi on them;
+// second: sum_k P_k B2_k, what their own sunlit occluders pass them, over albedo; from the bake's
+// bake_sun_bounce): a B1 + a^2 B2, the further bounces as the tail of the series above.
+vec3 suns_on_occluders(vec3 hit_albedo, float hit_visibility, vec3 first, vec3 second) {
+    return hit_albedo * first
+           + hit_albedo * hit_albedo * second / max(1.0 - hit_albedo * (1.0 - hit_visibility), vec3(1e-3));
+}
+
+// The roughness whose prefiltered lobe is as wide as the visibility cone: the inverse of
+// specular_occlusion's lobe aperture cos a = 0.1^(alpha^2), alpha = roughness^2, at the cone's
+// cos a = sqrt(1 - V); at most 1.
+float cone_roughness(float visibility) {
+    float alpha2 = log(max(cone_aperture_cos(visibility), 1e-4)) / log(0.1);
+    return min(sqrt(sqrt(alpha2)), 1.0);
+}
+
+// How much of the visible cone's mean radiance is taken as E(bent)/pi: 0 for a narrow cone (the
+// prefiltered lobe), 1 for an open point (the hemisphere's cosine mean, exact there).
+float cone_blend(float visibility) {
+    return smoothstep(0.6, 0.95, visibility);
+}
+
+// The cosine-weighted mean radiance over the visibility cone (V of it is what reaches the
+// point): E(bent)/pi means the whole hemisphere around the bent normal, which under a sky
+// brighter at the horizon than overhead lit a bowl's floor, seeing only the sky overhead, 26-37%
+// too bright (newport_loft, quarry_01, against the path tracer's direct light); the prefiltered
+// radiance at cone_roughness is the mean over a lobe as wide as the cone.
+vec3 visible_cone_radiance(vec3 bent, float visibility) {
+    vec3 cone = prefiltered_radiance_at(bent, cone_roughness(visibility), false);
+    return mix(cone, irradiance_at(bent, false), cone_blend(visibility));
+}
+
 #ifdef HAS_VISIBILITY
 in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
 in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
 in vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
+in vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
+in vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
+
+// sum_k P_k B_k over the suns, for B = v_sun_bounce (second: v_sun_bounce2). Clamped at 0: a
+// multisampled pixel's centre may lie outside its triangle, where the interpolation runs on
+// past a vertex (a steep B beside a shadow's edge went negative: black specks on the helmet).
+vec3 suns_weighted(vec4 per_sun) {
+    vec3 e = vec3(0.0);
+    for (int i = 0; i < u_sun_count; ++i) e += u_sun_power[i] * max(per_sun[i], 0.0);
+    return e;
+}
 
 // The baked values at this fragment, or none (V = 1) where the shading normal n faces away from
 // the side that was baked (an open mesh seen from behind: its bent normal lies in the front
@@ -101,9 +144,10 @@ float combined_visibility(Surface s, vec3 n) {
 // What the occluded directions see instead of the sky is the mesh: its radiance, one bounce, is
 // hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo taken as this surface's
 // (diffuse plus specular: a rough metal's walls light each other too).
-// Diffuse: V E(bent)/pi + (1 - V) times that; specular: the prefiltered radiance for the share of
+// Plus the suns' light on the occluders (in their own shadows, baked: suns_on_occluders).
+// Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
 // the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
-// The compact sources (with_suns) stay unoccluded here (shadows are theirs).
+// The compact sources' direct light (with_suns) stays unoccluded here (shadows are theirs).
 void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool with_suns,
                          inout vec3 irradiance, inout vec3 prefiltered) {
 #ifdef HAS_VISIBILITY
@@ -112,12 +156,17 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     float baked_visibility = baked ? v_visibility.w : 1.0;
     vec3 bent = bent_normal(n);
     vec3 occluder = vec3(0.0);
-    if (baked && v_bounce.w > 0.0) {
-        vec3 hit_albedo = min(s.base_color * (1.0 - s.metallic) + specular_albedo, vec3(1.0));
-        occluder = occluders_reflectance(hit_albedo, occluder_visibility(v_bounce.w, baked_visibility))
-                   * irradiance_at(normalize(v_bounce.xyz), false);
+    if (baked) {
+        vec3 hit_albedo = min(s.base_color * (1.0 - s.metallic) * (1.0 - specular_albedo) + specular_albedo, vec3(1.0));
+        float hit_visibility = occluder_visibility(v_bounce.w, baked_visibility);
+        if (v_bounce.w > 0.0) {
+            occluder = occluders_reflectance(hit_albedo, hit_visibility) * irradiance_at(normalize(v_bounce.xyz), false);
+        }
+        // The compact sources on the occluders, which E above (the map without them) leaves out.
+        occluder += suns_on_occluders(hit_albedo, hit_visibility, suns_weighted(v_sun_bounce),
+                                      suns_weighted(v_sun_bounce2));
     }
-    irradiance = visibility * irradiance_at(bent, false) + (1.0 - visibility) * occluder;
+    irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
     if (with_suns) irradiance += suns_irradiance_over_pi(n);
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
     prefiltered = so * prefiltered + (1.0 - so) * occluder;

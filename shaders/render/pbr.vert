@@ -20,8 +20,12 @@ out vec4 v_color;
 // The visibility bake's per-vertex values (app/core/visibility.py), for common/occlusion.glsl.
 layout(location = 6) in vec4 in_visibility;
 layout(location = 7) in vec4 in_bounce;
+layout(location = 8) in vec4 in_sun_bounce;    // per sun: its E/pi on the occluders over its power
+layout(location = 9) in vec4 in_sun_bounce2;   // ... and what their sunlit occluders pass them
 out vec4 v_visibility;
 out vec4 v_bounce;
+out vec4 v_sun_bounce;
+out vec4 v_sun_bounce2;
 out vec3 v_baked_normal;
 #endif
 
@@ -49,6 +53,8 @@ void main() {
 #ifdef HAS_VISIBILITY
     v_visibility = vec4(u_normal_matrix * in_visibility.xyz, in_visibility.w);
     v_bounce = vec4(u_normal_matrix * in_bounce.xyz, in_bounce.w);
+    v_sun_bounce = in_sun_bounce;
+    v_sun_bounce2 = in_sun_bounce2;
     v_baked_normal = v_normal;
 #endif
     gl_Position = u_view_projection * world;
