@@ -175,6 +175,8 @@ class Panel:
             self._environment(s, win)
         if header("Lights"):
             self._lights(s)
+        else:
+            self._removed = []   # a closed section keeps no removed lights' places
         if header("Display & camera"):
             self._display(s, win)
         if header("Compare"):   # the A/B split view (app/frontends/editor/compare.py)

@@ -27,6 +27,9 @@ from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
+# A material file's layer textures are drawn where the file is the mesh (material_files.MESH_HINT's
+# words for the editor's controls).
+EDITOR_MESH_HINT = "open the file as the mesh ('mesh', Environment) with 'mesh file's own materials' ticked to use them"
 # From the registry, so a layer added there is a --script key too (a colour as R,G,B).
 VECTOR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "color")
 SCALAR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "number")
@@ -245,7 +248,7 @@ class EditorState:
         from alight.exchange.material_files import load_material_file
         from alight.exchange.texture_sets import load_map_images
 
-        m, maps, warnings = load_material_file(name_or_path)
+        m, maps, warnings = load_material_file(name_or_path, mesh_hint=EDITOR_MESH_HINT)
         images = load_map_images(maps)   # read first: a bad map changes nothing
         self._say(warnings)
         self.material = self.saved_material = m
