@@ -127,6 +127,28 @@ def test_reference_compare_errors_name_the_panels_controls(ctx):
     ctx.item_close("**/Compare")
 
 
+def test_a_material_files_warning_names_the_editors_controls(ctx):
+    """A glTF material whose clearcoat has a texture, opened through 'load preset': the warning
+    (on stderr, counted in the panel) points to the editor's mesh field, not to --mesh (the
+    runner reads stderr)."""
+    from alight.frontends.editor.ui_test import editor
+
+    s = editor().state
+    _png(os.path.join(OUT, "coat.png"), (128, 128, 128))
+    doc = {"asset": {"version": "2.0"}, "images": [{"uri": "coat.png"}], "textures": [{"source": 0}],
+           "materials": [{"name": "coated", "extensions": {"KHR_materials_clearcoat": {
+               "clearcoatFactor": 1.0, "clearcoatTexture": {"index": 0}}}}],
+           "extensionsUsed": ["KHR_materials_clearcoat"]}
+    path = os.path.join(OUT, "coated.gltf")
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(doc, f)
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/load preset")
+    assert s.material.name == "coated" and not s.error, (s.material.name, s.error)
+    ctx.item_click("**/plastic_high")
+
+
 # --- 1: replacing a library entry asks ---------------------------------------------------------------
 
 def test_replacing_a_library_entry_asks_first(ctx):

@@ -26,6 +26,8 @@ def test_ed22a_checks_pass_through_the_test_engine(display, tmp_path):
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]
     assert f"{len(checks)} passed, 0 failed" in result.stdout, result.stdout
+    coat = [line for line in result.stderr.splitlines() if "KHR_materials_clearcoat's textures" in line]
+    assert coat and "'mesh file's own materials'" in coat[0] and "--" not in coat[0], result.stderr[-2000:]
 
 
 def test_clicks_aimed_at_a_moved_layout_do_not_land_on_what_moved_there(display, tmp_path):
