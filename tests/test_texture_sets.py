@@ -409,7 +409,7 @@ def test_editor_drop_of_several_files_is_a_texture_set(tmp_path, validate):
     assert set(other.texture_maps.paths()) == {"base_color", "metallic_roughness", "normal", "occlusion", "emissive"}
     # The editor's .json preset keeps the factors and says the maps were left out (the CLI refuses).
     note = s.save_material(str(tmp_path / "look.json"))
-    assert "5 maps left out" in note and ".gltf or .glb" in note, note
+    assert "6 maps left out" in note and ".gltf or .glb" in note, note   # a slot each
     assert EditorState().open_file(str(tmp_path / "look.json"))
 
 
