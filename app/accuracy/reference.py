@@ -84,14 +84,20 @@ class ReferenceResult:
     seconds: dict[str, float] = field(default_factory=dict)
 
 
-def check_roughness(roughness: float, what: str = "roughness") -> None:
+def cli_option(field: str) -> str:
+    """How the command line names a material field in a message: its flag (--clearcoat-roughness)."""
+    return "--" + field.replace("_", "-")
+
+
+def check_roughness(roughness: float, what: str = "roughness", name=cli_option) -> None:
+    """Errors: AlightError when ``roughness`` is below MIN_ROUGHNESS, led by ``name(what)``: the
+    CLI's flag, or the editor's control (the editor passes its own names)."""
     if roughness < MIN_ROUGHNESS - 1e-9:
-        option = "--" + what.replace("_", "-") if what != "roughness" else "--roughness"
-        raise AlightError(f"{option}: {what} {roughness:g} < {MIN_ROUGHNESS}: the GGX lobe is narrower than a "
+        raise AlightError(f"{name(what)}: {what} {roughness:g} < {MIN_ROUGHNESS}: the GGX lobe is narrower than a "
                           f"few texels and the texel sum is no longer an integral (no reference below {MIN_ROUGHNESS})")
 
 
-def check_layer_lobes(material, roughnesses) -> None:
+def check_layer_lobes(material, roughnesses, name=cli_option) -> None:
     """A refracting volume's lobe is narrower than the reflected one (about (ior - 1) / (2 ior) of
     its alpha): refused, one line, where it is narrower than the reflected lobe at MIN_ROUGHNESS
     (alight.accuracy.ground_truth.check_transmission_lobe; docs/layer_transmission.md)."""
@@ -103,14 +109,14 @@ def check_layer_lobes(material, roughnesses) -> None:
         try:
             check_transmission_lobe(r, material.ior)
         except ValueError as exc:
-            raise AlightError(f"--roughness: {exc} (no reference there)") from None
+            raise AlightError(f"{name('roughness')}: {exc} (no reference there)") from None
 
 
-def check_layer_roughness(material) -> None:
+def check_layer_roughness(material, name=cli_option) -> None:
     """The layers' own GGX lobes need the same: the coat's roughness (a coat below 0.1 is a
     mirror; its sum would sample a delta). The sheen's Charlie lobe is wide at every roughness."""
     if "clearcoat" in material.layers():
-        check_roughness(material.clearcoat_roughness, "clearcoat_roughness")
+        check_roughness(material.clearcoat_roughness, "clearcoat_roughness", name)
 
 
 def choose_env_level(radiance: np.ndarray, roughnesses) -> int:

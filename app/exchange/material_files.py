@@ -33,7 +33,13 @@ def is_gltf(path: str | os.PathLike) -> bool:
     return Path(os.fspath(path)).suffix.lower() in GLTF_SUFFIXES
 
 
-def load_material_file(name_or_path: str | os.PathLike, index: int = 0) -> tuple[Material, TextureMaps, list[str]]:
+# How a warning tells where a layer's textures are used: the CLI's words by default; the editor
+# passes its own (its messages name its controls, not flags).
+MESH_HINT = "render the file with --mesh to use them"
+
+
+def load_material_file(name_or_path: str | os.PathLike, index: int = 0,
+                       mesh_hint: str = MESH_HINT) -> tuple[Material, TextureMaps, list[str]]:
     """(material, maps, warnings) of a preset name, a .json preset or a glTF file's
     ``index``-th material. Errors: one-line AlightError naming the file and element."""
     text = os.fspath(name_or_path)
@@ -45,11 +51,11 @@ def load_material_file(name_or_path: str | os.PathLike, index: int = 0) -> tuple
 
     material = import_material(text, index)
     doc = read_gltf_json(text)
-    maps, warnings = _maps(doc["materials"][index], doc, text, index)
+    maps, warnings = _maps(doc["materials"][index], doc, text, index, mesh_hint)
     return material, maps, warnings
 
 
-def _maps(gm: dict, doc: dict, source: str, index: int) -> tuple[TextureMaps, list[str]]:
+def _maps(gm: dict, doc: dict, source: str, index: int, mesh_hint: str = MESH_HINT) -> tuple[TextureMaps, list[str]]:
     warnings: list[str] = []
     where = f"materials[{index}]"
     maps = TextureMaps()
@@ -104,7 +110,7 @@ def _maps(gm: dict, doc: dict, source: str, index: int) -> tuple[TextureMaps, li
                  "KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_specular"):
         e = ext.get(name)
         if isinstance(e, dict) and any(k.endswith("Texture") for k in e):
-            warnings.append(f"{source}: {where}: {name}'s textures are drawn without (render the file with --mesh to use them)")
+            warnings.append(f"{source}: {where}: {name}'s textures are drawn without ({mesh_hint})")
     return maps, warnings
 
 

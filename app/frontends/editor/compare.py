@@ -72,7 +72,28 @@ def reference_problem(state) -> str:
                 f"'{state.mesh_spec}'; 'alight reference' traces paths for meshes that shadow themselves)")
     if state.use_file_materials:
         return "reference compare: uses the panel's material (untick the mesh file's own materials)"
+    from alight.accuracy.reference import check_layer_lobes, check_layer_roughness, check_roughness
+
+    m = state.material
+    try:   # the reference's own limits, said with the panel's names (the CLI's name its flags)
+        check_roughness(m.roughness, name=control_name)
+        check_layer_roughness(m, name=control_name)
+        check_layer_lobes(m, [m.roughness], name=control_name)
+    except AlightError as exc:
+        return f"reference compare: {exc}"
     return ""
+
+
+def control_name(field: str) -> str:
+    """The panel's control for a material field, as an error names it ('--roughness' is the
+    CLI's): "'roughness' (Material)", "'clearcoat roughness' (Material, Clearcoat)"."""
+    from alight.frontends.editor.layer_rows import SECTIONS
+
+    for section in SECTIONS:
+        for row in section.rows:
+            if row.field == field:
+                return f"'{row.label}' (Material, {section.title})"
+    return f"'{field.replace('_', ' ')}' (Material)"
 
 
 def divider_from_mouse(mouse_x: float, view_width: float) -> float:

@@ -25,6 +25,7 @@ class LibraryPanel:
         self._stamp = None
         self._scanned = -1e9
         self.clicked = None               # the entry clicked this frame, applied by apply_click
+        self.pending = ""                 # an entry's name to replace once the artist confirms
 
     def rescan(self, force: bool = False) -> None:
         now = time.monotonic()
@@ -92,14 +93,49 @@ class LibraryPanel:
         except AlightError as exc:
             s.fail(exc)
 
-    def save(self, s, name: str) -> None:
-        """The material and its maps into the library as NAME.glb; the panel's message says where."""
+    def save(self, s, name: str, replace: bool = False) -> bool:
+        """The material and its maps into the library as NAME.glb; the panel's message says where.
+        An entry of that name holding another material is replaced only once the artist says so
+        (``draw_confirm``'s dialog, then ``replace``): a save is not undoable. Returns whether it
+        was written now."""
         try:
+            stem = library.entry_name(name)
+            existing = library.library_dir() / f"{stem}{library.LIBRARY_SUFFIX}"
+            same = any(e.name == stem and e.material == s.material and e.maps == s.texture_maps
+                       for e in self.entries)
+            if existing.is_file() and not same and not replace:
+                self.pending = stem
+                s.error, s.message = "", f"'{stem}' is in the library already: replace it?"
+                return False
             path = library.save_entry(s.material, s.texture_maps, name)
         except AlightError as exc:
             s.fail(exc)
-            return
+            self.name = ""   # the field shows the material's name again, not the name that failed
+            return False
         s.mark_saved()
         self.name = ""
         s.error, s.message = "", f"saved to the library: {path}"
         self.rescan(force=True)
+        return True
+
+    def draw_confirm(self, s) -> None:
+        """The dialog asking whether to replace a library entry (``save``), while one is pending:
+        a modal, so a click aimed at anything else does nothing until it is answered."""
+        from imgui_bundle import imgui
+
+        title = "replace library entry"
+        if self.pending and not imgui.is_popup_open(title):
+            imgui.open_popup(title)
+        if not imgui.begin_popup_modal(title, None, imgui.WindowFlags_.always_auto_resize)[0]:
+            return
+        imgui.text(f"The library has a material named '{self.pending}'. Replace it with this one?")
+        if imgui.button(f"replace {self.pending}"):
+            name, self.pending = self.pending, ""
+            self.save(s, name, replace=True)
+            imgui.close_current_popup()
+        imgui.same_line()
+        if imgui.button("keep the old one") or imgui.is_key_pressed(imgui.Key.escape, False):
+            s.error, s.message = "", f"kept the library's '{self.pending}'"
+            self.pending = ""
+            imgui.close_current_popup()
+        imgui.end_popup()

@@ -138,6 +138,10 @@ class Panel:
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
         self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
+        self.layout = None   # the scroll, each section header's height, the content's end (draw)
+        self._removed = []   # (index, light, height): removed lights' places, kept while the pointer is there
+        # Each path field's last path that worked (_attempt): a failed one is not left showing.
+        self._good = {"preset_path": self.preset_path, "gltf_path": self.gltf_path}
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -158,28 +162,40 @@ class Panel:
         self.shown_error = s.error
         self._status_line(s, win)
         self._follow_loaded(s)
-        if imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
+        headers = []   # each section header's height: the layout's signature (press_guard.py)
+
+        def header(label, flags=0):
+            opened = imgui.collapsing_header(label, flags)
+            headers.append(round(imgui.get_item_rect_min().y))
+            return opened
+
+        if header("Material", imgui.TreeNodeFlags_.default_open):
             self._material(s, win)
-        if imgui.collapsing_header("Environment"):
+        if header("Environment"):
             self._environment(s, win)
-        if imgui.collapsing_header("Lights"):
+        if header("Lights"):
             self._lights(s)
-        if imgui.collapsing_header("Display & camera"):
+        else:
+            self._removed = []   # a closed section keeps no removed lights' places
+        if header("Display & camera"):
             self._display(s, win)
-        if imgui.collapsing_header("Compare"):   # the A/B split view (app/frontends/editor/compare.py)
+        if header("Compare"):   # the A/B split view (app/frontends/editor/compare.py)
             from alight.frontends.editor.compare import draw_section
 
             draw_section(win, self.presets)
-        if imgui.collapsing_header("Performance", imgui.TreeNodeFlags_.default_open):
+        if header("Performance", imgui.TreeNodeFlags_.default_open):
             self._performance(win)
-        if imgui.collapsing_header("Accuracy chart"):   # the latest 'alight chart' (app/frontends/editor/chart_view.py)
+        if header("Accuracy chart"):   # the latest 'alight chart' (app/frontends/editor/chart_view.py)
             from alight.frontends.editor.chart_view import ChartView
 
             self.chart_view = getattr(self, "chart_view", None) or ChartView()
             self.chart_view.draw()
+        # Where the controls are this frame: a press aimed at another layout is not delivered.
+        self.layout = (round(imgui.get_scroll_y()), tuple(headers), round(imgui.get_cursor_pos_y()))
         imgui.end()
         imgui.pop_style_color(2)
         imgui.pop_style_var()
+        self.library.draw_confirm(s)
         self.browser.draw()
         close_popup_on_escape()
 
@@ -218,9 +234,9 @@ class Panel:
         if specs == self._specs_shown:
             return
         if s.mesh_spec != self._specs_shown[0] and s.mesh_spec not in BUILTIN_MESHES:
-            self.mesh_path = s.mesh_spec
+            self.mesh_path = self._good["mesh_path"] = s.mesh_spec
         if s.env_spec != self._specs_shown[1] and s.env_spec != "studio":
-            self.env_path = s.env_spec
+            self.env_path = self._good["env_path"] = s.env_spec
         self._specs_shown = specs
 
     # --- sections -------------------------------------------------------------------------------
@@ -307,28 +323,48 @@ class Panel:
             s.step_history(win.history, redo=True)
         _, self.preset_path = imgui.input_text("preset file", self.preset_path)
         if imgui.button("save preset"):
-            try:
-                s.save_material(self.preset_path)
-                s.error, s.message = "", f"saved {self.preset_path}"
-            except AlightError as exc:
-                s.fail(exc)
-            else:   # a saved material is in the library too, under the file's name
-                self.library.save(s, self.preset_path)
-                if not s.error:
-                    s.message = f"saved {self.preset_path} and {s.message.removeprefix('saved ')}"
+            self._attempt(s, "preset_path", lambda: self._save_preset(s))
         imgui.same_line()
         if imgui.button("load preset"):
-            s.open_file(self.preset_path)
+            self._attempt(s, "preset_path", lambda: s.open_file(self.preset_path))
         imgui.same_line()
         self._browse("browse files", (".hdr", ".exr", ".obj", ".gltf", ".glb", ".ply", ".stl", ".json"),
                      s.open_file)
         _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
         if imgui.button("export glTF"):   # the mesh with the material and its maps (.gltf or .glb)
-            try:
-                s.export_gltf(self.gltf_path)
-                s.error, s.message = "", f"exported {self.gltf_path}"
-            except AlightError as exc:
-                s.fail(exc)
+            self._attempt(s, "gltf_path", lambda: self._export_gltf(s))
+
+    def _save_preset(self, s) -> None:
+        """'save preset': the file (a .json with maps loaded: the factors, and the status row
+        says the maps were left out), then a copy into the library under the file's name."""
+        try:
+            note = s.save_material(self.preset_path)
+        except AlightError as exc:
+            s.fail(exc)
+            return
+        saved = self.library.save(s, self.preset_path)   # a saved material is in the library too
+        if not s.error:
+            done = f"saved {self.preset_path}{f' ({note})' if note else ''}"
+            s.message = f"{done} and {s.message.removeprefix('saved ')}" if saved else f"{done}; {s.message}"
+
+    def _export_gltf(self, s) -> None:
+        try:
+            s.export_gltf(self.gltf_path)
+            s.error, s.message = "", f"exported {self.gltf_path}"
+        except AlightError as exc:
+            s.fail(exc)
+
+    def _attempt(self, s, field: str, action) -> None:
+        """Run a path field's action (open, load, save); where it fails the field goes back to
+        the path that last worked (what is loaded or saved), and the status row names the path
+        that failed: a field never shows a file that is not what the editor holds."""
+        typed = getattr(self, field)
+        s.error = ""
+        action()
+        if s.error:
+            setattr(self, field, self._good.get(field, ""))
+        else:
+            self._good[field] = typed
 
     def _layers(self, s, m):
         """A collapsible section per layer of the material-field registry (layer_rows.py), open
@@ -384,7 +420,7 @@ class Panel:
                               "together): each goes to its slot by its name (NAME_BaseColor, _Normal, "
                               "_Roughness, _Metallic, _AO, _ORM, ...); the material takes the set's name")
         if imgui.button("load set") and self.set_path.strip():
-            self._load_texture_set(s, self.set_path)
+            self._attempt(s, "set_path", lambda: self._load_texture_set(s, self.set_path))
         imgui.same_line()
         if imgui.button("browse set"):   # any image of the set: its folder is loaded
             self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,
@@ -417,9 +453,9 @@ class Panel:
         imgui.same_line()
         if imgui.button("load##typed") and self.map_path:
             if os.path.isdir(self.map_path):
-                self._load_texture_set(s, self.map_path)
+                self._attempt(s, "map_path", lambda: self._load_texture_set(s, self.map_path))
             else:
-                loader(s.armed_slot)(self.map_path)
+                self._attempt(s, "map_path", lambda: loader(s.armed_slot)(self.map_path))
         changed, v = imgui.drag_float2("UV tiling", list(maps.uv_scale), 0.02, -64.0, 64.0)
         if changed:
             s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=tuple(v))
@@ -461,7 +497,7 @@ class Panel:
         imgui.text(f"environment: {s.env_spec}")
         _, self.env_path = imgui.input_text("env file", self.env_path)
         if imgui.button("open env"):
-            s.open_file(self.env_path)
+            self._attempt(s, "env_path", lambda: s.open_file(self.env_path))
         imgui.same_line()
         self._browse("browse env", (".hdr", ".exr"), s.open_file)
         imgui.same_line()
@@ -484,12 +520,7 @@ class Panel:
             imgui.set_tooltip("a built-in mesh, framed from its 3/4 view; or type a mesh file below")
         _, self.mesh_path = imgui.input_text("mesh", self.mesh_path)
         if imgui.button("open mesh"):
-            try:
-                s.load_mesh(self.mesh_path)
-                warned = f" ({s.warnings} warning{'s' if s.warnings > 1 else ''} on stderr)" if s.warnings else ""
-                s.error, s.message = "", f"opened mesh {self.mesh_path}{warned}"
-            except AlightError as exc:
-                s.fail(exc)
+            self._attempt(s, "mesh_path", lambda: self._open_mesh(s))
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
         if imgui.is_item_hovered():
             imgui.set_tooltip("or Shift + right drag in the view")
@@ -523,6 +554,14 @@ class Panel:
         if win.bake_seconds:
             imgui.text(f"last bake: {sum(win.bake_seconds.values()) * 1000:.0f} ms")
 
+    def _open_mesh(self, s) -> None:
+        try:
+            s.load_mesh(self.mesh_path)
+            warned = f" ({s.warnings} warning{'s' if s.warnings > 1 else ''} on stderr)" if s.warnings else ""
+            s.error, s.message = "", f"opened mesh {self.mesh_path}{warned}"
+        except AlightError as exc:
+            s.fail(exc)
+
     def _lights(self, s) -> None:
         from imgui_bundle import imgui
 
@@ -530,9 +569,12 @@ class Panel:
         # The fields narrower here, so the longest label ends at the panel's edge, not past it.
         imgui.push_item_width(-(imgui.calc_text_size(LONGEST_LIGHT_LABEL).x + imgui.get_style().item_inner_spacing.x))
         remove = None
+        top = imgui.get_cursor_screen_pos().y
         # Lights are replaced, not mutated, so the renderer's "lights changed?" check stays honest.
         for i, light in enumerate(s.lights):
+            self._removed_places(s, i)
             imgui.push_id(i)
+            start = imgui.get_cursor_pos_y()
             imgui.separator()
             imgui.text(f"{i}: {light.kind}")
             imgui.same_line()
@@ -557,10 +599,29 @@ class Panel:
                                                 inner_cone_deg=min(inner, outer), outer_cone_deg=max(outer, 1e-3))
             if light != s.lights[i]:
                 s.lights[i] = light
+            if remove == i:
+                height = imgui.get_cursor_pos_y() - start
             imgui.pop_id()
+        self._removed_places(s, len(s.lights))
         imgui.pop_item_width()
+        k, self._restore = getattr(self, "_restore", None), None
+        if k is not None:
+            j, light, _ = self._removed[k]
+            s.lights.insert(j, light)
+            self._removed = [(i + (i > j or (i == j and n > k)), lt, h)
+                             for n, (i, lt, h) in enumerate(self._removed) if n != k]
         if remove is not None:
+            # Its place stays (a row 'removed', 'restore') while the pointer is in the section: the
+            # lights below do not move up under a second click aimed at this one's 'remove'.
+            self._removed = [(j - (j > remove), lt, h) for j, lt, h in self._removed]
+            self._removed.append((remove, s.lights[remove], height))
             del s.lights[remove]
+        io = imgui.get_io()
+        x0 = imgui.get_window_pos().x
+        inside = x0 <= io.mouse_pos.x < x0 + imgui.get_window_width() and \
+            top <= io.mouse_pos.y < imgui.get_cursor_screen_pos().y
+        if self._removed and not inside and not imgui.is_any_mouse_down():
+            self._removed = []   # the pointer left: the list closes up
         if imgui.button("add point"):
             s.lights.append(Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0))
         imgui.same_line()
@@ -570,6 +631,25 @@ class Panel:
         if imgui.button("add spot"):   # above and in front, pointing at the origin
             s.lights.append(Light("spot", (0.0, 3.0, 3.0), (1.0, 1.0, 1.0), 30.0,
                                   direction=(0.0, -0.7071, -0.7071), inner_cone_deg=15.0, outer_cone_deg=30.0))
+
+    def _removed_places(self, s, index: int) -> None:
+        """The places of the lights removed just before list position ``index``: as tall as the
+        light was, with its kind and a 'restore' button at the row's start (not under 'remove')."""
+        from imgui_bundle import imgui
+
+        for k, (j, light, height) in enumerate(list(self._removed)):
+            if j != index:
+                continue
+            imgui.push_id(f"removed{k}")
+            start = imgui.get_cursor_pos_y()
+            imgui.separator()
+            if imgui.small_button("restore"):
+                self._restore = k   # put back after the list is drawn
+            imgui.same_line()
+            imgui.text_disabled(f"{light.kind} light removed")
+            imgui.dummy(imgui.ImVec2(1.0, max(0.0, height - (imgui.get_cursor_pos_y() - start)
+                                              - imgui.get_style().item_spacing.y)))
+            imgui.pop_id()
 
     def _display(self, s, win) -> None:
         from imgui_bundle import imgui

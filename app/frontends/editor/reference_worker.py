@@ -58,11 +58,13 @@ def reference_bands(renderer, scene, env, width: int, height: int, scale: float,
     use_env = env is not None and scene.ibl_enabled
     radiance = None
     if use_env:
+        from alight.frontends.editor.compare import control_name   # the panel's names, not the CLI's flags
+
         roughnesses = rr.scene_roughnesses(scene)
         for r in roughnesses:
-            check_roughness(r)
-        check_layer_roughness(rr.layered_material(scene))
-        check_layer_lobes(rr.layered_material(scene), roughnesses)
+            check_roughness(r, name=control_name)
+        check_layer_roughness(rr.layered_material(scene), name=control_name)
+        check_layer_lobes(rr.layered_material(scene), roughnesses, name=control_name)
         # Reduced once here (the reference's own choice of level), not per band.
         radiance = env_level_radiance(np.asarray(env.radiance, np.float32),
                                       choose_env_level(env.radiance, roughnesses))

@@ -27,6 +27,9 @@ from alight.ibl.bake import QUALITY
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
+# A material file's layer textures are drawn where the file is the mesh (material_files.MESH_HINT's
+# words for the editor's controls).
+EDITOR_MESH_HINT = "open the file as the mesh ('mesh', Environment) with 'mesh file's own materials' ticked to use them"
 # From the registry, so a layer added there is a --script key too (a colour as R,G,B).
 VECTOR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "color")
 SCALAR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "number")
@@ -245,21 +248,31 @@ class EditorState:
         from alight.exchange.material_files import load_material_file
         from alight.exchange.texture_sets import load_map_images
 
-        m, maps, warnings = load_material_file(name_or_path)
+        m, maps, warnings = load_material_file(name_or_path, mesh_hint=EDITOR_MESH_HINT)
         images = load_map_images(maps)   # read first: a bad map changes nothing
         self._say(warnings)
         self.material = self.saved_material = m
         self.texture_maps = self.saved_texture_maps = dataclasses.replace(maps)
         self.map_images = images
 
-    def save_material(self, path: str) -> None:
+    def save_material(self, path: str) -> str:
         """The material with its maps: .gltf (images beside it) or .glb with the mesh shown, so
-        the file reopens (here, in ``alight render --preset/--mesh``, other viewers) as drawn;
-        .json holds factors only and is refused when there are maps."""
+        the file reopens (here, in ``alight render --preset/--mesh``, other viewers) as drawn.
+        A .json preset holds factors only: with maps loaded it is written with the factors, and
+        the returned note (else '') says the maps were left out and where they are kept. (The
+        CLI's ``alight export`` still refuses: it has no status row to say so.)"""
         from alight.exchange.material_files import is_gltf, save_material_file
 
-        save_material_file(self.material, path, self.texture_maps, mesh=self.mesh if is_gltf(path) else None)
+        gltf = is_gltf(path)
+        left_out = {} if gltf else self.texture_maps.paths()
+        save_material_file(self.material, path, self.texture_maps if gltf else None,
+                           mesh=self.mesh if gltf else None)
         self.mark_saved()
+        if not left_out:
+            return ""
+        n = len(left_out)
+        return (f"factors only: {n} map{'s' if n > 1 else ''} left out "
+                f"({', '.join(left_out)}); save as .gltf or .glb to keep them")
 
     def export_gltf(self, path: str) -> None:
         """The edited material, its maps and the mesh (UVs, tangents) as .gltf or .glb

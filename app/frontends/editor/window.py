@@ -96,11 +96,14 @@ class EditorWindow:
             from alight.frontends.editor.keys import KeyEvents
 
             self.key_events = KeyEvents()
+            from alight.frontends.editor.press_guard import PressGuard
+
+            self.press_guard = PressGuard()   # presses aimed at a layout gone are dropped (press_guard.py)
             glfw.set_key_callback(self.window, self._key_callback)
             glfw.set_char_callback(self.window, lambda _w, c: self.key_events.char(c))
             glfw.set_cursor_pos_callback(self.window, self._cursor_callback)   # each motion where it was
             # Buttons and the wheel through the same queue, so a Ctrl+click keeps its order.
-            glfw.set_mouse_button_callback(self.window, lambda _w, b, a, m: self.key_events.button(b, a, m))
+            glfw.set_mouse_button_callback(self.window, self._button_callback)
             glfw.set_scroll_callback(self.window, lambda _w, dx, dy: self.key_events.scroll(dx, dy))
             self._native_imgui = self._start_native_imgui(imgui)
         from alight.frontends.editor.panel_image import PanelImage
@@ -172,6 +175,7 @@ class EditorWindow:
         self.turntable_request = False  # set by the panel's button or T; started after the frame
         self.turntable_job = None       # the turntable being drawn, a few frames a frame
         self.redraws = 0   # scene redraws so far (the Performance section shows it)
+        self._frame_no = 0   # frames built so far (press_guard.py tells them apart)
         self.adaptive_scale = 0.5      # the adaptive motion scale now (see adapt_motion_scale)
         self._was_moving = False
         from alight.frontends.editor.hot_reload import ShaderWatcher
@@ -219,11 +223,28 @@ class EditorWindow:
         name = self.glfw.get_key_name(key, scancode) if key != self.glfw.KEY_UNKNOWN else None
         self.key_events.key(translate_key(key, name), scancode, action, mods)
 
+    def _button_callback(self, _window, button, action, mods) -> None:
+        self.key_events.button(button, action, mods)
+        if action == self.glfw.PRESS:
+            self.press_guard.pressed(self.key_events.pending[-1])
+
+    def _over_panel(self, x: float, y: float) -> bool:
+        """Whether a press at (x, y) (window coordinates) is for the panel: over the side bar, or
+        over a popup of it (imgui wanted the mouse last frame)."""
+        return self.show_panel and (x >= self._sizes()[1][0] - self.panel_width()
+                                    or self.imgui.get_io().want_capture_mouse)
+
     def _deliver_keys(self) -> None:
         """This frame's key and character events to imgui, in order (keys.KeyEvents says why
-        not all of them)."""
+        not all of them), less the presses aimed at a panel layout gone (press_guard.py)."""
         io = self.imgui.get_io()
-        for event in self.key_events.take_frame():
+        guard = self.press_guard
+        dropped = guard.dropped
+        events, rest = guard.sort(self.key_events.take_frame(), self._frame_no, self._over_panel)
+        self.key_events.pending[:0] = rest
+        if guard.dropped != dropped and not self.state.error:
+            self.state.message = "a click came as the panel's controls moved: not applied (click again)"
+        for event in events:
             kind = event[0]
             if kind == "key":
                 self.impl.keyboard_callback(self.window, *event[1:])
@@ -635,11 +656,15 @@ class EditorWindow:
 
     def frame(self) -> None:
         self.draw()
+        if not self.hosted:   # events that came while the last frame was shown (press_guard.py)
+            self.glfw.poll_events()
         self.glfw.swap_buffers(self.window)
         self.after_swap()
 
     def after_swap(self) -> None:
         """After the frame is shown: the screenshot asked for during it, the frame time."""
+        if not self.hosted:
+            self.press_guard.shown = self._frame_no
         if self.screenshot_request and self.screenshot_job is None:
             path, self.screenshot_request = self.screenshot_request, ""
             try:
@@ -670,8 +695,11 @@ class EditorWindow:
         shader watcher, the undo history."""
         if self.hosted:
             self._size_cache = None   # the runner polled the events
+        self._frame_no += 1
         if self.show_panel:
             self.panel.draw(self)
+            if not self.hosted:
+                self.press_guard.built(self._frame_no, self.panel.layout)
         from alight.frontends.editor.compare import draw_overlay
 
         draw_overlay(self)   # the compare divider's line and the halves' names, over the view

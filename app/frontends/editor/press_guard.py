@@ -1,0 +1,68 @@
+"""Presses aimed at a layout the panel no longer has are not delivered (issue 22).
+
+Frames here take 50-500 ms, so a click aimed at what the screen showed can reach the editor
+after the panel's controls moved: a section collapsed, a library entry appeared, the panel
+scrolled; it then lands on whatever control moved under the pointer (once it overwrote a library
+entry). Each mouse press is stamped with the frame on screen when it arrived (the editor's loop
+polls its events once more just before each swap, so a press that came while frame N-1 was shown
+is told from one after frame N was), and is handed to imgui only if the panel's layout (the
+``Panel.layout`` signature: the scroll, each section header's height and the content's end) in
+the last frame built equals the layout of that frame on screen. Otherwise the press and its
+release are dropped and the status row says so. Pure: no imgui, no glfw.
+"""
+
+from __future__ import annotations
+
+from alight.frontends.editor.keys import PRESS, RELEASE
+
+KEPT_LAYOUTS = 8   # frames whose layout is remembered (a press is aimed at one of the last two)
+
+
+class PressGuard:
+    def __init__(self):
+        self.layouts: dict[int, object] = {}   # frame number -> the panel's layout in that frame
+        self.shown = -1        # the frame on screen now (set after each swap)
+        self.aims: dict[int, int] = {}   # id of a queued press event -> the frame on screen when it came
+        self._dropping: set[int] = set()   # buttons whose release belongs to a dropped press
+        self.dropped = 0       # presses dropped so far
+        self.pointer = (-1.0, -1.0)   # the pointer's last position in the events sorted
+
+    def pressed(self, event) -> None:
+        """A press event just queued: it is aimed at the frame on screen now."""
+        self.aims[id(event)] = self.shown
+
+    def built(self, frame: int, layout) -> None:
+        self.layouts[frame] = layout
+        for old in [k for k in self.layouts if k <= frame - KEPT_LAYOUTS]:
+            del self.layouts[old]
+
+    def sort(self, events: list[tuple], last_built: int, over_panel) -> tuple[list[tuple], list[tuple]]:
+        """(the events to hand imgui this frame, the rest: back to the queue's front). One button
+        change a frame: imgui would spread a press and release that came together over frames of
+        its own (its input trickling), and a press must reach it in the frame after
+        ``last_built``, whose layout it is checked against. A press over the panel (``over_panel``
+        (x, y) -> bool, window coordinates) aimed at a layout other than ``last_built``'s is
+        dropped, with its release."""
+        out = []
+        changed = False
+        for i, event in enumerate(events):
+            if event[0] == "cursor":
+                self.pointer = (event[1], event[2])
+            if event[0] != "button":
+                out.append(event)
+                continue
+            button, action = event[1], event[2]
+            if action == RELEASE and button in self._dropping:
+                self._dropping.discard(button)
+                continue
+            if changed:
+                return out, events[i:]
+            if action == PRESS:
+                aim = self.aims.pop(id(event), self.shown)
+                if over_panel(*self.pointer) and self.layouts.get(aim) != self.layouts.get(last_built):
+                    self._dropping.add(button)
+                    self.dropped += 1
+                    continue
+            out.append(event)
+            changed = True
+        return out, []
