@@ -816,13 +816,20 @@ class _Reader:
             det = np.einsum("ni,ni->n", m[:, 0], cof[:, 0])
             sign = np.where(det < 0, -1.0, 1.0)
             faces = local.indices
-            flip = (sign < 0) if len(sign) == 1 else (sign[faces[:, 0]] < 0)
             if len(sign) == 1:
-                flip = np.repeat(flip, len(faces))
-            faces = np.where(flip[:, None], faces[:, ::-1], faces)
+                faces = faces[:, ::-1] if sign[0] < 0 else faces
+            else:
+                faces = np.where((sign[faces[:, 0]] < 0)[:, None], faces[:, ::-1], faces)
             cof = cof * sign[:, None, None]
-            normals, ok = _normalize(_apply(cof, local.normals))
-            normals[~ok] = (0.0, 1.0, 0.0)
+            # A node without a transform (most big scans) keeps the decoded arrays as they are:
+            # their normals are unit already (_decode_primitive), and each pass over millions of
+            # float64 rows costs a fraction of a second and its copy.
+            identity = per_vertex is None and np.array_equal(world, np.eye(4))
+            if identity:
+                normals = local.normals
+            else:
+                normals, ok = _normalize(_apply(cof, local.normals))
+                normals[~ok] = (0.0, 1.0, 0.0)
             tangents = None
             if local.tangents is not None:
                 t_xyz, t_ok = _normalize(_apply(m, local.tangents[:, :3]))
@@ -836,7 +843,8 @@ class _Reader:
                 tangents = np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32)
             out.append(MeshPart(
                 name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
-                positions=np.ascontiguousarray(_apply(m, local.positions) + t, dtype=np.float32),
+                positions=np.ascontiguousarray(local.positions if identity else _apply(m, local.positions) + t,
+                                               dtype=np.float32),
                 normals=np.ascontiguousarray(normals, dtype=np.float32),
                 uvs=np.ascontiguousarray(local.uvs, dtype=np.float32),
                 tangents=tangents,
