@@ -7,6 +7,8 @@ the tables give medians, ranges and each row's ratio to the table's first row. A
     .venv/bin/python benchmarks/bench_assets.py                   # quick: about 10 min on 2 loaded cores
     .venv/bin/python benchmarks/bench_assets.py --full            # adds 4M triangles, 8k textures, 4k maps, 4096² output
     .venv/bin/python benchmarks/bench_assets.py --against main    # the triangle table for another git ref too
+    .venv/bin/python benchmarks/bench_assets.py --triangles-only 10000,1000000,4000000 --against main
+                                                                  # only those meshes: results/assets_triangles.md
 
 The inputs are generated into a temporary folder: a closed, bumpy UV sphere of N triangles with
 normals and uvs (.glb and .ply: the .ply without normals, so alight computes them), a 2 x 2
@@ -122,9 +124,14 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--against", default=None, help="a git ref whose triangle table runs alternated with this tree's")
     ap.add_argument("--only", default="triangles,textures,environments,outputs")
+    ap.add_argument("--triangles-only", default=None, metavar="N,N,...",
+                    help="only the triangle table, for these triangle counts (the first is the ratios' base)")
     args = ap.parse_args()
     only = set(args.only.split(","))
     triangles = [10_000, 1_000_000] + ([4_000_000] if args.full else [])
+    if args.triangles_only:
+        only = {"triangles"}
+        triangles = [int(t) for t in args.triangles_only.split(",")]
     textures = [1024, 2048, 4096] + ([8192] if args.full else [])
     environments = [1024, 2048] + ([4096] if args.full else [])
     outputs = [512, 1024, 2048] + ([4096] if args.full else [])
@@ -168,12 +175,13 @@ def main() -> None:
                     add("output size (built-in ball)", f"{s}x{s}", ["--out", out, "--size", str(s)])
     lines = ["# Cold `alight render` against its inputs (benchmarks/bench_assets.py)", "",
              f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {args.rounds} rounds alternated, "
-             f"{'--full' if args.full else 'quick'}; one fresh process per figure (imports, GL context, load, "
+             f"{'--triangles-only ' + args.triangles_only if args.triangles_only else '--full' if args.full else 'quick'}"
+             f"{', against ' + args.against if args.against else ''}; one fresh process per figure (imports, GL context, load, "
              "bake or bake-cache load, first frame with its shader compiles, PNG write). 1024x1024 4x MSAA "
              "unless the table varies the output size.", ""]
     for key, rows in results.items():
         lines += table(key, rows, "input")
-    name = "assets.md" if args.full else "assets_quick.md"
+    name = "assets_triangles.md" if args.triangles_only else "assets.md" if args.full else "assets_quick.md"
     (REPO / "benchmarks" / "results" / name).write_text("\n".join(lines))
     print("\n".join(lines))
 

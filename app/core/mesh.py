@@ -190,12 +190,35 @@ class MeshPart:
     positions: np.ndarray  # (N, 3) float32
     normals: np.ndarray  # (N, 3) float32, unit length
     uvs: np.ndarray  # (N, 2) float32, OpenGL convention (v = 0 bottom); zeros when absent
-    tangents: np.ndarray  # (N, 4) float32, bitangent = w * cross(n, t)
+    # (N, 4) float32, bitangent = w * cross(n, t). None: made from the uvs by compute_tangents
+    # when first read (MeshPart.tangents below), so a part no normal map is drawn on never pays
+    # for them (seconds and hundreds of MiB for millions of vertices).
+    tangents: np.ndarray | None
     indices: np.ndarray  # (M, 3) uint32, counter-clockwise front faces
     material: FileMaterial | None
     uvs1: np.ndarray | None = None  # (N, 2) float32, TEXCOORD_1
     colors: np.ndarray | None = None  # (N, 4) float32, linear RGBA
     element: str = ""
+
+
+def _part_tangents(part: MeshPart) -> np.ndarray:
+    tangents = part.__dict__.get("_tangents")
+    if tangents is None:
+        tangents = compute_tangents(part.positions, part.normals, part.uvs, part.indices)
+        part.__dict__["_tangents"] = tangents
+    return tangents
+
+
+def _set_part_tangents(part: MeshPart, tangents) -> None:
+    part.__dict__["_tangents"] = None if tangents is None else np.ascontiguousarray(tangents, dtype=np.float32)
+
+
+# After the dataclass is made: its __init__ assigns through the property's setter.
+MeshPart.tangents = property(_part_tangents, _set_part_tangents,
+                             doc="(N, 4) float32 tangents, made by compute_tangents on first read where the "
+                                 "part was given None")
+MeshPart.has_tangents = property(lambda part: part.__dict__.get("_tangents") is not None,
+                                 doc="Whether the tangents exist yet (given, or made by a read).")
 
 
 @dataclass

@@ -112,6 +112,7 @@ SHADER_OPTIONS: dict[str, str] = {
     "UNLIT": "KHR_materials_unlit: base colour only",
     "HAS_VERTEX_COLOR": "the mesh has COLOR_0",
     "HAS_UV1": "the mesh has TEXCOORD_1",
+    "PACKED_VERTICES": "normals and tangents arrive as int16 snorm (alight.render.gpu_mesh.pack_snorm16)",
     "MATERIAL_MAPS_MASK": "the maps present, a bit each (map_mask)",
     "MAP_UV1_MASK": "maps read with TEXCOORD_1",
     "MAP_TRANSFORM_MASK": "maps with KHR_texture_transform",

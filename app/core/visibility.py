@@ -237,14 +237,26 @@ def self_occludes(parts, faces: int = 2000, vertices: int = 20000, tolerance: fl
     face's plane (by more than ``tolerance`` times the mesh's size). False for a convex mesh and a
     flat one, whose faces see only the sky. Up to ``faces`` faces against up to ``vertices``
     vertices (seeded samples beyond those counts, for big meshes)."""
-    positions = np.concatenate([np.asarray(p.positions, np.float64) for p in parts])
-    if len(positions) < 4:
+    if sum(len(p.positions) for p in parts) < 4:
         return False
-    size = float(np.linalg.norm(positions.max(axis=0) - positions.min(axis=0))) or 1.0
+    lo = np.min([np.asarray(p.positions).min(axis=0) for p in parts if len(p.positions)], axis=0)
+    hi = np.max([np.asarray(p.positions).max(axis=0) for p in parts if len(p.positions)], axis=0)
+    size = float(np.linalg.norm(hi.astype(np.float64) - lo)) or 1.0
     rng = np.random.default_rng(0)
+    counts = [len(p.indices) for p in parts]
+    total = sum(counts)
+    # A big mesh's sample is drawn among its faces before any per-face array is made: the
+    # (T, 3, 3) corners of a 4M-triangle mesh were 0.8 GiB and seconds of work for 2000 faces.
+    # (A degenerate face drawn is dropped, so the sample can come out a little short.)
+    pick = np.sort(rng.choice(total, faces, replace=False)) if total > faces else None
     centroids, normals = [], []
-    for p in parts:
-        tri = np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)]
+    start = 0
+    for p, count in zip(parts, counts):
+        rows = np.asarray(p.indices).reshape(-1, 3)
+        if pick is not None:
+            rows = rows[pick[(pick >= start) & (pick < start + count)] - start]
+        start += count
+        tri = np.asarray(p.positions)[rows.astype(np.int64)].astype(np.float64)
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         length = np.linalg.norm(n, axis=1)
         keep = length > 1e-12 * size * size
@@ -252,13 +264,13 @@ def self_occludes(parts, faces: int = 2000, vertices: int = 20000, tolerance: fl
         normals.append(n[keep] / length[keep, None])
     centroids = np.concatenate(centroids)
     normals = np.concatenate(normals)
-    if len(centroids) > faces:
-        pick = rng.choice(len(centroids), faces, replace=False)
-        centroids, normals = centroids[pick], normals[pick]
-    if len(positions) > vertices:
-        positions = positions[rng.choice(len(positions), vertices, replace=False)]
-    for start in range(0, len(centroids), 256):
-        c, n = centroids[start:start + 256], normals[start:start + 256]
+    # The vertices likewise: only the sample becomes float64.
+    sizes = np.cumsum([0] + [len(p.positions) for p in parts])
+    chosen = np.sort(rng.choice(sizes[-1], vertices, replace=False)) if sizes[-1] > vertices else np.arange(sizes[-1])
+    positions = np.concatenate([np.asarray(p.positions)[chosen[(chosen >= a) & (chosen < b)] - a]
+                                for p, a, b in zip(parts, sizes[:-1], sizes[1:])]).astype(np.float64)
+    for start in range(0, len(centroids), 64):
+        c, n = centroids[start:start + 64], normals[start:start + 64]
         offset = np.einsum("ij,ij->i", c, n)
         ahead = positions @ n.T - offset                  # (V, C): > 0 in front of the face
         if (ahead > tolerance * size).any():

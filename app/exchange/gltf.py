@@ -166,7 +166,7 @@ class _Local:
     uvs: np.ndarray
     uvs1: np.ndarray | None
     colors: np.ndarray | None
-    tangents: np.ndarray
+    tangents: np.ndarray | None   # None: made later from the world-space part (MeshPart.tangents)
     indices: np.ndarray
     material: FileMaterial | None
     joints: tuple[np.ndarray, ...] = ()    # JOINTS_n (N, 4) ints, with WEIGHTS_n, for a skin
@@ -577,14 +577,11 @@ class _Reader:
             uv1 = uv1[source] if uv1 is not None else None
             colors = colors[source] if colors is not None else None
             origin = origin[source]
-        if tangents is None and uv0 is None:
-            tangents = _any_tangents(normals)   # no uvs: no map can be placed on it
-        elif tangents is None:
-            from alight.core.mesh import compute_tangents
-
-            tangents = compute_tangents(positions, normals, uvs, faces)   # for maps the user loads
+        # Without TANGENT and a normal map: None, made in world space from the uvs (or any
+        # perpendicular where there are none) if a map the user loads needs them (MeshPart.tangents).
         return _Local(positions=positions, normals=normals, uvs=uvs, uvs1=uv1, colors=colors,
-                      tangents=np.asarray(tangents, np.float64), indices=faces, material=material,
+                      tangents=None if tangents is None else np.asarray(tangents, np.float64), indices=faces,
+                      material=material,
                       joints=_skin_attributes(arrays, "JOINTS", origin),
                       weights=_skin_attributes(arrays, "WEIGHTS", origin))
 
@@ -819,27 +816,38 @@ class _Reader:
             det = np.einsum("ni,ni->n", m[:, 0], cof[:, 0])
             sign = np.where(det < 0, -1.0, 1.0)
             faces = local.indices
-            flip = (sign < 0) if len(sign) == 1 else (sign[faces[:, 0]] < 0)
             if len(sign) == 1:
-                flip = np.repeat(flip, len(faces))
-            faces = np.where(flip[:, None], faces[:, ::-1], faces)
+                faces = faces[:, ::-1] if sign[0] < 0 else faces
+            else:
+                faces = np.where((sign[faces[:, 0]] < 0)[:, None], faces[:, ::-1], faces)
             cof = cof * sign[:, None, None]
-            normals, ok = _normalize(_apply(cof, local.normals))
-            normals[~ok] = (0.0, 1.0, 0.0)
-            t_xyz, t_ok = _normalize(_apply(m, local.tangents[:, :3]))
-            t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
-            t_xyz, t_ok = _normalize(t_xyz)
-            if not t_ok.all():
-                axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-                fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
-                t_xyz[~t_ok] = fallback[~t_ok]
-            w = local.tangents[:, 3:4] * sign[:, None]
+            # A node without a transform (most big scans) keeps the decoded arrays as they are:
+            # their normals are unit already (_decode_primitive), and each pass over millions of
+            # float64 rows costs a fraction of a second and its copy.
+            identity = per_vertex is None and np.array_equal(world, np.eye(4))
+            if identity:
+                normals = local.normals
+            else:
+                normals, ok = _normalize(_apply(cof, local.normals))
+                normals[~ok] = (0.0, 1.0, 0.0)
+            tangents = None
+            if local.tangents is not None:
+                t_xyz, t_ok = _normalize(_apply(m, local.tangents[:, :3]))
+                t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
+                t_xyz, t_ok = _normalize(t_xyz)
+                if not t_ok.all():
+                    axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+                    fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
+                    t_xyz[~t_ok] = fallback[~t_ok]
+                w = local.tangents[:, 3:4] * sign[:, None]
+                tangents = np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32)
             out.append(MeshPart(
                 name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
-                positions=np.ascontiguousarray(_apply(m, local.positions) + t, dtype=np.float32),
+                positions=np.ascontiguousarray(local.positions if identity else _apply(m, local.positions) + t,
+                                               dtype=np.float32),
                 normals=np.ascontiguousarray(normals, dtype=np.float32),
                 uvs=np.ascontiguousarray(local.uvs, dtype=np.float32),
-                tangents=np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32),
+                tangents=tangents,
                 indices=np.ascontiguousarray(faces, dtype=np.uint32),
                 material=local.material,
                 uvs1=None if local.uvs1 is None else np.ascontiguousarray(local.uvs1, dtype=np.float32),
@@ -898,13 +906,6 @@ class _Reader:
 def _apply(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) vectors times (1, 3, 3) one matrix or (N, 3, 3) one a vertex."""
     return rows_times(v, m[0]) if len(m) == 1 else np.einsum("nij,nj->ni", m, v)
-
-
-def _any_tangents(normals: np.ndarray) -> np.ndarray:
-    """(N, 4) unit tangents orthogonal to the normals, w = 1 (a part without uvs)."""
-    axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-    t, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
-    return np.concatenate([t, np.ones((len(t), 1))], axis=1)
 
 
 def _missing_image_file(base: Path, uri: str) -> Path | None:

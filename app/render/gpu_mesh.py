@@ -18,38 +18,96 @@ SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color", "diffuse
 MAX_UPLOADED_MESHES = 8   # meshes kept on the GPU between frames (GpuMeshes.parts)
 
 
+# Vertex attributes as the GPU keeps them (GpuPart): normals and tangents as int16, decoded as
+# snorm in pbr.vert (PACKED_VERTICES: max(c / 32767, -1), GL 4.2's rule; moderngl's formats have
+# no normalized int16, so the shader divides), uvs as half floats where that holds to
+# UV_HALF_TEXELS of the textures they address. False: everything float32 (the reference path the
+# tests compare the packed one with).
+PACK_VERTICES = True
+SNORM16 = 32767.0
+# Half floats keep 11 significant bits: uvs in [0.5, 1) round by up to 2^-12, a quarter texel of a
+# 1024² map. They are used where the rounding stays under this many texels of the largest
+# texture the part reads with that uv set; a part with no texture keeps float32 (the user may
+# load a map of any size onto it later).
+UV_HALF_TEXELS = 1.0 / 8.0
+
+
+def pack_snorm16(values: np.ndarray) -> np.ndarray:
+    """(N, k) values in [-1, 1] as int16 snorm, rounded to nearest (decoded max(c / 32767, -1)):
+    at most 1.5e-5 off per component."""
+    return np.rint(np.clip(values, -1.0, 1.0) * SNORM16).astype(np.int16)
+
+
+def unpack_snorm16(packed: np.ndarray) -> np.ndarray:
+    """pbr.vert's decode of pack_snorm16, as float32 (its numpy twin)."""
+    return np.maximum(packed.astype(np.float32) / np.float32(SNORM16), np.float32(-1.0))
+
+
+def uvs_hold_as_half(uvs: np.ndarray, texels: int) -> bool:
+    """Whether ``uvs`` (N, 2) stored as half floats stay within UV_HALF_TEXELS of a
+    ``texels``-wide texture (0: no texture, float32 kept); out of half's range never."""
+    if texels <= 0 or not len(uvs):
+        return False
+    uvs = np.asarray(uvs, np.float32)
+    if not np.isfinite(uvs).all() or np.abs(uvs).max() > 60000.0:
+        return False
+    error = np.abs(uvs.astype(np.float16).astype(np.float32) - uvs).max()
+    return bool(error * texels <= UV_HALF_TEXELS)
+
+
 class GpuPart:
     """A mesh part's buffers, uploaded once, and what its shader variant needs to know.
 
-    The vertex buffer holds position, normal, uv and tangent, then TEXCOORD_1 and COLOR_0 only
-    when the part has them (pbr.vert's HAS_UV1, HAS_VERTEX_COLOR). Textures come from the mesh's
-    shared set (one upload per image and sampler).
+    The vertex buffer holds position (3 float32), normal (4 int16 snorm, the last 0), uv
+    (2 half floats where uvs_hold_as_half, else 2 float32), then TEXCOORD_1 (float32) and COLOR_0
+    (4 float32) only when the part has them (pbr.vert's HAS_UV1, HAS_VERTEX_COLOR): 28 or 24
+    bytes a vertex against 48 with float32 tangents. The tangents (4 int16 snorm) are a buffer of
+    their own, made the first time a program reads ``in_tangent`` (a normal or anisotropy map):
+    a part drawn without one never computes them (MeshPart.tangents is lazy). Textures come from
+    the mesh's shared set (one upload per image and sampler). No array the size of the mesh stays
+    on the CPU here; the MeshPart (the caller's) is kept for the tangents, the closedness test
+    and the anisotropy level.
     """
 
-    def __init__(self, ctx: moderngl.Context, part, textures: "MeshTextures"):
-        columns = [part.positions, part.normals, part.uvs, part.tangents]
-        self.layout = ["3f 3f 2f 4f", "in_position", "in_normal", "in_uv", "in_tangent"]
+    def __init__(self, ctx: moderngl.Context, part, textures: "MeshTextures", packed: bool | None = None):
+        self.packed = PACK_VERTICES if packed is None else bool(packed)
         self.has_uv1 = part.uvs1 is not None
         self.has_colors = part.colors is not None
+        self.infos: dict = {}
+        fm = part.material
+        if fm is not None:
+            self.infos = dict(fm.textures().items())
+        uv_texels = max((max(info.image.shape[:2]) for info in self.infos.values() if info.tex_coord == 0),
+                        default=0)
+        self.half_uvs = self.packed and uvs_hold_as_half(part.uvs, uv_texels)
+        n = len(part.positions)
+        # One structured array, each field written straight from the part's (float32) columns:
+        # no hstack of float64 copies, and ctx.buffer reads it without a tobytes() copy.
+        fields = [("in_position", np.float32, (3,), "3f")]
+        fields.append(("in_normal", np.int16, (4,), "4i2") if self.packed else ("in_normal", np.float32, (3,), "3f"))
+        fields.append(("in_uv", np.float16, (2,), "2f2") if self.half_uvs else ("in_uv", np.float32, (2,), "2f"))
         if self.has_uv1:
-            columns.append(part.uvs1)
-            self.layout[0] += " 2f"
-            self.layout.append("in_uv1")
+            fields.append(("in_uv1", np.float32, (2,), "2f"))
         if self.has_colors:
-            columns.append(part.colors)
-            self.layout[0] += " 4f"
-            self.layout.append("in_color")
-        # Interleaved into one array and handed to GL as it is (no hstack of float64 copies, no
-        # tobytes() copy): the CPU side peaks at one vertex buffer's bytes, then lets it go.
-        widths = [np.shape(c)[1] for c in columns]
-        vertices = np.empty((len(part.positions), sum(widths)), np.float32)
-        at = 0
-        for column, width in zip(columns, widths):
-            vertices[:, at:at + width] = column
-            at += width
+            fields.append(("in_color", np.float32, (4,), "4f"))
+        vertices = np.empty(n, np.dtype([(name, dtype, shape) for name, dtype, shape, _ in fields]))
+        vertices["in_position"] = part.positions
+        if self.packed:
+            vertices["in_normal"][:, :3] = pack_snorm16(part.normals)
+            vertices["in_normal"][:, 3] = 0
+        else:
+            vertices["in_normal"] = part.normals
+        vertices["in_uv"] = part.uvs
+        if self.has_uv1:
+            vertices["in_uv1"] = part.uvs1
+        if self.has_colors:
+            vertices["in_color"] = part.colors
+        self.layout = [" ".join(f for *_, f in fields), *(name for name, *_ in fields)]
+        self.vertex_bytes = vertices.dtype.itemsize
         self.vbo = ctx.buffer(vertices)
         del vertices
         self.ibo = ctx.buffer(np.ascontiguousarray(part.indices, dtype=np.uint32))
+        self.tangent_buffer: moderngl.Buffer | None = None
         self.ctx = ctx
         # More per-vertex buffers, (buffer, format, *names), and whether they carry the visibility
         # bake's values (alight.render.visibility_parts: HAS_VISIBILITY).
@@ -59,20 +117,17 @@ class GpuPart:
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}
         self.textures: dict[str, moderngl.Texture] = {}
-        self.infos: dict = {}
         self._part = part
         self._closed: bool | None = None
         self._anisotropy_key = None
         self._anisotropy = 1.0
-        positions = np.asarray(part.positions, np.float64)
-        self.lo = positions.min(axis=0) if len(positions) else np.zeros(3)    # bounding box corners
-        self.hi = positions.max(axis=0) if len(positions) else np.zeros(3)
+        positions = part.positions
+        # Bounding box corners (float32 reductions, exact: min and max pick elements).
+        self.lo = positions.min(axis=0).astype(np.float64) if len(positions) else np.zeros(3)
+        self.hi = positions.max(axis=0).astype(np.float64) if len(positions) else np.zeros(3)
         self.centre = (self.lo + self.hi) / 2.0
-        fm = part.material
-        if fm is not None:
-            for name, info in fm.textures().items():
-                self.infos[name] = info
-                self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
+        for name, info in self.infos.items():
+            self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
 
     @property
     def closed(self) -> bool:
@@ -108,16 +163,29 @@ class GpuPart:
     def vao_for(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._vaos.get(id(program))
         if vao is None:
+            buffers = [(self.vbo, *self.layout), *self.extra_buffers]
+            if program.get("in_tangent", None) is not None:   # active: the variant reads the tangent frame
+                buffers.append(self._tangents())
             vao = self._vaos[id(program)] = self.ctx.vertex_array(
-                program, [(self.vbo, *self.layout), *self.extra_buffers], self.ibo, index_element_size=4,
+                program, buffers, self.ibo, index_element_size=4,
                 skip_errors=True)  # a debug view may not read every attribute
         return vao
+
+    def _tangents(self) -> tuple:
+        """The tangent buffer and its format, uploaded on first use."""
+        if self.tangent_buffer is None:
+            tangents = np.asarray(self._part.tangents, np.float32)
+            data = pack_snorm16(tangents) if self.packed else np.ascontiguousarray(tangents)
+            self.tangent_buffer = self.ctx.buffer(data)
+        return (self.tangent_buffer, "4i2" if self.packed else "4f", "in_tangent")
 
     def release(self) -> None:
         for vao in self._vaos.values():
             vao.release()
         self.vbo.release()
         self.ibo.release()
+        if self.tangent_buffer is not None:
+            self.tangent_buffer.release()
 
 
 ANISOTROPIC_FILTERS = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR_MIPMAP_NEAREST,

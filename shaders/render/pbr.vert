@@ -29,6 +29,14 @@ out vec4 v_sun_bounce2;
 out vec3 v_baked_normal;
 #endif
 
+#ifdef PACKED_VERTICES
+// Normals and tangents arrive as int16 (alight.render.gpu_mesh.pack_snorm16): the snorm decode
+// of GL 4.2, max(c / 32767, -1), which moderngl's vertex formats cannot ask GL for.
+#define SNORM16(v) max((v) * (1.0 / 32767.0), -1.0)
+#else
+#define SNORM16(v) (v)
+#endif
+
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_view_projection;
@@ -41,8 +49,9 @@ out vec4 v_tangent;
 void main() {
     vec4 world = u_model * vec4(in_position, 1.0);
     v_position = world.xyz;
-    v_normal = u_normal_matrix * in_normal;
-    v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
+    v_normal = u_normal_matrix * SNORM16(in_normal);
+    vec4 tangent = SNORM16(in_tangent);
+    v_tangent = vec4(mat3(u_model) * tangent.xyz, tangent.w);
     v_uv = in_uv;
 #ifdef HAS_UV1
     v_uv1 = in_uv1;
