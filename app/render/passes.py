@@ -150,8 +150,10 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         fbo = targets.single()[1]
     else:
         frame.impostor_samples = 0
+    r.last_vbuffer = False
+    if frame.impostor_samples == 0:
         if vbuffer.wanted(r, scene, targets, fbo, background):
-            frame.vbuffer = True
+            frame.vbuffer = r.last_vbuffer = True
             fbo = targets.single()[1]
     frame.shadowed = prepare_shadows(r, scene, maps)    # (its own framebuffer: before this pass's)
     fbo.use()

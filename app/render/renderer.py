@@ -136,6 +136,7 @@ class ForwardRenderer:
         self.last_background_ring = False
         self.last_sphere_impostor: int | None = None
         self.last_anisotropy: dict[str, float] = {}
+        self.last_vbuffer = False   # whether the last scene pass shaded its mesh from the visibility buffer
         self._bakes: dict[tuple, IBLMaps] = {}
         self._targets: Targets | None = None
         self._units_assigned: set[int] = set()
