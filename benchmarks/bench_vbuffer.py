@@ -69,22 +69,26 @@ def sphere_file(folder: Path, triangles: int) -> Path:
     return path
 
 
-def steady(r, scene, maps, size: int, rounds: int) -> dict[str, list[float]]:
-    """Round medians of 3 frames per mode, the modes alternated round by round."""
+def steady(r, scene, maps, size: int, rounds: int) -> tuple[dict[str, list[float]], dict[str, list[float]]]:
+    """Round medians of 3 frames per mode, wall and CPU time (the process's, llvmpipe's threads
+    included: less moved by other jobs on the machine), the modes alternated round by round."""
     for mode in MODES:     # compiles both first
         r.mesh_shading = mode
         r.render(scene, maps, size, size, read_linear=False)
     times: dict[str, list[float]] = {m: [] for m in MODES}
+    cpu: dict[str, list[float]] = {m: [] for m in MODES}
     for i in range(rounds):
         for mode in (MODES if i % 2 == 0 else MODES[::-1]):
             r.mesh_shading = mode
-            runs = []
+            runs, cpus = [], []
             for _ in range(3):
-                t = time.perf_counter()
+                t, c = time.perf_counter(), time.process_time()
                 r.render(scene, maps, size, size, read_linear=False)
                 runs.append(time.perf_counter() - t)
+                cpus.append(time.process_time() - c)
             times[mode].append(statistics.median(runs))
-    return times
+            cpu[mode].append(statistics.median(cpus))
+    return times, cpu
 
 
 def rel_mae(r, scene, maps, size: int) -> tuple[float, float, float, bool]:
@@ -125,9 +129,11 @@ def main() -> None:
               "modes alternated; round medians: median (range)")
         for name, path in scenes.items():
             scene = Scene(mesh=load_mesh(str(path)))
-            times = steady(r, scene, maps, args.size, args.rounds)
-            print(f"  {name}: forward {summary(times['forward'])}, vbuffer {summary(times['vbuffer'])}, "
+            times, cpu = steady(r, scene, maps, args.size, args.rounds)
+            print(f"  {name} wall: forward {summary(times['forward'])}, vbuffer {summary(times['vbuffer'])}, "
                   f"vbuffer/forward {ratio_summary(times['forward'], times['vbuffer'])}")
+            print(f"  {name} CPU:  forward {summary(cpu['forward'])}, vbuffer {summary(cpu['vbuffer'])}, "
+                  f"vbuffer/forward {ratio_summary(cpu['forward'], cpu['vbuffer'])}")
         if args.first:
             env = {**os.environ, "MESA_SHADER_CACHE_DISABLE": "true"}
             for name, path in scenes.items():
