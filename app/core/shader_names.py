@@ -141,6 +141,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "BACKGROUND_RING": "the background drawn as a ring around the impostor's outline",
     "SCENE_SAMPLES": "the scene target's samples a pixel, read by the resolve",
     "NO_SURFACES": "the resolve runs where no surface was drawn (background only)",
+    "VBUFFER_SHADING": "a part shaded from the visibility buffer, its vertices fetched (app/render/vbuffer.py)",
+    "VERTEX_STRIDE": "the floats per vertex in the part's vertex buffer (app/render/gpu_mesh.py GpuPart)",
 }
 
 

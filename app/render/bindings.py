@@ -35,6 +35,7 @@ UNIT_ANISOTROPY_RATIO_A, UNIT_ANISOTROPY_RATIO_B = UNIT_SCENE_BEHIND + 1, UNIT_S
 UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_BEHIND + 3, UNIT_SCENE_BEHIND + 4
 # The shadow atlas (alight.render.shadows): with comparison (PCF) and as depths (the blocker search).
 UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH = UNIT_SCENE_BEHIND + 5, UNIT_SCENE_BEHIND + 6
+UNIT_VISIBILITY = UNIT_SCENE_BEHIND + 7   # the visibility buffer (alight.render.vbuffer)
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {
@@ -47,6 +48,7 @@ SAMPLER_UNITS = {
     "u_anisotropy_ratio_a": UNIT_ANISOTROPY_RATIO_A, "u_anisotropy_ratio_b": UNIT_ANISOTROPY_RATIO_B,
     "u_stretched_lobe_a": UNIT_STRETCHED_LOBE_A, "u_stretched_lobe_b": UNIT_STRETCHED_LOBE_B,
     "u_shadow_atlas": UNIT_SHADOW_ATLAS, "u_shadow_depth": UNIT_SHADOW_DEPTH,
+    "u_visibility": UNIT_VISIBILITY,
 }
 
 

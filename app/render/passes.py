@@ -35,6 +35,7 @@ from alight.render.bindings import (
     sun_world_directions,
 )
 from alight.render.gpu_mesh import ANISOTROPIC_FILTERS, GpuPart
+from alight.render import vbuffer
 from alight.render.ground import GroundPass
 from alight.render.shadows import casters as shadow_casters
 from alight.render.visibility_parts import light_through
@@ -67,6 +68,9 @@ class FrameContext:
     # resolve reads), 0 (a multisampled target: no impostor).
     impostor_model: np.ndarray | None = None
     impostor_samples: int = 1
+    # The mesh shaded from the visibility buffer (alight.render.vbuffer) into Targets.single,
+    # which the fused resolve reads.
+    vbuffer: bool = False
     shadowed: bool = False             # the pass reads the shadow maps (alight.render.shadows)
     view_projection: np.ndarray | None = None   # the pass's (a tile's: the image's, off centre)
     inverse_vp: np.ndarray | None = None        # its inverse: the background's rays
@@ -148,6 +152,11 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         fbo = targets.single()[1]
     else:
         frame.impostor_samples = 0
+    r.last_vbuffer = False
+    if frame.impostor_samples == 0:
+        if vbuffer.wanted(r, scene, targets, fbo, background):
+            frame.vbuffer = r.last_vbuffer = True
+            fbo = targets.single()[1]
     frame.shadowed = prepare_shadows(r, scene, maps)    # (its own framebuffer: before this pass's)
     fbo.use()
     ctx.viewport = (0, 0, width, height)
@@ -314,9 +323,9 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
         defines["HAS_SHADOWS"] = None
     bound: set[int] = set()
 
-    def program_for(variant: dict) -> moderngl.Program:
+    def program_for(variant: dict, vertex: str = "render/pbr.vert", fragment: str = "render/pbr.frag") -> moderngl.Program:
         all_defines = {**defines, **variant}
-        prog = scene_program(r, frame, "render/pbr.vert", "render/pbr.frag", all_defines)
+        prog = scene_program(r, frame, vertex, fragment, all_defines)
         if id(prog) not in bound:
             bound.add(id(prog))
             if scene.debug_view:
@@ -330,6 +339,9 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
 
     if blend:
         draw_mesh_parts(r, frame, scene, program_for, camera, view_projection, blend=True, image_size=image_size)
+        return
+    if frame.vbuffer:
+        vbuffer.draw(r, frame, scene, camera, view_projection, targets, program_for, image_size)
         return
     transmissive = transmissive_parts(scene)
     opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
@@ -413,41 +425,53 @@ def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_pr
             if id(program) not in prepared:
                 prepared.add(id(program))
                 _bind_view(program, ctx, frame, camera, view_projection, model, sphere_radius, proxy_model is not None)
-            material, maps_used = part_material(scene, part)
-            set_material(program, material)
-            _bind_part_factors(program, part.material if maps_used else None, material, maps_used, tiling)
-            if maps_used and any(info.transform is not None for info in gpu_part.infos.values()):
-                _bind_map_transforms(program, gpu_part)
-            bound_maps = []
-            for name in MATERIAL_MAPS:
-                tex = gpu_part.textures.get(name) if maps_used else user.get(name)
-                set_uniform(program, f"u_has_{name}_map", tex is not None)
-                if tex is not None:
-                    tex.use(UNIT_MATERIAL[name])
-                    if tex.filter[0] in ANISOTROPIC_FILTERS and tex.filter[1] != moderngl.NEAREST:
-                        bound_maps.append(tex)   # (a sampler's nearest magnification keeps 1: MeshTextures)
-            if bound_maps:
-                _set_anisotropy(r, scene, camera, gpu_part, part, bound_maps, size)
-            if part.element.startswith("meshes["):
-                # A glTF primitive: the file decides (the default material is single-sided).
-                cull = not (part.material is not None and part.material.double_sided)
-            else:
-                # A closed mesh's back faces are hidden: culling them halves the triangles
-                # rasterised and stops back faces drawn first from being shaded and then
-                # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
-                # behind (the shader flips n).
-                cull = gpu_part.closed
-            if cull:
-                ctx.front_face = "ccw"
-                ctx.enable(moderngl.CULL_FACE)
-            else:
-                ctx.disable(moderngl.CULL_FACE)
+            bind_part(r, scene, program, gpu_part, part, user, tiling, camera, size)
+            set_culling(ctx, gpu_part, part)
             gpu_part.vao_for(program).render(moderngl.TRIANGLES)
     finally:
         ctx.disable(moderngl.CULL_FACE)
         if blend:
             ctx.disable(moderngl.BLEND)
             ctx.depth_mask = True
+
+
+def bind_part(r, scene, program, gpu_part: GpuPart, part, user: dict, tiling: TextureMaps, camera: Camera,
+              size: tuple[int, int]) -> None:
+    """A part's material, factors, map transforms and maps (with their anisotropy for this view)
+    on ``program``; ``user``: the user's maps (GpuMeshes.user_textures)."""
+    material, maps_used = part_material(scene, part)
+    set_material(program, material)
+    _bind_part_factors(program, part.material if maps_used else None, material, maps_used, tiling)
+    if maps_used and any(info.transform is not None for info in gpu_part.infos.values()):
+        _bind_map_transforms(program, gpu_part)
+    bound_maps = []
+    for name in MATERIAL_MAPS:
+        tex = gpu_part.textures.get(name) if maps_used else user.get(name)
+        set_uniform(program, f"u_has_{name}_map", tex is not None)
+        if tex is not None:
+            tex.use(UNIT_MATERIAL[name])
+            if tex.filter[0] in ANISOTROPIC_FILTERS and tex.filter[1] != moderngl.NEAREST:
+                bound_maps.append(tex)   # (a sampler's nearest magnification keeps 1: MeshTextures)
+    if bound_maps:
+        _set_anisotropy(r, scene, camera, gpu_part, part, bound_maps, size)
+
+
+def set_culling(ctx, gpu_part: GpuPart, part) -> None:
+    """Back-face culling for the part, as its file or its closedness decides."""
+    if part.element.startswith("meshes["):
+        # A glTF primitive: the file decides (the default material is single-sided).
+        cull = not (part.material is not None and part.material.double_sided)
+    else:
+        # A closed mesh's back faces are hidden: culling them halves the triangles
+        # rasterised and stops back faces drawn first from being shaded and then
+        # overwritten (35% of the ball's cost on llvmpipe). Open meshes are seen from
+        # behind (the shader flips n).
+        cull = gpu_part.closed
+    if cull:
+        ctx.front_face = "ccw"
+        ctx.enable(moderngl.CULL_FACE)
+    else:
+        ctx.disable(moderngl.CULL_FACE)
 
 
 def _bind_view(program, ctx, frame: FrameContext, camera: Camera, view_projection: np.ndarray, model: np.ndarray,
@@ -557,7 +581,7 @@ def resolve(r, frame: FrameContext, scene, maps: IBLMaps | None, targets: Target
     radiance = radiance or not display
     mode = background_mode(scene, maps)
     # After the sphere's impostor the surfaces are in the single-sample stand-in, resolved already.
-    single = frame.impostor_samples == 4
+    single = frame.impostor_samples == 4 or frame.vbuffer
     defines = {"BACKGROUND_MODE": int(mode), "SCENE_SAMPLES": 1 if single else targets.samples}
     scene_texture = targets.single()[0] if single else targets.color
     if radiance:

@@ -125,6 +125,10 @@ class ForwardRenderer:
         # With the impostor and one sample a pixel, the background drawn around a hole the impostor
         # fills, without a depth buffer (passes.draw_scene); False: depth-tested after it (tests compare).
         self.background_ring = True
+        # How mesh files are shaded under 4x MSAA (alight.render.vbuffer MESH_SHADING): "forward"
+        # once per triangle covering a pixel's samples, "vbuffer" once per pixel (and per
+        # triangle only at its edges) from a visibility buffer, where the scene allows it.
+        self.mesh_shading = "forward"
         # What the last passes drew, for tests and benchmarks: the sphere's level, whether the
         # background's ring was drawn, the impostor's coverage samples (or None), and per
         # textured part's name the anisotropic filtering level.
@@ -132,6 +136,7 @@ class ForwardRenderer:
         self.last_background_ring = False
         self.last_sphere_impostor: int | None = None
         self.last_anisotropy: dict[str, float] = {}
+        self.last_vbuffer = False   # whether the last scene pass shaded its mesh from the visibility buffer
         self._bakes: dict[tuple, IBLMaps] = {}
         self._targets: Targets | None = None
         self._units_assigned: set[int] = set()

@@ -43,6 +43,7 @@ class Targets:
         self.draw = self.depth = self.radiance_fbo = self.radiance = self.display_fbo = self.display = None
         self._both_fbo = None
         self._single: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+        self._visibility: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.color = None
         try:
             self._allocate()
@@ -95,6 +96,14 @@ class Targets:
             self._single = (tex, self.ctx.framebuffer([tex]))
         return self._single
 
+    def visibility(self) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
+        """The visibility buffer (alight.render.vbuffer): per sample (triangle + 1, part + 1) as
+        unsigned integers, 0 where no surface, multisampled as the colour target, with its depth."""
+        if self._visibility is None:
+            tex = self.ctx.texture(self.draw_size, 2, samples=self.samples, dtype="u4")
+            self._visibility = (tex, self.ctx.framebuffer([tex], self.depth))
+        return self._visibility
+
     def display_draw(self) -> moderngl.Framebuffer:
         """The display image with the depth buffer, for ForwardRenderer.draw_display (no AA only)."""
         if self._display_draw is None:
@@ -119,6 +128,8 @@ class Targets:
             owned.extend(self._behind[::-1])
         if self._single is not None:
             owned.extend(self._single[::-1])
+        if self._visibility is not None:
+            owned.extend(self._visibility[::-1])
         release_objects(self.ctx, *owned)
 
 

@@ -15,6 +15,29 @@
 #include "common/surface.glsl"
 #include "common/material_layers.glsl"
 
+#ifdef VBUFFER_SHADING
+// Shaded from the visibility buffer (render/vbuffer_shade.frag): no rasteriser behind this pass,
+// so the "varyings" are globals its main() fills from the triangle's vertices at the shaded
+// point, with the uv derivatives per pixel (for the maps' mip level) and the facing it finds.
+vec3 v_position;
+vec3 v_normal;
+vec2 v_uv;
+vec4 v_tangent;
+#ifdef HAS_UV1
+vec2 v_uv1;
+vec2 vb_duv1_dx;
+vec2 vb_duv1_dy;
+#endif
+#ifdef HAS_VERTEX_COLOR
+vec4 v_color;
+#endif
+vec2 vb_duv_dx;
+vec2 vb_duv_dy;
+vec3 vb_centroid_normal;   // the normal at the triangle's covered samples' centroid
+vec3 vb_face_normal;   // the triangle's unit normal toward the eye (as cross(dFdx, dFdy) of the position)
+bool vb_front_facing;
+#define FRONT_FACING vb_front_facing
+#else
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
@@ -24,6 +47,8 @@ in vec2 v_uv1;
 #endif
 #ifdef HAS_VERTEX_COLOR
 in vec4 v_color;
+#endif
+#define FRONT_FACING gl_FrontFacing
 #endif
 
 uniform vec3 u_camera_position;
@@ -226,6 +251,20 @@ float mirrored_repeat(float x) {
 // unfolded derivatives, so the mip level does not jump at the folds.
 vec4 sample_map(sampler2D map, int bit, int slot) {
     vec2 uv = map_uv(bit, slot);
+#ifdef VBUFFER_SHADING
+    // The derivatives of the uvs this map reads, from the triangle's (a full-screen pass's own
+    // 2x2 blocks may straddle triangles): the tiling's scale, the uv set, the transform's linear part.
+    vec2 du = vb_duv_dx * u_uv_scale;
+    vec2 dv = vb_duv_dy * u_uv_scale;
+#ifdef HAS_UV1
+    if ((MAP_UV1_MASK & bit) != 0) { du = vb_duv1_dx; dv = vb_duv1_dy; }
+#endif
+    if ((MAP_TRANSFORM_MASK & bit) != 0) { du = mat2(u_map_transform[slot]) * du; dv = mat2(u_map_transform[slot]) * dv; }
+    vec2 folded = uv;
+    if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
+    if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
+    return textureGrad(map, folded, du, dv);
+#endif
     if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
         vec2 folded = uv;
         if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
@@ -240,6 +279,11 @@ vec4 sample_map(sampler2D map, int bit, int slot) {
 vec3 geometric_normal() {
 #ifdef SPHERE_SURFACE
     vec3 n = surface_position();
+#elif defined(VBUFFER_SHADING)
+    // As below, with the centroid's normal found by render/vbuffer_shade.frag.
+    vec3 n = v_normal;
+    if (dot(n, u_camera_position - v_position) * (vb_front_facing ? 1.0 : -1.0) < 0.0) n = vb_centroid_normal;
+    vec3 face = vb_face_normal;
 #else
     vec3 n = v_normal;
     // With MSAA the pixel centre of an edge pixel may lie off the triangle, where the
@@ -249,9 +293,11 @@ vec3 geometric_normal() {
     vec3 eye = u_camera_position - v_position;
     if (dot(n, eye) * (gl_FrontFacing ? 1.0 : -1.0) < 0.0) n = interpolateAtCentroid(v_normal);
 #endif
+#ifndef VBUFFER_SHADING
     vec3 face = normalize(cross(dFdx(v_position), dFdy(v_position)));
+#endif
     n = dot(n, n) > 1e-12 ? normalize(n) : face;
-    return gl_FrontFacing ? n : -n;
+    return FRONT_FACING ? n : -n;
 }
 
 // An orthonormal tangent frame about n from the mesh's tangent (Gram-Schmidt); a tangent

@@ -1,0 +1,136 @@
+"""Meshes shaded once per pixel from a visibility buffer (``ForwardRenderer.mesh_shading =
+"vbuffer"``), instead of once per triangle covering a pixel's samples.
+
+Under 4x MSAA a rasteriser shades a pixel once for every triangle that covers any of its
+samples, and llvmpipe shades whole 4x4 blocks per triangle: a mesh of small triangles pays for
+each pixel several times. Here (Burns and Hunt 2013, "The Visibility Buffer: A Cache-Friendly
+Approach to Deferred Shading"; Schied and Dachsbacher 2015):
+
+    visibility pass: the opaque and alphaMode MASK parts rasterised with 4x MSAA and depth into an
+        integer target, (triangle + 1, part + 1) per sample (render/vbuffer.frag; a MASK part
+        tests its alpha there, per pixel, as the forward pass does)
+    shading pass, one full-screen pass per part (render/vbuffer_shade.frag): each pixel fetches
+        the triangles its samples hold from the part's vertex and index buffers (bound as shader
+        storage), interpolates them where the view ray meets them, and shades each distinct
+        triangle once with the forward pass's material and light functions
+        (common/mesh_material.glsl VBUFFER_SHADING), weighted by its samples; the sum is added
+        into the single-sample target render/resolve.frag reads with SCENE_SAMPLES 1, as the
+        built-in sphere's impostor does (alight.render.sphere_impostor).
+
+Used only where the frame is the fused MSAA resolve with 4 samples and nothing but opaque and
+masked parts (``wanted``): blended, transmissive, the ground, the built-in sphere, the occlusion
+bake and debug views keep the forward pass.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from alight.core.shader_names import AlphaMode
+from alight.core.texture_maps import TextureMaps
+from alight.render.bindings import UNIT_VISIBILITY, set_uniform
+from alight.render.variants import has_blending_parts, part_defines, transmissive_parts, user_maps_present
+
+MESH_SHADING = ("forward", "vbuffer")   # ForwardRenderer.mesh_shading
+VBUFFER_SAMPLES = 4                     # render/vbuffer_shade.frag's sample pattern
+
+
+def wanted(r, scene, targets, fbo, background: bool) -> bool:
+    """Whether this scene pass shades its mesh from the visibility buffer: ``r.mesh_shading``
+    asks for it and the pass is the fused MSAA resolve's (4 samples, no background drawn, so no
+    blended parts) of a mesh file with no transmissive part, ground, occlusion bake or debug view."""
+    if getattr(r, "mesh_shading", "forward") != "vbuffer":
+        return False
+    mesh = scene.mesh
+    return (targets.aa == "msaa" and targets.samples == VBUFFER_SAMPLES and fbo is targets.draw and not background
+            and scene.view != "probe" and mesh is not None and mesh.lod_sphere is None and bool(mesh.parts)
+            and not scene.ground and not scene.debug_view and scene.occlusion == "off"
+            and not has_blending_parts(scene) and not transmissive_parts(scene))
+
+
+def vertex_stride(gpu_part) -> int:
+    """Floats per vertex in ``gpu_part.vbo`` (GpuPart.layout's '3f 3f 2f 4f ...')."""
+    return sum(int(field[:-1]) for field in gpu_part.layout[0].split())
+
+
+def box_rect(lo, hi, view_projection: np.ndarray, size: tuple[int, int]) -> tuple[int, int, int, int] | None:
+    """(x, y, width, height) in pixels holding the projection of the box ``lo``..``hi``, a pixel
+    wider each way; None where the box reaches behind the eye."""
+    corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    clip = corners @ np.asarray(view_projection, np.float64)
+    if (clip[:, 3] <= 1e-6).any():
+        return None
+    pixels = (clip[:, :2] / clip[:, 3:] * 0.5 + 0.5) * np.array(size, np.float64)
+    x0, y0 = np.clip(np.floor(pixels.min(axis=0)) - 1, 0, size).astype(int)
+    x1, y1 = np.clip(np.ceil(pixels.max(axis=0)) + 1, 0, size).astype(int)
+    return (int(x0), int(y0), int(max(x1 - x0, 0)), int(max(y1 - y0, 0)))
+
+
+def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_for, image_size) -> None:
+    """The mesh's parts into ``targets.single()`` (cleared by the scene pass): the visibility
+    pass, then one shading pass per part. ``program_for(variant, vertex, fragment)``: draw_mesh's
+    program with the scene's defines and bindings (IBL, shadows, layer tables)."""
+    from alight.render.passes import _bind_view, bind_part, set_culling
+
+    ctx = r.ctx
+    width, height = targets.draw_size
+    size = image_size or (width, height)
+    parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
+    user_maps = user_maps_present(scene)
+    user = r.meshes.user_textures(scene)
+    tiling = scene.texture_maps or TextureMaps()
+    model = np.eye(4, dtype=np.float32)
+    variants = [part_defines(scene, g, part, user_maps) for g, part in parts]
+
+    visibility, visibility_fbo = targets.visibility()
+    visibility_fbo.use()
+    ctx.viewport = (0, 0, width, height)
+    visibility_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+    ctx.enable(moderngl.DEPTH_TEST)
+    ctx.depth_func = "<="
+    prepared: set[int] = set()
+    try:
+        for index, ((gpu_part, part), variant) in enumerate(zip(parts, variants)):
+            masked = variant.get("ALPHA_MODE") == int(AlphaMode.MASK)
+            # An opaque part needs nothing of its material here: one program for all of them.
+            program = r.program("render/pbr.vert", "render/vbuffer.frag", variant if masked else None)
+            if id(program) not in prepared:
+                prepared.add(id(program))
+                _bind_view(program, ctx, frame, camera, view_projection, model, None, False)
+            if masked:
+                bind_part(r, scene, program, gpu_part, part, user, tiling, camera, size)
+            set_uniform(program, "u_part", index + 1)
+            set_culling(ctx, gpu_part, part)
+            gpu_part.vao_for(program).render(moderngl.TRIANGLES)
+    finally:
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.disable(moderngl.DEPTH_TEST)
+
+    targets.single()[1].use()
+    ctx.viewport = (0, 0, width, height)
+    ctx.enable(moderngl.BLEND)
+    ctx.blend_func = (moderngl.ONE, moderngl.ONE)   # each part adds its share of the pixel's mean
+    try:
+        for index, ((gpu_part, part), variant) in enumerate(zip(parts, variants)):
+            rect = box_rect(gpu_part.lo, gpu_part.hi, frame.view_projection, (width, height))
+            if rect is not None and (rect[2] == 0 or rect[3] == 0):
+                continue   # off screen
+            variant = {**variant, "VBUFFER_SHADING": None, "VERTEX_STRIDE": vertex_stride(gpu_part)}
+            variant.pop("ALPHA_MODE", None)   # (tested in the visibility pass; the samples are opaque)
+            program = program_for(variant, "render/fullscreen.vert", "render/vbuffer_shade.frag")
+            set_uniform(program, "u_model", model.tobytes(), write=True)
+            set_uniform(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
+            set_uniform(program, "u_camera_position", tuple(float(x) for x in camera.position))
+            set_uniform(program, "u_inverse_view_projection", frame.inverse_vp.tobytes(), write=True)
+            set_uniform(program, "u_viewport_size", (float(width), float(height)))
+            set_uniform(program, "u_part", index + 1)
+            bind_part(r, scene, program, gpu_part, part, user, tiling, camera, size)
+            visibility.use(UNIT_VISIBILITY)
+            gpu_part.vbo.bind_to_storage_buffer(0)
+            gpu_part.ibo.bind_to_storage_buffer(1)
+            ctx.scissor = rect
+            r.draws.triangle(program)
+    finally:
+        ctx.scissor = None
+        ctx.disable(moderngl.BLEND)

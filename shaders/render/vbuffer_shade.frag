@@ -1,0 +1,170 @@
+#version 450 core
+// A part shaded from the visibility buffer (app/render/vbuffer.py), one full-screen pass per
+// part, added into a single-sample target that render/resolve.frag reads with SCENE_SAMPLES 1.
+// Each pixel shades each distinct triangle of this part among its 4 samples once (the same
+// material and light functions as render/pbr.frag), weighted by the samples it covers: a pixel
+// inside a triangle once, an edge pixel once per triangle. Each is shaded where the forward pass
+// shades it under MSAA, at the pixel centre (extrapolated where the centre lies off the
+// triangle), with the normal read at the covered samples' centroid where the centre's faces
+// away (common/mesh_material.glsl geometric_normal). The triangle's vertices are fetched from the part's
+// own buffers, and its attributes interpolated with the barycentrics where the view ray meets
+// it, so they are perspective-correct; the maps' derivatives are those of the barycentrics
+// one pixel over (the triangle's plane, as the rasteriser's 2x2 differences see it: Burns and
+// Hunt 2013, "The Visibility Buffer"; Schied and Dachsbacher 2015).
+#include "common/shading.glsl"
+#include "common/mesh_material.glsl"
+#include "common/debug_views.glsl"
+#include "common/output_encoding.glsl"
+
+layout(std430, binding = 0) readonly buffer Vertices { float vertex_data[]; };   // GpuPart.vbo
+layout(std430, binding = 1) readonly buffer Indices { uint index_data[]; };       // GpuPart.ibo
+
+uniform usampler2DMS u_visibility;        // render/vbuffer.frag's (triangle + 1, part + 1)
+uniform uint u_part;                      // this part's index + 1
+uniform mat4 u_model;
+uniform mat3 u_normal_matrix;
+uniform mat4 u_inverse_view_projection;   // this pass's (a tile's off-centre projection included)
+uniform vec2 u_viewport_size;             // pixels
+
+layout(location = 0) out vec4 out_radiance;
+
+// OpenGL's standard 4x positions (the D3D pattern) from the pixel centre, as the impostor's
+// (common/mesh_material.glsl sphere_coverage).
+const vec2 SAMPLE_OFFSETS[4] = vec2[4](vec2(-0.125, -0.375), vec2(0.375, -0.125), vec2(-0.375, 0.125), vec2(0.125, 0.375));
+
+vec3 fetch3(uint v, int at) {
+    uint i = v * uint(VERTEX_STRIDE) + uint(at);
+    return vec3(vertex_data[i], vertex_data[i + 1u], vertex_data[i + 2u]);
+}
+
+vec4 fetch4(uint v, int at) {
+    uint i = v * uint(VERTEX_STRIDE) + uint(at);
+    return vec4(vertex_data[i], vertex_data[i + 1u], vertex_data[i + 2u], vertex_data[i + 3u]);
+}
+
+vec2 fetch2(uint v, int at) {
+    uint i = v * uint(VERTEX_STRIDE) + uint(at);
+    return vec2(vertex_data[i], vertex_data[i + 1u]);
+}
+
+// The world-space ray through window position xy (pixels): origin, direction.
+void view_ray(vec2 xy, out vec3 origin, out vec3 direction) {
+    vec2 ndc = xy / u_viewport_size * 2.0 - 1.0;
+    vec4 near = u_inverse_view_projection * vec4(ndc, -1.0, 1.0);
+    vec4 far = u_inverse_view_projection * vec4(ndc, 1.0, 1.0);
+    origin = near.xyz / near.w;
+    direction = far.xyz / far.w - origin;
+}
+
+// Barycentrics (of p1, p2; p0's is 1 - both) where the ray meets the triangle's plane
+// (Moller and Trumbore 1997), valid outside the triangle too: a pixel over's are the derivatives.
+vec2 barycentrics(vec2 xy, vec3 p0, vec3 e1, vec3 e2) {
+    vec3 origin, direction;
+    view_ray(xy, origin, direction);
+    vec3 pv = cross(direction, e2);
+    float inv = 1.0 / dot(e1, pv);
+    vec3 tv = origin - p0;
+    vec3 qv = cross(tv, e1);
+    return vec2(dot(tv, pv), dot(direction, qv)) * inv;
+}
+
+// Fills common/mesh_material.glsl's globals for triangle `triangle` at window position xy, and
+// vb_centroid_normal at xy + at_centroid (its covered samples' mean offset).
+void interpolate(uint triangle, vec2 xy, vec2 at_centroid) {
+    uint i0 = index_data[3u * triangle], i1 = index_data[3u * triangle + 1u], i2 = index_data[3u * triangle + 2u];
+    vec3 p0 = (u_model * vec4(fetch3(i0, 0), 1.0)).xyz;
+    vec3 p1 = (u_model * vec4(fetch3(i1, 0), 1.0)).xyz;
+    vec3 p2 = (u_model * vec4(fetch3(i2, 0), 1.0)).xyz;
+    vec3 e1 = p1 - p0, e2 = p2 - p0;
+    vec2 b = barycentrics(xy, p0, e1, e2);
+    vec2 bx = barycentrics(xy + vec2(1.0, 0.0), p0, e1, e2) - b;
+    vec2 by = barycentrics(xy + vec2(0.0, 1.0), p0, e1, e2) - b;
+    vec3 w = vec3(1.0 - b.x - b.y, b);
+    v_position = p0 + b.x * e1 + b.y * e2;
+    vec3 n0 = fetch3(i0, 3), n1 = fetch3(i1, 3), n2 = fetch3(i2, 3);
+    v_normal = u_normal_matrix * (w.x * n0 + w.y * n1 + w.z * n2);
+    vec2 bc = barycentrics(xy + at_centroid, p0, e1, e2);
+    vb_centroid_normal = u_normal_matrix * ((1.0 - bc.x - bc.y) * n0 + bc.x * n1 + bc.y * n2);
+    vec2 t0 = fetch2(i0, 6), t1 = fetch2(i1, 6), t2 = fetch2(i2, 6);
+    v_uv = w.x * t0 + w.y * t1 + w.z * t2;
+    vb_duv_dx = bx.x * (t1 - t0) + bx.y * (t2 - t0);
+    vb_duv_dy = by.x * (t1 - t0) + by.y * (t2 - t0);
+    vec4 tangent = w.x * fetch4(i0, 8) + w.y * fetch4(i1, 8) + w.z * fetch4(i2, 8);
+    v_tangent = vec4(mat3(u_model) * tangent.xyz, tangent.w);
+#ifdef HAS_UV1
+    vec2 s0 = fetch2(i0, 12), s1 = fetch2(i1, 12), s2 = fetch2(i2, 12);
+    v_uv1 = w.x * s0 + w.y * s1 + w.z * s2;
+    vb_duv1_dx = bx.x * (s1 - s0) + bx.y * (s2 - s0);
+    vb_duv1_dy = by.x * (s1 - s0) + by.y * (s2 - s0);
+#endif
+#ifdef HAS_VERTEX_COLOR
+#ifdef HAS_UV1
+    const int color_at = 14;
+#else
+    const int color_at = 12;
+#endif
+    v_color = w.x * fetch4(i0, color_at) + w.y * fetch4(i1, color_at) + w.z * fetch4(i2, color_at);
+#endif
+    // Counter-clockwise on screen is front (the forward pass's front_face "ccw"): the winding's
+    // normal faces the eye.
+    vec3 face = normalize(cross(e1, e2));
+    vb_front_facing = dot(face, u_camera_position - p0) > 0.0;
+    vb_face_normal = vb_front_facing ? face : -face;
+}
+
+vec3 shade_here() {
+#ifdef UNLIT
+    return material_base_color().rgb;
+#else
+    vec3 n = shading_normal();
+    vec3 v = normalize(u_camera_position - surface_position());
+#ifdef HAS_SHADOWS
+    set_shadow_receiver(surface_position(), geometric_normal());
+#endif
+#ifdef DEBUG_VIEW
+    return debug_view(material_surface(n), n, v, surface_position());
+#else
+    return shade(material_surface(n), n, v, surface_position());
+#endif
+#endif
+}
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    uvec2 ids[4];
+    for (int i = 0; i < 4; ++i) ids[i] = texelFetch(u_visibility, p, i).xy;
+    // This part's distinct triangles in the pixel, their sample counts and the centroids of
+    // their samples, packed first; the pixel centre where one triangle holds all four.
+    uint triangles[4];
+    float weights[4];
+    vec2 offsets[4];
+    int count = 0;
+    for (int i = 0; i < 4; ++i) {
+        bool first = ids[i].y == u_part;
+        for (int j = 0; j < i; ++j) first = first && ids[j] != ids[i];
+        if (first) {
+            float n = 0.0;
+            vec2 sum = vec2(0.0);
+            for (int j = i; j < 4; ++j) {
+                bool same = ids[j] == ids[i];
+                n += same ? 1.0 : 0.0;
+                sum += same ? SAMPLE_OFFSETS[j] : vec2(0.0);
+            }
+            triangles[count] = ids[i].x - 1u;
+            weights[count] = n;
+            offsets[count] = sum / n;   // (0 where all four: the centre)
+            ++count;
+        }
+    }
+    if (count == 0) discard;
+    // A loop, not four branches: llvmpipe runs both sides of a branch, but ends a loop once no
+    // pixel of its block needs another pass (most blocks: one).
+    vec4 sum = vec4(0.0);
+    for (int k = 0; k < count; ++k) {
+        interpolate(triangles[k], gl_FragCoord.xy, offsets[k]);
+        sum += vec4(encode_output(shade_here(), 1.0).rgb, 1.0) * weights[k];
+    }
+    // The mean over the pixel's 4 samples (this part's share: the others add theirs), as the
+    // MSAA resolve would take it; premultiplied by coverage in alpha.
+    out_radiance = sum / 4.0;
+}
