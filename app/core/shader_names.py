@@ -142,7 +142,14 @@ SHADER_OPTIONS: dict[str, str] = {
     "SCENE_SAMPLES": "the scene target's samples a pixel, read by the resolve",
     "NO_SURFACES": "the resolve runs where no surface was drawn (background only)",
     "VBUFFER_SHADING": "a part shaded from the visibility buffer, its vertices fetched (app/render/vbuffer.py)",
-    "VERTEX_STRIDE": "the floats per vertex in the part's vertex buffer (app/render/gpu_mesh.py GpuPart)",
+    "VERTEX_WORDS": "the 32-bit words per vertex in the part's vertex buffer (app/render/vbuffer.py vertex_layout)",
+    "NORMAL_AT": "the normal's offset in a vertex, in words",
+    "UV_AT": "TEXCOORD_0's offset in a vertex, in words",
+    "UV1_AT": "TEXCOORD_1's offset in a vertex, in words",
+    "COLOR_AT": "COLOR_0's offset in a vertex, in words",
+    "NORMAL_SNORM16": "the vertex buffer's normals are int16 snorm (app/render/gpu_mesh.py PACK_VERTICES)",
+    "UV_HALF": "the vertex buffer's TEXCOORD_0 is two half floats",
+    "TANGENT_SNORM16": "the tangent buffer holds int16 snorm",
 }
 
 

@@ -49,9 +49,37 @@ def wanted(r, scene, targets, fbo, background: bool) -> bool:
             and not has_blending_parts(scene) and not transmissive_parts(scene))
 
 
-def vertex_stride(gpu_part) -> int:
-    """Floats per vertex in ``gpu_part.vbo`` (GpuPart.layout's '3f 3f 2f 4f ...')."""
-    return sum(int(field[:-1]) for field in gpu_part.layout[0].split())
+_FORMAT_BYTES = {"f": 4, "f2": 2, "i2": 2, "i": 4, "u": 4}
+
+
+def vertex_layout(gpu_part) -> dict:
+    """render/vbuffer_shade.frag's defines for ``gpu_part.vbo``'s layout (GpuPart.layout, e.g.
+    '3f 4i2 2f2 2f'): each attribute's offset in 32-bit words, the vertex's size in words, and
+    which attributes are packed (int16 snorm normals and tangents, half-float uvs)."""
+    fields, names = gpu_part.layout[0].split(), gpu_part.layout[1:]
+    defines, at = {}, 0
+    for field, name in zip(fields, names):
+        count = int(field[0])
+        kind = field[1:]
+        if name == "in_normal":
+            defines["NORMAL_AT"] = at // 4
+            if kind == "i2":
+                defines["NORMAL_SNORM16"] = None
+        elif name == "in_uv":
+            defines["UV_AT"] = at // 4
+            if kind == "f2":
+                defines["UV_HALF"] = None
+        elif name == "in_uv1":
+            defines["UV1_AT"] = at // 4
+        elif name == "in_color":
+            defines["COLOR_AT"] = at // 4
+        at += count * _FORMAT_BYTES[kind]
+    if at % 4:
+        raise ValueError(f"vertex layout {gpu_part.layout[0]!r} is not whole 32-bit words")
+    defines["VERTEX_WORDS"] = at // 4
+    if gpu_part.packed:
+        defines["TANGENT_SNORM16"] = None
+    return defines
 
 
 def box_rect(lo, hi, view_projection: np.ndarray, size: tuple[int, int]) -> tuple[int, int, int, int] | None:
@@ -116,7 +144,7 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
             rect = box_rect(gpu_part.lo, gpu_part.hi, frame.view_projection, (width, height))
             if rect is not None and (rect[2] == 0 or rect[3] == 0):
                 continue   # off screen
-            variant = {**variant, "VBUFFER_SHADING": None, "VERTEX_STRIDE": vertex_stride(gpu_part)}
+            variant = {**variant, "VBUFFER_SHADING": None, **vertex_layout(gpu_part)}
             variant.pop("ALPHA_MODE", None)   # (tested in the visibility pass; the samples are opaque)
             program = program_for(variant, "render/fullscreen.vert", "render/vbuffer_shade.frag")
             set_uniform(program, "u_model", model.tobytes(), write=True)
@@ -129,6 +157,9 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
             visibility.use(UNIT_VISIBILITY)
             gpu_part.vbo.bind_to_storage_buffer(0)
             gpu_part.ibo.bind_to_storage_buffer(1)
+            # The tangents are made for every part shaded here (a full-screen pass has no
+            # attribute that says whether its variant reads them, as the forward pass's does).
+            gpu_part._tangents()[0].bind_to_storage_buffer(2)
             ctx.scissor = rect
             r.draws.triangle(program)
     finally:

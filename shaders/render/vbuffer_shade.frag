@@ -16,8 +16,12 @@
 #include "common/debug_views.glsl"
 #include "common/output_encoding.glsl"
 
-layout(std430, binding = 0) readonly buffer Vertices { float vertex_data[]; };   // GpuPart.vbo
+// GpuPart's buffers as 32-bit words: its vertex layout (packed or not) comes as defines from
+// app/render/vbuffer.py's vertex_layout (VERTEX_WORDS, NORMAL_AT, UV_AT, UV1_AT, COLOR_AT,
+// NORMAL_SNORM16, UV_HALF, TANGENT_SNORM16), the tangents from their own buffer.
+layout(std430, binding = 0) readonly buffer Vertices { uint vertex_words[]; };   // GpuPart.vbo
 layout(std430, binding = 1) readonly buffer Indices { uint index_data[]; };       // GpuPart.ibo
+layout(std430, binding = 2) readonly buffer Tangents { uint tangent_words[]; };  // GpuPart.tangent_buffer
 
 uniform usampler2DMS u_visibility;        // render/vbuffer.frag's (triangle + 1, part + 1)
 uniform uint u_part;                      // this part's index + 1
@@ -32,19 +36,53 @@ layout(location = 0) out vec4 out_radiance;
 // (common/mesh_material.glsl sphere_coverage).
 const vec2 SAMPLE_OFFSETS[4] = vec2[4](vec2(-0.125, -0.375), vec2(0.375, -0.125), vec2(-0.375, 0.125), vec2(0.125, 0.375));
 
+float word_float(uint v, int at) {
+    return uintBitsToFloat(vertex_words[v * uint(VERTEX_WORDS) + uint(at)]);
+}
+
 vec3 fetch3(uint v, int at) {
-    uint i = v * uint(VERTEX_STRIDE) + uint(at);
-    return vec3(vertex_data[i], vertex_data[i + 1u], vertex_data[i + 2u]);
+    return vec3(word_float(v, at), word_float(v, at + 1), word_float(v, at + 2));
 }
 
 vec4 fetch4(uint v, int at) {
-    uint i = v * uint(VERTEX_STRIDE) + uint(at);
-    return vec4(vertex_data[i], vertex_data[i + 1u], vertex_data[i + 2u], vertex_data[i + 3u]);
+    return vec4(word_float(v, at), word_float(v, at + 1), word_float(v, at + 2), word_float(v, at + 3));
 }
 
 vec2 fetch2(uint v, int at) {
-    uint i = v * uint(VERTEX_STRIDE) + uint(at);
-    return vec2(vertex_data[i], vertex_data[i + 1u]);
+    return vec2(word_float(v, at), word_float(v, at + 1));
+}
+
+// Four int16 in two words (little-endian, as numpy writes them), decoded as GL 4.2's snorm.
+vec4 snorm16x4(uint low, uint high) {
+    ivec4 c = ivec4(bitfieldExtract(int(low), 0, 16), bitfieldExtract(int(low), 16, 16),
+                    bitfieldExtract(int(high), 0, 16), bitfieldExtract(int(high), 16, 16));
+    return max(vec4(c) * (1.0 / 32767.0), vec4(-1.0));
+}
+
+vec3 fetch_normal(uint v) {
+#ifdef NORMAL_SNORM16
+    uint i = v * uint(VERTEX_WORDS) + uint(NORMAL_AT);
+    return snorm16x4(vertex_words[i], vertex_words[i + 1u]).xyz;
+#else
+    return fetch3(v, NORMAL_AT);
+#endif
+}
+
+vec2 fetch_uv(uint v) {
+#ifdef UV_HALF
+    return unpackHalf2x16(vertex_words[v * uint(VERTEX_WORDS) + uint(UV_AT)]);
+#else
+    return fetch2(v, UV_AT);
+#endif
+}
+
+vec4 fetch_tangent(uint v) {
+#ifdef TANGENT_SNORM16
+    return snorm16x4(tangent_words[2u * v], tangent_words[2u * v + 1u]);
+#else
+    uint i = 4u * v;
+    return uintBitsToFloat(uvec4(tangent_words[i], tangent_words[i + 1u], tangent_words[i + 2u], tangent_words[i + 3u]));
+#endif
 }
 
 // The world-space ray through window position xy (pixels): origin, direction.
@@ -81,29 +119,24 @@ void interpolate(uint triangle, vec2 xy, vec2 at_centroid) {
     vec2 by = barycentrics(xy + vec2(0.0, 1.0), p0, e1, e2) - b;
     vec3 w = vec3(1.0 - b.x - b.y, b);
     v_position = p0 + b.x * e1 + b.y * e2;
-    vec3 n0 = fetch3(i0, 3), n1 = fetch3(i1, 3), n2 = fetch3(i2, 3);
+    vec3 n0 = fetch_normal(i0), n1 = fetch_normal(i1), n2 = fetch_normal(i2);
     v_normal = u_normal_matrix * (w.x * n0 + w.y * n1 + w.z * n2);
     vec2 bc = barycentrics(xy + at_centroid, p0, e1, e2);
     vb_centroid_normal = u_normal_matrix * ((1.0 - bc.x - bc.y) * n0 + bc.x * n1 + bc.y * n2);
-    vec2 t0 = fetch2(i0, 6), t1 = fetch2(i1, 6), t2 = fetch2(i2, 6);
+    vec2 t0 = fetch_uv(i0), t1 = fetch_uv(i1), t2 = fetch_uv(i2);
     v_uv = w.x * t0 + w.y * t1 + w.z * t2;
     vb_duv_dx = bx.x * (t1 - t0) + bx.y * (t2 - t0);
     vb_duv_dy = by.x * (t1 - t0) + by.y * (t2 - t0);
-    vec4 tangent = w.x * fetch4(i0, 8) + w.y * fetch4(i1, 8) + w.z * fetch4(i2, 8);
+    vec4 tangent = w.x * fetch_tangent(i0) + w.y * fetch_tangent(i1) + w.z * fetch_tangent(i2);
     v_tangent = vec4(mat3(u_model) * tangent.xyz, tangent.w);
 #ifdef HAS_UV1
-    vec2 s0 = fetch2(i0, 12), s1 = fetch2(i1, 12), s2 = fetch2(i2, 12);
+    vec2 s0 = fetch2(i0, UV1_AT), s1 = fetch2(i1, UV1_AT), s2 = fetch2(i2, UV1_AT);
     v_uv1 = w.x * s0 + w.y * s1 + w.z * s2;
     vb_duv1_dx = bx.x * (s1 - s0) + bx.y * (s2 - s0);
     vb_duv1_dy = by.x * (s1 - s0) + by.y * (s2 - s0);
 #endif
 #ifdef HAS_VERTEX_COLOR
-#ifdef HAS_UV1
-    const int color_at = 14;
-#else
-    const int color_at = 12;
-#endif
-    v_color = w.x * fetch4(i0, color_at) + w.y * fetch4(i1, color_at) + w.z * fetch4(i2, color_at);
+    v_color = w.x * fetch4(i0, COLOR_AT) + w.y * fetch4(i1, COLOR_AT) + w.z * fetch4(i2, COLOR_AT);
 #endif
     // Counter-clockwise on screen is front (the forward pass's front_face "ccw"): the winding's
     // normal faces the eye.
