@@ -12,6 +12,11 @@ on the built-in sphere in the built-in studio:
 - reference: plastic_high at roughness 0.5, compare 'reference' at ``--scale``; frames are timed
   (``win.frame()`` then ``ctx.finish()``) from the switch until A's half is whole; then compare
   off for 10 frames and on again: the frames until A's half is whole again.
+- split: 20 frames, then frames until the start's pass warm-up (pass_warmup.py) is done where
+  the build has one; the tone map changed to agx (set on the state) until the view shows it and 10
+  more; then compare 'reference' at ``--scale`` until A's half is whole and 10 more (the composite
+  pass and the reference's tone map pass drawn first); then the tone map changed to neutral. Each
+  run has an empty Mesa shader cache of its own. The longest frame of each step.
 - variant: gold, 20 frames, then clearcoat 1.0 (set on the state); frames timed until the view
   shows the clearcoat picture and 10 more. Each run has an empty Mesa shader cache of its own
   (MESA_SHADER_CACHE_DIR), as a first switch on a new machine.
@@ -112,6 +117,52 @@ def child_variant(size) -> dict:
         win.close()
 
 
+def _frames_until(win, done, after: int = 10, limit_s: float = 300.0) -> list[float]:
+    """Timed frames until ``done()`` and ``after`` more."""
+    times, start, extra = [], time.perf_counter(), 0
+    while time.perf_counter() - start < limit_s and extra < after:
+        times.append(_timed_frame(win))
+        extra += bool(done())
+    return times
+
+
+def child_split(size, scale: float) -> dict:
+    """The artist's first split view and first tone map changes, the Mesa cache empty: the tone
+    map changed in the plain view, then compare 'reference' opened (the composite pass, the
+    reference's tone map pass), then the tone map changed while it shows."""
+    from alight.frontends.editor.compare import CompareState
+
+    state, win = _window(size)
+    warm = getattr(win, "variant_warmup", None)
+
+    def settled():
+        return warm is None or (not warm.pending and win._last_complete_scene.display == state.display)
+
+    try:
+        for _ in range(20):
+            win.frame()
+        out = {}
+        # The start's pass warm-up (pass_warmup.py, where the build has one) drawn to its end
+        # first, as by an artist who opens the split some seconds after the start.
+        passes, start = getattr(win, "pass_warmup", None), time.perf_counter()
+        while passes is not None and not passes.done and time.perf_counter() - start < 300:
+            win.frame()
+        out["pass_warmup_s"] = time.perf_counter() - start
+        state.display = dataclasses.replace(state.display, tonemap="agx")
+        t = _frames_until(win, settled)
+        out["plain_tonemap_max_ms"] = 1000 * max(t)
+        state.compare = CompareState(mode="reference", reference_scale=scale)
+        t = _frames_until(win, lambda: win.compare_view.a_ready and win.compare_view.reference_progress is None)
+        out["split_open_max_ms"], out["split_open_frames"] = 1000 * max(t), len(t)
+        out["split_open_first_ms"] = 1000 * t[0]
+        state.display = dataclasses.replace(state.display, tonemap="neutral")
+        t = _frames_until(win, lambda: settled() and win.compare_view.a_ready)
+        out["split_tonemap_max_ms"] = 1000 * max(t)
+        return out
+    finally:
+        win.close()
+
+
 def run(side: str, what: str, args) -> dict:
     env = dict(os.environ)
     if side == "before":
@@ -130,16 +181,19 @@ def run(side: str, what: str, args) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--base", help="a folder whose 'alight' is the other checkout's app/")
-    ap.add_argument("--what", choices=("reference", "variant", "both"), default="both")
+    ap.add_argument("--what", choices=("reference", "variant", "split", "both"), default="both")
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--size", default="800x720")
     ap.add_argument("--scale", type=float, default=0.25)
     ap.add_argument("--limit", type=float, default=600.0, help="seconds a reference run waits at most")
-    ap.add_argument("--child", choices=("reference", "variant"))
+    ap.add_argument("--child", choices=("reference", "variant", "split"))
     args = ap.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     if args.child == "reference":
         print(json.dumps(child_reference(size, args.scale, args.limit)))
+        return
+    if args.child == "split":
+        print(json.dumps(child_split(size, args.scale)))
         return
     if args.child == "variant":
         print(json.dumps(child_variant(size)))
@@ -156,7 +210,8 @@ def main() -> None:
                 print(f"{what} round {r + 1} {side}: " + ", ".join(
                     f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in res.items()), flush=True)
         for side, runs in results.items():
-            for field in ("median_ms", "max_ms"):
+            for field in (("median_ms", "max_ms") if what != "split" else
+                          ("plain_tonemap_max_ms", "split_open_max_ms", "split_tonemap_max_ms")):
                 xs = [x[field] for x in runs]
                 print(f"{what} {side} {field}: median {statistics.median(xs):.1f} (range {min(xs):.1f}-{max(xs):.1f})")
 

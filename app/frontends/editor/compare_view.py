@@ -75,6 +75,41 @@ def composite_rows(a: np.ndarray, b: np.ndarray, divider: float, b_behind_a: boo
     return out
 
 
+def composite_program(ctx):
+    """The composite pass's (program, vertex array)."""
+    prog = ctx.program(vertex_shader=_VERTEX, fragment_shader=_FRAGMENT)
+    return prog, ctx.vertex_array(prog, [])
+
+
+def composite(ctx, prog, vao, a_display, b_display, fbo, split: int, has_a: bool, b_behind_a: bool) -> None:
+    """The composite pass: A's image left of column ``split``, B's right of it, into ``fbo``
+    (the GL side of ``composite_rows``). pass_warmup.py draws the same pass, so the same state."""
+    a_display.use(0)
+    b_display.use(1)
+    prog["u_a"], prog["u_b"] = 0, 1
+    prog["u_split"] = split
+    prog["u_has_a"] = has_a
+    prog["u_b_behind_a"] = b_behind_a
+    fbo.use()
+    ctx.viewport = (0, 0) + fbo.size
+    vao.render(vertices=3)
+
+
+def tonemap_rows(ctx, renderer, src: np.ndarray, display, targets) -> None:
+    """The reference's radiance ``src`` (h, w, 4) float32, top row first, upscaled to ``targets``
+    (nearest: each summed pixel a block) and tone mapped with ``display`` into its display
+    image; alpha the coverage."""
+    h, w = targets.height, targets.width
+    rows = np.minimum((np.arange(h) + 0.5) * src.shape[0] / h, src.shape[0] - 1).astype(int)
+    cols = np.minimum((np.arange(w) + 0.5) * src.shape[1] / w, src.shape[1] - 1).astype(int)
+    full = src[rows][:, cols]
+    tex = ctx.texture((w, h), 4, np.ascontiguousarray(full[::-1], np.float32).tobytes(), dtype="f4")
+    try:
+        renderer.tonemap(tex, display, targets.display_fbo, opaque=False)
+    finally:
+        tex.release()
+
+
 class CompareView:
     def __init__(self, ctx, renderer, new_targets):
         """``new_targets(size, aa)``: view framebuffers of A's own (EditorWindow.new_targets)."""
@@ -232,16 +267,7 @@ class CompareView:
     def _tonemap_reference(self, scene, targets) -> None:
         """The reference's radiance, upscaled to A's image (nearest: each summed pixel a block),
         tone mapped with the view's display settings; alpha the coverage."""
-        h, w = targets.height, targets.width
-        src = self._ref_linear
-        rows = np.minimum((np.arange(h) + 0.5) * src.shape[0] / h, src.shape[0] - 1).astype(int)
-        cols = np.minimum((np.arange(w) + 0.5) * src.shape[1] / w, src.shape[1] - 1).astype(int)
-        full = src[rows][:, cols]
-        tex = self.ctx.texture((w, h), 4, np.ascontiguousarray(full[::-1], np.float32).tobytes(), dtype="f4")
-        try:
-            self.renderer.tonemap(tex, scene.display, targets.display_fbo, opaque=False)
-        finally:
-            tex.release()
+        tonemap_rows(self.ctx, self.renderer, self._ref_linear, scene.display, targets)
 
     # --- putting the halves together -------------------------------------------------------------
 
@@ -260,19 +286,10 @@ class CompareView:
             tex = self.ctx.texture(size, 4, dtype="f1")
             self._out = (tex, self.ctx.framebuffer([tex]))
         if self._prog is None:
-            self._prog = self.ctx.program(vertex_shader=_VERTEX, fragment_shader=_FRAGMENT)
-            self._vao = self.ctx.vertex_array(self._prog, [])
+            self._prog, self._vao = composite_program(self.ctx)
         tex, fbo = self._out
-        self._a_targets.display.use(0)
-        b_targets.display.use(1)
-        prog = self._prog
-        prog["u_a"], prog["u_b"] = 0, 1
-        prog["u_split"] = split_column(c.divider, size[0])
-        prog["u_has_a"] = bool(self._a_ok)
-        prog["u_b_behind_a"] = c.mode == "reference"
-        fbo.use()
-        self.ctx.viewport = (0, 0) + size
-        self._vao.render(vertices=3)
+        composite(self.ctx, self._prog, self._vao, self._a_targets.display, b_targets.display, fbo,
+                  split_column(c.divider, size[0]), bool(self._a_ok), c.mode == "reference")
         return types.SimpleNamespace(display=tex, display_fbo=fbo, width=size[0], height=size[1])
 
     def compose_frame(self, win, scene, maps, b_srgb: np.ndarray, aa: str) -> np.ndarray:

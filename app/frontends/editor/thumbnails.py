@@ -5,26 +5,23 @@ whatever the view shows, so a thumbnail depends on the material alone), kept as 
 user's cache folder under the material's content key (``library.content_key``): the next start
 only reads the files.
 
-They are rendered by one child process (thumbnail_worker.py), a job at a time, driven by a
-thread of their own: a layered material (transmission, sheen, anisotropy ...) needs its own shader
-variant, and compiling one took 12-19 s on this 2-core llvmpipe machine under load, a freeze
-of the editor had its own GL context done it. The panel asks for a texture id each frame
-(``texture_id``: no GL, None until ready); the window's ``step`` (after the view) uploads the
-PNGs that are ready, none in the first frames and a few milliseconds' worth a frame.
+They are rendered by one child process (thumbnail_worker.py, on worker_process.py as the
+reference's and the warm-up's children, niced below the editor), one job at a time, sent and
+answered from ``step``: a layered material (transmission, sheen, anisotropy ...) needs its own
+shader variant, and compiling one took 12-19 s on this 2-core llvmpipe machine under load, a
+freeze of the editor had its own GL context done it; at the editor's priority the child took the
+first frames' CPU (a first start's orbit 45.6 ms against 15.1 ms). The panel asks for a texture
+id each frame (``texture_id``: no GL, None until ready); the window's ``step`` (after the view)
+uploads the PNGs that are ready, none in the first frames and a few milliseconds' worth a frame.
 """
 
 from __future__ import annotations
 
-import subprocess
-import sys
-import tempfile
-import threading
 import time
 from pathlib import Path
 
 import numpy as np
 
-from alight.errors import AlightError
 from alight.frontends.editor.library import content_key
 
 THUMB_SIZE = 64          # pixels a side, rendered and cached (drawn smaller in the list)
@@ -47,11 +44,10 @@ class Thumbnails:
         self._wanted: dict = {}        # content key -> (material, maps), in the order asked
         self._failed: dict = {}        # content key -> the error line (not retried)
         self._frames = 0
-        self._lock = threading.Lock()
-        self._queue: list = []         # (key, material, maps) for the worker, in order
-        self._queued: set = set()
-        self._worker = None
-        self._stop = threading.Event()
+        self._queue: list = []         # (key, material, maps) for the child, in order
+        self._queued: set = set()      # keys sent or to send (their PNG is not looked for again until answered)
+        self._worker = None            # worker_process.WorkerProcess, started with the first job
+        self._job = None               # (job id, key) of the job the child has
         self.rendered = 0              # thumbnails rendered (not read from the cache) so far
         self.loaded = 0                # thumbnails read from the cache so far
 
@@ -78,95 +74,80 @@ class Thumbnails:
         return list(self._failed.values())
 
     def step(self, budget_s: float = FRAME_BUDGET_S) -> None:
-        """Upload the thumbnails asked for whose PNG is in the cache (GL context current), while
-        the budget lasts; hand the others to the worker thread. Binds nothing else."""
+        """Take the child's answer, upload the thumbnails asked for whose PNG is in the cache (GL
+        context current) while the budget lasts, queue the others and send the next job. Binds
+        nothing else."""
         self._frames += 1
+        self._settle()
         if self._frames <= START_AFTER_FRAMES or not self._wanted:
             return
         start = time.perf_counter()
         for key, (material, maps) in list(self._wanted.items()):
             if time.perf_counter() - start >= budget_s:
-                return
-            with self._lock:
-                failed = self._failed.get(key)
-            if failed is not None:
+                break
+            if key in self._failed:
                 del self._wanted[key]
+                continue
+            if key in self._queued:   # the child has it or will: no file to look for yet
                 continue
             pixels = _read(thumbnail_dir() / f"{key}.png")
             if pixels is None:
-                self._ask(key, material, maps)
+                self._queued.add(key)
+                self._queue.append((key, material, maps))
                 continue
-            self.loaded += key not in self._queued
-            self._textures[key] = self.ctx.texture((THUMB_SIZE, THUMB_SIZE), 4, np.ascontiguousarray(pixels).tobytes())
-            del self._wanted[key]
+            self.loaded += 1
+            self._upload(key, pixels)
+        self._send()
 
-    def _ask(self, key, material, maps) -> None:
-        with self._lock:
-            if key in self._queued:
-                return
-            self._queued.add(key)
-            self._queue.append((key, material, maps))
+    def _upload(self, key, pixels) -> None:
+        self._textures[key] = self.ctx.texture((THUMB_SIZE, THUMB_SIZE), 4, np.ascontiguousarray(pixels).tobytes())
+        self._wanted.pop(key, None)
+
+    def _send(self) -> None:
+        if self._job is not None or not self._queue:
+            return
+        from alight.frontends.editor.thumbnail_worker import ThumbnailJob
+        from alight.frontends.editor.worker_process import WorkerProcess
+
+        key, material, maps = self._queue.pop(0)
         if self._worker is None:
-            self._worker = threading.Thread(target=self._work, name="alight-thumbnails", daemon=True)
-            self._worker.start()
-
-    def _work(self) -> None:
-        """The worker thread: jobs to the render process (thumbnail_worker.py), one at a time."""
-        process = None
+            self._worker = WorkerProcess("alight.frontends.editor.thumbnail_worker")
+        out = thumbnail_dir() / f"{key}.png"
         try:
-            while not self._stop.is_set():
-                with self._lock:
-                    job = self._queue.pop(0) if self._queue else None
-                if job is None:
-                    self._stop.wait(0.1)
-                    continue
-                key, material, maps = job
-                try:
-                    if process is None or process.poll() is not None:
-                        process = _start_worker()
-                    render_thumbnail(process, material, maps, thumbnail_dir() / f"{key}.png")
-                    self.rendered += 1
-                except AlightError as exc:
-                    with self._lock:
-                        self._failed[key] = " ".join(str(exc).split())
-        finally:
-            if process is not None and process.poll() is None:
-                process.stdin.close()
-                try:
-                    process.wait(timeout=5)
-                except subprocess.TimeoutExpired:
-                    process.kill()
+            out.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            self._fail(key, material, f"cannot make {out.parent} ({exc})")
+            return
+        self._job = (self._worker.submit(ThumbnailJob(material=material, maps=maps, out=str(out))), key, material)
+
+    def _settle(self) -> None:
+        """The child's answer to the job it has: the PNG uploaded, or the error kept."""
+        if self._job is None:
+            return
+        job_id, key, material = self._job
+        for answered, word, text in self._worker.answers():
+            if answered != job_id or word == "progress":
+                continue
+            self._job = None
+            pixels = _read(thumbnail_dir() / f"{key}.png") if word == "done" else None
+            if pixels is not None:
+                self.rendered += 1
+                self._upload(key, pixels)
+            else:
+                self._fail(key, material, text if word == "error" else f"the render process answered {word}")
+            return
+
+    def _fail(self, key, material, text: str) -> None:
+        self._failed[key] = " ".join(f"thumbnail of '{material.name}': {text or 'the render process ended'}".split())
+        self._wanted.pop(key, None)
 
     def release(self) -> None:
-        self._stop.set()
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
         for texture in self._textures.values():
             texture.release()
         self._textures.clear()
-
-
-def _start_worker():
-    return subprocess.Popen([sys.executable, "-m", "alight.frontends.editor.thumbnail_worker"],
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                            text=True, bufsize=1)
-
-
-def render_thumbnail(process, material, maps, out: Path) -> None:
-    """The material (written to a scratch file: .json, or .glb with its maps) rendered by the
-    worker process into ``out``. Errors: AlightError with the worker's line."""
-    from alight.exchange.material_files import save_material_file
-
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix="alight-thumb-") as scratch:
-        source = Path(scratch) / ("material.glb" if maps.paths() else "material.json")
-        save_material_file(material, source, maps)
-        try:
-            process.stdin.write(f"{source}\t{out}\n")
-            process.stdin.flush()
-            answer = process.stdout.readline().strip()
-        except (OSError, ValueError):
-            answer = ""
-    if answer != "ok":
-        raise AlightError(f"thumbnail of '{material.name}': {answer or 'the render process ended'}")
 
 
 def _read(file: Path):

@@ -1,5 +1,5 @@
 """Turntables from the editor: N frames of the view with the camera orbiting once about the
-vertical axis through its target, as numbered PNGs or one animated WebP.
+vertical axis through its target, as numbered PNGs, one animated WebP or one MP4 (H.264).
 
 Why the camera orbits (and the environment and lights stay put): the mesh is seen from every
 side with the lighting the artist set up, as the orbit (left drag) shows it, and frame 0 is the
@@ -10,7 +10,13 @@ Drawn off the frame loop as the screenshots are (screenshot.py): a few frames ea
 frame, so the window keeps drawing and the panel shows the progress. Each frame is the
 screenshot of that camera (the renderer's offline path at the view's size). The files appear
 only whole: the PNGs are written under temporary names and renamed once all are drawn, the
-WebP (lossless, through imageio's Pillow plugin) is written to a temporary file and renamed.
+WebP (lossless, through imageio's Pillow plugin) is written to a temporary file and renamed; the
+MP4's frames go to imageio-ffmpeg's bundled ffmpeg as they are drawn (it encodes beside the
+editor's frames) into a temporary file renamed once ffmpeg has closed it.
+
+The MP4 is H.264 in yuv420p (what browsers and players read) at CRF 18: lossy, within a few
+levels of the PNG on the editor's ball (tests/editor_ui_checks_ed22b.py bounds it). 4:2:0 needs
+even sides: a view of odd width or height is padded by repeating its last column or row.
 """
 
 from __future__ import annotations
@@ -24,25 +30,26 @@ from pathlib import Path
 
 from alight.errors import AlightError
 
-SUFFIXES = (".png", ".webp")
+SUFFIXES = (".png", ".webp", ".mp4")
 MAX_FRAMES = 720
 STEP_BUDGET_S = 0.05   # time a frame gives the turntable, beyond one of its frames
-FRAME_MS = 40          # the WebP's frame time (25 frames a second)
+FRAME_MS = 40          # the WebP's and MP4's frame time (25 frames a second)
+MP4_CRF = 18           # x264's constant rate factor: 18 is about visually lossless, 23 its default
 
 
 @dataclass
 class TurntableSettings:
     """The panel's choice: how many frames, and where (``NAME.png``: NAME_000.png ...;
-    ``NAME.webp``: one animated file)."""
+    ``NAME.webp``, ``NAME.mp4``: one animated file)."""
 
     frames: int = 36
     path: str = "turntable.webp"
 
 
 def frame_paths(path: str, frames: int) -> list[Path]:
-    """The files a turntable writes: ``path`` itself for .webp, else NAME_000.png, NAME_001.png, ..."""
+    """The files a turntable writes: ``path`` itself for .webp and .mp4, else NAME_000.png, NAME_001.png, ..."""
     p = Path(path)
-    if p.suffix.lower() == ".webp":
+    if p.suffix.lower() in (".webp", ".mp4"):
         return [p]
     digits = max(3, len(str(frames - 1)))
     return [p.with_name(f"{p.stem}_{i:0{digits}d}{p.suffix}") for i in range(frames)]
@@ -70,6 +77,8 @@ class TurntableJob:
         out = check_output_path(path, SUFFIXES).resolve()
         self.path = str(out)
         self.webp = out.suffix.lower() == ".webp"
+        self.mp4 = out.suffix.lower() == ".mp4"
+        self._video = None              # the MP4's (writer, temporary path) once its first frame is drawn
         self.finals = frame_paths(self.path, len(cameras))
         self.width, self.height = size
         self._render = lambda camera: renderer.render(scene_for(camera), maps, size[0], size[1], aa=aa,
@@ -101,6 +110,9 @@ class TurntableJob:
             raise
 
     def _keep(self, pixels) -> None:
+        if self.mp4:
+            self._append_video(pixels[:, :, :3])
+            return
         if self.webp:
             self._frames.append(pixels.copy())
             return
@@ -111,7 +123,29 @@ class TurntableJob:
         self._temps.append(temp)
         write_image(temp, pixels, linear=False)
 
+    def _append_video(self, pixels) -> None:
+        import numpy as np
+
+        h, w = pixels.shape[:2]
+        pixels = np.pad(pixels, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+        try:
+            if self._video is None:
+                self._video = _open_mp4(self.path)
+            self._video[0].append_data(np.ascontiguousarray(pixels))
+        except (OSError, ValueError, RuntimeError) as exc:
+            raise AlightError(f"{self.path}: cannot write the turntable ({' '.join(str(exc).split())})") from None
+
     def _finish(self) -> None:
+        if self.mp4:
+            writer, temp = self._video
+            try:
+                writer.close()   # waits for ffmpeg to write the last frames and the index
+                os.chmod(temp, _default_mode(self.path))
+                os.replace(temp, self.path)
+            except (OSError, ValueError, RuntimeError) as exc:
+                raise AlightError(f"{self.path}: cannot write the turntable ({' '.join(str(exc).split())})") from None
+            self._video = None
+            return
         if self.webp:
             import imageio.v3 as iio
 
@@ -130,6 +164,13 @@ class TurntableJob:
         self._temps = []
 
     def cancel(self) -> None:
+        if self._video is not None:
+            writer, temp = self._video
+            self._video = None
+            with contextlib.suppress(Exception):
+                writer.close()
+            with contextlib.suppress(FileNotFoundError):
+                temp.unlink()
         for temp in self._temps:
             with contextlib.suppress(FileNotFoundError):
                 temp.unlink()
@@ -137,6 +178,35 @@ class TurntableJob:
 
     def progress(self) -> str:
         return f"turntable {os.path.basename(self.path)}: frame {self.done} of {len(self._cameras)}"
+
+
+def _open_mp4(path: str):
+    """imageio-ffmpeg's writer into a temporary .mp4 beside ``path``: (writer, temporary path)."""
+    import tempfile
+
+    import imageio.v2 as iio
+
+    final = Path(path)
+    fd, temp = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=".tmp.mp4", dir=final.parent)
+    os.close(fd)
+    try:
+        writer = iio.get_writer(temp, format="FFMPEG", mode="I", fps=1000.0 / FRAME_MS, codec="libx264",
+                                pixelformat="yuv420p", quality=None, macro_block_size=1, ffmpeg_log_level="error",
+                                output_params=["-crf", str(MP4_CRF), "-movflags", "+faststart"])
+    except BaseException:
+        os.unlink(temp)
+        raise
+    return writer, Path(temp)
+
+
+def _default_mode(path: str) -> int:
+    """The mode an ordinary write of ``path`` would give it (mkstemp's file is private)."""
+    try:
+        return os.stat(path).st_mode & 0o7777
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
 
 
 def draw_controls(win) -> None:
@@ -149,7 +219,7 @@ def draw_controls(win) -> None:
         t.frames = max(2, min(MAX_FRAMES, n))
     _, t.path = imgui.input_text("turntable file", t.path)
     if imgui.is_item_hovered():
-        imgui.set_tooltip("NAME.webp: one animated WebP (lossless); NAME.png: NAME_000.png, NAME_001.png, ...; "
+        imgui.set_tooltip("NAME.webp: one animated WebP (lossless); NAME.mp4: one H.264 video (lossy, CRF 18); NAME.png: NAME_000.png, NAME_001.png, ...; "
                           "the camera orbits once about the vertical axis, at the view's size")
     if imgui.button("turntable (T)"):
         win.turntable_request = True   # the window starts it after the frame

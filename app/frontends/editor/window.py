@@ -195,6 +195,9 @@ class EditorWindow:
         from alight.frontends.editor.variant_warmup import VariantWarmup
 
         self.variant_warmup = VariantWarmup()   # new shader variants compiled in a process of their own
+        from alight.frontends.editor.pass_warmup import PassWarmup
+
+        self.pass_warmup = PassWarmup()   # the split view's passes drawn once at the start (Mesa's cache)
 
     # --- input --------------------------------------------------------------------------------
 
@@ -715,6 +718,7 @@ class EditorWindow:
         self.render_view()
         self.advance_bake()
         self.thumbnails.step()
+        self.pass_warmup.step(self.state.display)
 
     def begin_imgui_frame(self) -> None:
         """imgui's input and new frame (after poll_events)."""
@@ -870,6 +874,7 @@ class EditorWindow:
         self._target_cache.clear()
         self.compare_view.release()
         self.variant_warmup.close()
+        self.pass_warmup.close()
         self._panel_image.release()
         self.thumbnails.release()
         if self.hosted:   # the runner closes imgui, the window and its context after this
