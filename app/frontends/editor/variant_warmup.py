@@ -120,7 +120,7 @@ class VariantWarmup:
 def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
     """``renderer.draw_display`` of the view, with the gate when ``gated``: a program not
     compiled yet is handed to the child and the last complete picture's scene is drawn instead
-    (with this frame's camera). Returns (the framebuffer drawn into, whether it is ``scene``)."""
+    (with this frame's camera, unless the mesh changed: then with its own). Returns (the framebuffer drawn into, whether it is ``scene``)."""
     from alight.core.gpu import ProgramPending
 
     renderer, warmup = win.renderer, win.variant_warmup
@@ -140,7 +140,11 @@ def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
         warmup.request(win, exc, scene, maps, (targets.width, targets.height))
     finally:
         renderer.shaders.gate = None
-    old = dataclasses.replace(old, camera=scene.camera)
+    if old.mesh is scene.mesh:
+        # The same mesh: the last look follows the orbit. A new mesh's camera frames the new
+        # mesh; the old mesh seen from it was the trial's "helmet turned to the shader ball's
+        # 3/4 view", so the last picture stays as it was until the new one is ready.
+        old = dataclasses.replace(old, camera=scene.camera)
     warmup.showing_old = True
     return renderer.draw_display(old, maps, targets, into=into, into_encodes_srgb=into_srgb), False
 
