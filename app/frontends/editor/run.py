@@ -66,7 +66,7 @@ def run(args) -> int:
     if interactive and not args.new and _no_scene_options(args):
         from alight.frontends.editor.session import restore_session
 
-        warning = restore_session(state, win.orbit)
+        warning = restore_session(state, win.orbit, win.turntable)
         if warning:
             state.error = " ".join(warning.split())
         win.history.committed = state.look
@@ -88,7 +88,7 @@ def run(args) -> int:
             win.frame()
         from alight.frontends.editor.session import save_session
 
-        save_session(state, win.orbit)
+        save_session(state, win.orbit, win.turntable)
         return 0
     finally:
         win.close()

@@ -1,5 +1,5 @@
-"""The last session (mesh, environment, material, camera), so the editor reopens where the
-artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written
+"""The last session (mesh, environment, material, camera, the view's settings, the turntable's
+frames and file), so the editor reopens where the artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written
 atomically on close."""
 
 from __future__ import annotations
@@ -26,23 +26,27 @@ def session_path() -> Path:
     return config_dir() / "editor-session.json"
 
 
-def save_session(state, orbit) -> None:
+def save_session(state, orbit, turntable=None) -> None:
+    """``turntable``: the window's turntable.TurntableSettings (kept when given)."""
     data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
             "texture_maps": state.texture_maps.to_dict(),
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
-                         "use_file_materials": state.use_file_materials,
+                         "use_file_materials": state.use_file_materials, "aa": state.aa,
                          "display": dataclasses.asdict(state.display),
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
             "compare": compare.to_dict(state.compare)}
+    if turntable is not None:
+        data["turntable"] = {"frames": turntable.frames, "path": turntable.path}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))
 
 
-def restore_session(state, orbit) -> str:
-    """Apply the saved session to ``state`` and ``orbit``. Returns '' or a one-line warning: a
-    missing mesh or environment file (moved since) or a broken session file restores what it can."""
+def restore_session(state, orbit, turntable=None) -> str:
+    """Apply the saved session to ``state`` and ``orbit`` (and ``turntable``, the window's
+    turntable.TurntableSettings, when given). Returns '' or a one-line warning: a missing mesh or
+    environment file (moved since) or a broken session file restores what it can."""
     path = session_path()
     if not path.is_file():
         return ""
@@ -89,6 +93,12 @@ def restore_session(state, orbit) -> str:
             state.compare = compare.from_dict(data["compare"], str(path))
         except AlightError as exc:
             warning = " ".join(str(exc).split())
+    spin = data.get("turntable")
+    if turntable is not None and isinstance(spin, dict):   # (older sessions lack it)
+        try:
+            turntable.frames, turntable.path = _read_turntable(spin)
+        except (KeyError, TypeError, ValueError) as exc:
+            warning = f"{path}: the turntable's settings not restored ({' '.join(str(exc).split())})"
     camera = data.get("camera")
     if isinstance(camera, dict):
         try:
@@ -100,6 +110,18 @@ def restore_session(state, orbit) -> str:
         except (KeyError, TypeError, ValueError):
             pass
     return warning
+
+
+def _read_turntable(data: dict) -> tuple[int, str]:
+    """(frames, path) from a session's "turntable". Errors: KeyError, TypeError, ValueError."""
+    from alight.frontends.editor.turntable import MAX_FRAMES
+
+    frames, path = data["frames"], data["path"]
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_FRAMES:
+        raise ValueError(f"frames {frames!r} is not a whole number from 2 to {MAX_FRAMES}")
+    if not isinstance(path, str):
+        raise TypeError(f"path {path!r} is not text")
+    return frames, path
 
 
 def _read_settings(data: dict):
@@ -129,6 +151,10 @@ def _read_settings(data: dict):
               "ibl_model": choice(data["ibl_model"], tuple(IBL_MODELS), "ibl_model"),
               "multiple_scattering": bool(data["multiple_scattering"]),
               "lights_follow_env": bool(data.get("lights_follow_env", False))}   # (older sessions lack it)
+    if "aa" in data:   # the anti-aliasing (older sessions lack it: the command line's stays)
+        from alight.render.renderer import AA_MODES
+
+        values["aa"] = choice(data["aa"], AA_MODES, "aa")
     d = data["display"]
     display = Display(tonemap=choice(d["tonemap"], TONEMAPS, "tonemap"), exposure=number(d["exposure"], "exposure"),
                       background=choice(d["background"], BACKGROUNDS, "background"),
