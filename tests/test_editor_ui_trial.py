@@ -84,3 +84,32 @@ def test_a_warning_of_a_dropped_file_is_in_the_message(tmp_path):
     assert state.message == f"opened nancolor.obj; warning: {line}", state.message
     state.warning_lines = ("a", "b")
     assert state.with_warnings("opened x") == "opened x; 2 warnings: a | b"
+
+
+def test_a_warning_of_the_mesh_given_at_start_is_in_the_status_row(display, tmp_path):
+    """`alight edit --mesh FILE` with a file drawn without something: the status row says what
+    from the first frame (only stderr did)."""
+    path = REPO.parent / "shared" / "data" / "bad" / "nancolor.obj"
+    check = tmp_path / "start.py"
+    check.write_text("from alight.frontends.editor.ui_test import editor\n"
+                     "def test_status(ctx):\n"
+                     "    ctx.yield_(2)\n"
+                     "    print('STATUS=' + editor().panel.shown_status)\n")
+    result = ui_test(tmp_path, check, "--new", "--mesh", str(path))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    status = next(line for line in result.stdout.splitlines() if line.startswith("STATUS="))
+    assert "warning: " in status and "1 vertex colour NaN or Inf (line 7)" in status, status
+
+
+def test_a_restored_meshs_warning_is_in_the_message(tmp_path, monkeypatch):
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session
+    from alight.frontends.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
+    state = EditorState()
+    state.load_mesh(str(REPO.parent / "shared" / "data" / "bad" / "nancolor.obj"))
+    save_session(state, OrbitCamera())
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert fresh.message.startswith("restored the last session; warning: ") and "NaN" in fresh.message, fresh.message

@@ -67,12 +67,17 @@ def restore_session(state, orbit, turntable=None) -> str:
         except AlightError as exc:
             warning = str(exc)
     state.mark_saved()   # 'revert' goes back to the restored material with its maps
+    said = ()
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
         if isinstance(spec, str):
             try:
                 loader(spec)
+                said += state.warning_lines
             except AlightError as exc:
                 warning = str(exc)
+    if said:   # what the restored files are drawn without, in the status row
+        state.warning_lines = said
+        state.message = state.with_warnings("restored the last session")
     settings = data.get("settings")
     if isinstance(settings, dict):
         try:
