@@ -60,7 +60,7 @@ def test_msaa_over_a_transparent_background_shows_the_checkerboard(ctx):
     ctx.item_close("**/Environment")
     ctx.item_open("**/Display & camera")
     levels = {}
-    for aa in ("none", "msaa"):
+    for aa in ("none", "msaa"):   # (the editor offers these two)
         ctx.combo_click(f"anti-aliasing/{aa}")
         assert win.state.aa == aa
         ctx.mouse_click_on_void()

@@ -45,20 +45,20 @@ def test_the_session_keeps_the_turntable_and_the_anti_aliasing(tmp_path, monkeyp
     from alight.frontends.editor.turntable import TurntableSettings
 
     monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
-    state = EditorState(aa="ssaa")
+    state = EditorState(aa="msaa")
     save_session(state, OrbitCamera(), TurntableSettings(frames=72, path="spin.png"))
     fresh, turntable = EditorState(), TurntableSettings()
     assert restore_session(fresh, OrbitCamera(), turntable) == ""
-    assert (fresh.aa, turntable.frames, turntable.path) == ("ssaa", 72, "spin.png")
+    assert (fresh.aa, turntable.frames, turntable.path) == ("msaa", 72, "spin.png")
     # A session from before these were kept: the command line's anti-aliasing and the defaults stay.
     data = json.loads(session_path().read_text())
     del data["turntable"], data["settings"]["aa"]
     session_path().write_text(json.dumps(data))
-    fresh, turntable = EditorState(aa="msaa"), TurntableSettings()
+    fresh, turntable = EditorState(aa="none"), TurntableSettings()
     assert restore_session(fresh, OrbitCamera(), turntable) == ""
-    assert (fresh.aa, turntable) == ("msaa", TurntableSettings())
+    assert (fresh.aa, turntable) == ("none", TurntableSettings())
     # Edited by hand: one line naming what was left out; the rest restored.
-    data["turntable"], data["settings"]["aa"] = {"frames": 1, "path": "x.webp"}, "fxaa"
+    data["turntable"], data["settings"]["aa"] = {"frames": 1, "path": "x.webp"}, "ssaa"
     session_path().write_text(json.dumps(data))
     fresh, turntable = EditorState(aa="msaa"), TurntableSettings()
     warning = restore_session(fresh, OrbitCamera(), turntable)
@@ -67,7 +67,7 @@ def test_the_session_keeps_the_turntable_and_the_anti_aliasing(tmp_path, monkeyp
     data["turntable"] = {"frames": 10, "path": "x.webp"}
     session_path().write_text(json.dumps(data))
     warning = restore_session(fresh, OrbitCamera(), turntable)
-    assert "aa 'fxaa'" in warning and fresh.aa == "msaa", (warning, fresh.aa)
+    assert "aa 'ssaa'" in warning and fresh.aa == "msaa", (warning, fresh.aa)   # (the editor has none and msaa)
     assert turntable.frames == 10
 
 

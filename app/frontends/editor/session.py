@@ -20,6 +20,7 @@ CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "rad
 # The view's settings kept beside the material and camera (with the display and the lights).
 SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering",
                   "lights_follow_env")
+EDITOR_AA = ("none", "msaa")   # the editor's anti-aliasing (alight edit --aa, the panel's combo)
 
 
 def session_path() -> Path:
@@ -157,9 +158,7 @@ def _read_settings(data: dict):
               "multiple_scattering": bool(data["multiple_scattering"]),
               "lights_follow_env": bool(data.get("lights_follow_env", False))}   # (older sessions lack it)
     if "aa" in data:   # the anti-aliasing (older sessions lack it: the command line's stays)
-        from alight.render.renderer import AA_MODES
-
-        values["aa"] = choice(data["aa"], AA_MODES, "aa")
+        values["aa"] = choice(data["aa"], EDITOR_AA, "aa")
     d = data["display"]
     display = Display(tonemap=choice(d["tonemap"], TONEMAPS, "tonemap"), exposure=number(d["exposure"], "exposure"),
                       background=choice(d["background"], BACKGROUNDS, "background"),
