@@ -350,7 +350,10 @@ class ForwardRenderer:
             # (transmissive parts read the opaque parts' radiance, which must not be tone mapped;
             # the ground darkens radiance, before the tone map)
             self.draw_hdr(scene, maps, targets)
-            self.tonemap(targets.radiance, scene.display, targets.display_fbo)
+            # A transparent background keeps the coverage as alpha, as the one pass below does
+            # (the editor shows it over a checkerboard; opaque, MSAA's view was black there).
+            self.tonemap(targets.radiance, scene.display, targets.display_fbo,
+                         opaque=scene.display.background != "transparent")
             return targets.display_fbo
         fbo = into or targets.display_draw()
         srgb = into is not None and into_encodes_srgb and not variants.has_blending_parts(scene)

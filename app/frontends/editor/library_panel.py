@@ -89,7 +89,7 @@ class LibraryPanel:
             return
         try:
             s.load_material(entry.path)
-            s.error, s.message = "", f"applied {entry.name} from the library"
+            s.error, s.message = "", s.with_warnings(f"applied {entry.name} from the library")
         except AlightError as exc:
             s.fail(exc)
 

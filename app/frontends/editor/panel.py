@@ -135,6 +135,8 @@ class Panel:
         self.set_path = ""      # the 'texture set' field: a folder, or image files separated by ';'
         self._specs_shown = (None, None)   # the mesh and environment the path fields were last set from
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
+        self.shown_status = ""  # the status row's text drawn last frame (tests read it)
+        self.shown_f0 = ""      # the F0 line drawn last frame (tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
         self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
@@ -160,7 +162,7 @@ class Panel:
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
         self.shown_error = s.error
-        self._status_line(s, win)
+        self.shown_status = self._status_line(s, win)
         self._follow_loaded(s)
         headers = []   # each section header's height: the layout's signature (press_guard.py)
 
@@ -200,32 +202,42 @@ class Panel:
         close_popup_on_escape()
 
     @staticmethod
-    def _status_line(s, win) -> None:
+    def _status_line(s, win) -> str:
         """The panel's menu bar, one row of a fixed height that never scrolls: the error (red),
         else the bake's progress, else the last message (green), else nothing; so a save or an
         error is seen wherever the panel is scrolled, and the rows below never move when one
-        appears or goes. A long line is cut at the panel's edge; hovering it shows it whole."""
+        appears or goes. A long line is cut at the panel's edge; hovering it shows it whole.
+        Returns the row's text."""
         from imgui_bundle import imgui
 
         if not imgui.begin_menu_bar():
-            return
+            return ""
+        shown = ""
         if s.error:
-            imgui.text_colored(imgui.ImVec4(*ERROR_RGBA), f"error: {s.error}")
+            shown = f"error: {s.error}"
+            imgui.text_colored(imgui.ImVec4(*ERROR_RGBA), shown)
         elif win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
             fraction, label = win.bake_progress
-            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), f"baking {s.quality}: {label}")
+            shown = f"baking {s.quality}: {label}"
+            imgui.progress_bar(fraction, imgui.ImVec2(-1, 0), shown)
+        elif getattr(win, "turntable_job", None) is not None:   # its frames, then "writing NAME..."
+            shown = win.turntable_job.progress()
+            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
         elif s.message:
-            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), s.message)
+            shown = s.message
+            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
         if (s.error or s.message) and imgui.is_item_hovered():
-            # The line whole, wrapped to the window's width (a set's assignment outgrew it).
+            # The line whole, wrapped to the window's width (a set's assignment outgrew it); a
+            # file's several warnings one a line.
             width = imgui.get_io().display_size.x
             imgui.set_next_window_pos(imgui.ImVec2(0.0, imgui.get_item_rect_max().y + 2.0))
             imgui.begin_tooltip()
             imgui.push_text_wrap_pos(width - 2.0 * imgui.get_style().window_padding.x)
-            imgui.text_unformatted(s.error or s.message)
+            imgui.text_unformatted(s.error or s.message.replace(" | ", "\n"))
             imgui.pop_text_wrap_pos()
             imgui.end_tooltip()
         imgui.end_menu_bar()
+        return shown
 
     def _follow_loaded(self, s) -> None:
         """The mesh and env path fields show the file loaded (a restored session, a drop), not
@@ -311,7 +323,11 @@ class Panel:
         if imgui.tree_node_ex("texture maps", imgui.TreeNodeFlags_.default_open):
             self._texture_maps(s)
             imgui.tree_pop()
-        imgui.text_disabled(f"F0 = {' '.join(f'{x:.3f}' for x in s.material.f0())}   "
+        # The factors' F0; where a map scales it (base colour, metallic), the map's texels times it.
+        f0 = ' '.join(f'{x:.3f}' for x in s.material.f0())
+        mapped = any(getattr(s.texture_maps, slot) for slot in ("base_color", "metallic_roughness", "metallic"))
+        self.shown_f0 = f"F0 (factors) = {f0} x maps" if mapped else f"F0 = {f0}"   # (the checks read it)
+        imgui.text_disabled(f"{self.shown_f0}   "
                             f"undo {len(win.history.undo_stack)}  redo {len(win.history.redo_stack)}")
         if imgui.button("revert"):
             s.revert()
@@ -557,8 +573,7 @@ class Panel:
     def _open_mesh(self, s) -> None:
         try:
             s.load_mesh(self.mesh_path)
-            warned = f" ({s.warnings} warning{'s' if s.warnings > 1 else ''} on stderr)" if s.warnings else ""
-            s.error, s.message = "", f"opened mesh {self.mesh_path}{warned}"
+            s.error, s.message = "", s.with_warnings(f"opened mesh {self.mesh_path}")
         except AlightError as exc:
             s.fail(exc)
 

@@ -26,7 +26,11 @@ def build_state(args) -> EditorState:
     _start_maps(state, maps, args)
     state.mark_saved()   # what 'revert' goes back to: the material and maps it started with
     state.load_mesh(args.mesh)
+    mesh_warnings = state.warning_lines
     state.load_env(args.env)
+    state.warning_lines = mesh_warnings + state.warning_lines
+    if state.warning_lines:   # what the files are drawn without, in the status row from the start
+        state.message = state.with_warnings(f"opened {args.mesh}, {args.env}")
     if args.no_ibl:
         state.ibl_enabled = False
     # As in 'alight render': a mesh file without --preset shows its own materials and maps.
@@ -66,7 +70,7 @@ def run(args) -> int:
     if interactive and not args.new and _no_scene_options(args):
         from alight.frontends.editor.session import restore_session
 
-        warning = restore_session(state, win.orbit)
+        warning = restore_session(state, win.orbit, win.turntable)
         if warning:
             state.error = " ".join(warning.split())
         win.history.committed = state.look
@@ -88,7 +92,7 @@ def run(args) -> int:
             win.frame()
         from alight.frontends.editor.session import save_session
 
-        save_session(state, win.orbit)
+        save_session(state, win.orbit, win.turntable)
         return 0
     finally:
         win.close()

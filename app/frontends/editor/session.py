@@ -1,5 +1,5 @@
-"""The last session (mesh, environment, material, camera), so the editor reopens where the
-artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written
+"""The last session (mesh, environment, material, camera, the view's settings, the turntable's
+frames and file), so the editor reopens where the artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written
 atomically on close."""
 
 from __future__ import annotations
@@ -20,29 +20,34 @@ CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "rad
 # The view's settings kept beside the material and camera (with the display and the lights).
 SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering",
                   "lights_follow_env")
+EDITOR_AA = ("none", "msaa")   # the editor's anti-aliasing (alight edit --aa, the panel's combo)
 
 
 def session_path() -> Path:
     return config_dir() / "editor-session.json"
 
 
-def save_session(state, orbit) -> None:
+def save_session(state, orbit, turntable=None) -> None:
+    """``turntable``: the window's turntable.TurntableSettings (kept when given)."""
     data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
             "texture_maps": state.texture_maps.to_dict(),
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
-                         "use_file_materials": state.use_file_materials,
+                         "use_file_materials": state.use_file_materials, "aa": state.aa,
                          "display": dataclasses.asdict(state.display),
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
             "compare": compare.to_dict(state.compare)}
+    if turntable is not None:
+        data["turntable"] = {"frames": turntable.frames, "path": turntable.path}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))
 
 
-def restore_session(state, orbit) -> str:
-    """Apply the saved session to ``state`` and ``orbit``. Returns '' or a one-line warning: a
-    missing mesh or environment file (moved since) or a broken session file restores what it can."""
+def restore_session(state, orbit, turntable=None) -> str:
+    """Apply the saved session to ``state`` and ``orbit`` (and ``turntable``, the window's
+    turntable.TurntableSettings, when given). Returns '' or a one-line warning: a missing mesh or
+    environment file (moved since) or a broken session file restores what it can."""
     path = session_path()
     if not path.is_file():
         return ""
@@ -63,12 +68,17 @@ def restore_session(state, orbit) -> str:
         except AlightError as exc:
             warning = str(exc)
     state.mark_saved()   # 'revert' goes back to the restored material with its maps
+    said = ()
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
         if isinstance(spec, str):
             try:
                 loader(spec)
+                said += state.warning_lines
             except AlightError as exc:
                 warning = str(exc)
+    if said:   # what the restored files are drawn without, in the status row
+        state.warning_lines = said
+        state.message = state.with_warnings("restored the last session")
     settings = data.get("settings")
     if isinstance(settings, dict):
         try:
@@ -89,6 +99,12 @@ def restore_session(state, orbit) -> str:
             state.compare = compare.from_dict(data["compare"], str(path))
         except AlightError as exc:
             warning = " ".join(str(exc).split())
+    spin = data.get("turntable")
+    if turntable is not None and isinstance(spin, dict):   # (older sessions lack it)
+        try:
+            turntable.frames, turntable.path = _read_turntable(spin)
+        except (KeyError, TypeError, ValueError) as exc:
+            warning = f"{path}: the turntable's settings not restored ({' '.join(str(exc).split())})"
     camera = data.get("camera")
     if isinstance(camera, dict):
         try:
@@ -100,6 +116,18 @@ def restore_session(state, orbit) -> str:
         except (KeyError, TypeError, ValueError):
             pass
     return warning
+
+
+def _read_turntable(data: dict) -> tuple[int, str]:
+    """(frames, path) from a session's "turntable". Errors: KeyError, TypeError, ValueError."""
+    from alight.frontends.editor.turntable import MAX_FRAMES
+
+    frames, path = data["frames"], data["path"]
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_FRAMES:
+        raise ValueError(f"frames {frames!r} is not a whole number from 2 to {MAX_FRAMES}")
+    if not isinstance(path, str):
+        raise TypeError(f"path {path!r} is not text")
+    return frames, path
 
 
 def _read_settings(data: dict):
@@ -129,6 +157,8 @@ def _read_settings(data: dict):
               "ibl_model": choice(data["ibl_model"], tuple(IBL_MODELS), "ibl_model"),
               "multiple_scattering": bool(data["multiple_scattering"]),
               "lights_follow_env": bool(data.get("lights_follow_env", False))}   # (older sessions lack it)
+    if "aa" in data:   # the anti-aliasing (older sessions lack it: the command line's stays)
+        values["aa"] = choice(data["aa"], EDITOR_AA, "aa")
     d = data["display"]
     display = Display(tonemap=choice(d["tonemap"], TONEMAPS, "tonemap"), exposure=number(d["exposure"], "exposure"),
                       background=choice(d["background"], BACKGROUNDS, "background"),

@@ -72,6 +72,7 @@ class EditorState:
     message: str = ""        # the last success ("saved gold.json")
     typed_name: str = ""     # the material name the artist typed last: a texture set loaded keeps it
     warnings: int = 0        # warning lines of the last mesh or environment file opened
+    warning_lines: tuple = ()   # ... and their text (the status row shows it: with_warnings)
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
     mesh: object = None
     env: object = None
@@ -128,6 +129,17 @@ class EditorState:
         for line in warnings:
             warn(line)
         self.warnings = len(warnings)
+        self.warning_lines = tuple(warnings)
+
+    def with_warnings(self, message: str) -> str:
+        """``message`` with the last file's warnings, for the status row (hovering it shows the
+        line whole): 'opened X; warning: TEXT', or 'opened X; 2 warnings: A | B'."""
+        lines = self.warning_lines
+        if not lines:
+            return message
+        if len(lines) == 1:
+            return f"{message}; warning: {lines[0]}"
+        return f"{message}; {len(lines)} warnings: " + " | ".join(lines)
 
     def set_map(self, slot: str, path: str, factor_to_1: bool = True) -> None:
         """Fill a texture slot from an image file (read now: a bad file raises, nothing changes).
@@ -327,9 +339,10 @@ class EditorState:
         except Exception as exc:
             self.fail(exc)
             return False
+        warned = suffix != "" and suffix not in IMAGE_SUFFIXES   # (a map's read says nothing)
         self.error, self.message = "", f"opened {os.path.basename(path)}"
-        if self.warnings and (suffix in ENV_SUFFIXES or suffix in MESH_EXTENSIONS):
-            self.message += f" ({self.warnings} warning{'s' if self.warnings > 1 else ''} on stderr)"
+        if warned:
+            self.message = self.with_warnings(self.message)
         return True
 
     def fail(self, exc: Exception) -> None:
