@@ -30,6 +30,7 @@ import numpy as np
 from alight.core.shader_names import AlphaMode
 from alight.core.texture_maps import TextureMaps
 from alight.render.bindings import UNIT_VISIBILITY, set_uniform
+from alight.render.part_bindings import _bind_view, bind_part, set_culling
 from alight.render.variants import has_blending_parts, part_defines, transmissive_parts, user_maps_present
 
 MESH_SHADING = ("forward", "vbuffer")   # ForwardRenderer.mesh_shading
@@ -99,7 +100,6 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
     """The mesh's parts into ``targets.single()`` (cleared by the scene pass): the visibility
     pass, then one shading pass per part. ``program_for(variant, vertex, fragment)``: draw_mesh's
     program with the scene's defines and bindings (IBL, shadows, layer tables)."""
-    from alight.render.passes import _bind_view, bind_part, set_culling
 
     ctx = r.ctx
     width, height = targets.draw_size

@@ -118,7 +118,7 @@ class Thumbnails:
         except OSError as exc:
             self._fail(key, material, f"cannot make {out.parent} ({exc})")
             return
-        self._job = (self._worker.submit(ThumbnailJob(material=material, maps=maps, out=str(out))), key, material)
+        self._job = (self._worker.submit(ThumbnailJob(material=material, maps=maps, out=str(out), size=THUMB_SIZE)), key, material)
 
     def _settle(self) -> None:
         """The child's answer to the job it has: the PNG uploaded, or the error kept."""
