@@ -134,7 +134,7 @@ def test_the_reference_fills_in_while_frames_go_on_and_reopening_reuses_it(ctx):
 def test_a_new_mesh_waiting_for_its_variant_keeps_the_last_picture_as_it_was(ctx):
     """A preview mesh whose program is not compiled yet: the view keeps the last picture as it
     was, not the old mesh seen from the new mesh's camera (a fresh trial saw the helmet turned to
-    the shader ball's 3/4 view for seconds), then shows the new mesh."""
+    the shader ball's 3/4 view for seconds), and the status row says it waits; then the new mesh."""
     s, warm = editor().state, editor().variant_warmup
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
@@ -149,6 +149,8 @@ def test_a_new_mesh_waiting_for_its_variant_keeps_the_last_picture_as_it_was(ctx
     assert warm.pending and warm.jobs == jobs + 1, (warm.pending, warm.jobs, jobs)
     ctx.yield_(2)
     assert same(shown(ctx), old) <= 1, "the old mesh was redrawn from the new mesh's camera"
+    status = editor().panel.shown_status
+    assert "compiling" in status, status   # the held picture does not pass for the new one
     wait_frames(ctx, lambda: not warm.pending)
     ctx.yield_(3)
     assert np.abs(shown(ctx).astype(np.float64) - old).mean() > 2.0, "the view still shows the old mesh"

@@ -204,7 +204,8 @@ class Panel:
     @staticmethod
     def _status_line(s, win) -> str:
         """The panel's menu bar, one row of a fixed height that never scrolls: the error (red),
-        else the bake's progress, else the last message (green), else nothing; so a save or an
+        else the bake's or turntable's progress, else that the view waits for a new look's
+        shaders, else the last message (green), else nothing; so a save or an
         error is seen wherever the panel is scrolled, and the rows below never move when one
         appears or goes. A long line is cut at the panel's edge; hovering it shows it whole.
         Returns the row's text."""
@@ -223,6 +224,11 @@ class Panel:
         elif getattr(win, "turntable_job", None) is not None:   # its frames, then "writing NAME..."
             shown = win.turntable_job.progress()
             imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
+        elif getattr(getattr(win, "variant_warmup", None), "showing_old", False):
+            # A new look's program compiles in the warm-up process (variant_warmup.py): the view
+            # holds the last picture meanwhile, which must not pass for the new one.
+            shown = "compiling the new look's shaders: the view shows the last one"
+            imgui.text_disabled(shown)
         elif s.message:
             shown = s.message
             imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
