@@ -38,6 +38,16 @@ def pack_snorm16(values: np.ndarray) -> np.ndarray:
     return np.rint(np.clip(values, -1.0, 1.0) * SNORM16).astype(np.int16)
 
 
+def unit_directions(values: np.ndarray) -> np.ndarray:
+    """(N, 3) directions scaled to unit length (zero rows stay zero), float32: what snorm can
+    hold. The shader normalizes after interpolation, so a uniformly scaled normal (a file's normals
+    of length 3, or 1e-3) draws as its unit twin; clipped to [-1, 1] or quantized at its own
+    length it did not (tests/test_stability.py test_non_unit_mesh_normals_change_nothing)."""
+    v = np.asarray(values, np.float32)
+    length = np.sqrt(np.einsum("ij,ij->i", v, v))
+    return v / np.where(length > 0.0, length, 1.0)[:, None]
+
+
 def unpack_snorm16(packed: np.ndarray) -> np.ndarray:
     """pbr.vert's decode of pack_snorm16, as float32 (its numpy twin)."""
     return np.maximum(packed.astype(np.float32) / np.float32(SNORM16), np.float32(-1.0))
@@ -93,7 +103,7 @@ class GpuPart:
         vertices = np.empty(n, np.dtype([(name, dtype, shape) for name, dtype, shape, _ in fields]))
         vertices["in_position"] = part.positions
         if self.packed:
-            vertices["in_normal"][:, :3] = pack_snorm16(part.normals)
+            vertices["in_normal"][:, :3] = pack_snorm16(unit_directions(part.normals))
             vertices["in_normal"][:, 3] = 0
         else:
             vertices["in_normal"] = part.normals
@@ -175,6 +185,8 @@ class GpuPart:
         """The tangent buffer and its format, uploaded on first use."""
         if self.tangent_buffer is None:
             tangents = np.asarray(self._part.tangents, np.float32)
+            if self.packed:
+                tangents = np.concatenate([unit_directions(tangents[:, :3]), tangents[:, 3:]], axis=1)
             data = pack_snorm16(tangents) if self.packed else np.ascontiguousarray(tangents)
             self.tangent_buffer = self.ctx.buffer(data)
         return (self.tangent_buffer, "4i2" if self.packed else "4f", "in_tangent")
