@@ -19,7 +19,7 @@ into a temporary file, which the worker thread closes (ffmpeg writes its last fr
 and renames.
 
 The MP4 is H.264 in yuv420p (what browsers and players read) at CRF 18: lossy, within a few
-levels of the PNG on the editor's ball (tests/editor_ui_checks_ed22b.py bounds it). 4:2:0 needs
+levels of the PNG on the editor's ball (tests/editor_ui_checks_turntable_video.py bounds it). 4:2:0 needs
 even sides: a view of odd width or height is padded by repeating its last column or row.
 """
 

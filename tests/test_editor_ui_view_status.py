@@ -1,5 +1,5 @@
-"""Faults a fresh trial of the editor found (issue 22), through its real UI: `alight edit
---ui-test` runs tests/editor_ui_checks_trial.py with the Dear ImGui Test Engine against the real
+"""The view and the status row (faults a fresh trial of the editor found), through its real UI: `alight edit
+--ui-test` runs tests/editor_ui_checks_view_status.py with the Dear ImGui Test Engine against the real
 window under Xvfb; a second editor, reopened on the session the first saved, checks the
 turntable's settings and the anti-aliasing. The session's own save and restore are checked
 here too, as the other session tests do."""
@@ -13,12 +13,12 @@ from test_editor import display  # noqa: F401  (the Xvfb fixture)
 from test_editor_ui import ui_test
 
 REPO = Path(__file__).resolve().parents[1]
-CHECKS = REPO / "tests" / "editor_ui_checks_trial.py"
+CHECKS = REPO / "tests" / "editor_ui_checks_view_status.py"
 
 REOPENED = f"""
 import sys
 sys.path.insert(0, {str(CHECKS.parent)!r})
-from editor_ui_checks_trial import reopened_turntable_and_aa_are_restored as test_reopened_turntable_and_aa
+from editor_ui_checks_view_status import reopened_turntable_and_aa_are_restored as test_reopened_turntable_and_aa
 """
 
 

@@ -1,5 +1,5 @@
-"""Issue 22's second artist trial through the real UI: `alight edit --ui-test` runs
-tests/editor_ui_checks_ed22a.py with the Dear ImGui Test Engine under Xvfb ('save preset' with
+"""The panel's guards and messages through the real UI: `alight edit --ui-test` runs
+tests/editor_ui_checks_guards.py with the Dear ImGui Test Engine under Xvfb ('save preset' with
 maps, path fields after a failure, the reference compare's wording, replacing a library entry),
 and the same file run as a script clicks `alight edit`'s own window with xdotool while frames are
 slow (a click aimed at a layout the panel no longer has)."""
@@ -18,10 +18,10 @@ from test_editor import display  # noqa: F401  (the Xvfb fixture)
 from test_editor_ui import ui_test
 
 REPO = Path(__file__).resolve().parents[1]
-CHECKS = REPO / "tests" / "editor_ui_checks_ed22a.py"
+CHECKS = REPO / "tests" / "editor_ui_checks_guards.py"
 
 
-def test_ed22a_checks_pass_through_the_test_engine(display, tmp_path):
+def test_guard_and_message_checks_pass_through_the_test_engine(display, tmp_path):
     result = ui_test(tmp_path, CHECKS, "--new", size="1280x720")
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]

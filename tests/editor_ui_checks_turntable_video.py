@@ -1,5 +1,5 @@
 """The editor's turntable as an MP4 (issue 22), through the panel's real controls. Run by
-tests/test_editor_ui_ed22b.py as ``alight edit --new --ui-test tests/editor_ui_checks_ed22b.py``
+tests/test_editor_ui_turntable_video.py as ``alight edit --new --ui-test tests/editor_ui_checks_turntable_video.py``
 (the Dear ImGui Test Engine against the real window under Xvfb); not collected by pytest.
 """
 

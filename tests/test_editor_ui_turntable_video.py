@@ -1,5 +1,5 @@
 """The MP4 turntable through the real UI (issue 22): `alight edit --ui-test` runs
-tests/editor_ui_checks_ed22b.py with the Dear ImGui Test Engine under Xvfb."""
+tests/editor_ui_checks_turntable_video.py with the Dear ImGui Test Engine under Xvfb."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ from test_editor import display  # noqa: F401  (the Xvfb fixture)
 from test_editor_ui import ui_test
 
 REPO = Path(__file__).resolve().parents[1]
-CHECKS = REPO / "tests" / "editor_ui_checks_ed22b.py"
+CHECKS = REPO / "tests" / "editor_ui_checks_turntable_video.py"
 
 
-def test_ed22b_checks_pass_through_the_test_engine(display, tmp_path):
+def test_turntable_video_checks_pass_through_the_test_engine(display, tmp_path):
     result = ui_test(tmp_path, CHECKS, "--new", size="1280x720")
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]

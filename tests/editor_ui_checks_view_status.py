@@ -1,6 +1,6 @@
-"""Faults a fresh trial of the editor found (issue 22), operated through the panel by the Dear
-ImGui Test Engine: run by tests/test_editor_ui_trial.py as ``alight edit --new --ui-test
-tests/editor_ui_checks_trial.py`` (a real window under Xvfb); not collected by pytest.
+"""The view and the status row (faults a fresh trial of the editor found), operated through the panel by the Dear
+ImGui Test Engine: run by tests/test_editor_ui_view_status.py as ``alight edit --new --ui-test
+tests/editor_ui_checks_view_status.py`` (a real window under Xvfb); not collected by pytest.
 
 MSAA over a transparent background, the turntable's file written while frames go on, a mesh's
 warning in the status row, the F0 line with maps, and (in the runner's second editor, reopened

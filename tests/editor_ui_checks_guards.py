@@ -1,12 +1,12 @@
-"""Issue 22's second artist trial, through the panel's real UI. Run by tests/test_editor_ui_ed22a.py
-as ``alight edit --new --ui-test tests/editor_ui_checks_ed22a.py`` (the Dear ImGui Test Engine
+"""Guards and messages of the panel (what a second artist trial found), through its real UI. Run by tests/test_editor_ui_guards.py
+as ``alight edit --new --ui-test tests/editor_ui_checks_guards.py`` (the Dear ImGui Test Engine
 against the real window under Xvfb); not collected by pytest.
 
 'save preset' to a .json with maps loaded writes the factors and says so; a path that failed to
 load, open or save does not stay in its field; the reference compare's errors name the panel's
 controls, not the CLI's flags; replacing a library entry asks first.
 
-Run as a script (``python tests/editor_ui_checks_ed22a.py xdotool``, DISPLAY set), it drives the
+Run as a script (``python tests/editor_ui_checks_guards.py xdotool``, DISPLAY set), it drives the
 editor's own glfw loop with real X clicks from xdotool while each frame takes 0.3 s: a second
 click aimed at a light's 'remove' (or at a section header) arriving before the frame that moved
 the panel is shown does not land on the control that moved there.
