@@ -22,6 +22,8 @@ from alight.core.material_fields import FIELDS, MaterialField
 _NOTES = {
     "volume": "acts through transmission or diffuse transmission; thickness 0 is thin-walled",
     "dispersion": "acts through a volume's refraction (transmission, thickness > 0)",
+    # The panel has no thickness-map slot: without a map the film is the maximum throughout.
+    "iridescence": "thickness minimum acts only through a thickness map (a glTF file's)",
 }
 _SWITCH_LABELS = {"attenuation_distance": "attenuate"}
 _UNITS = {"NM": "nm"}   # metavar -> the unit shown in the widget's number
