@@ -11,13 +11,16 @@ target says it finished and accepted, 1 with one line otherwise.
 ``python tests/editor_x_drop.py checks`` (DISPLAY set; run by tests/test_editor_ui_drop.py) runs
 the editor's own loop and drops, each through a source process while the window draws its
 frames: an HDR (the environment changes, in the view's pixels), a mesh file (the mesh is loaded,
-the view changes), and five texture maps at once (one texture set: each file in its slot, the
-slots' rows in the panel name them, the view changes). Prints one line per failure.
+the view changes), five texture maps at once (one texture set: each file in its slot, the
+slots' rows in the panel name them, the view changes), one image with the roughness slot armed
+(that slot alone takes it) and a .json preset (the material, its maps cleared). Prints one line
+per failure.
 """
 
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -119,7 +122,16 @@ def _write_inputs(folder: str) -> dict:
     for slot, (suffix, pixels) in maps.items():
         files[slot] = os.path.join(folder, f"tiles_{suffix}.png")
         Image.fromarray(pixels).save(files[slot])
-    return {"mesh": mesh, "maps": files}
+    preset = os.path.join(folder, "copper.json")   # the preset as alight ships it, from elsewhere
+    shutil.copyfile(os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "presets", "copper.json"), preset)
+    return {"mesh": mesh, "maps": files, "preset": preset}
+
+
+def _grey_png(path: str, level: int) -> None:
+    import numpy as np
+    from PIL import Image
+
+    Image.fromarray(np.full((16, 16), level, np.uint8)).save(path)
 
 
 def _checks(env_file: str) -> int:
@@ -207,8 +219,38 @@ def _checks(env_file: str) -> int:
     else:
         print(f"texture set: {len(got)} maps in their slots ({', '.join(sorted(got))}); the view changed by "
               f"{changed(before, after):.1f} mean levels")
+    # One image with a slot armed (the radio button is operated in editor_ui_checks.py; here the
+    # drop is the control under test): it fills that slot and no other.
+    before = after
+    rough = os.path.join(os.path.dirname(inputs["mesh"]), "smooth_patch.png")
+    _grey_png(rough, 10)
+    state.armed_slot = "roughness"
+    problem = drop(rough)
+    after = win.view_pixels()
+    keep("dropped_image", after)
+    got_now = state.texture_maps.paths()
+    if problem or got_now.get("roughness") != rough or got_now.get("base_color") != got.get("base_color"):
+        fail(f"armed slot: roughness is {got_now.get('roughness')!r}, base colour "
+             f"{got_now.get('base_color')!r} ({problem or state.error})")
+    elif changed(before, after) < 1.0:
+        fail(f"armed slot: the view hardly changed ({changed(before, after):.2f} mean levels)")
+    else:
+        print(f"armed slot: {os.path.basename(rough)} is the roughness map; the view changed by "
+              f"{changed(before, after):.1f} mean levels")
+    # A .json preset: the whole material, its maps cleared (a preset has none).
+    before = after
+    problem = drop(inputs["preset"])
+    after = win.view_pixels()
+    keep("dropped_preset", after)
+    if problem or state.material.name != "copper" or state.texture_maps.paths():
+        fail(f"preset: the material is {state.material.name!r} with maps {state.texture_maps.paths()} "
+             f"({problem or state.error})")
+    elif changed(before, after) < 2.0:
+        fail(f"preset: the view hardly changed ({changed(before, after):.2f} mean levels)")
+    else:
+        print(f"preset: copper.json is the material; the view changed by {changed(before, after):.1f} mean levels")
     win.close()
-    print(f"x drop: {failures} failures in 3 drops")
+    print(f"x drop: {failures} failures in 5 drops")
     return failures
 
 
