@@ -311,6 +311,10 @@ def test_f12_saves_the_view_with_alpha_on_a_transparent_background(ctx):
     w, h = win.view_area()
     assert image.shape == (h, w, 4), (image.shape, (w, h), win.size)
     assert image[h // 2, w // 2, 3] == 255 and image[:4, :4, 3].max() == 0, (image[h // 2, w // 2], image[0, 0])
+    # The view draws without anti-aliasing by default; the file's alpha is still graded at the
+    # silhouette (a cut-out of 0 or 255 alone is stair-stepped over any backdrop).
+    alpha = image[..., 3]
+    assert win.state.aa == "none" and ((alpha > 0) & (alpha < 255)).sum() > 20, np.unique(alpha)
     ctx.set_ref("alight")
     ctx.item_open("**/Display & camera")
     ctx.item_click("**/screenshot (F12)")   # the button does the same, RGB once the background is back

@@ -13,8 +13,8 @@ the editor's own loop and drops, each through a source process while the window 
 frames: an HDR (the environment changes, in the view's pixels), a mesh file (the mesh is loaded,
 the view changes), five texture maps at once (one texture set: each file in its slot, the
 slots' rows in the panel name them, the view changes), one image with the roughness slot armed
-(that slot alone takes it) and a .json preset (the material, its maps cleared). Prints one line
-per failure.
+(that slot alone takes it), a .json preset (the material, its maps cleared) and a folder (its
+images one texture set). Prints one line per failure.
 """
 
 from __future__ import annotations
@@ -249,8 +249,21 @@ def _checks(env_file: str) -> int:
         fail(f"preset: the view hardly changed ({changed(before, after):.2f} mean levels)")
     else:
         print(f"preset: copper.json is the material; the view changed by {changed(before, after):.1f} mean levels")
+    # A folder, as a file manager drags one: its images are one texture set.
+    before = after
+    folder = os.path.dirname(inputs["mesh"])
+    problem = drop(folder)
+    after = win.view_pixels()
+    got = state.texture_maps.paths()
+    wrong = {slot: got.get(slot) for slot, path in inputs["maps"].items() if got.get(slot) != path}
+    if problem or wrong or state.error:
+        fail(f"folder: slots not as in the folder: {wrong} ({problem or state.error})")
+    elif changed(before, after) < 2.0:
+        fail(f"folder: the view hardly changed ({changed(before, after):.2f} mean levels)")
+    else:
+        print(f"folder: {len(got)} maps in their slots; the view changed by {changed(before, after):.1f} mean levels")
     win.close()
-    print(f"x drop: {failures} failures in 5 drops")
+    print(f"x drop: {failures} failures in 6 drops")
     return failures
 
 

@@ -2,7 +2,7 @@
 (python-xlib) that drops file:// URIs on `alight edit`'s own glfw window under Xvfb as a file
 manager does; glfw's XDND code turns them into the window's drop callback. An HDR changes the
 environment, a mesh file loads, five maps dropped together become one texture set, one image
-fills the armed slot, a .json preset becomes the material."""
+fills the armed slot, a .json preset becomes the material, a folder is a texture set."""
 
 from __future__ import annotations
 
@@ -30,10 +30,11 @@ def test_files_dropped_through_xdnd_reach_the_editor(display, tmp_path):
     result = subprocess.run([sys.executable, str(DROP), "checks", str(HDR)], cwd=tmp_path, env=env,
                             capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
-    assert "x drop: 0 failures in 5 drops" in result.stdout, result.stdout
+    assert "x drop: 0 failures in 6 drops" in result.stdout, result.stdout
     assert "texture set: 5 maps in their slots" in result.stdout, result.stdout
     assert "armed slot: smooth_patch.png is the roughness map" in result.stdout, result.stdout
     assert "preset: copper.json is the material" in result.stdout, result.stdout
+    assert "folder: 5 maps in their slots" in result.stdout, result.stdout
 
 
 def test_a_uri_list_is_what_file_managers_send():

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from pathlib import Path
 
 import numpy as np
 
@@ -134,6 +135,7 @@ class Panel:
         self.map_path = ""
         self.set_path = ""      # the 'texture set' field: a folder, or image files separated by ';'
         self._specs_shown = (None, None)   # the mesh and environment the path fields were last set from
+        self._set_shown = ""    # the texture set the 'texture set' field was last set from
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.shown_status = ""  # the status row's text drawn last frame (tests read it)
         self.shown_f0 = ""      # the F0 line drawn last frame (tests read it)
@@ -164,6 +166,7 @@ class Panel:
         self.shown_error = s.error
         self.shown_status = self._status_line(s, win)
         self._follow_loaded(s)
+        self._follow_maps(s)
         headers = []   # each section header's height: the layout's signature (press_guard.py)
 
         def header(label, flags=0):
@@ -224,14 +227,18 @@ class Panel:
         elif getattr(win, "turntable_job", None) is not None:   # its frames, then "writing NAME..."
             shown = win.turntable_job.progress()
             imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
-        elif getattr(getattr(win, "variant_warmup", None), "showing_old", False):
-            # A new look's program compiles in the warm-up process (variant_warmup.py): the view
-            # holds the last picture meanwhile, which must not pass for the new one.
-            shown = "compiling the new look's shaders: the view shows the last one"
-            imgui.text_disabled(shown)
-        elif s.message:
-            shown = s.message
-            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
+        else:
+            if getattr(getattr(win, "variant_warmup", None), "showing_old", False):
+                # A new look's program compiles in the warm-up process (variant_warmup.py): the
+                # view holds the last picture meanwhile, which must not pass for the new one. The
+                # message (a file's warnings) stays beside it: it is not seen again later.
+                shown = "compiling shaders: the view shows the last look"
+                imgui.text_disabled(shown)
+                if s.message:
+                    imgui.same_line()
+            if s.message:
+                shown = f"{shown} | {s.message}" if shown else s.message
+                imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), s.message)
         if (s.error or s.message) and imgui.is_item_hovered():
             # The line whole, wrapped to the window's width (a set's assignment outgrew it); a
             # file's several warnings one a line.
@@ -256,6 +263,18 @@ class Panel:
         if s.env_spec != self._specs_shown[1] and s.env_spec != "studio":
             self.env_path = self._good["env_path"] = s.env_spec
         self._specs_shown = specs
+
+    def _follow_maps(self, s) -> None:
+        """The 'texture set' field shows the set loaded (a drop, a folder typed into 'map file',
+        undo), and both map fields empty once no map is loaded (a preset click): a field never
+        names maps that are not what is drawn. Typing changes nothing loaded, so it stays."""
+        text = s.texture_set_text()
+        if text == self._set_shown:
+            return
+        self.set_path = self._good["set_path"] = text
+        if not text:
+            self.map_path = self._good["map_path"] = ""
+        self._set_shown = text
 
     # --- sections -------------------------------------------------------------------------------
 
@@ -359,6 +378,12 @@ class Panel:
     def _save_preset(self, s) -> None:
         """'save preset': the file (a .json with maps loaded: the factors, and the status row
         says the maps were left out), then a copy into the library under the file's name."""
+        stem = Path(self.preset_path).stem
+        if stem and stem.isprintable() and s.material.name not in (stem, s.typed_name):
+            # The file and its library entry are named by the file: the material inside takes
+            # that name too (unless the artist typed one), so a click on the entry and a later
+            # 'save to library' name the same entry, not the preset the work started from.
+            s.material = dataclasses.replace(s.material, name=stem)
         try:
             note = s.save_material(self.preset_path)
         except AlightError as exc:
@@ -499,17 +524,13 @@ class Panel:
         folder = entries[0] if len(entries) == 1 and os.path.isdir(entries[0]) else ""
         try:
             if folder:
-                files = sorted(os.path.join(folder, f) for f in os.listdir(folder)
-                               if os.path.splitext(f)[1].lower() in IMAGE_SUFFIXES)
-                if not files:
-                    raise AlightError(f"{folder}: no image files in the folder")
-            else:
-                files = entries
-                for path in files:
-                    if not os.path.isfile(path):
-                        raise AlightError(f"{path}: texture set: no such file (a folder, or image files "
-                                          f"separated by ';')")
-            s.open_texture_set(files, folder)
+                s.open_texture_folder(folder)
+                return
+            for path in entries:
+                if not os.path.isfile(path):
+                    raise AlightError(f"{path}: texture set: no such file (a folder, or image files "
+                                      f"separated by ';')")
+            s.open_texture_set(entries)
         except (AlightError, OSError) as exc:
             s.fail(exc if isinstance(exc, AlightError) else AlightError(f"{text}: {exc.strerror}"))
 
@@ -603,7 +624,10 @@ class Panel:
                 remove = i
             label = "direction (light travels)" if light.kind == "directional" else "position"
             c1, vec = imgui.drag_float3(label, list(light.vector), 0.05)
-            c2, col = imgui.color_edit3("colour", list(light.color))
+            # Linear RGB, shown as 0-1 floats: 0-255 bytes would read as sRGB, as the base colour's do.
+            c2, col = imgui.color_edit3("colour", list(light.color), imgui.ColorEditFlags_.float_)
+            if imgui.is_item_hovered():
+                imgui.set_tooltip("the light's colour, linear RGB (times its intensity)")
             c3, inten = imgui.drag_float("intensity", light.intensity, 0.1, 0.0, 1000.0)
             if c1 or c2 or c3:
                 if light.kind == "directional" and not any(vec):

@@ -71,6 +71,7 @@ class EditorState:
     error: str = ""          # the last error, shown in the panel until the next success
     message: str = ""        # the last success ("saved gold.json")
     typed_name: str = ""     # the material name the artist typed last: a texture set loaded keeps it
+    texture_set_folder: str = ""   # the folder the last texture set was read from ('' for files)
     warnings: int = 0        # warning lines of the last mesh or environment file opened
     warning_lines: tuple = ()   # ... and their text (the status row shows it: with_warnings)
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
@@ -240,10 +241,17 @@ class EditorState:
         'revert' along: after a preset click is undone, 'revert' returns to the look before the
         click, not to the preset the artist took back."""
         leaving_saved = self.look == (self.saved_material, self.saved_texture_maps)
+        word = "redo" if redo else "undo"
+        before = self.look
         self.look = history.redo(self.look) if redo else history.undo(self.look)
         self.sync_map_images()
         if leaving_saved:
             self.saved_material, self.saved_texture_maps = self.look
+        # The status row said what the step took back ('applied silver'): it says where it is now.
+        maps = len(self.texture_maps.paths())
+        now = f"{self.material.name}{f' with {maps} map' + ('s' if maps > 1 else '') if maps else ''}"
+        self.error = ""
+        self.message = f"{word}: {now}" if self.look != before else f"nothing to {word}"
 
     def apply_preset(self, preset: Material) -> None:
         """A preset of the F0 table: a whole material, so its factors and no maps (maps loaded
@@ -302,19 +310,52 @@ class EditorState:
         from alight.core.texture_maps import map_factors
         from alight.exchange.texture_sets import assign_files, load_map_images, set_name
 
-        found = assign_files(paths, self.texture_maps)
+        before = self.texture_maps
+        # A set is whole: it replaces the maps before it (a slot it leaves empty is empty, not the
+        # last set's map, which would tint it), keeping only the UV tiling.
+        found = assign_files(paths, TextureMaps(uv_scale=before.uv_scale, uv_offset=before.uv_offset))
         if not found.slots:
             raise AlightError(f"{os.path.basename(paths[0])}: no file of the {len(paths)} has a texture map's name "
                               f"(e.g. NAME_BaseColor.png, NAME_Normal.png); drop one at a time into the armed slot")
         images = load_map_images(found.maps)
         self.map_images = images
         self.texture_maps = found.maps
-        self.material = with_overrides(self.material, **map_factors(found.slots))
+        self.texture_set_folder = folder
+        factors = map_factors(found.slots)
+        # The last set's metal or emission map set its factor to 1; a set without one is a
+        # dielectric that does not glow, not a white metal or a white light.
+        filled, had = set(found.maps.paths()), set(before.paths())
+        metal = {"metallic", "metallic_roughness"}
+        if had & metal and not filled & metal:
+            factors["metallic"] = 0.0
+        if "emissive" in had and "emissive" not in filled:
+            factors["emissive"] = (0.0, 0.0, 0.0)
+        self.material = with_overrides(self.material, **factors)
         name = set_name(paths, folder)
         if name and name.isprintable() and self.material.name != self.typed_name:
             self.material = dataclasses.replace(self.material, name=name)
         self.error, self.message = "", "texture set: " + "; ".join(found.lines())
         return found.lines()
+
+    def open_texture_folder(self, folder: str) -> list[str]:
+        """Every image file in ``folder`` as one texture set (``open_texture_set``)."""
+        try:
+            files = sorted(os.path.join(folder, f) for f in os.listdir(folder)
+                           if os.path.splitext(f)[1].lower() in IMAGE_SUFFIXES)
+        except OSError as exc:
+            raise AlightError(f"{folder}: cannot read the folder ({exc.strerror})") from None
+        if not files:
+            raise AlightError(f"{folder}: no image files in the folder")
+        return self.open_texture_set(files, folder)
+
+    def texture_set_text(self) -> str:
+        """What the 'texture set' field shows for the maps loaded: the folder they were read from
+        while every map is in it, else the files separated by '; ' ('' without maps)."""
+        paths = sorted(set(self.texture_maps.paths().values()))
+        folder = self.texture_set_folder
+        if folder and paths and all(os.path.dirname(p) == folder.rstrip(os.sep) for p in paths):
+            return folder
+        return "; ".join(paths)
 
     def open_file(self, path: str) -> bool:
         """A dropped or typed file, by its suffix. Returns False (and sets ``error``) on failure."""

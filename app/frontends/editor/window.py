@@ -203,13 +203,21 @@ class EditorWindow:
 
     def drop(self, paths: list[str]) -> None:
         """glfw's drop callback: each file by its suffix; a bad one keeps the previous state.
-        Several image files dropped together are a texture set (``drop_texture_set``)."""
+        Several image files dropped together are a texture set (``drop_texture_set``), and so is
+        a dropped folder (its images, as the 'texture set' field reads a folder)."""
+        folders = [p for p in paths if os.path.isdir(p)]
+        paths = [p for p in paths if p not in folders]
         images = [p for p in paths if os.path.splitext(p)[1].lower() in IMAGE_SUFFIXES]
         for path in paths:
             if len(images) < 2 or path not in images:
                 self.state.open_file(path)
         if len(images) >= 2:
             self.drop_texture_set(images)
+        for folder in folders:
+            try:
+                self.state.open_texture_folder(folder)
+            except Exception as exc:   # one line in the panel, never a traceback
+                self.state.fail(exc)
 
     def drop_texture_set(self, images: list[str]) -> None:
         """Images assigned to slots by their names (EditorState.open_texture_set), one undo step."""
@@ -766,7 +774,7 @@ class EditorWindow:
         if self.state.compare.active:   # the split view, as shown: its halves put together whole
             from alight.frontends.editor.screenshot import WholeScreenshotJob
 
-            maps, aa = self.maps(), self.state.aa
+            maps, aa = self.maps(), self.saved_aa()
 
             def pixels():
                 frame = self.renderer.render(scene, maps, size[0], size[1], aa=aa, read_linear=False, read_srgb=True)
@@ -774,7 +782,16 @@ class EditorWindow:
                 return self.compare_view.compose_frame(self, scene, maps, b, aa)
 
             return WholeScreenshotJob(pixels, size, path)
-        return ScreenshotJob(self.renderer, scene, self.maps(), size, self.state.aa, path)
+        return ScreenshotJob(self.renderer, scene, self.maps(), size, self.saved_aa(), path)
+
+    def saved_aa(self) -> str:
+        """The anti-aliasing of a file the view is saved to (screenshot, turntable): the view's,
+        but at least MSAA over a transparent background, whose alpha is the cut-out a file is
+        composited with (without it 0 or 1: stair steps over any backdrop). The view's 'none'
+        is a choice of speed for live frames, not of what a file should hold."""
+        if self.state.aa == "none" and self.state.display.background == "transparent":
+            return "msaa"
+        return self.state.aa
 
     def wait_for_thumbnails(self, timeout_s: float) -> float:
         """Draw frames until every thumbnail asked for has arrived (they render in a child
@@ -814,7 +831,7 @@ class EditorWindow:
         scene = self.state.scene(cameras[0])
         channels = 4 if scene.display.background == "transparent" else 3
         return TurntableJob(self.renderer, lambda camera: dataclasses.replace(scene, camera=camera), cameras,
-                            self.maps(), self.view_area(), self.state.aa, t.path, channels)
+                            self.maps(), self.view_area(), self.saved_aa(), t.path, channels)
 
     def _advance_turntable(self) -> None:
         """Start the turntable asked for, or draw a few more of its frames; the panel's message

@@ -1,0 +1,141 @@
+"""Texture sets one after another, the path fields that name them, undo's status row and a saved
+preset's name (what a fresh artist trial found), operated by the Dear ImGui Test Engine. Run by
+tests/test_editor_ui_sets.py as ``alight edit --new --ui-test tests/editor_ui_checks_sets.py`` (a
+real window under Xvfb); not collected by pytest. Each check operates the panel's controls and
+looks at the view's pixels, the fields the panel shows or the file written.
+
+- a texture set loaded after another is the new set alone: the same pixels as loading it over
+  the same preset, no map of the first left in a slot the second leaves empty;
+- the 'texture set' field names the set loaded, and both map fields are empty after a preset
+  click;
+- Ctrl+Z says in the status row where it went (it kept saying 'applied silver');
+- 'save preset' to NAME.json names the material NAME, so the library entry and the file agree.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+from PIL import Image
+
+from alight.frontends.editor.ui_test import editor, view
+
+OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # the run's folder (the editor's cwd too)
+
+
+def _write_set(folder: str, name: str, maps: dict) -> str:
+    """Maps named as Substance writes them (NAME_BaseColor.png ...) from {suffix: (h, w, c) uint8}."""
+    os.makedirs(folder, exist_ok=True)
+    for suffix, pixels in maps.items():
+        Image.fromarray(pixels).save(os.path.join(folder, f"{name}_{suffix}.png"))
+    return folder
+
+
+def _sets() -> tuple[str, str]:
+    """'wood': base colour, normal, roughness, a white metallic map and an emissive one; 'rock':
+    base colour and roughness only (a dielectric set that does not glow)."""
+    yy, xx = np.mgrid[0:32, 0:32]
+    checker = ((yy // 8 + xx // 8) % 2).astype(np.uint8)
+    wood = _write_set(os.path.join(OUT, "sets", "wood"), "wood", {
+        "BaseColor": np.dstack([120 + 60 * checker, 70 + 30 * checker, 30 + 0 * checker]).astype(np.uint8),
+        "Normal": np.dstack([np.full((32, 32), 128), np.full((32, 32), 128), np.full((32, 32), 255)]).astype(np.uint8),
+        "Roughness": np.full((32, 32), 200, np.uint8),
+        "Metallic": np.full((32, 32), 255, np.uint8),
+        "Emissive": np.full((32, 32, 3), 90, np.uint8),
+    })
+    rock = _write_set(os.path.join(OUT, "sets", "rock"), "rock", {
+        "BaseColor": np.dstack([90 + 90 * checker, 90 + 90 * checker, 100 + 90 * checker]).astype(np.uint8),
+        "Roughness": np.full((32, 32), 150, np.uint8),
+    })
+    return wood, rock
+
+
+def _load_set(ctx, folder: str) -> None:
+    ctx.item_input_value("**/texture set", folder)
+    ctx.item_click("**/load set")
+    ctx.yield_(3)
+
+
+def test_a_set_loaded_after_another_is_the_new_set_alone(ctx):
+    s = editor().state
+    wood, rock = _sets()
+    ctx.set_ref("alight")
+    ctx.item_open("**/texture maps")
+    ctx.item_click("**/plastic_high")
+    _load_set(ctx, rock)
+    assert not s.error, s.error
+    alone, alone_maps = view(ctx).astype(np.float64), s.texture_maps.paths()
+    ctx.item_click("**/plastic_high")
+    _load_set(ctx, wood)
+    assert set(s.texture_maps.paths()) == {"base_color", "normal", "roughness", "metallic", "emissive"}, s.texture_maps
+    _load_set(ctx, rock)
+    assert s.texture_maps.paths() == alone_maps, s.texture_maps.paths()   # wood's metal, normal, glow gone
+    after = view(ctx).astype(np.float64)
+    assert s.material.metallic == 0.0 and s.material.emissive == (0.0, 0.0, 0.0), s.material
+    assert np.abs(after - alone).max() <= 1, np.abs(after - alone).max()
+    ctx.item_close("**/texture maps")
+
+
+def test_the_set_fields_name_what_is_loaded(ctx):
+    s, panel = editor().state, editor().panel
+    wood, rock = _sets()
+    ctx.set_ref("alight")
+    ctx.item_open("**/texture maps")
+    _load_set(ctx, wood)
+    ctx.item_input_value("**/map file", rock)   # a folder typed into 'map file' is a set too
+    ctx.item_click("**/load##typed")
+    ctx.yield_(2)
+    assert set(s.texture_maps.paths()) == {"base_color", "roughness"}, s.texture_maps
+    assert panel.set_path == rock, panel.set_path
+    ctx.item_click("**/copper")   # a preset has no maps: neither field names any
+    ctx.yield_(2)
+    assert not s.texture_maps.paths() and panel.set_path == "" and panel.map_path == "", \
+        (panel.set_path, panel.map_path)
+    _ctrl_z(ctx)
+    assert panel.set_path == rock and s.texture_maps.paths(), panel.set_path   # undo brings the set back
+    ctx.item_close("**/texture maps")
+
+
+def _ctrl_z(ctx) -> None:
+    """Ctrl+Z in the view (a click on the view first: the panel lets go of the keyboard)."""
+    from imgui_bundle import imgui
+
+    ctx.mouse_click_on_void()
+    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.z)
+    ctx.yield_(2)
+
+
+def test_undo_says_where_it_went(ctx):
+    s, panel = editor().state, editor().panel
+    ctx.set_ref("alight")
+    ctx.item_click("**/gold")
+    ctx.item_click("**/silver")
+    ctx.yield_(2)
+    assert panel.shown_status.endswith("applied silver"), panel.shown_status
+    _ctrl_z(ctx)
+    assert s.material.name == "gold" and panel.shown_status.endswith("undo: gold"), panel.shown_status
+    ctx.item_click("**/redo")
+    ctx.yield_(2)
+    assert s.material.name == "silver" and panel.shown_status.endswith("redo: silver"), panel.shown_status
+
+
+def test_a_saved_preset_is_named_after_its_file(ctx):
+    from alight.frontends.editor.library import library_dir
+
+    s, lib = editor().state, editor().panel.library
+    path = os.path.join(OUT, "myblue.json")
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    ctx.item_input_value("**/roughness", 0.35)
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    ctx.yield_(3)
+    assert json.loads(open(path, encoding="utf-8").read())["name"] == "myblue", open(path).read()
+    assert (library_dir() / "myblue.glb").is_file() and s.material.name == "myblue", s.material.name
+    ctx.item_click("**/gold")
+    ctx.item_click("**/myblue##library")   # the library's entry gives back the same name
+    ctx.yield_(2)
+    assert s.material.name == "myblue" and abs(s.material.roughness - 0.35) < 1e-6, s.material
+    assert lib.name in ("", "myblue"), lib.name
