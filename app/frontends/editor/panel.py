@@ -625,7 +625,7 @@ class Panel:
             label = "direction (light travels)" if light.kind == "directional" else "position"
             c1, vec = imgui.drag_float3(label, list(light.vector), 0.05)
             # Linear RGB, shown as 0-1 floats: 0-255 bytes would read as sRGB, as the base colour's do.
-            c2, col = imgui.color_edit3("colour", list(light.color), imgui.ColorEditFlags_.float_)
+            c2, col = imgui.color_edit3("colour", list(light.color), imgui.ColorEditFlags_.float)
             if imgui.is_item_hovered():
                 imgui.set_tooltip("the light's colour, linear RGB (times its intensity)")
             c3, inten = imgui.drag_float("intensity", light.intensity, 0.1, 0.0, 1000.0)
