@@ -59,9 +59,15 @@ DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
 DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
-BAKE_VERSION = 4   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses
+BAKE_VERSION = 5   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
+                   # 5: vertices covered by a part take their open neighbours' values
 # Refinement keeps a split only where the midpoint's value is not the edge's linear interpolation.
 INTERPOLATION_TEST = True
+# A vertex at least this share of whose rays hit a part from its inside, or hit one closer than
+# COVERED_DISTANCE times the finest edge, lies inside or under another part, unseen: it takes its
+# open neighbours' values (_fill_covered). Inside a closed part every ray hits its inside.
+COVERED_SHARE = 0.9
+COVERED_DISTANCE = 0.25
 OCCLUSION_MODES = ("auto", "on", "off")
 # --occlusion auto: bake where the mesh's mean occlusion (occlusion_statistic) is above this.
 AUTO_MIN_OCCLUSION = 0.03
@@ -496,24 +502,31 @@ def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.
 
 
 class _Occluders:
-    """Embree's scene of triangles (T, 3, 3) and their unit normals."""
+    """Embree's scene of triangles (T, 3, 3) and their unit normals (by winding); ``outside``
+    (T,) +1 or -1: the side the mesh's vertex normals call the outside (default: the winding's)."""
 
-    def __init__(self, triangles: np.ndarray):
+    def __init__(self, triangles: np.ndarray, outside: np.ndarray | None = None):
         rtcore_scene, TriangleMesh = _import_embree()
         self.triangles = np.ascontiguousarray(triangles, np.float32)
         self.scene = rtcore_scene.EmbreeScene()
         self._mesh = TriangleMesh(scene=self.scene, vertices=self.triangles)
         n = np.cross(self.triangles[:, 1] - self.triangles[:, 0], self.triangles[:, 2] - self.triangles[:, 0])
         self.normals = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+        self.outward = self.normals if outside is None else self.normals * np.asarray(outside, np.float32)[:, None]
+        self.near = 0.0          # a hit closer than this is "covered" (hemisphere's covered_share)
+        self.covered_share = None  # after hemisphere(): per origin, the share of its rays covered
 
     def hemisphere(self, origins, normals, rays: int, rng, eps: float):
         """Cast ``rays`` cosine-weighted rays from each origin about its normal: (hit triangle
-        (N, R) or -1, Embree's u, v (N, R, 2), the unoccluded directions' sum (N, 3))."""
+        (N, R) or -1, Embree's u, v (N, R, 2), the unoccluded directions' sum (N, 3)). Leaves
+        ``covered_share`` (N,): the share of the rays that hit a triangle's inside (``outward``)
+        or any triangle closer than ``near`` (``_covered``)."""
         local = cosine_directions(rays).astype(np.float32)
         count = len(origins)
         hit = np.empty((count, rays), np.int32)
         uv = np.empty((count, rays, 2), np.float32)
         open_sum = np.zeros((count, 3), np.float64)
+        covered = np.zeros(count, np.float64)
         chunk = max(1, 262_144 // rays)
         for s0 in range(0, count, chunk):
             n = normals[s0:s0 + chunk]
@@ -522,7 +535,36 @@ class _Occluders:
             hit[s0:s0 + chunk] = prim.reshape(len(n), rays)
             uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
             open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
+            covered[s0:s0 + chunk] = _covered(self, prim, u, v, o, d).reshape(len(n), rays).mean(axis=1)
+        self.covered_share = covered
         return hit, uv, open_sum
+
+
+def _covered(occluders, prim, u, v, o, d) -> np.ndarray:
+    """Per ray, whether its hit says the origin is covered by a part: it hit a triangle from the
+    inside (along the triangle's ``outward`` normal: a ray that starts inside a closed part does
+    so in every direction) or hit one closer than ``occluders.near`` (a part lying on the surface
+    with a thin gap under it)."""
+    out = np.zeros(len(prim), bool)
+    hit = np.nonzero(prim >= 0)[0]
+    if not len(hit):
+        return out
+    p = prim[hit]
+    out[hit] = np.einsum("ij,ij->i", d[hit], occluders.outward[p]) > 0.0
+    if occluders.near > 0.0:
+        tri = occluders.triangles[p]
+        point = tri[:, 0] + u[hit, None] * (tri[:, 1] - tri[:, 0]) + v[hit, None] * (tri[:, 2] - tri[:, 0])
+        out[hit] |= np.linalg.norm(point - o[hit], axis=1) < occluders.near
+    return out
+
+
+def _outside_sign(positions: np.ndarray, normals: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """(T,) +1 where a triangle's winding normal agrees with its vertex normals' sum, else -1 (a
+    clockwise or mirrored part: its vertex normals say which side is the outside)."""
+    tri = np.asarray(positions, np.float64)[indices]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    vn = np.asarray(normals, np.float64)[indices].sum(axis=1)
+    return np.where(np.einsum("ij,ij->i", n, vn) < 0.0, -1.0, 1.0)
 
 
 def _chunk_rays(local: np.ndarray, origins: np.ndarray, normals: np.ndarray, rng) -> tuple[np.ndarray, np.ndarray]:
@@ -547,35 +589,70 @@ def _free_rays(occluders, see_through, through_of_triangle, origins, normals, ra
     see-through part it meets; and the free directions' weighted sum (N, 3)."""
     if see_through is None:
         hit, _, open_sum = occluders.hemisphere(origins, normals, rays, rng, eps)
-        return (hit < 0).astype(np.float64), open_sum
+        return (hit < 0).astype(np.float64), open_sum, occluders.covered_share
     local = cosine_directions(rays).astype(np.float32)
     count = len(origins)
     free = np.empty((count, rays), np.float64)
     open_sum = np.zeros((count, 3), np.float64)
+    back = np.zeros(count, np.float64)
     chunk = max(1, 262_144 // rays)
     for s0 in range(0, count, chunk):
         n = normals[s0:s0 + chunk]
         d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
         w = np.ones(len(d))
         if occluders is not None:
-            prim, _, _ = _cast(occluders.scene, o, d, occluders.normals, eps)
+            prim, u, v = _cast(occluders.scene, o, d, occluders.normals, eps)
             w = (prim < 0).astype(np.float64)
+            back[s0:s0 + chunk] = _covered(occluders, prim, u, v, o, d).reshape(len(n), rays).mean(axis=1)
         prim_t, _, _ = _cast(see_through.scene, o, d, see_through.normals, eps)
         w = w * np.where(prim_t < 0, 1.0, through_of_triangle[np.maximum(prim_t, 0)])
         free[s0:s0 + chunk] = w.reshape(len(n), rays)
         open_sum[s0:s0 + chunk] = (d * w[:, None]).reshape(len(n), rays, 3).sum(axis=1)
-    return free, open_sum
+    return free, open_sum, back
 
 
 def _values_at(data, faces, first: int, occluders, see_through, through_of_triangle, rays: int, rng, eps: float):
-    """(N - first, 4): the bent normal and V of the vertices ``data[first:]`` of a refined part."""
+    """(N - first, 5): the bent normal, V and the covered share (``_covered``: the share of the
+    rays that say the vertex lies inside or under a part) of the vertices ``data[first:]`` of a
+    refined part."""
     p, n = data[:, :3], data[:, 3:6] / np.maximum(np.linalg.norm(data[:, 3:6], axis=1, keepdims=True), 1e-30)
     origins = _origins(p, n, faces, eps)[first:]
-    free, open_sum = _free_rays(occluders, see_through, through_of_triangle, origins,
-                                n[first:].astype(np.float32), rays, rng, eps)
+    free, open_sum, back = _free_rays(occluders, see_through, through_of_triangle, origins,
+                                      n[first:].astype(np.float32), rays, rng, eps)
     length = np.linalg.norm(open_sum, axis=1, keepdims=True)
     bent = np.where(length > 1e-8, open_sum / np.maximum(length, 1e-30), n[first:])
-    return np.column_stack([bent, free.mean(axis=1)])
+    return np.column_stack([bent, free.mean(axis=1), back])
+
+
+def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray) -> np.ndarray:
+    """``values`` (N, 4: a unit direction and a scalar) of a refined part with its buried
+    vertices' rows replaced, ring by ring, by the mean of their neighbours' already known rows
+    (the direction renormalised). A buried vertex lies inside another part (a floor vertex under
+    a box standing on it, an arrow lying in a face): what it sees is that part's inside, V ~ 0
+    and the bounce off the part's inner walls, and nothing of it is ever drawn but its share of
+    its triangles' interpolation, which then ran a black (or, by the bounce, bright) wedge out to
+    the next vertex outside the part. Its open neighbours' values are what the visible rest of
+    those triangles sees (lightmap bakers dilate valid texels into those inside geometry alike).
+    A buried region with no open neighbour keeps its own values."""
+    out = np.array(values, np.float64, copy=True)
+    unknown = np.asarray(buried, bool).copy()
+    if not unknown.any() or unknown.all():
+        return out
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = np.concatenate([edges, edges[:, ::-1]])            # both ways: (from, to)
+    count = len(out)
+    while unknown.any():
+        e = edges[unknown[edges[:, 1]] & ~unknown[edges[:, 0]]]   # known -> unknown
+        if not len(e):
+            break
+        n = np.bincount(e[:, 1], minlength=count)
+        sums = np.column_stack([np.bincount(e[:, 1], out[e[:, 0], k], minlength=count) for k in range(out.shape[1])])
+        ring = n > 0
+        out[ring] = sums[ring] / n[ring, None]
+        length = np.linalg.norm(out[ring, :3], axis=1, keepdims=True)
+        out[ring, :3] = np.where(length > 1e-8, out[ring, :3] / np.maximum(length, 1e-30), values[ring, :3])
+        unknown &= ~ring
+    return out
 
 
 def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
@@ -602,8 +679,10 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     through = np.zeros(len(mesh.parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
     tris = [np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)] for p in mesh.parts]
     clear = through > 0.0
+    outside = [_outside_sign(p.positions, p.normals, np.asarray(p.indices, np.int64)) for p in mesh.parts]
     opaque = [t for t, c in zip(tris, clear) if not c]
-    occluders = _Occluders(np.concatenate(opaque)) if opaque else None
+    occluders = _Occluders(np.concatenate(opaque), np.concatenate([o for o, c in zip(outside, clear) if not c])) \
+        if opaque else None
     see_through = None
     if clear.any():
         see_through = _Occluders(np.concatenate([t for t, c in zip(tris, clear) if c]))
@@ -611,9 +690,11 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     else:
         through_of_triangle = None
     state = [refine_part(p, coarse_fraction * size, per_part_limit) for p in mesh.parts]
-    values = [np.zeros((0, 4)) for _ in state]        # per vertex: bent normal, V
+    values = [np.zeros((0, 5)) for _ in state]        # per vertex: bent normal, V, back-hit share
     cast = 0
     fine = edge_fraction * size
+    if occluders is not None:
+        occluders.near = COVERED_DISTANCE * fine
     cos_limit = math.cos(math.radians(25.0))
     for level in range(MAX_LEVELS + 1):
         split_any = False
@@ -632,7 +713,11 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
                 long = np.linalg.norm(p[e[:, 0]] - p[e[:, 1]], axis=1) > fine
                 dv = np.abs(val[e[:, 0], 3] - val[e[:, 1], 3]) > threshold
                 db = np.einsum("ij,ij->i", val[e[:, 0], :3], val[e[:, 1], :3]) < cos_limit
-                picked["edges"], picked["marked"] = e, long & (dv | db)
+                # A buried end (inside another part: its values are never seen, only
+                # interpolated, see _fill_covered) does not compare; an edge from a buried end to
+                # an open one is split, to bring a vertex to the buried part's edge.
+                b0, b1 = val[e[:, 0], 4] >= COVERED_SHARE, val[e[:, 1], 4] >= COVERED_SHARE
+                picked["edges"], picked["marked"] = e, long & (((dv | db) & ~b0 & ~b1) | (b0 != b1))
                 return picked["marked"]
 
             split_data, split_faces, split = _split_step(data, faces, mark)
@@ -649,6 +734,7 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
                 lin_b = val[e[:, 0], :3] + val[e[:, 1], :3]
                 lin_b /= np.maximum(np.linalg.norm(lin_b, axis=1, keepdims=True), 1e-30)
                 needed = (np.abs(new[:, 3] - lin_v) > threshold) | (np.einsum("ij,ij->i", new[:, :3], lin_b) < cos_limit)
+                needed |= (val[e[:, 0], 4] >= COVERED_SHARE) != (val[e[:, 1], 4] >= COVERED_SHARE)
                 keep = picked["marked"].copy()
                 keep[keep] = needed
                 split_data, split_faces, split = _split_step(data, faces, lambda _e, keep=keep: keep)
@@ -658,6 +744,9 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
             split_any |= split
         if not split_any:
             break
+    # Buried vertices (inside another part) take their open neighbours' values.
+    buried = [val[:, 4] >= COVERED_SHARE for val in values]
+    values = [_fill_covered(val[:, :4], f, b) for val, (_, _, f), b in zip(values, state, buried)]
     # The bounce: what each vertex's rays hit on the refined mesh, and the V and bent normal there.
     offsets = np.cumsum([0] + [len(d) for d, _, _ in state])
     all_p = np.concatenate([d[:, :3] for d, _, _ in state])
@@ -680,6 +769,9 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     bounce_dir = np.column_stack([np.bincount(rows, at_hit[:, k] * at_hit[:, 3], minlength=count) for k in range(3)])
     length = np.linalg.norm(bounce_dir, axis=1, keepdims=True)
     bounce_dir = np.where(length > 1e-8, bounce_dir / np.maximum(length, 1e-30), -all_n)
+    for (_, _, f), b, a, z in zip(state, buried, offsets[:-1], offsets[1:]):
+        filled = _fill_covered(np.column_stack([bounce_dir[a:z], bounce_weight[a:z]]), f, b)
+        bounce_dir[a:z], bounce_weight[a:z] = filled[:, :3], filled[:, 3]
     parts = []
     for (data, widths, faces), part, val, a, b in zip(state, mesh.parts, values, offsets[:-1], offsets[1:]):
         cols_ = np.split(data, np.cumsum(widths)[:-1], axis=1)
