@@ -238,3 +238,35 @@ def test_keys_are_translated_by_the_layouts_character():
         expected = getattr(glfw, f"KEY_{c.upper()}", None) if c.isalnum() else None
         if expected is not None:
             assert translate_key(glfw.KEY_SPACE, c) == expected, c
+
+
+def test_a_terminated_editor_keeps_its_session(display, tmp_path):
+    """SIGTERM (a logout, a kill) ends the editor as a close does: the session is saved, then the
+    CLI's one line and status 143; it was lost whole (a trial's hour of work)."""
+    import json
+    import signal
+    import time
+
+    if shutil.which("xdotool") is None:
+        pytest.skip("xdotool is not installed (tools/setup.sh installs it)")   # tells when the window is up
+    env = dict(os.environ, ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"),
+               ALIGHT_DATA_DIR=str(tmp_path / "data"))
+    proc = subprocess.Popen([sys.executable, "-m", "alight", "edit", "--size", "320x240", "--preset", "copper"],
+                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            found = subprocess.run(["xdotool", "search", "--onlyvisible", "--pid", str(proc.pid)],
+                                   capture_output=True, text=True)
+            if found.stdout.strip():
+                break
+            time.sleep(0.5)
+        time.sleep(2.0)   # a few frames drawn
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 143 and "alight: terminated" in err, (proc.returncode, err[-2000:])
+    session = json.loads((tmp_path / "config" / "editor-session.json").read_text())
+    assert session["material"]["name"] == "copper", session

@@ -88,10 +88,16 @@ def run(args) -> int:
                 print(f"alight: panel error: {state.error}", file=sys.stderr)
             print(args.screenshot)
             return 0
-        while not win.should_close():
-            win.frame()
         from alight.frontends.editor.session import save_session
 
+        try:
+            while not win.should_close():
+                win.frame()
+        except KeyboardInterrupt:
+            # Ctrl+C, or SIGTERM (the CLI raises its Terminated, a KeyboardInterrupt: a logout,
+            # a kill): the session is kept as after a normal close, then the CLI says which.
+            save_session(state, win.orbit, win.turntable)
+            raise
         save_session(state, win.orbit, win.turntable)
         return 0
     finally:
