@@ -11,6 +11,7 @@ from alight.errors import AlightError
 from alight.frontends.editor import library
 
 ICON = 24              # a thumbnail's side in the list, pixels
+LIST_ROWS = 4          # the entries' box shows this many rows and scrolls beyond them
 RESCAN_S = 0.5         # how often the library folder is looked at for new or removed entries
 _NO_MAPS = TextureMaps()
 
@@ -62,6 +63,11 @@ class LibraryPanel:
         self.rescan()
         if not imgui.tree_node_ex("library", imgui.TreeNodeFlags_.default_open):
             return
+        # The entries scroll in a box of a fixed height: a save adds a row, and a list that grew
+        # moved every control below it under the pointer (a trial's next click missed its field).
+        spacing = imgui.get_style().item_spacing.y
+        imgui.begin_child("##library_entries", imgui.ImVec2(0, LIST_ROWS * (ICON + spacing) + spacing),
+                          imgui.ChildFlags_.borders)
         for entry in self.entries:
             self.icon(win, f"##lib_icon_{entry.name}", entry.material, entry.maps)
             imgui.same_line()
@@ -71,9 +77,10 @@ class LibraryPanel:
             if imgui.is_item_hovered():
                 imgui.set_tooltip(entry.path)
         if not self.entries:
-            imgui.text_disabled("empty: 'save to library' or 'save preset' adds the material")
+            imgui.text_disabled("empty: 'save to library' or\n'save preset' adds the material")
         for line in self.problems:
             imgui.text_disabled(line)
+        imgui.end_child()
         changed, typed = imgui.input_text("library name", self.name or s.material.name)
         if changed:
             self.name = typed

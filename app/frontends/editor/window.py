@@ -850,6 +850,10 @@ class EditorWindow:
             if job.rows == job.height:
                 where = job.path if job.webp else f"{job.finals[0]} ... {job.finals[-1].name}"
                 self.state.error, self.state.message = "", f"wrote {where} ({job.done} frames, {job.width}x{job.height})"
+                if job.mp4 and self.state.display.background == "transparent":
+                    # H.264 in yuv420p has no alpha: said, not left to be found in the video.
+                    self.state.message += ("; warning: an MP4 has no alpha: the transparent background is black "
+                                           "in it (.webp or .png frames keep it)")
 
     def save_view(self, path: str) -> None:
         """``start_save_view`` run to the end now."""
