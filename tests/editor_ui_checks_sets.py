@@ -9,7 +9,8 @@ looks at the view's pixels, the fields the panel shows or the file written.
 - the 'texture set' field names the set loaded, and both map fields are empty after a preset
   click;
 - Ctrl+Z says in the status row where it went (it kept saying 'applied silver');
-- 'save preset' to NAME.json names the material NAME, so the library entry and the file agree.
+- 'save preset' to NAME.json names the material NAME, so the library entry and the file agree,
+  and the entry it adds moves no control below the library's list.
 """
 
 from __future__ import annotations
@@ -130,8 +131,11 @@ def test_a_saved_preset_is_named_after_its_file(ctx):
     ctx.item_click("**/plastic_high")
     ctx.item_input_value("**/roughness", 0.35)
     ctx.item_input_value("**/preset file", path)
+    below = ctx.item_info("**/glTF file").rect_full.min.y
     ctx.item_click("**/save preset")
     ctx.yield_(3)
+    # The new library entry moves no control below the list (the next click lands where aimed).
+    assert ctx.item_info("**/glTF file").rect_full.min.y == below, (below, ctx.item_info("**/glTF file").rect_full.min.y)
     assert json.loads(open(path, encoding="utf-8").read())["name"] == "myblue", open(path).read()
     assert (library_dir() / "myblue.glb").is_file() and s.material.name == "myblue", s.material.name
     ctx.item_click("**/gold")

@@ -35,7 +35,8 @@ def test_every_panel_check_passes_through_the_test_engine(display, tmp_path):
     assert list(tmp_path.glob("alight-screenshot-*.png"))
     # The session is saved at the end, as after a normal close: the last material clicked.
     session = json.loads((tmp_path / "config" / "editor-session.json").read_text())
-    assert session["material"]["name"] == "gold", session   # the last material (the error-line check's)
+    # The last material: the error-line check's gold, saved as before_error.json (named after it).
+    assert session["material"]["name"] == "before_error" and session["material"]["roughness"] == 0.5, session
 
 
 def test_failures_exit_1_with_their_message_and_the_view_is_the_editors(display, tmp_path):
