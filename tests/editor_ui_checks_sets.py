@@ -10,7 +10,8 @@ looks at the view's pixels, the fields the panel shows or the file written.
   click;
 - Ctrl+Z says in the status row where it went (it kept saying 'applied silver');
 - 'save preset' to NAME.json names the material NAME, so the library entry and the file agree,
-  and the entry it adds moves no control below the library's list.
+  and the entry it adds moves no control below the library's list; a name typed into 'name' is
+  the one the file holds.
 """
 
 from __future__ import annotations
@@ -143,3 +144,18 @@ def test_a_saved_preset_is_named_after_its_file(ctx):
     ctx.yield_(2)
     assert s.material.name == "myblue" and abs(s.material.roughness - 0.35) < 1e-6, s.material
     assert lib.name in ("", "myblue"), lib.name
+
+
+def test_a_typed_name_is_the_saved_materials_name(ctx):
+    """The 'name' field's effect is in the files: a name typed there is what a preset saved under
+    another file name holds (the file's name is taken only where no name was typed)."""
+    s = editor().state
+    path = os.path.join(OUT, "named_file.json")
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/name", "my_copper")
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    ctx.yield_(3)
+    assert json.loads(open(path, encoding="utf-8").read())["name"] == "my_copper", open(path).read()
+    assert s.material.name == "my_copper", s.material.name
