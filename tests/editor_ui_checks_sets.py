@@ -159,3 +159,74 @@ def test_a_typed_name_is_the_saved_materials_name(ctx):
     ctx.yield_(3)
     assert json.loads(open(path, encoding="utf-8").read())["name"] == "my_copper", open(path).read()
     assert s.material.name == "my_copper", s.material.name
+
+
+def test_a_library_name_typed_names_the_entrys_material(ctx):
+    """'save to library' under a typed name: the material in the entry is named so, a click on
+    the entry names the material so, and the next save goes back to that entry (it offered to
+    replace the entry of the name the work began with)."""
+    s, lib = editor().state, editor().panel.library
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.55)
+    ctx.item_input_value("**/library name", "crate_lib")
+    ctx.item_click("**/save to library")
+    ctx.yield_(3)
+    assert s.material.name == "crate_lib" and not lib.pending, (s.material.name, lib.pending, s.message)
+    ctx.item_click("**/gold")
+    ctx.item_click("**/crate_lib##library")
+    ctx.yield_(2)
+    assert s.material.name == "crate_lib" and abs(s.material.roughness - 0.55) < 1e-6, s.material
+    ctx.item_input_value("**/roughness", 0.6)
+    ctx.item_click("**/save to library")
+    ctx.yield_(3)
+    assert lib.pending == "crate_lib", (lib.pending, s.message)   # it asks to replace this entry
+    ctx.set_ref("replace library entry")
+    ctx.item_click("replace crate_lib")
+    ctx.set_ref("alight")
+    ctx.yield_(2)
+    assert not lib.pending and s.message.startswith("saved to the library"), (lib.pending, s.message)
+
+
+def test_every_layer_rows_label_fits_the_panel(ctx):
+    """Each layer section opened: every row's label ends inside the panel ('clearcoat
+    roughness' read 'clearcoat roughne')."""
+    from imgui_bundle import imgui
+
+    from alight.frontends.editor.layer_rows import SECTIONS
+
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    edge = imgui.internal.find_window_by_name("alight").inner_clip_rect.max.x
+    spacing = imgui.get_style().item_inner_spacing.x
+    checked = 0
+    for section in SECTIONS:
+        ctx.item_open(f"**/###layer_{section.layer}")
+        ctx.yield_(2)
+        for row in section.rows:
+            if row.switch:
+                continue   # a checkbox's label is beside its box; the drag appears only when on
+            ref = f"###layer_{section.layer}/{row.label}"
+            if row.widget == "color":   # a group: its last part, the swatch, then the label
+                right = ctx.item_info(f"{ref}/##ColorButton").rect_full.max.x + spacing \
+                    + imgui.calc_text_size(row.label).x
+            else:
+                right = ctx.item_info(ref).rect_full.max.x
+            assert right <= edge + 0.5, f"'{row.label}' ends at x={right:.0f}, past the panel's edge {edge:.0f}"
+            checked += 1
+        ctx.item_close(f"**/###layer_{section.layer}")
+    assert checked >= 15, checked
+
+
+def test_adding_a_light_says_so(ctx):
+    s, panel = editor().state, editor().panel
+    ctx.set_ref("alight")
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    ctx.item_click("**/add spot")
+    ctx.yield_(2)
+    assert len(s.lights) == n + 1 and panel.shown_status.endswith(f"added light {n}: spot"), panel.shown_status
+    ctx.item_click(f"**/$${n}/remove")
+    ctx.yield_(2)
+    assert len(s.lights) == n and f"removed light {n}" in panel.shown_status, panel.shown_status
+    ctx.item_close("**/Lights")

@@ -234,6 +234,8 @@ def _checks(env_file: str) -> int:
              f"{got_now.get('base_color')!r} ({problem or state.error})")
     elif changed(before, after) < 1.0:
         fail(f"armed slot: the view hardly changed ({changed(before, after):.2f} mean levels)")
+    elif not state.message.endswith("as the roughness map"):   # which slot, in the status row
+        fail(f"armed slot: the status row says {state.message!r}")
     else:
         print(f"armed slot: {os.path.basename(rough)} is the roughness map; the view changed by "
               f"{changed(before, after):.1f} mean levels")

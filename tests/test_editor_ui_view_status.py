@@ -113,3 +113,35 @@ def test_a_restored_meshs_warning_is_in_the_message(tmp_path, monkeypatch):
     fresh = EditorState()
     assert restore_session(fresh, OrbitCamera()) == ""
     assert fresh.message.startswith("restored the last session; warning: ") and "NaN" in fresh.message, fresh.message
+
+
+def test_the_session_keeps_the_texture_sets_folder_and_the_armed_slot(tmp_path, monkeypatch):
+    """Reopened, the 'texture set' field names the folder the set came from (it read the files'
+    list) and a dropped image goes to the slot armed before (it went to base colour)."""
+    import numpy as np
+    from PIL import Image
+
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session, session_path
+    from alight.frontends.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path / "config"))
+    folder = tmp_path / "moss"
+    folder.mkdir()
+    for suffix in ("diff", "rough"):
+        Image.fromarray(np.full((8, 8, 3), 90, np.uint8)).save(folder / f"moss_{suffix}.png")
+    state = EditorState()
+    state.open_texture_folder(str(folder))
+    state.armed_slot = "roughness"
+    assert state.texture_set_text() == str(folder)
+    save_session(state, OrbitCamera())
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert fresh.texture_set_text() == str(folder) and fresh.armed_slot == "roughness", \
+        (fresh.texture_set_text(), fresh.armed_slot)
+    data = json.loads(session_path().read_text())   # an older session: the files, base colour
+    del data["texture_set_folder"], data["armed_slot"]
+    session_path().write_text(json.dumps(data))
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert ";" in fresh.texture_set_text() and fresh.armed_slot == "base_color", fresh.texture_set_text()

@@ -4,6 +4,7 @@ imgui only: the files are library.py's, the thumbnails' GL is thumbnails.py's (t
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 from alight.core.texture_maps import TextureMaps
@@ -26,6 +27,7 @@ class LibraryPanel:
         self._stamp = None
         self._scanned = -1e9
         self.clicked = None               # the entry clicked this frame, applied by apply_click
+        self._renamed = None              # the material as saved into an entry (named so), ditto
         self.pending = ""                 # an entry's name to replace once the artist confirms
 
     def rescan(self, force: bool = False) -> None:
@@ -91,6 +93,11 @@ class LibraryPanel:
     def apply_click(self, s) -> None:
         """The entry clicked this frame becomes the material, with its maps (one undo step, as a
         preset click; 'revert' goes back to it)."""
+        renamed, self._renamed = self._renamed, None
+        if renamed is not None:
+            if s.material.name != renamed.name:
+                s.material = dataclasses.replace(s.material, name=renamed.name)
+            s.mark_saved()
         entry, self.clicked = self.clicked, None
         if entry is None:
             return
@@ -100,26 +107,32 @@ class LibraryPanel:
         except AlightError as exc:
             s.fail(exc)
 
-    def save(self, s, name: str, replace: bool = False) -> bool:
+    def save(self, s, name: str, replace: bool = False, rename: bool = True) -> bool:
         """The material and its maps into the library as NAME.glb; the panel's message says where.
         An entry of that name holding another material is replaced only once the artist says so
         (``draw_confirm``'s dialog, then ``replace``): a save is not undoable. Returns whether it
         was written now."""
         try:
             stem = library.entry_name(name)
+            # The entry's material is named as the entry: a click on it later names the material
+            # so, and the next save goes back to this entry, not to the name the work began with.
+            # ('save preset' names it itself: a name typed into 'name' stays, rename False.)
+            named = dataclasses.replace(s.material, name=stem) if rename and s.material.name != stem else s.material
             existing = library.library_dir() / f"{stem}{library.LIBRARY_SUFFIX}"
-            same = any(e.name == stem and e.material == s.material and e.maps == s.texture_maps
+            same = any(e.name == stem and e.material == named and e.maps == s.texture_maps
                        for e in self.entries)
             if existing.is_file() and not same and not replace:
                 self.pending = stem
                 s.error, s.message = "", f"'{stem}' is in the library already: replace it?"
                 return False
-            path = library.save_entry(s.material, s.texture_maps, name)
+            path = library.save_entry(named, s.texture_maps, name)
         except AlightError as exc:
             s.fail(exc)
             self.name = ""   # the field shows the material's name again, not the name that failed
             return False
-        s.mark_saved()
+        # The rename waits for apply_click: the panel's material widgets, drawn after this, write
+        # their copy of the material back in this frame.
+        self._renamed = named
         self.name = ""
         s.error, s.message = "", f"saved to the library: {path}"
         self.rescan(force=True)

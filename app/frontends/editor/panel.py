@@ -389,7 +389,7 @@ class Panel:
         except AlightError as exc:
             s.fail(exc)
             return
-        saved = self.library.save(s, self.preset_path)   # a saved material is in the library too
+        saved = self.library.save(s, self.preset_path, rename=False)   # a saved material is in the library too
         if not s.error:
             done = f"saved {self.preset_path}{f' ({note})' if note else ''}"
             s.message = f"{done} and {s.message.removeprefix('saved ')}" if saved else f"{done}; {s.message}"
@@ -432,8 +432,14 @@ class Panel:
             if opened:
                 if section.note:
                     imgui.text_disabled(section.note)
+                # Widgets narrow enough for the section's longest label to fit beside them
+                # ('clearcoat roughness' was cut at the panel's edge), but not below 40% of the row.
+                label = max(imgui.calc_text_size(row.label).x for row in section.rows)
+                avail = imgui.get_content_region_avail().x
+                imgui.push_item_width(max(avail - label - imgui.get_style().item_inner_spacing.x, 0.4 * avail))
                 for row in section.rows:
                     m = layer_row(row, m)
+                imgui.pop_item_width()
                 imgui.tree_pop()
         return m
 
@@ -667,15 +673,21 @@ class Panel:
             top <= io.mouse_pos.y < imgui.get_cursor_screen_pos().y
         if self._removed and not inside and not imgui.is_any_mouse_down():
             self._removed = []   # the pointer left: the list closes up
+        added = None
         if imgui.button("add point"):
-            s.lights.append(Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0))
+            added = Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0)
         imgui.same_line()
         if imgui.button("add directional"):
-            s.lights.append(Light("directional", (0.0, -1.0, -1.0), (1.0, 1.0, 1.0), 2.0))
+            added = Light("directional", (0.0, -1.0, -1.0), (1.0, 1.0, 1.0), 2.0)
         imgui.same_line()
         if imgui.button("add spot"):   # above and in front, pointing at the origin
-            s.lights.append(Light("spot", (0.0, 3.0, 3.0), (1.0, 1.0, 1.0), 30.0,
-                                  direction=(0.0, -0.7071, -0.7071), inner_cone_deg=15.0, outer_cone_deg=30.0))
+            added = Light("spot", (0.0, 3.0, 3.0), (1.0, 1.0, 1.0), 30.0,
+                          direction=(0.0, -0.7071, -0.7071), inner_cone_deg=15.0, outer_cone_deg=30.0)
+        if added is not None:   # (the status row kept saying the last material step)
+            s.lights.append(added)
+            s.error, s.message = "", f"added light {len(s.lights) - 1}: {added.kind}"
+        if remove is not None:
+            s.error, s.message = "", f"removed light {remove} ('restore' while the pointer is here)"
 
     def _removed_places(self, s, index: int) -> None:
         """The places of the lights removed just before list position ``index``: as tall as the

@@ -10,7 +10,7 @@ import math
 from pathlib import Path
 
 from alight.core.material import material_from_dict
-from alight.core.texture_maps import TextureMaps
+from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
 from alight.exchange.output import write_text_atomic
 from alight.frontends.editor import compare
@@ -31,6 +31,9 @@ def save_session(state, orbit, turntable=None) -> None:
     """``turntable``: the window's turntable.TurntableSettings (kept when given)."""
     data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
             "texture_maps": state.texture_maps.to_dict(),
+            # The folder the set was read from (the 'texture set' field names it) and the slot a
+            # dropped image fills: older sessions lack both.
+            "texture_set_folder": state.texture_set_folder, "armed_slot": state.armed_slot,
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
                          "use_file_materials": state.use_file_materials, "aa": state.aa,
@@ -68,6 +71,10 @@ def restore_session(state, orbit, turntable=None) -> str:
         except AlightError as exc:
             warning = str(exc)
     state.mark_saved()   # 'revert' goes back to the restored material with its maps
+    if isinstance(data.get("texture_set_folder"), str):
+        state.texture_set_folder = data["texture_set_folder"]
+    if data.get("armed_slot") in MAP_SLOTS:
+        state.armed_slot = data["armed_slot"]
     said = ()
     for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
         if isinstance(spec, str):

@@ -382,6 +382,10 @@ class EditorState:
             return False
         warned = suffix != "" and suffix not in IMAGE_SUFFIXES   # (a map's read says nothing)
         self.error, self.message = "", f"opened {os.path.basename(path)}"
+        if suffix in IMAGE_SUFFIXES:   # which slot it went to: the armed one, chosen frames ago
+            from alight.core.texture_maps import SLOT_LABELS
+
+            self.message += f" as the {SLOT_LABELS[self.armed_slot].split(' (')[0]} map"
         if warned:
             self.message = self.with_warnings(self.message)
         return True
