@@ -313,7 +313,7 @@ def _own_loop_checks(tries: int = 20) -> int:
     state = EditorState()
     state.load_mesh("sphere")
     state.load_env("studio")
-    win = EditorWindow(state, (1280, 720))
+    win = EditorWindow(state, (1280, 1000))   # (tall: the base colour row in view below the F0 table and the library box)
     for _ in range(3):
         win.frame()
     win.finish_bake()

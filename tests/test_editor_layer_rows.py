@@ -79,6 +79,31 @@ class FakeImgui:
     def tree_pop(self):
         pass
 
+    # Layout calls (the rows' width beside their labels): a fixed geometry.
+    class _Vec:
+        def __init__(self, x=0.0, y=0.0):
+            self.x, self.y = x, y
+
+    class _Style:
+        item_inner_spacing = None
+
+    def calc_text_size(self, text):
+        return self._Vec(7.0 * len(text), 13.0)
+
+    def get_content_region_avail(self):
+        return self._Vec(400.0, 600.0)
+
+    def get_style(self):
+        style = self._Style()
+        style.item_inner_spacing = self._Vec(4.0, 4.0)
+        return style
+
+    def push_item_width(self, _):
+        pass
+
+    def pop_item_width(self):
+        pass
+
     def text_disabled(self, _):
         pass
 

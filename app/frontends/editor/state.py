@@ -352,6 +352,8 @@ class EditorState:
         """What the 'texture set' field shows for the maps loaded: the folder they were read from
         while every map is in it, else the files separated by '; ' ('' without maps)."""
         paths = sorted(set(self.texture_maps.paths().values()))
+        if any("#" in os.path.basename(p) for p in paths):
+            return ""   # images inside a .glb/.gltf (a library entry): no folder or files to load again
         folder = self.texture_set_folder
         if folder and paths and all(os.path.dirname(p) == folder.rstrip(os.sep) for p in paths):
             return folder
