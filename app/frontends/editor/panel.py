@@ -160,6 +160,9 @@ class Panel:
         for col in (imgui.Col_.slider_grab, imgui.Col_.slider_grab_active):
             c = imgui.get_style_color_vec4(col)
             imgui.push_style_color(col, imgui.ImVec4(c.x, c.y, c.z, SLIDER_GRAB_ALPHA))
+        # Opaque popups: a combo's open list showed the rows under it through its 0.94 alpha.
+        c = imgui.get_style_color_vec4(imgui.Col_.popup_bg)
+        imgui.push_style_color(imgui.Col_.popup_bg, imgui.ImVec4(c.x, c.y, c.z, 1.0))
         # The status row is the window's menu bar: it stays in view whatever the panel's scroll.
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
@@ -198,7 +201,7 @@ class Panel:
         # Where the controls are this frame: a press aimed at another layout is not delivered.
         self.layout = (round(imgui.get_scroll_y()), tuple(headers), round(imgui.get_cursor_pos_y()))
         imgui.end()
-        imgui.pop_style_color(2)
+        imgui.pop_style_color(3)
         imgui.pop_style_var()
         self.library.draw_confirm(s)
         self.browser.draw()
