@@ -44,6 +44,24 @@ class Entry:
     maps: TextureMaps
 
 
+def holds(entry: Entry, material: Material, maps: TextureMaps) -> bool:
+    """Whether ``entry`` holds ``material`` with ``maps``: numbers equal to float32 rounding, as
+    the .glb stores them (a preset's F0 of 0.04 comes back from the file's ior as 0.04000000000000001:
+    compared exactly, saving an unchanged material again asked to replace its own entry)."""
+    if entry.maps != maps:
+        return False
+    a, b = dataclasses.asdict(entry.material), dataclasses.asdict(material)
+    return all(_close(a[k], b[k]) for k in a)
+
+
+def _close(x, y) -> bool:
+    if isinstance(x, (tuple, list)) and isinstance(y, (tuple, list)):
+        return len(x) == len(y) and all(_close(p, q) for p, q in zip(x, y))
+    if isinstance(x, float) and isinstance(y, (int, float)) and not isinstance(y, bool):
+        return x == y or abs(x - y) <= 1e-6 * max(abs(x), abs(y))   # float32's 2^-23 and then some
+    return x == y
+
+
 def entry_name(text: str) -> str:
     """A library name from a file name or typed text: the stem, with characters that do not
     belong in a file name replaced by '_'. Errors: AlightError when nothing is left."""

@@ -27,7 +27,7 @@ class LibraryPanel:
         self._stamp = None
         self._scanned = -1e9
         self.clicked = None               # the entry clicked this frame, applied by apply_click
-        self._renamed = None              # the material as saved into an entry (named so), ditto
+        self._renamed = None              # the name of the entry a save wrote, for the material (ditto)
         self.pending = ""                 # an entry's name to replace once the artist confirms
 
     def rescan(self, force: bool = False) -> None:
@@ -95,8 +95,8 @@ class LibraryPanel:
         preset click; 'revert' goes back to it)."""
         renamed, self._renamed = self._renamed, None
         if renamed is not None:
-            if s.material.name != renamed.name:
-                s.material = dataclasses.replace(s.material, name=renamed.name)
+            if s.material.name != renamed:
+                s.material = dataclasses.replace(s.material, name=renamed)
             s.mark_saved()
         entry, self.clicked = self.clicked, None
         if entry is None:
@@ -119,8 +119,7 @@ class LibraryPanel:
             # ('save preset' names it itself: a name typed into 'name' stays, rename False.)
             named = dataclasses.replace(s.material, name=stem) if rename and s.material.name != stem else s.material
             existing = library.library_dir() / f"{stem}{library.LIBRARY_SUFFIX}"
-            same = any(e.name == stem and e.material == named and e.maps == s.texture_maps
-                       for e in self.entries)
+            same = any(e.name == stem and library.holds(e, named, s.texture_maps) for e in self.entries)
             if existing.is_file() and not same and not replace:
                 self.pending = stem
                 s.error, s.message = "", f"'{stem}' is in the library already: replace it?"
@@ -132,7 +131,7 @@ class LibraryPanel:
             return False
         # The rename waits for apply_click: the panel's material widgets, drawn after this, write
         # their copy of the material back in this frame.
-        self._renamed = named
+        self._renamed = named.name
         self.name = ""
         s.error, s.message = "", f"saved to the library: {path}"
         self.rescan(force=True)
