@@ -20,6 +20,7 @@ OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the p
 BAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "bad"   # ../shared/data/bad
 SPIN_FRAMES = 36
 LAST_FRAMES, LAST_FILE = 5, "again.webp"   # what the last check leaves for the reopened editor
+LAST_PRESET, LAST_GLTF = "kept_preset.json", "kept_export.glb"   # the path fields it leaves
 
 
 def _capture(ctx, name: str) -> np.ndarray:
@@ -174,6 +175,12 @@ def test_leave_turntable_settings_and_msaa_for_the_next_session(ctx):
     ctx.combo_click("anti-aliasing/msaa")
     ctx.item_close("**/Display & camera")
     assert (win.turntable.frames, win.state.aa) == (LAST_FRAMES, "msaa")
+    # The path fields (a third trial found both back at their defaults after a reopen).
+    ctx.item_input_value("**/preset file", os.path.join(OUT, LAST_PRESET))
+    ctx.item_click("**/save preset")
+    ctx.item_input_value("**/glTF file", os.path.join(OUT, LAST_GLTF))
+    ctx.item_click("**/export glTF")
+    _until(ctx, lambda: os.path.isfile(os.path.join(OUT, LAST_PRESET)) and os.path.isfile(os.path.join(OUT, LAST_GLTF)))
 
 
 def reopened_turntable_and_aa_are_restored(ctx):
@@ -193,3 +200,10 @@ def reopened_turntable_and_aa_are_restored(ctx):
     with Image.open(path) as im:
         assert im.n_frames == LAST_FRAMES, im.n_frames
     ctx.item_close("**/Display & camera")
+    # The path fields are the last session's: their buttons write there without typing.
+    for name, button in ((LAST_PRESET, "save preset"), (LAST_GLTF, "export glTF")):
+        kept = os.path.join(OUT, name)
+        os.remove(kept)
+        ctx.item_click(f"**/{button}")
+        _until(ctx, lambda: os.path.isfile(kept))
+        assert not win.state.error, win.state.error

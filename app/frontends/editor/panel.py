@@ -117,6 +117,10 @@ def close_popup_on_escape() -> None:
         imgui.internal.close_popups_except_modals()
 
 
+# The path fields kept across sessions (the others follow what is loaded: mesh, env, maps).
+KEPT_PATH_FIELDS = ("preset_path", "gltf_path")
+
+
 class Panel:
     def __init__(self):
         # The F0 table, read once: (name, material, linear F0, sRGB F0).
@@ -403,6 +407,18 @@ class Panel:
             s.error, s.message = "", f"exported {self.gltf_path}"
         except AlightError as exc:
             s.fail(exc)
+
+    def kept_paths(self) -> dict:
+        """The 'preset file' and 'glTF file' fields for the next session: the paths that last
+        worked (a typed path that failed is not kept, as it is not left showing)."""
+        return {field: self._good[field] for field in KEPT_PATH_FIELDS}
+
+    def restore_paths(self, paths: dict) -> None:
+        """The fields of a saved session (``kept_paths``); entries that are not text are skipped."""
+        for field in KEPT_PATH_FIELDS:
+            if isinstance(paths.get(field), str) and paths[field]:
+                setattr(self, field, paths[field])
+                self._good[field] = paths[field]
 
     def _attempt(self, s, field: str, action) -> None:
         """Run a path field's action (open, load, save); where it fails the field goes back to

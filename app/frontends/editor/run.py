@@ -70,7 +70,7 @@ def run(args) -> int:
     if interactive and not args.new and _no_scene_options(args):
         from alight.frontends.editor.session import restore_session
 
-        warning = restore_session(state, win.orbit, win.turntable)
+        warning = restore_session(state, win.orbit, win.turntable, win.panel)
         if warning:
             state.error = " ".join(warning.split())
         win.history.committed = state.look
@@ -96,9 +96,9 @@ def run(args) -> int:
         except KeyboardInterrupt:
             # Ctrl+C, or SIGTERM (the CLI raises its Terminated, a KeyboardInterrupt: a logout,
             # a kill): the session is kept as after a normal close, then the CLI says which.
-            save_session(state, win.orbit, win.turntable)
+            save_session(state, win.orbit, win.turntable, win.panel)
             raise
-        save_session(state, win.orbit, win.turntable)
+        save_session(state, win.orbit, win.turntable, win.panel)
         return 0
     finally:
         win.close()

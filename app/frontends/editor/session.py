@@ -1,6 +1,7 @@
 """The last session (mesh, environment, material, camera, the view's settings, the turntable's
-frames and file), so the editor reopens where the artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written
-atomically on close."""
+frames and file, the panel's preset and glTF file fields), so the editor reopens where the artist
+left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written atomically
+on close."""
 
 from __future__ import annotations
 
@@ -27,8 +28,9 @@ def session_path() -> Path:
     return config_dir() / "editor-session.json"
 
 
-def save_session(state, orbit, turntable=None) -> None:
-    """``turntable``: the window's turntable.TurntableSettings (kept when given)."""
+def save_session(state, orbit, turntable=None, panel=None) -> None:
+    """``turntable``: the window's turntable.TurntableSettings, ``panel``: its panel.Panel (the
+    'preset file' and 'glTF file' fields), each kept when given."""
     data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
             "texture_maps": state.texture_maps.to_dict(),
             # The folder the set was read from (the 'texture set' field names it) and the slot a
@@ -42,15 +44,18 @@ def save_session(state, orbit, turntable=None) -> None:
             "compare": compare.to_dict(state.compare)}
     if turntable is not None:
         data["turntable"] = {"frames": turntable.frames, "path": turntable.path}
+    if panel is not None:
+        data["files"] = panel.kept_paths()
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))
 
 
-def restore_session(state, orbit, turntable=None) -> str:
+def restore_session(state, orbit, turntable=None, panel=None) -> str:
     """Apply the saved session to ``state`` and ``orbit`` (and ``turntable``, the window's
-    turntable.TurntableSettings, when given). Returns '' or a one-line warning: a missing mesh or
-    environment file (moved since) or a broken session file restores what it can."""
+    turntable.TurntableSettings, and ``panel``'s path fields, when given). Returns '' or a one-line
+    warning: a missing mesh or environment file (moved since) or a broken session file restores
+    what it can."""
     path = session_path()
     if not path.is_file():
         return ""
@@ -112,6 +117,9 @@ def restore_session(state, orbit, turntable=None) -> str:
             turntable.frames, turntable.path = _read_turntable(spin)
         except (KeyError, TypeError, ValueError) as exc:
             warning = f"{path}: the turntable's settings not restored ({' '.join(str(exc).split())})"
+    files = data.get("files")
+    if panel is not None and isinstance(files, dict):   # (older sessions lack it: the defaults stay)
+        panel.restore_paths(files)
     camera = data.get("camera")
     if isinstance(camera, dict):
         try:

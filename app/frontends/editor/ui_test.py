@@ -123,7 +123,7 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
         if restore:
             from alight.frontends.editor.session import restore_session
 
-            warning = restore_session(state, _window.orbit, _window.turntable)
+            warning = restore_session(state, _window.orbit, _window.turntable, _window.panel)
             if warning:
                 state.error = " ".join(warning.split())
             _window.history.committed = state.look
@@ -210,7 +210,7 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
             return
         from alight.frontends.editor.session import save_session
 
-        save_session(state, _window.orbit, _window.turntable)   # as after a normal close
+        save_session(state, _window.orbit, _window.turntable, _window.panel)   # as after a normal close
         _window.close()
 
     cb = params.callbacks
