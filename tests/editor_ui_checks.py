@@ -11,27 +11,16 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 
 import numpy as np
 
 from alight.frontends.editor.ui_test import editor, view
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import ball, capture, changed, checker_levels, contrast, until_seconds  # noqa: E402
+
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
-
-
-def ball(image: np.ndarray) -> np.ndarray:
-    """Pixels well inside the ball (it fills the middle of the view)."""
-    h, w = image.shape[:2]
-    y, x = np.mgrid[0:h, 0:w]
-    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2].astype(np.float64)
-
-
-def contrast(image: np.ndarray) -> float:
-    """Mean horizontal luminance step inside the ball: high for a mirror, low for a rough ball."""
-    lum = image.astype(np.float64).mean(axis=2)
-    step = np.zeros_like(lum)
-    step[:, 1:] = np.abs(np.diff(lum, axis=1))
-    return float(ball(step[:, :, None]).mean())
 
 
 def void(ctx) -> None:
@@ -550,17 +539,6 @@ def test_texture_set_folder_typed_into_the_map_field(ctx):
         s.clear_map(slot)
 
 
-def _until(ctx, done, limit_s: float) -> float:
-    """Frames until ``done()`` (the seconds it took), failing after ``limit_s``."""
-    import time
-
-    start = time.monotonic()
-    while not done():
-        assert time.monotonic() - start < limit_s, f"not within {limit_s} s"
-        ctx.yield_()
-    return time.monotonic() - start
-
-
 def _write_atomically(path: str, pixels: np.ndarray) -> None:
     """As image editors and exporters save: a new file renamed over the old one."""
     import OpenImageIO as oiio
@@ -586,7 +564,7 @@ def test_hot_reload_of_a_map_and_the_environment(ctx):
     assert red[0] > 2 * red[2], red
     before = s.map_images[path]
     _write_atomically(path, np.full((16, 16, 3), (20, 20, 230), np.uint8))
-    seconds = _until(ctx, lambda: s.map_images.get(path) is not before, 1.0)
+    seconds = until_seconds(ctx, lambda: s.map_images.get(path) is not before, 1.0)
     blue = ball(view(ctx)).mean(axis=0)
     assert blue[2] > 2 * blue[0], (blue, red)
     print(f"hot reload: the map was reloaded {seconds:.2f} s after the rewrite")
@@ -601,7 +579,7 @@ def test_hot_reload_of_a_map_and_the_environment(ctx):
     warm = ball(view(ctx)).mean(axis=0)
     old_env = s.env
     _write_atomically(env, np.full((32, 64, 3), (0.3, 0.6, 1.0), np.float32))
-    seconds = _until(ctx, lambda: s.env is not old_env, 1.0)
+    seconds = until_seconds(ctx, lambda: s.env is not old_env, 1.0)
     cold = ball(view(ctx)).mean(axis=0)
     assert cold[2] > cold[0] + 20 and warm[0] > warm[2] + 20, (warm, cold)
     print(f"hot reload: the environment was reloaded {seconds:.2f} s after the rewrite")
@@ -612,11 +590,6 @@ def test_hot_reload_of_a_map_and_the_environment(ctx):
 def test_anisotropy_and_sheen_sections(ctx):
     s = editor().state
 
-    def changed(before, what):
-        after = view(ctx).astype(np.float64)
-        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
-        return after
-
     ctx.set_ref("alight")
     ctx.item_click("**/copper")
     ctx.item_input_value("**/roughness", 0.4)
@@ -624,10 +597,10 @@ def test_anisotropy_and_sheen_sections(ctx):
     ctx.item_open("**/###layer_anisotropy")
     ctx.item_input_value("**/anisotropy strength", 0.9)
     assert abs(s.material.anisotropy_strength - 0.9) < 1e-6
-    image = changed(image, "anisotropy strength")
+    image = changed(ctx, image, "anisotropy strength")
     ctx.item_input_value("**/anisotropy rotation", 60.0)   # degrees, stored in radians
     assert abs(s.material.anisotropy_rotation - np.radians(60.0)) < 1e-4, s.material.anisotropy_rotation
-    image = changed(image, "anisotropy rotation")
+    image = changed(ctx, image, "anisotropy rotation")
     ctx.item_close("**/###layer_anisotropy")
     ctx.item_click("**/plastic_high")
     image = view(ctx).astype(np.float64)
@@ -635,7 +608,7 @@ def test_anisotropy_and_sheen_sections(ctx):
     ctx.item_input_value("###layer_sheen/sheen colour (sRGB)/##X", 255)
     ctx.item_input_value("**/sheen roughness", 0.5)
     assert s.material.sheen_color[0] == 1.0 and abs(s.material.sheen_roughness - 0.5) < 1e-6, s.material
-    image = changed(image, "sheen")
+    image = changed(ctx, image, "sheen")
     ctx.item_close("**/###layer_sheen")
     ctx.item_click("**/revert")
     assert s.material.sheen_color == (0.0, 0.0, 0.0)
@@ -644,25 +617,20 @@ def test_anisotropy_and_sheen_sections(ctx):
 def test_transmission_and_volume_sections(ctx):
     s = editor().state
 
-    def changed(before, what):
-        after = view(ctx).astype(np.float64)
-        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
-        return after
-
     ctx.set_ref("alight")
     ctx.item_click("**/plastic_high")
     image = view(ctx).astype(np.float64)
     ctx.item_open("**/###layer_transmission")
     ctx.item_input_value("**/transmission", 1.0)
     assert s.material.transmission == 1.0
-    image = changed(image, "transmission")
+    image = changed(ctx, image, "transmission")
     ctx.item_close("**/###layer_transmission")
     ctx.item_open("**/###layer_volume")
     ctx.item_input_value("**/thickness", 1.0)
     ctx.item_check("**/attenuate")
     ctx.item_input_value("###layer_volume/attenuation colour (sRGB)/##Y", 40)
     assert s.material.thickness == 1.0 and s.material.attenuation_distance == 1.0, s.material
-    changed(image, "volume")
+    changed(ctx, image, "volume")
     ctx.item_close("**/###layer_volume")
     ctx.item_click("**/revert")
     assert s.material.transmission == 0.0 and s.material.thickness == 0.0
@@ -673,11 +641,6 @@ def test_iridescence_dispersion_and_diffuse_transmission_sections(ctx):
     each edit through its widget changes the ball and is one undo step."""
     s = editor().state
 
-    def changed(before, what):
-        after = view(ctx).astype(np.float64)
-        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
-        return after
-
     ctx.set_ref("alight")
     ctx.item_click("**/copper")
     ctx.item_input_value("**/roughness", 0.3)
@@ -685,10 +648,10 @@ def test_iridescence_dispersion_and_diffuse_transmission_sections(ctx):
     ctx.item_open("**/###layer_iridescence")
     ctx.item_input_value("**/iridescence", 1.0)
     assert s.material.iridescence == 1.0 and "iridescence" in s.material.layers(), s.material
-    filmed = changed(plain, "iridescence")
+    filmed = changed(ctx, plain, "iridescence")
     ctx.item_input_value("**/iridescence thickness maximum", 250.0)   # a drag, in nm
     assert s.material.iridescence_thickness_maximum == 250.0, s.material
-    changed(filmed, "iridescence thickness maximum")
+    changed(ctx, filmed, "iridescence thickness maximum")
     # Each edit one undo step: Ctrl+Z twice takes the film off, and the ball is copper again.
     void(ctx)
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
@@ -706,7 +669,7 @@ def test_iridescence_dispersion_and_diffuse_transmission_sections(ctx):
     ctx.item_input_value("**/diffuse transmission", 1.0)
     ctx.item_input_value("###layer_diffuse_transmission/diffuse transmission colour (sRGB)/##X", 20)
     assert s.material.diffuse_transmission == 1.0 and s.material.diffuse_transmission_color[0] < 0.01, s.material
-    changed(image, "diffuse transmission")
+    changed(ctx, image, "diffuse transmission")
     ctx.item_close("**/###layer_diffuse_transmission")
     # Dispersion acts on a volume's refraction: transmission, thickness and a high ior first,
     # through white (plastic_high's dark blue hides the fringes: 0.15 at 10 in one run).
@@ -725,7 +688,7 @@ def test_iridescence_dispersion_and_diffuse_transmission_sections(ctx):
     ctx.item_open("**/###layer_dispersion")
     ctx.item_input_value("**/dispersion", 20.0)   # Abbe number 1: the fringes at the horizon's edge
     assert s.material.dispersion == 20.0 and "dispersion" in s.material.layers(), s.material
-    changed(image, "dispersion")
+    changed(ctx, image, "dispersion")
     ctx.item_close("**/###layer_dispersion")
     ctx.item_click("**/revert")
     assert s.material.dispersion == 0.0 and s.material.transmission == 0.0
@@ -1006,16 +969,6 @@ def _same_material(a, b) -> bool:
     return True
 
 
-def _capture(ctx, name: str) -> np.ndarray:
-    """The whole window as the engine captures it (panel and view, as shown): uint8 (h, w, 4)."""
-    import OpenImageIO as oiio
-    from imgui_bundle.immapp.testing import capture
-
-    path = os.path.join(OUT, name)
-    capture(ctx, path)
-    return oiio.ImageBuf(path).get_pixels(oiio.UINT8)
-
-
 def _wait_for_thumbnails(ctx, seconds: float = 400.0) -> None:
     """Frames until no thumbnail the panel asked for is still to be made (each is an 'alight
     render' in a child process; on a loaded machine a layered material's takes many seconds)."""
@@ -1062,7 +1015,7 @@ def test_presets_show_rendered_thumbnails(ctx):
     assert copper[0] / copper[2] > 1.15 * silver[0] / silver[2], (copper, silver)
     ctx.item_make_visible("**/copper", 0)   # earlier checks leave the panel scrolled down
     ctx.item_make_visible("**/silver", 0)
-    shot = _capture(ctx, "thumbnails.png")
+    shot = capture(ctx, "thumbnails.png")
     on_screen = {name: _icon_pixels(ctx, shot, f"**/{name}").mean(axis=(0, 1)) for name in ("copper", "silver")}
     c, g = on_screen["copper"], on_screen["silver"]
     assert c[0] / max(c[2], 1) > 1.15 * g[0] / max(g[2], 1), on_screen
@@ -1098,7 +1051,7 @@ def test_library_save_thumbnail_and_click_applies_undoably(ctx):
     np.testing.assert_allclose(ball(view(ctx)).mean(axis=0), shown, atol=0.5)
     _wait_for_thumbnails(ctx)
     ctx.item_make_visible("**/ui_copper##library", 0)
-    icon = _icon_pixels(ctx, _capture(ctx, "library.png"), "**/ui_copper##library").mean(axis=(0, 1))
+    icon = _icon_pixels(ctx, capture(ctx, "library.png"), "**/ui_copper##library").mean(axis=(0, 1))
     assert icon[0] > icon[2] + 10, icon   # copper's ball, not the grey placeholder
     void(ctx)
     ctx.key_press(imgui_key("mod_ctrl") | imgui_key("z"))
@@ -1106,15 +1059,6 @@ def test_library_save_thumbnail_and_click_applies_undoably(ctx):
 
 
 # --- a transparent background over a checkerboard --------------------------------------------------
-
-def _checker_levels(corner: np.ndarray) -> tuple[float, float]:
-    """The fractions of a corner's pixels at the checkerboard's light and dark grey."""
-    v = corner.astype(np.int32)
-    grey = (v.max(axis=2) - v.min(axis=2)) <= 2
-    light = (grey & (np.abs(v[:, :, 0] - 204) <= 2)).mean()
-    dark = (grey & (np.abs(v[:, :, 0] - 153) <= 2)).mean()
-    return float(light), float(dark)
-
 
 def test_transparent_background_shows_a_checkerboard(ctx):
     """With the transparent background the window shows the view over light and dark grey
@@ -1125,13 +1069,13 @@ def test_transparent_background_shows_a_checkerboard(ctx):
     void(ctx)
     w, h = win.view_area()
     middle = (slice(h // 2 - 4, h // 2 + 4), slice(w // 2 - 4, w // 2 + 4))
-    over_env = _capture(ctx, "over_env.png")[middle][:, :, :3].mean(axis=(0, 1))
+    over_env = capture(ctx, "over_env.png")[middle][:, :, :3].mean(axis=(0, 1))
     ctx.item_open("**/Environment")
     ctx.combo_click("background/transparent")
     ctx.item_close("**/Environment")
     void(ctx)
-    shot = _capture(ctx, "checker.png")[:, :, :3]
-    light, dark = _checker_levels(shot[:32, :32])
+    shot = capture(ctx, "checker.png")[:, :, :3]
+    light, dark = checker_levels(shot[:32, :32])
     assert light > 0.3 and dark > 0.3, (light, dark, shot[:2, :10, 0])
     row = shot[2, :32, 0].astype(np.int32)
     assert abs(row[:8].mean() - row[8:16].mean()) > 40, row   # the squares alternate every 8 px
@@ -1139,7 +1083,7 @@ def test_transparent_background_shows_a_checkerboard(ctx):
     ctx.item_open("**/Environment")
     ctx.combo_click("background/env")
     ctx.item_close("**/Environment")
-    light, dark = _checker_levels(_capture(ctx, "no_checker.png")[:32, :32, :3])
+    light, dark = checker_levels(capture(ctx, "no_checker.png")[:32, :32, :3])
     assert light + dark < 0.5, (light, dark)
 
 

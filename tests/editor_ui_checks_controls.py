@@ -18,30 +18,19 @@ separate program the engine cannot reach).
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from alight.frontends.editor.ui_test import editor, view
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import ball, capture, changed, contrast  # noqa: E402
+
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # the run's folder (the editor's cwd too)
 SHARED = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..", "shared", "data")
 BROWSER = "###file browser"   # the built-in browser's window (its title changes, its ID does not)
-
-
-def ball(image: np.ndarray) -> np.ndarray:
-    """Pixels well inside the ball (it fills the middle of the view)."""
-    h, w = image.shape[:2]
-    y, x = np.mgrid[0:h, 0:w]
-    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2].astype(np.float64)
-
-
-def contrast(image: np.ndarray) -> float:
-    """Mean horizontal luminance step inside the ball: high for a sharp reflection, low for a blur."""
-    lum = image.astype(np.float64).mean(axis=2)
-    step = np.zeros_like(lum)
-    step[:, 1:] = np.abs(np.diff(lum, axis=1))
-    return float(ball(step[:, :, None]).mean())
 
 
 def _png(path: str, rgb) -> str:
@@ -50,16 +39,6 @@ def _png(path: str, rgb) -> str:
     os.makedirs(os.path.dirname(path), exist_ok=True)
     Image.fromarray(np.full((8, 8, 3), rgb, np.uint8)).save(path)
     return path
-
-
-def _capture(ctx, name: str) -> np.ndarray:
-    """The window as shown (panel and view), captured by the engine: uint8 (h, w, 4)."""
-    import OpenImageIO as oiio
-    from imgui_bundle.immapp.testing import capture
-
-    path = os.path.join(OUT, name)
-    capture(ctx, path)
-    return oiio.ImageBuf(path).get_pixels(oiio.UINT8)
 
 
 def _view_of(shot: np.ndarray) -> np.ndarray:
@@ -226,11 +205,11 @@ def test_render_scale_and_anti_aliasing_in_the_window(ctx):
     ctx.item_open("**/Display & camera")
     ctx.item_click("**/frame mesh (F)")
     ctx.yield_(3)
-    full = _view_of(_capture(ctx, "scale_full.png"))
+    full = _view_of(capture(ctx, "scale_full.png"))
     ctx.item_input_value("**/render scale", 0.25)
     assert s.render_scale == 0.25
     ctx.yield_(3)
-    quarter = _view_of(_capture(ctx, "scale_quarter.png"))
+    quarter = _view_of(capture(ctx, "scale_quarter.png"))
     # A quarter of the pixels a side, stretched: the ball's edge turns to steps, the highlights blur
     # (1448 pixels off by more than 8 levels in an 800x720 view in one run; a smooth ball in the
     # studio differs little elsewhere).
@@ -238,13 +217,13 @@ def test_render_scale_and_anti_aliasing_in_the_window(ctx):
     assert stepped > 500, stepped
     ctx.item_input_value("**/render scale", 1.0)
     ctx.yield_(3)
-    again = _view_of(_capture(ctx, "scale_again.png"))
+    again = _view_of(capture(ctx, "scale_again.png"))
     assert np.abs(again - full).max() <= 2, np.abs(again - full).max()
     # MSAA smooths the ball's silhouette against the flat background: edge pixels change.
     ctx.combo_click("anti-aliasing/msaa")
     assert s.aa == "msaa"
     ctx.yield_(3)
-    smooth = _view_of(_capture(ctx, "aa_msaa.png"))
+    smooth = _view_of(capture(ctx, "aa_msaa.png"))
     moved = (np.abs(smooth - full).max(axis=2) > 8).sum()
     assert moved > 30, moved
     ctx.combo_click("anti-aliasing/none")
@@ -322,11 +301,6 @@ def test_restore_puts_a_removed_light_back(ctx):
 def test_iridescence_ior_and_attenuation_distance(ctx):
     s = editor().state
 
-    def changed(before, what):
-        after = view(ctx).astype(np.float64)
-        assert np.abs(ball(after) - ball(before)).mean() > 0.3, what
-        return after
-
     ctx.set_ref("alight")
     ctx.item_click("**/copper")
     ctx.item_input_value("**/roughness", 0.3)
@@ -335,7 +309,7 @@ def test_iridescence_ior_and_attenuation_distance(ctx):
     image = view(ctx).astype(np.float64)
     ctx.item_input_value("**/iridescence ior", 2.0)
     assert s.material.iridescence_ior == 2.0, s.material
-    changed(image, "iridescence ior")
+    changed(ctx, image, "iridescence ior")
     ctx.item_close("**/###layer_iridescence")
     ctx.item_click("**/plastic_high")
     for c in "XYZ":
@@ -350,6 +324,6 @@ def test_iridescence_ior_and_attenuation_distance(ctx):
     image = view(ctx).astype(np.float64)
     ctx.item_input_value("**/attenuation distance", 0.05)   # a twentieth of the way: far deeper colour
     assert s.material.attenuation_distance == np.float32(0.05), s.material
-    changed(image, "attenuation distance")
+    changed(ctx, image, "attenuation distance")
     ctx.item_close("**/###layer_volume")
     ctx.item_click("**/revert")

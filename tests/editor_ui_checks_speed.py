@@ -9,9 +9,15 @@ at the window's size (and waits for a reference sum, and compiles what it needs)
 
 from __future__ import annotations
 
+import os
+import sys
+
 import numpy as np
 
 from alight.frontends.editor.ui_test import editor, on_main_thread
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import ball  # noqa: E402
 
 FRAMES = 6000   # frames a check waits for the child process at most (minutes on a loaded llvmpipe)
 
@@ -27,12 +33,6 @@ def shown(ctx) -> np.ndarray:
         return np.frombuffer(tex.read(), np.uint8).reshape(h, w, -1)[::-1, :, :3].copy()
 
     return on_main_thread(ctx, read)
-
-
-def ball(image: np.ndarray) -> np.ndarray:
-    h, w = image.shape[:2]
-    y, x = np.mgrid[0:h, 0:w]
-    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2].astype(np.float64)
 
 
 def same(a: np.ndarray, b: np.ndarray) -> int:

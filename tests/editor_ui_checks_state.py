@@ -13,21 +13,18 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 
 import numpy as np
 
 from alight.frontends.editor.ui_test import editor, on_main_thread, view
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import ball  # noqa: E402
+
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where the files these checks write go
 ERROR_RGB = (255, 89, 77)      # panel.ERROR_RGBA in 8 bits
 MESSAGE_RGB = (115, 217, 115)  # panel.MESSAGE_RGBA in 8 bits
-
-
-def ball(image: np.ndarray) -> np.ndarray:
-    """Pixels well inside the ball (it fills the middle of the view)."""
-    h, w = image.shape[:2]
-    y, x = np.mgrid[0:h, 0:w]
-    return image[(x - w / 2) ** 2 + (y - h / 2) ** 2 < (0.2 * h) ** 2].astype(np.float64)
 
 
 def key(name: str):

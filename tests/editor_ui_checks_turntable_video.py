@@ -6,8 +6,12 @@ tests/test_editor_ui_turntable_video.py as ``alight edit --new --ui-test tests/e
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import screenshot, until  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
 # Frame 0 of the MP4 (H.264, yuv420p, CRF 18) against the F12 screenshot of the same view, in
@@ -15,28 +19,6 @@ OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the p
 # view (two runs alike); frame 1, 60 degrees on, is mean 18.1, max 194 from it. Bounded with room.
 MP4_MEAN_LEVELS = 3.0
 MP4_MAX_LEVELS = 64
-
-
-def _until(ctx, done, frames: int = 6000) -> None:
-    for _ in range(frames):
-        ctx.yield_()
-        if done():
-            return
-    raise AssertionError("timed out")
-
-
-def _screenshot(ctx) -> np.ndarray:
-    import OpenImageIO as oiio
-
-    from alight.frontends.editor.ui_test import editor
-
-    names = set(os.listdir("."))
-    ctx.set_ref("alight")
-    ctx.item_click("**/screenshot (F12)")
-    new = []
-    _until(ctx, lambda: editor().screenshot_job is None and
-           bool(new.extend(n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")) or new))
-    return oiio.ImageBuf(new[0]).get_pixels(oiio.UINT8)
 
 
 def test_turntable_file_ending_mp4_writes_an_h264_video(ctx):
@@ -54,9 +36,9 @@ def test_turntable_file_ending_mp4_writes_an_h264_video(ctx):
     ctx.item_open("**/Display & camera")
     ctx.item_input_value("**/turntable frames", 6)
     ctx.item_input_value("**/turntable file", path)
-    still = _screenshot(ctx)
+    still = screenshot(ctx)
     ctx.item_click("**/turntable (T)")
-    _until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
+    until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
     m = win.state.message   # (a long path is shortened in the middle)
     assert m.startswith("wrote ") and "spin.mp4 (6 frames" in m, (m, win.state.error)
     reader = iio.get_reader(path, format="FFMPEG")
@@ -102,12 +84,12 @@ def test_an_mp4_over_a_transparent_background_says_it_has_no_alpha(ctx):
     ctx.item_input_value("**/turntable frames", 2)
     ctx.item_input_value("**/turntable file", path)
     ctx.item_click("**/turntable (T)")
-    _until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
+    until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
     m = win.state.message
     assert "spin_clear.mp4 (2 frames" in m and "has no alpha" in m, (m, win.state.error)
     ctx.item_input_value("**/turntable file", os.path.join(OUT, "spin_clear.webp"))
     ctx.item_click("**/turntable (T)")
-    _until(ctx, lambda: win.turntable_job is None and os.path.isfile(os.path.join(OUT, "spin_clear.webp")))
+    until(ctx, lambda: win.turntable_job is None and os.path.isfile(os.path.join(OUT, "spin_clear.webp")))
     assert "no alpha" not in win.state.message, win.state.message
     ctx.item_close("**/Display & camera")
     ctx.item_open("**/Environment")

@@ -9,6 +9,7 @@ on the session this run saved) the turntable's settings and the anti-aliasing re
 from __future__ import annotations
 
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -16,38 +17,14 @@ import numpy as np
 
 from alight.frontends.editor.ui_test import editor
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import capture, checker_levels, until  # noqa: E402
+
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
 BAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "bad"   # ../shared/data/bad
 SPIN_FRAMES = 36
 LAST_FRAMES, LAST_FILE = 5, "again.webp"   # what the last check leaves for the reopened editor
 LAST_PRESET, LAST_GLTF = "kept_preset.json", "kept_export.glb"   # the path fields it leaves
-
-
-def _capture(ctx, name: str) -> np.ndarray:
-    """The whole window as the engine captures it (panel and view, as shown): uint8 (h, w, 4)."""
-    import OpenImageIO as oiio
-    from imgui_bundle.immapp.testing import capture
-
-    path = os.path.join(OUT, name)
-    capture(ctx, path)
-    return oiio.ImageBuf(path).get_pixels(oiio.UINT8)
-
-
-def _checker_levels(corner: np.ndarray) -> tuple[float, float]:
-    """The fractions of a corner's pixels at the checkerboard's light and dark grey (204, 153)."""
-    v = corner.astype(np.int32)
-    grey = (v.max(axis=2) - v.min(axis=2)) <= 2
-    light = (grey & (np.abs(v[:, :, 0] - 204) <= 2)).mean()
-    dark = (grey & (np.abs(v[:, :, 0] - 153) <= 2)).mean()
-    return float(light), float(dark)
-
-
-def _until(ctx, done, frames: int = 6000) -> None:
-    for _ in range(frames):
-        ctx.yield_()
-        if done():
-            return
-    raise AssertionError("timed out")
 
 
 def test_msaa_over_a_transparent_background_shows_the_checkerboard(ctx):
@@ -66,8 +43,8 @@ def test_msaa_over_a_transparent_background_shows_the_checkerboard(ctx):
         assert win.state.aa == aa
         ctx.mouse_click_on_void()
         ctx.yield_(3)
-        shot = _capture(ctx, f"checker_{aa}.png")[:, :, :3]
-        levels[aa] = _checker_levels(shot[:32, :32])
+        shot = capture(ctx, f"checker_{aa}.png")[:, :, :3]
+        levels[aa] = checker_levels(shot[:32, :32])
         w, h = win.view_area()
         middle = shot[h // 2 - 4:h // 2 + 4, w // 2 - 4:w // 2 + 4].astype(np.float64).mean(axis=(0, 1))
         assert middle[0] > middle[2] + 30, (aa, middle)   # the gold ball, opaque over the squares
@@ -180,7 +157,7 @@ def test_leave_turntable_settings_and_msaa_for_the_next_session(ctx):
     ctx.item_click("**/save preset")
     ctx.item_input_value("**/glTF file", os.path.join(OUT, LAST_GLTF))
     ctx.item_click("**/export glTF")
-    _until(ctx, lambda: os.path.isfile(os.path.join(OUT, LAST_PRESET)) and os.path.isfile(os.path.join(OUT, LAST_GLTF)))
+    until(ctx, lambda: os.path.isfile(os.path.join(OUT, LAST_PRESET)) and os.path.isfile(os.path.join(OUT, LAST_GLTF)))
 
 
 def reopened_turntable_and_aa_are_restored(ctx):
@@ -196,7 +173,7 @@ def reopened_turntable_and_aa_are_restored(ctx):
     ctx.set_ref("alight")
     ctx.item_open("**/Display & camera")
     ctx.item_click("**/turntable (T)")
-    _until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
+    until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
     with Image.open(path) as im:
         assert im.n_frames == LAST_FRAMES, im.n_frames
     ctx.item_close("**/Display & camera")
@@ -205,5 +182,5 @@ def reopened_turntable_and_aa_are_restored(ctx):
         kept = os.path.join(OUT, name)
         os.remove(kept)
         ctx.item_click(f"**/{button}")
-        _until(ctx, lambda: os.path.isfile(kept))
+        until(ctx, lambda: os.path.isfile(kept))
         assert not win.state.error, win.state.error

@@ -18,6 +18,9 @@ import time
 
 import numpy as np
 
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import screenshot, until  # noqa: E402
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
 
 
@@ -208,28 +211,6 @@ def test_lights_turn_with_the_environment_when_the_box_is_on(ctx):
 
 # --- turntables ------------------------------------------------------------------------------------
 
-def _until(ctx, done, frames: int = 6000) -> None:
-    for _ in range(frames):
-        ctx.yield_()
-        if done():
-            return
-    raise AssertionError("timed out")
-
-
-def _screenshot(ctx) -> np.ndarray:
-    import OpenImageIO as oiio
-
-    from alight.frontends.editor.ui_test import editor
-
-    names = set(os.listdir("."))
-    ctx.set_ref("alight")
-    ctx.item_click("**/screenshot (F12)")
-    new = []
-    _until(ctx, lambda: editor().screenshot_job is None and
-           bool(new.extend(n for n in set(os.listdir(".")) - names if n.startswith("alight-screenshot-")) or new))
-    return oiio.ImageBuf(new[0]).get_pixels(oiio.UINT8)
-
-
 def test_turntable_button_writes_an_animated_webp(ctx):
     """The button writes N frames at the view's size; frame 0 is the screenshot of the view;
     the frames differ (the camera orbits); the panel says where."""
@@ -244,9 +225,9 @@ def test_turntable_button_writes_an_animated_webp(ctx):
     ctx.item_open("**/Display & camera")
     ctx.item_input_value("**/turntable frames", 6)
     ctx.item_input_value("**/turntable file", path)
-    still = _screenshot(ctx)
+    still = screenshot(ctx)
     ctx.item_click("**/turntable (T)")
-    _until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
+    until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
     assert win.state.message.startswith(f"wrote {path} (6 frames"), (win.state.message, win.state.error)
     with Image.open(path) as im:
         assert im.n_frames == 6, im.n_frames
@@ -278,7 +259,7 @@ def test_turntable_key_writes_numbered_pngs(ctx):
     ctx.mouse_click_on_void()
     ctx.key_press(imgui.Key.t)
     ctx.yield_(2)
-    _until(ctx, lambda: win.turntable_job is None)
+    until(ctx, lambda: win.turntable_job is None)
     names = sorted(n for n in os.listdir(OUT) if n.startswith("spin_"))
     assert names == [f"spin_{i:03d}.png" for i in range(4)], (names, win.state.error)
     frames = [oiio.ImageBuf(os.path.join(OUT, n)).get_pixels(oiio.UINT8).astype(np.float64) for n in names]
