@@ -446,9 +446,13 @@ def ibl_converged(model: str, radiance, normals, view, base_color, metallic, rou
     elif model == "stretched":
         from alight.core.stretched_lobe import stretched_fetches
 
+        from alight.core.stretched_lobe import blend_weight
+
         d_lo, d_hi, w_hi, fetch_r = stretched_fetches(n, v, direction, f0, A[:, 0], B[:, 0], r)
-        prefiltered = ((1.0 - w_hi)[:, None] * prefiltered_converged_each(lighting, d_lo, fetch_r)
-                       + w_hi[:, None] * prefiltered_converged_each(lighting, d_hi, fetch_r))
+        two = ((1.0 - w_hi)[:, None] * prefiltered_converged_each(lighting, d_lo, fetch_r)
+               + w_hi[:, None] * prefiltered_converged_each(lighting, d_hi, fetch_r))
+        share = float(blend_weight(r))
+        prefiltered = two if share >= 1.0 else (1.0 - share) * prefiltered_converged(lighting, direction, r) + share * two
     else:
         prefiltered = prefiltered_converged(lighting, direction, r)
     if material is not None and "transmission" in material.layers():

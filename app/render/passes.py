@@ -51,6 +51,7 @@ from alight.render.variants import (
     material_defines,
     part_defines,
     part_material,
+    stretched_span_defines,
     transmissive_parts,
     user_maps_present,
 )
@@ -287,7 +288,7 @@ def draw_background(r, frame: FrameContext, scene, maps: IBLMaps | None, inverse
 def draw_probe(r, scene, maps: IBLMaps | None, size: int, origin: tuple[int, int] = (0, 0)) -> None:
     """The probe view (render/probe.frag): the material on the unit sphere, per pixel centre."""
     defines = {**ibl_defines(scene), **r._below_grid_defines(scene, maps, [scene.material]),
-               **material_defines([scene.material])}
+               **stretched_span_defines(scene, [scene.material]), **material_defines([scene.material])}
     prog = r.program("render/fullscreen.vert", "render/probe.frag", defines)
     prog["u_size"] = float(size)
     set_uniform(prog, "u_pixel_origin", tuple(float(x) for x in origin))
@@ -316,7 +317,9 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     for gpu_part, part in parts:
         any_maps |= part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
     # (through the renderer, where a test replaces it)
-    defines.update(r._below_grid_defines(scene, maps, [part_material(scene, part)[0] for _, part in parts], any_maps))
+    materials = [part_material(scene, part)[0] for _, part in parts]
+    defines.update(r._below_grid_defines(scene, maps, materials, any_maps))
+    defines.update(stretched_span_defines(scene, materials, any_maps))
     if scene.debug_view:
         defines["DEBUG_VIEW"] = None
     if frame.shadowed:

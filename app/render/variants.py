@@ -7,6 +7,8 @@ materials the renderer draws."""
 
 from __future__ import annotations
 
+import math
+
 import dataclasses
 from dataclasses import replace
 
@@ -132,6 +134,11 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
 def ibl_defines(scene) -> dict:
     """The shader defines that pick the scene's IBL model (app/core/ibl_models.py)."""
     defines = {"IBL_MODEL": int(glsl_member(IblModel, scene.ibl_model))}
+    if scene.ibl_model == "stretched":
+        from alight.core.stretched_lobe import ROUGHNESS_FULL, ROUGHNESS_START
+
+        defines["STRETCHED_ROUGHNESS_START"] = f"{ROUGHNESS_START:.6f}"
+        defines["STRETCHED_ROUGHNESS_FULL"] = f"{ROUGHNESS_FULL:.6f}"
     if scene.multiple_scattering:
         defines["MULTIPLE_SCATTERING"] = None
     return defines
@@ -166,7 +173,12 @@ def below_grid_defines(scene, maps: IBLMaps | None, materials, map_mask: int = 0
         return {}
     first_step = grid_roughness(0, maps.quality.prefiltered_levels)
     if scene.ibl_model == "stretched":
-        return {}   # its fetches' roughness is the material's times a fitted factor below 1
+        from alight.core.stretched_lobe import ROUGHNESS_START, lobe_table
+
+        # its two fetches, taken from ROUGHNESS_START up, read at the material's roughness times
+        # sqrt(beta) (a fitted factor below 1): their lowest must be on the grid too
+        if ROUGHNESS_START * math.sqrt(float(lobe_table()[..., 3].min())) < first_step:
+            return {}
     for m in materials:
         if m.layers() - {"clearcoat"}:
             # sheen, anisotropy and transmission read the prefiltered maps at a roughness of
@@ -179,6 +191,28 @@ def below_grid_defines(scene, maps: IBLMaps | None, materials, map_mask: int = 0
             if f.name in used and f.name.endswith("roughness") and float(getattr(m, f.name)) < first_step:
                 return {}
     return {"IBL_BELOW_GRID": 0}
+
+
+def stretched_span_defines(scene, materials, map_mask: int = 0) -> dict:
+    """The `stretched` model's STRETCHED_SPAN (ibl.glsl): 0 where every roughness the pass shades
+    is at or below ROUGHNESS_START (the single round fetch only), 2 where all are at or above
+    ROUGHNESS_FULL (the two fitted fetches only), else nothing (1: both, blended). llvmpipe runs
+    both sides of a branch, so the blend's three fetches cost every pixel unless compiled out
+    (1.5x the built-in sphere's frame)."""
+    if scene.ibl_model != "stretched":
+        return {}
+    from alight.core.stretched_lobe import ROUGHNESS_FULL, ROUGHNESS_START
+
+    unsafe = {name for i, name in enumerate(MATERIAL_MAPS) if map_mask & (1 << i)} - ROUGHNESS_FREE_MAPS
+    if unsafe or map_mask >> len(MATERIAL_MAPS) or not materials:
+        return {}
+    # the base layer's roughness only: the layers' own lobes fetch at their roughness directly
+    rough = [float(m.roughness) for m in materials]
+    if max(rough) <= ROUGHNESS_START:
+        return {"STRETCHED_SPAN": 0}
+    if min(rough) >= ROUGHNESS_FULL:
+        return {"STRETCHED_SPAN": 2}
+    return {}
 
 
 def background_mode(scene, maps: IBLMaps | None) -> BackgroundMode:

@@ -141,12 +141,34 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
 // second weighted w_hi, both at roughness r sqrt(beta). tools/fit_stretched_lobe.py fits them in
 // lobe space (no environment map): the real lobe is narrower across the plane of incidence than
 // the round one the prefiltered map holds, and reaches further toward n.
+// Below STRETCHED_ROUGHNESS_START the two narrow fetches draw a compact bright feature of the map
+// twice (a ghost arc on a flat floor under royal_esplanade at r 0.3: 22% against the single
+// fetch's 2%), so the lobe is the single round fetch there and blends into the two fetches by
+// STRETCHED_ROUGHNESS_FULL (benchmarks/results/oblique_ibl.md). Both come from
+// app/core/stretched_lobe.py (ROUGHNESS_START, ROUGHNESS_FULL) through app/render/variants.py.
+#ifndef STRETCHED_ROUGHNESS_START
+#define STRETCHED_ROUGHNESS_START 0.3
+#define STRETCHED_ROUGHNESS_FULL 0.5
+#endif
+// STRETCHED_SPAN (app/render/variants.py stretched_span_defines): 0 the single fetch only (every
+// roughness at or below the start), 2 the two fetches only (all at or above the full), 1 both.
+#ifndef STRETCHED_SPAN
+#define STRETCHED_SPAN 1
+#endif
 uniform sampler2D u_stretched_lobe_a;
 uniform sampler2D u_stretched_lobe_b;
 
 // The prefiltered radiance for the real lobe around its mean direction d: the two fitted
 // fetches, the parts' fits mixed by their weights as specular_dominant_direction mixes t_A, t_B.
 vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float roughness, vec3 d, bool with_suns) {
+#if STRETCHED_SPAN == 0
+    return prefiltered_radiance_at(d, roughness, with_suns);
+#else
+#if STRETCHED_SPAN == 1
+    float weight = smoothstep(STRETCHED_ROUGHNESS_START, STRETCHED_ROUGHNESS_FULL, roughness);
+    vec3 single = weight < 1.0 ? prefiltered_radiance_at(d, roughness, with_suns) : vec3(0.0);
+    if (weight <= 0.0) return single;
+#endif
     vec2 coord = vec2(max(dot(n, v), 0.0), roughness);
     float weight_a = dot(f0, vec3(0.2126, 0.7152, 0.0722)) * lut.x;
     vec4 fit = (weight_a * texture(u_stretched_lobe_a, coord) + lut.y * texture(u_stretched_lobe_b, coord))
@@ -156,8 +178,14 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
     float fetch_roughness = roughness * sqrt(fit.w);
     vec3 d_lo = cos(fit.x) * d + sin(fit.x) * toward_horizon;
     vec3 d_hi = cos(fit.y) * d + sin(fit.y) * toward_horizon;
-    return mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
-               prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
+    vec3 stretched = mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
+                         prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
+#if STRETCHED_SPAN == 1
+    return mix(single, stretched, weight);
+#else
+    return stretched;
+#endif
+#endif
 }
 #endif
 
