@@ -32,6 +32,10 @@ across them (``bake_visibility``), every attribute interpolated linearly, which 
 anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached like the
 IBL bake (alight.render.visibility_parts.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
+The visible sky weight (app/core/sky_weight.py) is a pass of its own after the bake, per
+environment: the share of the environment's *light* each vertex sees, per channel, which the
+shader takes in place of V's share of directions for the diffuse term (HAS_SKY_WEIGHT).
+
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
 ``cone_blend``, ``suns_on_occluders`` and ``occluded_environment`` here (tests/test_occlusion.py,
