@@ -1,4 +1,4 @@
-"""The visible sky weight (alight.core.sky_weight, issue 18): the share of the environment's light
+"""The visible sky weight (alight.core.sky_weight): the share of the environment's light
 a vertex sees, per channel, in place of the share of directions V. Its numpy twin against a
 brute-force integral beside a wall under a half-lit sky, W = V under a uniform sky, the shader's
 term against its twin, the bowl under newport_loft against the path tracer with and without it,
