@@ -1,9 +1,11 @@
 """What --occlusion costs a frame: DamagedHelmet (the grey material of bench_occlusion.py), 256x256,
 quarry_01 (a map with a sun: its shadow map and the bake's sun pass both at work), the medium
-bake; frames alternated in one run: occlusion off, on without the suns' light on the occluders
-(OcclusionParts.sun_bounce off: the render before the sun pass), and on as now. Wall time and
+bake; frames alternated in one run: occlusion off, on without the visible sky weight
+(OcclusionParts.sky_weight off: the render before it, app/core/sky_weight.py), and on as now
+(sun pass and sky weight). Wall time and
 this process's CPU time (llvmpipe's threads included: steadier than the wall clock on a shared
-machine), medians and ranges; the refined meshes' sizes; the sun pass's own time.
+machine), medians and ranges; the refined meshes' sizes; the sun pass's and the sky weight's own
+times (its rays, and the weight from them).
 
     .venv/bin/python benchmarks/bench_occlusion_cost.py [--rounds 9] [--size 256] [--env NAME]
 """
@@ -47,13 +49,13 @@ def main(argv=None) -> int:
     r.visibility_parts.cache = None
     maps = r.bake(env, "medium")
     conditions = {}
-    for name, sun_bounce in (("off", True), ("on, no sun pass", False), ("on (now)", True)):
+    for name, weight in (("off", True), ("on, no sky weight", False), ("on (now)", True)):
         copy = dataclasses.replace(mesh, parts=[dataclasses.replace(p) for p in mesh.parts])
         scene = scene_for(copy, "helmet", size, "off" if name == "off" else "on")
-        r.visibility_parts.sun_bounce = sun_bounce
+        r.visibility_parts.sky_weight = weight
         r.render(scene, maps, size, size)          # the bake (if any), programs compiled
         r.render(scene, maps, size, size)
-        conditions[name] = (copy, scene, sun_bounce)
+        conditions[name] = (copy, scene, weight)
     from alight.render.bindings import sun_world_directions
 
     baked_now = r.visibility_parts._parts[id(conditions["on (now)"][0])][3]
@@ -63,12 +65,25 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         vis.bake_sun_bounce(baked_now.parts, directions)
         sun_seconds.append(time.perf_counter() - t0)
+    from alight.core import sky_weight as sw
+    from alight.render.visibility_parts import environment_texels
+
+    texels, _ = environment_texels(r.shaders, maps)
+    ray_seconds, weight_seconds = [], []
+    for _ in range(2):
+        t0 = time.perf_counter()
+        rays = sw.sky_rays(baked_now.parts, vis.DEFAULT_RAYS)
+        ray_seconds.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        for (free, angle), p in zip(rays, baked_now.parts):
+            sw.sky_weight(free, angle, p.normals, p.indices.reshape(-1, 3), texels, 0.0)
+        weight_seconds.append(time.perf_counter() - t0)
     baked = {name: _refined_triangles(r, copy) for name, (copy, _, _) in conditions.items()}
     wall = {n: [] for n in conditions}
     cpu = {n: [] for n in conditions}
     for _ in range(args.rounds):
-        for name, (_, scene, sun_bounce) in conditions.items():
-            r.visibility_parts.sun_bounce = sun_bounce
+        for name, (_, scene, weight) in conditions.items():
+            r.visibility_parts.sky_weight = weight
             t0, c0 = time.perf_counter(), time.process_time()
             r.render(scene, maps, size, size)
             wall[name].append(time.perf_counter() - t0)
@@ -84,6 +99,8 @@ def main(argv=None) -> int:
               f"{np.median(c) / np.median(np.array(cpu['off']) * 1e3):.2f} |")
     print(f"the sun pass ({len(directions)} sun, {sum(len(p.positions) for p in baked_now.parts)} vertices): "
           f"{sun_seconds[0]:.2f} s, {sun_seconds[1]:.2f} s")
+    print(f"the sky weight: its rays ({vis.DEFAULT_RAYS} a vertex) {ray_seconds[0]:.2f} s, {ray_seconds[1]:.2f} s; "
+          f"the weight from them {weight_seconds[0]:.2f} s, {weight_seconds[1]:.2f} s")
     return 0
 
 

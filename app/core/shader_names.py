@@ -133,6 +133,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "HAS_SHADOWS": "shadow maps are read for the lights and suns (app/render/shadows.py)",
     "HAS_VISIBILITY": "the visibility bake's per-vertex occlusion, bent normal and bounce are read "
                       "(app/core/visibility.py, common/occlusion.glsl)",
+    "HAS_SKY_WEIGHT": "the visible sky weight of the environment drawn is read with the visibility bake "
+                      "(app/core/sky_weight.py, common/occlusion.glsl)",
     # Views and passes.
     "DEBUG_VIEW": "the editor's debug views are compiled in (u_debug_view picks one)",
     "SPHERE_IMPOSTOR": "the built-in sphere drawn as an impostor with this many samples a pixel",

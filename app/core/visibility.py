@@ -32,6 +32,10 @@ across them (``bake_visibility``), every attribute interpolated linearly, which 
 anyway, so the picture without occlusion is unchanged. Baked once per mesh content and settings and cached like the
 IBL bake (alight.render.visibility_parts.cached_visibility). Convex meshes cannot occlude themselves (``self_occludes``): they pay nothing.
 
+The visible sky weight (app/core/sky_weight.py) is a pass of its own after the bake, per
+environment: the share of the environment's *light* each vertex sees, per channel, which the
+shader takes in place of V's share of directions for the diffuse term (HAS_SKY_WEIGHT).
+
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
 ``cone_blend``, ``suns_on_occluders`` and ``occluded_environment`` here (tests/test_occlusion.py,
@@ -177,8 +181,10 @@ def combined_visibility(visibility, occlusion_texture):
     """The diffuse visibility with a glTF occlusion texture: the smaller of the two. Both estimate
     the same quantity for the same geometry (the texture is this mesh's own baked AO), so
     multiplying would darken a crease twice; the minimum keeps the texture's finer detail where it
-    is darker and the ray-traced value where the texture misses an occluder (another part)."""
-    return np.minimum(np.asarray(visibility, np.float64), np.asarray(occlusion_texture, np.float64))
+    is darker and the ray-traced value where the texture misses an occluder (another part).
+    Clamped to [0, 1]: the texture's strength, 1 + strength (texel - 1), goes below 0 past 1."""
+    return np.clip(np.minimum(np.asarray(visibility, np.float64), np.asarray(occlusion_texture, np.float64)),
+                   0.0, 1.0)
 
 
 def occluder_visibility(bounce_weight, baked_visibility):
@@ -212,7 +218,8 @@ def suns_on_occluders(hit_albedo, hit_visibility, first, second):
 
 
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
-                         hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None):
+                         hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None,
+                         sky=None):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
     and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
@@ -221,7 +228,10 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     ``sun_second`` (N, 3) (sum_k P_k B1_k and B2_k of bake_sun_bounce), ``suns_on_occluders``.
     ``cone_radiance`` (N, 3): the prefiltered radiance at the bent normal and ``cone_roughness``
     (default: irradiance_bent, as a uniform environment has it); what V multiplies is its mix with
-    E(bent)/pi by ``cone_blend`` (occlusion.glsl's visible_cone_radiance)."""
+    E(bent)/pi by ``cone_blend`` (occlusion.glsl's visible_cone_radiance). ``sky``: (W (N, 3),
+    the rays' V (N,), E/pi at the shading normal (N, 3)) of the visible sky weight
+    (HAS_SKY_WEIGHT, app/core/sky_weight.py): the visible part is then
+    sky_visibility(V, W, V_rays) E(n)/pi instead of V times the cone's radiance."""
     v = np.asarray(visibility, np.float64)[..., None]
     albedo = np.minimum(hit_albedo, 1.0)
     hit_visibility = occluder_visibility(bounce_weight, baked_visibility)
@@ -233,7 +243,14 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     cone = bent if cone_radiance is None else np.asarray(cone_radiance, np.float64)
     blend = cone_blend(visibility)[..., None]
     visible = cone + (bent - cone) * blend
-    return v * visible + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
+    if sky is not None:
+        from alight.core.sky_weight import sky_visibility
+
+        w, ray_visibility, irradiance_n = sky
+        diffuse = sky_visibility(visibility, w, ray_visibility) * np.asarray(irradiance_n, np.float64)
+    else:
+        diffuse = v * visible
+    return diffuse + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
 
 
 # ---- which meshes need it -----------------------------------------------------------------------

@@ -123,6 +123,7 @@ class GpuPart:
         # bake's values (alight.render.visibility_parts: HAS_VISIBILITY).
         self.extra_buffers: list[tuple] = []
         self.has_visibility = False
+        self.has_sky_weight = False     # ... and the visible sky weight (HAS_SKY_WEIGHT)
         # A vertex array belongs to one program: one per program this part is drawn with (the
         # shaded pass, a debug view), made on first use.
         self._vaos: dict[int, moderngl.VertexArray] = {}

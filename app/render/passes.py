@@ -38,7 +38,7 @@ from alight.render import vbuffer
 from alight.render.part_bindings import _bind_view, bind_part, set_culling
 from alight.render.ground import GroundPass
 from alight.render.shadows import casters as shadow_casters
-from alight.render.visibility_parts import light_through
+from alight.render.visibility_parts import environment_texels, light_through
 from alight.render.sphere_impostor import impostor_placement, lod_parts, proxy_part
 from alight.render.targets import Targets, View, read_tile
 from alight.render.tiles import TilePlan, tile_matrix, tile_origin
@@ -77,6 +77,7 @@ class FrameContext:
     inverse_vp: np.ndarray | None = None        # its inverse: the background's rays
     image_size: tuple[int, int] = (0, 0)        # the targets' output size (width, height)
     sun_directions: np.ndarray | None = None    # (K, 3) world: the compact sources (the bake's sun bounce)
+    maps: IBLMaps | None = None                 # the environment drawn (the bake's visible sky weight)
 
 
 # --- a frame: the passes for each anti-aliasing mode, tile by tile -------------------------
@@ -132,7 +133,8 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
     ctx = r.ctx
     frame = FrameContext(display=display, srgb_by_framebuffer=srgb_by_framebuffer,
                          half_output=targets.half and fbo is targets.draw,
-                         image_size=(targets.width, targets.height), sun_directions=sun_world_directions(scene, maps))
+                         image_size=(targets.width, targets.height), sun_directions=sun_world_directions(scene, maps),
+                         maps=maps)
     width, height = targets.draw_size
     scale = width // targets.width      # SSAA draws 2x2 sub-pixels per output pixel
     view = view or View(targets.width, targets.height)
@@ -399,7 +401,7 @@ def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_pr
         model = np.ascontiguousarray(proxy_model.T, dtype=np.float32)   # GLSL reads columns
         r.last_sphere_impostor = frame.impostor_samples
     if callable(prog) and sphere_radius is None and proxy_model is None:
-        drawn = occluded_parts(r, scene, drawn, frame.sun_directions)
+        drawn = occluded_parts(r, scene, drawn, frame.sun_directions, frame.maps)
     chosen = None if parts is None else set(parts)
     for index, (gpu_part, part) in enumerate(zip(drawn, scene.mesh.parts)):
         if (blend is None or blends(scene, part) == blend) and (chosen is None or index in chosen):
@@ -438,14 +440,18 @@ def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_pr
             ctx.depth_mask = True
 
 
-def occluded_parts(r, scene, drawn: list[GpuPart], sun_directions=None) -> list[GpuPart]:
+def occluded_parts(r, scene, drawn: list[GpuPart], sun_directions=None, maps: IBLMaps | None = None) -> list[GpuPart]:
     """The mesh's parts refined and baked with visibility where ``scene.occlusion`` wants them
     (alight.render.visibility_parts), else ``drawn``; ``sun_directions``: (K, 3) world, the
-    compact sources whose light on the occluders the bake adds (None: none)."""
+    compact sources whose light on the occluders the bake adds (None: none); ``maps``: the
+    environment drawn, whose visible sky weight the parts carry (None: none)."""
     textures = r.meshes.textures(scene.mesh)
+    sky = None
+    if maps is not None:
+        sky = (lambda: environment_texels(r.shaders, maps), float(scene.env_rotation_deg))
     return r.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
                                         lambda part: GpuPart(r.ctx, part, textures), light_through(scene),
-                                        sun_directions)
+                                        sun_directions, sky)
 
 
 # --- after the scene pass: resolve, reduce, tone map ------------------------------------

@@ -124,6 +124,8 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
         defines["HAS_VERTEX_COLOR"] = None
     if gpu_part.has_visibility:
         defines["HAS_VISIBILITY"] = None
+        if getattr(gpu_part, "has_sky_weight", False):
+            defines["HAS_SKY_WEIGHT"] = None
     if getattr(gpu_part, "packed", False):
         defines["PACKED_VERTICES"] = None
     defines["MATERIAL_MAPS_MASK"] = map_mask(present & set(MATERIAL_MAPS))

@@ -2,7 +2,10 @@
 and their refined parts on the GPU with the baked values as two more vertex attributes
 (pbr.vert's in_visibility, in_bounce; HAS_VISIBILITY in shaders/common/occlusion.glsl), and the
 suns' light on the occluders (in_sun_bounce: alight.core.visibility.bake_sun_bounce, for the
-environment's compact sources in world space; a new map or rotation reruns that pass only).
+environment's compact sources in world space; a new map or rotation reruns that pass only), and
+the visible sky weight (in_sky_weight: alight.core.sky_weight, HAS_SKY_WEIGHT): its rays cast and
+cached once per bake (``cached_sky_rays``), the weight read along them from the environment drawn
+(``cached_sky_weight``, keyed by the read-back texels and the rotation too).
 
 One ``OcclusionParts`` per renderer keeps, per mesh, the decision (``Scene.occlusion``: 'auto'
 bakes where the mean occlusion of the surface, ``occlusion_statistic``, is above
@@ -14,8 +17,11 @@ settings; the sun pass beside it, keyed by the bake's key and the suns' directio
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from alight.core import sky_weight as sw
 from alight.core.visibility import (AUTO_MAX_VERTICES, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
                                     VISIBILITY_FIELDS, MeshVisibility, PartVisibility, auto_too_big, bake_sun_bounce,
                                     bake_visibility, embree_available, refined_mesh_part, sun_bounce_key,
@@ -92,10 +98,55 @@ def cached_sun_bounce(mesh, baked: MeshVisibility, directions, cache=None, rays:
     return values, False
 
 
+def environment_texels(shaders, maps, size: int = sw.SKY_TEXELS) -> tuple[np.ndarray, str]:
+    """The environment's light as the sky weight reads it: the box mip of ``size`` texels a face
+    of the IBL's source cube without its compact sources (``maps.lighting_environment``, else
+    ``maps.environment``: the cube the irradiance map is made from), (6, size, size, 3) float32
+    in map space, and its digest; read back once per ``maps``."""
+    from alight.ibl.bake import read_cube
+
+    kept = getattr(maps, "_sky_texels", None)
+    if kept is not None and kept[0].shape[1] == size:
+        return kept
+    cube = maps.lighting_environment if maps.lighting_environment is not None else maps.environment
+    level = max(0, int(round(math.log2(max(cube.size[0], 1) / size))))
+    texels = np.ascontiguousarray(read_cube(shaders, cube, level)[..., :3], np.float32)
+    kept = (texels, sw.texels_digest(texels))
+    maps._sky_texels = kept
+    return kept
+
+
+def cached_sky_rays(mesh, baked: MeshVisibility, cache=None, rays: int = DEFAULT_RAYS,
+                    edge_fraction: float = DEFAULT_EDGE_FRACTION, max_vertices: int = DEFAULT_MAX_VERTICES,
+                    light_through=None) -> tuple[list[tuple[np.ndarray, np.ndarray]], bool]:
+    """``sky_weight.sky_rays`` of ``baked`` through ``cache`` (``sky_rays_key``): (per part (free
+    (N, R) uint8, angle (N,) float32), whether it came from the cache)."""
+    bake_key, _ = visibility_key(mesh, rays, edge_fraction, max_vertices, light_through)
+    key, description = sw.sky_rays_key(bake_key, rays, light_through)
+    if cache is not None:
+        arrays = cache.load(key, description, "sky rays")
+        if arrays is not None:
+            values = [(arrays.get(f"{i}.free"), arrays.get(f"{i}.angle")) for i in range(len(baked.parts))]
+            if all(f is not None and a is not None and f.shape == (len(p.positions), rays) and a.shape == (len(p.positions),)
+                   for (f, a), p in zip(values, baked.parts)):
+                return [(np.asarray(f, np.uint8), np.asarray(a, np.float32)) for f, a in values], True
+            cache.reject(key, "sky rays", "a part's arrays are missing or of another size")
+    values = sw.sky_rays(baked.parts, rays, light_through=light_through)
+    if cache is not None:
+        arrays = {}
+        for i, (f, a) in enumerate(values):
+            arrays[f"{i}.free"], arrays[f"{i}.angle"] = f, a
+        cache.save(key, encode_entry(description, arrays))
+    return values, False
+
+
 class OcclusionParts:
     """Baked GPU parts per mesh, made on first use; ``cache``: a BakeCache or None.
     Counters: ``bakes_run`` (ray-traced here), ``bakes_loaded`` (from the cache), ``last_seconds``
-    (the last bake's wall time); ``sun_bakes_run``, ``sun_bakes_loaded``: the same for the sun pass."""
+    (the last bake's wall time); ``sun_bakes_run``, ``sun_bakes_loaded``: the same for the sun pass;
+    ``sky_rays_run``, ``sky_rays_loaded`` for the sky weight's rays and ``sky_weights_run``,
+    ``sky_weights_loaded`` for the weight (``last_sky_seconds``: the last weight's wall time, its
+    rays included when they were cast)."""
 
     def __init__(self, ctx, cache=None, rays: int = DEFAULT_RAYS,
                  edge_fraction: float = DEFAULT_EDGE_FRACTION, max_vertices: int = DEFAULT_MAX_VERTICES):
@@ -110,6 +161,12 @@ class OcclusionParts:
         self.sun_bakes_loaded = 0
         self.sun_bounce = True      # False: the occluders see the map without its suns (the benchmarks' before)
         self.last_seconds = 0.0
+        self.sky_weight = True      # False: no visible sky weight (HAS_SKY_WEIGHT off: the benchmarks' before)
+        self.sky_rays_run = 0
+        self.sky_rays_loaded = 0
+        self.sky_weights_run = 0
+        self.sky_weights_loaded = 0
+        self.last_sky_seconds = 0.0
 
     def wanted(self, mesh, mode: str) -> bool:
         """Whether ``mesh`` is drawn with occlusion under ``mode`` (decided once per mesh)."""
@@ -118,12 +175,15 @@ class OcclusionParts:
             entry = self._wanted[(id(mesh), mode)] = (mesh, wants_occlusion(mesh, mode))
         return entry[1]
 
-    def parts_for(self, mesh, mode: str, drawn: list, make_part, through=None, sun_directions=None) -> list:
+    def parts_for(self, mesh, mode: str, drawn: list, make_part, through=None, sun_directions=None, sky=None) -> list:
         """The GPU parts to draw for ``mesh``: its baked ones where it is wanted, else ``drawn``.
         ``make_part(part)`` uploads a MeshPart (alight.render.gpu_mesh.GpuPart, the mesh's
         textures shared); ``through``: the parts' light_through (None: all opaque);
         ``sun_directions``: (K, 3) world directions of the environment's compact sources (None:
-        none), whose light on the occluders is baked (``cached_sun_bounce``) when they change."""
+        none), whose light on the occluders is baked (``cached_sun_bounce``) when they change;
+        ``sky``: (a callable giving the environment's read-back texels and their digest,
+        ``environment_texels``; the rotation in degrees) or None: the parts' visible sky weight,
+        made (``cached_sky_weight``) when they change."""
         if not self.wanted(mesh, mode):
             return drawn
         if mode == "auto" and not embree_available():
@@ -154,9 +214,10 @@ class OcclusionParts:
                 # Written in place when the suns change (the vertex arrays keep the buffer).
                 g.extra_buffers.append((self.ctx.buffer(reserve=len(vis.positions) * 32), "4f 4f", "in_sun_bounce",
                                         "in_sun_bounce2"))
+                g.extra_buffers.append((self.ctx.buffer(reserve=len(vis.positions) * 16), "4f", "in_sky_weight"))
                 g.has_visibility = True
                 gpu.append(g)
-            entry = self._parts[id(mesh)] = [mesh, gpu, through, baked, None]
+            entry = self._parts[id(mesh)] = [mesh, gpu, through, baked, None, None]
         suns = np.zeros((0, 3)) if sun_directions is None or not self.sun_bounce else np.asarray(sun_directions, np.float64).reshape(-1, 3)
         sun_key = tuple(np.round(suns, 5).ravel())
         if entry[4] != sun_key:
@@ -166,9 +227,53 @@ class OcclusionParts:
                 self.sun_bakes_loaded += int(loaded)
                 self.sun_bakes_run += int(not loaded)
             for g, v in zip(entry[1], values):
-                g.extra_buffers[-1][0].write(np.ascontiguousarray(v, np.float32).tobytes())
+                g.extra_buffers[1][0].write(np.ascontiguousarray(v, np.float32).tobytes())
             entry[4] = sun_key
+        if sky is None or not self.sky_weight:
+            for g in entry[1]:       # the buffer keeps the weight of entry[5] for the next frame
+                g.has_sky_weight = False
+        else:
+            texels, digest = sky[0]()
+            sky_key = (digest, round(float(sky[1]) % 360.0, 6))
+            if entry[5] != sky_key:
+                values = self.cached_sky_weight(mesh, entry[3], texels, digest, sky[1], through)
+                for g, v in zip(entry[1], values):
+                    g.extra_buffers[2][0].write(np.ascontiguousarray(v, np.float32).tobytes())
+                entry[5] = sky_key
+            for g in entry[1]:
+                g.has_sky_weight = True
         return entry[1]
+
+    def cached_sky_weight(self, mesh, baked: MeshVisibility, texels, digest: str, rotation_deg: float,
+                          through=None) -> list[np.ndarray]:
+        """Per part (N, 4) float32, the visible sky weight of ``baked`` under the environment
+        ``texels`` (digest ``digest``) turned by ``rotation_deg``, through the cache
+        (``sky_weight_key``): a hit casts nothing and reads no rays; a miss reads the rays from the
+        cache (``cached_sky_rays``; cast on a miss) and weighs them (numpy)."""
+        import time
+
+        bake_key, _ = visibility_key(mesh, self.rays, self.edge_fraction, self.max_vertices, through)
+        key, description = sw.sky_weight_key(bake_key, digest, rotation_deg, self.rays)
+        if self.cache is not None:
+            arrays = self.cache.load(key, description, "sky weight")
+            if arrays is not None:
+                values = [arrays.get(f"{i}.sky_weight") for i in range(len(baked.parts))]
+                if all(v is not None and v.shape == (len(p.positions), 4) for v, p in zip(values, baked.parts)):
+                    self.sky_weights_loaded += 1
+                    return [np.asarray(v, np.float32) for v in values]
+                self.cache.reject(key, "sky weight", "a part's arrays are missing or of another size")
+        start = time.perf_counter()
+        rays, loaded = cached_sky_rays(mesh, baked, self.cache, self.rays, self.edge_fraction, self.max_vertices,
+                                       through)
+        self.sky_rays_loaded += int(loaded)
+        self.sky_rays_run += int(not loaded)
+        values = [sw.sky_weight(free, angle, p.normals, p.indices.reshape(-1, 3), texels, rotation_deg)
+                  for (free, angle), p in zip(rays, baked.parts)]
+        self.last_sky_seconds = time.perf_counter() - start
+        self.sky_weights_run += 1
+        if self.cache is not None:
+            self.cache.save(key, encode_entry(description, {f"{i}.sky_weight": v for i, v in enumerate(values)}))
+        return values
 
     @staticmethod
     def _release(parts) -> None:

@@ -18,6 +18,7 @@ const int TERM_OCCLUDER_VISIBILITY = 4; // (bounce weight, V)
 const int TERM_OCCLUDERS_REFLECTANCE = 5; // (hit albedo rgb, hit visibility)
 const int TERM_SUNS_ON_OCCLUDERS = 6;     // (hit albedo rgb, hit visibility; first = 1, second = 1)
 const int TERM_CONE = 7;                  // (V): cone_roughness, cone_blend
+const int TERM_SKY_VISIBILITY = 8;        // (W r, W g, V_rays, V); W b = (W r + W g) / 2
 
 vec3 polar_direction(float theta, float phi) {
     return vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
@@ -53,6 +54,9 @@ void main() {
         case TERM_CONE:
             o.x = cone_roughness(a.x);
             o.y = cone_blend(a.x);
+            break;
+        case TERM_SKY_VISIBILITY:
+            o.xyz = sky_visibility(a.w, vec3(a.x, a.y, 0.5 * (a.x + a.y)), a.z);
             break;
     }
     u_outputs[i] = o;

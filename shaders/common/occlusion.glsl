@@ -1,8 +1,10 @@
 // Occlusion of the environment light and one diffuse bounce, from the per-vertex visibility bake
 // (app/core/visibility.py; its numpy twins there: cone_aperture_cos, spherical_caps_intersection,
-// specular_occlusion, combined_visibility, occluded_environment). Compiled only with HAS_VISIBILITY, which
-// app/render/visibility_parts.py sets for a mesh that was baked: every other mesh reads the glTF
-// occlusion texture alone, exactly as before.
+// specular_occlusion, combined_visibility, occluded_environment; sky_visibility's in
+// app/core/sky_weight.py). Compiled only with HAS_VISIBILITY, which app/render/visibility_parts.py
+// sets for a mesh that was baked: every other mesh reads the glTF occlusion texture alone,
+// exactly as before. HAS_SKY_WEIGHT (with it): the visible sky weight of the environment drawn
+// (app/core/sky_weight.py) is in the vertices too.
 
 // cos of the visibility cone's half-angle: a cone of half-angle a holds cosine-weighted
 // visibility sin^2 a (Jimenez et al. 2016, "Practical Real-Time Strategies for Accurate Indirect
@@ -99,12 +101,25 @@ vec3 visible_cone_radiance(vec3 bent, float visibility) {
     return mix(cone, irradiance_at(bent, false), cone_blend(visibility));
 }
 
+// The combined visibility V made a per-channel share of the environment's light: the visible sky
+// weight W (per channel: the share of the light the vertex's rays see) over those rays' V, times
+// V, at most 1 (app/core/sky_weight.py). Under a uniform environment W = V_rays: V as before;
+// under newport_loft a bowl's floor sees the dim ceiling, not the bright windows. V where the
+// rays' V is 0.
+vec3 sky_visibility(float visibility, vec3 sky, float ray_visibility) {
+    vec3 ratio = ray_visibility > 1e-4 ? max(sky, vec3(0.0)) / ray_visibility : vec3(1.0);
+    return min(visibility * ratio, vec3(1.0));
+}
+
 #ifdef HAS_VISIBILITY
 in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
 in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
 in vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
 in vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
 in vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
+#ifdef HAS_SKY_WEIGHT
+in vec4 v_sky_weight;   // the visible sky weight W (rgb) and its rays' V (w): app/core/sky_weight.py
+#endif
 
 // sum_k P_k B_k over the suns, for B = v_sun_bounce (second: v_sun_bounce2). Clamped at 0: a
 // multisampled pixel's centre may lie outside its triangle, where the interpolation runs on
@@ -131,9 +146,10 @@ vec3 bent_normal(vec3 n) {
 
 // The diffuse visibility with the glTF occlusion texture (s.occlusion): the smaller of the two,
 // not the product. The texture is this mesh's own baked AO, so the same crease would otherwise
-// be darkened twice; the minimum keeps the texture's finer detail where it is darker.
+// be darkened twice; the minimum keeps the texture's finer detail where it is darker. Clamped to
+// [0, 1]: the texture's strength (1 + strength (texel - 1)) takes it below 0 past strength 1.
 float combined_visibility(Surface s, vec3 n) {
-    return min(baked_side(n) ? v_visibility.w : 1.0, s.occlusion);
+    return clamp(min(baked_side(n) ? v_visibility.w : 1.0, s.occlusion), 0.0, 1.0);
 }
 
 #endif
@@ -166,7 +182,15 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
         occluder += suns_on_occluders(hit_albedo, hit_visibility, suns_weighted(v_sun_bounce),
                                       suns_weighted(v_sun_bounce2));
     }
+#ifdef HAS_SKY_WEIGHT
+    // The visible sky's light: the share W / V_rays of the irradiance at n (the map without its
+    // suns) that the vertex's rays see, per channel (sky_visibility). The occluded share of the
+    // directions, 1 - V, still sees the occluders.
+    vec3 sky = baked ? sky_visibility(visibility, v_sky_weight.rgb, v_sky_weight.w) : vec3(visibility);
+    irradiance = sky * irradiance_at(n, false) + (1.0 - visibility) * occluder;
+#else
     irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
+#endif
     if (with_suns) irradiance += suns_irradiance_over_pi(n);
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
     prefiltered = so * prefiltered + (1.0 - so) * occluder;

@@ -22,6 +22,10 @@ layout(location = 6) in vec4 in_visibility;
 layout(location = 7) in vec4 in_bounce;
 layout(location = 8) in vec4 in_sun_bounce;    // per sun: its E/pi on the occluders over its power
 layout(location = 9) in vec4 in_sun_bounce2;   // ... and what their sunlit occluders pass them
+#ifdef HAS_SKY_WEIGHT
+layout(location = 10) in vec4 in_sky_weight;    // the visible sky weight W (rgb), its rays' V (app/core/sky_weight.py)
+out vec4 v_sky_weight;
+#endif
 out vec4 v_visibility;
 out vec4 v_bounce;
 out vec4 v_sun_bounce;
@@ -64,6 +68,9 @@ void main() {
     v_bounce = vec4(u_normal_matrix * in_bounce.xyz, in_bounce.w);
     v_sun_bounce = in_sun_bounce;
     v_sun_bounce2 = in_sun_bounce2;
+#ifdef HAS_SKY_WEIGHT
+    v_sky_weight = in_sky_weight;
+#endif
     v_baked_normal = v_normal;
 #endif
     gl_Position = u_view_projection * world;
