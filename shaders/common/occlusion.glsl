@@ -100,11 +100,18 @@ vec3 visible_cone_radiance(vec3 bent, float visibility) {
 }
 
 #ifdef HAS_VISIBILITY
-in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
-in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
-in vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
-in vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
-in vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
+#ifdef VBUFFER_SHADING
+// Shaded from the visibility buffer: globals render/vbuffer_shade.frag fills from the bake's
+// per-vertex buffers (the other varyings: common/mesh_material.glsl).
+#define VISIBILITY_IN
+#else
+#define VISIBILITY_IN in
+#endif
+VISIBILITY_IN vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
+VISIBILITY_IN vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
+VISIBILITY_IN vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
+VISIBILITY_IN vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
+VISIBILITY_IN vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
 
 // sum_k P_k B_k over the suns, for B = v_sun_bounce (second: v_sun_bounce2). Clamped at 0: a
 // multisampled pixel's centre may lie outside its triangle, where the interpolation runs on
