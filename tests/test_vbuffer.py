@@ -209,3 +209,34 @@ def test_per_vertex_occlusion():
     # (and the occlusion is there: the picture differs from the helmet's without it well beyond that)
     plain = both(Scene(mesh=load_mesh(str(HELMET))), 192)[0]
     assert rel_mae(forward.linear, plain.linear) > 1e-3
+
+
+def test_tangents_only_where_read(tmp_path):
+    """A part whose material reads no tangent frame (no normal map, no anisotropy) is shaded
+    without its tangents ever being made (common/mesh_material.glsl READS_TANGENT); the helmet's
+    normal-mapped part has them."""
+    from tests.gpu import renderer
+
+    r = renderer()
+    grid = load_mesh(str(_checker_grid(tmp_path, 4)))
+    helmet = load_mesh(str(HELMET))
+    r.mesh_shading = "vbuffer"
+    try:
+        for mesh in (grid, helmet):
+            r.render(Scene(mesh=mesh, camera=CAMERA), _maps(), 64, 64, aa="msaa")
+            assert r.last_vbuffer
+    finally:
+        r.mesh_shading = "forward"
+    assert all(g.tangent_buffer is None for g in r.meshes.parts(grid))
+    assert all(g.tangent_buffer is not None for g in r.meshes.parts(helmet))
+
+
+def test_scissor_rectangle_has_even_corners():
+    """The shading pass's rectangle is made of whole 2x2 blocks, inside the image."""
+    from alight.render.vbuffer import box_rect
+
+    vp = np.eye(4)
+    for lo, hi in (((-0.31, -0.52, 0.0), (0.47, 0.13, 0.0)), ((-2.0, -2.0, 0.0), (0.011, 2.0, 0.0))):
+        x, y, w, h = box_rect(np.array(lo), np.array(hi), vp, (64, 48))
+        assert x % 2 == 0 and y % 2 == 0 and w % 2 == 0 and h % 2 == 0, (x, y, w, h)
+        assert 0 <= x and 0 <= y and x + w <= 64 and y + h <= 48

@@ -20,8 +20,9 @@ Approach to Deferred Shading"; Schied and Dachsbacher 2015):
 The shading pass is quad-coherent: each 2x2 block of pixels shades one triangle at a time at all
 four of its pixels (the triangle's plane extended past its edges), as the rasteriser's block does
 for the forward pass, so plain ``texture()`` takes the forward pass's derivatives and mip levels.
-It is drawn as one full-screen triangle (larger than the viewport: nothing clipped) under a
-scissor rectangle with even corners, so its blocks are the forward pass's.
+It is drawn as one triangle that nothing clips, over a viewport twice the image's size
+(render/vbuffer_shade.vert), under a scissor rectangle with even corners, so its blocks are the
+forward pass's, each whole and run once.
 
 Used only where the frame is the fused MSAA resolve with 4 samples, an even width and height,
 and nothing but opaque and masked parts (``wanted``): blended, transmissive, the ground, the
@@ -185,7 +186,8 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
             gpu_part.vbo.bind_to_storage_buffer(0)
             gpu_part.ibo.bind_to_storage_buffer(1)
             # The tangents only where the variant reads them (common/mesh_material.glsl
-            # READS_TANGENT: the Tangents block is active), as the forward pass's in_tangent.
+            # READS_TANGENT, under which alone the Tangents block is declared), as the forward
+            # pass's in_tangent.
             if _active(program, "Tangents"):
                 gpu_part._tangents()[0].bind_to_storage_buffer(2)
             if gpu_part.has_visibility:
@@ -206,7 +208,8 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
 
 
 def _active(program: moderngl.Program, name: str) -> bool:
-    """Whether ``program`` has the active member ``name`` (a storage block among them)."""
+    """Whether ``program`` has the member ``name`` (a storage block among them; llvmpipe lists a
+    declared block even where nothing reads it)."""
     try:
         program[name]
     except KeyError:

@@ -235,7 +235,10 @@ void main() {
     // a branch, but ends a loop once no block of its vector needs another round (most: one).
     uint pending = (1u << uint(count)) - 1u;
     vec4 sum = vec4(0.0);
-    for (;;) {
+    // At most 16 rounds (4 pixels of 4 triangles): each round the pixel whose triangle it is
+    // shades it, so one round fewer is left. (The bound only keeps a driver whose fine
+    // derivatives are not, which the tests would show as wrong pictures, from looping forever.)
+    for (int round = 0; round < 16; ++round) {
         // The block's least pending triangle; the same in all four pixels, so the loop's exit
         // and the derivatives inside it are uniform over the block.
         float mine = pending != 0u ? float(triangles[findLSB(pending)]) : NO_TRIANGLE;
