@@ -19,7 +19,9 @@ Approach to Deferred Shading"; Schied and Dachsbacher 2015):
 
 The shading pass is quad-coherent: each 2x2 block of pixels shades one triangle at a time at all
 four of its pixels (the triangle's plane extended past its edges), as the rasteriser's block does
-for the forward pass, so plain ``texture()`` takes the forward pass's derivatives and mip levels.
+for the forward pass, so plain ``texture()`` takes the forward pass's derivatives and mip levels
+(a block on k visible triangles is shaded k times, as the rasteriser shades it: what is saved is
+the forward pass's overdraw and per-triangle work, benchmarks/results/vbuffer.md).
 It is drawn as one triangle that nothing clips, over a viewport twice the image's size
 (render/vbuffer_shade.vert), under a scissor rectangle with even corners, so its blocks are the
 forward pass's, each whole and run once.
