@@ -3,12 +3,13 @@ alight.render.vbuffer) against the forward pass: steady frames alternated in one
 (A B A B ...), the first frame of a fresh process (shader compiles, Mesa's cache off), and how far
 the pictures differ (relMAE of the linear radiance, as an EXR holds it). Asserts nothing.
 
-    .venv/bin/python benchmarks/bench_vbuffer.py [--size 1024] [--rounds 5] [--triangles 1000000]
+    .venv/bin/python benchmarks/bench_vbuffer.py [--size 1024] [--rounds 5] [--triangles 8000,1000000]
         [--first 3] [--pictures 512]
 
-Scenes: DamagedHelmet (its materials) and a bumpy sphere of --triangles triangles
+Scenes: DamagedHelmet (its materials) and bumpy spheres of each --triangles count
 (bench_assets.bumpy_sphere, untextured), the royal_esplanade environment, 4x MSAA, read back as sRGB.
---pictures: the helmet and every Khronos model in ../shared/data/models/khronos at that size.
+--pictures: the helmet (also with its per-vertex occlusion, Scene.occlusion 'auto') and every
+Khronos model in ../shared/data/models/khronos at that size.
 """
 
 from __future__ import annotations
@@ -110,7 +111,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=1024)
     ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--triangles", type=int, default=1_000_000)
+    ap.add_argument("--triangles", default="8000,1000000", help="the spheres' triangle counts, comma-separated")
     ap.add_argument("--first", type=int, default=3, help="fresh processes per mode for the first frame (0: skip)")
     ap.add_argument("--pictures", type=int, default=512, help="size of the picture comparison (0: skip)")
     args = ap.parse_args()
@@ -123,8 +124,10 @@ def main() -> None:
     r = ForwardRenderer()
     maps = r.bake(load_environment(str(ENV)), "medium")
     with tempfile.TemporaryDirectory() as tmp:
-        sphere = sphere_file(Path(tmp), args.triangles)
-        scenes = {"DamagedHelmet": HELMET, sphere.stem: sphere}
+        scenes = {"DamagedHelmet": HELMET}
+        for count in args.triangles.split(","):
+            sphere = sphere_file(Path(tmp), int(count))
+            scenes[sphere.stem] = sphere
         print(f"{args.size}x{args.size} 4x MSAA, sRGB read back, {ENV.name}; {args.rounds} rounds of 3 frames, "
               "modes alternated; round medians: median (range)")
         for name, path in scenes.items():
@@ -149,6 +152,9 @@ def main() -> None:
     if args.pictures:
         print(f"pictures at {args.pictures}x{args.pictures}: relMAE of linear RGB, share of pixels > 4/255 in sRGB, "
               "largest sRGB difference")
+        rel, share, worst, used = rel_mae(r, Scene(mesh=load_mesh(str(HELMET)), occlusion="auto"), maps, args.pictures)
+        print(f"  DamagedHelmet, occlusion auto: {rel:.2e}, {share:.4%}, {worst:.0f}/255"
+              + ("" if used else " (forward both: the scene keeps the forward pass)"))
         models = [HELMET] + sorted(p for p in (SHARED / "models" / "khronos").glob("*/glTF-Binary/*.glb"))
         for path in models:
             scene = Scene(mesh=load_mesh(str(path)))

@@ -20,13 +20,16 @@ HELMET = SHARED / "models" / "DamagedHelmet" / "DamagedHelmet.gltf"
 NORMAL_TANGENT = SHARED / "models" / "khronos" / "NormalTangentTest" / "glTF-Binary" / "NormalTangentTest.glb"
 CAMERA = Camera(position=(0.3, 0.4, 4.0), target=(0.0, 0.0, 0.0), fov_y_deg=35.0, near=0.1, far=20.0)
 LIGHTS = [Light(kind="directional", vector=(-0.4, -0.5, -1.0), intensity=2.0)]
-# Every pixel is shaded at the same point as the forward pass; what differs are the maps'
-# derivatives (the triangle's one pixel over, not a 2x2 block's differences: another mip level
-# here and there) and float rounding. Measured: the helmet 1.3e-4 at 256x256; NormalTangentTest
-# 3.8e-3 at 192x192 (a minified bump map under a sharp gold highlight: specks where the level
-# differs); the limits leave 1.5-8x room.
-REL_LIMIT = 1e-3
-REL_LIMIT_BUMPS = 6e-3
+# Every pixel is shaded at the same point as the forward pass, and each 2x2 block evaluates one
+# triangle at all four pixels as the rasteriser's block does (render/vbuffer_shade.frag), so the
+# maps' implicit derivatives, and with them their mip levels, are the forward pass's: what is
+# left is float rounding (the barycentrics from the view ray, not the rasteriser's planes).
+# Measured (llvmpipe, Mesa 22.3): the helmet 6.8e-6 at 256x256 (7.2e-6 with occlusion 'auto' at
+# 192), NormalTangentTest 5.7e-6 at 192, the masked planes 3.5e-6, the checker grids 5.4e-6 (4x4
+# cells) and 5.0e-6 (40x40) at 160. Before the quad-coherent shading (textureGrad on derivatives
+# one pixel over) these were 1.3e-4, 3.8e-3, -, 2.0e-3 and 5.8e-3.
+REL_LIMIT = 2e-5
+REL_LIMIT_GRID = 1e-4
 
 
 @functools.lru_cache(maxsize=1)
@@ -78,7 +81,7 @@ def test_textured_normal_mapped_helmet():
 def test_normal_tangent_model():
     """Khronos NormalTangentTest: normal maps on the file's tangents, both handednesses."""
     scene = Scene(mesh=load_mesh(str(NORMAL_TANGENT)), lights=list(LIGHTS))
-    assert_same(*both(scene, 192), limit=REL_LIMIT_BUMPS)
+    assert_same(*both(scene, 192))
 
 
 def _masked_plane(path: Path) -> Path:
@@ -152,3 +155,88 @@ def test_forward_where_not_eligible(tmp_path, kind):
         assert not r.last_vbuffer
     finally:
         r.mesh_shading = "forward"
+
+
+def _checker_grid(path: Path, cells: int) -> Path:
+    """A grid plane of cells x cells quads (two triangles each) with a 256x256 checker texture
+    repeated 6 times across it, tilted away from the camera: every 2x2 block on a triangle edge
+    straddles two triangles, and the minified checker's mip level shows any wrong derivative."""
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(cells, size=3.0)
+    t = g.image(np.concatenate([checker(32, 256), np.full((256, 256, 1), 255, np.uint8)], axis=2))
+    mat = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}, "metallicFactor": 0.0,
+                                           "roughnessFactor": 0.5}, doubleSided=True)
+    turn = np.array([[1.0, 0.0, 0.0], [0.0, 0.35, -0.94], [0.0, 0.94, 0.35]])
+    turn = turn @ np.array([[0.94, 0.0, 0.34], [0.0, 1.0, 0.0], [-0.34, 0.0, 0.94]])
+    g.mesh([{"attributes": {"POSITION": g.accessor(positions @ turn.T, bounds=True),
+                            "NORMAL": g.accessor(normals @ turn.T), "TEXCOORD_0": g.accessor(uvs * 6.0)},
+             "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
+    return g.save(path / f"grid{cells}.glb")
+
+
+@pytest.mark.parametrize("cells", [4, 40])
+def test_tilted_checker_grid(tmp_path, cells):
+    """Triangle edges across a minified, tilted checker: each block's mip level is the forward
+    pass's, where its pixels lie on two triangles too."""
+    scene = Scene(mesh=load_mesh(str(_checker_grid(tmp_path, cells))), camera=CAMERA, lights=list(LIGHTS))
+    assert_same(*both(scene, 160), limit=REL_LIMIT_GRID)
+
+
+def test_odd_size_keeps_forward():
+    """An odd width or height keeps the forward pass: the shading pass's 2x2 blocks could not all
+    lie inside the image, as the forward pass's do (alight.render.vbuffer.wanted)."""
+    from tests.gpu import renderer
+
+    scene = Scene(mesh=load_mesh(str(HELMET)))
+    r = renderer()
+    r.mesh_shading = "vbuffer"
+    try:
+        for width, height in ((65, 64), (64, 65), (65, 65)):
+            r.render(scene, _maps(), width, height, aa="msaa")
+            assert not r.last_vbuffer, (width, height)
+        r.render(scene, _maps(), 64, 64, aa="msaa")
+        assert r.last_vbuffer
+    finally:
+        r.mesh_shading = "forward"
+
+
+def test_per_vertex_occlusion():
+    """The visibility bake's per-vertex occlusion (Scene.occlusion 'auto': the helmet is baked)
+    is read in the shading pass as the forward pass reads it; the scene takes the visibility buffer."""
+    scene = Scene(mesh=load_mesh(str(HELMET)), occlusion="auto")
+    forward, vbuffer, used = both(scene, 192)
+    assert_same(forward, vbuffer, used)
+    # (and the occlusion is there: the picture differs from the helmet's without it well beyond that)
+    plain = both(Scene(mesh=load_mesh(str(HELMET))), 192)[0]
+    assert rel_mae(forward.linear, plain.linear) > 1e-3
+
+
+def test_tangents_only_where_read(tmp_path):
+    """A part whose material reads no tangent frame (no normal map, no anisotropy) is shaded
+    without its tangents ever being made (common/mesh_material.glsl READS_TANGENT); the helmet's
+    normal-mapped part has them."""
+    from tests.gpu import renderer
+
+    r = renderer()
+    grid = load_mesh(str(_checker_grid(tmp_path, 4)))
+    helmet = load_mesh(str(HELMET))
+    r.mesh_shading = "vbuffer"
+    try:
+        for mesh in (grid, helmet):
+            r.render(Scene(mesh=mesh, camera=CAMERA), _maps(), 64, 64, aa="msaa")
+            assert r.last_vbuffer
+    finally:
+        r.mesh_shading = "forward"
+    assert all(g.tangent_buffer is None for g in r.meshes.parts(grid))
+    assert all(g.tangent_buffer is not None for g in r.meshes.parts(helmet))
+
+
+def test_scissor_rectangle_has_even_corners():
+    """The shading pass's rectangle is made of whole 2x2 blocks, inside the image."""
+    from alight.render.vbuffer import box_rect
+
+    vp = np.eye(4)
+    for lo, hi in (((-0.31, -0.52, 0.0), (0.47, 0.13, 0.0)), ((-2.0, -2.0, 0.0), (0.011, 2.0, 0.0))):
+        x, y, w, h = box_rect(np.array(lo), np.array(hi), vp, (64, 48))
+        assert x % 2 == 0 and y % 2 == 0 and w % 2 == 0 and h % 2 == 0, (x, y, w, h)
+        assert 0 <= x and 0 <= y and x + w <= 64 and y + h <= 48

@@ -126,8 +126,8 @@ class ForwardRenderer:
         # fills, without a depth buffer (passes.draw_scene); False: depth-tested after it (tests compare).
         self.background_ring = True
         # How mesh files are shaded under 4x MSAA (alight.render.vbuffer MESH_SHADING): "forward"
-        # once per triangle covering a pixel's samples, "vbuffer" once per pixel (and per
-        # triangle only at its edges) from a visibility buffer, where the scene allows it.
+        # once per triangle covering a pixel's samples, "vbuffer" from a visibility buffer, each
+        # 2x2 block once per visible triangle in it, where the scene allows it.
         self.mesh_shading = "forward"
         # What the last passes drew, for tests and benchmarks: the sphere's level, whether the
         # background's ring was drawn, the impostor's coverage samples (or None), and per

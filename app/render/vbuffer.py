@@ -17,9 +17,19 @@ Approach to Deferred Shading"; Schied and Dachsbacher 2015):
         into the single-sample target render/resolve.frag reads with SCENE_SAMPLES 1, as the
         built-in sphere's impostor does (alight.render.sphere_impostor).
 
-Used only where the frame is the fused MSAA resolve with 4 samples and nothing but opaque and
-masked parts (``wanted``): blended, transmissive, the ground, the built-in sphere, the occlusion
-bake and debug views keep the forward pass.
+The shading pass is quad-coherent: each 2x2 block of pixels shades one triangle at a time at all
+four of its pixels (the triangle's plane extended past its edges), as the rasteriser's block does
+for the forward pass, so plain ``texture()`` takes the forward pass's derivatives and mip levels
+(a block on k visible triangles is shaded k times, as the rasteriser shades it: what is saved is
+the forward pass's overdraw and per-triangle work, benchmarks/results/vbuffer.md).
+It is drawn as one triangle that nothing clips, over a viewport twice the image's size
+(render/vbuffer_shade.vert), under a scissor rectangle with even corners, so its blocks are the
+forward pass's, each whole and run once.
+
+Used only where the frame is the fused MSAA resolve with 4 samples, an even width and height,
+and nothing but opaque and masked parts (``wanted``): blended, transmissive, the ground, the
+built-in sphere and debug views keep the forward pass. The visibility bake's per-vertex
+occlusion (Scene.occlusion) is read in the shading pass from the baked parts' buffers.
 """
 
 from __future__ import annotations
@@ -35,6 +45,9 @@ from alight.render.variants import has_blending_parts, part_defines, transmissiv
 
 MESH_SHADING = ("forward", "vbuffer")   # ForwardRenderer.mesh_shading
 VBUFFER_SAMPLES = 4                     # render/vbuffer_shade.frag's sample pattern
+# render/vbuffer_shade.frag passes triangle ids between a block's pixels as floats (exact below
+# 2^24, one id kept for "none"): a part with more triangles keeps the forward pass.
+MAX_TRIANGLES = (1 << 24) - 2
 
 
 def wanted(r, scene, targets, fbo, background: bool) -> bool:
@@ -44,10 +57,21 @@ def wanted(r, scene, targets, fbo, background: bool) -> bool:
     if getattr(r, "mesh_shading", "forward") != "vbuffer":
         return False
     mesh = scene.mesh
+    width, height = targets.draw_size
+    # An odd width or height keeps the forward pass: the shading pass's 2x2 blocks must be the
+    # forward pass's, and along an odd edge the last column or row of blocks would reach past the
+    # image, where their other pixels have no samples to share.
     return (targets.aa == "msaa" and targets.samples == VBUFFER_SAMPLES and fbo is targets.draw and not background
+            and width % 2 == 0 and height % 2 == 0 and 2 * max(width, height) <= max_viewport(r.ctx)
             and scene.view != "probe" and mesh is not None and mesh.lod_sphere is None and bool(mesh.parts)
-            and not scene.ground and not scene.debug_view and scene.occlusion == "off"
+            and not scene.ground and not scene.debug_view
+            and all(len(part.indices) <= MAX_TRIANGLES for part in mesh.parts)
             and not has_blending_parts(scene) and not transmissive_parts(scene))
+
+
+def max_viewport(ctx) -> int:
+    """GL_MAX_VIEWPORT_DIMS's smaller side: the shading pass's viewport is twice the image's."""
+    return int(min(ctx.info["GL_MAX_VIEWPORT_DIMS"]))
 
 
 _FORMAT_BYTES = {"f": 4, "f2": 2, "i2": 2, "i": 4, "u": 4}
@@ -85,14 +109,15 @@ def vertex_layout(gpu_part) -> dict:
 
 def box_rect(lo, hi, view_projection: np.ndarray, size: tuple[int, int]) -> tuple[int, int, int, int] | None:
     """(x, y, width, height) in pixels holding the projection of the box ``lo``..``hi``, a pixel
-    wider each way; None where the box reaches behind the eye."""
+    wider each way and out to even corners (whole 2x2 blocks, ``size`` being even); None where
+    the box reaches behind the eye."""
     corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     clip = corners @ np.asarray(view_projection, np.float64)
     if (clip[:, 3] <= 1e-6).any():
         return None
     pixels = (clip[:, :2] / clip[:, 3:] * 0.5 + 0.5) * np.array(size, np.float64)
-    x0, y0 = np.clip(np.floor(pixels.min(axis=0)) - 1, 0, size).astype(int)
-    x1, y1 = np.clip(np.ceil(pixels.max(axis=0)) + 1, 0, size).astype(int)
+    x0, y0 = np.clip(np.floor(pixels.min(axis=0)) - 1, 0, size).astype(int) // 2 * 2
+    x1, y1 = np.minimum((np.clip(np.ceil(pixels.max(axis=0)) + 1, 0, size).astype(int) + 1) // 2 * 2, size)
     return (int(x0), int(y0), int(max(x1 - x0, 0)), int(max(y1 - y0, 0)))
 
 
@@ -101,10 +126,15 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
     pass, then one shading pass per part. ``program_for(variant, vertex, fragment)``: draw_mesh's
     program with the scene's defines and bindings (IBL, shadows, layer tables)."""
 
+    from alight.render.passes import occluded_parts   # (passes imports this module)
+
     ctx = r.ctx
     width, height = targets.draw_size
     size = image_size or (width, height)
-    parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
+    # The baked parts where Scene.occlusion wants them (their refined vertices and the bake's
+    # per-vertex buffers), as the forward pass draws them.
+    drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions)
+    parts = list(zip(drawn, scene.mesh.parts))
     user_maps = user_maps_present(scene)
     user = r.meshes.user_textures(scene)
     tiling = scene.texture_maps or TextureMaps()
@@ -146,7 +176,7 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
                 continue   # off screen
             variant = {**variant, "VBUFFER_SHADING": None, **vertex_layout(gpu_part)}
             variant.pop("ALPHA_MODE", None)   # (tested in the visibility pass; the samples are opaque)
-            program = program_for(variant, "render/fullscreen.vert", "render/vbuffer_shade.frag")
+            program = program_for(variant, "render/vbuffer_shade.vert", "render/vbuffer_shade.frag")
             set_uniform(program, "u_model", model.tobytes(), write=True)
             set_uniform(program, "u_normal_matrix", np.eye(3, dtype=np.float32).tobytes(), write=True)
             set_uniform(program, "u_camera_position", tuple(float(x) for x in camera.position))
@@ -157,11 +187,35 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
             visibility.use(UNIT_VISIBILITY)
             gpu_part.vbo.bind_to_storage_buffer(0)
             gpu_part.ibo.bind_to_storage_buffer(1)
-            # The tangents are made for every part shaded here (a full-screen pass has no
-            # attribute that says whether its variant reads them, as the forward pass's does).
-            gpu_part._tangents()[0].bind_to_storage_buffer(2)
-            ctx.scissor = rect
+            # The tangents only where the variant reads them (common/mesh_material.glsl
+            # READS_TANGENT, under which alone the Tangents block is declared), as the forward
+            # pass's in_tangent.
+            if _active(program, "Tangents"):
+                gpu_part._tangents()[0].bind_to_storage_buffer(2)
+            if gpu_part.has_visibility:
+                for buffer, _format, *names in gpu_part.extra_buffers:
+                    if "in_visibility" in names:
+                        buffer.bind_to_storage_buffer(3)
+                    elif "in_sun_bounce" in names:
+                        buffer.bind_to_storage_buffer(4)
+                    elif "in_sky_weight" in names and gpu_part.has_sky_weight:
+                        buffer.bind_to_storage_buffer(5)
+            ctx.scissor = (0, 0, width, height) if rect is None else rect
+            # One unclipped triangle over a viewport twice the image's size (render/vbuffer_shade.vert):
+            # every 2x2 block inside the scissor is whole, and runs once.
+            ctx.viewport = (0, 0, 2 * width, 2 * height)
             r.draws.triangle(program)
     finally:
         ctx.scissor = None
+        ctx.viewport = (0, 0, width, height)
         ctx.disable(moderngl.BLEND)
+
+
+def _active(program: moderngl.Program, name: str) -> bool:
+    """Whether ``program`` has the member ``name`` (a storage block among them; llvmpipe lists a
+    declared block even where nothing reads it)."""
+    try:
+        program[name]
+    except KeyError:
+        return False
+    return True

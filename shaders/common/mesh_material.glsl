@@ -18,21 +18,18 @@
 #ifdef VBUFFER_SHADING
 // Shaded from the visibility buffer (render/vbuffer_shade.frag): no rasteriser behind this pass,
 // so the "varyings" are globals its main() fills from the triangle's vertices at the shaded
-// point, with the uv derivatives per pixel (for the maps' mip level) and the facing it finds.
+// point (each 2x2 block evaluating one triangle, so the implicit derivatives are the forward
+// pass's), with the facing it finds.
 vec3 v_position;
 vec3 v_normal;
 vec2 v_uv;
 vec4 v_tangent;
 #ifdef HAS_UV1
 vec2 v_uv1;
-vec2 vb_duv1_dx;
-vec2 vb_duv1_dy;
 #endif
 #ifdef HAS_VERTEX_COLOR
 vec4 v_color;
 #endif
-vec2 vb_duv_dx;
-vec2 vb_duv_dy;
 vec3 vb_centroid_normal;   // the normal at the triangle's covered samples' centroid
 vec3 vb_face_normal;   // the triangle's unit normal toward the eye (as cross(dFdx, dFdy) of the position)
 bool vb_front_facing;
@@ -143,6 +140,13 @@ uniform sampler2D u_diffuse_transmission_map;
 #endif
 // MAP_BASE_COLOR ... MAP_SPECULAR_COLOR (a bit each), MAP_SLOTS and MAP_ALL: app/core/shader_names.py
 // MATERIAL_MAPS (generated).
+// READS_TANGENT: the material reads the mesh's tangent frame (a normal map, the coat's normal
+// map, anisotropy); elsewhere the frame tangent_frame() builds for the layers goes unused.
+// render/vbuffer_shade.frag fetches and interpolates tangents only where it is defined (the
+// forward pass's in_tangent is inactive, and unbound, in the same variants).
+#if (MATERIAL_MAPS_MASK & (MAP_NORMAL | MAP_CLEARCOAT_NORMAL)) != 0 || defined(HAS_ANISOTROPY)
+#define READS_TANGENT
+#endif
 // KHR_materials_specular's textures, compiled in only where a part has one 
 #if (MATERIAL_MAPS_MASK & (MAP_SPECULAR | MAP_SPECULAR_COLOR)) != 0
 #define HAS_SPECULAR_MAPS
@@ -251,20 +255,6 @@ float mirrored_repeat(float x) {
 // unfolded derivatives, so the mip level does not jump at the folds.
 vec4 sample_map(sampler2D map, int bit, int slot) {
     vec2 uv = map_uv(bit, slot);
-#ifdef VBUFFER_SHADING
-    // The derivatives of the uvs this map reads, from the triangle's (a full-screen pass's own
-    // 2x2 blocks may straddle triangles): the tiling's scale, the uv set, the transform's linear part.
-    vec2 du = vb_duv_dx * u_uv_scale;
-    vec2 dv = vb_duv_dy * u_uv_scale;
-#ifdef HAS_UV1
-    if ((MAP_UV1_MASK & bit) != 0) { du = vb_duv1_dx; dv = vb_duv1_dy; }
-#endif
-    if ((MAP_TRANSFORM_MASK & bit) != 0) { du = mat2(u_map_transform[slot]) * du; dv = mat2(u_map_transform[slot]) * dv; }
-    vec2 folded = uv;
-    if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
-    if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
-    return textureGrad(map, folded, du, dv);
-#endif
     if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
         vec2 folded = uv;
         if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);

@@ -112,13 +112,20 @@ vec3 sky_visibility(float visibility, vec3 sky, float ray_visibility) {
 }
 
 #ifdef HAS_VISIBILITY
-in vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
-in vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
-in vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
-in vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
-in vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
+#ifdef VBUFFER_SHADING
+// Shaded from the visibility buffer: globals render/vbuffer_shade.frag fills from the bake's
+// per-vertex buffers (the other varyings: common/mesh_material.glsl).
+#define VISIBILITY_IN
+#else
+#define VISIBILITY_IN in
+#endif
+VISIBILITY_IN vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
+VISIBILITY_IN vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
+VISIBILITY_IN vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
+VISIBILITY_IN vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
+VISIBILITY_IN vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
 #ifdef HAS_SKY_WEIGHT
-in vec4 v_sky_weight;   // the visible sky weight W (rgb) and its rays' V (w): app/core/sky_weight.py
+VISIBILITY_IN vec4 v_sky_weight;   // the visible sky weight W (rgb) and its rays' V (w): app/core/sky_weight.py
 #endif
 
 // sum_k P_k B_k over the suns, for B = v_sun_bounce (second: v_sun_bounce2). Clamped at 0: a
