@@ -133,7 +133,7 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
     size = image_size or (width, height)
     # The baked parts where Scene.occlusion wants them (their refined vertices and the bake's
     # per-vertex buffers), as the forward pass draws them.
-    drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions)
+    drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions, frame.maps)
     parts = list(zip(drawn, scene.mesh.parts))
     user_maps = user_maps_present(scene)
     user = r.meshes.user_textures(scene)
