@@ -50,8 +50,8 @@ def errors(radiance, preset, roughness, models):
     return out
 
 
-def test_the_default_is_alight_and_every_name_has_a_shader_index():
-    assert DEFAULT_IBL_MODEL == "alight"
+def test_the_default_is_stretched_and_every_name_has_a_shader_index():
+    assert DEFAULT_IBL_MODEL == "stretched"
     assert [ibl_model_index(m) for m in IBL_MODELS] == list(range(len(IBL_MODELS)))
     with pytest.raises(ValueError, match="unknown IBL model"):
         ibl_model_index("nonsense")

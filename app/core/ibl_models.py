@@ -22,7 +22,7 @@ IBL_MODELS: dict[str, str] = {
                  "space (app/core/stretched_lobe.json) instead of one at its mean direction",
 }
 
-DEFAULT_IBL_MODEL = "alight"
+DEFAULT_IBL_MODEL = "stretched"
 
 # Models whose maps hold the compact sources as the lecture's bake would (the shader adds them as
 # baked); the others shade them exactly.
