@@ -120,3 +120,7 @@ def test_the_stretched_lobe_table_is_the_round_lookup_where_it_is_not_fitted():
     assert (table[..., 0] <= table[..., 1]).all()                   # canonical: a_lo <= a_hi
     assert ((table[..., 2] >= 0) & (table[..., 2] <= 1)).all()
     assert ((table[..., 3] > 0) & (table[..., 3] <= 1.3 + 1e-6)).all()
+    from alight.ibl.bake import FETCH_REACH
+
+    # a bake trimmed at a material's roughness keeps the steps the two fetches read
+    assert np.sqrt(table[..., 3].max()) <= FETCH_REACH

@@ -73,11 +73,17 @@ class BakeQuality:
 
     def prefilter_samples_at(self, step: int) -> int:
         """Samples per texel at a grid step (step 2m: grid A's mip m; 2j+1: grid B's mip j).
-        Steps beyond the first one at or above ``max_roughness`` get SKIPPED_STEP_SAMPLES."""
+        Steps beyond the first one at or above ``max_roughness`` times FETCH_REACH (the roughest
+        any IBL model fetches for a material that rough) get SKIPPED_STEP_SAMPLES."""
         if self.max_roughness < 1.0 and step > 0 and \
-                grid_roughness(step - 1, self.prefiltered_levels) >= self.max_roughness:
+                grid_roughness(step - 1, self.prefiltered_levels) >= self.max_roughness * FETCH_REACH:
             return SKIPPED_STEP_SAMPLES
         return min(self.prefilter_max_samples, int(self.prefilter_samples * self.prefilter_sample_growth ** (step / 2)))
+
+
+# The `stretched` model (the default) fetches at up to sqrt(beta) times the material's roughness,
+# beta <= 1.3 in its table (alight.core.stretched_lobe; tests/test_ibl_models.py holds the bound).
+FETCH_REACH = 1.15
 
 
 # The one place where bake quality is chosen. 'medium' is the default: it keeps the probe within
