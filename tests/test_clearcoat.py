@@ -9,6 +9,7 @@ import pytest
 
 from alight.accuracy.converged import downsample_equirect, ibl_converged
 from alight.accuracy.ground_truth import layered_ground_truth, probe_points, reflectance_ground_truth
+from alight.core.ibl_models import DEFAULT_IBL_MODEL
 from alight.core.layers import clearcoat as cc
 from alight.core.material import Material
 from alight.core.scene import Light, Scene
@@ -128,7 +129,7 @@ def test_forward_pass_matches_its_converged_twin(name, shared_data):
     maps = r.bake(env, "medium")
     img = r.render(Scene(material=m, view="probe"), maps, 32, 32).linear
     normals, inside = probe_normals(32)
-    twin = ibl_converged("alight", downsample_equirect(env.radiance, 2), normals[inside], (0, 0, 1), m.base_color,
+    twin = ibl_converged(DEFAULT_IBL_MODEL, downsample_equirect(env.radiance, 2), normals[inside], (0, 0, 1), m.base_color,
                          m.metallic, m.roughness, m.specular_f0, material=m)
     got = img[..., :3][inside]
     rel = np.abs(got - twin).sum() / np.abs(twin).sum()

@@ -44,7 +44,7 @@ from alight.core.sphere_lod import MAX_SILHOUETTE_ERROR_PX
 from alight.ibl.bake import QUALITY, BakeQuality, IBLMaps, bake_environment, bake_steps
 from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.render import passes, variants
-from alight.render.bindings import LightsBlock, LookupTables, assign_units
+from alight.render.bindings import UNIT_SCRATCH, LightsBlock, LookupTables, assign_units
 from alight.render.gpu_mesh import FullscreenDraws, GpuMeshes, GpuPart
 from alight.render.ground import GroundPass
 from alight.render.passes import FrameContext
@@ -102,6 +102,7 @@ class ForwardRenderer:
         # same names: GL_INVALID_OPERATION and black maps). A context given is the caller's to manage.
         self._owns_context = ctx is None
         self.ctx = ctx or create_headless_context()
+        self.ctx.default_texture_unit = UNIT_SCRATCH   # (alight.render.bindings: off every unit a pass binds)
         self.shaders = shaders or ShaderLibrary(self.ctx)
         self.tables = LookupTables(self.ctx, self.shaders)   # LUTs and lobe tables (alight.render.bindings)
         self.luts = self.tables.luts
