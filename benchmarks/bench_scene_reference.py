@@ -63,6 +63,8 @@ def materials():
     gold = load_preset("gold")
     return {
         "gold r0.3": replace(gold, roughness=0.3),
+        "gold r0.4": replace(gold, roughness=0.4),
+        "gold r0.5": replace(gold, roughness=0.5),
         "gold r0.7": replace(gold, roughness=0.7),
         "red dielectric r0.5": Material(base_color=(0.8, 0.1, 0.1), metallic=0.0, roughness=0.5),
         "grey dielectric r0.5": Material(base_color=(0.7, 0.7, 0.7), metallic=0.0, roughness=0.5),
@@ -177,7 +179,7 @@ def part_oblique(envs, renderer, exact, size, suffix: str) -> None:
             mesh = load_mesh(mesh_name)
             for elevation in elevations:
                 camera = camera_for(mesh, size, 0.0, elevation)
-                for mat_name in ("gold r0.3", "gold r0.7", "red dielectric r0.5"):
+                for mat_name in ("gold r0.3", "gold r0.4", "gold r0.5", "gold r0.7", "red dielectric r0.5"):
                     scene = Scene(mesh=mesh, material=mats[mat_name], camera=camera, view="camera")
                     ex = exact.render(scene, env.radiance, size[0], size[1]).linear
                     errors = {}

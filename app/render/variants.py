@@ -174,12 +174,14 @@ def below_grid_defines(scene, maps: IBLMaps | None, materials, map_mask: int = 0
     if unsafe or map_mask >> len(MATERIAL_MAPS):
         return {}
     first_step = grid_roughness(0, maps.quality.prefiltered_levels)
-    if scene.ibl_model == "stretched":
+    if scene.ibl_model == "stretched" and materials:
         from alight.core.stretched_lobe import ROUGHNESS_START, lobe_table
 
-        # its two fetches, taken from ROUGHNESS_START up, read at the material's roughness times
-        # sqrt(beta) (a fitted factor below 1): their lowest must be on the grid too
-        if ROUGHNESS_START * math.sqrt(float(lobe_table()[..., 3].min())) < first_step:
+        # its two fetches, taken above ROUGHNESS_START, read at the material's roughness times
+        # sqrt(beta) (a fitted factor, down to 0.66): their lowest must be on the grid too
+        rough = [float(m.roughness) for m in materials]
+        lowest = max(ROUGHNESS_START, min(rough)) * math.sqrt(float(lobe_table()[..., 3].min()))
+        if max(rough) > ROUGHNESS_START and lowest < first_step:
             return {}
     for m in materials:
         if m.layers() - {"clearcoat"}:
