@@ -227,6 +227,8 @@ with alight.Renderer(w, h, aa="msaa") as r:
     r.set_mesh(scene["path"]).set_environment(a["env"])
     if scene["kind"] != "gltf":
         r.set_material("gold", roughness=scene["roughness"])
+    if "shadows" in scene:
+        r.set_shadows(scene["shadows"])
     times, cpu, previous = [], [], None
     for i in range(frames + 2):
         r.set_camera(orbit_deg=float(i))
@@ -306,6 +308,7 @@ def main() -> int:
         load_before = f.read().split()[:3]
     results = {}   # (scene, part, who) -> (walls, cpus)
     failures = {}  # (scene, peer) -> message
+    per_round = {}  # (scene, part, peer) -> [(alight / peer wall, alight / peer CPU) of each round]
 
     def add(key, wall, cpu):
         walls, cpus = results.setdefault(key, ([], []))
@@ -322,7 +325,11 @@ def main() -> int:
             if name == "helmet":
                 scenes[name] = {"kind": "gltf", "path": str(HELMET)}
             elif name == "mesh1m":
-                scenes[name] = {"kind": "mesh", "path": str(make_mesh1m(tmp)), "color": GOLD, "roughness": ROUGHNESS}
+                # alight --shadows off: no peer draws shadows, and alight's 'auto' test of whether a
+                # mesh can shadow itself (alight.core.shadow_fit.can_shadow_itself) tests every face's
+                # plane against every vertex when the mesh is convex: over 4 minutes on this sphere.
+                scenes[name] = {"kind": "mesh", "path": str(make_mesh1m(tmp)), "color": GOLD, "roughness": ROUGHNESS,
+                                "shadows": "off"}
             else:
                 raise SystemExit(f"unknown scene {name!r}")
         for name, scene in scenes.items():
@@ -337,6 +344,8 @@ def main() -> int:
                       "--size", str(size), "--aa", "msaa", "--out", str(tmp / f"{name}_alight.png")]
             if scene["kind"] != "gltf":
                 render += ["--preset", "gold", "--roughness", str(ROUGHNESS)]
+            if "shadows" in scene:
+                render += ["--shadows", scene["shadows"]]
             for i in range(args.rounds if "cold" in parts else 0):
                 # The BRDF LUT stays cached (it does not depend on the scene); the bakes do not.
                 for sub in cache.iterdir() if cache.exists() else ():
@@ -356,7 +365,9 @@ def main() -> int:
                         continue
                     add((name, "cold", peer), wall, cpu)
                     line.append(f"{peer} {wall:.2f}")
+                    peer_wall, peer_cpu = wall, cpu
                     wall, cpu, _ = run(render, alight_env)   # alternated: alight (bake cached) after each peer
+                    per_round.setdefault((name, "cold", peer), []).append((wall / peer_wall, cpu / peer_cpu))
                     add((name, "cold", "alight"), wall, cpu)
                     add((name, "cold", f"alight/{peer}"), wall, cpu)
                     line.append(f"alight {wall:.2f}")
@@ -367,9 +378,9 @@ def main() -> int:
                 for peer in peers:
                     if (name, peer) in failures:
                         continue
-                    out = json.loads(run([py, "-c", ALIGHT_STEADY, blob], alight_env)[2])
-                    add((name, "steady", f"alight/{peer}"), out["frames"], out["cpu"])
-                    add((name, "steady", "alight"), out["frames"], out["cpu"])
+                    mine = json.loads(run([py, "-c", ALIGHT_STEADY, blob], alight_env)[2])
+                    add((name, "steady", f"alight/{peer}"), mine["frames"], mine["cpu"])
+                    add((name, "steady", "alight"), mine["frames"], mine["cpu"])
                     try:
                         out = json.loads(run(peer_args(peer, "steady"), peer_env)[2])
                     except RuntimeError as e:
@@ -377,6 +388,9 @@ def main() -> int:
                         print(f"{peer} failed on {name}:\n{e}", file=sys.stderr)
                         continue
                     add((name, "steady", peer), out["frames"], out["cpu"])
+                    m = statistics.median
+                    per_round.setdefault((name, "steady", peer), []).append(
+                        (m(mine["frames"]) / m(out["frames"]), m(mine["cpu"]) / m(out["cpu"])))
                     line.append(f"alight {statistics.median(results[(name, 'steady', f'alight/{peer}')][0]) * 1000:.0f}"
                                 f" / {peer} {statistics.median(out['frames']) * 1000:.0f}")
                 print(f"{name} steady round {i + 1}/{args.rounds} (ms): " + ", ".join(line), file=sys.stderr)
@@ -402,13 +416,17 @@ def main() -> int:
                 if who.startswith("alight/"):
                     continue
                 print(f"  {who:16s} wall {summary(walls)}\n  {'':16s} CPU  {summary(cpus)}")
-            print(f"  ratios of medians alight / peer, wall (CPU); below 1: alight takes less:")
+            print("  ratios of medians alight / peer, wall (CPU), then the range of the rounds' ratios; "
+                  "below 1: alight takes less:")
             for peer in peers:
                 if (name, part, peer) not in results:
                     continue
                 pw, pc = results[(name, part, peer)]
                 a = results[(name, part, f"alight/{peer}")]   # the alight runs next to this peer's
-                print(f"    {peer:10s} {m(a[0]) / m(pw):.2f} ({m(a[1]) / m(pc):.2f})", end="")
+                rounds = per_round[(name, part, peer)]
+                print(f"    {peer:10s} {m(a[0]) / m(pw):.2f} ({m(a[1]) / m(pc):.2f})   rounds "
+                      f"{min(r[0] for r in rounds):.2f}-{max(r[0] for r in rounds):.2f} "
+                      f"({min(r[1] for r in rounds):.2f}-{max(r[1] for r in rounds):.2f})", end="")
                 if part == "cold":
                     first = results[(name, part, "alight first")]
                     print(f"   empty bake cache: {m(first[0]) / m(pw):.2f} ({m(first[1]) / m(pc):.2f})", end="")
