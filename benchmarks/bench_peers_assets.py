@@ -10,7 +10,8 @@ The scenes (``--scenes``):
   normal, occlusion and emissive maps), royal_esplanade_1k.hdr as image-based light and
   background where the peer has image-based light, no other light.
 - **mesh1m**: a 1.31M-triangle icosphere (trimesh, 8 subdivisions) written to a .ply in a
-  temporary folder, gold at roughness 0.3, the same environment.
+  temporary folder, gold at roughness 0.3, the same environment; alight with shadows off (no
+  peer draws them, and the 'auto' self-shadow test is quadratic on a convex mesh: see below).
 
 alight's camera for every scene and frame (``alight.Renderer.set_camera(orbit_deg=i)``: the
 mesh framed from +Z, 35 degrees vertical field, then orbiting 1 degree per frame) is computed
