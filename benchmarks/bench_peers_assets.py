@@ -10,7 +10,8 @@ The scenes (``--scenes``):
   normal, occlusion and emissive maps), royal_esplanade_1k.hdr as image-based light and
   background where the peer has image-based light, no other light.
 - **mesh1m**: a 1.31M-triangle icosphere (trimesh, 8 subdivisions) written to a .ply in a
-  temporary folder, gold at roughness 0.3, the same environment.
+  temporary folder, gold at roughness 0.3, the same environment; alight with shadows off (no
+  peer draws them, and the 'auto' self-shadow test is quadratic on a convex mesh: see below).
 
 alight's camera for every scene and frame (``alight.Renderer.set_camera(orbit_deg=i)``: the
 mesh framed from +Z, 35 degrees vertical field, then orbiting 1 degree per frame) is computed
@@ -24,7 +25,9 @@ Image-based light per peer:
   the GPU in every process) with the glTF's PBR materials (``import_gltf``), the map as skybox;
 - pygfx: a cube map made from the .hdr (read with OpenImageIO, resampled to 6 x 256² in numpy in
   the peer's process, mipmapped by pygfx) as ``env_map`` of every MeshStandardMaterial, and as
-  the skybox background; pygfx has no equirectangular environment;
+  the skybox background; pygfx has no equirectangular environment. pygfx decodes material
+  colours, environment maps and skyboxes as sRGB, so the map and the sphere's colour are handed
+  to it sRGB-encoded;
 - pyrender: no image-based light at all. It gets a directional light from the camera and an
   ambient term instead, so its picture is lit differently (a reference for speed only).
 
@@ -140,9 +143,16 @@ def cube_from_equirect(path, size=256):
         out[i, :, :, 3] = 1
     return out
 
+def srgb_encoded(linear):
+    """pygfx linearises colours, environment maps and skyboxes as sRGB (srgb2physical in its shaders):
+    hand it alight's linear values sRGB-encoded (the curve continued above 1) so that it lights with them."""
+    c = np.maximum(np.asarray(linear, np.float32), 0.0)
+    return np.where(c > 0.0031308, 1.055 * np.power(c, 1 / 2.4) - 0.055, 12.92 * c).astype(np.float32)
+
 canvas = RenderCanvas(size=(w, h), pixel_ratio=1)
 renderer = gfx.renderers.WgpuRenderer(canvas, pixel_scale=2)   # no MSAA in pygfx: 2x2 supersampling
 cube = cube_from_equirect(env)
+cube[..., :3] = srgb_encoded(cube[..., :3])
 env_tex = gfx.Texture(cube, dim=2, size=(cube.shape[2], cube.shape[1], 6), generate_mipmaps=True)
 world = gfx.Scene()
 sky_tex = gfx.Texture(cube, dim=2, size=(cube.shape[2], cube.shape[1], 6))   # the skybox without mips
@@ -154,7 +164,7 @@ else:
     m = trimesh.load(scene["path"], process=False)
     geometry = gfx.Geometry(positions=np.asarray(m.vertices, np.float32), indices=np.asarray(m.faces, np.int32),
                             normals=np.asarray(m.vertex_normals, np.float32))
-    world.add(gfx.Mesh(geometry, gfx.MeshStandardMaterial(color=scene["color"], metalness=1.0,
+    world.add(gfx.Mesh(geometry, gfx.MeshStandardMaterial(color=tuple(srgb_encoded(scene["color"])), metalness=1.0,
                                                           roughness=scene["roughness"])))
 for obj in world.iter():
     if isinstance(getattr(obj, "material", None), gfx.MeshStandardMaterial):
