@@ -24,7 +24,8 @@ neighbours' values (as the bake's _fill_covered); then ``SMOOTHING_ROUNDS`` roun
 over mesh neighbours cut the rays' noise (numerator and denominator alike, so a uniform
 environment still gives V).
 
-The shader (shaders/common/occlusion.glsl's sky_visibility; numpy twin ``sky_visibility`` here)
+The shader (shaders/common/occlusion.glsl's sky_visibility; its numpy twin
+alight.core.visibility.sky_visibility, with the other shader terms' twins)
 gets W and the same rays' V per vertex and uses ``min(V_c W / V_rays, 1)`` per channel in place
 of V_c (the combined visibility) on the irradiance at the shading normal: under a uniform
 environment W / V_rays = 1 and it is V_c as before; elsewhere W / V_rays is the visible sky's
@@ -37,11 +38,12 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import time
 
 import numpy as np
 
 from alight.core.shading import rotate_world_to_map
+from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_directions, eps_of
+from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
 SKY_WEIGHT_VERSION = 1
 SKY_TEXELS = 16          # texels per cube face read back (the source cube's box mip of that size)
@@ -99,8 +101,6 @@ def ray_directions(normals: np.ndarray, angles: np.ndarray, rays: int) -> np.nda
     """(N, R, 3) world directions of each vertex's rays: visibility.cosine_directions(rays) about
     +Z, turned onto the unit normal in the frame spun by the vertex's angle (as the bake's
     _chunk_rays)."""
-    from alight.core.visibility import _frame, cosine_directions
-
     n = np.asarray(normals, np.float64)
     t, b = _frame(n)
     c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]
@@ -115,8 +115,6 @@ def sky_rays(parts, rays: int, seed: int = SKY_SEED, light_through=None) -> list
     cosine-weighted rays about each vertex normal from the bake's ray origins, against the
     refined mesh (Embree). An opaque part stops a ray; a see-through one (``light_through`` per
     part, as the bake's) passes its share of the first one met."""
-    from alight.core.visibility import _cast, _Occluders, _origins, eps_of
-
     out = [(np.zeros((len(p.positions), rays), np.uint8), np.zeros(len(p.positions), np.float32)) for p in parts]
     if not parts or not sum(len(p.positions) for p in parts):
         return out
@@ -240,16 +238,6 @@ def sky_weight(free: np.ndarray, angles: np.ndarray, normals: np.ndarray, faces:
     return smooth(values, faces, rounds).astype(np.float32)
 
 
-def sky_visibility(visibility, sky, ray_visibility):
-    """occlusion.glsl's sky_visibility: the combined V (N,) made a per-channel share of the light,
-    min(V W / V_rays, 1) (N, 3), W (N, 3) and V_rays (N,) the rays' (``sky_weight``); V where
-    V_rays is 0 (no ray escaped anywhere near)."""
-    v = np.asarray(visibility, np.float64)[..., None]
-    rv = np.asarray(ray_visibility, np.float64)[..., None]
-    ratio = np.where(rv > 1e-4, np.asarray(sky, np.float64) / np.maximum(rv, 1e-4), 1.0)
-    return np.minimum(v * ratio, 1.0)
-
-
 def sky_weight_key(visibility_key_: str, texels_digest_: str, rotation_deg: float, rays: int,
                    rounds: int = SMOOTHING_ROUNDS) -> tuple[str, dict]:
     """The cache key of the weight of the bake ``visibility_key_`` under an environment."""
@@ -268,9 +256,3 @@ def sky_rays_key(visibility_key_: str, rays: int, light_through=None) -> tuple[s
         description["light_through"] = [round(float(t), 6) for t in light_through]
     text = json.dumps(description, sort_keys=True)
     return "alight-sky-rays-" + hashlib.sha256(text.encode()).hexdigest(), description
-
-
-def timed(fn, *args, **kwargs):
-    start = time.perf_counter()
-    out = fn(*args, **kwargs)
-    return out, time.perf_counter() - start

@@ -38,7 +38,7 @@ shader takes in place of V's share of directions for the diffuse term (HAS_SKY_W
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
-``cone_blend``, ``suns_on_occluders`` and ``occluded_environment`` here (tests/test_occlusion.py,
+``cone_blend``, ``suns_on_occluders``, ``sky_visibility`` and ``occluded_environment`` here (tests/test_occlusion.py,
 test_occlusion_cone.py and test_occlusion_suns.py hold them equal).
 """
 
@@ -217,6 +217,16 @@ def suns_on_occluders(hit_albedo, hit_visibility, first, second):
     return a * b1 + a * a * b2 / np.maximum(1.0 - a * (1.0 - v), 1e-3)
 
 
+def sky_visibility(visibility, sky, ray_visibility):
+    """occlusion.glsl's sky_visibility: the combined V (N,) made a per-channel share of the light,
+    min(V W / V_rays, 1) (N, 3), W (N, 3) and V_rays (N,) the visible sky weight's
+    (alight.core.sky_weight.sky_weight); V where V_rays is 0 (no ray escaped anywhere near)."""
+    v = np.asarray(visibility, np.float64)[..., None]
+    rv = np.asarray(ray_visibility, np.float64)[..., None]
+    ratio = np.where(rv > 1e-4, np.asarray(sky, np.float64) / np.maximum(rv, 1e-4), 1.0)
+    return np.minimum(v * ratio, 1.0)
+
+
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
                          hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None,
                          sky=None):
@@ -244,8 +254,6 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     blend = cone_blend(visibility)[..., None]
     visible = cone + (bent - cone) * blend
     if sky is not None:
-        from alight.core.sky_weight import sky_visibility
-
         w, ray_visibility, irradiance_n = sky
         diffuse = sky_visibility(visibility, w, ray_visibility) * np.asarray(irradiance_n, np.float64)
     else:
