@@ -346,7 +346,10 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
         draw_mesh_parts(r, frame, scene, program_for, camera, view_projection, blend=True, image_size=image_size)
         return
     if frame.vbuffer:
-        vbuffer.draw(r, frame, scene, camera, view_projection, targets, program_for, image_size)
+        # The baked parts where Scene.occlusion wants them, as draw_mesh_parts draws them.
+        # (with the environment drawn, so they keep their visible sky weight)
+        drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions, frame.maps)
+        vbuffer.draw(r, frame, scene, camera, view_projection, targets, program_for, image_size, drawn)
         return
     transmissive = transmissive_parts(scene)
     opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]

@@ -121,20 +121,18 @@ def box_rect(lo, hi, view_projection: np.ndarray, size: tuple[int, int]) -> tupl
     return (int(x0), int(y0), int(max(x1 - x0, 0)), int(max(y1 - y0, 0)))
 
 
-def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_for, image_size) -> None:
+def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_for, image_size,
+         drawn: list | None = None) -> None:
     """The mesh's parts into ``targets.single()`` (cleared by the scene pass): the visibility
     pass, then one shading pass per part. ``program_for(variant, vertex, fragment)``: draw_mesh's
-    program with the scene's defines and bindings (IBL, shadows, layer tables)."""
-
-    from alight.render.passes import occluded_parts   # (passes imports this module)
+    program with the scene's defines and bindings (IBL, shadows, layer tables). ``drawn``: the
+    GPU parts to draw (passes.occluded_parts: the baked parts, with the bake's per-vertex buffers,
+    where Scene.occlusion wants them); None: the mesh's own."""
 
     ctx = r.ctx
     width, height = targets.draw_size
     size = image_size or (width, height)
-    # The baked parts where Scene.occlusion wants them (their refined vertices and the bake's
-    # per-vertex buffers), as the forward pass draws them.
-    drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions, frame.maps)
-    parts = list(zip(drawn, scene.mesh.parts))
+    parts = list(zip(r.meshes.parts(scene.mesh) if drawn is None else drawn, scene.mesh.parts))
     user_maps = user_maps_present(scene)
     user = r.meshes.user_textures(scene)
     tiling = scene.texture_maps or TextureMaps()
