@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from alight.core import shading
+from alight.core.ibl_models import DEFAULT_IBL_MODEL
 from alight.core.layers import anisotropy
 from alight.core.layers.stack import Pairs, layered_brdf_cos
 from alight.core.material import Material
@@ -197,7 +198,7 @@ def test_probe_within_bound_of_its_converged_twin(shared_data, rotation):
         m = Material(base_color=(0.91, 0.92, 0.92), metallic=1.0, roughness=rough, anisotropy_strength=strength,
                      anisotropy_rotation=rotation)
         got = _probe(r, maps, m, width)[..., :3][inside]
-        ideal = ibl_converged("alight", radiance, normals[inside], (0.0, 0.0, 1.0), m.base_color, m.metallic, rough,
+        ideal = ibl_converged(DEFAULT_IBL_MODEL, radiance, normals[inside], (0.0, 0.0, 1.0), m.base_color, m.metallic, rough,
                               m.specular_f0, material=m)
         error = float(np.abs(got - ideal).sum() / np.abs(ideal).sum())
         print(f"r={rough} strength={strength} rotation={rotation}: {100 * error:.2f}%")

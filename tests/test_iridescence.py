@@ -13,6 +13,7 @@ import pytest
 
 from alight.accuracy.converged import downsample_equirect, ibl_converged
 from alight.accuracy.ground_truth import layered_ground_truth, probe_points
+from alight.core.ibl_models import DEFAULT_IBL_MODEL
 from alight.core.layers import iridescence as ir
 from alight.core.material import Material
 from alight.core.scene import Light, Scene
@@ -156,7 +157,7 @@ def test_forward_pass_matches_its_converged_twin(name, shared_data):
     env = _royal(shared_data)
     img = r.render(Scene(material=m, view="probe"), r.bake(env, "medium"), 32, 32).linear
     normals, inside = probe_normals(32)
-    twin = ibl_converged("alight", downsample_equirect(env.radiance, 2), normals[inside], (0, 0, 1), m.base_color,
+    twin = ibl_converged(DEFAULT_IBL_MODEL, downsample_equirect(env.radiance, 2), normals[inside], (0, 0, 1), m.base_color,
                          m.metallic, m.roughness, m.specular_f0, material=m)
     rel = np.abs(img[..., :3][inside] - twin).sum() / np.abs(twin).sum()
     print(f"{name}: {100 * rel:.2f}% off the converged twin")

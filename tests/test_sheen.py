@@ -9,6 +9,7 @@ import pytest
 
 from alight.accuracy.converged import downsample_equirect, ibl_converged
 from alight.accuracy.ground_truth import layered_ground_truth, probe_points
+from alight.core.ibl_models import DEFAULT_IBL_MODEL
 from alight.core.layers import sheen as sh
 from alight.core.material import Material
 from alight.core.scene import Light, Scene
@@ -150,7 +151,7 @@ def test_forward_pass_matches_its_converged_twin(name, shared_data):
     maps = r.bake(env, "medium")
     img = r.render(Scene(material=m, view="probe"), maps, 32, 32).linear
     normals, inside = probe_normals(32)
-    twin = ibl_converged("alight", downsample_equirect(env.radiance, 2), normals[inside], (0, 0, 1), m.base_color,
+    twin = ibl_converged(DEFAULT_IBL_MODEL, downsample_equirect(env.radiance, 2), normals[inside], (0, 0, 1), m.base_color,
                          m.metallic, m.roughness, m.specular_f0, material=m)
     rel = np.abs(img[..., :3][inside] - twin).sum() / np.abs(twin).sum()
     print(f"{name}: {100 * rel:.2f}% off the converged twin")

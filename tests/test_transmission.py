@@ -25,6 +25,7 @@ from alight.accuracy.ground_truth import (
 )
 from alight.core.btdf import beer_lambert
 from alight.core.equirect import box_reduce
+from alight.core.ibl_models import DEFAULT_IBL_MODEL
 from alight.core.material import Material
 from alight.core.mesh import sphere
 from alight.core.scene import Display, Light, Scene
@@ -218,7 +219,7 @@ def test_probe_within_bound_of_its_converged_twin(shared_data, material, roughne
     got, inside, n = probe(m, maps_for(env))
     radiance = downsample_equirect(env.radiance, 2)
     pts = n[inside]
-    twin = ibl_converged("alight", radiance, pts, (0, 0, 1), m.base_color, m.metallic, roughness, m.specular_f0,
+    twin = ibl_converged(DEFAULT_IBL_MODEL, radiance, pts, (0, 0, 1), m.base_color, m.metallic, roughness, m.specular_f0,
                          material=m)
     error = relative(got[inside], twin)
     print(f"{'volume' if m.thickness else 'thin'} r={roughness}: {error * 100:.2f}%")
