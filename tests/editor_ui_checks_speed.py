@@ -53,6 +53,8 @@ def test_a_new_variant_keeps_the_old_picture_until_it_is_compiled(ctx):
     s, warm = editor().state, editor().variant_warmup
     ctx.set_ref("alight")
     ctx.item_click("**/copper")
+    # (copper's roughness may need a variant of its own, STRETCHED_SPAN: the view settles first)
+    wait_frames(ctx, lambda: not warm.pending)
     ctx.yield_(3)
     old = shown(ctx)
     jobs = warm.jobs
