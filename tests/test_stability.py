@@ -33,6 +33,7 @@ from alight.core.ibl_models import IBL_MODELS
 from alight.core.material import Material
 from alight.core.mesh import FileMaterial, Mesh, MeshPart, plane, sphere
 from alight.core.scene import Camera, Scene
+from alight.core.sky_weight import cube_texel_directions
 from alight.ibl.bake import QUALITY, grid_roughness, quality_named, read_cube, read_lut
 from alight.ibl.environment import Environment, constant_environment, load_environment
 from alight.ibl.sun import extract_suns
@@ -230,17 +231,6 @@ def neighbour_ratio(faces: np.ndarray) -> float:
     return float((win[..., 4] / np.maximum(median, 1e-30)).max())
 
 
-def cube_directions(size: int) -> np.ndarray:
-    """Unit directions of a cube level's texel centres, (6, size, size, 3), OpenGL face order
-    (numpy twin of common/cubemap.glsl's cube_texel_direction)."""
-    c = 2.0 * (np.arange(size) + 0.5) / size - 1.0
-    t, s = np.meshgrid(c, c, indexing="ij")
-    one = np.ones_like(s)
-    faces = [(one, -t, -s), (-one, -t, s), (s, one, t), (s, -one, -t), (s, -t, one), (-s, -t, -one)]
-    d = np.stack([np.stack(f, axis=-1) for f in faces])
-    return d / np.linalg.norm(d, axis=-1, keepdims=True)
-
-
 # (map, quality): (neighbour-ratio bound, bound on the step's error against converged)
 FIREFLY_BOUNDS = {
     ("quarry_01_1k.hdr", "low"): (1.25, 0.03), ("quarry_01_1k.hdr", "medium"): (1.25, 0.025),
@@ -285,7 +275,7 @@ def test_no_fireflies_in_prefiltered_map(env_of, env_name, quality):
         faces = read_cube(r.shaders, cube, step // 2)[..., :3]
         assert np.isfinite(faces).all() and faces.min() >= 0.0
         ratio = neighbour_ratio(faces)
-        dirs = cube_directions(faces.shape[1]).reshape(-1, 3)
+        dirs = cube_texel_directions(faces.shape[1]).reshape(-1, 3)
         pick = rng.choice(len(dirs), min(len(dirs), 1000), replace=False)
         want = prefiltered_converged(small, dirs[pick], grid_roughness(step, levels))
         err = rel_error(faces.reshape(-1, 3)[pick], want)

@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from alight.core.shading import rotate_world_to_map
-from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_directions, eps_of
+from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_directions, merged_parts
 from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
 SKY_WEIGHT_VERSION = 1
@@ -118,14 +118,7 @@ def sky_rays(parts, rays: int, seed: int = SKY_SEED, light_through=None) -> list
     out = [(np.zeros((len(p.positions), rays), np.uint8), np.zeros(len(p.positions), np.float32)) for p in parts]
     if not parts or not sum(len(p.positions) for p in parts):
         return out
-    positions = np.concatenate([p.positions for p in parts]).astype(np.float64)
-    lo, hi = positions.min(axis=0), positions.max(axis=0)
-    eps = eps_of(float(np.linalg.norm(hi - lo)) or 1.0)
-    offsets = np.cumsum([0] + [len(p.positions) for p in parts])
-    faces = [np.asarray(p.indices, np.int64).reshape(-1, 3) for p in parts]
-    all_f = np.concatenate([f + o for f, o in zip(faces, offsets[:-1])])
-    all_n = np.concatenate([p.normals for p in parts]).astype(np.float64)
-    all_n /= np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
+    positions, eps, offsets, faces, all_f, all_n = merged_parts(parts)
     through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
     part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
     opaque_tri = ~(through > 0.0)[part_of_triangle]

@@ -821,6 +821,21 @@ MAX_SUNS = 4          # shaders/common/suns.glsl's MAX_SUNS: one vec4 per vertex
 SUN_BOUNCE_VERSION = 2   # 2: the second bounce (B2)
 
 
+def merged_parts(parts):
+    """The refined parts as one mesh for ray casting: (positions (N, 3) float64, the ray offset
+    eps, per-part vertex offsets (P + 1,), per-part faces [(M_k, 3)], all faces (M, 3) in the merged
+    numbering, unit normals (N, 3) float64)."""
+    positions = np.concatenate([p.positions for p in parts]).astype(np.float64)
+    lo, hi = positions.min(axis=0), positions.max(axis=0)
+    eps = eps_of(float(np.linalg.norm(hi - lo)) or 1.0)
+    offsets = np.cumsum([0] + [len(p.positions) for p in parts])
+    faces = [np.asarray(p.indices, np.int64).reshape(-1, 3) for p in parts]
+    all_f = np.concatenate([f + o for f, o in zip(faces, offsets[:-1])])
+    all_n = np.concatenate([p.normals for p in parts]).astype(np.float64)
+    all_n /= np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
+    return positions, eps, offsets, faces, all_f, all_n
+
+
 def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
                     seed: int = 0, light_through=None) -> list[np.ndarray]:
     """Per part of a bake (``bake_visibility``'s refined parts, world space), (N, 8) float32: the
@@ -842,14 +857,7 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
     out = [np.zeros((len(p.positions), 2 * MAX_SUNS), np.float32) for p in parts]
     if not len(directions) or not parts:
         return out
-    positions = np.concatenate([p.positions for p in parts]).astype(np.float64)
-    lo, hi = positions.min(axis=0), positions.max(axis=0)
-    eps = eps_of(float(np.linalg.norm(hi - lo)) or 1.0)
-    offsets = np.cumsum([0] + [len(p.positions) for p in parts])
-    faces = [np.asarray(p.indices, np.int64).reshape(-1, 3) for p in parts]
-    all_f = np.concatenate([f + o for f, o in zip(faces, offsets[:-1])])
-    all_n = np.concatenate([p.normals for p in parts]).astype(np.float64)
-    all_n /= np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
+    positions, eps, offsets, faces, all_f, all_n = merged_parts(parts)
     refined = _Occluders(positions[all_f])
     through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
     part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
