@@ -26,7 +26,12 @@ Transmission (KHR_materials_transmission's factor) is a thin wall: the share t (
 what meets it goes straight on, chosen with that probability, shadow rays carry the product of
 the walls' shares (no refraction, no Fresnel loss on the way through; alight's shadows and bake
 weigh parts the same way, alight.render.visibility_parts.light_through).
-Not modelled (refused or said in one warning line): the other layers (clearcoat, sheen, anisotropy), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
+KHR_materials_clearcoat's coat is traced as docs/layer_clearcoat.md defines it (the renderer's
+and the exact reference's layering, alight.core.layers.clearcoat): f = f_base (1 - c F_c(n.v))
++ c F_c(n.v) D_c G_c / (4 (n.l)(n.v)), F0 = 0.04, the coat's normal the base's (no maps), with a
+third lobe to sample (GGX at the coat's roughness, picked by c F_c(n.v) against the base's albedo).
+Not modelled (refused or said in one warning line): the other layers (sheen, anisotropy,
+iridescence, ...), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
 """
 
 from __future__ import annotations
@@ -37,9 +42,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from alight.core.layers.clearcoat import clearcoat_fresnel
 from alight.core.shading import (
+    D_GGX,
     MIN_N_DOT_V,
     MIN_PUNCTUAL_ROUGHNESS,
+    G1_SchlickGGX,
+    k_direct,
+    k_ibl,
     punctual_light,
     range_attenuation,
     spot_attenuation,
@@ -100,10 +110,11 @@ def _normalize(v):
     return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
 
 
-def brdf_cos(n, v, l, base, metallic, roughness, f0):
+def brdf_cos(n, v, l, base, metallic, roughness, f0, clearcoat=None, clearcoat_roughness=None):
     """docs/conventions.md's f(l, v) (n.l) with the ground truth's k = r^2/2; (N, 3). n, v, l: (N, 3)
     unit vectors; base, f0: (N, 3); metallic, roughness: (N,). n.v is floored at MIN_N_DOT_V and
-    |l + v| at 1e-7, as the exact reference does."""
+    |l + v| at 1e-7, as the exact reference does. clearcoat, clearcoat_roughness (N,): the coat
+    over it (coat_cos), or None."""
     n_dot_l = _dot(n, l)
     n_dot_v = np.maximum(_dot(n, v), MIN_N_DOT_V)
     lv = l + v
@@ -120,7 +131,42 @@ def brdf_cos(n, v, l, base, metallic, roughness, f0):
     G = (n_dot_v / (n_dot_v * (1.0 - k) + k)) * (nl / (nl * (1.0 - k) + k))
     spec = (D * G / (4.0 * nl * n_dot_v))[:, None] * F
     out = (kd * base / PI + spec) * n_dot_l[:, None]
+    if clearcoat is not None:
+        out = out * coat_base_weight(n, v, clearcoat)[:, None] + coat_cos(n, v, l, clearcoat, clearcoat_roughness,
+                                                                           False)[:, None]
     return np.where((n_dot_l > 0.0)[:, None], out, 0.0)
+
+
+def coat_base_weight(n, v, clearcoat):
+    """What the coat lets through to the base: 1 - c F_c(n.v); (N,)."""
+    return 1.0 - clearcoat * clearcoat_fresnel(_dot(n, v))
+
+
+def coat_cos(n, v, l, clearcoat, clearcoat_roughness, punctual):
+    """The coat's c F_c(n.v) D G / (4 (n.l)(n.v)) (n.l), as alight.core.layers.clearcoat's
+    clearcoat_light per row (D's roughness floored at MIN_PUNCTUAL_ROUGHNESS, k = r^2/2, or the
+    punctual k and floor for a light); (N,), 0 where n.l <= 0."""
+    n_dot_l = _dot(n, l)
+    n_dot_v = np.maximum(_dot(n, v), MIN_N_DOT_V)
+    h = _normalize(l + v)
+    n_dot_h = np.maximum(_dot(n, h), 0.0)
+    r = np.maximum(clearcoat_roughness, MIN_PUNCTUAL_ROUGHNESS)
+    k = k_direct(r) if punctual else k_ibl(r)
+    nl = np.maximum(n_dot_l, 1e-12)
+    lobe = D_GGX(n_dot_h, r) * G1_SchlickGGX(n_dot_v, k) * G1_SchlickGGX(nl, k) / (4.0 * n_dot_v)
+    out = clearcoat * clearcoat_fresnel(_dot(n, v)) * lobe
+    return np.where(n_dot_l > 0.0, out, 0.0)
+
+
+def _coat_probability(n_dot_v, base, metallic, f0, clearcoat):
+    """The chance of sampling the coat's lobe: its weight c F_c(n.v) against what the base under
+    it reflects (its Fresnel and diffuse albedo, times 1 - c F_c), in [0.05, 0.95] where a coat
+    is present, else 0."""
+    fc = clearcoat * clearcoat_fresnel(n_dot_v)
+    F = f0 + (1.0 - f0) * ((1.0 - np.clip(n_dot_v, 0.0, 1.0)) ** 5)[:, None]
+    under = (F + (1.0 - F) * (1.0 - metallic)[:, None] * base) @ LUMA * (1.0 - fc)
+    p = fc / np.maximum(fc + under, 1e-12)
+    return np.where(clearcoat > 0.0, np.clip(p, 0.05, 0.95), 0.0)
 
 
 def _specular_probability(n_dot_v, base, metallic, f0):
@@ -143,27 +189,43 @@ def _frame(n):
     return t, bb
 
 
-def brdf_pdf(n, v, l, roughness, p_spec):
+def _ggx_reflection_pdf(n_dot_h, v_dot_h, roughness):
+    a2 = roughness ** 4
+    d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0
+    return a2 / (PI * d * d) * n_dot_h / (4.0 * v_dot_h)
+
+
+def brdf_pdf(n, v, l, roughness, p_spec, p_coat=None, coat_roughness=None):
     """Solid-angle pdf of ``sample_brdf``'s mixture at l; (N,)."""
     n_dot_l = _dot(n, l)
     h = _normalize(l + v)
     n_dot_h = np.clip(_dot(n, h), 0.0, 1.0)
     v_dot_h = np.maximum(_dot(v, h), 1e-12)
-    a2 = roughness ** 4
-    d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0
-    pdf_spec = a2 / (PI * d * d) * n_dot_h / (4.0 * v_dot_h)
+    pdf_spec = _ggx_reflection_pdf(n_dot_h, v_dot_h, roughness)
     pdf_diff = np.maximum(n_dot_l, 0.0) / PI
-    return np.where(n_dot_l > 0.0, p_spec * pdf_spec + (1.0 - p_spec) * pdf_diff, 0.0)
+    pdf = p_spec * pdf_spec + (1.0 - p_spec) * pdf_diff
+    if p_coat is not None:
+        pdf_coat = _ggx_reflection_pdf(n_dot_h, v_dot_h, np.maximum(coat_roughness, MIN_PUNCTUAL_ROUGHNESS))
+        pdf = p_coat * pdf_coat + (1.0 - p_coat) * pdf
+    return np.where(n_dot_l > 0.0, pdf, 0.0)
 
 
-def sample_brdf(n, v, roughness, p_spec, xi):
+def sample_brdf(n, v, roughness, p_spec, xi, p_coat=None, coat_roughness=None):
     """Directions l (N, 3): GGX half vectors drawn by D(h)(n.h) (Walter et al. 2007) reflected
-    about h with chance p_spec, else cosine-weighted; xi (N, 3) uniform in [0, 1)."""
+    about h with chance p_spec, else cosine-weighted; xi (N, 3) uniform in [0, 1). With p_coat,
+    the coat's GGX lobe (roughness floored as coat_cos's D) first, with that chance."""
     t, b = _frame(n)
+    xi0 = xi[:, 0]
+    coat = np.zeros(len(xi0), bool)
+    if p_coat is not None:
+        coat = xi0 < p_coat
+        xi0 = np.where(coat, xi0 / np.maximum(p_coat, 1e-12), (xi0 - p_coat) / np.maximum(1.0 - p_coat, 1e-12))
+        xi0 = np.clip(xi0, 0.0, 1.0 - 1e-12)
+        roughness = np.where(coat, np.maximum(coat_roughness, MIN_PUNCTUAL_ROUGHNESS), roughness)
     a2 = roughness ** 4
     phi = 2.0 * PI * xi[:, 1]
-    spec = xi[:, 0] < p_spec
-    u = np.where(spec, xi[:, 0] / np.maximum(p_spec, 1e-12), (xi[:, 0] - p_spec) / np.maximum(1.0 - p_spec, 1e-12))
+    spec = (xi0 < p_spec) | coat
+    u = np.where(spec, xi0 / np.maximum(p_spec, 1e-12), (xi0 - p_spec) / np.maximum(1.0 - p_spec, 1e-12))
     u = np.clip(u, 0.0, 1.0 - 1e-12)
     # GGX: cos^2(theta_h) = (1 - u) / (1 + (a^2 - 1) u); cosine: cos^2(theta) = 1 - u
     cos2_h = (1.0 - xi[:, 2]) / (1.0 + (a2 - 1.0) * xi[:, 2])
@@ -261,13 +323,14 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     mesh = scene.mesh
     warnings: list[str] = []
     corners, normals, mats, table = [], [], [], {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0",
-                                                                           "emissive", "through")}
+                                                                           "emissive", "through", "clearcoat",
+                                                                           "clearcoat_roughness")}
     # The user's maps (--map, --texture-set) are left out as a file's are.
     textured = bool(getattr(scene, "texture_maps", None))
     layered = masked = False
     for index, part in enumerate(mesh.parts):
         m, maps_apply = part_material(scene, part)
-        if m.layers() - {"transmission"}:
+        if m.layers() - {"transmission", "clearcoat"}:
             layered = True
         # KHR_materials_transmission as a thin wall: the share t (1 - metallic) goes straight on
         # (no refraction, no Fresnel loss), the rest meets the base BRDF.
@@ -292,8 +355,11 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
         table["f0"].append(m.f0())
         table["specular_f0"].append(m.specular_f0)
         table["emissive"].append(m.emissive)
+        table["clearcoat"].append(float(m.clearcoat))
+        table["clearcoat_roughness"].append(max(float(m.clearcoat_roughness), MIN_TRACE_ROUGHNESS))
     if layered:
-        raise AlightError(f"{mesh.source}: the path tracer has the base BRDF only (no clearcoat, sheen, anisotropy; "
+        raise AlightError(f"{mesh.source}: the path tracer has the base BRDF and the clearcoat only (no sheen, anisotropy, "
+                          "iridescence; "
                           "transmission as a thin wall); use the exact reference (--integrator exact) for layered "
                           "materials")
     if textured:
@@ -429,6 +495,7 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
     tb = geom.table
     clear_parts = bool((tb["through"] > 0.0).any())
     through_of_triangle = tb["through"][geom.material]
+    coated = bool((tb["clearcoat"] > 0.0).any())
 
     def shadow(origins, dirs, dists):
         """1 where the light is seen, 0 behind an opaque triangle, the thin walls' product between."""
@@ -497,11 +564,17 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                 else:
                     passing = None
             base, metal, rough, f0 = tb["base"][m], tb["metallic"][m], tb["roughness"][m], tb["f0"][m]
+            # the coat's weight and roughness, or None for every lobe function when no part has one
+            coat, coat_rough = (tb["clearcoat"][m], tb["clearcoat_roughness"][m]) if coated else (None, None)
             radiance_sum[alive] += throughput * tb["emissive"][m]
             p_off = p + ng * eps
             last = bounce + 1 >= settings.max_bounces or not settings.visibility
             n_dot_v = _dot(n, v)
             p_spec = _specular_probability(n_dot_v, base, metal, f0)
+            p_coat = _coat_probability(n_dot_v, base, metal, f0, coat) if coated else None
+
+            def rows(x, sub):
+                return None if x is None else x[sub]
             # next-event estimation: the environment
             if env is not None:
                 xi = rng.random((len(alive), 3))
@@ -515,8 +588,10 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                     ok &= seen > 0.0
                 if ok.any():
                     sub = np.flatnonzero(ok)
-                    f = seen[sub, None] * brdf_cos(n[sub], v[sub], l[sub], base[sub], metal[sub], rough[sub], f0[sub])
-                    pb = brdf_pdf(n[sub], v[sub], l[sub], rough[sub], p_spec[sub])
+                    f = seen[sub, None] * brdf_cos(n[sub], v[sub], l[sub], base[sub], metal[sub], rough[sub], f0[sub],
+                                                   rows(coat, sub), rows(coat_rough, sub))
+                    pb = brdf_pdf(n[sub], v[sub], l[sub], rough[sub], p_spec[sub], rows(p_coat, sub),
+                                  rows(coat_rough, sub))
                     # power heuristic: (f L / pe) pe^2 / (pe^2 + pb^2), where a BRDF sample follows;
                     # at a path's last vertex the environment sample is the only strategy
                     if last:
@@ -535,18 +610,21 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                     ok &= seen > 0.0
                 if ok.any():
                     sub = np.flatnonzero(ok)
-                    radiance_sum[alive[sub]] += seen[sub, None] * throughput[sub] * punctual_light(
-                        n[sub], v[sub], l[sub], base[sub], metal[sub], np.maximum(rough[sub], MIN_PUNCTUAL_ROUGHNESS),
-                        tb["specular_f0"][m[sub]], Li[sub])
+                    lit = punctual_light(n[sub], v[sub], l[sub], base[sub], metal[sub],
+                                         np.maximum(rough[sub], MIN_PUNCTUAL_ROUGHNESS), tb["specular_f0"][m[sub]], Li[sub])
+                    if coated:
+                        lit = (lit * coat_base_weight(n[sub], v[sub], coat[sub])[:, None]
+                               + coat_cos(n[sub], v[sub], l[sub], coat[sub], coat_rough[sub], True)[:, None] * Li[sub])
+                    radiance_sum[alive[sub]] += seen[sub, None] * throughput[sub] * lit
             if last:
                 break
             # the BRDF sample that carries the path on
             xi = rng.random((len(alive), 3))
             xi[:, 2] = stratified(xi[:, 2], 1, alive)
-            l = sample_brdf(n, v, rough, p_spec, xi)
-            pb = brdf_pdf(n, v, l, rough, p_spec)
+            l = sample_brdf(n, v, rough, p_spec, xi, p_coat, coat_rough)
+            pb = brdf_pdf(n, v, l, rough, p_spec, p_coat, coat_rough)
             ok = (_dot(ng, l) > 0.0) & (pb > 0.0)
-            f = brdf_cos(n, v, l, base, metal, rough, f0)
+            f = brdf_cos(n, v, l, base, metal, rough, f0, coat, coat_rough)
             throughput = throughput * f / np.maximum(pb, 1e-300)[:, None]
             if bounce + 1 >= ROULETTE_FROM:
                 q = np.clip(throughput.max(axis=1), 0.05, 0.95)

@@ -48,7 +48,8 @@ vec3 clearcoat_ibl(Surface s, vec3 v, bool with_suns) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec4 lut = brdf_lut_at(n_dot_v, s.clearcoat_roughness);
     vec3 d = specular_dominant_direction(n, reflect(-v, n), vec3(1.0), lut);
-    vec3 prefiltered = prefiltered_radiance_at(d, s.clearcoat_roughness, with_suns);
+    vec3 prefiltered = occluded_layer_radiance(s, n, d, s.clearcoat_roughness,
+                                               prefiltered_radiance_at(d, s.clearcoat_roughness, with_suns));
     return s.clearcoat * clearcoat_fresnel(s, v) * (lut.x + lut.y) * prefiltered;
 }
 

@@ -171,6 +171,14 @@ float combined_visibility(Surface s, vec3 n) {
 // Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
 // the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
 // The compact sources' direct light (with_suns) stays unoccluded here (shadows are theirs).
+#ifdef HAS_VISIBILITY
+// What the occluded directions send this point (the occluders' bounce and the suns on them),
+// which occlude_environment works out for the base; the layers' lobes above it (clearcoat_ibl,
+// sheen_ibl) see the same surroundings, and the base's IBL always runs before layered_ibl, so
+// they read it here instead of fetching the bounce's irradiance again.
+vec3 g_occluder_radiance = vec3(0.0);
+#endif
+
 void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool with_suns,
                          inout vec3 irradiance, inout vec3 prefiltered) {
 #ifdef HAS_VISIBILITY
@@ -201,6 +209,21 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     if (with_suns) irradiance += suns_irradiance_over_pi(n);
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
     prefiltered = so * prefiltered + (1.0 - so) * occluder;
+    g_occluder_radiance = occluder;
+#endif
+}
+
+// A layer's lobe over the base (the clearcoat's about its normal n, the sheen's) under the same
+// occlusion as the base's specular: the share so of the lobe of roughness `roughness` around d
+// that falls inside the visibility cone sees the prefiltered radiance, the rest the occluders
+// (Jimenez et al. 2016's cone-cone specular occlusion, as occlude_environment). Without it a
+// coat inside a crevice reflected the whole sky (ibl_outer_occlusion is 1 under a bake).
+vec3 occluded_layer_radiance(Surface s, vec3 n, vec3 d, float roughness, vec3 prefiltered) {
+#ifdef HAS_VISIBILITY
+    float so = specular_occlusion(dot(bent_normal(n), d), dot(n, d), combined_visibility(s, n), roughness);
+    return so * prefiltered + (1.0 - so) * g_occluder_radiance;
+#else
+    return prefiltered;
 #endif
 }
 

@@ -50,7 +50,7 @@ vec3 sheen_ibl(Surface s, vec3 n, vec3 v, bool with_suns) {
     // At n.v = 1 the lobe is symmetric about n (sin phi = 0), so any tangent serves.
     vec3 t = len2 > 1e-12 ? toward_v * inversesqrt(len2) : vec3(0.0);
     vec3 d = normalize(n * sqrt(max(1.0 - lut.y * lut.y, 0.0)) + t * lut.y);
-    return s.sheen_color * min(lut.x, 1.0) * prefiltered_radiance_at(d, lut.z, with_suns);
+    return s.sheen_color * min(lut.x, 1.0) * occluded_layer_radiance(s, n, d, lut.z, prefiltered_radiance_at(d, lut.z, with_suns));
 }
 
 #endif
