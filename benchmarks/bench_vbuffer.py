@@ -3,8 +3,12 @@ alight.render.vbuffer) against the forward pass: steady frames alternated in one
 (A B A B ...), the first frame of a fresh process (shader compiles, Mesa's cache off), and how far
 the pictures differ (relMAE of the linear radiance, as an EXR holds it). Asserts nothing.
 
-    .venv/bin/python benchmarks/bench_vbuffer.py [--size 1024] [--rounds 5] [--triangles 8000,1000000]
+    .venv/bin/python benchmarks/bench_vbuffer.py [--size 1024[,512...]] [--rounds 5] [--triangles 8000,1000000]
         [--first 3] [--pictures 512]
+
+Per scene and size it also prints the triangle density that mesh_shading "auto" chooses by
+(alight.render.vbuffer.pixels_per_triangle, the estimate, next to the covered pixels counted in
+the forward frame, alpha > 0, per triangle of the mesh) and what "auto" chose, then a table of all.
 
 Scenes: DamagedHelmet (its materials) and bumpy spheres of each --triangles count
 (bench_assets.bumpy_sphere, untextured), the royal_esplanade environment, 4x MSAA, read back as sRGB.
@@ -92,6 +96,21 @@ def steady(r, scene, maps, size: int, rounds: int) -> tuple[dict[str, list[float
     return times, cpu
 
 
+def density(r, scene, maps, size: int) -> tuple[int, float, float | None, bool]:
+    """(triangles, covered pixels per triangle counted in the forward frame, the estimate "auto"
+    chooses by, whether "auto" took the visibility buffer)."""
+    from alight.render.vbuffer import pixels_per_triangle
+
+    r.mesh_shading = "forward"
+    covered = int((r.render(scene, maps, size, size, read_srgb=False).linear[..., 3] > 0).sum())
+    triangles = sum(len(part.indices) for part in scene.mesh.parts)
+    view_projection = r.camera_for(scene, 1.0).view_projection(1.0)
+    estimate = pixels_per_triangle(r, scene, view_projection, (size, size))
+    r.mesh_shading = "auto"
+    r.render(scene, maps, size, size, read_linear=False)
+    return triangles, covered / triangles, estimate, r.last_vbuffer
+
+
 def rel_mae(r, scene, maps, size: int) -> tuple[float, float, float, bool]:
     """relMAE of the linear RGB (vbuffer against forward), the share of pixels whose sRGB differs
     by more than 4/255, the largest sRGB difference (of 255), and whether the visibility buffer
@@ -109,7 +128,7 @@ def rel_mae(r, scene, maps, size: int) -> tuple[float, float, float, bool]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--size", type=int, default=1024)
+    ap.add_argument("--size", default="1024", help="image sizes, comma-separated")
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--triangles", default="8000,1000000", help="the spheres' triangle counts, comma-separated")
     ap.add_argument("--first", type=int, default=3, help="fresh processes per mode for the first frame (0: skip)")
@@ -128,15 +147,31 @@ def main() -> None:
         for count in args.triangles.split(","):
             sphere = sphere_file(Path(tmp), int(count))
             scenes[sphere.stem] = sphere
-        print(f"{args.size}x{args.size} 4x MSAA, sRGB read back, {ENV.name}; {args.rounds} rounds of 3 frames, "
+        sizes = [int(x) for x in args.size.split(",")]
+        print(f"{args.size} square, 4x MSAA, sRGB read back, {ENV.name}; {args.rounds} rounds of 3 frames, "
               "modes alternated; round medians: median (range)")
+        rows = []
         for name, path in scenes.items():
             scene = Scene(mesh=load_mesh(str(path)))
-            times, cpu = steady(r, scene, maps, args.size, args.rounds)
-            print(f"  {name} wall: forward {summary(times['forward'])}, vbuffer {summary(times['vbuffer'])}, "
-                  f"vbuffer/forward {ratio_summary(times['forward'], times['vbuffer'])}")
-            print(f"  {name} CPU:  forward {summary(cpu['forward'])}, vbuffer {summary(cpu['vbuffer'])}, "
-                  f"vbuffer/forward {ratio_summary(cpu['forward'], cpu['vbuffer'])}")
+            for size in sizes:
+                times, cpu = steady(r, scene, maps, size, args.rounds)
+                triangles, counted, estimate, auto = density(r, scene, maps, size)
+                wall, proc = (ratio_summary(times["forward"], times["vbuffer"]),
+                              ratio_summary(cpu["forward"], cpu["vbuffer"]))
+                guess = "-" if estimate is None else f"{estimate:.2f}"
+                chosen = "vbuffer" if auto else "forward"
+                print(f"  {name} {size}: wall: forward {summary(times['forward'])}, "
+                      f"vbuffer {summary(times['vbuffer'])}, vbuffer/forward {wall}")
+                print(f"  {name} {size}: CPU:  forward {summary(cpu['forward'])}, "
+                      f"vbuffer {summary(cpu['vbuffer'])}, vbuffer/forward {proc}")
+                print(f"  {name} {size}: {triangles} triangles, covered pixels per triangle {counted:.2f} "
+                      f"(estimate {guess}), auto: {chosen}")
+                rows.append((name, size, triangles, counted, guess, wall, proc, chosen))
+        print("| scene | size | triangles | covered px / triangle | estimate | vbuffer/forward wall | CPU | auto |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+        for name, size, triangles, counted, guess, wall, proc, chosen in rows:
+            print(f"| {name} | {size} | {triangles:,} | {counted:.2f} | {guess} | {wall} | {proc} | {chosen} |")
+        sys.stdout.flush()
         if args.first:
             env = {**os.environ, "MESA_SHADER_CACHE_DISABLE": "true"}
             for name, path in scenes.items():
@@ -144,7 +179,7 @@ def main() -> None:
                 for i in range(args.first):
                     for mode in (MODES if i % 2 == 0 else MODES[::-1]):
                         out = subprocess.run([sys.executable, "-c", FIRST_FRAME, str(ENV), str(path), mode,
-                                              str(args.size)], capture_output=True, text=True, env=env, check=True)
+                                              str(sizes[0])], capture_output=True, text=True, env=env, check=True)
                         first[mode].append(float(out.stdout.split()[-1]))
                 print(f"  {name} first frame of a fresh process (Mesa cache off, bake cached), {args.first} each: "
                       f"forward {summary(first['forward'])}, vbuffer {summary(first['vbuffer'])}, "

@@ -53,7 +53,7 @@ def both(scene: Scene, size: int = 128, **kwargs):
             frames.append(r.render(scene, _maps(), size, size, aa="msaa", **kwargs))
         used = r.last_vbuffer
     finally:
-        r.mesh_shading = "forward"
+        r.mesh_shading = "auto"   # (the renderer's default)
     return frames[0], frames[1], used
 
 
@@ -130,7 +130,7 @@ def test_tiles_match_one_framebuffer():
         tiled = r.render(scene, _maps(), 160, 160, aa="msaa", tile=(64, 64)).linear
         assert r.last_vbuffer
     finally:
-        r.mesh_shading = "forward"
+        r.mesh_shading = "auto"   # (the renderer's default)
     np.testing.assert_allclose(tiled, whole, atol=2e-3)
 
 
@@ -154,7 +154,7 @@ def test_forward_where_not_eligible(tmp_path, kind):
         r.render(scene, _maps(), 64, 64, aa="ssaa" if kind == "ssaa" else "msaa")
         assert not r.last_vbuffer
     finally:
-        r.mesh_shading = "forward"
+        r.mesh_shading = "auto"   # (the renderer's default)
 
 
 def _checker_grid(path: Path, cells: int) -> Path:
@@ -197,7 +197,7 @@ def test_odd_size_keeps_forward():
         r.render(scene, _maps(), 64, 64, aa="msaa")
         assert r.last_vbuffer
     finally:
-        r.mesh_shading = "forward"
+        r.mesh_shading = "auto"   # (the renderer's default)
 
 
 def test_per_vertex_occlusion():
@@ -226,7 +226,7 @@ def test_tangents_only_where_read(tmp_path):
             r.render(Scene(mesh=mesh, camera=CAMERA), _maps(), 64, 64, aa="msaa")
             assert r.last_vbuffer
     finally:
-        r.mesh_shading = "forward"
+        r.mesh_shading = "auto"   # (the renderer's default)
     assert all(g.tangent_buffer is None for g in r.meshes.parts(grid))
     assert all(g.tangent_buffer is not None for g in r.meshes.parts(helmet))
 
@@ -240,3 +240,123 @@ def test_scissor_rectangle_has_even_corners():
         x, y, w, h = box_rect(np.array(lo), np.array(hi), vp, (64, 48))
         assert x % 2 == 0 and y % 2 == 0 and w % 2 == 0 and h % 2 == 0, (x, y, w, h)
         assert 0 <= x and 0 <= y and x + w <= 64 and y + h <= 48
+
+
+# --- mesh_shading "auto" (the default): the visibility buffer only on a dense mesh ----------
+
+def _auto(scene: Scene, size: int):
+    """The "auto" frame of ``scene`` and whether it took the visibility buffer."""
+    from tests.gpu import renderer
+
+    r = renderer()
+    r.mesh_shading = "auto"
+    frame = r.render(scene, _maps(), size, size, aa="msaa")
+    return frame, r.last_vbuffer
+
+
+def _estimate(scene: Scene, size: int) -> float:
+    from tests.gpu import renderer
+
+    from alight.render.vbuffer import pixels_per_triangle
+
+    r = renderer()
+    return pixels_per_triangle(r, scene, r.camera_for(scene, 1.0).view_projection(1.0), (size, size))
+
+
+def test_auto_takes_the_visibility_buffer_on_a_dense_mesh_only(tmp_path):
+    """A grid of 28,800 triangles over a few thousand pixels takes the visibility buffer, with
+    the forward pass's picture; a grid of 32 triangles in the same place keeps the forward pass."""
+    from alight.render.vbuffer import AUTO_PIXELS_PER_TRIANGLE
+
+    dense = Scene(mesh=load_mesh(str(_checker_grid(tmp_path, 120))), camera=CAMERA, lights=list(LIGHTS))
+    sparse = Scene(mesh=load_mesh(str(_checker_grid(tmp_path, 4))), camera=CAMERA, lights=list(LIGHTS))
+    assert _estimate(dense, 160) < AUTO_PIXELS_PER_TRIANGLE < _estimate(sparse, 160)
+    frame, used = _auto(dense, 160)
+    forward = both(dense, 160)[0]
+    assert_same(forward, frame, used, limit=REL_LIMIT_GRID)
+    frame, used = _auto(sparse, 160)
+    assert not used
+    np.testing.assert_array_equal(frame.linear, both(sparse, 160)[0].linear)
+
+
+@pytest.mark.parametrize("size", [1024, 512])
+def test_auto_keeps_the_helmet_forward(size):
+    """DamagedHelmet at the command line's default size (1024) and the API's (512) keeps the
+    forward pass: its triangles are too large there for the visibility buffer to pay."""
+    scene = Scene(mesh=load_mesh(str(HELMET)))
+    assert not _auto(scene, size)[1]
+
+
+def test_auto_keeps_the_builtin_sphere_forward():
+    assert not _auto(Scene(), 128)[1]
+
+
+def test_estimate_bounds_the_covered_pixels(tmp_path):
+    """pixels_per_triangle's projected boxes hold every pixel the mesh covers (an upper bound,
+    so that "auto" errs toward the forward pass): on the helmet within 3x (2.2x at the sizes of
+    benchmarks/results/vbuffer.md); the tilted grid reaches past the image, whose pixels the
+    estimate counts and the frame cannot."""
+    for mesh, camera, most in ((load_mesh(str(HELMET)), None, 3.0),
+                               (load_mesh(str(_checker_grid(tmp_path, 40))), CAMERA, None)):
+        scene = Scene(mesh=mesh, camera=camera)
+        frame = both(scene, 192)[0]
+        covered = float((frame.linear[..., 3] > 0).sum())
+        estimate = _estimate(scene, 192) * sum(len(part.indices) for part in mesh.parts)
+        assert covered <= estimate, (covered, estimate)
+        assert most is None or estimate < most * covered, (covered, estimate)
+
+
+def _grid_file(path: Path, cells: int) -> Path:
+    """A plain grid plane of cells x cells quads facing the default camera (+Z)."""
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(cells)
+    mat = g.material(pbrMetallicRoughness={"baseColorFactor": [0.8, 0.5, 0.2, 1.0], "roughnessFactor": 0.5})
+    g.mesh([{"attributes": {"POSITION": g.accessor(positions, bounds=True), "NORMAL": g.accessor(normals)},
+             "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
+    return g.save(path / f"plain{cells}.glb")
+
+
+def test_cli_mesh_shading_flag(tmp_path):
+    """``alight render --mesh-shading`` (default auto) through the command line: --verbose says
+    which shading ran; auto takes the visibility buffer on the dense grid, not on the sparse one,
+    and its picture is the forward one's."""
+    import os
+    import subprocess
+    import sys
+
+    import OpenImageIO as oiio
+
+    def render(mesh: Path, *flags) -> tuple[str, np.ndarray]:
+        out = tmp_path / f"{mesh.stem}_{'_'.join(flags) or 'default'}.exr"
+        proc = subprocess.run([sys.executable, "-m", "alight", "render", "--size", "64", "--quality", "low",
+                               "--mesh", str(mesh), "--verbose", *flags, "--out", str(out)],
+                              capture_output=True, text=True, env=dict(os.environ), timeout=300)
+        assert proc.returncode == 0, proc.stderr
+        line = next(x for x in proc.stderr.splitlines() if x.startswith("mesh shading:"))
+        return line, np.asarray(oiio.ImageBuf(str(out)).get_pixels(oiio.FLOAT))
+
+    dense, sparse = _grid_file(tmp_path, 80), _grid_file(tmp_path, 2)
+    line, auto = render(dense)
+    assert line == "mesh shading: vbuffer (--mesh-shading auto)"
+    line, forward = render(dense, "--mesh-shading", "forward")
+    assert line == "mesh shading: forward (--mesh-shading forward)"
+    assert rel_mae(forward, auto) < REL_LIMIT_GRID
+    assert render(sparse)[0] == "mesh shading: forward (--mesh-shading auto)"
+    assert render(sparse, "--mesh-shading", "vbuffer")[0] == "mesh shading: vbuffer (--mesh-shading vbuffer)"
+
+
+def test_api_and_batch_check_the_mode(tmp_path):
+    from alight.errors import AlightError
+    from alight.frontends.api import Renderer
+    from alight.frontends.batch import plan
+
+    assert Renderer(32).mesh_shading == "auto"
+    assert Renderer(32, mesh_shading="forward").mesh_shading == "forward"
+    with pytest.raises(AlightError, match="mesh_shading"):
+        Renderer(32, mesh_shading="deferred")
+    spec = tmp_path / "spec.toml"
+    spec.write_text('size = 32\nmeshes = ["sphere"]\nmesh_shading = "vbuffer"\n')
+    assert {item.mesh_shading for item in plan(spec).stills} == {"vbuffer"}
+    spec.write_text('size = 32\nmeshes = ["sphere"]\nmesh_shading = "deferred"\n')
+    with pytest.raises(AlightError, match="mesh_shading"):
+        plan(spec)

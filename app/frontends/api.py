@@ -41,6 +41,7 @@ from alight.frontends.scene_setup import framing_warnings, load_scene_environmen
 from alight.ibl.environment import Environment, load_environment
 
 Quality = Literal["low", "medium", "high", "auto"]
+MESH_SHADING = ("auto", "forward", "vbuffer")   # alight.render.vbuffer.MESH_SHADING (not imported: it imports moderngl)
 AA = Literal["none", "msaa", "ssaa"]
 
 
@@ -49,11 +50,14 @@ class Renderer:
 
     Parameters are the defaults for :meth:`render`; every ``set_*`` method returns ``self`` so
     calls can be chained. Nothing touches the GPU until the first render (or :meth:`open`).
+    ``mesh_shading`` (also an attribute): how a mesh file is shaded under msaa, 'auto' (the
+    default: from a visibility buffer where the mesh has under 3 estimated covered pixels per
+    triangle, alight.render.vbuffer), 'forward' or 'vbuffer'.
     """
 
     def __init__(self, width: int = 512, height: int | None = None, *, quality: Quality | str = "medium",
                  aa: AA = "msaa", tonemap: str = "aces", exposure: float = 0.0, background: str = "env",
-                 error_budget: float = 0.02):
+                 error_budget: float = 0.02, mesh_shading: str = "auto"):
         self.width, self.height = _size(width, width if height is None else height)
         self.quality = quality
         # quality="auto": app/accuracy/auto_quality.py chooses per render within this error budget (a
@@ -63,6 +67,11 @@ class Renderer:
         self.last_texture_set = None   # the assignment of the last set_material(texture_set=...)
         self._features: dict[str, object] = {}
         self.aa: str = aa
+        # How mesh files are shaded under msaa (alight.render.vbuffer): 'auto' (the visibility
+        # buffer where the mesh is dense on screen), 'forward' or 'vbuffer'; read at each render.
+        if mesh_shading not in MESH_SHADING:
+            raise AlightError(f"mesh_shading: {mesh_shading!r} is not one of {', '.join(MESH_SHADING)}")
+        self.mesh_shading: str = mesh_shading
         self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
         self.bakes_done = 0    # how many bakes actually ran (misses of the memory and disk caches)
         self._mesh: Mesh | None = None
@@ -355,6 +364,9 @@ class Renderer:
         from alight.ibl.bake import QUALITY
 
         r = self._renderer
+        if self.mesh_shading not in MESH_SHADING:
+            raise AlightError(f"mesh_shading: {self.mesh_shading!r} is not one of {', '.join(MESH_SHADING)}")
+        r.mesh_shading = self.mesh_shading
         maps = None
         if self.quality == "auto":
             return self._frame_auto(w, h, linear, srgb)

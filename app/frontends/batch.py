@@ -12,6 +12,7 @@ A spec (paths are relative to the spec file's folder)::
     camera_angles = [0, 90]         # orbit about +Y, degrees (default [0])
     environment_angles = [0]        # environment rotation, degrees (default [0])
     contact_sheet = true            # contact_sheet.png with every still, labelled
+    mesh_shading = "auto"           # or "forward", "vbuffer" (alight render --mesh-shading)
     [turntable]                     # optional: N frames per mesh x environment x material
     frames = 24
     rotate = "camera"               # or "environment"
@@ -43,7 +44,8 @@ from alight.errors import AlightError
 from alight.frontends.batch_worker import MATERIAL_FIELDS, render_item
 
 _KEYS = {"out", "size", "quality", "meshes", "environments", "materials", "camera_angles",
-         "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background", "shadows", "ground"}
+         "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background", "shadows", "ground",
+         "mesh_shading"}
 _TURNTABLE_KEYS = {"frames", "rotate", "format", "fps"}
 
 
@@ -65,6 +67,7 @@ class Item:
     background: str = "env"
     shadows: str = "auto"     # alight.render.shadows
     ground: bool = False      # alight.render.ground
+    mesh_shading: str = "auto"   # alight.render.vbuffer: auto, forward or vbuffer
     inputs: list[str] = field(default_factory=list)  # files whose change makes the output stale
     label: str = ""
 
@@ -256,8 +259,10 @@ def _size_and_quality(spec: dict, source: Path) -> tuple[list[int], str]:
 
 
 def _item_options(spec: dict, source: Path) -> dict:
-    """The Item options the spec sets (aa, tonemap, background, shadows, ground), checked."""
-    options = {k: spec[k] for k in ("aa", "tonemap", "background", "shadows", "ground") if k in spec}
+    """The Item options the spec sets (aa, tonemap, background, shadows, ground, mesh_shading), checked."""
+    options = {k: spec[k] for k in ("aa", "tonemap", "background", "shadows", "ground", "mesh_shading") if k in spec}
+    if options.get("mesh_shading", "auto") not in ("auto", "forward", "vbuffer"):
+        raise AlightError(f"{source}: 'mesh_shading' must be auto, forward or vbuffer")
     if options.get("shadows", "auto") not in ("auto", "on", "off"):
         raise AlightError(f"{source}: 'shadows' must be auto, on or off")
     if not isinstance(options.get("ground", False), bool):

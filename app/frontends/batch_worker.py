@@ -54,7 +54,7 @@ def _render(item, warnings: list[str]) -> None:
     if item.environment not in envs:
         envs[item.environment] = load_environment(item.environment)
     warnings.extend([*meshes[item.mesh].warnings, *envs[item.environment].warnings])
-    r.quality, r.aa = item.quality, item.aa
+    r.quality, r.aa, r.mesh_shading = item.quality, item.aa, item.mesh_shading
     r.width, r.height = item.size
     r.set_mesh(meshes[item.mesh]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)
     material, maps = _material(item.material)

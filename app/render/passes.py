@@ -157,7 +157,7 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         frame.impostor_samples = 0
     r.last_vbuffer = False
     if frame.impostor_samples == 0:
-        if vbuffer.wanted(r, scene, targets, fbo, background):
+        if vbuffer.wanted(r, scene, targets, fbo, background, view_projection, (view.width, view.height)):
             frame.vbuffer = r.last_vbuffer = True
             fbo = targets.single()[1]
     frame.shadowed = prepare_shadows(r, scene, maps)    # (its own framebuffer: before this pass's)

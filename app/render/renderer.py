@@ -128,8 +128,10 @@ class ForwardRenderer:
         self.background_ring = True
         # How mesh files are shaded under 4x MSAA (alight.render.vbuffer MESH_SHADING): "forward"
         # once per triangle covering a pixel's samples, "vbuffer" from a visibility buffer, each
-        # 2x2 block once per visible triangle in it, where the scene allows it.
-        self.mesh_shading = "forward"
+        # 2x2 block once per visible triangle in it, where the scene allows it; "auto" (the
+        # default) the visibility buffer only where the mesh is dense on screen (vbuffer.dense:
+        # fewer than AUTO_PIXELS_PER_TRIANGLE covered pixels per triangle), where it is faster.
+        self.mesh_shading = "auto"
         # What the last passes drew, for tests and benchmarks: the sphere's level, whether the
         # background's ring was drawn, the impostor's coverage samples (or None), and per
         # textured part's name the anisotropic filtering level.

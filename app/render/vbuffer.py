@@ -1,5 +1,5 @@
 """Meshes shaded once per pixel from a visibility buffer (``ForwardRenderer.mesh_shading =
-"vbuffer"``), instead of once per triangle covering a pixel's samples.
+"vbuffer"``, or "auto" on dense meshes), instead of once per triangle covering a pixel's samples.
 
 Under 4x MSAA a rasteriser shades a pixel once for every triangle that covers any of its
 samples, and llvmpipe shades whole 4x4 blocks per triangle: a mesh of small triangles pays for
@@ -27,9 +27,19 @@ It is drawn as one triangle that nothing clips, over a viewport twice the image'
 forward pass's, each whole and run once.
 
 Used only where the frame is the fused MSAA resolve with 4 samples, an even width and height,
-and nothing but opaque and masked parts (``wanted``): blended, transmissive, the ground, the
-built-in sphere and debug views keep the forward pass. The visibility bake's per-vertex
-occlusion (Scene.occlusion) is read in the shading pass from the baked parts' buffers.
+and nothing but opaque and masked parts (``eligible``): blended, transmissive, the ground, the
+built-in sphere and debug views keep the forward pass. Under ``mesh_shading = "auto"`` (the
+default) only where the mesh is dense on screen as well (``dense``: fewer than
+AUTO_PIXELS_PER_TRIANGLE = 3 estimated covered pixels per triangle, about 1.5 counted on a
+sphere), since the visibility pass, the vertex fetches and the id exchange cost about 0.17 s of
+CPU time a 1024x1024 frame whatever the mesh: on large triangles that is pure overhead (1.5-1.9x
+the forward frame on a sphere of 56-15 pixels per triangle), on small ones it is less than the
+forward pass's overshading and per-triangle work (0.66x at 0.44 pixels per triangle). The
+threshold was measured on untextured spheres (benchmarks/results/vbuffer.md); a heavier
+material moves the crossover toward more pixels per triangle (DamagedHelmet: 0.71x at 4.3 pixels
+per triangle, even at 17), which the one threshold does not follow, so the helmet at 512 to
+1024 pixels keeps the forward pass. The visibility bake's per-vertex occlusion
+(Scene.occlusion) is read in the shading pass from the baked parts' buffers.
 """
 
 from __future__ import annotations
@@ -43,19 +53,38 @@ from alight.render.bindings import UNIT_VISIBILITY, set_uniform
 from alight.render.part_bindings import _bind_view, bind_part, set_culling
 from alight.render.variants import has_blending_parts, part_defines, transmissive_parts, user_maps_present
 
-MESH_SHADING = ("forward", "vbuffer")   # ForwardRenderer.mesh_shading
+MESH_SHADING = ("auto", "forward", "vbuffer")   # ForwardRenderer.mesh_shading
+# "auto" takes the visibility buffer where the mesh has fewer estimated covered pixels per
+# triangle than this (pixels_per_triangle, about twice the pixels counted on a sphere).
+# Measured (benchmarks/results/vbuffer.md, 2026-12-06: untextured bumpy spheres of 8k-1M
+# triangles at 256-1024 pixels, CPU time vbuffer/forward): 1.02-1.06x at 3.6-7.1 estimated
+# (1.8-3.5 counted) pixels per triangle, 1.1-1.9x above, 0.81-0.85x at 1.8-2.3 and 0.54-0.66x
+# at 0.2-0.9; the ratio follows the density whatever the size. Below 3 only meshes that gain
+# take it; a textured, normal-mapped mesh gains at more pixels per triangle (DamagedHelmet 0.71x
+# at 9.6 estimated), which this one threshold leaves to the forward pass.
+AUTO_PIXELS_PER_TRIANGLE = 3.0
 VBUFFER_SAMPLES = 4                     # render/vbuffer_shade.frag's sample pattern
 # render/vbuffer_shade.frag passes triangle ids between a block's pixels as floats (exact below
 # 2^24, one id kept for "none"): a part with more triangles keeps the forward pass.
 MAX_TRIANGLES = (1 << 24) - 2
 
 
-def wanted(r, scene, targets, fbo, background: bool) -> bool:
+def wanted(r, scene, targets, fbo, background: bool, view_projection: np.ndarray | None = None,
+           image_size: tuple[int, int] | None = None) -> bool:
     """Whether this scene pass shades its mesh from the visibility buffer: ``r.mesh_shading``
-    asks for it and the pass is the fused MSAA resolve's (4 samples, no background drawn, so no
-    blended parts) of a mesh file with no transmissive part, ground, occlusion bake or debug view."""
-    if getattr(r, "mesh_shading", "forward") != "vbuffer":
+    asks for it ("vbuffer"; "auto": where the mesh is dense enough on screen, ``dense``) and the
+    pass is the fused MSAA resolve's (4 samples, no background drawn, so no blended parts) of a
+    mesh file with no transmissive part, ground or debug view. ``view_projection`` and
+    ``image_size``: the whole image's (a tile's pass too), for "auto"."""
+    mode = getattr(r, "mesh_shading", "auto")
+    if mode not in ("auto", "vbuffer") or not eligible(r, scene, targets, fbo, background):
         return False
+    return mode == "vbuffer" or (view_projection is not None and dense(r, scene, view_projection, image_size))
+
+
+def eligible(r, scene, targets, fbo, background: bool) -> bool:
+    """Whether the visibility buffer can draw this pass as the forward pass would (``wanted``'s
+    conditions but the density)."""
     mesh = scene.mesh
     width, height = targets.draw_size
     # An odd width or height keeps the forward pass: the shading pass's 2x2 blocks must be the
@@ -67,6 +96,43 @@ def wanted(r, scene, targets, fbo, background: bool) -> bool:
             and not scene.ground and not scene.debug_view
             and all(len(part.indices) <= MAX_TRIANGLES for part in mesh.parts)
             and not has_blending_parts(scene) and not transmissive_parts(scene))
+
+
+def pixels_per_triangle(r, scene, view_projection: np.ndarray, image_size: tuple[int, int]) -> float | None:
+    """An estimate of the pixels the mesh covers per triangle it has: the areas of its parts'
+    bounding boxes projected to the image (the rectangle holding a box's 8 projected corners,
+    not clipped to the image), over all of its triangles (front- and back-facing). None where a
+    box reaches behind the eye (the camera in or at the mesh: near triangles are large on
+    screen, so the forward pass).
+
+    Why this is good enough: the rectangle holds everything the box's contents project to, so
+    the estimate is an upper bound of the pixels covered (2.0x on the benchmark's spheres, 2.2x on
+    DamagedHelmet), and it errs only toward the forward pass (the old default) by that factor; the
+    threshold is calibrated on this same estimate (AUTO_PIXELS_PER_TRIANGLE), and the measured
+    ratio moves slowly with the density. It costs 8 corners a part, nothing per triangle. Not
+    clipping to the image keeps the density of a mesh that the camera is close to (part of it
+    off screen) at the density of its visible part: its triangles spread over the whole
+    unclipped area."""
+    size = np.array(image_size, np.float64)
+    area, triangles = 0.0, 0
+    for gpu_part, part in zip(r.meshes.parts(scene.mesh), scene.mesh.parts):
+        lo, hi = gpu_part.lo, gpu_part.hi
+        corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        clip = corners @ np.asarray(view_projection, np.float64)
+        if (clip[:, 3] <= 1e-6).any():
+            return None
+        pixels = clip[:, :2] / clip[:, 3:] * 0.5 * size
+        extent = pixels.max(axis=0) - pixels.min(axis=0)
+        area += float(extent[0] * extent[1])
+        triangles += len(part.indices)
+    return area / triangles if triangles else None
+
+
+def dense(r, scene, view_projection: np.ndarray, image_size: tuple[int, int]) -> bool:
+    """"auto"'s choice: the visibility buffer where the mesh has fewer than
+    AUTO_PIXELS_PER_TRIANGLE estimated covered pixels per triangle (``pixels_per_triangle``)."""
+    density = pixels_per_triangle(r, scene, view_projection, image_size)
+    return density is not None and density < AUTO_PIXELS_PER_TRIANGLE
 
 
 def max_viewport(ctx) -> int:

@@ -50,6 +50,11 @@ def add_parser(sub) -> None:
     d.add_argument("--aa", choices=("none", "msaa", "ssaa"), default="msaa",
                    help="anti-aliasing: msaa (4 samples) or ssaa (2x2 supersampling) (default: msaa; "
                         "the probe view never blends pixels)")
+    d.add_argument("--mesh-shading", choices=("auto", "forward", "vbuffer"), default="auto",
+                   help="with --aa msaa, how a mesh file's opaque parts are shaded: forward (once per triangle "
+                        "covering a pixel), vbuffer (once per pixel from a visibility buffer: faster on dense "
+                        "meshes, slower on coarse ones), auto: vbuffer where the mesh has under 3 estimated covered "
+                        "pixels per triangle (docs/performance.md) (default: auto)")
     d.add_argument("--out", required=True, metavar="FILE.png|FILE.exr",
                    help=".png: 8-bit sRGB after exposure and tone mapping; .exr: linear float32 RGBA radiance, "
                         "alpha 1 on the surface (docs/conventions.md)")
@@ -83,6 +88,7 @@ def run(args) -> int:
     from alight.render.renderer import ForwardRenderer
 
     renderer = ForwardRenderer()
+    renderer.mesh_shading = args.mesh_shading
     if args.quality == "auto":
         quality = _auto_quality(args, scene, env)
         if quality is None:
@@ -99,6 +105,9 @@ def run(args) -> int:
         done = time.perf_counter()
         print(f"{describe(renderer.ctx)}\nload {loaded - start:.3f}s  bake {baked - loaded:.3f}s "
               f"render {done - baked - writing:.3f}s  write {writing:.3f}s", file=sys.stderr)
+        # Which shading the mesh took (--mesh-shading auto decides per scene, alight.render.vbuffer).
+        print(f"mesh shading: {'vbuffer' if renderer.last_vbuffer else 'forward'} (--mesh-shading {args.mesh_shading})",
+              file=sys.stderr)
         if maps is not None:
             print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
                   file=sys.stderr)
