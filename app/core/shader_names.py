@@ -112,6 +112,7 @@ SHADER_OPTIONS: dict[str, str] = {
     "UNLIT": "KHR_materials_unlit: base colour only",
     "HAS_VERTEX_COLOR": "the mesh has COLOR_0",
     "HAS_UV1": "the part has TEXCOORD_1 and maps (u_map_uv1 picks each map's set)",
+    "HAS_TEXTURE_TRANSFORM": "a map has KHR_texture_transform (u_map_transform, identity for the others)",
     "PACKED_VERTICES": "normals and tangents arrive as int16 snorm (alight.render.gpu_mesh.pack_snorm16)",
     "MATERIAL_MAPS_MASK": "the maps present, a bit each (map_mask)",
     "MAP_MIRROR_S_MASK": "maps whose sampler mirrors in s",

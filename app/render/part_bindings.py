@@ -22,7 +22,7 @@ def bind_part(r, scene, program, gpu_part: GpuPart, part, user: dict, tiling: Te
     material, maps_used = part_material(scene, part)
     set_material(program, material)
     _bind_part_factors(program, part.material if maps_used else None, material, maps_used, tiling)
-    # Always: parts whose maps differ only in uv set or transform share a program (variants.py).
+    # Every part: parts whose maps differ only in uv set or transform share a program (variants.py).
     _bind_map_uvs(program, gpu_part, maps_used)
     bound_maps = []
     for name in MATERIAL_MAPS:

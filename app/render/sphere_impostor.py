@@ -23,7 +23,7 @@ from alight.render.variants import part_defines, user_maps_present
 _PROXY_POINTS = np.hstack([impostor_proxy_polygon()[0],
                            np.ones((len(impostor_proxy_polygon()[0]), 1))]).astype(np.float64)
 # What a file's material could ask of a part and the built-in sphere's cannot.
-_REFUSED = ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_UV1")
+_REFUSED = ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_UV1", "HAS_TEXTURE_TRANSFORM")
 _REFUSED_MASKS = ("MAP_MIRROR_S_MASK", "MAP_MIRROR_T_MASK")
 
 
@@ -85,11 +85,6 @@ def impostor_placement(meshes: GpuMeshes, scene, camera, image_size: tuple[int, 
         return None
     defines = part_defines(scene, meshes.parts(mesh)[0], mesh.parts[0], user_maps_present(scene))
     if any(k in defines for k in _REFUSED) or any(defines.get(k) for k in _REFUSED_MASKS):
-        return None
-    # nor a file's texture transforms (uniforms, not defines: variants.map_uv_uniforms; a map
-    # on TEXCOORD_1 has HAS_UV1, refused above)
-    if (scene.use_file_materials and mesh.parts[0].material is not None
-            and any(info.transform is not None for info in meshes.parts(mesh)[0].infos.values())):
         return None
     return model, radius_px
 

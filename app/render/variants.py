@@ -100,12 +100,14 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
     defines: dict = {}
     if file_material:
         present = set(gpu_part.textures)
-        # The uv set and KHR_texture_transform are uniforms (map_uv_uniforms), not masks: each
-        # costs a select or a mat3 multiply a map, where a variant of its own costs a whole LLVM
-        # compile at its first draw on llvmpipe (TextureTransformMultiTest's nine materials:
-        # benchmarks/results/compile.md). The mirrored wraps stay compiled in (their fold and
-        # textureGrad cost every fetch). HAS_UV1: the part carries TEXCOORD_1 and has maps, so
-        # parts that differ only in which set a map reads share a program.
+        # Which uv set each map reads and its KHR_texture_transform are uniforms
+        # (map_uv_uniforms), not a mask a map: a select or a mat3 multiply costs less than a
+        # variant of its own, compiled by LLVM at its first draw on llvmpipe (TextureTransformMultiTest's
+        # nine materials: benchmarks/results/compile.md). Two flags stay, so that a part
+        # without either pays nothing: HAS_UV1 (the part carries TEXCOORD_1 and has maps) and
+        # HAS_TEXTURE_TRANSFORM (a map of it has a transform: every map then multiplies, by the
+        # identity where it has none). The mirrored wraps stay masks (their fold and textureGrad
+        # cost every fetch).
         masks = {"MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
         for name, info in gpu_part.infos.items():
             bit = map_bit(name)
@@ -116,6 +118,8 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
         defines.update({k: v for k, v in masks.items() if v})
         if gpu_part.has_uv1 and gpu_part.infos:
             defines["HAS_UV1"] = None
+        if any(info.transform is not None for info in gpu_part.infos.values()):
+            defines["HAS_TEXTURE_TRANSFORM"] = None
         if fm.alpha_mode == "MASK":
             defines["ALPHA_MODE"] = int(AlphaMode.MASK)
         elif fm.alpha_mode == "BLEND":

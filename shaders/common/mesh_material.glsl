@@ -8,8 +8,8 @@
 //   MAP_MIRROR_S_MASK,   maps whose sampler wraps by MIRRORED_REPEAT in s or t (REPEAT and
 //   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state).
 // Which uv set a map reads (u_map_uv1, with HAS_UV1) and its KHR_texture_transform
-// (u_map_transform) are uniforms: a select and a mat3 multiply a map cost less than a variant
-// of their own, compiled by LLVM at its first draw (app/render/variants.py).
+// (u_map_transform, with HAS_TEXTURE_TRANSFORM) are uniforms: a select and a mat3 multiply a map
+// cost less than a variant of their own, compiled by LLVM at its first draw (app/render/variants.py).
 // HAS_VERTEX_COLOR: COLOR_0 multiplies the base colour and alpha (glTF 2.0 section 3.9.2).
 // SPHERE_SURFACE: the part is the built-in sphere drawn at a coarser level (alight.core.sphere_lod):
 // the surface point is where the view ray meets the true sphere, and the normal is the sphere's.
@@ -241,7 +241,10 @@ vec2 map_uv(int bit, int slot) {
 #ifdef HAS_UV1
     if ((u_map_uv1 & bit) != 0) uv = v_uv1;
 #endif
-    return (u_map_transform[slot] * vec3(uv, 1.0)).xy;
+#ifdef HAS_TEXTURE_TRANSFORM
+    uv = (u_map_transform[slot] * vec3(uv, 1.0)).xy;
+#endif
+    return uv;
 }
 
 // MIRRORED_REPEAT (OpenGL 4.5 section 8.14.2): the triangle wave of period 2.
