@@ -95,11 +95,11 @@ def test_texcoord1_equals_texcoord0(tmp_path):
 
 
 def _transform_row(path, baked: bool) -> None:
-    """Four quads in a row with a base-colour checker and a white occlusion map (no effect: it
+    """Five quads in a row with a base-colour checker and a white occlusion map (no effect: it
     makes the maps alike); KHR_texture_transform on the checker's TEXCOORD_0, then on the
     occlusion map only, then on the checker's TEXCOORD_1 (TEXCOORD_0 zero), then on the occlusion
-    map again. ``baked``: the checker's transformed uvs written into TEXCOORD_0 instead, no
-    transform and no second set."""
+    map again, then none and no TEXCOORD_1 at all. ``baked``: the checker's transformed uvs
+    written into TEXCOORD_0 instead, no transform and no second set."""
     from alight.core.mesh import TextureTransform
 
     t = {"offset": [0.1, 0.2], "rotation": 0.4, "scale": [2.0, 1.5]}
@@ -110,10 +110,10 @@ def _transform_row(path, baked: bool) -> None:
     tex = g.image(checker())
     white = g.image(np.full((4, 4, 3), 255, np.uint8))
     ext = {"extensions": {"KHR_texture_transform": t}}
-    for k, (moved_checker, tex_coord) in enumerate(((True, 0), (False, 0), (True, 1), (False, 0))):
-        attributes = {"POSITION": g.accessor(positions + [(k - 1.5) * 1.0, 0.0, 0.0], bounds=True),
+    for k, (moved_checker, tex_coord) in enumerate(((True, 0), (False, 0), (True, 1), (False, 0), (False, None))):
+        attributes = {"POSITION": g.accessor(positions + [(k - 2) * 1.0, 0.0, 0.0], bounds=True),
                       "NORMAL": g.accessor(normals)}
-        if baked:
+        if baked or tex_coord is None:
             attributes["TEXCOORD_0"] = g.accessor(moved if moved_checker else uvs)
             base, occlusion = {"index": tex}, {"index": white}
         else:
@@ -130,10 +130,11 @@ def _transform_row(path, baked: bool) -> None:
 
 
 def test_transforms_and_uv_sets_share_one_program(tmp_path, monkeypatch):
-    """Parts whose maps differ only in KHR_texture_transform and texCoord draw with one program
-    (uniforms, not variants: alight.render.variants.map_uv_uniforms), each with its own uvs: a
-    map without a transform drawn after one with a transform must not keep its matrix, nor a
-    TEXCOORD_0 map the other's uv set."""
+    """Parts whose maps differ only in KHR_texture_transform and texCoord, or in having a
+    TEXCOORD_1, draw with one program (uniforms, not variants: alight.render.variants.map_uv_uniforms),
+    each with its own uvs: a map without a transform drawn after one with a transform must not
+    keep its matrix, nor a TEXCOORD_0 map the other's uv set. The same from the visibility buffer
+    (a part without TEXCOORD_1 in a HAS_UV1 variant)."""
     from tests.gpu import renderer
 
     _transform_row(tmp_path / "row.glb", baked=False)
@@ -148,10 +149,19 @@ def test_transforms_and_uv_sets_share_one_program(tmp_path, monkeypatch):
         return program(vertex, fragment, defines)
 
     monkeypatch.setattr(shaders, "program", recording)
-    camera = Camera(position=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0), fov_y_deg=35.0, near=0.1, far=20.0)
+    camera = Camera(position=(0.0, 0.0, 6.0), target=(0.0, 0.0, 0.0), fov_y_deg=35.0, near=0.1, far=20.0)
     row = render(tmp_path / "row.glb", camera=camera)
-    assert len(used) >= 4 and len(set(used)) == 1, set(used)
-    assert_equivalent(row, render(tmp_path / "baked.glb", camera=camera))
+    assert len(used) >= 5 and len(set(used)) == 1, set(used)
+    baked = render(tmp_path / "baked.glb", camera=camera)
+    assert_equivalent(row, baked)
+    r = renderer()
+    try:
+        r.mesh_shading = "vbuffer"
+        shaded = render(tmp_path / "row.glb", camera=camera, aa="msaa")
+        assert r.last_vbuffer
+    finally:
+        r.mesh_shading = "forward"
+    assert_equivalent(shaded, render(tmp_path / "baked.glb", camera=camera, aa="msaa"))
 
 
 def test_quantized_uvs_equal_float(tmp_path):

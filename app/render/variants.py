@@ -103,11 +103,12 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
         # Which uv set each map reads and its KHR_texture_transform are uniforms
         # (map_uv_uniforms), not a mask a map: a select or a mat3 multiply costs less than a
         # variant of its own, compiled by LLVM at its first draw on llvmpipe (TextureTransformMultiTest's
-        # nine materials: benchmarks/results/compile.md). Two flags stay, so that a part
-        # without either pays nothing: HAS_UV1 (the part carries TEXCOORD_1 and has maps) and
-        # HAS_TEXTURE_TRANSFORM (a map of it has a transform: every map then multiplies, by the
-        # identity where it has none). The mirrored wraps stay masks (their fold and textureGrad
-        # cost every fetch).
+        # nine materials: benchmarks/results/compile.md). Two flags stay, set for every textured
+        # part of a mesh where some map uses the feature (gpu_mesh.mark_mesh_uv_features), so a
+        # file that uses neither pays nothing and the parts of one that does share programs:
+        # HAS_UV1 (a part without TEXCOORD_1 reads the attribute's constant, and u_map_uv1 is 0
+        # for it) and HAS_TEXTURE_TRANSFORM (every map multiplies, by the identity where it has
+        # no transform). The mirrored wraps stay masks (their fold and textureGrad cost every fetch).
         masks = {"MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
         for name, info in gpu_part.infos.items():
             bit = map_bit(name)
@@ -116,9 +117,11 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
             if info.sampler.wrap_t == "mirrored_repeat":
                 masks["MAP_MIRROR_T_MASK"] |= bit
         defines.update({k: v for k, v in masks.items() if v})
-        if gpu_part.has_uv1 and gpu_part.infos:
+        own = gpu_part.infos.values()   # (a part outside GpuMeshes.parts: its own maps decide)
+        if gpu_part.infos and getattr(gpu_part, "mesh_reads_uv1",
+                                      gpu_part.has_uv1 and any(i.tex_coord == 1 for i in own)):
             defines["HAS_UV1"] = None
-        if any(info.transform is not None for info in gpu_part.infos.values()):
+        if gpu_part.infos and getattr(gpu_part, "mesh_transforms", any(i.transform is not None for i in own)):
             defines["HAS_TEXTURE_TRANSFORM"] = None
         if fm.alpha_mode == "MASK":
             defines["ALPHA_MODE"] = int(AlphaMode.MASK)
