@@ -84,10 +84,13 @@ def _bind_part_factors(program, fm, material, maps_used: bool, tiling: TextureMa
 
 
 def _bind_map_uvs(program, gpu_part: GpuPart, file_maps: bool) -> None:
-    """Each map's uv set and KHR_texture_transform matrix (variants.map_uv_uniforms)."""
+    """Each map's uv set and KHR_texture_transform matrix (variants.map_uv_uniforms), where the
+    variant reads them (HAS_UV1, HAS_TEXTURE_TRANSFORM): nothing to do for most files' parts."""
+    member = program.get("u_map_transform", None)
+    if member is None and program.get("u_map_uv1", None) is None:
+        return
     uv1, transforms = map_uv_uniforms(gpu_part, file_maps)
     set_uniform(program, "u_map_uv1", uv1)
-    member = program.get("u_map_transform", None)
     if member is not None:
         # GLSL mat3 is column-major: upload the transposes. The compiler trims the array after
         # the last slot the variant reads.
