@@ -3,12 +3,17 @@ frame's time goes: compiling and linking the GL programs (``ShaderLibrary.progra
 draws themselves (llvmpipe compiles each shader variant with LLVM at its first draw). Rounds
 alternate empty and warm (A B A B ...) in fresh processes; asserts nothing.
 
-    .venv/bin/python benchmarks/bench_compile.py [--model PATH] [--rounds 3] [--against REF]
+    .venv/bin/python benchmarks/bench_compile.py [--model PATH | --scene multi] [--rounds 3] [--against REF]
 
 "empty": ``MESA_SHADER_CACHE_DISABLE=true``; "warm": Mesa's cache in a private folder
 (``MESA_SHADER_CACHE_DIR``) filled by one run first, so the user's own cache is never touched.
 alight's bake cache is warm in both (a shared temporary ``ALIGHT_CACHE_DIR``). The default model
 is the Khronos TextureTransformTest (``../shared/data/models/khronos/``), 512x512, 4x MSAA.
+``--scene multi`` writes a file like Khronos' TextureTransformMultiTest (not in the shared data)
+and renders it: nine materials in a 3x3 grid of quads, each reading one map (baseColorTexture,
+emissiveTexture, normalTexture, metallicRoughnessTexture, occlusionTexture) with
+KHR_texture_transform on TEXCOORD_0 or TEXCOORD_1, or untransformed ("Sample"), as that file's
+rows and columns do; its textures are made in numpy (``multi_scene``).
 """
 
 from __future__ import annotations
@@ -24,7 +29,8 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "benchmarks"))
-from bench_gltf import export  # noqa: E402
+sys.path.insert(0, str(REPO))
+from bench_gltf import export, this_tree  # noqa: E402
 
 MODEL = REPO.parent / "shared" / "data" / "models" / "khronos" / "TextureTransformTest" / "glTF" / "TextureTransformTest.gltf"
 
@@ -33,12 +39,15 @@ import json, sys, time
 t0 = time.perf_counter()
 from alight.core import gpu
 compile_seconds = [0.0, 0]
+mesh_variants = set()   # the mesh pass's programs (render/pbr.frag), one per distinct define set
 original = gpu.ShaderLibrary.program
 def program(self, vertex, fragment, defines=None):
     key = ("program", vertex, fragment, tuple(sorted((defines or {}).items())))
     new = key not in self._programs
     t = time.perf_counter()
     out = original(self, vertex, fragment, defines)
+    if new and "pbr.frag" in fragment:
+        mesh_variants.add(key)
     if new:
         compile_seconds[0] += time.perf_counter() - t
         compile_seconds[1] += 1
@@ -59,16 +68,73 @@ t = time.perf_counter()
 r.render(scene, maps, 512, 512, aa="msaa")
 second = time.perf_counter() - t
 print(json.dumps({"process": time.perf_counter() - t0, "first": first, "second": second,
-                  "compile": compile_seconds[0], "programs": compile_seconds[1]}))
+                  "compile": compile_seconds[0], "programs": compile_seconds[1],
+                  "mesh_variants": len(mesh_variants)}))
 """
 
 
-def run(model: Path, env_extra: dict, pythonpath: str | None, cache: str) -> dict:
-    env = dict(os.environ, ALIGHT_CACHE_DIR=cache, **env_extra)
-    if pythonpath:
-        env["PYTHONPATH"] = pythonpath
-    else:
-        env.pop("PYTHONPATH", None)
+# The Khronos file's transform (every transformed map there has it): a quarter turn, scale 0.35
+TRANSFORM = {"offset": [0.705, 0.285], "rotation": 1.5707963705062866, "scale": [0.35, 0.35]}
+# (name, textureInfo's place, texCoord, transformed), one material each, as TextureTransformMultiTest's
+# "UV 0", "UV 1" and "Sample" columns on its base colour, emission, normal, metal-rough and occlusion rows.
+MULTI_MATERIALS = (
+    ("BaseColorUV0", "baseColorTexture", 0, True),
+    ("BaseColorUV1", "baseColorTexture", 1, True),
+    ("BaseColorSample", "baseColorTexture", 0, False),
+    ("EmissionUV0", "emissiveTexture", 0, True),
+    ("EmissionUV1", "emissiveTexture", 1, True),
+    ("NormalUV0", "normalTexture", 0, True),
+    ("NormalUV1", "normalTexture", 1, True),
+    ("MetalRoughUV0", "metallicRoughnessTexture", 0, True),
+    ("OcclusionUV1", "occlusionTexture", 1, True),
+)
+
+
+def multi_scene(path: Path) -> Path:
+    """A .glb like TextureTransformMultiTest: MULTI_MATERIALS on nine quads; a "Sample" quad has
+    TEXCOORD_0 only (as that column's meshes), the others both sets."""
+    import numpy as np
+    from tests.gltf_builder import USHORT, Gltf, grid_plane
+
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(2, size=0.9)
+    y, x = np.mgrid[0:128, 0:128] / 128.0
+    ring = np.abs(np.hypot(x - 0.5, y - 0.5) - 0.3) < 0.06
+    mark = ring | ((np.abs(x - y) < 0.05) & (np.abs(x - 0.5) < 0.3))
+    images = {   # a mark in each map's own terms (sRGB colour, tangent-space normal, G/B, R)
+        "baseColorTexture": np.where(mark[..., None], [220, 40, 30], [235, 235, 235]),
+        "emissiveTexture": np.where(mark[..., None], [255, 200, 40], [0, 0, 0]),
+        "normalTexture": np.where(mark[..., None], [200, 128, 220], [128, 128, 255]),
+        "metallicRoughnessTexture": np.where(mark[..., None], [0, 40, 255], [0, 230, 0]),
+        "occlusionTexture": np.where(mark[..., None], [40, 40, 40], [255, 255, 255]),
+    }
+    g.use("KHR_texture_transform")
+    for k, (name, slot, tex_coord, transformed) in enumerate(MULTI_MATERIALS):
+        info = {"index": g.image(images[slot].astype(np.uint8)), "texCoord": tex_coord}
+        if transformed:
+            info["extensions"] = {"KHR_texture_transform": dict(TRANSFORM)}
+        pbr = {"metallicFactor": 0.0, "roughnessFactor": 0.5}
+        fields = {"name": name}
+        if slot in ("baseColorTexture", "metallicRoughnessTexture"):
+            pbr[slot] = info
+            if slot == "metallicRoughnessTexture":
+                pbr["metallicFactor"] = 1.0
+        else:
+            fields[slot] = info
+            if slot == "emissiveTexture":
+                fields["emissiveFactor"] = [1.0, 1.0, 1.0]
+        mat = g.material(pbrMetallicRoughness=pbr, **fields)
+        offset = np.array([(k % 3 - 1) * 1.0, (1 - k // 3) * 1.0, 0.0])
+        attributes = {"POSITION": g.accessor(positions + offset, bounds=True), "NORMAL": g.accessor(normals),
+                      "TEXCOORD_0": g.accessor(uvs)}
+        if transformed:   # the second set: the first turned a half (what a UV 1 quad reads)
+            attributes["TEXCOORD_1"] = g.accessor(1.0 - uvs)
+        g.mesh([{"attributes": attributes, "indices": g.accessor(idx.ravel(), USHORT), "material": mat}], name=name)
+    return g.save(path)
+
+
+def run(model: Path, env_extra: dict, pythonpath: str, cache: str) -> dict:
+    env = dict(os.environ, ALIGHT_CACHE_DIR=cache, PYTHONPATH=pythonpath, **env_extra)
     done = subprocess.run([sys.executable, "-c", PROBE, str(model)], env=env, capture_output=True, text=True,
                           cwd=tempfile.gettempdir())
     if done.returncode != 0:
@@ -79,13 +145,17 @@ def run(model: Path, env_extra: dict, pythonpath: str | None, cache: str) -> dic
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", type=Path, default=MODEL)
+    ap.add_argument("--scene", choices=("model", "multi"), default="model",
+                    help="multi: the nine-material TextureTransformMultiTest-like file (multi_scene)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--against", default=None, help="another git ref, alternated with this tree")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="alight-compile-") as tmp:
         folder = Path(tmp)
         cache = str(folder / "alight-cache")
-        trees = {"this tree": None}
+        if args.scene == "multi":
+            args.model = multi_scene(folder / "TextureTransformMultiLike.glb")
+        trees = {"this tree": str(this_tree(folder / "this"))}
         if args.against:
             trees[args.against] = str(export(args.against, folder / "other"))
         modes = {}
@@ -100,7 +170,8 @@ def main() -> None:
                 out = run(args.model, extra, path, cache)
                 results[name].append(out)
                 print(f"round {r + 1} {name:22s} process {out['process']:.2f} s first frame {out['first']:.2f} s "
-                      f"(compile+link {out['compile']:.2f} s, {out['programs']} programs) second {out['second']:.2f} s",
+                      f"(compile+link {out['compile']:.2f} s, {out['programs']} programs, "
+                      f"{out['mesh_variants']} of pbr.frag) second {out['second']:.2f} s",
                       flush=True)
 
     def med(name, key):

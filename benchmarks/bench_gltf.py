@@ -9,7 +9,7 @@ what one ``alight render --mesh`` pays), ``load warm`` the median of three more;
 ``ForwardRenderer.draw_display`` (the editor's path: no anti-aliasing, tone mapped as drawn) at
 1280x720 plus ``finish()``, the median of 15 after 3 warm-up frames, for the material ball (studio
 IBL, 3 lights) and for DamagedHelmet. The other ref is exported with ``git archive`` into a
-temporary folder and imported from there; this tree is the editable install.
+temporary folder and imported from there; this tree through a symlink to its app/ (``this_tree``).
 """
 
 from __future__ import annotations
@@ -70,12 +70,17 @@ def export(ref: str, into: Path) -> Path:
     return pkg
 
 
-def run(pythonpath: str | None, cache: str) -> dict:
-    env = dict(os.environ, ALIGHT_CACHE_DIR=cache)
-    if pythonpath:
-        env["PYTHONPATH"] = pythonpath
-    else:
-        env.pop("PYTHONPATH", None)
+def this_tree(into: Path) -> Path:
+    """A folder to put on PYTHONPATH that imports this checkout's app/ as ``alight`` (the venv's
+    editable install may point at another checkout: a worktree shares the venv)."""
+    pkg = into / "pkg"
+    pkg.mkdir(parents=True)
+    (pkg / "alight").symlink_to(REPO / "app")
+    return pkg
+
+
+def run(pythonpath: str, cache: str) -> dict:
+    env = dict(os.environ, ALIGHT_CACHE_DIR=cache, PYTHONPATH=pythonpath)
     done = subprocess.run([sys.executable, "-c", PROBE, str(HELMET)], env=env, capture_output=True, text=True,
                           cwd=tempfile.gettempdir())
     if done.returncode != 0:
@@ -90,10 +95,11 @@ def main() -> int:
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         pkg = export(args.ref, Path(tmp) / "ref")
+        mine = this_tree(Path(tmp) / "this")
         cache = str(Path(tmp) / "cache")
         results: dict[str, list[dict]] = {args.ref: [], "this tree": []}
         for k in range(args.rounds):
-            for label, path in ((args.ref, str(pkg)), ("this tree", None)):
+            for label, path in ((args.ref, str(pkg)), ("this tree", str(mine))):
                 results[label].append(run(path, cache))
                 print(f"round {k + 1}/{args.rounds} {label}: " +
                       ", ".join(f"{m} {v * 1000:.0f} ms" for m, v in results[label][-1].items()), file=sys.stderr)

@@ -94,6 +94,76 @@ def test_texcoord1_equals_texcoord0(tmp_path):
     assert_equivalent(render(tmp_path / "uv1.glb"), render(tmp_path / "uv0.glb"))
 
 
+def _transform_row(path, baked: bool) -> None:
+    """Five quads in a row with a base-colour checker and a white occlusion map (no effect: it
+    makes the maps alike); KHR_texture_transform on the checker's TEXCOORD_0, then on the
+    occlusion map only, then on the checker's TEXCOORD_1 (TEXCOORD_0 zero), then on the occlusion
+    map again, then none and no TEXCOORD_1 at all. ``baked``: the checker's transformed uvs
+    written into TEXCOORD_0 instead, no transform and no second set."""
+    from alight.core.mesh import TextureTransform
+
+    t = {"offset": [0.1, 0.2], "rotation": 0.4, "scale": [2.0, 1.5]}
+    matrix = TextureTransform(offset=(0.1, 0.2), rotation=0.4, scale=(2.0, 1.5)).matrix()
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(4, size=0.9)
+    moved = (matrix @ np.c_[uvs, np.ones(len(uvs))].T).T[:, :2]
+    tex = g.image(checker())
+    white = g.image(np.full((4, 4, 3), 255, np.uint8))
+    ext = {"extensions": {"KHR_texture_transform": t}}
+    for k, (moved_checker, tex_coord) in enumerate(((True, 0), (False, 0), (True, 1), (False, 0), (False, None))):
+        attributes = {"POSITION": g.accessor(positions + [(k - 2) * 1.0, 0.0, 0.0], bounds=True),
+                      "NORMAL": g.accessor(normals)}
+        if baked or tex_coord is None:
+            attributes["TEXCOORD_0"] = g.accessor(moved if moved_checker else uvs)
+            base, occlusion = {"index": tex}, {"index": white}
+        else:
+            attributes["TEXCOORD_0"] = g.accessor(np.zeros_like(uvs) if tex_coord else uvs)
+            attributes["TEXCOORD_1"] = g.accessor(uvs)
+            base = {"index": tex, "texCoord": tex_coord, **(ext if moved_checker else {})}
+            occlusion = {"index": white, **({} if moved_checker else ext)}
+        mat = g.material(pbrMetallicRoughness={"baseColorTexture": base, "metallicFactor": 0.0, "roughnessFactor": 0.6},
+                         occlusionTexture=occlusion)
+        g.mesh([{"attributes": attributes, "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
+    if not baked:
+        g.use("KHR_texture_transform")
+    g.save(path)
+
+
+def test_transforms_and_uv_sets_share_one_program(tmp_path, monkeypatch):
+    """Parts whose maps differ only in KHR_texture_transform and texCoord, or in having a
+    TEXCOORD_1, draw with one program (uniforms, not variants: alight.render.variants.map_uv_uniforms),
+    each with its own uvs: a map without a transform drawn after one with a transform must not
+    keep its matrix, nor a TEXCOORD_0 map the other's uv set. The same from the visibility buffer
+    (a part without TEXCOORD_1 in a HAS_UV1 variant)."""
+    from tests.gpu import renderer
+
+    _transform_row(tmp_path / "row.glb", baked=False)
+    _transform_row(tmp_path / "baked.glb", baked=True)
+    shaders = renderer().shaders
+    used = []
+    program = shaders.program
+
+    def recording(vertex, fragment, defines=None):
+        if fragment == "render/pbr.frag":
+            used.append(shaders.program_key(vertex, fragment, defines))
+        return program(vertex, fragment, defines)
+
+    monkeypatch.setattr(shaders, "program", recording)
+    camera = Camera(position=(0.0, 0.0, 6.0), target=(0.0, 0.0, 0.0), fov_y_deg=35.0, near=0.1, far=20.0)
+    row = render(tmp_path / "row.glb", camera=camera)
+    assert len(used) >= 5 and len(set(used)) == 1, set(used)
+    baked = render(tmp_path / "baked.glb", camera=camera)
+    assert_equivalent(row, baked)
+    r = renderer()
+    try:
+        r.mesh_shading = "vbuffer"
+        shaded = render(tmp_path / "row.glb", camera=camera, aa="msaa")
+        assert r.last_vbuffer
+    finally:
+        r.mesh_shading = "forward"
+    assert_equivalent(shaded, render(tmp_path / "baked.glb", camera=camera, aa="msaa"))
+
+
 def test_quantized_uvs_equal_float(tmp_path):
     """KHR_mesh_quantization: TEXCOORD_0 as normalized unsigned short."""
     _, _, uvs, _ = grid_plane(4)

@@ -264,6 +264,18 @@ def release_mesh(entry) -> None:
     entry[2].release()
 
 
+def mark_mesh_uv_features(parts: list["GpuPart"]) -> None:
+    """Whether any map of the mesh reads TEXCOORD_1 (``mesh_reads_uv1``) and whether any has
+    KHR_texture_transform (``mesh_transforms``), on each of its parts: alight.render.variants
+    compiles these in for every textured part of such a mesh, so that its parts share programs."""
+    infos = [(gp, info) for gp in parts for info in gp.infos.values()]
+    reads_uv1 = any(info.tex_coord == 1 and gp.has_uv1 for gp, info in infos)
+    transforms = any(info.transform is not None for _, info in infos)
+    for gp in parts:
+        gp.mesh_reads_uv1 = reads_uv1
+        gp.mesh_transforms = transforms
+
+
 class GpuMeshes:
     """The uploaded meshes (by the mesh's id, kept while that mesh is the one asked for), the
     built-in sphere's stand-ins (coarser levels, the impostor's proxy: alight.render.sphere_impostor)
@@ -289,6 +301,7 @@ class GpuMeshes:
                 release_mesh(self._meshes.pop(next(iter(self._meshes))))
             textures = MeshTextures(self.ctx)
             entry = (mesh, [GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
+            mark_mesh_uv_features(entry[1])
         self._meshes[id(mesh)] = entry    # last: the most recently drawn
         return entry[1]
 

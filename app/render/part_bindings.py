@@ -12,7 +12,7 @@ from alight.core.shader_names import MATERIAL_MAPS
 from alight.core.texture_maps import TextureMaps
 from alight.render.bindings import UNIT_MATERIAL, set_material, set_uniform
 from alight.render.gpu_mesh import ANISOTROPIC_FILTERS, GpuPart
-from alight.render.variants import part_material
+from alight.render.variants import map_uv_uniforms, part_material
 
 
 def bind_part(r, scene, program, gpu_part: GpuPart, part, user: dict, tiling: TextureMaps, camera: Camera,
@@ -22,8 +22,8 @@ def bind_part(r, scene, program, gpu_part: GpuPart, part, user: dict, tiling: Te
     material, maps_used = part_material(scene, part)
     set_material(program, material)
     _bind_part_factors(program, part.material if maps_used else None, material, maps_used, tiling)
-    if maps_used and any(info.transform is not None for info in gpu_part.infos.values()):
-        _bind_map_transforms(program, gpu_part)
+    # Every part: parts whose maps differ only in uv set or transform share a program (variants.py).
+    _bind_map_uvs(program, gpu_part, maps_used)
     bound_maps = []
     for name in MATERIAL_MAPS:
         tex = gpu_part.textures.get(name) if maps_used else user.get(name)
@@ -83,13 +83,14 @@ def _bind_part_factors(program, fm, material, maps_used: bool, tiling: TextureMa
     set_uniform(program, "u_uv_offset", (0.0, 0.0) if maps_used else tuple(map(float, tiling.uv_offset)))
 
 
-def _bind_map_transforms(program, gpu_part: GpuPart) -> None:
-    """KHR_texture_transform's matrices, one per map slot (identity where a map has none)."""
-    transforms = np.tile(np.eye(3, dtype=np.float32), (len(MATERIAL_MAPS), 1, 1))
-    for name, info in gpu_part.infos.items():
-        if info.transform is not None:
-            transforms[MATERIAL_MAPS.index(name)] = info.transform.gl_matrix()
+def _bind_map_uvs(program, gpu_part: GpuPart, file_maps: bool) -> None:
+    """Each map's uv set and KHR_texture_transform matrix (variants.map_uv_uniforms), where the
+    variant reads them (HAS_UV1, HAS_TEXTURE_TRANSFORM): nothing to do for most files' parts."""
     member = program.get("u_map_transform", None)
+    if member is None and program.get("u_map_uv1", None) is None:
+        return
+    uv1, transforms = map_uv_uniforms(gpu_part, file_maps)
+    set_uniform(program, "u_map_uv1", uv1)
     if member is not None:
         # GLSL mat3 is column-major: upload the transposes. The compiler trims the array after
         # the last slot the variant reads.

@@ -23,8 +23,8 @@ from alight.render.variants import part_defines, user_maps_present
 _PROXY_POINTS = np.hstack([impostor_proxy_polygon()[0],
                            np.ones((len(impostor_proxy_polygon()[0]), 1))]).astype(np.float64)
 # What a file's material could ask of a part and the built-in sphere's cannot.
-_REFUSED = ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_UV1")
-_REFUSED_MASKS = ("MAP_UV1_MASK", "MAP_TRANSFORM_MASK", "MAP_MIRROR_S_MASK", "MAP_MIRROR_T_MASK")
+_REFUSED = ("ALPHA_MODE", "UNLIT", "HAS_VERTEX_COLOR", "HAS_UV1", "HAS_TEXTURE_TRANSFORM")
+_REFUSED_MASKS = ("MAP_MIRROR_S_MASK", "MAP_MIRROR_T_MASK")
 
 
 def lod_parts(meshes: GpuMeshes, mesh, camera, image_size: tuple[int, int],

@@ -12,6 +12,8 @@ import math
 import dataclasses
 from dataclasses import replace
 
+import numpy as np
+
 from alight.core.layers import layer_defines
 from alight.core.material import LAYERS, Material, with_overrides
 from alight.core.shader_names import (
@@ -90,7 +92,7 @@ def user_maps_present(scene) -> set[str]:
 
 def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
     """The shader variant a part needs (pbr.frag, mesh_material.glsl): the maps it reads, their
-    uv sets, transforms and mirrored axes, vertex colours, alpha mode, unlit and the layers
+    mirrored axes, whether it has a second uv set, vertex colours, alpha mode, unlit and the layers
     its material uses. A part with none of these compiles to the plain opaque shader.
     ``gpu_part``: its alight.render.gpu_mesh.GpuPart; ``user_maps``: ``user_maps_present``."""
     fm = part.material
@@ -98,20 +100,29 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
     defines: dict = {}
     if file_material:
         present = set(gpu_part.textures)
-        masks = {"MAP_UV1_MASK": 0, "MAP_TRANSFORM_MASK": 0, "MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
+        # Which uv set each map reads and its KHR_texture_transform are uniforms
+        # (map_uv_uniforms), not a mask a map: a select or a mat3 multiply costs less than a
+        # variant of its own, compiled by LLVM at its first draw on llvmpipe (TextureTransformMultiTest's
+        # nine materials: benchmarks/results/compile.md). Two flags stay, set for every textured
+        # part of a mesh where some map uses the feature (gpu_mesh.mark_mesh_uv_features), so a
+        # file that uses neither pays nothing and the parts of one that does share programs:
+        # HAS_UV1 (a part without TEXCOORD_1 reads the attribute's constant, and u_map_uv1 is 0
+        # for it) and HAS_TEXTURE_TRANSFORM (every map multiplies, by the identity where it has
+        # no transform). The mirrored wraps stay masks (their fold and textureGrad cost every fetch).
+        masks = {"MAP_MIRROR_S_MASK": 0, "MAP_MIRROR_T_MASK": 0}
         for name, info in gpu_part.infos.items():
             bit = map_bit(name)
-            if info.tex_coord == 1 and gpu_part.has_uv1:
-                masks["MAP_UV1_MASK"] |= bit
-            if info.transform is not None:
-                masks["MAP_TRANSFORM_MASK"] |= bit
             if info.sampler.wrap_s == "mirrored_repeat":
                 masks["MAP_MIRROR_S_MASK"] |= bit
             if info.sampler.wrap_t == "mirrored_repeat":
                 masks["MAP_MIRROR_T_MASK"] |= bit
         defines.update({k: v for k, v in masks.items() if v})
-        if masks["MAP_UV1_MASK"]:
+        own = gpu_part.infos.values()   # (a part outside GpuMeshes.parts: its own maps decide)
+        if gpu_part.infos and getattr(gpu_part, "mesh_reads_uv1",
+                                      gpu_part.has_uv1 and any(i.tex_coord == 1 for i in own)):
             defines["HAS_UV1"] = None
+        if gpu_part.infos and getattr(gpu_part, "mesh_transforms", any(i.transform is not None for i in own)):
+            defines["HAS_TEXTURE_TRANSFORM"] = None
         if fm.alpha_mode == "MASK":
             defines["ALPHA_MODE"] = int(AlphaMode.MASK)
         elif fm.alpha_mode == "BLEND":
@@ -131,6 +142,23 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
     defines["MATERIAL_MAPS_MASK"] = map_mask(present & set(MATERIAL_MAPS))
     defines.update(material_defines([part_material(scene, part)[0]]))
     return defines
+
+
+def map_uv_uniforms(gpu_part, file_maps: bool) -> tuple[int, np.ndarray]:
+    """What mesh_material.glsl's map_uv() reads of a part: ``u_map_uv1`` (MATERIAL_MAPS bits of
+    the maps read with TEXCOORD_1; glTF textureInfo texCoord) and ``u_map_transform`` (a 3x3
+    KHR_texture_transform matrix per map slot, on alight's OpenGL uvs; identity where a map has
+    none, which leaves the uvs exactly as they are). ``file_maps``: the part's file maps apply
+    (else the user's maps: TEXCOORD_0, untransformed)."""
+    transforms = np.tile(np.eye(3, dtype=np.float32), (len(MATERIAL_MAPS), 1, 1))
+    uv1 = 0
+    if file_maps:
+        for name, info in gpu_part.infos.items():
+            if info.transform is not None:
+                transforms[MATERIAL_MAPS.index(name)] = info.transform.gl_matrix()
+            if info.tex_coord == 1 and gpu_part.has_uv1:
+                uv1 |= map_bit(name)
+    return uv1, transforms
 
 
 def ibl_defines(scene) -> dict:

@@ -2,13 +2,14 @@
 // texture maps, the shading normal and the Surface at a fragment. Shared by render/pbr.frag
 // (forward shading) and render/gbuffer.frag (the reference's G-buffer).
 //
-// Every per-texture feature of glTF is a compile-time choice, a bit per map in a mask, so a
-// part pays only for what its maps use (llvmpipe runs both sides of a branch):
+// The per-texture features of glTF that cost a fetch or more are compile-time choices, a bit per
+// map in a mask, so a part pays only for what its maps use (llvmpipe runs both sides of a branch):
 //   MATERIAL_MAPS_MASK   the maps present;
-//   MAP_UV1_MASK         maps read with TEXCOORD_1 (needs HAS_UV1), the rest TEXCOORD_0;
-//   MAP_TRANSFORM_MASK   maps with KHR_texture_transform (u_map_transform[slot]);
 //   MAP_MIRROR_S_MASK,   maps whose sampler wraps by MIRRORED_REPEAT in s or t (REPEAT and
 //   MAP_MIRROR_T_MASK    CLAMP_TO_EDGE are the texture's own wrap state).
+// Which uv set a map reads (u_map_uv1, with HAS_UV1) and its KHR_texture_transform
+// (u_map_transform, with HAS_TEXTURE_TRANSFORM) are uniforms: a select and a mat3 multiply a map
+// cost less than a variant of their own, compiled by LLVM at its first draw (app/render/variants.py).
 // HAS_VERTEX_COLOR: COLOR_0 multiplies the base colour and alpha (glTF 2.0 section 3.9.2).
 // SPHERE_SURFACE: the part is the built-in sphere drawn at a coarser level (alight.core.sphere_lod):
 // the surface point is where the view ray meets the true sphere, and the normal is the sphere's.
@@ -126,12 +127,6 @@ uniform sampler2D u_diffuse_transmission_map;
 #ifndef MATERIAL_MAPS_MASK
 #define MATERIAL_MAPS_MASK MAP_ALL
 #endif
-#ifndef MAP_UV1_MASK
-#define MAP_UV1_MASK 0
-#endif
-#ifndef MAP_TRANSFORM_MASK
-#define MAP_TRANSFORM_MASK 0
-#endif
 #ifndef MAP_MIRROR_S_MASK
 #define MAP_MIRROR_S_MASK 0
 #endif
@@ -158,8 +153,12 @@ uniform float u_specular_factor;
 uniform vec3 u_specular_color_f0;             // F0(ior) * specularColorFactor, before the min(., 1)
 #endif
 uniform float u_specular_f90 = 1.0;           // KHR_materials_specular's specularFactor (1 without it)
-// KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs.
+// KHR_texture_transform's matrix per map (slot = log2 of its bit), on alight's OpenGL uvs;
+// identity for a map without one (exact: 1 * u + 0 * v + 0).
 uniform mat3 u_map_transform[MAP_SLOTS];
+#ifdef HAS_UV1
+uniform int u_map_uv1;   // the maps read with TEXCOORD_1 (MATERIAL_MAPS bits); the rest TEXCOORD_0
+#endif
 
 #ifdef SPHERE_SURFACE
 #include "common/sphere_surface.glsl"
@@ -240,9 +239,11 @@ vec2 material_uv() {
 vec2 map_uv(int bit, int slot) {
     vec2 uv = material_uv();
 #ifdef HAS_UV1
-    if ((MAP_UV1_MASK & bit) != 0) uv = v_uv1;
+    if ((u_map_uv1 & bit) != 0) uv = v_uv1;
 #endif
-    if ((MAP_TRANSFORM_MASK & bit) != 0) uv = (u_map_transform[slot] * vec3(uv, 1.0)).xy;
+#ifdef HAS_TEXTURE_TRANSFORM
+    uv = (u_map_transform[slot] * vec3(uv, 1.0)).xy;
+#endif
     return uv;
 }
 

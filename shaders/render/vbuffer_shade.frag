@@ -164,9 +164,13 @@ void interpolate(uint triangle, vec2 xy, vec2 at_centroid) {
     v_sky_weight = w.x * sky_weight_data[i0] + w.y * sky_weight_data[i1] + w.z * sky_weight_data[i2];
 #endif
 #endif
-#ifdef HAS_UV1
+#if defined(HAS_UV1) && defined(UV1_AT)
     vec2 s0 = fetch2(i0, UV1_AT), s1 = fetch2(i1, UV1_AT), s2 = fetch2(i2, UV1_AT);
     v_uv1 = w.x * s0 + w.y * s1 + w.z * s2;
+#elif defined(HAS_UV1)
+    // A part without TEXCOORD_1 in a mesh whose maps read it (HAS_UV1 is the mesh's,
+    // app/render/variants.py): its own maps read TEXCOORD_0 (u_map_uv1 is 0).
+    v_uv1 = vec2(0.0);
 #endif
 #ifdef HAS_VERTEX_COLOR
     v_color = w.x * fetch4(i0, COLOR_AT) + w.y * fetch4(i1, COLOR_AT) + w.z * fetch4(i2, COLOR_AT);
