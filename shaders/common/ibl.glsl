@@ -222,28 +222,10 @@ vec3 sun_layered(Surface s, vec3 n, vec3 v, vec3 l, vec3 power, float spread) {
     return layered_light(s, n, v, l, transmitted + sun_light(s, n, v, l, spread), false, spread) * power;
 }
 
-// Whether a source along l can light this point at all: the base, the sheen and the coat reflect
-// nothing from behind their normals (sun_light, sheen_lobe, clearcoat_lobe return 0 there), the
-// transmission layers do. Where it cannot, sun_layered is 0 and its shadow lookup (a blocker
-// search and PCF: 20 taps) is skipped; llvmpipe leaves the loops once no pixel of a block needs
-// them, and a GPU's warps on the dark side do the same.
-bool sun_reaches(Surface s, vec3 n, vec3 l) {
-#if defined(HAS_TRANSMISSION) || defined(HAS_DIFFUSE_TRANSMISSION)
-    return true;
-#else
-    bool front = dot(n, l) > 0.0;
-#ifdef HAS_CLEARCOAT
-    front = front || dot(s.clearcoat_normal, l) > 0.0;
-#endif
-    return front;
-#endif
-}
-
 vec3 suns_exact(Surface s, vec3 n, vec3 v) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < u_sun_count; ++i) {
 #ifdef HAS_SHADOWS
-        if (!sun_reaches(s, n, u_sun_direction[i])) continue;
         float visible = sun_shadow(i, u_sun_direction[i]);   // (common/shadows.glsl)
         if (visible <= 0.0) continue;
         sum += visible * sun_layered(s, n, v, u_sun_direction[i], u_sun_power[i], u_sun_spread[i]);
