@@ -26,7 +26,7 @@ import numpy as np
 from alight.core.gpu import release_objects
 from alight.errors import warn
 from alight.core.ibl_models import SUNS_AS_BAKED
-from alight.core.mesh import is_closed
+from alight.core.mesh import closed_edges
 from alight.core.shading import rotate_world_to_map
 from alight.core.shadow_fit import (
     ShadowView,
@@ -147,8 +147,10 @@ class ShadowMaps:
         entry = self._self_shadowing.get(id(mesh))
         if entry is None or entry[0] is not mesh:
             parts = [(p.positions, p.indices) for p in mesh.parts]
-            closed = [is_closed(p.positions, p.indices) for p in mesh.parts]
-            entry = self._self_shadowing[id(mesh)] = (mesh, can_shadow_itself(parts, closed))
+            # The closedness test's weld and edge sort, kept for the convexity test's edges.
+            edges = [closed_edges(p.positions, p.indices) for p in mesh.parts]
+            closed = [e is not None for e in edges]
+            entry = self._self_shadowing[id(mesh)] = (mesh, can_shadow_itself(parts, closed, edges=edges))
         return entry[1]
 
     def wanted(self, scene, maps, receivers: bool = False) -> bool:
