@@ -256,6 +256,48 @@ def test_shared_edges_give_the_former_convexity_answers():
     assert set(answers) == {True, False}
 
 
+def test_closedness_found_by_the_test_gives_the_callers_answers(monkeypatch):
+    """Without ``closed`` (as alight.render.shadows calls it) the test answers as with the
+    caller's is_closed, open and closed, convex and not; and where its sample of faces against
+    vertices finds a splitting plane it answers before welding or sorting anything."""
+    import trimesh
+
+    from alight.core import mesh as mesh_module
+
+    ball = trimesh.creation.icosphere(subdivisions=4)
+    pos, idx = np.asarray(ball.vertices, np.float32), np.asarray(ball.faces, np.uint32)
+    corners = BOX_CORNERS * (2.0, 1.0, 1.0)
+    l_shape = [(np.concatenate([BOX_CORNERS, corners + (0.0, 1.0, 0.0)]),
+                np.concatenate([np.array(BOX_FACES), np.array(BOX_FACES) + 8]))]
+    dented = pos.copy()
+    dented[100] *= 0.97
+    cases = {
+        "built-in sphere": [(p.positions, p.indices) for p in sphere().parts],
+        "cube": [(p.positions, p.indices) for p in cube().parts],
+        "box on a plane": [(p.positions, p.indices) for p in box_on_plane().parts],
+        "L of two boxes": l_shape,
+        "icosphere": [(pos, idx)],
+        "icosphere, a face missing (open, convex)": [(pos, idx[1:])],
+        "icosphere, one vertex pushed in by 3%": [(dented, idx)],
+        "two icospheres": [(np.concatenate([pos, pos + (3.0, 0.0, 0.0)]), np.concatenate([idx, idx + len(pos)]))],
+    }
+    answers = {}
+    for name, parts in cases.items():
+        closed = [is_closed(p, i) for p, i in parts]
+        answers[name] = can_shadow_itself(parts)
+        assert answers[name] == can_shadow_itself(parts, closed), name
+    assert answers == {"built-in sphere": False, "cube": False, "box on a plane": True, "L of two boxes": True,
+                       "icosphere": False, "icosphere, a face missing (open, convex)": True,
+                       "icosphere, one vertex pushed in by 3%": True, "two icospheres": True}
+
+    def no_sort(*args, **kwargs):
+        raise AssertionError("welded and sorted although the sample had answered")
+
+    monkeypatch.setattr(mesh_module, "closed_edges", no_sort)
+    assert can_shadow_itself(l_shape)
+    assert can_shadow_itself(cases["two icospheres"])
+
+
 def test_sphere_draws_no_shadow_pass_and_is_unchanged():
     r = renderer()
     light = Light(kind="directional", vector=(-0.3, -1.0, -0.5), intensity=3.0)

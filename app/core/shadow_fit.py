@@ -153,24 +153,26 @@ def cube_face(vector) -> int:
     return 2 * axis + (0 if v[axis] >= 0.0 else 1)
 
 
-def can_shadow_itself(parts, closed, faces: int = 2000, vertices: int = 20000, edges=None) -> bool:
+def can_shadow_itself(parts, closed=None, faces: int = 2000, vertices: int = 20000, edges=None) -> bool:
     """Whether any part of a mesh can cast a shadow on the mesh: False only where every face's
     plane has the whole mesh on one side of it (to 1e-5 of the mesh's size) and the mesh is
-    ``closed`` (``closed``: the parts' closedness, alight.core.mesh.is_closed), or where it is
-    flat. Such a surface bounds a convex solid, and a point of a convex solid's surface that faces
-    a light (n.l > 0) sees it unoccluded, so shadow maps would change nothing. An open shell
-    fails (a bowl's inside is shaded from both sides and its rim shadows it).
+    closed (alight.core.mesh.is_closed), or where it is flat. Such a surface bounds a convex
+    solid, and a point of a convex solid's surface that faces a light (n.l > 0) sees it
+    unoccluded, so shadow maps would change nothing. An open shell fails (a bowl's inside is
+    shaded from both sides and its rim shadows it).
 
-    ``parts``: [(positions (N, 3), indices (M, 3))]. Linear in the mesh: first every edge is
-    tested locally (the vertex across it behind the face's plane: ``_locally_convex``), which finds
-    any concave edge; a closed surface convex at every edge is convex, unless it is several
-    solids, which the faces against the vertices then find: all of them up to ``faces`` faces and
-    ``vertices`` vertices, a seeded sample of each beyond (testing every face against every vertex
-    took minutes on a 1.3M-triangle sphere).
+    ``parts``: [(positions (N, 3), indices (M, 3))]. Linear in the mesh. First a seeded sample of
+    ``faces`` faces against one of ``vertices`` vertices (all of them below those counts): a
+    plane with vertices on both sides answers True whether the mesh is closed or not, so most
+    meshes that can shadow themselves (a bumpy 1M-triangle sphere) stop here, before any weld
+    or sort. Otherwise the parts' closedness and every edge, tested locally (the vertex across
+    it behind the face's plane: ``_locally_convex``), decide: a closed surface convex at every
+    edge is convex (several solids side by side are what the sample is for; testing every face
+    against every vertex took minutes on a 1.3M-triangle sphere).
 
-    ``edges``: per part, its alight.core.mesh.closed_edges (None where open), when the caller
-    has them: the closedness test's weld and edge sort then serve the local test too, instead of
-    being done again here (``closed`` is then ``[e is not None for e in edges]``)."""
+    ``closed``: the parts' closedness where the caller knows it (else computed here, only when
+    the sample did not answer); ``edges``: per part, its alight.core.mesh.closed_edges (None where
+    open), which then serve both the closedness and the local test (one weld and one sort)."""
     points = np.concatenate([np.asarray(p, np.float64) for p, _ in parts]) if parts else np.zeros((0, 3))
     if len(points) < 4:
         return False
@@ -183,12 +185,26 @@ def can_shadow_itself(parts, closed, faces: int = 2000, vertices: int = 20000, e
     values = np.linalg.eigvalsh(centred.T @ centred)
     if values[0] <= 1e-10 * values[-1]:
         return False                 # flat: one plane cannot shadow itself
-    if not all(closed):
+    if _sampled_planes_split(parts, centred, centre, size, eps, faces, vertices):
         return True
     if edges is None:
-        edges = [None] * len(parts)
-    if not all(_locally_convex(positions, indices, eps, e) for (positions, indices), e in zip(parts, edges)):
+        if closed is not None and not all(closed):
+            return True
+        from alight.core.mesh import closed_edges
+
+        edges = []
+        for positions, indices in parts:
+            edges.append(closed_edges(positions, indices))
+            if edges[-1] is None and closed is None:
+                return True          # open: a rim can shadow the inside
+    elif not all(e is not None for e in edges):
         return True
+    return not all(_locally_convex(positions, indices, eps, e) for (positions, indices), e in zip(parts, edges))
+
+
+def _sampled_planes_split(parts, centred, centre, size: float, eps: float, faces: int, vertices: int) -> bool:
+    """Whether some face's plane has (sampled) vertices more than ``eps`` on both sides of it:
+    up to ``faces`` faces against up to ``vertices`` vertices, seeded samples beyond."""
     rng = np.random.default_rng(0)
     if len(centred) > vertices:
         centred = centred[rng.choice(len(centred), vertices, replace=False)]
