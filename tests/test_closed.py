@@ -5,7 +5,8 @@ meshes; that version is kept here as the reference."""
 import numpy as np
 import pytest
 
-from alight.core.mesh import cube, is_closed, plane, sphere
+from alight.core import mesh as mesh_module
+from alight.core.mesh import closed_edges, cube, is_closed, plane, sphere
 
 
 def reference_is_closed(positions, indices) -> bool:
@@ -76,6 +77,9 @@ def test_verdict_matches_the_former_test(name):
     positions, indices, expected = _cases()[name]
     assert reference_is_closed(positions, indices) == expected
     assert is_closed(positions, indices) == expected
+    # The shadow test's variant, which keeps the edge pairing: the same verdict, packed or not.
+    assert (closed_edges(positions, indices) is not None) == expected
+    assert (closed_edges(positions, indices, pack=False) is not None) == expected
 
 
 def test_random_edits_of_a_closed_mesh_agree():
@@ -97,5 +101,47 @@ def test_random_edits_of_a_closed_mesh_agree():
         rng.shuffle(faces)
         expected = reference_is_closed(s.positions, faces)
         assert is_closed(s.positions, faces) == expected
+        assert (closed_edges(s.positions, faces) is not None) == expected
         verdicts.add(expected)
     assert verdicts == {True, False}
+
+
+def test_hashed_weld_groups_as_the_column_weld_and_survives_collisions(monkeypatch):
+    """_weld hashes rounded positions; its groups are _weld_by_columns' (ids may differ, the
+    partition may not), and where every position hashes alike the exact check sends it to
+    _weld_by_columns, so the verdicts stay right."""
+    s = sphere(32, 16).parts[0]       # seams and poles: many positions at equal coordinates
+    rng = np.random.default_rng(3)
+    for positions in (s.positions, s.positions * -1.0, rng.integers(-3, 3, (500, 3)) * 0.5,
+                      np.concatenate([s.positions, s.positions + 1e-8])):
+        a, b = mesh_module._weld(positions), mesh_module._weld_by_columns(positions)
+        pairs = np.unique(np.stack([a, b], axis=1), axis=0)
+        assert len(pairs) == len(np.unique(a)) == len(np.unique(b))
+    monkeypatch.setattr(mesh_module, "_mix64", lambda v: v * np.uint64(0))
+    a = mesh_module._weld(s.positions)
+    assert np.array_equal(a, mesh_module._weld_by_columns(s.positions))
+    assert is_closed(s.positions, s.indices)
+    assert not is_closed(s.positions, s.indices[1:])
+
+
+@pytest.mark.parametrize("pack", [True, False])
+def test_closed_edges_pairs_the_two_faces_of_each_edge(pack):
+    """Per edge, ``face`` holds the edge and ``across`` is the other face's third corner: after
+    the weld, the face and across's face share exactly the edge's two corners, and across is
+    not one of the face's corners; no face is named for more than its 3 edges."""
+    s = sphere(24, 12).parts[0]
+    weld = mesh_module._weld(s.positions)
+    e = closed_edges(s.positions, s.indices, pack=pack)
+    assert e is not None
+    welded = weld[e.faces]
+    assert len(e.face) == 3 * len(e.faces) // 2
+    near = welded[e.face]
+    across = weld[e.across]
+    assert not (near == across[:, None]).any()
+    count = np.bincount(e.face, minlength=len(e.faces))
+    assert count.max() <= 3
+    # The other face: one of the faces holding `across` shares two corners with the edge's face.
+    for i in range(0, len(e.face), 7):
+        f = welded[e.face[i]]
+        holders = np.where((welded == across[i]).any(axis=1))[0]
+        assert any(len(set(f) & set(welded[h])) == 2 for h in holders)

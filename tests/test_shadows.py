@@ -186,6 +186,118 @@ def test_convexity_of_big_meshes_without_testing_every_face_against_every_vertex
     assert not can_shadow_itself([(p2, i2[:, ::-1])], [True])
 
 
+def _reference_locally_convex(positions, indices, eps: float) -> bool:
+    """shadow_fit._locally_convex as it was before it shared closed_edges' weld and edge sort
+    (its own column weld, an argsort of undirected edge keys, (M, 3) float32 rows)."""
+    from alight.core.mesh import _weld_by_columns
+
+    p = np.asarray(positions, np.float64).reshape(-1, 3)
+    tri = np.asarray(indices, np.int64).reshape(-1, 3)
+    welded = _weld_by_columns(p)[tri]
+    good = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
+    tri, welded = tri[good], welded[good]
+    if len(tri) == 0:
+        return True
+    p32 = (p - p.mean(axis=0)).astype(np.float32)
+    p0 = p32[tri[:, 0]]
+    normals = np.cross(p32[tri[:, 1]] - p0, p32[tri[:, 2]] - p0)
+    normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-30)[:, None]
+    offsets = np.einsum("ij,ij->i", normals, p0)
+    n = int(welded.max()) + 1
+    count = len(tri)
+    keys = np.empty(3 * count, np.int64)
+    opposite = np.empty(3 * count, np.int64)
+    for k in range(3):
+        a, b = welded[:, k], welded[:, (k + 1) % 3]
+        keys[k * count:(k + 1) * count] = np.minimum(a, b) * n + np.maximum(a, b)
+        opposite[k * count:(k + 1) * count] = tri[:, (k + 2) % 3]
+    order = np.argsort(keys)
+    keys = keys[order]
+    paired = keys[0::2] == keys[1::2]
+    face = order[0::2][paired] % count
+    across = opposite[order[1::2][paired]]
+    d = np.einsum("ij,ij->i", normals[face], p32[across]) - offsets[face]
+    return bool(d.max() <= eps or d.min() >= -eps)
+
+
+def test_shared_edges_give_the_former_convexity_answers():
+    """can_shadow_itself's local test on closed_edges' pairing (the closedness test's weld and
+    sort, as alight.render.shadows passes it) answers as the former test with its own weld and
+    sort, on the convex and concave closed meshes above and on dents of growing depth, some
+    within the 1e-5 tolerance, the deeper ones past it."""
+    import trimesh
+
+    from alight.core.mesh import closed_edges
+    from alight.core.shadow_fit import _locally_convex
+
+    ball = trimesh.creation.icosphere(subdivisions=4)
+    pos, idx = np.asarray(ball.vertices, np.float32), np.asarray(ball.faces, np.uint32)
+    s = sphere().parts[0]
+    corners = BOX_CORNERS * (2.0, 1.0, 1.0)
+    l_shape = (np.concatenate([BOX_CORNERS, corners + (0.0, 1.0, 0.0)]),
+               np.concatenate([np.array(BOX_FACES), np.array(BOX_FACES) + 8]))
+    cases = [(s.positions, s.indices), (pos, idx), (pos, idx[:, ::-1]), l_shape,
+             (BOX_CORNERS, np.array(BOX_FACES))]
+    for depth in (1e-7, 1e-6, 1e-4, 1e-2):
+        dented = pos.copy()
+        dented[100] *= 1.0 - depth
+        cases.append((dented, idx))
+    answers = []
+    for positions, indices in cases:
+        size = float(np.abs(positions - np.asarray(positions, np.float64).mean(axis=0)).max())
+        edges = closed_edges(positions, indices)
+        assert edges is not None
+        for e in (edges, closed_edges(positions, indices, pack=False), None):
+            got = _locally_convex(positions, indices, 1e-5 * size, e)
+            assert got == _reference_locally_convex(positions, indices, 1e-5 * size)
+        answers.append(got)
+        assert can_shadow_itself([(positions, indices)], [True], edges=[edges]) == \
+            can_shadow_itself([(positions, indices)], [True])
+    assert set(answers) == {True, False}
+
+
+def test_closedness_found_by_the_test_gives_the_callers_answers(monkeypatch):
+    """Without ``closed`` (as alight.render.shadows calls it) the test answers as with the
+    caller's is_closed, open and closed, convex and not; and where its sample of faces against
+    vertices finds a splitting plane it answers before welding or sorting anything."""
+    import trimesh
+
+    from alight.core import mesh as mesh_module
+
+    ball = trimesh.creation.icosphere(subdivisions=4)
+    pos, idx = np.asarray(ball.vertices, np.float32), np.asarray(ball.faces, np.uint32)
+    corners = BOX_CORNERS * (2.0, 1.0, 1.0)
+    l_shape = [(np.concatenate([BOX_CORNERS, corners + (0.0, 1.0, 0.0)]),
+                np.concatenate([np.array(BOX_FACES), np.array(BOX_FACES) + 8]))]
+    dented = pos.copy()
+    dented[100] *= 0.97
+    cases = {
+        "built-in sphere": [(p.positions, p.indices) for p in sphere().parts],
+        "cube": [(p.positions, p.indices) for p in cube().parts],
+        "box on a plane": [(p.positions, p.indices) for p in box_on_plane().parts],
+        "L of two boxes": l_shape,
+        "icosphere": [(pos, idx)],
+        "icosphere, a face missing (open, convex)": [(pos, idx[1:])],
+        "icosphere, one vertex pushed in by 3%": [(dented, idx)],
+        "two icospheres": [(np.concatenate([pos, pos + (3.0, 0.0, 0.0)]), np.concatenate([idx, idx + len(pos)]))],
+    }
+    answers = {}
+    for name, parts in cases.items():
+        closed = [is_closed(p, i) for p, i in parts]
+        answers[name] = can_shadow_itself(parts)
+        assert answers[name] == can_shadow_itself(parts, closed), name
+    assert answers == {"built-in sphere": False, "cube": False, "box on a plane": True, "L of two boxes": True,
+                       "icosphere": False, "icosphere, a face missing (open, convex)": True,
+                       "icosphere, one vertex pushed in by 3%": True, "two icospheres": True}
+
+    def no_sort(*args, **kwargs):
+        raise AssertionError("welded and sorted although the sample had answered")
+
+    monkeypatch.setattr(mesh_module, "closed_edges", no_sort)
+    assert can_shadow_itself(l_shape)
+    assert can_shadow_itself(cases["two icospheres"])
+
+
 def test_sphere_draws_no_shadow_pass_and_is_unchanged():
     r = renderer()
     light = Light(kind="directional", vector=(-0.3, -1.0, -0.5), intensity=3.0)

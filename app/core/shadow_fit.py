@@ -153,20 +153,26 @@ def cube_face(vector) -> int:
     return 2 * axis + (0 if v[axis] >= 0.0 else 1)
 
 
-def can_shadow_itself(parts, closed, faces: int = 2000, vertices: int = 20000) -> bool:
+def can_shadow_itself(parts, closed=None, faces: int = 2000, vertices: int = 20000, edges=None) -> bool:
     """Whether any part of a mesh can cast a shadow on the mesh: False only where every face's
     plane has the whole mesh on one side of it (to 1e-5 of the mesh's size) and the mesh is
-    ``closed`` (``closed``: the parts' closedness, alight.core.mesh.is_closed), or where it is
-    flat. Such a surface bounds a convex solid, and a point of a convex solid's surface that faces
-    a light (n.l > 0) sees it unoccluded, so shadow maps would change nothing. An open shell
-    fails (a bowl's inside is shaded from both sides and its rim shadows it).
+    closed (alight.core.mesh.is_closed), or where it is flat. Such a surface bounds a convex
+    solid, and a point of a convex solid's surface that faces a light (n.l > 0) sees it
+    unoccluded, so shadow maps would change nothing. An open shell fails (a bowl's inside is
+    shaded from both sides and its rim shadows it).
 
-    ``parts``: [(positions (N, 3), indices (M, 3))]. Linear in the mesh: first every edge is
-    tested locally (the vertex across it behind the face's plane: ``_locally_convex``), which finds
-    any concave edge; a closed surface convex at every edge is convex, unless it is several
-    solids, which the faces against the vertices then find: all of them up to ``faces`` faces and
-    ``vertices`` vertices, a seeded sample of each beyond (testing every face against every vertex
-    took minutes on a 1.3M-triangle sphere)."""
+    ``parts``: [(positions (N, 3), indices (M, 3))]. Linear in the mesh. First a seeded sample of
+    ``faces`` faces against one of ``vertices`` vertices (all of them below those counts): a
+    plane with vertices on both sides answers True whether the mesh is closed or not, so most
+    meshes that can shadow themselves (a bumpy 1M-triangle sphere) stop here, before any weld
+    or sort. Otherwise the parts' closedness and every edge, tested locally (the vertex across
+    it behind the face's plane: ``_locally_convex``), decide: a closed surface convex at every
+    edge is convex (several solids side by side are what the sample is for; testing every face
+    against every vertex took minutes on a 1.3M-triangle sphere).
+
+    ``closed``: the parts' closedness where the caller knows it (else computed here, only when
+    the sample did not answer); ``edges``: per part, its alight.core.mesh.closed_edges (None where
+    open), which then serve both the closedness and the local test (one weld and one sort)."""
     points = np.concatenate([np.asarray(p, np.float64) for p, _ in parts]) if parts else np.zeros((0, 3))
     if len(points) < 4:
         return False
@@ -179,10 +185,26 @@ def can_shadow_itself(parts, closed, faces: int = 2000, vertices: int = 20000) -
     values = np.linalg.eigvalsh(centred.T @ centred)
     if values[0] <= 1e-10 * values[-1]:
         return False                 # flat: one plane cannot shadow itself
-    if not all(closed):
+    if _sampled_planes_split(parts, centred, centre, size, eps, faces, vertices):
         return True
-    if not all(_locally_convex(positions, indices, eps) for positions, indices in parts):
+    if edges is None:
+        if closed is not None and not all(closed):
+            return True
+        from alight.core.mesh import closed_edges
+
+        edges = []
+        for positions, indices in parts:
+            edges.append(closed_edges(positions, indices))
+            if edges[-1] is None and closed is None:
+                return True          # open: a rim can shadow the inside
+    elif not all(e is not None for e in edges):
         return True
+    return not all(_locally_convex(positions, indices, eps, e) for (positions, indices), e in zip(parts, edges))
+
+
+def _sampled_planes_split(parts, centred, centre, size: float, eps: float, faces: int, vertices: int) -> bool:
+    """Whether some face's plane has (sampled) vertices more than ``eps`` on both sides of it:
+    up to ``faces`` faces against up to ``vertices`` vertices, seeded samples beyond."""
     rng = np.random.default_rng(0)
     if len(centred) > vertices:
         centred = centred[rng.choice(len(centred), vertices, replace=False)]
@@ -206,44 +228,41 @@ def can_shadow_itself(parts, closed, faces: int = 2000, vertices: int = 20000) -
     return False
 
 
-def _locally_convex(positions, indices, eps: float) -> bool:
+def _locally_convex(positions, indices, eps: float, edges=None) -> bool:
     """Whether a closed, consistently wound part bends the same way at every edge: across each
     edge, the third vertex of one face lies on the same side of the other face's plane (within
-    ``eps``) as everywhere else. Vertices at equal positions are welded first (UV seams). Sorts of
-    the 3M edges: linear but for the sort's log."""
-    from alight.core.mesh import _weld
+    ``eps``) as everywhere else. Vertices at equal positions are welded (UV seams) and the 3M
+    edges sorted by alight.core.mesh.closed_edges (``edges``, computed here when not given):
+    linear but for the sort's log."""
+    if edges is None:
+        from alight.core.mesh import closed_edges
 
+        edges = closed_edges(positions, indices)
+        if edges is None:
+            return False          # (the caller said closed; a part that is not is no convex solid)
     p = np.asarray(positions, np.float64).reshape(-1, 3)
-    tri = np.asarray(indices, np.int64).reshape(-1, 3)
-    welded = _weld(p)[tri]
-    good = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
-    if not good.all():
-        tri, welded = tri[good], welded[good]
+    tri = edges.faces
     if len(tri) == 0:
         return True
-    # Each face's plane n.x = c, in float32: the gathers below are memory-bound (3.9M edges at 1.3M
-    # faces) and the test's tolerance is 1e-5 of the mesh's size.
-    p32 = (p - p.mean(axis=0)).astype(np.float32)   # (centred: float32 keeps 1e-7 of the size, not of the offset)
-    p0 = p32[tri[:, 0]]
-    normals = np.cross(p32[tri[:, 1]] - p0, p32[tri[:, 2]] - p0)
-    normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-30)[:, None]
-    offsets = np.einsum("ij,ij->i", normals, p0)
-    del p0
-    n = int(welded.max()) + 1
-    count = len(tri)
-    keys = np.empty(3 * count, np.int64)
-    opposite = np.empty(3 * count, np.int64)      # the face's corner not on the edge (an original index)
-    for k in range(3):
-        a, b = welded[:, k], welded[:, (k + 1) % 3]
-        keys[k * count:(k + 1) * count] = np.minimum(a, b) * n + np.maximum(a, b)
-        opposite[k * count:(k + 1) * count] = tri[:, (k + 2) % 3]
-    order = np.argsort(keys)
-    keys = keys[order]
-    paired = keys[0::2] == keys[1::2]              # closed: every edge has its two faces side by side
-    del keys
+    # Each face's plane n.x = c, in float32 and one coordinate at a time (contiguous 1-D
+    # gathers and products: np.cross and einsum on (M, 3) rows took most of this test's time);
+    # the gathers are memory-bound (3M edges at 1M faces) and the test's tolerance is 1e-5 of
+    # the mesh's size. Centred: float32 keeps 1e-7 of the size, not of the offset.
+    x, y, z = np.ascontiguousarray((p - p.mean(axis=0)).T.astype(np.float32))
+    t0, t1, t2 = (np.ascontiguousarray(tri[:, k]) for k in range(3))
+    ax, ay, az = x[t0], y[t0], z[t0]
+    ux, uy, uz = x[t1] - ax, y[t1] - ay, z[t1] - az
+    vx, vy, vz = x[t2] - ax, y[t2] - ay, z[t2] - az
+    nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+    del ux, uy, uz, vx, vy, vz
+    length = np.maximum(np.sqrt(nx * nx + ny * ny + nz * nz), 1e-30)
+    nx /= length
+    ny /= length
+    nz /= length
+    offsets = nx * ax + ny * ay + nz * az
+    del ax, ay, az, length
     # One face of each edge against the vertex across it: an edge bends the same way seen from
     # either face, so one side of each pair suffices.
-    face = order[0::2][paired] % count
-    across = opposite[order[1::2][paired]]
-    d = np.einsum("ij,ij->i", normals[face], p32[across]) - offsets[face]
+    f, v = edges.face, edges.across
+    d = nx[f] * x[v] + ny[f] * y[v] + nz[f] * z[v] - offsets[f]
     return bool(d.max() <= eps or d.min() >= -eps)

@@ -26,7 +26,6 @@ import numpy as np
 from alight.core.gpu import release_objects
 from alight.errors import warn
 from alight.core.ibl_models import SUNS_AS_BAKED
-from alight.core.mesh import is_closed
 from alight.core.shading import rotate_world_to_map
 from alight.core.shadow_fit import (
     ShadowView,
@@ -146,9 +145,10 @@ class ShadowMaps:
         """shadow_fit.can_shadow_itself for ``mesh``'s parts, computed once per mesh."""
         entry = self._self_shadowing.get(id(mesh))
         if entry is None or entry[0] is not mesh:
+            # Closedness is left to the test: it welds and sorts only when its sample of faces
+            # against vertices finds no plane that splits the mesh (mesh.closed_edges).
             parts = [(p.positions, p.indices) for p in mesh.parts]
-            closed = [is_closed(p.positions, p.indices) for p in mesh.parts]
-            entry = self._self_shadowing[id(mesh)] = (mesh, can_shadow_itself(parts, closed))
+            entry = self._self_shadowing[id(mesh)] = (mesh, can_shadow_itself(parts))
         return entry[1]
 
     def wanted(self, scene, maps, receivers: bool = False) -> bool:
