@@ -195,6 +195,9 @@ class EditorWindow:
         from alight.frontends.editor.variant_warmup import VariantWarmup
 
         self.variant_warmup = VariantWarmup()   # new shader variants compiled in a process of their own
+        from alight.frontends.editor.occlusion_bake import OcclusionBake
+
+        self.occlusion_bake = OcclusionBake()   # the visibility bake made in a process of its own
         from alight.frontends.editor.pass_warmup import PassWarmup
 
         self.pass_warmup = PassWarmup()   # the split view's passes drawn once at the start (Mesa's cache)
@@ -569,7 +572,7 @@ class EditorWindow:
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
-                scene.ibl_model, scene.multiple_scattering,
+                scene.ibl_model, scene.multiple_scattering, scene.occlusion,
                 size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials,
                 scene.texture_maps, tuple(id(scene.texture_images.get(p)) for p in scene.texture_maps.paths().values()))
 
@@ -598,6 +601,8 @@ class EditorWindow:
         targets = self.targets(size)
         scene = self.state.scene(camera)
         maps = self.maps()
+        # Occlusion once its bake is in the cache (made by a child process: occlusion_bake.py).
+        scene, hold_lighting = self.occlusion_bake.view_scene(self, scene, maps, whole=full)
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
@@ -612,10 +617,16 @@ class EditorWindow:
         direct = False     # drawn into the window (the renderer may not: draw_display)
         if self.variant_warmup.step():   # a new variant compiled in the warm-up process: draw it now
             self._drawn_key = None
+        if self.occlusion_bake.step(self):   # a bake (or its new lighting) is in the cache: draw it now
+            self._drawn_key = None
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
                 # (a variant not compiled yet: the last picture's scene meanwhile, variant_warmup.py)
-                drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
+                self.renderer.visibility_parts.hold_lighting = hold_lighting
+                try:
+                    drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
+                finally:
+                    self.renderer.visibility_parts.hold_lighting = False
                 direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
@@ -895,6 +906,7 @@ class EditorWindow:
         self._target_cache.clear()
         self.compare_view.release()
         self.variant_warmup.close()
+        self.occlusion_bake.close()
         self.pass_warmup.close()
         self._panel_image.release()
         self.thumbnails.release()
