@@ -1,0 +1,55 @@
+"""The editor's occlusion through its real UI (tests/editor_ui_checks_occlusion.py under the Dear
+ImGui Test Engine, a real window under Xvfb), and its occluded view against ``alight render`` of
+the same scene, size and camera."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from test_editor import display  # noqa: F401  (the Xvfb fixture)
+from test_editor_ui import ui_test
+
+REPO = Path(__file__).resolve().parents[1]
+CHECKS = REPO / "tests" / "editor_ui_checks_occlusion.py"
+LIGHT = "dir:dir=-0.3,-1,-0.5:intensity=1"   # one light, given to both (the editor's default is three)
+
+
+def test_occlusion_through_the_panel_and_the_view_equals_alight_render(display, tmp_path):
+    from alight.accuracy.scenes import write_scene
+
+    bowl = write_scene("bowl", tmp_path)
+    result = ui_test(tmp_path, CHECKS, "--new", "--mesh", str(bowl), "--occlusion", "off", "--light", LIGHT,
+                     size="800x480")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]
+    assert f"{len(checks)} passed, 0 failed" in result.stdout, result.stdout
+    for line in result.stdout.splitlines():
+        if line.startswith("OCCLUSION_"):
+            print(line)
+    view = json.loads((tmp_path / "occlusion_view.json").read_text())
+    w, h = view["size"]
+    out = tmp_path / "render.png"
+    env = dict(os.environ, ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_CONFIG_DIR=str(tmp_path / "config"))
+    done = subprocess.run([sys.executable, "-m", "alight", "render", "--mesh", str(bowl), "--light", LIGHT,
+                           "--occlusion", "auto", "--size", f"{w}x{h}", "--orbit", str(view["orbit"]),
+                           "--elevation", str(view["elevation"]), "--distance", str(view["distance"]),
+                           "--fov", str(view["fov"]), "--target", ",".join(map(str, view["target"])),
+                           "--aa", "none", "--out", str(out)], env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    import OpenImageIO as oiio
+
+    rendered = oiio.ImageBuf(str(out)).get_pixels(oiio.UINT8)[:, :, :3].astype(np.float64)
+    shown = oiio.ImageBuf(str(tmp_path / "occlusion_view.png")).get_pixels(oiio.UINT8)[:h, :w, :3].astype(np.float64)
+    off = oiio.ImageBuf(str(tmp_path / "occlusion_off.png")).get_pixels(oiio.UINT8)[:h, :w, :3].astype(np.float64)
+    diff = np.abs(shown - rendered)
+    print(f"EDITOR_VS_RENDER mean={diff.mean():.4f} max={diff.max():.0f} over2={(diff.max(axis=2) > 2).mean():.5f}; "
+          f"off vs render mean={np.abs(off - rendered).mean():.4f}")
+    # The same picture (the editor's anti-aliasing 'none' given to both): far closer than the
+    # unoccluded one is.
+    assert diff.max() <= 1.0, (diff.mean(), diff.max(), (diff.max(axis=2) > 1).mean())
+    assert np.abs(off - rendered).mean() > 5 * diff.mean() + 0.5
