@@ -119,12 +119,16 @@ class OcclusionBake:
         if self._worker is None:
             self._worker = WorkerProcess("alight.frontends.editor.occlusion_bake")
         mesh, mode, through, suns, texels, digest, rotation = job
-        # The mesh is pickled once (its arrays and textures: megabytes), then named by its token.
+        # The mesh is sent once, then named by its token; and its geometry only: the bake and its
+        # cache key (visibility.mesh_digest) read nothing else, and DamagedHelmet's decoded
+        # textures made an 85 MB pickle (0.9 MB without), written in the frame that sends it.
         token = id(mesh)
         send = token != self._sent_token
         self._sent_token = token
+        geometry = dataclasses.replace(mesh, parts=[dataclasses.replace(p, material=None) for p in mesh.parts],
+                                       cameras=[], lights=[]) if send else None
         out = self._worker.scratch_file(f"occlusion-{self.jobs}.pickle")
-        job_id = self._worker.submit(OcclusionJob(mesh=mesh if send else None, mesh_token=token, mode=mode,
+        job_id = self._worker.submit(OcclusionJob(mesh=geometry, mesh_token=token, mode=mode,
                                                   through=through, suns=np.asarray(suns, np.float64),
                                                   texels=texels, digest=digest, rotation_deg=rotation,
                                                   out=str(out)))
