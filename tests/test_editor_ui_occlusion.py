@@ -53,3 +53,36 @@ def test_occlusion_through_the_panel_and_the_view_equals_alight_render(display, 
     # unoccluded one is.
     assert diff.max() <= 1.0, (diff.mean(), diff.max(), (diff.max(axis=2) > 1).mean())
     assert np.abs(off - rendered).mean() > 5 * diff.mean() + 0.5
+
+
+def test_the_occlusion_setting_is_kept_in_the_session_and_taken_from_the_command_line(tmp_path, monkeypatch):
+    """The combo's value is saved and reopened (an older session without it: 'auto', as 'alight
+    render'); `alight edit --occlusion` and `--script occlusion=` set it; a bad value is one line."""
+    import pytest
+
+    from alight.errors import AlightError
+    from alight.frontends.cli import build_parser
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.run import _no_scene_options, build_state
+    from alight.frontends.editor.session import restore_session, save_session, session_path
+    from alight.frontends.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
+    assert EditorState().occlusion == "auto" and EditorState().scene(None).occlusion == "auto"
+    state = EditorState(occlusion="off")
+    save_session(state, OrbitCamera())
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == "" and fresh.occlusion == "off"
+    data = json.loads(session_path().read_text())
+    del data["settings"]["occlusion"]
+    session_path().write_text(json.dumps(data))
+    fresh = EditorState(occlusion="on")
+    assert restore_session(fresh, OrbitCamera()) == "" and fresh.occlusion == "auto"
+    state.apply_edit("occlusion=on")
+    assert state.occlusion == "on"
+    with pytest.raises(AlightError, match="occlusion 'maybe' is not one of auto, on, off"):
+        state.apply_edit("occlusion=maybe")
+    args = build_parser().parse_args(["edit", "--occlusion", "off"])
+    assert build_state(args).occlusion == "off" and not _no_scene_options(args)   # (a scene option: no reopening)
+    args = build_parser().parse_args(["edit"])
+    assert build_state(args).occlusion == "auto" and _no_scene_options(args)

@@ -601,7 +601,10 @@ class EditorWindow:
         targets = self.targets(size)
         scene = self.state.scene(camera)
         maps = self.maps()
-        # Occlusion once its bake is in the cache (made by a child process: occlusion_bake.py).
+        # Occlusion once its bake is in the cache (made by a child process: occlusion_bake.py);
+        # its answers first, so the frame that gets one draws the occluded picture.
+        if self.occlusion_bake.step(self):
+            self._drawn_key = None
         scene, hold_lighting = self.occlusion_bake.view_scene(self, scene, maps, whole=full)
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
@@ -616,8 +619,6 @@ class EditorWindow:
         key = self._view_key(scene, maps, size) if into is None else None
         direct = False     # drawn into the window (the renderer may not: draw_display)
         if self.variant_warmup.step():   # a new variant compiled in the warm-up process: draw it now
-            self._drawn_key = None
-        if self.occlusion_bake.step(self):   # a bake (or its new lighting) is in the cache: draw it now
             self._drawn_key = None
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
