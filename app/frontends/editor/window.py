@@ -781,6 +781,7 @@ class EditorWindow:
         from alight.frontends.editor.screenshot import ScreenshotJob
 
         self.finish_bake()
+        self.occlusion_bake.finish(self)   # (the renderer would bake what the child has not written yet)
         size = self.screenshot_size.size(self.view_area())
         scene = self.state.scene(self.orbit.camera())
         if self.state.compare.active:   # the split view, as shown: its halves put together whole
@@ -838,6 +839,7 @@ class EditorWindow:
         from alight.frontends.editor.turntable import TurntableJob, orbit_cameras
 
         self.finish_bake()
+        self.occlusion_bake.finish(self)   # its frames drawn with occlusion, as 'alight render' draws them
         t = self.turntable
         cameras = orbit_cameras(self.orbit, t.frames)
         scene = self.state.scene(cameras[0])
