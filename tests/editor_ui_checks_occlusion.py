@@ -5,8 +5,9 @@ collected by pytest.
 
 The 'occlusion' combo set to auto: the bake runs in its child process while frames go on, the
 status row says so, and the view switches to the occluded picture (darker inside the bowl) when
-the cache holds it; 'off' gives the unoccluded picture back. The last check leaves the occluded
-view and its camera in the run's folder, for the runner to compare with ``alight render``."""
+the cache holds it; 'off' gives the unoccluded picture back. The rotation slider: the view stays
+occluded with the last light terms while the child makes the new ones. The last check leaves the
+occluded view and its camera in the run's folder, for the runner to compare with ``alight render``."""
 
 from __future__ import annotations
 
@@ -86,8 +87,35 @@ def test_occlusion_is_baked_while_frames_go_on_and_darkens_the_bowl(ctx):
     assert np.abs(back - off).max() <= 1.0, np.abs(back - off).max()   # the unoccluded picture again
 
 
+def test_turning_the_environment_keeps_the_view_occluded_until_its_light_is_made(ctx):
+    """The rotation slider: the sky weight is the environment's, so the child makes it again; the
+    view stays occluded meanwhile, with the last weight (never the unoccluded picture), and the
+    status row says the light follows; then it is drawn with the new one (a frame later)."""
+    win = editor()
+    ctx.set_ref("alight")
+    ctx.combo_click("occlusion/auto")   # (the last check left it off; the bake is in the cache)
+    until_seconds(ctx, lambda: _settled(win), 60.0)
+    jobs = win.occlusion_bake.jobs
+    parts = win.renderer.visibility_parts
+    ctx.item_input_value("**/rotation", 120.0)
+    assert win.state.env_rotation_deg == 120.0
+    seen = set()
+    start = time.perf_counter()
+    while not (win.occlusion_bake.jobs > jobs and _settled(win)):
+        assert time.perf_counter() - start < BAKE_LIMIT_S, "the light terms never came"
+        ctx.yield_()
+        seen.add((win.panel.shown_status, parts.hold_lighting))
+    # Drawn occluded with the last weight meanwhile (the baked parts held), the status row saying so.
+    assert any("follows in a moment" in status and hold for status, hold in seen), seen
+    assert parts.bakes_run == 0 and parts.sky_weights_run == 0   # every term read from the cache the child filled
+    turned = _shown_view(ctx, win, "occlusion_turned.png")
+    assert not parts.hold_lighting and turned.std() > 5.0
+    ctx.item_input_value("**/rotation", 0.0)
+    until_seconds(ctx, lambda: _settled(win) and not parts.hold_lighting, BAKE_LIMIT_S)
+
+
 def test_the_occluded_view_is_left_for_alight_render(ctx):
-    """Auto again: the bake is in the cache, so the view is occluded at once; the view and its
+    """Auto (again): the bake is in the cache, so the view is occluded at once; the view and its
     camera are written for the runner's ``alight render`` of the same scene."""
     win = editor()
     ctx.set_ref("alight")

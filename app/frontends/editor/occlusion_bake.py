@@ -183,6 +183,7 @@ class OcclusionBake:
         """Wait for the running bake (and the lighting queued after it)."""
         while self._running is not None and self._worker is not None:
             self.step(win, self._worker.wait(self._running.job_id, timeout_s))
+        win.renderer.visibility_parts.hold_lighting = False   # the terms are in the cache now
 
     def close(self) -> None:
         if self._worker is not None:

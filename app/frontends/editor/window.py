@@ -606,6 +606,9 @@ class EditorWindow:
         if self.occlusion_bake.step(self):
             self._drawn_key = None
         scene, hold_lighting = self.occlusion_bake.view_scene(self, scene, maps, whole=full)
+        # For every draw of this view (the compare split's A half too) until the next frame says;
+        # a screenshot or turntable clears it once the child has made the light terms (finish).
+        self.renderer.visibility_parts.hold_lighting = hold_lighting
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
@@ -623,11 +626,7 @@ class EditorWindow:
         if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
                 # (a variant not compiled yet: the last picture's scene meanwhile, variant_warmup.py)
-                self.renderer.visibility_parts.hold_lighting = hold_lighting
-                try:
-                    drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
-                finally:
-                    self.renderer.visibility_parts.hold_lighting = False
+                drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
                 direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
