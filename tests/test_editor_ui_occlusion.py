@@ -4,6 +4,7 @@ the same scene, size and camera."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -86,3 +87,38 @@ def test_the_occlusion_setting_is_kept_in_the_session_and_taken_from_the_command
     assert build_state(args).occlusion == "off" and not _no_scene_options(args)   # (a scene option: no reopening)
     args = build_parser().parse_args(["edit"])
     assert build_state(args).occlusion == "auto" and _no_scene_options(args)
+
+
+def test_held_lighting_keeps_the_last_sky_weight_and_a_recorded_decision_casts_no_ray(tmp_path):
+    """OcclusionParts as the editor drives it: with ``hold_lighting`` a turned environment draws
+    the baked parts with the last sky weight (none made: the child makes it); without, it is made;
+    ``decide`` stands for the child's 'auto' decision."""
+    import pytest
+
+    pytest.importorskip("embreex")
+    from alight.accuracy.scenes import write_scene
+    from alight.core.material import Material
+    from alight.core.scene import Scene, default_camera
+    from alight.exchange.meshes import load_mesh
+    from alight.ibl.environment import studio_environment
+    from tests.gpu import renderer
+
+    mesh = load_mesh(str(write_scene("bowl", tmp_path)))
+    r = renderer()
+    maps = r.bake(studio_environment(), "low")
+    parts = r.visibility_parts
+    scene = Scene(mesh=mesh, material=Material(), camera=default_camera(mesh, 1.0), occlusion="on")
+    r.render(scene, maps, 48, 48, aa="none")
+    made = parts.sky_weights_run + parts.sky_weights_loaded
+    assert made >= 1
+    parts.hold_lighting = True
+    try:
+        r.render(dataclasses.replace(scene, env_rotation_deg=90.0), maps, 48, 48, aa="none")
+    finally:
+        parts.hold_lighting = False
+    assert parts.sky_weights_run + parts.sky_weights_loaded == made   # the last weight drawn
+    r.render(dataclasses.replace(scene, env_rotation_deg=90.0), maps, 48, 48, aa="none")
+    assert parts.sky_weights_run + parts.sky_weights_loaded == made + 1   # the new rotation's weight
+    other = load_mesh(str(write_scene("corner", tmp_path)))
+    parts.decide(other, "auto", False)
+    assert parts.wanted(other, "auto") is False   # (the corner occludes itself: cast, it would be True)

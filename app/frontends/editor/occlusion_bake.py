@@ -69,9 +69,6 @@ class OcclusionBake:
         waits for a running bake as it waits for the IBL's (``finish_bake``) and is drawn with
         occlusion as ``alight render`` draws it (the renderer bakes what the cache lacks)."""
         mode = scene.occlusion
-        if whole:
-            self.finish(win)
-            return scene, False
         if mode == "off" or scene.mesh is None or scene.mesh.lod_sphere is not None:
             self.status = ""
             return scene, False
@@ -82,10 +79,17 @@ class OcclusionBake:
         if id(mesh) not in self._meshes:
             self._forget_meshes(keep={id(mesh)} | ({self._running.key[0][0]} if self._running else set()))
             self._meshes[id(mesh)] = mesh
+            self._sent_token = None   # a new object, though it may have a forgotten mesh's id: sent whole
         mesh_key = (id(mesh), mode, light_through(scene))
+        if whole:
+            self.finish(win)
         wanted = self._decided.get(mesh_key)
-        if wanted is False:   # 'auto' found it occludes too little of itself (or the child failed)
+        if wanted is False:
+            # 'auto' found it occludes too little of itself (the same picture as 'off'), or the
+            # child failed (said in the status row): drawn without, never baked in this process.
             self.status = ""
+            return dataclasses.replace(scene, occlusion="off"), False
+        if whole:
             return scene, False
         suns = sun_world_directions(scene, maps)
         texels, digest = environment_texels(win.renderer.shaders, maps) if maps is not None else (None, "")
