@@ -254,6 +254,7 @@ class Scene:
     texture_images: dict = field(default_factory=dict)
     # Occlusion of the environment light by the mesh itself (alight.core.visibility): 'auto'
     # bakes it where the mesh occludes enough of itself, 'on' for every mesh but the built-in
-    # sphere. The still previews ('alight render', alight.Renderer) default to 'auto'; a bare
-    # Scene (the editor's moving view, batch) stays 'off', the bake being for a still view.
+    # sphere. The still previews ('alight render', alight.Renderer) default to 'auto', and so
+    # does the editor's 'occlusion' combo (its bake made by a child process,
+    # app/frontends/editor/occlusion_bake.py); a bare Scene (batch) stays 'off'.
     occlusion: str = "off"

@@ -167,6 +167,15 @@ class OcclusionParts:
         self.sky_weights_run = 0
         self.sky_weights_loaded = 0
         self.last_sky_seconds = 0.0
+        # True: a mesh already drawn baked keeps its suns' and sky's values (a few degrees of
+        # rotation stale) instead of making new ones in this draw: the editor sets it while its
+        # child process makes them (alight.frontends.editor.occlusion_bake), as each takes seconds.
+        self.hold_lighting = False
+
+    def decide(self, mesh, mode: str, wanted: bool) -> None:
+        """Record ``wants_occlusion(mesh, mode)`` decided elsewhere (the editor's child process
+        casts its rays), so ``wanted`` casts none."""
+        self._wanted[(id(mesh), mode)] = (mesh, bool(wanted))
 
     def wanted(self, mesh, mode: str) -> bool:
         """Whether ``mesh`` is drawn with occlusion under ``mode`` (decided once per mesh)."""
@@ -220,6 +229,10 @@ class OcclusionParts:
             entry = self._parts[id(mesh)] = [mesh, gpu, through, baked, None, None]
         suns = np.zeros((0, 3)) if sun_directions is None or not self.sun_bounce else np.asarray(sun_directions, np.float64).reshape(-1, 3)
         sun_key = tuple(np.round(suns, 5).ravel())
+        if self.hold_lighting and entry[4] is not None:
+            sun_key = entry[4]       # the last suns' values stay until the new ones are made
+        elif self.hold_lighting:
+            suns, sun_key = np.zeros((0, 3)), ()   # none made yet: the occluders without suns (no ray)
         if entry[4] != sun_key:
             values, loaded = cached_sun_bounce(mesh, entry[3], suns, self.cache, self.rays, self.edge_fraction,
                                                self.max_vertices, through)
@@ -229,9 +242,12 @@ class OcclusionParts:
             for g, v in zip(entry[1], values):
                 g.extra_buffers[1][0].write(np.ascontiguousarray(v, np.float32).tobytes())
             entry[4] = sun_key
-        if sky is None or not self.sky_weight:
+        if sky is None or not self.sky_weight or (self.hold_lighting and entry[5] is None):
             for g in entry[1]:       # the buffer keeps the weight of entry[5] for the next frame
                 g.has_sky_weight = False
+        elif self.hold_lighting:
+            for g in entry[1]:       # the last weight, read along the last rotation
+                g.has_sky_weight = True
         else:
             texels, digest = sky[0]()
             sky_key = (digest, round(float(sky[1]) % 360.0, 6))

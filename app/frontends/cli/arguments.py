@@ -141,6 +141,17 @@ def _add_material_options(p: argparse.ArgumentParser) -> None:
                                help=field.help)
 
 
+def _add_occlusion_option(p: argparse.ArgumentParser, editor: bool = False) -> None:
+    """--occlusion, 'alight render''s and 'alight edit''s (the panel's 'occlusion' combo)."""
+    p.add_argument("--occlusion", choices=("auto", "on", "off"), default="auto",
+                   help="occlusion of the environment light and one diffuse bounce from a per-vertex "
+                        "ray-traced visibility bake (cached like the IBL bake): auto bakes it where the mesh "
+                        "occludes more than 3%% of its own surface (never the built-in sphere or a convex mesh; "
+                        "docs/explanation/occlusion.md"
+                        + ("; the editor bakes it in a background process and draws the view without it "
+                           "meanwhile" if editor else "") + ") (default: auto)")
+
+
 def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:
     g = p.add_argument_group("image-based lighting")
     if auto:

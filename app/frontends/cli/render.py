@@ -11,6 +11,7 @@ from alight.frontends.cli.arguments import (
     Command,
     _add_bake_options,
     _add_camera_options,
+    _add_occlusion_option,
     _add_scene_options,
     _number,
     _size,
@@ -28,11 +29,7 @@ def add_parser(sub) -> None:
     _add_scene_options(r)
     _add_camera_options(r)
     _add_bake_options(r, auto=True)
-    r.add_argument("--occlusion", choices=("auto", "on", "off"), default="auto",
-                   help="occlusion of the environment light and one diffuse bounce from a per-vertex "
-                        "ray-traced visibility bake (cached like the IBL bake): auto bakes it where the mesh "
-                        "occludes more than 3%% of its own surface (never the built-in sphere or a convex mesh; "
-                        "docs/explanation/occlusion.md) (default: auto)")
+    _add_occlusion_option(r)
     d = r.add_argument_group("image")
     d.add_argument("--size", type=_size, default=_Size(1024, 1024, True), metavar="W|WxH",
                    help="image size; W alone is square, or with --camera gltf the camera's aspect ratio "

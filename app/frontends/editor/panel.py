@@ -11,6 +11,7 @@ import numpy as np
 
 from alight.accuracy.auto_quality import DEFAULT_ERROR_BUDGET
 from alight.core.ibl_models import IBL_MODELS
+from alight.core.visibility import OCCLUSION_MODES
 from alight.core.mesh import BUILTIN_MESHES
 from alight.core.material import validate_material, with_overrides
 from alight.core.scene import BACKGROUNDS, TONEMAPS, Light
@@ -235,12 +236,19 @@ class Panel:
             shown = win.turntable_job.progress()
             imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
         else:
+            baking = getattr(getattr(win, "occlusion_bake", None), "status", "")
+            if baking:   # the child process bakes (occlusion_bake.py): the view is drawn without meanwhile
+                shown = baking
+                imgui.text_disabled(shown)
+                if s.message or getattr(getattr(win, "variant_warmup", None), "showing_old", False):
+                    imgui.same_line()
             if getattr(getattr(win, "variant_warmup", None), "showing_old", False):
                 # A new look's program compiles in the warm-up process (variant_warmup.py): the
                 # view holds the last picture meanwhile, which must not pass for the new one. The
                 # message (a file's warnings) stays beside it: it is not seen again later.
-                shown = "compiling shaders: the view shows the last look"
-                imgui.text_disabled(shown)
+                compiling = "compiling shaders: the view shows the last look"
+                shown = f"{shown} | {compiling}" if shown else compiling
+                imgui.text_disabled(compiling)
                 if s.message:
                     imgui.same_line()
             if s.message:
@@ -612,6 +620,13 @@ class Panel:
         if imgui.is_item_hovered():
             imgui.set_tooltip("Fdez-Aguera 2019: the energy single scattering loses on rough surfaces "
                               "(a white furnace gives 1; the single-scattering ground truth does not)")
+        changed, i = imgui.combo("occlusion", OCCLUSION_MODES.index(s.occlusion), list(OCCLUSION_MODES))
+        if changed:
+            s.occlusion = OCCLUSION_MODES[i]
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("occlusion of the environment light and one bounce, from a per-vertex bake as "
+                              "'alight render --occlusion' makes (auto: where the mesh occludes itself; "
+                              "baked in the background, the view drawn without it meanwhile)")
         names = list(QUALITY) + ["auto"]
         changed, i = imgui.combo("bake quality", names.index(s.quality), names)
         if changed:

@@ -18,6 +18,7 @@ from alight.core.material import Material, validate_material, with_overrides
 from alight.core.material_fields import FIELDS
 from alight.core.scene import TONEMAPS, Display, Light, Scene
 from alight.core.shader_names import DATA_VIEWS, DEBUG_VIEWS
+from alight.core.visibility import OCCLUSION_MODES
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
@@ -57,6 +58,9 @@ class EditorState:
     ibl_enabled: bool = True
     ibl_model: str = DEFAULT_IBL_MODEL     # app/core/ibl_models.py
     multiple_scattering: bool = False
+    # Occlusion of the environment light by the mesh (Scene.occlusion), as 'alight render''s
+    # default: its bake is made by a child process (occlusion_bake.py), the view drawn without meanwhile.
+    occlusion: str = "auto"
     env_rotation_deg: float = 0.0
     lights_follow_env: bool = False   # turning the environment turns the lights with it (env_turn.py)
     env_intensity: float = 1.0
@@ -95,6 +99,7 @@ class EditorState:
                      lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
                      env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
                      ibl_model=self.ibl_model, multiple_scattering=self.multiple_scattering,
+                     occlusion=self.occlusion,
                      # Data views are shown as values: no exposure, no tone curve.
                      display=dataclasses.replace(self.display, tonemap="none", exposure=0.0)
                      if self.debug_view in DATA_VIEWS else self.display,
@@ -404,7 +409,8 @@ class EditorState:
         """``field=value``: roughness / metallic / ior and the layers' numbers (clearcoat, ...),
         base_color / emissive / specular_f0 and the layers' colours (sheen_color, ...: R,G,B linear),
         preset / open / mesh / env (a name or path), exposure, tonemap,
-        env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), quality;
+        env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), occlusion
+        (auto/on/off), quality;
         map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
         uv_offset (U,V)."""
         from alight.core.material import parse_color
@@ -443,6 +449,10 @@ class EditorState:
                 self.ibl_model = value
             elif key == "multiple_scattering":
                 self.multiple_scattering = value not in ("0", "false", "off")
+            elif key == "occlusion":
+                if value not in OCCLUSION_MODES:
+                    raise AlightError(f"--script: occlusion '{value}' is not one of {', '.join(OCCLUSION_MODES)}")
+                self.occlusion = value
             elif key == "quality":
                 if value not in (*QUALITY, "auto"):
                     raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}, auto")

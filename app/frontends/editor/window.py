@@ -195,6 +195,9 @@ class EditorWindow:
         from alight.frontends.editor.variant_warmup import VariantWarmup
 
         self.variant_warmup = VariantWarmup()   # new shader variants compiled in a process of their own
+        from alight.frontends.editor.occlusion_bake import OcclusionBake
+
+        self.occlusion_bake = OcclusionBake()   # the visibility bake made in a process of its own
         from alight.frontends.editor.pass_warmup import PassWarmup
 
         self.pass_warmup = PassWarmup()   # the split view's passes drawn once at the start (Mesa's cache)
@@ -569,7 +572,7 @@ class EditorWindow:
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
-                scene.ibl_model, scene.multiple_scattering,
+                scene.ibl_model, scene.multiple_scattering, scene.occlusion,
                 size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials,
                 scene.texture_maps, tuple(id(scene.texture_images.get(p)) for p in scene.texture_maps.paths().values()))
 
@@ -598,6 +601,14 @@ class EditorWindow:
         targets = self.targets(size)
         scene = self.state.scene(camera)
         maps = self.maps()
+        # Occlusion once its bake is in the cache (made by a child process: occlusion_bake.py);
+        # its answers first, so the frame that gets one draws the occluded picture.
+        if self.occlusion_bake.step(self):
+            self._drawn_key = None
+        scene, hold_lighting = self.occlusion_bake.view_scene(self, scene, maps, whole=full)
+        # For every draw of this view (the compare split's A half too) until the next frame says;
+        # a screenshot or turntable clears it once the child has made the light terms (finish).
+        self.renderer.visibility_parts.hold_lighting = hold_lighting
         # While the camera moves every frame is drawn anew: at the window's size straight into
         # the window, without the view image's copy (3 ms of a 860x720 frame on llvmpipe). The
         # view image is then stale, and the first still frame draws it.
@@ -769,6 +780,7 @@ class EditorWindow:
         from alight.frontends.editor.screenshot import ScreenshotJob
 
         self.finish_bake()
+        self.occlusion_bake.finish(self)   # (the renderer would bake what the child has not written yet)
         size = self.screenshot_size.size(self.view_area())
         scene = self.state.scene(self.orbit.camera())
         if self.state.compare.active:   # the split view, as shown: its halves put together whole
@@ -826,6 +838,7 @@ class EditorWindow:
         from alight.frontends.editor.turntable import TurntableJob, orbit_cameras
 
         self.finish_bake()
+        self.occlusion_bake.finish(self)   # its frames drawn with occlusion, as 'alight render' draws them
         t = self.turntable
         cameras = orbit_cameras(self.orbit, t.frames)
         scene = self.state.scene(cameras[0])
@@ -895,6 +908,7 @@ class EditorWindow:
         self._target_cache.clear()
         self.compare_view.release()
         self.variant_warmup.close()
+        self.occlusion_bake.close()
         self.pass_warmup.close()
         self._panel_image.release()
         self.thumbnails.release()
