@@ -254,6 +254,7 @@ def test_chart_quick_visibility_rows(quick_chart):
         assert 0.0 < r["ref_noise_mean"] < 0.05, config
         assert math.isnan(r["bake_ms"]) and not r["pareto_bake"]    # kept off the IBL bake panel
     assert by["off"]["occlusion"] == "off" and by["occlusion"]["occlusion"] == "on"
+    assert by["off"]["shadows"] == by["occlusion"]["shadows"] == "off"
     assert by["auto"]["occlusion"] == "on"      # the bowl hides enough of itself for 'auto' to bake
     assert math.isnan(by["off"]["visibility_bake_ms"]) and by["occlusion"]["visibility_bake_ms"] > 0
     assert by["occlusion"]["rel_mae_mean"] < 0.5 * by["off"]["rel_mae_mean"]
@@ -269,17 +270,20 @@ def test_visibility_summary_rows_keep_each_scene_apart():
     from alight.accuracy.chart import visibility_summary_rows
     from alight.accuracy.chart_visibility import VisibilityResult
 
-    res = [VisibilityResult("bowl", "off", frame_seconds=0.01, cases=[("a.hdr", 0.2, 0.01), ("spot1Lux.hdr", 0.9, 0.1)]),
+    res = [VisibilityResult("bowl", "off", frame_seconds=0.01,
+                            cases=[("a.hdr", 0.2, 0.01, False), ("spot1Lux.hdr", 0.9, 0.1, False)]),
            VisibilityResult("bowl", "occlusion", baked=True, bake_seconds=0.5, frame_seconds=0.02,
-                            cases=[("a.hdr", 0.03, 0.01)]),
-           VisibilityResult("bowl", "auto", baked=True, frame_seconds=0.03, cases=[("a.hdr", 0.04, 0.01)]),
-           VisibilityResult("corner", "off", frame_seconds=0.05, cases=[("a.hdr", 0.3, 0.02)])]
+                            cases=[("a.hdr", 0.03, 0.01, False)]),
+           VisibilityResult("bowl", "auto", baked=True, frame_seconds=0.03,
+                            cases=[("a.hdr", 0.04, 0.01, True), ("b.hdr", 0.04, 0.01, False)]),
+           VisibilityResult("corner", "off", frame_seconds=0.05, cases=[("a.hdr", 0.3, 0.02, False)])]
     rows = visibility_summary_rows(res)
     assert [r["setting"] for r in rows] == ["visibility bowl: off", "visibility bowl: occlusion",
                                             "visibility bowl: auto", "visibility corner: off"]
     assert [r["pareto_frame"] for r in rows] == [True, True, False, True]
     assert rows[0]["rel_mae_mean"] == pytest.approx(0.2) and rows[0]["ref_noise_mean"] == pytest.approx(0.01)
     assert rows[1]["visibility_bake_ms"] == pytest.approx(500.0) and rows[1]["occlusion"] == "on"
+    assert [r["shadows"] for r in rows] == ["off", "off", "1/2 maps", "off"]
 
 
 def test_chart_without_the_path_tracer_skips_the_visibility_rows(monkeypatch):

@@ -644,7 +644,8 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                 for (res, _), seconds in zip(frame_items, medians):
                     res.frame_seconds = seconds
             if visibility:
-                _measure_visibility(renderer, env, env_name, bakes, results[0].setting, visibility, config, e == 0)
+                _measure_visibility(renderer, env, env_name, bakes, results[0].setting, visibility, config,
+                                    e == len(envs) - 1)
                 progress.step(f"{env_name}: visibility rows")
             for maps, _ in bakes.values():
                 maps.release()
@@ -677,17 +678,19 @@ def _visibility_rows(settings, stream):
     return scene_meshes(settings.scenes), new_results(settings)
 
 
-def _measure_visibility(renderer, env, env_name, bakes, baseline: Setting, visibility, config, first: bool) -> None:
+def _measure_visibility(renderer, env, env_name, bakes, baseline: Setting, visibility, config, last: bool) -> None:
     """The visibility rows under one environment, with the baseline setting's bake (medium, the
-    default IBL model); their frame times on the first environment only, as the other rows'."""
+    default IBL model). Their frame times once: under the first environment with a sun, where the
+    shadows configuration draws its shadow map (under a map without one it draws what 'off' draws,
+    and its time would say nothing), or the last one where none has a sun."""
     from alight.accuracy.chart_visibility import frame_seconds_interleaved as vis_frames
     from alight.accuracy.chart_visibility import measure_environment
 
     meshes, vis_results = visibility
     maps = _with_lut(renderer, bakes[baseline.bake_key][0], baseline.quality)
     measure_environment(renderer, maps, env.radiance, env_name, meshes, vis_results, config.visibility)
-    if first:
-        vis_frames(renderer, maps, meshes, vis_results, config.frame_size, config.frame_repeats)
+    if math.isnan(vis_results[0].frame_seconds) and (maps.suns or last):
+        vis_frames(renderer, maps, meshes, vis_results, config.frame_size, config.frame_repeats, env_name)
 
 
 # --- writing -------------------------------------------------------------------------------
@@ -773,7 +776,7 @@ def visibility_summary_rows(vis_results) -> list[dict]:
                 "rel_mae_mean": res._mean(1, excluded=SUMMARY_EXCLUDED),
                 "rel_mae_max": res._mean(1, np.max, SUMMARY_EXCLUDED),
                 "pareto_bake": False, "pareto_frame": pf, "scene": scene,
-                "occlusion": "on" if res.baked else "off", "shadows": "on" if res.shadowed else "off",
+                "occlusion": "on" if res.baked else "off", "shadows": res.shadows_drawn,
                 "visibility_bake_ms": res.bake_seconds * 1000,
                 "ref_noise_mean": res._mean(2, excluded=SUMMARY_EXCLUDED),
             })
@@ -791,7 +794,7 @@ def write_outputs(results, error_map: ErrorMap, config: ChartConfig, out_dir: Pa
         ("setting", "environment", "preset", "roughness", "rel_mae", "flip"),
         [[res.setting.name, env, p, _fmt(r), _fmt(rel), _fmt(fl)] for res in results for env, p, r, rel, fl in res.cases]
         # the visibility rows: the scene in the preset column, the grey's roughness, no FLIP
-        + [[res.name, env, res.scene, _fmt(0.5), _fmt(rel), ""] for res in vis_results for env, rel, _ in res.cases]))
+        + [[res.name, env, res.scene, _fmt(0.5), _fmt(rel), ""] for res in vis_results for env, rel, *_ in res.cases]))
     write_text_atomic(out_dir / "furnace.csv", _csv_text(
         ("setting", "ibl_model", "multiple_scattering", "roughness", "mean", "min", "max"),
         [[res.setting.name, res.setting.ibl_model, int(res.setting.multiple_scattering), _fmt(r), _fmt(a), _fmt(b), _fmt(c)]
@@ -810,7 +813,8 @@ def write_outputs(results, error_map: ErrorMap, config: ChartConfig, out_dir: Pa
     meta = {"title": title, "frame": frame}
     if vis_results:
         v = config.visibility
-        meta["visibility"] = f"scene camera at {config.frame_size[0]}x{config.frame_size[1]}"
+        meta["visibility"] = (f"scene camera at {config.frame_size[0]}x{config.frame_size[1]}"
+                              f" under {vis_results[0].frame_env}")
         meta["visibility_error"] = f"{v.size}x{v.size} px, {v.samples} spp"
     write_text_atomic(out_dir / "chart_meta.json", json.dumps(meta) + "\n")
     replot(out_dir)

@@ -115,7 +115,7 @@ def _visibility_panel(ax, rows, label: tuple[str, str]) -> None:
     ax.set_ylabel(f"scene error against the path tracer{' (' + error + ')' if error else ''}:\n"
                   "4x4-binned relMAE, mean over environments (%)")
     ax.set_title("visibility: error against frame time\n(black edge: per-scene Pareto frontier)", fontsize=10)
-    ax.legend(fontsize=6, loc="best", framealpha=0.85, ncol=1 + len(scenes) // 3)
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), framealpha=0.85)   # beside: off the points
     ax.grid(True, which="both", alpha=0.25)
 
 

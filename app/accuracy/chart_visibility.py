@@ -17,7 +17,8 @@ part. The reference's own noise is measured beside it: a second trace with seed 
 relMAE against seed 0's (an error below that is not resolved).
 
 Cost: the steady frame at the chart's frame size (scene camera, median of a few, every scene x
-configuration interleaved, on the first environment, like the chart's other frame times; the
+configuration interleaved, under the first environment with a sun, so that the shadows are
+drawn (the first environment where none has one); the
 shadow map is drawn once and kept while nothing moves, so a steady frame holds its lookups, not
 its drawing) and the one-off visibility bake (alight.core.visibility.bake_visibility, never from
 the disk cache) for the configurations that bake.
@@ -61,14 +62,21 @@ class VisibilityResult:
     scene: str
     config: str
     baked: bool = False                       # whether the configuration drew the visibility bake
-    shadowed: bool = False                    # whether it drew a shadow map (on the first environment)
     bake_seconds: float = math.nan            # the uncached visibility bake, where it bakes
     frame_seconds: float = math.nan
-    cases: list[tuple[str, float, float]] = field(default_factory=list)   # env, binned relMAE, reference noise
+    frame_env: str = ""                       # the map the frame was timed under
+    # env, binned relMAE, reference noise, whether a shadow map was drawn (a map without a sun has none)
+    cases: list[tuple[str, float, float, bool]] = field(default_factory=list)
 
     @property
     def name(self) -> str:
         return f"visibility {self.scene}: {self.config}"
+
+    @property
+    def shadows_drawn(self) -> str:
+        """'on', 'off', or under how many of the maps the shadow map was drawn."""
+        n = sum(1 for c in self.cases if c[3])
+        return "off" if n == 0 else "on" if n == len(self.cases) else f"{n}/{len(self.cases)} maps"
 
     def _mean(self, column: int, reduce=np.mean, excluded=()) -> float:
         c = [x[column] for x in self.cases if not any(e in x[0] for e in excluded)]
@@ -127,13 +135,14 @@ def measure_environment(renderer, maps, radiance, env_name: str, meshes: dict, r
         ref = traced(mesh, name, radiance, settings, REFERENCE_SEED)
         noise = binned_relative_mae(traced(mesh, name, radiance, settings, NOISE_SEED), ref, BIN)
         for res in rows:
-            image = renderer.render(scene_view(mesh, name, size, size, res.config), maps, size, size,
-                                    read_linear=True, read_srgb=False).linear
-            res.cases.append((env_name, binned_relative_mae(image, ref, BIN), noise))
+            scene = scene_view(mesh, name, size, size, res.config)
+            image = renderer.render(scene, maps, size, size, read_linear=True, read_srgb=False).linear
+            res.cases.append((env_name, binned_relative_mae(image, ref, BIN), noise,
+                              renderer.shadow_maps.wanted(scene, maps)))
 
 
 def frame_seconds_interleaved(renderer, maps, meshes: dict, results: list[VisibilityResult], size,
-                              repeats: int) -> None:
+                              repeats: int, env_name: str = "") -> None:
     """Each scene x configuration's steady frame (render + finish, no read-back), median over
     ``repeats`` rounds that go round all of them in turn (chart.frame_seconds_interleaved's
     reason: a burst of load falls on all alike). The first draw of each (bake, shadow map,
@@ -143,7 +152,6 @@ def frame_seconds_interleaved(renderer, maps, meshes: dict, results: list[Visibi
     for res, scene in zip(results, scenes):
         renderer.render(scene, maps, w, h, read_linear=False, read_srgb=False)
         res.baked = renderer.visibility_parts.wanted(scene.mesh, scene.occlusion)
-        res.shadowed = renderer.shadow_maps.wanted(scene, maps)
     renderer.ctx.finish()
     times = [[] for _ in results]
     for _ in range(repeats):
@@ -154,6 +162,7 @@ def frame_seconds_interleaved(renderer, maps, meshes: dict, results: list[Visibi
             times[k].append(time.perf_counter() - t)
     for res, t in zip(results, times):
         res.frame_seconds = statistics.median(t)
+        res.frame_env = env_name
 
 
 def new_results(settings: VisibilitySettings) -> list[VisibilityResult]:
