@@ -4,6 +4,7 @@ frontier, the error map, and ``alight chart --quick`` end to end. No timing is a
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 import subprocess
@@ -255,6 +256,10 @@ def test_chart_quick_visibility_rows(quick_chart):
         assert math.isnan(r["bake_ms"]) and not r["pareto_bake"]    # kept off the IBL bake panel
     assert by["off"]["occlusion"] == "off" and by["occlusion"]["occlusion"] == "on"
     assert by["off"]["shadows"] == by["occlusion"]["shadows"] == "off"
+    # royal_esplanade has a sun: the shadow rows drew its map, and were timed under it
+    assert by["shadows"]["shadows"] == by["auto"]["shadows"] == "on"
+    meta = json.loads((out / "chart_meta.json").read_text())
+    assert "royal_esplanade" in meta["visibility"] and "128 spp" in meta["visibility_error"]
     assert by["auto"]["occlusion"] == "on"      # the bowl hides enough of itself for 'auto' to bake
     assert math.isnan(by["off"]["visibility_bake_ms"]) and by["occlusion"]["visibility_bake_ms"] > 0
     assert by["occlusion"]["rel_mae_mean"] < 0.5 * by["off"]["rel_mae_mean"]
