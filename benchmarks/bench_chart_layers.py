@@ -36,7 +36,7 @@ def main() -> int:
     envs = args.env or [str(ENV_DIR / name) for name in DEFAULT_ENVS]
     settings = [s for s in sweep() if s.factor in ("baseline", "layer")]
     presets = [p for p in list_presets() if layer_row(load_preset(p))] + ["gold", "plastic_high"]
-    config = ChartConfig(envs=envs, presets=presets, settings=settings)
+    config = ChartConfig(envs=envs, presets=presets, settings=settings, visibility=None)   # the layers only
     start = time.perf_counter()
     results = run_chart(config, args.out)
     print(f"{len(results)} settings x {len(envs)} environment(s) ({', '.join(Path(e).stem for e in envs)}), "

@@ -4,6 +4,7 @@ frontier, the error map, and ``alight chart --quick`` end to end. No timing is a
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 import subprocess
@@ -176,6 +177,8 @@ def test_chart_quick_end_to_end(quick_chart):
     for name in ("chart.csv", "chart_cases.csv", "furnace.csv", "error_map.csv", "chart.png", "error_map.png"):
         assert (out / name).is_file() and (out / name).stat().st_size > 0, name
     rows = read_summary(out / "chart.csv")
+    vis_rows = [r for r in rows if r["factor"] == "visibility"]
+    rows = [r for r in rows if r["factor"] != "visibility"]
     assert [r["setting"] for r in rows] == [s.name for s in sweep(quick=True)]
     for r in rows:
         assert r["bake_ms"] > 0 and r["frame_ms"] > 0 and r["lut_cold_ms"] > 0
@@ -210,7 +213,8 @@ def test_chart_quick_end_to_end(quick_chart):
     # flint_glass's ior 1.7 bends more than water's 1.33: its refracted lobe at r = 0.25 is wide enough.
     assert {float(c["roughness"]) for c in per_layer["layer dispersion"]} == {0.25, 0.5, 1.0}
     assert {float(c["roughness"]) for c in per_layer["layer diffuse_transmission"]} == {0.25, 0.5, 1.0}
-    assert len(cases) == (len(judged) - len(layer_preset)) * 2 * 3 + sum(len(v) for v in per_layer.values())
+    assert len(cases) == ((len(judged) - len(layer_preset)) * 2 * 3 + sum(len(v) for v in per_layer.values())
+                          + len(vis_rows))   # one environment: one case per visibility row
     # The baseline's summary is the mean of its cases.
     base = [float(c["rel_mae"]) for c in cases if c["setting"] == rows[0]["setting"]]
     assert rows[0]["rel_mae_mean"] == pytest.approx(np.mean(base), rel=1e-4)
@@ -230,6 +234,75 @@ def test_chart_quick_end_to_end(quick_chart):
     for png in ("chart.png", "error_map.png"):
         spec = oiio.ImageInput.open(str(out / png)).spec()
         assert spec.width > 500 and spec.height > 300
+
+
+def test_chart_quick_visibility_rows(quick_chart):
+    """--quick's visibility rows: the bowl under royal_esplanade with each configuration, against
+    the path tracer. Occlusion must remove most of the bowl's error (21.7% off, 2.8% on when
+    written; benchmarks/results/occlusion-stretched-default.md has the same pair), and the
+    reference's own noise (seed 0 against seed 1) must sit below the error it resolves."""
+    from alight.accuracy.chart_visibility import QUICK_VISIBILITY_SCENES, VISIBILITY_CONFIGS
+
+    out, proc = quick_chart
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    rows = {r["setting"]: r for r in read_summary(out / "chart.csv") if r["factor"] == "visibility"}
+    assert list(rows) == [f"visibility {s}: {c}" for s in QUICK_VISIBILITY_SCENES for c in VISIBILITY_CONFIGS]
+    by = {name.split(": ")[1]: r for name, r in rows.items()}
+    for config, r in by.items():
+        assert r["scene"] == "bowl" and r["frame_ms"] > 0, config
+        assert 0.0 < r["rel_mae_mean"] < 2.0, config
+        assert r["rel_mae_mean"] == pytest.approx(r["rel_mae_max"]), config   # one environment
+        assert 0.0 < r["ref_noise_mean"] < 0.05, config
+        assert math.isnan(r["bake_ms"]) and not r["pareto_bake"]    # kept off the IBL bake panel
+    assert by["off"]["occlusion"] == "off" and by["occlusion"]["occlusion"] == "on"
+    assert by["off"]["shadows"] == by["occlusion"]["shadows"] == "off"
+    # royal_esplanade has a sun: the shadow rows drew its map, and were timed under it
+    assert by["shadows"]["shadows"] == by["auto"]["shadows"] == "on"
+    meta = json.loads((out / "chart_meta.json").read_text())
+    assert "royal_esplanade" in meta["visibility"] and "128 spp" in meta["visibility_error"]
+    assert by["auto"]["occlusion"] == "on"      # the bowl hides enough of itself for 'auto' to bake
+    assert math.isnan(by["off"]["visibility_bake_ms"]) and by["occlusion"]["visibility_bake_ms"] > 0
+    assert by["occlusion"]["rel_mae_mean"] < 0.5 * by["off"]["rel_mae_mean"]
+    assert by["auto"]["rel_mae_mean"] < 0.5 * by["off"]["rel_mae_mean"]
+    assert by["occlusion"]["rel_mae_mean"] > by["occlusion"]["ref_noise_mean"]
+    assert any(r["pareto_frame"] for r in by.values())
+    assert "visibility bowl: occlusion" in proc.stdout
+
+
+def test_visibility_summary_rows_keep_each_scene_apart():
+    """The frontier is per scene (one scene's error is not another's), and the summary leaves out
+    SUMMARY_EXCLUDED's environments as the probe rows do."""
+    from alight.accuracy.chart import visibility_summary_rows
+    from alight.accuracy.chart_visibility import VisibilityResult
+
+    res = [VisibilityResult("bowl", "off", frame_seconds=0.01,
+                            cases=[("a.hdr", 0.2, 0.01, False), ("spot1Lux.hdr", 0.9, 0.1, False)]),
+           VisibilityResult("bowl", "occlusion", baked=True, bake_seconds=0.5, frame_seconds=0.02,
+                            cases=[("a.hdr", 0.03, 0.01, False)]),
+           VisibilityResult("bowl", "auto", baked=True, frame_seconds=0.03,
+                            cases=[("a.hdr", 0.04, 0.01, True), ("b.hdr", 0.04, 0.01, False)]),
+           VisibilityResult("corner", "off", frame_seconds=0.05, cases=[("a.hdr", 0.3, 0.02, False)])]
+    rows = visibility_summary_rows(res)
+    assert [r["setting"] for r in rows] == ["visibility bowl: off", "visibility bowl: occlusion",
+                                            "visibility bowl: auto", "visibility corner: off"]
+    assert [r["pareto_frame"] for r in rows] == [True, True, False, True]
+    assert rows[0]["rel_mae_mean"] == pytest.approx(0.2) and rows[0]["ref_noise_mean"] == pytest.approx(0.01)
+    assert rows[1]["visibility_bake_ms"] == pytest.approx(500.0) and rows[1]["occlusion"] == "on"
+    assert [r["shadows"] for r in rows] == ["off", "off", "1/2 maps", "off"]
+
+
+def test_chart_without_the_path_tracer_skips_the_visibility_rows(monkeypatch):
+    import io
+
+    from alight.accuracy import chart
+    from alight.accuracy.chart_visibility import VisibilitySettings
+    from alight.core import visibility
+
+    monkeypatch.setattr(visibility, "embree_available", lambda: False)
+    stream = io.StringIO()
+    assert chart._visibility_rows(VisibilitySettings(), stream) is None
+    assert len(stream.getvalue().splitlines()) == 1 and "embreex" in stream.getvalue()
+    assert chart._visibility_rows(None, stream) is None
 
 
 def test_chart_refuses_a_bad_environment(tmp_path, shared_data):
@@ -253,7 +326,8 @@ def test_editor_chart_view_reads_and_draws_the_latest_chart(quick_chart):
     assert find_chart_csv() == (out / "chart.csv").resolve()      # noted in ALIGHT_CACHE_DIR by the run
     data = load_chart(out / "chart.csv")
     rows = read_summary(out / "chart.csv")
-    judged = [r for r in rows if math.isfinite(r["rel_mae_mean"])]
+    # (The visibility rows have no bake time: the editor's bake-time view leaves them out.)
+    judged = [r for r in rows if math.isfinite(r["rel_mae_mean"]) and r["factor"] != "visibility"]
     assert sum(len(x) for x, _, _ in data.factors.values()) == len(judged)
     assert data.frontier[2] and set(data.frontier[2]) == {r["setting"] for r in judged if r["pareto_bake"] == 1.0}
     assert np.all(np.diff(data.frontier[0]) >= 0) and np.all(np.diff(data.frontier[1]) <= 0)

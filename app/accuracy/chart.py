@@ -117,6 +117,7 @@ LEVEL1_FROM = 0.25
 LATEST_FILE = "latest_chart.txt"   # in alight.paths.cache_dir(): where the last chart's CSV is
 FRAME_REPEATS = 5
 REFERENCE_WEIGHT = 10.0   # a reference's time in settings' times (for the ETA)
+VISIBILITY_WEIGHT = 2.0   # one scene's visibility rows under one environment, likewise
 
 
 @dataclass(frozen=True)
@@ -301,6 +302,14 @@ class ChartConfig:
     frame_size: tuple[int, int] = (1280, 720)
     frame_repeats: int = FRAME_REPEATS
     settings: list[Setting] = field(default_factory=sweep)
+    # The visibility rows (app/accuracy/chart_visibility.py); None: none.
+    visibility: "VisibilitySettings | None" = field(default_factory=lambda: _visibility_settings())
+
+
+def _visibility_settings():
+    from alight.accuracy.chart_visibility import VisibilitySettings
+
+    return VisibilitySettings()
 
 
 @dataclass
@@ -543,9 +552,12 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
 
     settings = config.settings
     results = [SettingResult(s) for s in settings]
-    # Step weights, measured: a reference ~ 10 settings; the furnace and cold LUTs ~ 5.
-    progress = Progress([5.0] + ([REFERENCE_WEIGHT * len(config.roughness) / len(ROUGHNESS)] + [1.0] * len(settings))
-                        * len(envs), stream)
+    visibility = _visibility_rows(config.visibility, stream)
+    # Step weights, measured: a reference ~ 10 settings; the furnace and cold LUTs ~ 5; a scene's
+    # visibility rows (two traces, four renders) ~ 2.
+    vis_steps = [VISIBILITY_WEIGHT * len(config.visibility.scenes)] if visibility else []
+    progress = Progress([5.0] + ([REFERENCE_WEIGHT * len(config.roughness) / len(ROUGHNESS)] + [1.0] * len(settings)
+                                 + vis_steps) * len(envs), stream)
     renderer = ForwardRenderer()
     ref_renderer = ReferenceRenderer(renderer)
     error_map = ErrorMap(config.roughness, config.size)
@@ -631,14 +643,54 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                                                     config.frame_size, config.frame_repeats)
                 for (res, _), seconds in zip(frame_items, medians):
                     res.frame_seconds = seconds
+            if visibility:
+                _measure_visibility(renderer, env, env_name, bakes, results[0].setting, visibility, config,
+                                    e == len(envs) - 1)
+                progress.step(f"{env_name}: visibility rows")
             for maps, _ in bakes.values():
                 maps.release()
+        if visibility:
+            from alight.accuracy.chart_visibility import add_bake_seconds
+
+            add_bake_seconds(*visibility)
     finally:
         renderer.release()
 
-    write_outputs(results, error_map, config, out_dir, truth_furnace)
+    vis_results = visibility[1] if visibility else []
+    write_outputs(results, error_map, config, out_dir, truth_furnace, vis_results)
     _remember(out_dir / "chart.csv")
     return results
+
+
+def _visibility_rows(settings, stream):
+    """(the scenes' meshes, a VisibilityResult per scene x configuration), or None where there are
+    none to measure: none asked for, or no path tracer (one warning line)."""
+    from alight.core.visibility import embree_available
+
+    if settings is None or not settings.scenes:
+        return None
+    if not embree_available():
+        (stream or sys.stderr).write("alight chart: no visibility rows: the path tracer needs embreex "
+                                     "(pip install embreex)\n")
+        return None
+    from alight.accuracy.chart_visibility import new_results, scene_meshes
+
+    return scene_meshes(settings.scenes), new_results(settings)
+
+
+def _measure_visibility(renderer, env, env_name, bakes, baseline: Setting, visibility, config, last: bool) -> None:
+    """The visibility rows under one environment, with the baseline setting's bake (medium, the
+    default IBL model). Their frame times once: under the first environment with a sun, where the
+    shadows configuration draws its shadow map (under a map without one it draws what 'off' draws,
+    and its time would say nothing), or the last one where none has a sun."""
+    from alight.accuracy.chart_visibility import frame_seconds_interleaved as vis_frames
+    from alight.accuracy.chart_visibility import measure_environment
+
+    meshes, vis_results = visibility
+    maps = _with_lut(renderer, bakes[baseline.bake_key][0], baseline.quality)
+    measure_environment(renderer, maps, env.radiance, env_name, meshes, vis_results, config.visibility)
+    if math.isnan(vis_results[0].frame_seconds) and (maps.suns or last):
+        vis_frames(renderer, maps, meshes, vis_results, config.frame_size, config.frame_repeats, env_name)
 
 
 # --- writing -------------------------------------------------------------------------------
@@ -646,7 +698,9 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
 SUMMARY_FIELDS = ("setting", "factor", "ibl_model", "multiple_scattering", "irradiance", "irradiance_size",
                   "irradiance_steps", "specular_cube", "prefilter_samples", "fis", "lut_size", "lut_samples",
                   "bake_ms", "lut_cold_ms", "frame_ms", "rel_mae_mean", "rel_mae_max", "flip_mean",
-                  "furnace_mean", "furnace_min", "furnace_max", "furnace_r1", "pareto_bake", "pareto_frame")
+                  "furnace_mean", "furnace_min", "furnace_max", "furnace_r1", "pareto_bake", "pareto_frame",
+                  # the visibility rows' (app/accuracy/chart_visibility.py; empty on the others)
+                  "scene", "occlusion", "shadows", "visibility_bake_ms", "ref_noise_mean")
 
 
 def pareto(points: list[tuple[float, float]]) -> list[bool]:
@@ -701,18 +755,46 @@ def summary_rows(results: list[SettingResult]) -> list[dict]:
             "furnace_max": max((f[3] for f in res.furnace), default=math.nan),
             "furnace_r1": r1[0] if r1 else math.nan,
             "pareto_bake": pb, "pareto_frame": pf,
+            "scene": "", "occlusion": "", "shadows": "", "visibility_bake_ms": math.nan, "ref_noise_mean": math.nan,
         })
     return rows
 
 
-def write_outputs(results, error_map: ErrorMap, config: ChartConfig, out_dir: Path, truth_furnace=()) -> None:
+def visibility_summary_rows(vis_results) -> list[dict]:
+    """chart.csv's rows of the visibility results: error against frame time, the frontier per
+    scene (a scene's error is not comparable with another's, nor with the probe's)."""
+    rows = []
+    for scene in dict.fromkeys(r.scene for r in vis_results):
+        group = [r for r in vis_results if r.scene == scene]
+        front = pareto([(r.frame_seconds, r._mean(1, excluded=SUMMARY_EXCLUDED)) for r in group])
+        for res, pf in zip(group, front):
+            row = {k: math.nan for k in SUMMARY_FIELDS}
+            row.update({
+                "setting": res.name, "factor": "visibility", "ibl_model": "", "multiple_scattering": False,
+                "irradiance": "", "irradiance_steps": "", "fis": "",
+                "frame_ms": res.frame_seconds * 1000,
+                "rel_mae_mean": res._mean(1, excluded=SUMMARY_EXCLUDED),
+                "rel_mae_max": res._mean(1, np.max, SUMMARY_EXCLUDED),
+                "pareto_bake": False, "pareto_frame": pf, "scene": scene,
+                "occlusion": "on" if res.baked else "off", "shadows": res.shadows_drawn,
+                "visibility_bake_ms": res.bake_seconds * 1000,
+                "ref_noise_mean": res._mean(2, excluded=SUMMARY_EXCLUDED),
+            })
+            rows.append(row)
+    return rows
+
+
+def write_outputs(results, error_map: ErrorMap, config: ChartConfig, out_dir: Path, truth_furnace=(),
+                  vis_results=()) -> None:
     from alight.exchange.output import write_text_atomic
 
-    rows = summary_rows(results)
+    rows = summary_rows(results) + visibility_summary_rows(vis_results)
     write_text_atomic(out_dir / "chart.csv", _csv_text(SUMMARY_FIELDS, [[_fmt(r[k]) for k in SUMMARY_FIELDS] for r in rows]))
     write_text_atomic(out_dir / "chart_cases.csv", _csv_text(
         ("setting", "environment", "preset", "roughness", "rel_mae", "flip"),
-        [[res.setting.name, env, p, _fmt(r), _fmt(rel), _fmt(fl)] for res in results for env, p, r, rel, fl in res.cases]))
+        [[res.setting.name, env, p, _fmt(r), _fmt(rel), _fmt(fl)] for res in results for env, p, r, rel, fl in res.cases]
+        # the visibility rows: the scene in the preset column, the grey's roughness, no FLIP
+        + [[res.name, env, res.scene, _fmt(0.5), _fmt(rel), ""] for res in vis_results for env, rel, *_ in res.cases]))
     write_text_atomic(out_dir / "furnace.csv", _csv_text(
         ("setting", "ibl_model", "multiple_scattering", "roughness", "mean", "min", "max"),
         [[res.setting.name, res.setting.ibl_model, int(res.setting.multiple_scattering), _fmt(r), _fmt(a), _fmt(b), _fmt(c)]
@@ -728,7 +810,13 @@ def write_outputs(results, error_map: ErrorMap, config: ChartConfig, out_dir: Pa
     title = (f"{len(config.envs)} environment(s), {len(config.presets)} presets, roughness "
              f"{', '.join(f'{r:g}' for r in config.roughness)}, probe {config.size}x{config.size}")
     frame = f"material ball at {config.frame_size[0]}x{config.frame_size[1]}, median"
-    write_text_atomic(out_dir / "chart_meta.json", json.dumps({"title": title, "frame": frame}) + "\n")
+    meta = {"title": title, "frame": frame}
+    if vis_results:
+        v = config.visibility
+        meta["visibility"] = (f"scene camera at {config.frame_size[0]}x{config.frame_size[1]}"
+                              f" under {vis_results[0].frame_env}")
+        meta["visibility_error"] = f"{v.size}x{v.size} px, {v.samples} spp"
+    write_text_atomic(out_dir / "chart_meta.json", json.dumps(meta) + "\n")
     replot(out_dir)
 
 
@@ -742,7 +830,8 @@ def replot(out_dir: str | os.PathLike) -> list[Path]:
     except (OSError, ValueError):
         meta = {"title": "", "frame": "material ball, median"}
     written = [plot_chart(read_summary(out_dir / "chart.csv"), read_summary(out_dir / "furnace.csv"),
-                          out_dir / "chart.png", meta["title"], meta["frame"])]
+                          out_dir / "chart.png", meta["title"], meta["frame"],
+                          (meta.get("visibility", ""), meta.get("visibility_error", "")))]
     maps: dict[str, dict[float, dict[float, float]]] = {}
     for row in read_summary(out_dir / "error_map.csv"):
         maps.setdefault(row["ibl_model"], {}).setdefault(row["roughness"], {})[row["nv_lo"]] = row["rel_mae"]

@@ -19,6 +19,9 @@ FACTOR_STYLE = {   # factor -> (colour, marker)
     "IBL model": ("tab:pink", "X"),
     "multiple scattering": ("tab:gray", "h"),
 }
+# The visibility rows' panel: a marker per configuration, a colour per scene.
+VISIBILITY_MARKER = {"off": "o", "occlusion": "s", "shadows": "^", "auto": "*"}
+SCENE_COLOUR = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")
 
 
 def _figure(width_in: float, height_in: float):
@@ -85,10 +88,49 @@ def _error_panel(ax, rows, time_key: str, front_key: str, xlabel: str) -> None:
     ax.grid(True, which="both", alpha=0.25)
 
 
-def plot_chart(rows: list[dict], furnace: list[dict], path: Path, title: str, frame_label: str) -> Path:
-    """chart.png from chart.csv's rows and furnace.csv's rows (dicts, numbers as float)."""
-    fig = _figure(18.0, 6.2)
-    axes = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.15, 1.15, 0.9]})
+def _visibility_panel(ax, rows, label: tuple[str, str]) -> None:
+    """The visibility rows: each scene's configurations, error against frame time, joined in the
+    order off, occlusion, shadows, auto; the reference's own noise as a dashed line."""
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    for k, scene in enumerate(scenes):
+        colour = SCENE_COLOUR[k % len(SCENE_COLOUR)]
+        group = [r for r in rows if r["scene"] == scene and math.isfinite(r["frame_ms"])
+                 and math.isfinite(r["rel_mae_mean"])]
+        for r in group:
+            config = r["setting"].split(": ", 1)[-1]
+            ax.scatter(r["frame_ms"], r["rel_mae_mean"] * 100, c=colour, marker=VISIBILITY_MARKER.get(config, "o"),
+                       s=90 if config == "auto" else 40, zorder=3, edgecolors="black" if r["pareto_frame"] else "none",
+                       label=f"{scene}: {config}")
+        noise = [r["ref_noise_mean"] for r in group if math.isfinite(r.get("ref_noise_mean", math.nan))]
+        if noise:
+            ax.axhline(noise[0] * 100, color=colour, ls="--", lw=0.8, alpha=0.7,
+                       label=f"{scene}: reference noise (seed 0 vs 1)")
+    ax.set_yscale("log")
+    ys = [r["rel_mae_mean"] * 100 for r in rows if math.isfinite(r["rel_mae_mean"])]
+    ys += [r["ref_noise_mean"] * 100 for r in rows if math.isfinite(r.get("ref_noise_mean", math.nan))]
+    if ys:
+        _plain_log_ticks(ax.yaxis, min(ys), max(ys))
+    frame, error = label
+    ax.set_xlabel(f"frame time: {frame or 'scene camera'}, median (ms)")
+    ax.set_ylabel(f"scene error against the path tracer{' (' + error + ')' if error else ''}:\n"
+                  "4x4-binned relMAE, mean over environments (%)")
+    ax.set_title("visibility: error against frame time\n(black edge: per-scene Pareto frontier)", fontsize=10)
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), framealpha=0.85)   # beside: off the points
+    ax.grid(True, which="both", alpha=0.25)
+
+
+def plot_chart(rows: list[dict], furnace: list[dict], path: Path, title: str, frame_label: str,
+               visibility_label: tuple[str, str] = ("", "")) -> Path:
+    """chart.png from chart.csv's rows and furnace.csv's rows (dicts, numbers as float); the
+    visibility rows (factor 'visibility') in a panel of their own: their error is a scene's
+    against the path tracer, not the probe's against the ground truth."""
+    vis_rows = [r for r in rows if r["factor"] == "visibility"]
+    rows = [r for r in rows if r["factor"] != "visibility"]
+    panels = 4 if vis_rows else 3
+    fig = _figure(18.0 + (6.0 if vis_rows else 0.0), 6.2)
+    axes = fig.subplots(1, panels, gridspec_kw={"width_ratios": [1.15, 1.15, 0.9, 1.15][:panels]})
+    if vis_rows:
+        _visibility_panel(axes[3], vis_rows, visibility_label)
     _error_panel(axes[0], rows, "bake_ms", "pareto_bake",
                  "bake time per environment, warm, LUT cached (ms, log)")
     axes[0].set_title("error against bake time")
@@ -123,7 +165,9 @@ def plot_chart(rows: list[dict], furnace: list[dict], path: Path, title: str, fr
     ax.set_title("white furnace: metal F0 = 1, radiance 1\n(MS on should give 1)", fontsize=10)
     ax.legend(fontsize=7, loc="lower left")
     ax.grid(True, alpha=0.25)
-    fig.suptitle(f"alight chart: split-sum IBL settings around 'medium', one factor at a time\n{title}", fontsize=10)
+    what = "; visibility (occlusion, shadows) on test scenes" if vis_rows else ""
+    fig.suptitle(f"alight chart: split-sum IBL settings around 'medium', one factor at a time{what}\n{title}",
+                 fontsize=10)
     _save(fig, path)
     return path
 

@@ -15,7 +15,9 @@ def add_parser(sub) -> None:
                                     "(irradiance method and size, specular cube size, sample counts, filtered "
                                     "importance sampling, LUT size and samples, every IBL model, multiple "
                                     "scattering judged by the white furnace) against the GPU ground truth on the "
-                                    "presets x roughness x environments. Writes CSVs and PNG charts (app/accuracy/chart.py).")
+                                    "presets x roughness x environments; and the visibility features (occlusion, "
+                                    "shadows) on test scenes against the path tracer. Writes CSVs and PNG charts "
+                                    "(app/accuracy/chart.py, app/accuracy/chart_visibility.py).")
     ch.add_argument("--quick", action="store_true",
                     help="a small sweep: royal_esplanade only, 3 presets, 3 roughness values, a few settings")
     ch.add_argument("--env", action="append", metavar="MAP",
@@ -23,6 +25,9 @@ def add_parser(sub) -> None:
     ch.add_argument("--presets", metavar="A,B,...", help="presets to measure (default: all; --quick: gold, "
                                                           "plastic_high and one preset per layer)")
     ch.add_argument("--size", type=int, default=32, metavar="N", help="probe size for the errors (default: 32)")
+    ch.add_argument("--visibility", metavar="A,B,...|none",
+                    help="scenes of the visibility rows (corner, bowl, product: each with occlusion and shadows "
+                         "off / on / auto against the path tracer; default: all three; --quick: bowl; none: no rows)")
     ch.add_argument("--out", default="alight-chart", metavar="DIR", help="output folder (default: alight-chart)")
 
 
@@ -38,6 +43,7 @@ def run(args) -> int:
         run_chart,
         sweep,
     )
+    from alight.accuracy.chart_visibility import QUICK_VISIBILITY_SCENES, VISIBILITY_SCENES, VisibilitySettings
     from alight.exchange.presets import list_presets
 
     if args.size < 8 or args.size > 256:
@@ -58,10 +64,17 @@ def run(args) -> int:
     presets = list(QUICK_PRESETS) if args.quick else list_presets()
     if args.presets:
         presets = [p.strip() for p in args.presets.split(",") if p.strip()]
+    scenes = QUICK_VISIBILITY_SCENES if args.quick else VISIBILITY_SCENES
+    if args.visibility:
+        scenes = tuple(s.strip() for s in args.visibility.split(",") if s.strip() and s.strip() != "none")
+        unknown = [s for s in scenes if s not in VISIBILITY_SCENES]
+        if unknown:
+            raise AlightError(f"--visibility: unknown scene '{unknown[0]}' (one of {', '.join(VISIBILITY_SCENES)}, none)")
     config = ChartConfig(envs=envs, presets=presets, size=args.size,
                          roughness=QUICK_ROUGHNESS if args.quick else ChartConfig.__dataclass_fields__["roughness"].default,
                          frame_size=(320, 180) if args.quick else (1280, 720),
-                         frame_repeats=3 if args.quick else 7, settings=sweep(args.quick))
+                         frame_repeats=3 if args.quick else 7, settings=sweep(args.quick),
+                         visibility=VisibilitySettings(scenes=scenes) if scenes else None)
     start = time.perf_counter()
     results = run_chart(config, args.out)
     out = Path(args.out)
@@ -73,10 +86,26 @@ def run(args) -> int:
         print(f"{res.setting.name:34s} {res.bake_median * 1000:8.0f} {res.frame_seconds * 1000:9.1f} "
               f"{res.rel_mean * 100:9.2f} {res.rel_max * 100:7.1f} {res.flip_mean:6.3f} "
               f"{fr[0] if fr else float('nan'):11.3f}")
+    _print_visibility(out / "chart.csv")
     for name in ("chart.csv", "chart_cases.csv", "furnace.csv", "error_map.csv", "chart.png", "error_map.png"):
         if (out / name).exists():
             print(out / name)
     return 0
+
+
+def _print_visibility(csv_path) -> None:
+    """The visibility rows of the chart just written (chart.csv: factor 'visibility')."""
+    from alight.accuracy.chart import read_summary
+
+    rows = [r for r in read_summary(csv_path) if r["factor"] == "visibility"]
+    if not rows:
+        return
+    print(f"{'visibility row':34s} {'bake ms':>8s} {'frame ms':>9s} {'relMAE %':>9s} {'max %':>7s} {'noise %':>8s} "
+          f"drawn")
+    for r in rows:
+        print(f"{r['setting']:34s} {r['visibility_bake_ms']:8.0f} {r['frame_ms']:9.1f} {r['rel_mae_mean'] * 100:9.2f} "
+              f"{r['rel_mae_max'] * 100:7.1f} {r['ref_noise_mean'] * 100:8.2f} occlusion {r['occlusion']}, "
+              f"shadows {r['shadows']}")
 
 
 COMMAND = Command("chart", add_parser, run)
