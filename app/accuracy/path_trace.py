@@ -106,6 +106,11 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
+def _rows(x, sub):
+    """x[sub], or None for a lobe the scene does not have (the coat's arrays)."""
+    return None if x is None else x[sub]
+
+
 def _normalize(v):
     return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-30)
 
@@ -572,9 +577,6 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
             n_dot_v = _dot(n, v)
             p_spec = _specular_probability(n_dot_v, base, metal, f0)
             p_coat = _coat_probability(n_dot_v, base, metal, f0, coat) if coated else None
-
-            def rows(x, sub):
-                return None if x is None else x[sub]
             # next-event estimation: the environment
             if env is not None:
                 xi = rng.random((len(alive), 3))
@@ -589,9 +591,9 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
                 if ok.any():
                     sub = np.flatnonzero(ok)
                     f = seen[sub, None] * brdf_cos(n[sub], v[sub], l[sub], base[sub], metal[sub], rough[sub], f0[sub],
-                                                   rows(coat, sub), rows(coat_rough, sub))
-                    pb = brdf_pdf(n[sub], v[sub], l[sub], rough[sub], p_spec[sub], rows(p_coat, sub),
-                                  rows(coat_rough, sub))
+                                                   _rows(coat, sub), _rows(coat_rough, sub))
+                    pb = brdf_pdf(n[sub], v[sub], l[sub], rough[sub], p_spec[sub], _rows(p_coat, sub),
+                                  _rows(coat_rough, sub))
                     # power heuristic: (f L / pe) pe^2 / (pe^2 + pb^2), where a BRDF sample follows;
                     # at a path's last vertex the environment sample is the only strategy
                     if last:
