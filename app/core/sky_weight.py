@@ -45,7 +45,8 @@ from alight.core.shading import rotate_world_to_map
 from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_directions, merged_parts
 from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
-SKY_WEIGHT_VERSION = 1
+WELD_CREASE_DEG = 30.0   # welded: copies of a vertex further than this from their mean normal stay apart
+SKY_WEIGHT_VERSION = 2   # 2: filled and smoothed on the welded mesh (welded)
 SKY_TEXELS = 16          # texels per cube face read back (the source cube's box mip of that size)
 SMOOTHING_ROUNDS = 2     # rounds of averaging over mesh neighbours
 SKY_SEED = 7             # the rays' own seed (another set than the bake's)
@@ -180,6 +181,46 @@ def fill_from_neighbours(values: np.ndarray, faces: np.ndarray, unknown: np.ndar
     return out
 
 
+def welded(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(N,) int64: per vertex, one index shared by the copies of a vertex: vertices at one position
+    (to 1e-6 of the mesh's size) whose normals lie within WELD_CREASE_DEG of the copies' mean.
+    Files that repeat a vertex per triangle (an OBJ written without shared indices, an exporter's
+    per-face split) give each copy rays of its own and, where the normals were made per copy,
+    normals a degree or two apart: copies at one point got different values, a smooth bowl's
+    inside a speckle of triangles, and the faces alone connect no copy to its neighbours, so
+    neighbour averaging stayed inside each triangle. A crease (a cube's edge: copies 45 degrees
+    or more from their mean) keeps one index per copy."""
+    p = np.asarray(positions, np.float64).reshape(-1, 3)
+    if not len(p):
+        return np.zeros(0, np.int64)
+    n = np.asarray(normals, np.float64).reshape(-1, 3)
+    n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+    size = max(float(np.ptp(p, axis=0).max()), 1e-30)
+    _, at = np.unique(np.round((p - p.min(axis=0)) / size * 1e6), axis=0, return_inverse=True)
+    at = np.asarray(at, np.int64).reshape(-1)
+    mean = np.zeros((int(at.max()) + 1, 3))
+    np.add.at(mean, at, n)
+    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), 1e-30)
+    crease = np.einsum("ij,ij->i", n, mean[at]) < math.cos(math.radians(WELD_CREASE_DEG))
+    key = np.where(crease, len(mean) + np.arange(len(p)), at)
+    _, ids = np.unique(key, return_inverse=True)
+    return np.asarray(ids, np.int64).reshape(-1)
+
+
+def on_welded(values: np.ndarray, faces: np.ndarray, ids: np.ndarray | None, work):
+    """``work(values, faces)`` on the welded mesh (``welded`` ids: each copy's rows averaged,
+    the faces renumbered), its result handed back to every copy; ``ids`` None: on the mesh as
+    it is."""
+    values = np.asarray(values, np.float64)
+    if ids is None or not len(values):
+        return work(values, faces)
+    count = int(ids.max()) + 1
+    copies = np.bincount(ids, minlength=count).astype(np.float64)
+    merged = np.column_stack([np.bincount(ids, values[:, k], minlength=count) for k in range(values.shape[1])])
+    merged /= np.maximum(copies, 1.0)[:, None]
+    return work(merged, ids[np.asarray(faces, np.int64).reshape(-1, 3)])[ids]
+
+
 def smooth(values: np.ndarray, faces: np.ndarray, rounds: int) -> np.ndarray:
     """``rounds`` rounds of each row becoming the mean of itself and its mesh neighbours."""
     out = np.array(values, np.float64, copy=True)
@@ -207,11 +248,13 @@ def vertex_sky_weight(free: np.ndarray, directions: np.ndarray, texels: np.ndarr
 
 
 def sky_weight(free: np.ndarray, angles: np.ndarray, normals: np.ndarray, faces: np.ndarray, texels: np.ndarray,
-               rotation_deg: float = 0.0, rounds: int = SMOOTHING_ROUNDS, chunk: int = 4096) -> np.ndarray:
+               rotation_deg: float = 0.0, rounds: int = SMOOTHING_ROUNDS, chunk: int = 4096,
+               positions: np.ndarray | None = None) -> np.ndarray:
     """One part's (N, 4) float32: W (rgb) and the same rays' V, both filled where no ray escapes
     and smoothed alike. ``free`` (N, R) uint8 (``sky_rays``) or float in [0, 1]; ``angles``,
     ``normals`` (N, 3) the bake's vertex normals; ``faces`` (M, 3); ``texels`` (6, S, S, 3), the
-    environment in map space; ``rotation_deg``: the environment's rotation."""
+    environment in map space; ``rotation_deg``: the environment's rotation. ``positions`` (N, 3):
+    the fill and the smoothing run on the welded mesh (``welded``), copies of a vertex alike."""
     free = np.asarray(free)
     scale = 1.0 / 255.0 if free.dtype == np.uint8 else 1.0
     n = np.asarray(normals, np.float64)
@@ -227,8 +270,12 @@ def sky_weight(free: np.ndarray, angles: np.ndarray, normals: np.ndarray, faces:
     dark = total <= 1e-30 * np.maximum(total.max(), 1e-30)
     w = np.where(dark, vis[:, None], seen / np.where(dark, 1.0, total))
     values = np.column_stack([w, vis])
-    values = fill_from_neighbours(values, faces, vis <= 0.0)
-    return smooth(values, faces, rounds).astype(np.float32)
+    ids = None if positions is None else welded(positions, n)
+
+    def fill_and_smooth(v, f):
+        return smooth(fill_from_neighbours(v, f, v[:, 3] <= 0.0), f, rounds)
+
+    return on_welded(values, faces, ids, fill_and_smooth).astype(np.float32)
 
 
 def sky_weight_key(visibility_key_: str, texels_digest_: str, rotation_deg: float, rays: int,
@@ -236,7 +283,7 @@ def sky_weight_key(visibility_key_: str, texels_digest_: str, rotation_deg: floa
     """The cache key of the weight of the bake ``visibility_key_`` under an environment."""
     description = {"what": "sky-weight", "version": SKY_WEIGHT_VERSION, "visibility": visibility_key_,
                    "environment": texels_digest_, "rotation": round(float(rotation_deg) % 360.0, 6),
-                   "rays": rays, "rounds": rounds, "seed": SKY_SEED}
+                   "rays": rays, "rounds": rounds, "seed": SKY_SEED, "welded": True}
     text = json.dumps(description, sort_keys=True)
     return "alight-sky-weight-" + hashlib.sha256(text.encode()).hexdigest(), description
 

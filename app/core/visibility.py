@@ -63,8 +63,9 @@ DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
 DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
-BAKE_VERSION = 5   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
-                   # 5: vertices covered by a part take their open neighbours' values
+BAKE_VERSION = 6   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
+                   # 5: vertices covered by a part take their open neighbours' values;
+                   # 6: a vertex's copies share V, the bent normal and the bounce (_copies_averaged)
 # Refinement keeps a split only where the midpoint's value is not the edge's linear interpolation.
 INTERPOLATION_TEST = True
 # A vertex at least this share of whose rays hit a part from its inside, or hit one closer than
@@ -680,6 +681,22 @@ def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray) -> 
     return out
 
 
+def _copies_averaged(values: np.ndarray, faces: np.ndarray, data: np.ndarray) -> np.ndarray:
+    """``values`` (N, 4: a direction and a share) averaged over each vertex's copies
+    (sky_weight.welded over ``data``'s positions and normals), the direction renormalised. A
+    file that repeats a vertex per face around it (an OBJ or STL without shared normals: the
+    loader keeps a copy per face) gave each copy rays of its own, so copies at one point drew
+    different values: a speckle of triangles over a smooth bowl's inside. Only copies are
+    averaged, no neighbours: V's sharp changes (a contact, a slab's foot) stay where the
+    refinement put them."""
+    from alight.core.sky_weight import on_welded, welded
+
+    out = on_welded(values, faces, welded(data[:, :3], data[:, 3:6]), lambda v, f: v)
+    length = np.linalg.norm(out[:, :3], axis=1, keepdims=True)
+    out[:, :3] = np.where(length > 1e-12, out[:, :3] / np.maximum(length, 1e-30), values[:, :3])
+    return out
+
+
 def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
                     max_vertices: int = DEFAULT_MAX_VERTICES, seed: int = 0,
                     coarse_fraction: float = DEFAULT_COARSE_FRACTION, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
@@ -772,6 +789,7 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     # Buried vertices (inside another part) take their open neighbours' values.
     buried = [val[:, 4] >= COVERED_SHARE for val in values]
     values = [_fill_covered(val[:, :4], f, b) for val, (_, _, f), b in zip(values, state, buried)]
+    values = [_copies_averaged(val, f, d) for val, (d, _, f) in zip(values, state)]
     # The bounce: what each vertex's rays hit on the refined mesh, and the V and bent normal there.
     offsets = np.cumsum([0] + [len(d) for d, _, _ in state])
     all_p = np.concatenate([d[:, :3] for d, _, _ in state])
@@ -794,8 +812,8 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     bounce_dir = np.column_stack([np.bincount(rows, at_hit[:, k] * at_hit[:, 3], minlength=count) for k in range(3)])
     length = np.linalg.norm(bounce_dir, axis=1, keepdims=True)
     bounce_dir = np.where(length > 1e-8, bounce_dir / np.maximum(length, 1e-30), -all_n)
-    for (_, _, f), b, a, z in zip(state, buried, offsets[:-1], offsets[1:]):
-        filled = _fill_covered(np.column_stack([bounce_dir[a:z], bounce_weight[a:z]]), f, b)
+    for (d, _, f), b, a, z in zip(state, buried, offsets[:-1], offsets[1:]):
+        filled = _copies_averaged(_fill_covered(np.column_stack([bounce_dir[a:z], bounce_weight[a:z]]), f, b), f, d)
         bounce_dir[a:z], bounce_weight[a:z] = filled[:, :3], filled[:, 3]
     parts = []
     for (data, widths, faces), part, val, a, b in zip(state, mesh.parts, values, offsets[:-1], offsets[1:]):

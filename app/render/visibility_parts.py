@@ -283,7 +283,8 @@ class OcclusionParts:
                                        through)
         self.sky_rays_loaded += int(loaded)
         self.sky_rays_run += int(not loaded)
-        values = [sw.sky_weight(free, angle, p.normals, p.indices.reshape(-1, 3), texels, rotation_deg)
+        values = [sw.sky_weight(free, angle, p.normals, p.indices.reshape(-1, 3), texels, rotation_deg,
+                                positions=p.positions)
                   for (free, angle), p in zip(rays, baked.parts)]
         self.last_sky_seconds = time.perf_counter() - start
         self.sky_weights_run += 1
