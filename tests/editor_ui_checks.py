@@ -418,6 +418,13 @@ def test_open_env_typed_and_studio_button(ctx):
     ctx.item_click("**/studio")
     assert s.env_spec == "studio"
     np.testing.assert_allclose(view(ctx).astype(np.float64).mean(), studio.mean(), atol=0.5)
+    # A 2:1 PNG typed there is the environment too (it went to the base colour map by its suffix).
+    png = os.path.join(SHARED, "cases", "with_controls", "ldr_srgb.png")
+    ctx.item_input_value("**/env file", png)
+    ctx.item_click("**/open env")
+    assert s.env_spec == png and "as the environment" in s.message, (s.env_spec, s.message, s.error)
+    assert not (s.texture_maps and s.texture_maps.base_color), s.texture_maps
+    ctx.item_click("**/studio")
     ctx.item_close("**/Environment")
 
 

@@ -573,9 +573,9 @@ class Panel:
         imgui.text(f"environment: {s.env_spec}")
         _, self.env_path = imgui.input_text("env file", self.env_path)
         if imgui.button("open env"):
-            self._attempt(s, "env_path", lambda: s.open_file(self.env_path))
+            self._attempt(s, "env_path", lambda: s.open_environment(self.env_path))
         imgui.same_line()
-        self._browse("browse env", (".hdr", ".exr"), s.open_file)
+        self._browse("browse env", (".hdr", ".exr"), s.open_environment)
         imgui.same_line()
         if imgui.button("studio"):
             try:

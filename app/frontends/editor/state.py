@@ -397,6 +397,18 @@ class EditorState:
             self.message = self.with_warnings(self.message)
         return True
 
+    def open_environment(self, path: str) -> bool:
+        """The environment row's file: always the environment, whatever its suffix (a 2:1 PNG as
+        ``alight render --env`` takes it), never a texture map by way of ``open_file``'s routing.
+        Returns False (and sets ``error``) on failure."""
+        try:
+            self.load_env(path)
+        except Exception as exc:
+            self.fail(exc)
+            return False
+        self.error, self.message = "", self.with_warnings(f"opened {os.path.basename(path)} as the environment")
+        return True
+
     def fail(self, exc: Exception) -> None:
         """One line, never a traceback: a loader's surprise is named by its type."""
         text = str(exc) if isinstance(exc, AlightError) else f"{type(exc).__name__}: {exc}"
