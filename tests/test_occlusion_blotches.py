@@ -180,7 +180,7 @@ def test_copies_of_a_vertex_share_their_occlusion(tmp_path, shared_data):
     """The revolved bowl under royal_esplanade (its bright sky makes the visible sky weight
     vary most), 256 px from 45 degrees up: with the bake the inside is as smooth as without it.
     Each copy of a vertex cast rays of its own and the faces connected no copy to its
-    neighbours, so the smoothing stayed inside each triangle (sky_weight.welded). Measured when
+    neighbours, so the smoothing stayed inside each triangle (visibility.welded). Measured when
     written: the speckle 1.10x the unoccluded frame's, 1.68x before."""
     from alight.core.scene import orbit_camera
     from alight.ibl.environment import load_environment
@@ -202,7 +202,7 @@ def test_copies_of_a_vertex_share_their_occlusion(tmp_path, shared_data):
 def test_welded_keeps_creases_apart():
     """Copies at one position within 30 degrees of their mean normal share an index; a cube's
     corner (three faces' copies, 55 degrees from their mean) keeps three."""
-    from alight.core.sky_weight import welded
+    from alight.core.visibility import welded
 
     smooth = welded([[0, 0, 0], [0, 0, 0], [1, 0, 0]], [[0, 0, 1], [0.02, 0, 1], [0, 0, 1]])
     assert smooth[0] == smooth[1] != smooth[2]

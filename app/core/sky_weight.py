@@ -43,9 +43,9 @@ import numpy as np
 
 from alight.core.shading import rotate_world_to_map
 from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_directions, merged_parts
+from alight.core.visibility import on_welded, welded  # noqa: F401  (the weight's fill and smoothing run welded)
 from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
-WELD_CREASE_DEG = 30.0   # welded: copies of a vertex further than this from their mean normal stay apart
 SKY_WEIGHT_VERSION = 2   # 2: filled and smoothed on the welded mesh (welded)
 SKY_TEXELS = 16          # texels per cube face read back (the source cube's box mip of that size)
 SMOOTHING_ROUNDS = 2     # rounds of averaging over mesh neighbours
@@ -179,46 +179,6 @@ def fill_from_neighbours(values: np.ndarray, faces: np.ndarray, unknown: np.ndar
         out[ring] = sums[ring] / n[ring, None]
         unknown &= ~ring
     return out
-
-
-def welded(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
-    """(N,) int64: per vertex, one index shared by the copies of a vertex: vertices at one position
-    (to 1e-6 of the mesh's size) whose normals lie within WELD_CREASE_DEG of the copies' mean.
-    Files that repeat a vertex per triangle (an OBJ written without shared indices, an exporter's
-    per-face split) give each copy rays of its own and, where the normals were made per copy,
-    normals a degree or two apart: copies at one point got different values, a smooth bowl's
-    inside a speckle of triangles, and the faces alone connect no copy to its neighbours, so
-    neighbour averaging stayed inside each triangle. A crease (a cube's edge: copies 45 degrees
-    or more from their mean) keeps one index per copy."""
-    p = np.asarray(positions, np.float64).reshape(-1, 3)
-    if not len(p):
-        return np.zeros(0, np.int64)
-    n = np.asarray(normals, np.float64).reshape(-1, 3)
-    n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
-    size = max(float(np.ptp(p, axis=0).max()), 1e-30)
-    _, at = np.unique(np.round((p - p.min(axis=0)) / size * 1e6), axis=0, return_inverse=True)
-    at = np.asarray(at, np.int64).reshape(-1)
-    mean = np.zeros((int(at.max()) + 1, 3))
-    np.add.at(mean, at, n)
-    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), 1e-30)
-    crease = np.einsum("ij,ij->i", n, mean[at]) < math.cos(math.radians(WELD_CREASE_DEG))
-    key = np.where(crease, len(mean) + np.arange(len(p)), at)
-    _, ids = np.unique(key, return_inverse=True)
-    return np.asarray(ids, np.int64).reshape(-1)
-
-
-def on_welded(values: np.ndarray, faces: np.ndarray, ids: np.ndarray | None, work):
-    """``work(values, faces)`` on the welded mesh (``welded`` ids: each copy's rows averaged,
-    the faces renumbered), its result handed back to every copy; ``ids`` None: on the mesh as
-    it is."""
-    values = np.asarray(values, np.float64)
-    if ids is None or not len(values):
-        return work(values, faces)
-    count = int(ids.max()) + 1
-    copies = np.bincount(ids, minlength=count).astype(np.float64)
-    merged = np.column_stack([np.bincount(ids, values[:, k], minlength=count) for k in range(values.shape[1])])
-    merged /= np.maximum(copies, 1.0)[:, None]
-    return work(merged, ids[np.asarray(faces, np.int64).reshape(-1, 3)])[ids]
 
 
 def smooth(values: np.ndarray, faces: np.ndarray, rounds: int) -> np.ndarray:

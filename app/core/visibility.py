@@ -63,6 +63,7 @@ DEFAULT_EDGE_FRACTION = 1.0 / 48.0    # then where V changes, down to this
 DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
+WELD_CREASE_DEG = 30.0   # welded: copies of a vertex further than this from their mean normal stay apart
 BAKE_VERSION = 6   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
                    # 5: vertices covered by a part take their open neighbours' values;
                    # 6: a vertex's copies share V, the bent normal and the bounce (_copies_averaged)
@@ -681,16 +682,54 @@ def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray) -> 
     return out
 
 
+def welded(positions: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(N,) int64: per vertex, one index shared by the copies of a vertex: vertices at one position
+    (to 1e-6 of the mesh's size) whose normals lie within WELD_CREASE_DEG of the copies' mean.
+    Files that repeat a vertex per triangle (an OBJ written without shared indices, an exporter's
+    per-face split) give each copy rays of its own and, where the normals were made per copy,
+    normals a degree or two apart: copies at one point got different values, a smooth bowl's
+    inside a speckle of triangles, and the faces alone connect no copy to its neighbours, so
+    neighbour averaging stayed inside each triangle. A crease (a cube's edge: copies 45 degrees
+    or more from their mean) keeps one index per copy."""
+    p = np.asarray(positions, np.float64).reshape(-1, 3)
+    if not len(p):
+        return np.zeros(0, np.int64)
+    n = np.asarray(normals, np.float64).reshape(-1, 3)
+    n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+    size = max(float(np.ptp(p, axis=0).max()), 1e-30)
+    _, at = np.unique(np.round((p - p.min(axis=0)) / size * 1e6), axis=0, return_inverse=True)
+    at = np.asarray(at, np.int64).reshape(-1)
+    mean = np.zeros((int(at.max()) + 1, 3))
+    np.add.at(mean, at, n)
+    mean /= np.maximum(np.linalg.norm(mean, axis=1, keepdims=True), 1e-30)
+    crease = np.einsum("ij,ij->i", n, mean[at]) < math.cos(math.radians(WELD_CREASE_DEG))
+    key = np.where(crease, len(mean) + np.arange(len(p)), at)
+    _, ids = np.unique(key, return_inverse=True)
+    return np.asarray(ids, np.int64).reshape(-1)
+
+
+def on_welded(values: np.ndarray, faces: np.ndarray, ids: np.ndarray | None, work):
+    """``work(values, faces)`` on the welded mesh (``welded`` ids: each copy's rows averaged,
+    the faces renumbered), its result handed back to every copy; ``ids`` None: on the mesh as
+    it is."""
+    values = np.asarray(values, np.float64)
+    if ids is None or not len(values):
+        return work(values, faces)
+    count = int(ids.max()) + 1
+    copies = np.bincount(ids, minlength=count).astype(np.float64)
+    merged = np.column_stack([np.bincount(ids, values[:, k], minlength=count) for k in range(values.shape[1])])
+    merged /= np.maximum(copies, 1.0)[:, None]
+    return work(merged, ids[np.asarray(faces, np.int64).reshape(-1, 3)])[ids]
+
+
 def _copies_averaged(values: np.ndarray, faces: np.ndarray, data: np.ndarray) -> np.ndarray:
     """``values`` (N, 4: a direction and a share) averaged over each vertex's copies
-    (sky_weight.welded over ``data``'s positions and normals), the direction renormalised. A
+    (``welded`` over ``data``'s positions and normals), the direction renormalised. A
     file that repeats a vertex per face around it (an OBJ or STL without shared normals: the
     loader keeps a copy per face) gave each copy rays of its own, so copies at one point drew
     different values: a speckle of triangles over a smooth bowl's inside. Only copies are
     averaged, no neighbours: V's sharp changes (a contact, a slab's foot) stay where the
     refinement put them."""
-    from alight.core.sky_weight import on_welded, welded
-
     out = on_welded(values, faces, welded(data[:, :3], data[:, 3:6]), lambda v, f: v)
     length = np.linalg.norm(out[:, :3], axis=1, keepdims=True)
     out[:, :3] = np.where(length > 1e-12, out[:, :3] / np.maximum(length, 1e-30), values[:, :3])
