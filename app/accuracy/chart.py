@@ -766,19 +766,19 @@ def visibility_summary_rows(vis_results) -> list[dict]:
     rows = []
     for scene in dict.fromkeys(r.scene for r in vis_results):
         group = [r for r in vis_results if r.scene == scene]
-        front = pareto([(r.frame_seconds, r._mean(1, excluded=SUMMARY_EXCLUDED)) for r in group])
+        front = pareto([(r.frame_seconds, r.over_maps(1, excluded=SUMMARY_EXCLUDED)) for r in group])
         for res, pf in zip(group, front):
             row = {k: math.nan for k in SUMMARY_FIELDS}
             row.update({
                 "setting": res.name, "factor": "visibility", "ibl_model": "", "multiple_scattering": False,
                 "irradiance": "", "irradiance_steps": "", "fis": "",
                 "frame_ms": res.frame_seconds * 1000,
-                "rel_mae_mean": res._mean(1, excluded=SUMMARY_EXCLUDED),
-                "rel_mae_max": res._mean(1, np.max, SUMMARY_EXCLUDED),
+                "rel_mae_mean": res.over_maps(1, excluded=SUMMARY_EXCLUDED),
+                "rel_mae_max": res.over_maps(1, np.max, SUMMARY_EXCLUDED),
                 "pareto_bake": False, "pareto_frame": pf, "scene": scene,
                 "occlusion": "on" if res.baked else "off", "shadows": res.shadows_drawn,
                 "visibility_bake_ms": res.bake_seconds * 1000,
-                "ref_noise_mean": res._mean(2, excluded=SUMMARY_EXCLUDED),
+                "ref_noise_mean": res.over_maps(2, excluded=SUMMARY_EXCLUDED),
             })
             rows.append(row)
     return rows

@@ -77,7 +77,9 @@ class VisibilityResult:
         n = sum(1 for c in self.cases if c[3])
         return "off" if n == 0 else "on" if n == len(self.cases) else f"{n}/{len(self.cases)} maps"
 
-    def _mean(self, column: int, reduce=np.mean, excluded=()) -> float:
+    def over_maps(self, column: int, reduce=np.mean, excluded=()) -> float:
+        """``reduce`` of a case column (1: the error, 2: the reference's noise) over the maps whose
+        names hold none of ``excluded``; NaN where none is left."""
         c = [x[column] for x in self.cases if not any(e in x[0] for e in excluded)]
         return float(reduce(c)) if c else math.nan
 
