@@ -16,11 +16,13 @@ import argparse
 import statistics
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "benchmarks"))
+
+
+from bench_shader_frame import median_display_frame  # noqa: E402
 
 
 def main() -> None:
@@ -64,13 +66,7 @@ def main() -> None:
         batch = {}
         for name in (list(modes) if b % 2 == 0 else list(reversed(modes))):
             use(modes[name])
-            frames = []
-            for _ in range(args.frames):
-                t = time.perf_counter()
-                r.draw_display(scene, maps, targets)
-                r.ctx.finish()
-                frames.append(time.perf_counter() - t)
-            batch[name] = statistics.median(frames)
+            batch[name] = median_display_frame(r, scene, maps, targets, args.frames)
             times[name].append(batch[name])
         ratios.append(batch["mesh"] / batch["part"])
         print(f"batch {b + 1}: per mesh {batch['mesh'] * 1000:.1f} ms, per part {batch['part'] * 1000:.1f} ms, "

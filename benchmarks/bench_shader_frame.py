@@ -27,6 +27,18 @@ REPO = Path(__file__).resolve().parents[1]
 HELMET = REPO.parent / "shared" / "data" / "models" / "DamagedHelmet" / "DamagedHelmet.gltf"
 
 
+def median_display_frame(r, scene, maps, targets, frames: int) -> float:
+    """Median seconds of ``frames`` of the editor's view pass (``draw_display`` then
+    ``ctx.finish()``), the renderer current (bench_mesh_flags.py times with it too)."""
+    times = []
+    for _ in range(frames):
+        t = time.perf_counter()
+        r.draw_display(scene, maps, targets)
+        r.ctx.finish()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ref", required=True)
@@ -69,13 +81,7 @@ def main() -> None:
                 for label in order:
                     r, maps, targets = state[label]
                     r.make_current()
-                    frames = []
-                    for _ in range(args.frames):
-                        t = time.perf_counter()
-                        r.draw_display(scene, maps, targets)
-                        r.ctx.finish()
-                        frames.append(time.perf_counter() - t)
-                    batch[label] = statistics.median(frames)
+                    batch[label] = median_display_frame(r, scene, maps, targets, args.frames)
                     times[label].append(batch[label])
                 ratios.append(batch["this tree"] / batch[args.ref])
                 print(f"{name} batch {b + 1}: this tree {batch['this tree'] * 1000:.1f} ms, "
