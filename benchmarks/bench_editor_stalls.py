@@ -117,6 +117,55 @@ def child_variant(size) -> dict:
         win.close()
 
 
+def child_occlusion(size) -> dict:
+    """DamagedHelmet with occlusion off, then 'on' (set on the state, as the combo sets it), the
+    bake cache and Mesa's shader cache empty: frames until the view shows the occluded picture
+    (the bake's child done, no variant held back) and 10 more. Each frame's wall time and the
+    main thread's CPU time (``time.thread_time``: on a shared machine a frame's wall time also
+    holds the time other processes took the cores). "send": the frame that handed the occluded
+    variant to the warm-up process; "switch": the frame that first drew the occluded picture
+    (each [wall, main thread's CPU, the process's CPU: llvmpipe's threads too] in ms);
+    "other": the longest of the rest. The camera orbits 1 degree a frame throughout, as an
+    artist's drag does, so every frame draws the helmet."""
+    state, win = _window(size)
+    state.load_mesh(os.path.join(REPO, "..", "shared", "data", "models", "DamagedHelmet", "DamagedHelmet.gltf"))
+    state.occlusion = "off"
+    warm, bake = win.variant_warmup, win.occlusion_bake
+    try:
+        _frames_until(win, lambda: not warm.pending and not warm.showing_old, after=20)
+        steady = []
+        for _ in range(10):
+            win.orbit.yaw_deg += 1.0
+            steady.append(_timed_frame(win))
+        state.occlusion = "on"
+        frames, start, shown, after = [], time.perf_counter(), None, 0
+        send = switch = None
+        while time.perf_counter() - start < 600 and after < 10:
+            win.orbit.yaw_deg += 1.0
+            jobs, cpu0, proc0 = warm.jobs, time.thread_time(), time.process_time()
+            t = _timed_frame(win)
+            frames.append((t, time.thread_time() - cpu0, time.process_time() - proc0))
+            if warm.jobs > jobs and send is None:
+                send = len(frames) - 1
+            last = win._last_complete_scene
+            done = (not bake.status and not warm.pending and not warm.showing_old
+                    and last is not None and last.occlusion == "on")
+            if shown is None and done:
+                shown, switch = time.perf_counter() - start, len(frames) - 1
+            after += shown is not None
+        rest = [f for i, f in enumerate(frames) if i not in (send, switch)]
+        ms = lambda i: [round(1000 * v, 1) for v in frames[i]] if i is not None else None
+        return {"frames": len(frames), "steady_ms": 1000 * statistics.median(steady),
+                "median_ms": 1000 * statistics.median(f[0] for f in frames), "max_ms": 1000 * max(f[0] for f in frames),
+                "median_process_cpu_ms": 1000 * statistics.median(f[2] for f in frames),
+                "send_ms": ms(send), "switch_ms": ms(switch),
+                "other_max_wall_ms": 1000 * max(f[0] for f in rest), "other_max_cpu_ms": 1000 * max(f[1] for f in rest),
+                "other_max_process_cpu_ms": 1000 * max(f[2] for f in rest),
+                "shown_s": shown}
+    finally:
+        win.close()
+
+
 def _frames_until(win, done, after: int = 10, limit_s: float = 300.0) -> list[float]:
     """Timed frames until ``done()`` and ``after`` more."""
     times, start, extra = [], time.perf_counter(), 0
@@ -181,12 +230,12 @@ def run(side: str, what: str, args) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--base", help="a folder whose 'alight' is the other checkout's app/")
-    ap.add_argument("--what", choices=("reference", "variant", "split", "both"), default="both")
+    ap.add_argument("--what", choices=("reference", "variant", "split", "occlusion", "both"), default="both")
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--size", default="800x720")
     ap.add_argument("--scale", type=float, default=0.25)
     ap.add_argument("--limit", type=float, default=600.0, help="seconds a reference run waits at most")
-    ap.add_argument("--child", choices=("reference", "variant", "split"))
+    ap.add_argument("--child", choices=("reference", "variant", "split", "occlusion"))
     args = ap.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     if args.child == "reference":
@@ -194,6 +243,9 @@ def main() -> None:
         return
     if args.child == "split":
         print(json.dumps(child_split(size, args.scale)))
+        return
+    if args.child == "occlusion":
+        print(json.dumps(child_occlusion(size)))
         return
     if args.child == "variant":
         print(json.dumps(child_variant(size)))
@@ -210,7 +262,8 @@ def main() -> None:
                 print(f"{what} round {r + 1} {side}: " + ", ".join(
                     f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in res.items()), flush=True)
         for side, runs in results.items():
-            for field in (("median_ms", "max_ms") if what != "split" else
+            for field in (("median_ms", "max_ms") if what not in ("split", "occlusion") else
+                          ("other_max_wall_ms", "other_max_cpu_ms", "other_max_process_cpu_ms") if what == "occlusion" else
                           ("plain_tonemap_max_ms", "split_open_max_ms", "split_tonemap_max_ms")):
                 xs = [x[field] for x in runs]
                 print(f"{what} {side} {field}: median {statistics.median(xs):.1f} (range {min(xs):.1f}-{max(xs):.1f})")

@@ -8,8 +8,8 @@ its own context could do this work without stalling the window.
 
 Protocol, one line each way:
 
-- to the child: ``ID<TAB>JOB.pickle`` (a pickled job the child's ``handle`` reads; the parent
-  deletes the file once answered);
+- to the child: ``ID<TAB>JOB.pickle`` (a job file the child's ``handle`` reads, ``write_job``'s
+  layout; the parent deletes the file once answered);
 - from the child: ``ID<TAB>WORD<TAB>TEXT``, WORD one of ``progress`` (TEXT a fraction),
   ``done`` (TEXT the job's seconds), ``error`` (TEXT one line) or ``cancelled``.
 
@@ -17,6 +17,13 @@ A job sent while another runs supersedes it: the child's job sees ``superseded()
 steps and stops (``cancelled``).
 
 Parent side: ``WorkerProcess``; child side: ``serve``.
+
+A job is pickled with protocol 5's out-of-band buffers: its arrays (a mesh's decoded textures,
+85 MB for DamagedHelmet) are not copied into the pickle but written from them by a thread of
+the parent, whose file writes release the GIL. The frame that submits pays only the pickle of
+the rest (the whole pickle took that frame 0.82-0.87 s with the helmet: benchmarks/results/
+editor_occlusion.md). The job's arrays must not be changed in place after ``submit``; alight's
+meshes and scenes are replaced, never changed in place.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from __future__ import annotations
 import os
 import pickle
 import queue
+import struct
 import subprocess
 import sys
 import tempfile
@@ -33,6 +41,41 @@ from pathlib import Path
 
 # A long job (the reference's sum) runs below the editor's priority: the frames first.
 CHILD_NICENESS = 10
+
+_JOB_MAGIC = b"ALJOB5\0\0"
+
+
+def job_pickle(job) -> tuple[bytes, list]:
+    """``job`` pickled with protocol 5: (the pickle, its out-of-band buffers as memoryviews of
+    the job's own arrays, uncopied)."""
+    buffers: list = []
+    head = pickle.dumps(job, protocol=5, buffer_callback=buffers.append)
+    return head, [b.raw() for b in buffers]
+
+
+def write_job(f, head: bytes, buffers: list) -> None:
+    """The job file: magic, the buffer count, the pickle's and each buffer's length (little-endian
+    uint64), the pickle, the buffers."""
+    f.write(_JOB_MAGIC + struct.pack(f"<{2 + len(buffers)}Q", len(buffers), len(head), *(b.nbytes for b in buffers)))
+    f.write(head)
+    for b in buffers:
+        f.write(b)
+
+
+def read_job(f):
+    """The job ``write_job`` wrote to the open file ``f``."""
+    if f.read(len(_JOB_MAGIC)) != _JOB_MAGIC:
+        raise ValueError("not a worker job file")
+    count, head_size = struct.unpack("<2Q", f.read(16))
+    sizes = struct.unpack(f"<{count}Q", f.read(8 * count)) if count else ()
+    head = f.read(head_size)
+    buffers = []
+    for size in sizes:
+        b = bytearray(size)
+        if f.readinto(b) != size:
+            raise ValueError("a worker job file ends early")
+        buffers.append(b)
+    return pickle.loads(head, buffers=buffers)
 
 
 class WorkerProcess:
@@ -47,25 +90,44 @@ class WorkerProcess:
         self._next_id = 0
         self._scratch = Path(tempfile.mkdtemp(prefix="alight-worker-"))
         self._files: dict[int, Path] = {}
+        self._outbox: queue.Queue = queue.Queue()   # jobs for the writer thread, in order
+        self._writer = None
 
     def submit(self, job) -> int:
-        """Send ``job`` (picklable); returns its id. A child that cannot be started or written to
-        answers ``error`` for it."""
+        """Send ``job`` (picklable; its arrays left unchanged from now on); returns its id. The
+        file is written and the child told by a thread of this object, so the caller's frame
+        pays only the pickle without the arrays' bytes. A child that cannot be started or
+        written to answers ``error`` for it."""
         self._next_id += 1
         job_id = self._next_id
         path = self._scratch / f"job-{job_id}.pickle"
-        with open(path.with_suffix(".tmp"), "wb") as f:
-            pickle.dump(job, f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(path.with_suffix(".tmp"), path)
         self._files[job_id] = path
-        try:
-            if self._process is None or self._process.poll() is not None:
-                self._start()
-            self._process.stdin.write(f"{job_id}\t{path}\n")
-            self._process.stdin.flush()
-        except (OSError, ValueError) as exc:
-            self._answers.put((job_id, "error", f"the worker process could not be started ({exc})"))
+        self._outbox.put((job_id, path, *job_pickle(job)))
+        if self._writer is None:
+            self._stop = threading.Event()
+            self._writer = threading.Thread(target=self._write, args=(self._outbox, self._stop),
+                                            name=f"alight-{self.module}-writer", daemon=True)
+            self._writer.start()
         return job_id
+
+    def _write(self, outbox: queue.Queue, stop: threading.Event) -> None:
+        while True:
+            item = outbox.get()
+            if item is None or stop.is_set():
+                return
+            job_id, path, head, buffers = item
+            try:
+                with open(path.with_suffix(".tmp"), "wb") as f:
+                    write_job(f, head, buffers)
+                os.replace(path.with_suffix(".tmp"), path)
+                if stop.is_set():   # closed while this job was written: no child started for it
+                    return
+                if self._process is None or self._process.poll() is not None:
+                    self._start()
+                self._process.stdin.write(f"{job_id}\t{path}\n")
+                self._process.stdin.flush()
+            except (OSError, ValueError, AttributeError) as exc:
+                self._answers.put((job_id, "error", f"the worker process could not be started ({exc})"))
 
     def scratch_file(self, name: str) -> Path:
         """A path in this worker's scratch folder (a job's output the child writes)."""
@@ -128,6 +190,11 @@ class WorkerProcess:
             path.unlink(missing_ok=True)
 
     def close(self) -> None:
+        if self._writer is not None:   # (a job being written is abandoned with the child)
+            self._stop.set()
+            self._outbox.put(None)
+            self._writer.join(timeout=2)
+            self._writer, self._outbox = None, queue.Queue()
         process, self._process = self._process, None
         if process is not None and process.poll() is None:
             try:
@@ -196,7 +263,7 @@ def serve(handle, niceness: int = CHILD_NICENESS) -> int:
         start = time.perf_counter()
         try:
             with open(path, "rb") as f:
-                job = pickle.load(f)
+                job = read_job(f)
             finished = handle(job, lambda fraction: answer(job_id, "progress", f"{fraction:.4f}"), jobs.waiting)
             if finished is False:
                 answer(job_id, "cancelled")
