@@ -17,10 +17,10 @@ import moderngl
 import numpy as np
 
 from alight.core.scene import Camera, Display
-from alight.errors import warn
 from alight.core.shader_names import BackgroundMode, Tonemap, glsl_member
 from alight.core.sphere_lod import impostor_background_ring, impostor_hole_model
 from alight.core.texture_maps import TextureMaps
+from alight.errors import warn
 from alight.ibl.bake import QUALITY, IBLMaps
 from alight.render.bindings import (
     UNIT_LUT,
