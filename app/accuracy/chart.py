@@ -373,8 +373,8 @@ class Progress:
     kind also compiles its shaders and bakes: 33-87 s of the first setting's, 0.1-2 s the
     others', in --quick runs), or the first's where only it ran and few of its kind are left.
     The kinds left that are not timed yet are named after the sum, which is then a lower bound
-    ('ETA >0m05s (frames, visibility not timed yet)'): weights guessed in advance gave a first
-    ETA of 14 s for a run of 51 s."""
+    ('ETA >0m05s (frames, visibility not timed yet)'; 'ETA unknown (...)' under a second):
+    weights guessed in advance gave a first ETA of 14 s for a run of 51 s."""
 
     def __init__(self, kinds: list[str], stream=None, clock=time.perf_counter):
         self.kinds = list(kinds)
@@ -413,6 +413,8 @@ class Progress:
         seconds, untimed = self.eta()
         if not untimed:
             return f"ETA {_mmss(seconds)}"
+        if seconds < 1.0:
+            return f"ETA unknown ({', '.join(untimed)} not timed yet)"
         return f"ETA >{_mmss(seconds)} ({', '.join(untimed)} not timed yet)"
 
     def step(self, what: str) -> None:
