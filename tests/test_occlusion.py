@@ -347,3 +347,45 @@ def test_splits_are_kept_only_where_interpolation_misses(tmp_path, monkeypatch):
     # measured: every split 474 triangles, 0.067; splits kept 306 triangles, 0.085
     assert kept_count < 0.8 * every_count
     assert kept < every + 0.025
+
+
+def _big_sphere_ply(path: Path, bump) -> Path:
+    """A latitude-longitude sphere of 512x512 vertices (over --occlusion auto's AUTO_MAX_VERTICES)
+    whose radius is ``bump(theta, phi)``, as a binary PLY (counter-clockwise from outside)."""
+    n = 512
+    theta, phi = np.meshgrid(np.linspace(0.0, np.pi, n), np.linspace(0.0, 2.0 * np.pi, n, endpoint=False),
+                             indexing="ij")
+    radius = bump(theta, phi)
+    points = np.stack([radius * np.sin(theta) * np.cos(phi), radius * np.cos(theta),
+                       radius * np.sin(theta) * np.sin(phi)], axis=-1).reshape(-1, 3).astype("<f4")
+    i, j = np.meshgrid(np.arange(n - 1), np.arange(n), indexing="ij")
+    a, b = i * n + j, i * n + (j + 1) % n
+    c, d = a + n, b + n
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([b, d, c], -1).reshape(-1, 3)])
+    rows = np.empty(len(faces), [("n", "u1"), ("i", "<i4", (3,))])
+    rows["n"], rows["i"] = 3, faces
+    header = (f"ply\nformat binary_little_endian 1.0\nelement vertex {len(points)}\nproperty float x\n"
+              f"property float y\nproperty float z\nelement face {len(faces)}\n"
+              f"property list uchar int vertex_indices\nend_header\n")
+    out = path / "big.ply"
+    out.write_bytes(header.encode() + points.tobytes() + rows.tobytes())
+    return out
+
+
+@pytest.mark.parametrize("shape", ["bumpy", "lobed"])
+def test_cli_warns_of_a_huge_mesh_only_where_it_would_need_occlusion(tmp_path, shape):
+    """--occlusion auto on a mesh over AUTO_MAX_VERTICES: the 'rendered without occlusion' warning
+    only where the mesh would plausibly need occlusion (occlusion_estimate above
+    AUTO_MIN_OCCLUSION), not for a nearly convex sphere whose bumps of 0.2% of its radius made
+    self_occludes true."""
+    bump = {"bumpy": lambda t, p: 1.0 + 0.002 * np.sin(40.0 * t) * np.sin(40.0 * p),
+            "lobed": lambda t, p: 1.0 + 0.45 * np.sin(5.0 * t) * np.sin(5.0 * p)}[shape]
+    mesh = _big_sphere_ply(tmp_path, bump)
+    p = _cli("render", "--mesh", mesh, "--size", "32", "--quality", "low", "--occlusion", "auto",
+             "--out", tmp_path / "x.png", cache=tmp_path / "cache")
+    assert p.returncode == 0, p.stderr
+    warned = [x for x in p.stderr.splitlines() if "rendered without occlusion" in x]
+    if shape == "bumpy":
+        assert not warned, p.stderr
+    else:
+        assert len(warned) == 1 and "--occlusion on bakes it" in warned[0], p.stderr

@@ -250,3 +250,13 @@ def test_cli_writes_tiled_images_strip_by_strip(tmp_path):
     diff = np.abs(outs[(False, "png")] - outs[(True, "png")]).max(axis=2)
     assert np.mean(diff > 1.5 / 255) <= 0.005
     assert outs[(True, "png")].shape == (64, 96, 3)
+
+
+@pytest.mark.parametrize("size", [(8000, 6000), (4002, 4002), (7000, 5000)])
+def test_even_image_gets_even_tiles(size):
+    """An even image's automatic tiles are even (8000x6000 was cut into 2667-wide tiles): a pass
+    of an odd size cannot use the visibility buffer (alight.render.vbuffer.ineligible_reason)."""
+    plan = plan_tiles(*size, 16384, framebuffer_bytes("msaa", 4))
+    assert not plan.single and plan.tile_width % 2 == 0 and plan.tile_height % 2 == 0, plan
+    assert sum(t.width for t in plan.strips()[0]) == size[0]
+    assert sum(s[0].height for s in plan.strips()) == size[1]

@@ -337,12 +337,12 @@ def test_cli_mesh_shading_flag(tmp_path):
 
     dense, sparse = _grid_file(tmp_path, 80), _grid_file(tmp_path, 2)
     line, auto = render(dense)
-    assert line == "mesh shading: vbuffer (--mesh-shading auto)"
+    assert line.startswith("mesh shading: vbuffer (--mesh-shading auto: the mesh is dense on screen")
     line, forward = render(dense, "--mesh-shading", "forward")
-    assert line == "mesh shading: forward (--mesh-shading forward)"
+    assert line == "mesh shading: forward (--mesh-shading forward: asked for)"
     assert rel_mae(forward, auto) < REL_LIMIT_GRID
-    assert render(sparse)[0] == "mesh shading: forward (--mesh-shading auto)"
-    assert render(sparse, "--mesh-shading", "vbuffer")[0] == "mesh shading: vbuffer (--mesh-shading vbuffer)"
+    assert render(sparse)[0].startswith("mesh shading: forward (--mesh-shading auto: the mesh is not dense")
+    assert render(sparse, "--mesh-shading", "vbuffer")[0] == "mesh shading: vbuffer (--mesh-shading vbuffer: asked for)"
 
 
 def test_api_and_batch_check_the_mode(tmp_path):
@@ -360,3 +360,71 @@ def test_api_and_batch_check_the_mode(tmp_path):
     spec.write_text('size = 32\nmeshes = ["sphere"]\nmesh_shading = "deferred"\n')
     with pytest.raises(AlightError, match="mesh_shading"):
         plan(spec)
+
+
+def _warnings(stderr: str) -> list[str]:
+    return [x for x in stderr.splitlines() if x.startswith("alight: warning:")]
+
+
+def _cli(tmp_path, mesh, *flags, size="64"):
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / f"w_{len(list(tmp_path.iterdir()))}.png"
+    proc = subprocess.run([sys.executable, "-m", "alight", "render", "--size", size, "--quality", "low",
+                           *(["--mesh", str(mesh)] if mesh else []), *flags, "--out", str(out)],
+                          capture_output=True, text=True, env=dict(os.environ), timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    return proc.stderr
+
+
+def _blended_file(path: Path) -> Path:
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(2)
+    mat = g.material(pbrMetallicRoughness={"baseColorFactor": [1.0, 1.0, 1.0, 0.5]}, alphaMode="BLEND")
+    g.mesh([{"attributes": {"POSITION": g.accessor(positions, bounds=True), "NORMAL": g.accessor(normals)},
+             "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
+    return g.save(path / "blended.glb")
+
+
+@pytest.mark.parametrize("case", ["blend", "odd", "ground", "aa", "sphere", "probe"])
+def test_cli_says_why_vbuffer_was_not_used(tmp_path, case):
+    """``alight render --mesh-shading vbuffer`` where the visibility buffer cannot draw the pass:
+    one warning line naming the reason (vbuffer.ineligible_reason), not a silent forward pass;
+    the same scene under auto says nothing."""
+    mesh, flags, size, reason = {
+        "blend": (_blended_file(tmp_path), [], "64", "the scene has blended parts"),
+        "odd": (_grid_file(tmp_path, 8), [], "65x64", "the size 65x64 is odd"),
+        "ground": (_grid_file(tmp_path, 8), ["--ground"], "64", "the scene has a ground"),
+        "aa": (_grid_file(tmp_path, 8), ["--aa", "ssaa"], "64", "needs 4x msaa, not anti-aliasing ssaa"),
+        "sphere": (None, [], "64", "the built-in sphere"),
+        "probe": (None, ["--view", "probe"], "64", "the probe view"),
+    }[case]
+    lines = _warnings(_cli(tmp_path, mesh, *flags, "--mesh-shading", "vbuffer", size=size))
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("alight: warning: --mesh-shading vbuffer: drawn with the forward pass (")
+    assert reason in lines[0], lines[0]
+    assert not [x for x in _warnings(_cli(tmp_path, mesh, *flags, size=size)) if "mesh-shading" in x]
+
+
+def test_cli_vbuffer_used_says_nothing(tmp_path):
+    assert not _warnings(_cli(tmp_path, _grid_file(tmp_path, 8), "--mesh-shading", "vbuffer"))
+
+
+def test_one_warning_per_render_not_per_tile(capsys):
+    """Tiles of an odd width (an even image cut in two): the forward pass in each tile, one
+    warning for the render, naming the tile."""
+    from tests.gpu import renderer
+
+    r = renderer()
+    r.mesh_shading = "vbuffer"
+    try:
+        r.render(Scene(mesh=load_mesh(str(HELMET))), _maps(), 66, 64, aa="msaa", tile=(33, 64))
+        assert not r.last_vbuffer
+    finally:
+        r.mesh_shading = "auto"   # (the renderer's default)
+    lines = _warnings(capsys.readouterr().err)
+    assert len(lines) == 1, lines
+    assert "2 of its 2 tiles" not in lines[0] and "the tile 33x64 of the 66x64 image is odd" in lines[0], lines[0]

@@ -116,8 +116,6 @@ NV_BINS = 10
 LEVEL1_FROM = 0.25
 LATEST_FILE = "latest_chart.txt"   # in alight.paths.cache_dir(): where the last chart's CSV is
 FRAME_REPEATS = 5
-REFERENCE_WEIGHT = 10.0   # a reference's time in settings' times (for the ETA)
-VISIBILITY_WEIGHT = 2.0   # one scene's visibility rows under one environment, likewise
 
 
 @dataclass(frozen=True)
@@ -140,6 +138,14 @@ class Setting:
     @property
     def judged_by_truth(self) -> bool:
         return not self.multiple_scattering
+
+    @property
+    def alternative(self) -> bool:
+        """Whether the setting is one of the IBL settings' alternatives to each other (the
+        baseline, one factor changed, another IBL model), compared on the Pareto fronts. A layer
+        row is judged on other presets (and its frame on another material), and a multiple
+        scattering row by the white furnace only: neither is another way to draw the same thing."""
+        return self.factor not in ("layer", "multiple scattering")
 
 
 def sweep(quick: bool = False) -> list[Setting]:
@@ -343,25 +349,81 @@ class SettingResult:
         return statistics.median(self.bake_seconds) if self.bake_seconds else math.nan
 
 
-class Progress:
-    """'step i/N ... ETA' lines on stderr (one rewritten line on a terminal). Steps may weigh
-    more than 1 (a reference costs about as much as ten settings) so the ETA is not fooled by
-    the order of the work."""
+def why_missing(res: SettingResult, column: str) -> str:
+    """Why ``res`` has no value (NaN) in ``column`` ('rel', 'flip', 'bake', 'frame', 'furnace'),
+    for the CLI's 'n/a' footnotes."""
+    s = res.setting
+    if column in ("rel", "flip"):
+        if s.multiple_scattering:
+            return ("multiple scattering rows are judged by the white furnace only (the ground truth is "
+                    "single scattering)")
+        if not res.cases:
+            if s.layer:
+                return (f"no case for the {s.layer} layer: no preset measured uses it, or its lobes are too "
+                        f"narrow for the reference at the roughness values measured")
+            return "no case: no preset without layers was measured"
+        return f"only environments left out of the summary ({', '.join(SUMMARY_EXCLUDED)}) were measured"
+    return "not measured"
 
-    def __init__(self, weights: list[float], stream=None):
-        self.weights = list(weights)
-        self.total, self.done = len(self.weights), 0
-        self.total_weight, self.done_weight = float(sum(self.weights)), 0.0
+
+class Progress:
+    """'step i/N ... ETA' lines on stderr (one rewritten line on a terminal). Each step has a
+    kind ('furnace', 'reference', 'setting', 'frames', 'visibility'); the ETA is the remaining
+    steps' measured times: per kind, the median of its steps after the first (the first of a
+    kind also compiles its shaders and bakes: 33-87 s of the first setting's, 0.1-2 s the
+    others', in --quick runs), or the first's where only it ran and few of its kind are left.
+    The kinds left that are not timed yet are named after the sum, which is then a lower bound
+    ('ETA >0m05s (frames, visibility not timed yet)'; 'ETA unknown (...)' under a second):
+    weights guessed in advance gave a first ETA of 14 s for a run of 51 s."""
+
+    def __init__(self, kinds: list[str], stream=None, clock=time.perf_counter):
+        self.kinds = list(kinds)
+        self.total, self.done = len(self.kinds), 0
         self.stream = stream or sys.stderr
-        self.start = time.perf_counter()
+        self.clock = clock
+        self.start = self.last = clock()
+        self.seconds: dict[str, list[float]] = {}
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
 
+    def typical(self, kind: str, left: int) -> float | None:
+        """A step of ``kind``'s expected time, from those measured, with ``left`` of its steps
+        still to run; None while it cannot be told (none ran, or only the first, with its
+        one-time costs, and three or more are left: the next one comes soon)."""
+        measured = self.seconds.get(kind, [])
+        if len(measured) > 1:
+            return statistics.median(measured[1:])
+        if len(measured) == 1 and left < 3:
+            return measured[0]
+        return None
+
+    def eta(self) -> tuple[float, list[str]]:
+        """(seconds left for the kinds that are timed, the kinds left that are not)."""
+        left = self.kinds[self.done:]
+        seconds, untimed = 0.0, []
+        for kind in dict.fromkeys(left):
+            count = left.count(kind)
+            t = self.typical(kind, count)
+            if t is None:
+                untimed.append(kind)
+            else:
+                seconds += t * count
+        return seconds, untimed
+
+    def eta_text(self) -> str:
+        seconds, untimed = self.eta()
+        if not untimed:
+            return f"ETA {_mmss(seconds)}"
+        if seconds < 1.0:
+            return f"ETA unknown ({', '.join(untimed)} not timed yet)"
+        return f"ETA >{_mmss(seconds)} ({', '.join(untimed)} not timed yet)"
+
     def step(self, what: str) -> None:
-        self.done_weight += self.weights[self.done]
+        now = self.clock()
+        self.seconds.setdefault(self.kinds[self.done], []).append(now - self.last)
+        self.last = now
         self.done += 1
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed / self.done_weight * (self.total_weight - self.done_weight)
-        line = f"alight chart: step {self.done}/{self.total} {what}  elapsed {_mmss(elapsed)}  ETA {_mmss(eta)}"
+        line = (f"alight chart: step {self.done}/{self.total} {what}  elapsed {_mmss(now - self.start)}  "
+                f"{self.eta_text()}")
         if self.tty:
             self.stream.write("\r" + line[:150].ljust(150) + ("\n" if self.done == self.total else ""))
         else:
@@ -553,11 +615,10 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
     settings = config.settings
     results = [SettingResult(s) for s in settings]
     visibility = _visibility_rows(config.visibility, stream)
-    # Step weights, measured: a reference ~ 10 settings; the furnace and cold LUTs ~ 5; a scene's
-    # visibility rows (two traces, four renders) ~ 2.
-    vis_steps = [VISIBILITY_WEIGHT * len(config.visibility.scenes)] if visibility else []
-    progress = Progress([5.0] + ([REFERENCE_WEIGHT * len(config.roughness) / len(ROUGHNESS)] + [1.0] * len(settings)
-                                 + vis_steps) * len(envs), stream)
+    # The steps' kinds, for the ETA (Progress): the frame times under the first environment only.
+    env_steps = ["reference"] + ["setting"] * len(settings) + (["visibility"] if visibility else [])
+    progress = Progress(["furnace"] + env_steps[:1 + len(settings)] + (["frames"] if settings else []) + env_steps[1 + len(settings):]
+                        + env_steps * (len(envs) - 1), stream)
     renderer = ForwardRenderer()
     ref_renderer = ReferenceRenderer(renderer)
     error_map = ErrorMap(config.roughness, config.size)
@@ -643,6 +704,7 @@ def run_chart(config: ChartConfig, out_dir: str | os.PathLike, stream=None) -> l
                                                     config.frame_size, config.frame_repeats)
                 for (res, _), seconds in zip(frame_items, medians):
                     res.frame_seconds = seconds
+                progress.step("frame times")
             if visibility:
                 _measure_visibility(renderer, env, env_name, bakes, results[0].setting, visibility, config,
                                     e == len(envs) - 1)
@@ -733,9 +795,20 @@ def _fmt(x, digits=6):
     return x
 
 
+def alternatives_pareto(results: list[SettingResult], seconds) -> list[bool]:
+    """``pareto`` of (seconds(result), mean relMAE) among the results whose settings are
+    alternatives to each other (Setting.alternative: not the layer rows, not multiple
+    scattering's); False for the others."""
+    pick = [i for i, r in enumerate(results) if r.setting.alternative]
+    flags = [False] * len(results)
+    for i, flag in zip(pick, pareto([(seconds(results[i]), results[i].rel_mean) for i in pick])):
+        flags[i] = flag
+    return flags
+
+
 def summary_rows(results: list[SettingResult]) -> list[dict]:
-    bake_front = pareto([(r.bake_median, r.rel_mean) for r in results])
-    frame_front = pareto([(r.frame_seconds, r.rel_mean) for r in results])
+    bake_front = alternatives_pareto(results, lambda r: r.bake_median)
+    frame_front = alternatives_pareto(results, lambda r: r.frame_seconds)
     rows = []
     for res, pb, pf in zip(results, bake_front, frame_front):
         s, q = res.setting, res.setting.quality

@@ -50,6 +50,7 @@ import json
 import math
 import time
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -80,6 +81,9 @@ AUTO_MIN_OCCLUSION = 0.03
 AUTO_SAMPLES = 1024           # surface points of the statistic
 AUTO_RAYS = 32                # rays per point
 AUTO_MAX_VERTICES = 250_000   # auto bakes no bigger mesh (MetalRoughSpheresNoTextures' 1M triangles: 97 s)
+# A bigger mesh's statistic, for its warning only, is taken on a copy merged to a grid of this
+# many cells along its longest side (occlusion_estimate).
+AUTO_ESTIMATE_CELLS = 64
 
 
 @dataclass
@@ -355,9 +359,63 @@ def wants_occlusion(mesh, mode: str) -> bool:
         return False
     if mode == "on":
         return True
-    if not embree_available() or auto_too_big(mesh):
+    if not embree_available():
         return self_occludes(mesh.parts)    # the caller says it draws without (visibility_parts)
+    if auto_too_big(mesh):
+        # Not baked either way (the caller says so where it is wanted): the statistic on a coarse
+        # copy, so the warning comes only for a mesh that would need it. self_occludes here was
+        # true for nearly every big mesh (a scan's noise, a bump of 1e-4 of its size).
+        return occlusion_estimate(mesh.parts) > AUTO_MIN_OCCLUSION
     return occlusion_statistic(mesh.parts) > AUTO_MIN_OCCLUSION
+
+
+def occlusion_estimate(parts, cells: int = AUTO_ESTIMATE_CELLS) -> float:
+    """``occlusion_statistic`` of a big mesh, on a coarse copy of it (``clustered``: its vertices
+    merged per cell of a grid of ``cells`` along its bounding box's longest side): what would
+    occlude a point by more than a cell's size is kept, bumps and noise smaller than a cell are
+    flattened. A hole or gap narrower than a cell closes, so a finely perforated mesh reads as
+    more occluded than it is (the estimate errs toward "would need occlusion").
+
+    Measured (2 cores, llvmpipe machine, 1.3M-1.4M triangles): 0.0 on an icosphere and on the
+    same sphere with bumps of 0.2% of its radius (occlusion_statistic on the full mesh: 0.0 in
+    2.6 s and 13.8 s), 0.81 on an open box with a cube inside (full: 0.82 in 7.0 s), in about
+    0.5-0.9 s. Used by ``wants_occlusion`` only for meshes --occlusion auto does not bake."""
+    coarse = clustered(parts, cells)
+    return occlusion_statistic([coarse]) if len(coarse.indices) else 0.0
+
+
+def clustered(parts, cells: int = AUTO_ESTIMATE_CELLS) -> SimpleNamespace:
+    """The mesh's parts as one coarse part (positions, normals, indices), its vertices merged per
+    cell of a grid of ``cells`` along its bounding box's longest side (vertex clustering,
+    Rossignac and Borrel 1993), each merged vertex at its cell's mean position, its normal the
+    sum of theirs (occlusion_statistic reads only its side). Triangles that collapse (two
+    corners in one cell) are dropped, repeated ones kept once; connectivity is kept, so no holes
+    open. Vectorised: a 1.3M-triangle mesh in about 0.3 s."""
+    positions = [np.asarray(p.positions, np.float64).reshape(-1, 3) for p in parts]
+    sizes = np.cumsum([0] + [len(x) for x in positions])
+    empty = SimpleNamespace(positions=np.zeros((0, 3)), normals=np.zeros((0, 3)), indices=np.zeros((0, 3), np.int64))
+    if sizes[-1] == 0:
+        return empty
+    points = np.concatenate(positions)
+    normals = np.concatenate([np.asarray(p.normals, np.float64).reshape(-1, 3) for p in parts])
+    indices = np.concatenate([np.asarray(p.indices, np.int64).reshape(-1, 3) + start
+                              for p, start in zip(parts, sizes[:-1])])
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    step = float((hi - lo).max()) / cells or 1.0
+    cell = np.minimum(((points - lo) / step).astype(np.int64), cells)
+    key = (cell[:, 0] * (cells + 1) + cell[:, 1]) * (cells + 1) + cell[:, 2]
+    _, merged = np.unique(key, return_inverse=True)
+    merged = merged.ravel()
+    count = int(merged.max()) + 1
+    weight = np.bincount(merged, minlength=count).astype(np.float64)
+    mean = np.stack([np.bincount(merged, points[:, k], count) for k in range(3)], axis=1) / weight[:, None]
+    normal = np.stack([np.bincount(merged, normals[:, k], count) for k in range(3)], axis=1)
+    tri = merged[indices]
+    tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])]
+    if not len(tri):
+        return empty
+    _, first = np.unique(np.sort(tri, axis=1), axis=0, return_index=True)
+    return SimpleNamespace(positions=mean, normals=normal, indices=tri[np.sort(first)])
 
 
 def auto_too_big(mesh) -> bool:

@@ -20,6 +20,7 @@ from alight.core.scene import Camera, Display
 from alight.core.shader_names import BackgroundMode, Tonemap, glsl_member
 from alight.core.sphere_lod import impostor_background_ring, impostor_hole_model
 from alight.core.texture_maps import TextureMaps
+from alight.errors import warn
 from alight.ibl.bake import QUALITY, IBLMaps
 from alight.render.bindings import (
     UNIT_LUT,
@@ -88,7 +89,9 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
     (alight.render.renderer's docstring) and read back; yields (y0, linear, srgb)."""
     opaque = scene.display.background != "transparent"
     blending = has_blending_parts(scene)
-    for tiles in plan.strips():
+    strips = plan.strips()
+    shading = []    # each tile's (r.last_vbuffer, r.last_mesh_shading_reason)
+    for number, tiles in enumerate(strips):
         rows = tiles[0].height
         linear = np.empty((rows, width, 4), np.float32) if read_linear and not plan.single else None
         srgb = np.empty((rows, width, 4), np.uint8) if read_srgb and not plan.single else None
@@ -105,6 +108,7 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
                 draw_scene(r, scene, maps, targets, targets.draw, view=view)
                 if read_srgb:
                     tonemap(r, targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
+            shading.append((r.last_vbuffer, r.last_mesh_shading_reason))
             if read_linear:
                 block = read_tile(targets.radiance_fbo, t, "f4", np.float32)
                 if plan.single:
@@ -119,7 +123,23 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
                     srgb[:, t.x:t.x + t.width] = block
         if linear is not None and scene.view == "probe":
             linear[linear[:, :, 3] == 0.0] = 0.0  # docs/conventions.md: probe background radiance is 0
+        if number == len(strips) - 1:   # (before the last yield: a caller may stop there)
+            note_mesh_shading(r, shading)
         yield tiles[0].y, linear, srgb
+
+
+def note_mesh_shading(r, shading: list[tuple[bool, str]]) -> None:
+    """A render's mesh shading from its tiles' (vbuffer?, reason): r.last_vbuffer where every
+    tile took the visibility buffer, r.last_mesh_shading_reason the first forward tile's reason;
+    and where ``r.mesh_shading`` asked for "vbuffer" and some tile was drawn by the forward pass,
+    one warning line naming the reason (once per render, not per tile or pass)."""
+    forward = [reason for used, reason in shading if not used]
+    r.last_vbuffer = bool(shading) and not forward
+    r.last_mesh_shading_reason = forward[0] if forward else (shading[0][1] if shading else "")
+    if forward and getattr(r, "mesh_shading", "auto") == "vbuffer":
+        some = "" if len(forward) == len(shading) else f"{len(forward)} of its {len(shading)} tiles "
+        warn(f"{getattr(r, 'mesh_shading_option', 'mesh_shading')} vbuffer: {some}drawn with the forward pass "
+             f"({forward[0]})")
 
 
 # --- the scene pass ----------------------------------------------------------------------
@@ -155,11 +175,15 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         fbo = targets.single()[1]
     else:
         frame.impostor_samples = 0
-    r.last_vbuffer = False
-    if frame.impostor_samples == 0:
-        if vbuffer.wanted(r, scene, targets, fbo, background, view_projection, (view.width, view.height)):
-            frame.vbuffer = r.last_vbuffer = True
-            fbo = targets.single()[1]
+    if frame.impostor_model is None:    # (without an impostor only 4x msaa is eligible: vbuffer.choose)
+        use, r.last_mesh_shading_reason = vbuffer.choose(r, scene, targets, fbo, background, view_projection,
+                                                         (view.width, view.height))
+    else:
+        use, r.last_mesh_shading_reason = False, "the built-in sphere has its own impostor"
+    r.last_vbuffer = use
+    if use:
+        frame.vbuffer = True
+        fbo = targets.single()[1]
     frame.shadowed = prepare_shadows(r, scene, maps)    # (its own framebuffer: before this pass's)
     fbo.use()
     ctx.viewport = (0, 0, width, height)

@@ -132,6 +132,9 @@ class ForwardRenderer:
         # default) the visibility buffer only where the mesh is dense on screen (vbuffer.dense:
         # fewer than AUTO_PIXELS_PER_TRIANGLE covered pixels per triangle), where it is faster.
         self.mesh_shading = "auto"
+        # How the user named mesh_shading, for the one warning a render gives where "vbuffer" was
+        # asked for and the forward pass drew (passes.note_mesh_shading; the CLI: --mesh-shading).
+        self.mesh_shading_option = "mesh_shading"
         # What the last passes drew, for tests and benchmarks: the sphere's level, whether the
         # background's ring was drawn, the impostor's coverage samples (or None), and per
         # textured part's name the anisotropic filtering level.
@@ -139,7 +142,9 @@ class ForwardRenderer:
         self.last_background_ring = False
         self.last_sphere_impostor: int | None = None
         self.last_anisotropy: dict[str, float] = {}
-        self.last_vbuffer = False   # whether the last scene pass shaded its mesh from the visibility buffer
+        self.last_vbuffer = False   # whether the last scene pass (a render: its every tile) shaded its mesh from the visibility buffer
+        # ... and why (vbuffer.choose): why the forward pass where it drew, a phrase
+        self.last_mesh_shading_reason = ""
         self._bakes: dict[tuple, IBLMaps] = {}
         self._targets: Targets | None = None
         self._units_assigned: set[int] = set()

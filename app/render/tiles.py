@@ -88,7 +88,22 @@ def plan_tiles(width: int, height: int, max_side: int, bytes_per_pixel: int, til
         th = max(1, min(height, max_side, strip_bytes // (width * READBACK_BYTES), square))
         tw = max(1, min(width, max_side, tile_bytes // (th * bytes_per_pixel)))
     nx, ny = -(-width // tw), -(-height // th)
-    return TilePlan(width, height, -(-width // nx), -(-height // ny))
+    tw, th = -(-width // nx), -(-height // ny)
+    if tile is None:
+        # Even sides where the image's are: a pass with an odd width or height cannot shade its
+        # mesh from the visibility buffer (alight.render.vbuffer.ineligible_reason), so an even
+        # image cut into odd tiles would lose it in every tile. One more column or row than the
+        # budget (or one fewer at the GL limit).
+        tw = _even(tw, width, max_side)
+        th = _even(th, height, max_side)
+    return TilePlan(width, height, tw, th)
+
+
+def _even(side: int, whole: int, max_side: int) -> int:
+    """``side`` made even where ``whole`` is even and ``side`` cuts it."""
+    if side % 2 == 0 or whole % 2 or side >= whole:
+        return side
+    return side + 1 if side + 1 <= max_side else side - 1
 
 
 def tile_matrix(plan: TilePlan, tile: Tile) -> np.ndarray:

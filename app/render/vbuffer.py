@@ -47,7 +47,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from alight.core.shader_names import AlphaMode
+from alight.core.shader_names import DEBUG_VIEWS, AlphaMode
 from alight.core.texture_maps import TextureMaps
 from alight.render.bindings import UNIT_VISIBILITY, set_uniform
 from alight.render.part_bindings import _bind_view, bind_part, set_culling
@@ -76,26 +76,83 @@ def wanted(r, scene, targets, fbo, background: bool, view_projection: np.ndarray
     pass is the fused MSAA resolve's (4 samples, no background drawn, so no blended parts) of a
     mesh file with no transmissive part, ground or debug view. ``view_projection`` and
     ``image_size``: the whole image's (a tile's pass too), for "auto"."""
+    return choose(r, scene, targets, fbo, background, view_projection, image_size)[0]
+
+
+def choose(r, scene, targets, fbo, background: bool, view_projection: np.ndarray | None = None,
+           image_size: tuple[int, int] | None = None) -> tuple[bool, str]:
+    """``wanted`` and why: (True, why the visibility buffer) or (False, why the forward pass),
+    the reason a phrase for a message ("the scene has blended parts"; ForwardRenderer's
+    last_mesh_shading_reason, the CLI's warning and --verbose line)."""
     mode = getattr(r, "mesh_shading", "auto")
-    if mode not in ("auto", "vbuffer") or not eligible(r, scene, targets, fbo, background):
-        return False
-    return mode == "vbuffer" or (view_projection is not None and dense(r, scene, view_projection, image_size))
+    if mode not in ("auto", "vbuffer"):
+        return False, "asked for"
+    reason = ineligible_reason(r, scene, targets, fbo, background, image_size)
+    if reason is not None:
+        return False, reason
+    if mode == "vbuffer":
+        return True, "asked for"
+    density = None
+    if view_projection is not None:
+        density = pixels_per_triangle(r, scene, view_projection, image_size)
+    if density is None:
+        return False, "the camera is at or inside the mesh" if view_projection is not None else \
+            "no view to estimate the mesh's density"
+    if density < AUTO_PIXELS_PER_TRIANGLE:
+        return True, f"the mesh is dense on screen, about {density:.1f} pixels per triangle, " \
+                     f"below {AUTO_PIXELS_PER_TRIANGLE:g}"
+    return False, f"the mesh is not dense on screen, about {density:.1f} pixels per triangle; " \
+                  f"auto takes the visibility buffer below {AUTO_PIXELS_PER_TRIANGLE:g}"
 
 
 def eligible(r, scene, targets, fbo, background: bool) -> bool:
     """Whether the visibility buffer can draw this pass as the forward pass would (``wanted``'s
-    conditions but the density)."""
+    conditions but the density): ``ineligible_reason`` finds none."""
+    return ineligible_reason(r, scene, targets, fbo, background) is None
+
+
+def ineligible_reason(r, scene, targets, fbo, background: bool,
+                      image_size: tuple[int, int] | None = None) -> str | None:
+    """Why the visibility buffer cannot draw this pass as the forward pass would, as a phrase
+    ("the scene has blended parts"), or None where it can. The first reason found, the user's
+    choices (view, mesh, ground, materials) before the frame's (anti-aliasing, size).
+    ``image_size``: the whole image's, where the pass draws a tile of it (named in the reason)."""
     mesh = scene.mesh
     width, height = targets.draw_size
+    if scene.view == "probe":
+        return "the probe view draws no mesh"
+    if mesh is None or not mesh.parts:
+        return "there is no mesh"
+    if mesh.lod_sphere is not None:
+        return "the built-in sphere has its own impostor"
+    if scene.debug_view:
+        view = DEBUG_VIEWS[scene.debug_view] if 0 <= scene.debug_view < len(DEBUG_VIEWS) else scene.debug_view
+        return f"the debug view '{view}' is drawn by the forward pass"
+    if scene.ground:
+        return "the scene has a ground"
+    if has_blending_parts(scene):
+        return "the scene has blended parts"
+    if transmissive_parts(scene):
+        return "the scene has transmissive parts"
+    if targets.aa != "msaa" or targets.samples != VBUFFER_SAMPLES:
+        aa = f"{targets.samples}x msaa" if targets.aa == "msaa" else f"anti-aliasing {targets.aa}"
+        return f"the visibility buffer needs {VBUFFER_SAMPLES}x msaa, not {aa}"
+    if fbo is not targets.draw or background:
+        return "the pass draws the background (not the fused MSAA resolve)"
     # An odd width or height keeps the forward pass: the shading pass's 2x2 blocks must be the
     # forward pass's, and along an odd edge the last column or row of blocks would reach past the
     # image, where their other pixels have no samples to share.
-    return (targets.aa == "msaa" and targets.samples == VBUFFER_SAMPLES and fbo is targets.draw and not background
-            and width % 2 == 0 and height % 2 == 0 and 2 * max(width, height) <= max_viewport(r.ctx)
-            and scene.view != "probe" and mesh is not None and mesh.lod_sphere is None and bool(mesh.parts)
-            and not scene.ground and not scene.debug_view
-            and all(len(part.indices) <= MAX_TRIANGLES for part in mesh.parts)
-            and not has_blending_parts(scene) and not transmissive_parts(scene))
+    tiled = image_size is not None and tuple(image_size) != (targets.width, targets.height)
+    size = f"the tile {width}x{height} of the {image_size[0]}x{image_size[1]} image" if tiled \
+        else f"the size {width}x{height}"
+    if width % 2 or height % 2:
+        return f"{size} is odd; the visibility buffer needs an even width and height"
+    if 2 * max(width, height) > max_viewport(r.ctx):
+        return f"{size} is over half of GL_MAX_VIEWPORT_DIMS ({max_viewport(r.ctx)})"
+    big = max(len(part.indices) for part in mesh.parts)
+    if big > MAX_TRIANGLES:
+        return f"a part has {big} triangles, over the visibility buffer's {MAX_TRIANGLES}"
+    return None
 
 
 def pixels_per_triangle(r, scene, view_projection: np.ndarray, image_size: tuple[int, int]) -> float | None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -42,6 +43,7 @@ def run(args) -> int:
         equirect_envs,
         run_chart,
         sweep,
+        why_missing,
     )
     from alight.accuracy.chart_visibility import QUICK_VISIBILITY_SCENES, VISIBILITY_SCENES, VisibilitySettings
     from alight.exchange.presets import list_presets
@@ -81,19 +83,26 @@ def run(args) -> int:
     print(f"{len(results)} settings x {len(envs)} environment(s) in {time.perf_counter() - start:.0f} s")
     print(f"{'setting':34s} {'bake ms':>8s} {'frame ms':>9s} {'relMAE %':>9s} {'max %':>7s} {'FLIP':>6s} "
           f"{'furnace r=1':>11s}")
+    notes = Notes()
     for res in results:
         fr = [f[1] for f in res.furnace if f[0] == 1.0]
-        print(f"{res.setting.name:34s} {res.bake_median * 1000:8.0f} {res.frame_seconds * 1000:9.1f} "
-              f"{res.rel_mean * 100:9.2f} {res.rel_max * 100:7.1f} {res.flip_mean:6.3f} "
-              f"{fr[0] if fr else float('nan'):11.3f}")
-    _print_visibility(out / "chart.csv")
+
+        def cell(value, spec, column, res=res):
+            return notes.cell(value, spec, lambda: why_missing(res, column))
+
+        print(f"{res.setting.name:34s} {cell(res.bake_median * 1000, '8.0f', 'bake')} "
+              f"{cell(res.frame_seconds * 1000, '9.1f', 'frame')} {cell(res.rel_mean * 100, '9.2f', 'rel')} "
+              f"{cell(res.rel_max * 100, '7.1f', 'rel')} {cell(res.flip_mean, '6.3f', 'flip')} "
+              f"{cell(fr[0] if fr else math.nan, '11.3f', 'furnace')}")
+    notes.print()
+    _print_visibility(out / "chart.csv", notes)
     for name in ("chart.csv", "chart_cases.csv", "furnace.csv", "error_map.csv", "chart.png", "error_map.png"):
         if (out / name).exists():
             print(out / name)
     return 0
 
 
-def _print_visibility(csv_path) -> None:
+def _print_visibility(csv_path, notes: "Notes") -> None:
     """The visibility rows of the chart just written (chart.csv: factor 'visibility')."""
     from alight.accuracy.chart import read_summary
 
@@ -102,10 +111,40 @@ def _print_visibility(csv_path) -> None:
         return
     print(f"{'visibility row':34s} {'bake ms':>8s} {'frame ms':>9s} {'relMAE %':>9s} {'max %':>7s} {'noise %':>8s} "
           f"drawn")
+    printed = len(notes.reasons)
     for r in rows:
-        print(f"{r['setting']:34s} {r['visibility_bake_ms']:8.0f} {r['frame_ms']:9.1f} {r['rel_mae_mean'] * 100:9.2f} "
-              f"{r['rel_mae_max'] * 100:7.1f} {r['ref_noise_mean'] * 100:8.2f} occlusion {r['occlusion']}, "
-              f"shadows {r['shadows']}")
+        def cell(value, spec, why="not measured"):
+            return notes.cell(value, spec, lambda: why)
+
+        bake_why = "no visibility bake: occlusion is off in this configuration" if r["occlusion"] == "off" \
+            else "not measured"
+        print(f"{r['setting']:34s} {cell(r['visibility_bake_ms'], '8.0f', bake_why)} {cell(r['frame_ms'], '9.1f')} "
+              f"{cell(r['rel_mae_mean'] * 100, '9.2f')} {cell(r['rel_mae_max'] * 100, '7.1f')} "
+              f"{cell(r['ref_noise_mean'] * 100, '8.2f')} occlusion {r['occlusion']}, shadows {r['shadows']}")
+    notes.print(printed)
+
+
+class Notes:
+    """The tables' missing values: 'n/a(k)' in the cell, and footnote k saying why, once per
+    reason (a NaN is never printed unexplained)."""
+
+    def __init__(self):
+        self.reasons: list[str] = []
+
+    def cell(self, value, spec: str, why) -> str:
+        """``value`` formatted by ``spec`` (e.g. '9.2f'), or 'n/a(k)' as wide, k the footnote of
+        ``why()``."""
+        if isinstance(value, (int, float)) and math.isfinite(value):
+            return format(value, spec)
+        reason = why()
+        if reason not in self.reasons:
+            self.reasons.append(reason)
+        return f"n/a({self.reasons.index(reason) + 1})".rjust(int(spec.split(".")[0]))
+
+    def print(self, start: int = 0) -> None:
+        """The footnotes from number ``start`` + 1 on (those under an earlier table printed)."""
+        for k, reason in enumerate(self.reasons[start:], start + 1):
+            print(f"  n/a({k}): {reason}")
 
 
 COMMAND = Command("chart", add_parser, run)

@@ -86,6 +86,7 @@ def run(args) -> int:
 
     renderer = ForwardRenderer()
     renderer.mesh_shading = args.mesh_shading
+    renderer.mesh_shading_option = "--mesh-shading"     # (its warning names the flag)
     if args.quality == "auto":
         quality = _auto_quality(args, scene, env)
         if quality is None:
@@ -103,8 +104,8 @@ def run(args) -> int:
         print(f"{describe(renderer.ctx)}\nload {loaded - start:.3f}s  bake {baked - loaded:.3f}s "
               f"render {done - baked - writing:.3f}s  write {writing:.3f}s", file=sys.stderr)
         # Which shading the mesh took (--mesh-shading auto decides per scene, alight.render.vbuffer).
-        print(f"mesh shading: {'vbuffer' if renderer.last_vbuffer else 'forward'} (--mesh-shading {args.mesh_shading})",
-              file=sys.stderr)
+        print(f"mesh shading: {'vbuffer' if renderer.last_vbuffer else 'forward'} (--mesh-shading {args.mesh_shading}: "
+              f"{renderer.last_mesh_shading_reason})", file=sys.stderr)
         if maps is not None:
             print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
                   file=sys.stderr)
