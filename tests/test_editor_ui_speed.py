@@ -31,3 +31,18 @@ def test_a_drag_made_during_a_busy_frame_turns_the_camera(display):
                             env=dict(os.environ, DISPLAY=display), capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert result.stdout.startswith("ok: turned"), result.stdout
+
+
+def test_the_first_orbit_of_a_material_is_compiled_away_from_the_frames(display, tmp_path):
+    """A real drag (XTest) starts the first orbit; its window-drawn variant is the warm-up
+    process's job, not the frame's, with an empty Mesa shader cache (tests/editor_x_events_first_orbit.py)."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, DISPLAY=display, MESA_SHADER_CACHE_DIR=str(tmp_path / "mesa"),
+               ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
+    result = subprocess.run([sys.executable, str(REPO / "tests" / "editor_x_events_first_orbit.py")], cwd=REPO,
+                            env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok:"), result.stdout

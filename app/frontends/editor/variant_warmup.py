@@ -15,6 +15,14 @@ compiles the new programs into the driver's cache and reports their keys. Those 
 gate afterwards, and the view draws the new picture, its compile now a cache read. Where the
 child cannot help (it fails, or the driver keeps no cache) the compile happens in the frame, as
 without this module.
+
+An orbiting view is drawn straight into the window (``draw_display``'s ``into``): another
+program (SRGB_BY_FRAMEBUFFER) and, on llvmpipe, other fragment code, generated for the window's
+framebuffer format. The child draws those jobs into a hidden window configured as the editor's
+(gl_window.py), so its cache entries are the window's; meanwhile the view draws the last picture
+into the view image, whose programs are compiled. (Without this, the first orbit of each new
+material took 0.7 s of the main thread's time with an empty Mesa cache, in the held-back
+frame's fallback: benchmarks/results/editor_stalls.md.)
 """
 
 from __future__ import annotations
@@ -39,6 +47,8 @@ class WarmupJob:
     out: str               # where the child writes the keys it compiled (a pickle)
     mesh_token: int = 0    # which mesh and environment these are (0: none): each is sent once, then named by token
     env_token: int = 0
+    direct: bool = False        # drawn straight into the window (draw_display's into), as the view was
+    direct_srgb: bool = False   # ... with the window's framebuffer encoding sRGB (into_encodes_srgb)
 
 
 class VariantWarmup:
@@ -50,6 +60,7 @@ class VariantWarmup:
         self._job_id = None
         self._job_trigger = None   # the key that started the job
         self._warm: set = set()    # program keys the child compiled (or that may compile here)
+        self.drawn_by_child: set = set()   # program keys the child compiled (tests read it)
         self.jobs = 0              # warm-ups asked of the child (tests read it)
         self.held = 0              # draws held back for a program not compiled yet
         self._sent = (None, None)  # the tokens of the mesh and environment the child has
@@ -63,9 +74,10 @@ class VariantWarmup:
     def gate(self, key) -> bool:
         return key in self._warm
 
-    def request(self, win, exc, scene, maps, size) -> None:
+    def request(self, win, exc, scene, maps, size, direct: bool = False, direct_srgb: bool = False) -> None:
         """A draw of ``scene`` was held back for ``exc.key``: start the child's draw of it
-        (unless one runs: the draw after it asks again for what it did not compile)."""
+        (unless one runs: the draw after it asks again for what it did not compile).
+        ``direct``, ``direct_srgb``: the view's draw went straight into the window (sRGB-encoding)."""
         self.held += 1
         if self._job_id is not None:
             return
@@ -83,7 +95,8 @@ class VariantWarmup:
         job = WarmupJob(scene=scene if send_mesh else dataclasses.replace(scene, mesh=None),
                         env=env if send_env else None,
                         quality=maps.quality if maps is not None else None, size=tuple(size),
-                        aa=win.state.aa, out=str(out), mesh_token=mesh_token, env_token=env_token)
+                        aa=win.state.aa, out=str(out), mesh_token=mesh_token, env_token=env_token,
+                        direct=direct, direct_srgb=direct_srgb)
         self._job_id, self._job_trigger, self._out = self._worker.submit(job), exc.key, out
         self.jobs += 1
 
@@ -98,7 +111,9 @@ class VariantWarmup:
             if word == "done":
                 try:
                     with open(self._out, "rb") as f:
-                        self._warm.update(pickle.load(f))
+                        keys = pickle.load(f)
+                    self._warm.update(keys)
+                    self.drawn_by_child.update(keys)
                 except (OSError, pickle.UnpicklingError, EOFError):
                     pass
                 self._out.unlink(missing_ok=True)
@@ -120,7 +135,9 @@ class VariantWarmup:
 def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
     """``renderer.draw_display`` of the view, with the gate when ``gated``: a program not
     compiled yet is handed to the child and the last complete picture's scene is drawn instead
-    (with this frame's camera, unless the mesh changed: then with its own). Returns (the framebuffer drawn into, whether it is ``scene``)."""
+    (with this frame's camera, unless the mesh changed: then with its own). Returns (the
+    framebuffer drawn into, whether it is ``scene``); (None, False) where nothing could be drawn
+    without a compile and the window's last view image (``last_view_image``) is to be shown again."""
     from alight.core.gpu import ProgramPending
 
     renderer, warmup = win.renderer, win.variant_warmup
@@ -137,15 +154,44 @@ def draw_view(win, scene, maps, targets, into, into_srgb, gated: bool):
         win._last_complete_scene, warmup.showing_old = scene, False
         return drawn, True
     except ProgramPending as exc:
-        warmup.request(win, exc, scene, maps, (targets.width, targets.height))
+        warmup.request(win, exc, scene, maps, (targets.width, targets.height),
+                       direct=into is not None, direct_srgb=into_srgb)
     finally:
         renderer.shaders.gate = None
+    if into is not None:
+        # Only the window's variant missing (a first orbit): the scene itself into the view
+        # image, whose programs the still view compiled, while the child draws the window's.
+        renderer.shaders.gate = warmup.gate
+        try:
+            drawn = renderer.draw_display(scene, maps, targets)
+            win._last_complete_scene, warmup.showing_old = scene, False
+            return drawn, True
+        except ProgramPending:
+            pass
+        finally:
+            renderer.shaders.gate = None
     if old.mesh is scene.mesh:
         # The same mesh: the last look follows the orbit. A new mesh's camera frames the new
         # mesh; the old mesh seen from it was the trial's "helmet turned to the shader ball's
         # 3/4 view", so the last picture stays as it was until the new one is ready.
         old = dataclasses.replace(old, camera=scene.camera)
     warmup.showing_old = True
+    # The last picture where its programs are compiled: into the window if it was drawn there,
+    # else into the view image (a first orbit: the window's variants are the child's job now).
+    renderer.shaders.gate = warmup.gate
+    try:
+        for target, srgb in ((into, into_srgb), (None, False)) if into is not None else ((None, False),):
+            try:
+                return renderer.draw_display(old, maps, targets, into=target, into_encodes_srgb=srgb), False
+            except ProgramPending:
+                continue
+    finally:
+        renderer.shaders.gate = None
+    if getattr(win, "last_view_image", lambda: None)() is not None:
+        # Neither (an orbit that reaches a view whose programs differ, as the built-in sphere's
+        # background ring): the view image drawn last is shown again (render_view), a few degrees
+        # behind the hand until the child is done, rather than a compile in this frame.
+        return None, False
     return renderer.draw_display(old, maps, targets, into=into, into_encodes_srgb=into_srgb), False
 
 
@@ -156,7 +202,12 @@ def main() -> int:
     from alight.render.renderer import ForwardRenderer
     from alight.render.targets import Targets
 
-    renderer = ForwardRenderer()
+    from alight.frontends.editor.gl_window import hidden_window_context
+
+    # A hidden window as the editor's (where a display is), for the view's moving frames; its
+    # context serves the offscreen draws too (the same llvmpipe, the same shader cache).
+    window = hidden_window_context()
+    renderer = ForwardRenderer(window[1] if window is not None else None)
     targets = {}
     have = {"mesh": (None, None), "env": (None, None)}   # token -> the object last sent
 
@@ -179,7 +230,8 @@ def main() -> int:
                 t.release()
             targets.clear()
             targets[key] = Targets(renderer.ctx, job.size[0], job.size[1], job.aa, 4)
-        renderer.draw_display(scene, maps, targets[key])
+        into = renderer.ctx.screen if job.direct and window is not None else None
+        renderer.draw_display(scene, maps, targets[key], into=into, into_encodes_srgb=job.direct_srgb and into is not None)
         renderer.ctx.finish()   # the first draw's code generation happens by here
         # Mesa writes its shader disk cache from a thread of its own: a moment for the entries
         # to be on disk when the editor compiles the same programs.

@@ -23,6 +23,7 @@ import os
 import time
 
 from alight.core.gpu import ShaderCompileError
+from alight.frontends.editor.gl_window import set_window_hints
 from alight.frontends.editor.variant_warmup import draw_view
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
@@ -122,12 +123,7 @@ class EditorWindow:
         """Our own glfw window with an OpenGL 4.5 core context, current on this thread."""
         if not glfw.init():
             raise AlightError("editor: cannot open a window (no display? set DISPLAY, or run under xvfb-run -a)")
-        glfw.window_hint(glfw.CONTEXT_VERSION_MAJOR, 4)
-        glfw.window_hint(glfw.CONTEXT_VERSION_MINOR, 5)
-        glfw.window_hint(glfw.OPENGL_PROFILE, glfw.OPENGL_CORE_PROFILE)
-        glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
-        glfw.window_hint(glfw.DEPTH_BITS, 24)   # moving views are drawn straight into the window (render_view)
-        glfw.window_hint(glfw.SRGB_CAPABLE, True)   # ... and sRGB-encoded by it (_screen_encodes_srgb)
+        set_window_hints(glfw)   # (gl_window.py: the variant warm-up's hidden window has the same)
         self.window = glfw.create_window(size[0], size[1], title, None, None)
         self._size_cache: tuple[tuple[int, int], tuple[int, int]] | None = None   # _sizes
         if not self.window:
@@ -559,6 +555,12 @@ class EditorWindow:
             self._target_cache.popitem(last=False)[1].release()
         return targets
 
+    def last_view_image(self):
+        """The targets the view was last drawn into as an image (not straight into the window),
+        while still in the cache (their display image then holds that picture), else None."""
+        image = getattr(self, "_view_image", None)
+        return image if image is not None and any(t is image for t in self._target_cache.values()) else None
+
     def new_targets(self, size, aa):
         """Framebuffers of their own for an image of the view's kind (the compare view's half A),
         outside the view's cache."""
@@ -632,8 +634,14 @@ class EditorWindow:
                 self.state.fail(exc)
                 self.state.debug_view = 0
                 return None
-            self._drawn_key, self._drawn_targets = (None, None) if direct else \
-                (key or self._view_key(scene, maps, size), targets)
+            if drawn_into is None:   # every program waits for the warm-up: the last view image again
+                targets = self.last_view_image()
+                size, into, self._drawn_key, self._drawn_targets = (targets.width, targets.height), None, None, None
+            else:
+                self._drawn_key, self._drawn_targets = (None, None) if direct else \
+                    (key or self._view_key(scene, maps, size), targets)
+                if not direct:
+                    self._view_image = targets
             self.redraws += 1
             if scene.texture_maps != self._drawn_maps:   # uploaded maps no slot uses any more
                 # (compare's A keeps the maps of its snapshot)

@@ -1,0 +1,94 @@
+"""The first orbit of a material, as real X events (XTest) under Xvfb: run by
+tests/test_editor_ui_speed.py in a fresh interpreter with an empty Mesa shader cache; exits 0
+when it passes, 1 with a line saying what happened.
+
+An orbiting view is drawn straight into the window, with another program and (llvmpipe) other
+fragment code than the still view's. Its first orbit must not compile that in the editor's
+frames: the warm-up process draws it into a hidden window like the editor's
+(variant_warmup.py, gl_window.py) while the view shows the last picture, and the editor's own
+compile comes after, a read of the shader cache."""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import sys
+
+
+def main() -> int:
+    from alight.frontends.editor.state import EditorState
+    from alight.frontends.editor.window import EditorWindow
+
+    x11 = ctypes.CDLL(ctypes.util.find_library("X11"))
+    xtst = ctypes.CDLL(ctypes.util.find_library("Xtst") or "libXtst.so.6")
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XSync.argtypes = [ctypes.c_void_p, ctypes.c_int]
+    xtst.XTestFakeMotionEvent.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_ulong]
+    xtst.XTestFakeButtonEvent.argtypes = [ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_ulong]
+    display = x11.XOpenDisplay(None)
+
+    state = EditorState()
+    state.load_mesh("sphere")
+    state.load_env("studio")
+    win = EditorWindow(state, (640, 400))
+    warm, shaders = win.variant_warmup, win.renderer.shaders
+    try:
+        if win.direct_target()[0] is None:
+            print("ok: skipped (the window has no depth buffer: orbits are drawn into the view image)")
+            return 0
+        glfw = win.glfw
+        glfw.set_window_pos(win.window, 0, 0)
+        glfw.focus_window(win.window)
+        # The view settles first, as before an artist's drag: the opening camera's ease-in done,
+        # the still view's programs compiled (the warm-up's jobs where gated), its image drawn.
+        for _ in range(600):
+            win.frame()
+            if (not warm.pending and not warm.showing_old and win._drawn_targets is not None
+                    and win.orbit.camera() == win._last_camera):
+                break
+        x0, y0 = glfw.get_window_pos(win.window)
+        start = (x0 + (win.size[0] - win.panel_width()) // 4, y0 + 200)
+        xtst.XTestFakeMotionEvent(display, -1, start[0], start[1], 0)
+        x11.XSync(display, 0)
+        for _ in range(3):
+            win.frame()
+        before, jobs = set(shaders.compiled_keys()), warm.jobs
+        xtst.XTestFakeButtonEvent(display, 1, 1, 0)
+        x11.XSync(display, 0)
+        compiled_in_frame, frames, step, settled = [], 0, 0, False
+        # The hand keeps dragging, a motion a frame, until the view is drawn into the window.
+        while frames < 600:
+            step += 1
+            xtst.XTestFakeMotionEvent(display, -1, start[0] + (step % 40) * 4, start[1], 0)
+            x11.XSync(display, 0)
+            win.frame()
+            frames += 1
+            new = set(shaders.compiled_keys()) - before
+            # Every program the orbit compiles in a frame was drawn by the warm-up process first.
+            compiled_in_frame.extend(sorted(str(k) for k in new - warm.drawn_by_child))
+            before |= new
+            settled = warm.jobs > jobs and not warm.pending and not warm.showing_old
+            if settled:
+                break
+        xtst.XTestFakeButtonEvent(display, 1, 0, 0)
+        x11.XSync(display, 0)
+        win.frame()
+        if warm.jobs == jobs:
+            print("the first orbit asked the warm-up process for nothing (its program was compiled in the frame, "
+                  "or the view was not drawn into the window)")
+            return 1
+        if compiled_in_frame:
+            print(f"a program the warm-up process had not drawn was compiled in the editor's frame: {compiled_in_frame[0]}")
+            return 1
+        if not settled:
+            print(f"the orbit still waited for the warm-up after {frames} frames")
+            return 1
+        print(f"ok: {warm.jobs - jobs} warm-up job(s), the orbit drawn into the window after {frames} frames")
+        return 0
+    finally:
+        win.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
