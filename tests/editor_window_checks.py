@@ -357,6 +357,20 @@ def test_orbiting_frame_in_the_window_matches_the_still_view(window):
             .reshape(h, w, 3).astype(int)
 
     window.frame()
+    # The window's own variants are drawn first by the warm-up process (variant_warmup.py), the
+    # view meanwhile drawn into its image: orbit to and fro until they are compiled here.
+    import time
+
+    for _ in range(600):
+        window.orbit.orbit(7.0, 3.0)
+        window.frame()
+        window.orbit.orbit(-7.0, -3.0)
+        window.frame()
+        if not window.variant_warmup.pending and not window.variant_warmup.showing_old \
+                and window._drawn_key is None:
+            break
+        time.sleep(0.02)
+    window.frame()
     window.orbit.orbit(7.0, 3.0)
     drawn = window.redraws
     window.draw()                                       # moving: into the window, sRGB by the window
