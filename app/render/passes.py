@@ -44,6 +44,7 @@ from alight.render.sphere_impostor import impostor_placement, lod_parts, proxy_p
 from alight.render.targets import Targets, View, read_tile
 from alight.render.tiles import TilePlan, tile_matrix, tile_origin
 from alight.render.variants import (
+    alpha_to_coverage,
     background_mode,
     blends,
     has_blending_parts,
@@ -451,6 +452,7 @@ def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_pr
                     variant["SPHERE_SURFACE"] = None
                 if proxy_model is not None:
                     variant["SPHERE_IMPOSTOR"] = frame.impostor_samples
+                alpha_to_coverage(variant, ctx)
                 program = prog(variant)
             else:
                 program = prog

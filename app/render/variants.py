@@ -254,3 +254,13 @@ def background_mode(scene, maps: IBLMaps | None) -> BackgroundMode:
     if mode in (BackgroundMode.ENV, BackgroundMode.BLUR) and maps is None:
         return BackgroundMode.TRANSPARENT
     return mode
+
+
+def alpha_to_coverage(variant: dict, ctx) -> dict:
+    """An alphaMode MASK part drawn into a multisampled framebuffer tests its alpha per sample
+    (ALPHA_TO_COVERAGE = the sample count: common/mesh_material.glsl alpha_coverage_mask), so the
+    cutoff's edges are antialiased as a triangle's are; single-sampled, the plain test."""
+    samples = getattr(ctx.fbo, "samples", 0) or 0
+    if variant.get("ALPHA_MODE") == int(AlphaMode.MASK) and samples > 1:
+        variant["ALPHA_TO_COVERAGE"] = int(samples)
+    return variant

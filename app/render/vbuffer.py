@@ -51,7 +51,8 @@ from alight.core.shader_names import DEBUG_VIEWS, AlphaMode
 from alight.core.texture_maps import TextureMaps
 from alight.render.bindings import UNIT_VISIBILITY, set_uniform
 from alight.render.part_bindings import _bind_view, bind_part, set_culling
-from alight.render.variants import has_blending_parts, part_defines, transmissive_parts, user_maps_present
+from alight.render.variants import (alpha_to_coverage, has_blending_parts, part_defines, transmissive_parts,
+                                    user_maps_present)
 
 MESH_SHADING = ("auto", "forward", "vbuffer")   # ForwardRenderer.mesh_shading
 # "auto" takes the visibility buffer where the mesh has fewer estimated covered pixels per
@@ -273,7 +274,8 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
         for index, ((gpu_part, part), variant) in enumerate(zip(parts, variants)):
             masked = variant.get("ALPHA_MODE") == int(AlphaMode.MASK)
             # An opaque part needs nothing of its material here: one program for all of them.
-            program = r.program("render/pbr.vert", "render/vbuffer.frag", variant if masked else None)
+            program = r.program("render/pbr.vert", "render/vbuffer.frag",
+                                alpha_to_coverage(dict(variant), ctx) if masked else None)
             if id(program) not in prepared:
                 prepared.add(id(program))
                 _bind_view(program, ctx, frame, camera, view_projection, model, None, False)

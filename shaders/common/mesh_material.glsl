@@ -332,6 +332,21 @@ float material_alpha() {
     return material_base_color().a;
 }
 
+#ifdef ALPHA_TO_COVERAGE
+// alphaMode MASK under MSAA: the samples the alpha test keeps, as a gl_SampleMask word. Sharpened
+// alpha to coverage (Golus, "Anti-aliased Alpha Test: The Esoteric Alpha To Coverage", 2017): the
+// distance past the cutoff in units of alpha's change over one pixel (fwidth) picks how many of
+// the ALPHA_TO_COVERAGE samples are covered, so the cutoff's edge is resolved to one pixel
+// across as a triangle's edge is, and a pixel wholly past it keeps every sample (the plain test).
+// In the shader, not GL's SAMPLE_ALPHA_TO_COVERAGE: the visibility buffer's integer target skips
+// that (GL 4.5 section 17.3.3), and both passes must keep the same samples.
+int alpha_coverage_mask(float alpha) {
+    float past = clamp((alpha - u_alpha_cutoff) / max(fwidth(alpha), 1e-4) + 0.5, 0.0, 1.0);
+    int kept = int(past * float(ALPHA_TO_COVERAGE) + 0.5);
+    return (1 << kept) - 1;
+}
+#endif
+
 // The material at this fragment; n is shading_normal() (the layers' directions are built about it).
 Surface material_surface(vec3 n) {
     Surface s = surface_base(material_base_color().rgb, u_metallic, u_roughness, u_specular_f0, u_emissive, 1.0);

@@ -1,7 +1,8 @@
 #version 450 core
 // Forward PBR pass: a mesh with the metal-roughness material (factors times glTF textures).
 // ALPHA_MODE (glTF 2.0 material.alphaMode; app/core/shader_names.py AlphaMode): unset or OPAQUE
-// (alpha ignored, written as 1), MASK (fragments below the cutoff discarded), BLEND (alpha
+// (alpha ignored, written as 1), MASK (fragments below the cutoff discarded; under MSAA,
+// ALPHA_TO_COVERAGE = the sample count: the samples kept by alpha_coverage_mask), BLEND (alpha
 // written; the renderer blends).
 // UNLIT (KHR_materials_unlit): the base colour is the radiance.
 // SPHERE_IMPOSTOR: the built-in sphere's proxy, coverage per pixel (common/mesh_material.glsl).
@@ -20,7 +21,13 @@ void main() {
 #if defined(ALPHA_MODE) && ALPHA_MODE != ALPHA_MODE_OPAQUE
     float alpha = material_alpha();
 #if ALPHA_MODE == ALPHA_MODE_MASK
+#ifdef ALPHA_TO_COVERAGE
+    int kept_samples = alpha_coverage_mask(alpha);
+    if (kept_samples == 0) discard;
+    gl_SampleMask[0] = kept_samples;
+#else
     if (alpha < u_alpha_cutoff) discard;
+#endif
     alpha = 1.0;
 #endif
 #else

@@ -15,7 +15,13 @@ layout(location = 0) out uvec2 out_id;
 
 void main() {
 #if defined(ALPHA_MODE) && ALPHA_MODE == ALPHA_MODE_MASK
+#ifdef ALPHA_TO_COVERAGE
+    int kept_samples = alpha_coverage_mask(material_alpha());   // (the forward pass's samples)
+    if (kept_samples == 0) discard;
+    gl_SampleMask[0] = kept_samples;
+#else
     if (material_alpha() < u_alpha_cutoff) discard;
+#endif
 #endif
     out_id = uvec2(uint(gl_PrimitiveID) + 1u, u_part);
 }
