@@ -333,7 +333,7 @@ def occlusion_statistic(parts, samples: int = AUTO_SAMPLES, rays: int = AUTO_RAY
     area = 0.5 * np.linalg.norm(cross, axis=1)
     if area.sum() <= 0.0:
         return 0.0
-    occluders = _Occluders(triangles, one_way=np.concatenate([np.full(len(p.indices), single_sided(p)) for p in parts]))
+    occluders = _Occluders(triangles, one_way=np.concatenate([np.full(len(np.asarray(p.indices).reshape(-1, 3)), single_sided(p)) for p in parts]))
     rng = np.random.default_rng(seed)
     pick = rng.choice(len(triangles), samples, p=area / area.sum())
     a, b = rng.random(samples), rng.random(samples)
