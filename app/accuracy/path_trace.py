@@ -390,12 +390,14 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
 class _Rays:
     """Embree's scene, queried in float32 for hits and shadow rays. Single-sided triangles
     (``geom.one_way``) are one-way: a camera ray passes the ones it meets from behind (the camera
-    pass culls their back faces); every other ray (shadow rays, the paths' bounces) passes the
-    ones it meets from the front, so that light coming back along it, which meets their back,
-    goes through (a shadow map culls the faces turned away from its light; the occlusion bake's
-    rays do the same: alight.core.visibility._cast)."""
+    pass culls their back faces); for every other ray (shadow rays, the paths' bounces) they stop
+    light only where it meets their front, as a shadow map culling the faces turned away from its
+    light draws them: a ray from a surface that meets one's front is not stopped by it (the light
+    coming back along the ray meets its back). The occlusion bake's rays do the same
+    (alight.core.visibility._cast): a bounce that is stopped sees the first surface it met (a
+    closed part's near wall), one that is not escapes."""
 
-    def __init__(self, geom: _Geometry, eps: float = 0.0):
+    def __init__(self, geom: _Geometry):
         rtcore_scene, TriangleMesh = _import_embree()
         self.scene = rtcore_scene.EmbreeScene()
         tris = np.stack([geom.v0, geom.v0 + geom.e1, geom.v0 + geom.e2], axis=1).astype(np.float32)
@@ -403,7 +405,7 @@ class _Rays:
         one_way = geom.one_way
         self.one_way = one_way if one_way is not None and one_way.any() else None
         self.ng = geom.ng
-        self.eps = eps if eps > 0.0 else 1e-5 * geom.scale
+        self.eps = 1e-5 * geom.scale
 
     def _run(self, origins, dirs):
         out = self.scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(dirs, np.float32),
@@ -414,32 +416,40 @@ class _Rays:
         t, u, v = (np.asarray(out[k], np.float64) for k in ("tfar", "u", "v"))
         return prim, t, u, v
 
-    def hit(self, origins, dirs, camera: bool = False, passes: int = 8):
-        """Triangle index (-1: none), distance, barycentrics u, v of each ray; ``camera``: the
-        rays are the camera's (which single-sided faces they pass: the class's docstring). A ray
-        still on a one-way face after ``passes`` re-casts stops there."""
+    def hit(self, origins, dirs, camera=False, seen: bool = True, passes: int = 8):
+        """Triangle index (-1: none), distance, barycentrics u, v of each ray. ``camera`` (one
+        bool, or one per ray): the rays are the camera's; the others, with ``seen``, report the
+        first surface they meet where the light is stopped (a bounce), without it what stops the
+        light (a shadow ray): the class's docstring. A ray still on a one-way face after
+        ``passes`` re-casts stops there."""
         prim, t, u, v = self._run(origins, dirs)
         if self.one_way is None:
             return prim, t, u, v
         origins = np.asarray(origins, np.float64)
         dirs = np.asarray(dirs, np.float64)
+        camera = np.broadcast_to(np.asarray(camera, bool), (len(prim),))
+        first = (prim.copy(), t.copy(), u.copy(), v.copy())
         for _ in range(passes):
             hit = np.flatnonzero(prim >= 0)
             facing = np.einsum("ij,ij->i", dirs[hit], self.ng[prim[hit]])
-            skip = self.one_way[prim[hit]] & ((facing > 0.0) if camera else (facing < 0.0))
+            skip = self.one_way[prim[hit]] & np.where(camera[hit], facing > 0.0, facing < 0.0)
             again = hit[skip]
             if not len(again):
                 break
-            start = t[again] + self.eps
+            start = t[again] + 0.05 * self.eps   # (a thin part's far side may lie closer than eps)
             p2, t2, u2, v2 = self._run(origins[again] + dirs[again] * start[:, None], dirs[again])
-            prim[again], t[again], u[again], v[again] = p2, np.where(p2 >= 0, t2 + start, t2), u2, v2
+            prim[again], t[again], u[again], v[again] = p2, t2 + start, u2, v2
+        if seen:
+            keep = ~camera & (prim >= 0)
+            for now, was in zip((prim, t, u, v), first):
+                now[keep] = was[keep]
         return prim, t, u, v
 
     def blocked(self, origins, dirs, dists):
         """True where something lies between each origin and its distance along dir."""
         if len(origins) == 0:
             return np.zeros(0, bool)
-        prim, t, _, _ = self.hit(origins, dirs)
+        prim, t, _, _ = self.hit(origins, dirs, seen=False)
         return (prim >= 0) & (t < dists)
 
     def transmittance(self, origins, dirs, dists, through, eps: float, walls: int = 8):
@@ -451,7 +461,7 @@ class _Rays:
         for _ in range(walls):
             if len(todo) == 0:
                 break
-            prim, t, _, _ = self.hit(o[todo], dirs[todo])
+            prim, t, _, _ = self.hit(o[todo], dirs[todo], seen=False)
             hit = (prim >= 0) & (t < left[todo])
             out[todo[hit]] *= through[prim[hit]]
             go = hit & (out[todo] > 0.0)
@@ -557,7 +567,9 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
         alive = np.arange(len(pix))
         prev_pdf = None   # the BRDF pdf of the ray that led here (None: the camera ray)
         for bounce in range(settings.max_bounces if settings.visibility else 1):
-            prim, dist, bu, bv = rays.hit(origin, direction, camera=bounce == 0)
+            # camera rays: the first, and those gone straight on through thin walls (pdf inf)
+            prim, dist, bu, bv = rays.hit(origin, direction,
+                                          camera=True if prev_pdf is None else np.isinf(prev_pdf))
             miss = prim < 0
             if bounce == 0:
                 np.add.at(cover, pix[alive[~miss]], 1.0)

@@ -66,11 +66,12 @@ DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
 WELD_CREASE_DEG = 30.0   # welded: copies of a vertex further than this from their mean normal stay apart
-BAKE_VERSION = 7   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
+BAKE_VERSION = 8   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
                    # 5: vertices covered by a part take their open neighbours' values;
                    # 6: a vertex's copies share V, the bent normal and the bounce (_copies_averaged);
-                   # 7: single-sided parts let light through from their back (_cast's one_way)
-# A ray passes at most this many single-sided faces met from the front (_cast's one_way).
+                   # 7, 8: single-sided parts let light through from their back (_cast's one_way; 8: a
+                   # stopped ray reports the first surface it met)
+# A ray goes on past at most this many single-sided faces met from the front (_cast's one_way).
 ONE_WAY_PASSES = 4
 # Refinement keeps a split only where the midpoint's value is not the edge's linear interpolation.
 INTERPOLATION_TEST = True
@@ -539,27 +540,50 @@ def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2, one_way=Non
     """First hits (triangle index, -1 for none; Embree's barycentric u, v). A ray that starts on
     or just behind a triangle (its own, or a wall its vertex stands against) and leaves through
     it in the direction of its normal hits it at t ~ 0: such hits are skipped by casting again
-    from just past them. ``one_way`` (T,) bool: the triangles of single-sided parts
-    (alight.core.mesh.single_sided), which stop a ray only where it meets their back: the light
-    coming back along the ray meets their front, as a shadow map that culls the faces turned away
-    from the light draws them. A ray meeting one's front goes on from just past it (up to
-    ONE_WAY_PASSES such faces; past that it counts as stopped)."""
-    if one_way is not None and one_way.any():
-        retries += ONE_WAY_PASSES
-    else:
-        one_way = None
+    from just past them.
+
+    ``one_way`` (T,) bool: the triangles of single-sided parts (alight.core.mesh.single_sided),
+    which stop light only where it meets their front, as a shadow map that culls the faces turned
+    away from the light draws them: a ray (from the receiver) that meets one's front is not
+    stopped by it, the light coming back along the ray meeting its back. Such a ray goes on from
+    just past it (up to ONE_WAY_PASSES faces; past that it counts as stopped). A ray that is
+    stopped reports its first hit all the same (what the vertex sees there: a closed part's near
+    wall, though its far wall is what stops the light), one that is not reports none."""
+    prim, tfar, u, v = _first_hits(scene, origins, dirs, face_normals, eps, retries)
+    if one_way is None or not one_way.any():
+        return prim, u, v
+    # Rays on a one-way face met from the front: on past it, to whatever stops the light.
+    stop = prim.copy()
+    far = tfar.copy()
+    for _ in range(ONE_WAY_PASSES):
+        hit = np.nonzero(stop >= 0)[0]
+        passing = one_way[stop[hit]] & (np.einsum("ij,ij->i", dirs[hit], face_normals[stop[hit]]) < 0.0)
+        again = hit[passing]
+        if not len(again):
+            break
+        # From just past the face (a twentieth of eps: a thin part's far side may be closer than eps)
+        o2 = np.ascontiguousarray(origins[again] + dirs[again] * (far[again, None] + 0.05 * eps))
+        # (no t ~ 0 skip past a face: a back face that close is a thin part's far side, not a
+        # wall the origin stands against)
+        p2, t2, _, _ = _first_hits(scene, o2, np.ascontiguousarray(dirs[again]), face_normals, eps, 0)
+        stop[again] = p2
+        far[again] = t2 + far[again] + 0.05 * eps
+    free = stop < 0
+    prim[free] = -1
+    return prim, u, v
+
+
+def _first_hits(scene, origins, dirs, face_normals, eps, retries: int):
+    """``_cast``'s first hits without the one-way faces: (triangle, distance, u, v)."""
     out = scene.run(origins, dirs, output=1)
     prim = np.where(np.asarray(out["geomID"]) < 0, -1, np.asarray(out["primID"])).astype(np.int32)
-    tfar = np.asarray(out["tfar"], np.float32)
+    tfar = np.asarray(out["tfar"], np.float32).copy()
     u = np.asarray(out["u"], np.float32).copy()
     v = np.asarray(out["v"], np.float32).copy()
     for _ in range(retries):
         hit = prim >= 0
         self_hit = np.zeros(len(prim), bool)
-        facing = np.einsum("ij,ij->i", dirs[hit], face_normals[prim[hit]])
-        self_hit[hit] = (tfar[hit] < 4.0 * eps) & (facing > 0.0)
-        if one_way is not None:
-            self_hit[hit] |= one_way[prim[hit]] & (facing < 0.0)
+        self_hit[hit] = (tfar[hit] < 4.0 * eps) & (np.einsum("ij,ij->i", dirs[hit], face_normals[prim[hit]]) > 0.0)
         if not self_hit.any():
             break
         again = np.nonzero(self_hit)[0]
@@ -569,7 +593,7 @@ def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2, one_way=Non
         tfar[again] = np.asarray(out["tfar"], np.float32) + tfar[again] + eps
         u[again] = out["u"]
         v[again] = out["v"]
-    return prim, u, v
+    return prim, tfar, u, v
 
 
 def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.ndarray:
