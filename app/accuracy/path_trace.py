@@ -329,9 +329,9 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
 
     mesh = scene.mesh
     warnings: list[str] = []
-    corners, normals, mats, sided, table = [], [], [], [], {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0",
-                                                                           "emissive", "through", "clearcoat",
-                                                                           "clearcoat_roughness")}
+    corners, normals, mats, sided = [], [], [], []
+    table = {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0", "emissive", "through", "clearcoat",
+                             "clearcoat_roughness")}
     # The user's maps (--map, --texture-set) are left out as a file's are.
     textured = bool(getattr(scene, "texture_maps", None))
     layered = masked = False

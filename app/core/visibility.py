@@ -334,7 +334,8 @@ def occlusion_statistic(parts, samples: int = AUTO_SAMPLES, rays: int = AUTO_RAY
     area = 0.5 * np.linalg.norm(cross, axis=1)
     if area.sum() <= 0.0:
         return 0.0
-    occluders = _Occluders(triangles, one_way=np.concatenate([np.full(len(np.asarray(p.indices).reshape(-1, 3)), single_sided(p)) for p in parts]))
+    one_way = np.concatenate([np.full(len(np.asarray(p.indices).reshape(-1, 3)), single_sided(p)) for p in parts])
+    occluders = _Occluders(triangles, one_way=one_way)
     rng = np.random.default_rng(seed)
     pick = rng.choice(len(triangles), samples, p=area / area.sum())
     a, b = rng.random(samples), rng.random(samples)
@@ -940,7 +941,8 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     all_n = all_n / np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
     all_f = np.concatenate([f + o for (_, _, f), o in zip(state, offsets[:-1])])
     all_values = np.concatenate(values).astype(np.float32)
-    refined = _Occluders(all_p[all_f], one_way=np.concatenate([np.full(len(f), s) for (_, _, f), s in zip(state, sided)]))
+    refined = _Occluders(all_p[all_f],
+                         one_way=np.concatenate([np.full(len(f), s) for (_, _, f), s in zip(state, sided)]))
     origins = np.concatenate([_origins(d[:, :3], all_n[a:b], f, eps)
                               for (d, _, f), a, b in zip(state, offsets[:-1], offsets[1:])])
     hit, uv, _ = refined.hemisphere(origins, all_n.astype(np.float32), bounce_rays, rng, eps)
