@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from alight.core.layers.clearcoat import clearcoat_fresnel
+from alight.core.mesh import single_sided
 from alight.core.shading import (
     D_GGX,
     MIN_N_DOT_V,
@@ -318,6 +319,7 @@ class _Geometry:
     material: np.ndarray    # (M,) index into the material table
     table: dict             # name -> (K, ...) arrays: base, metallic, roughness, f0, emissive
     scale: float            # the scene's size, for ray offsets
+    one_way: np.ndarray | None = None   # (M,) bool: single-sided triangles (alight.core.mesh.single_sided)
 
 
 def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
@@ -327,9 +329,9 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
 
     mesh = scene.mesh
     warnings: list[str] = []
-    corners, normals, mats, table = [], [], [], {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0",
-                                                                           "emissive", "through", "clearcoat",
-                                                                           "clearcoat_roughness")}
+    corners, normals, mats, sided = [], [], [], []
+    table = {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0", "emissive", "through", "clearcoat",
+                             "clearcoat_roughness")}
     # The user's maps (--map, --texture-set) are left out as a file's are.
     textured = bool(getattr(scene, "texture_maps", None))
     layered = masked = False
@@ -351,6 +353,7 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
         corners.append(pos[tri])
         normals.append(np.asarray(part.normals, np.float64)[tri])
         mats.append(np.full(len(tri), index, np.int64))
+        sided.append(np.full(len(tri), single_sided(part)))
         table["base"].append(m.base_color)
         table["metallic"].append(m.metallic)
         r = float(m.roughness)
@@ -380,21 +383,31 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     geom = _Geometry(v0=v0[keep], e1=(v1 - v0)[keep], e2=(v2 - v0)[keep], normals=np.concatenate(normals)[keep],
                      ng=_normalize(ng[keep]), material=np.concatenate(mats)[keep],
                      table={k: np.asarray(v, np.float64) for k, v in table.items()},
-                     scale=float(max(np.linalg.norm(hi - lo), 1e-6)))
+                     scale=float(max(np.linalg.norm(hi - lo), 1e-6)), one_way=np.concatenate(sided)[keep])
     return geom, warnings
 
 
 class _Rays:
-    """Embree's scene, queried in float32 for hits and shadow rays."""
+    """Embree's scene, queried in float32 for hits and shadow rays. Single-sided triangles
+    (``geom.one_way``) are one-way: a camera ray passes the ones it meets from behind (the camera
+    pass culls their back faces); for every other ray (shadow rays, the paths' bounces) they stop
+    light only where it meets their front, as a shadow map culling the faces turned away from its
+    light draws them: a ray from a surface that meets one's front is not stopped by it (the light
+    coming back along the ray meets its back). The occlusion bake's rays do the same
+    (alight.core.visibility._cast): a bounce that is stopped sees the first surface it met (a
+    closed part's near wall), one that is not escapes."""
 
     def __init__(self, geom: _Geometry):
         rtcore_scene, TriangleMesh = _import_embree()
         self.scene = rtcore_scene.EmbreeScene()
         tris = np.stack([geom.v0, geom.v0 + geom.e1, geom.v0 + geom.e2], axis=1).astype(np.float32)
         self._mesh = TriangleMesh(scene=self.scene, vertices=tris)
+        one_way = geom.one_way
+        self.one_way = one_way if one_way is not None and one_way.any() else None
+        self.ng = geom.ng
+        self.eps = 1e-5 * geom.scale
 
-    def hit(self, origins, dirs):
-        """Triangle index (-1: none), distance, barycentrics u, v of each ray."""
+    def _run(self, origins, dirs):
         out = self.scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(dirs, np.float32),
                              output=1)
         prim = np.asarray(out["primID"], np.int64)
@@ -403,11 +416,40 @@ class _Rays:
         t, u, v = (np.asarray(out[k], np.float64) for k in ("tfar", "u", "v"))
         return prim, t, u, v
 
+    def hit(self, origins, dirs, camera=False, seen: bool = True, passes: int = 8):
+        """Triangle index (-1: none), distance, barycentrics u, v of each ray. ``camera`` (one
+        bool, or one per ray): the rays are the camera's; the others, with ``seen``, report the
+        first surface they meet where the light is stopped (a bounce), without it what stops the
+        light (a shadow ray): the class's docstring. A ray still on a one-way face after
+        ``passes`` re-casts stops there."""
+        prim, t, u, v = self._run(origins, dirs)
+        if self.one_way is None:
+            return prim, t, u, v
+        origins = np.asarray(origins, np.float64)
+        dirs = np.asarray(dirs, np.float64)
+        camera = np.broadcast_to(np.asarray(camera, bool), (len(prim),))
+        first = (prim.copy(), t.copy(), u.copy(), v.copy())
+        for _ in range(passes):
+            hit = np.flatnonzero(prim >= 0)
+            facing = np.einsum("ij,ij->i", dirs[hit], self.ng[prim[hit]])
+            skip = self.one_way[prim[hit]] & np.where(camera[hit], facing > 0.0, facing < 0.0)
+            again = hit[skip]
+            if not len(again):
+                break
+            start = t[again] + 0.05 * self.eps   # (a thin part's far side may lie closer than eps)
+            p2, t2, u2, v2 = self._run(origins[again] + dirs[again] * start[:, None], dirs[again])
+            prim[again], t[again], u[again], v[again] = p2, t2 + start, u2, v2
+        if seen:
+            keep = ~camera & (prim >= 0)
+            for now, was in zip((prim, t, u, v), first):
+                now[keep] = was[keep]
+        return prim, t, u, v
+
     def blocked(self, origins, dirs, dists):
         """True where something lies between each origin and its distance along dir."""
         if len(origins) == 0:
             return np.zeros(0, bool)
-        prim, t, _, _ = self.hit(origins, dirs)
+        prim, t, _, _ = self.hit(origins, dirs, seen=False)
         return (prim >= 0) & (t < dists)
 
     def transmittance(self, origins, dirs, dists, through, eps: float, walls: int = 8):
@@ -419,7 +461,7 @@ class _Rays:
         for _ in range(walls):
             if len(todo) == 0:
                 break
-            prim, t, _, _ = self.hit(o[todo], dirs[todo])
+            prim, t, _, _ = self.hit(o[todo], dirs[todo], seen=False)
             hit = (prim >= 0) & (t < left[todo])
             out[todo[hit]] *= through[prim[hit]]
             go = hit & (out[todo] > 0.0)
@@ -525,7 +567,9 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
         alive = np.arange(len(pix))
         prev_pdf = None   # the BRDF pdf of the ray that led here (None: the camera ray)
         for bounce in range(settings.max_bounces if settings.visibility else 1):
-            prim, dist, bu, bv = rays.hit(origin, direction)
+            # camera rays: the first, and those gone straight on through thin walls (pdf inf)
+            prim, dist, bu, bv = rays.hit(origin, direction,
+                                          camera=True if prev_pdf is None else np.isinf(prev_pdf))
             miss = prim < 0
             if bounce == 0:
                 np.add.at(cover, pix[alive[~miss]], 1.0)

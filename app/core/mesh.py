@@ -201,6 +201,18 @@ class MeshPart:
     element: str = ""
 
 
+def single_sided(part) -> bool:
+    """Whether ``part`` exists from its front side only (counter-clockwise winding): a glTF
+    primitive whose material is not doubleSided (the default material is single-sided). The
+    camera pass culls its back faces; a shadow map draws only the faces whose front faces the
+    light; the occlusion bake and the path tracer let light through it where the light would
+    meet its back. Parts from other files (OBJ, PLY, the built-ins) are two-sided."""
+    if not str(getattr(part, "element", "")).startswith("meshes["):
+        return False
+    material = getattr(part, "material", None)
+    return not (material is not None and material.double_sided)
+
+
 def _part_tangents(part: MeshPart) -> np.ndarray:
     tangents = part.__dict__.get("_tangents")
     if tangents is None:

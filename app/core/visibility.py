@@ -54,6 +54,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from alight.core.mesh import single_sided
 from alight.errors import AlightError
 
 # Bake settings (all in the cache key).
@@ -65,9 +66,13 @@ DEFAULT_THRESHOLD = 0.1               # ... by more than this across an edge
 DEFAULT_MAX_VERTICES = 400_000        # refinement stops growing a mesh past this
 MAX_LEVELS = 3                        # adaptive levels at most (each halves the split edges)
 WELD_CREASE_DEG = 30.0   # welded: copies of a vertex further than this from their mean normal stay apart
-BAKE_VERSION = 6   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
+BAKE_VERSION = 8   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
                    # 5: vertices covered by a part take their open neighbours' values;
-                   # 6: a vertex's copies share V, the bent normal and the bounce (_copies_averaged)
+                   # 6: a vertex's copies share V, the bent normal and the bounce (_copies_averaged);
+                   # 7, 8: single-sided parts let light through from their back (_cast's one_way; 8: a
+                   # stopped ray reports the first surface it met)
+# A ray goes on past at most this many single-sided faces met from the front (_cast's one_way).
+ONE_WAY_PASSES = 4
 # Refinement keeps a split only where the midpoint's value is not the edge's linear interpolation.
 INTERPOLATION_TEST = True
 # A vertex at least this share of whose rays hit a part from its inside, or hit one closer than
@@ -103,6 +108,7 @@ class PartVisibility:
     bent_normal: np.ndarray
     bounce_direction: np.ndarray
     bounce_weight: np.ndarray
+    one_way: bool = False     # the part is single-sided (alight.core.mesh.single_sided; not cached)
 
     def vertex_data(self) -> np.ndarray:
         """(N, 8) float32: bent normal and V, bounce direction and weight (pbr.vert's
@@ -328,7 +334,8 @@ def occlusion_statistic(parts, samples: int = AUTO_SAMPLES, rays: int = AUTO_RAY
     area = 0.5 * np.linalg.norm(cross, axis=1)
     if area.sum() <= 0.0:
         return 0.0
-    occluders = _Occluders(triangles)
+    one_way = np.concatenate([np.full(len(np.asarray(p.indices).reshape(-1, 3)), single_sided(p)) for p in parts])
+    occluders = _Occluders(triangles, one_way=one_way)
     rng = np.random.default_rng(seed)
     pick = rng.choice(len(triangles), samples, p=area / area.sum())
     a, b = rng.random(samples), rng.random(samples)
@@ -530,14 +537,48 @@ def eps_of(size: float) -> float:
     return 1e-4 * size
 
 
-def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2):
+def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2, one_way=None):
     """First hits (triangle index, -1 for none; Embree's barycentric u, v). A ray that starts on
     or just behind a triangle (its own, or a wall its vertex stands against) and leaves through
     it in the direction of its normal hits it at t ~ 0: such hits are skipped by casting again
-    from just past them."""
+    from just past them.
+
+    ``one_way`` (T,) bool: the triangles of single-sided parts (alight.core.mesh.single_sided),
+    which stop light only where it meets their front, as a shadow map that culls the faces turned
+    away from the light draws them: a ray (from the receiver) that meets one's front is not
+    stopped by it, the light coming back along the ray meeting its back. Such a ray goes on from
+    just past it (up to ONE_WAY_PASSES faces; past that it counts as stopped). A ray that is
+    stopped reports its first hit all the same (what the vertex sees there: a closed part's near
+    wall, though its far wall is what stops the light), one that is not reports none."""
+    prim, tfar, u, v = _first_hits(scene, origins, dirs, face_normals, eps, retries)
+    if one_way is None or not one_way.any():
+        return prim, u, v
+    # Rays on a one-way face met from the front: on past it, to whatever stops the light.
+    stop = prim.copy()
+    far = tfar.copy()
+    for _ in range(ONE_WAY_PASSES):
+        hit = np.nonzero(stop >= 0)[0]
+        passing = one_way[stop[hit]] & (np.einsum("ij,ij->i", dirs[hit], face_normals[stop[hit]]) < 0.0)
+        again = hit[passing]
+        if not len(again):
+            break
+        # From just past the face (a twentieth of eps: a thin part's far side may be closer than eps)
+        o2 = np.ascontiguousarray(origins[again] + dirs[again] * (far[again, None] + 0.05 * eps))
+        # (no t ~ 0 skip past a face: a back face that close is a thin part's far side, not a
+        # wall the origin stands against)
+        p2, t2, _, _ = _first_hits(scene, o2, np.ascontiguousarray(dirs[again]), face_normals, eps, 0)
+        stop[again] = p2
+        far[again] = t2 + far[again] + 0.05 * eps
+    free = stop < 0
+    prim[free] = -1
+    return prim, u, v
+
+
+def _first_hits(scene, origins, dirs, face_normals, eps, retries: int):
+    """``_cast``'s first hits without the one-way faces: (triangle, distance, u, v)."""
     out = scene.run(origins, dirs, output=1)
     prim = np.where(np.asarray(out["geomID"]) < 0, -1, np.asarray(out["primID"])).astype(np.int32)
-    tfar = np.asarray(out["tfar"], np.float32)
+    tfar = np.asarray(out["tfar"], np.float32).copy()
     u = np.asarray(out["u"], np.float32).copy()
     v = np.asarray(out["v"], np.float32).copy()
     for _ in range(retries):
@@ -553,7 +594,7 @@ def _cast(scene, origins, dirs, face_normals, eps, retries: int = 2):
         tfar[again] = np.asarray(out["tfar"], np.float32) + tfar[again] + eps
         u[again] = out["u"]
         v[again] = out["v"]
-    return prim, u, v
+    return prim, tfar, u, v
 
 
 def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.ndarray:
@@ -588,10 +629,13 @@ def _origins(p: np.ndarray, n: np.ndarray, faces: np.ndarray, eps: float) -> np.
 
 class _Occluders:
     """Embree's scene of triangles (T, 3, 3) and their unit normals (by winding); ``outside``
-    (T,) +1 or -1: the side the mesh's vertex normals call the outside (default: the winding's)."""
+    (T,) +1 or -1: the side the mesh's vertex normals call the outside (default: the winding's);
+    ``one_way`` (T,) bool: the single-sided triangles (``_cast``)."""
 
-    def __init__(self, triangles: np.ndarray, outside: np.ndarray | None = None):
+    def __init__(self, triangles: np.ndarray, outside: np.ndarray | None = None, one_way: np.ndarray | None = None):
         rtcore_scene, TriangleMesh = _import_embree()
+        # (T,) bool: single-sided triangles (_cast's one_way); None: every one two-sided
+        self.one_way = None if one_way is None or not np.any(one_way) else np.asarray(one_way, bool)
         self.triangles = np.ascontiguousarray(triangles, np.float32)
         self.scene = rtcore_scene.EmbreeScene()
         self._mesh = TriangleMesh(scene=self.scene, vertices=self.triangles)
@@ -616,7 +660,7 @@ class _Occluders:
         for s0 in range(0, count, chunk):
             n = normals[s0:s0 + chunk]
             d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
-            prim, u, v = _cast(self.scene, o, d, self.normals, eps)
+            prim, u, v = _cast(self.scene, o, d, self.normals, eps, one_way=self.one_way)
             hit[s0:s0 + chunk] = prim.reshape(len(n), rays)
             uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
             open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
@@ -686,10 +730,10 @@ def _free_rays(occluders, see_through, through_of_triangle, origins, normals, ra
         d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
         w = np.ones(len(d))
         if occluders is not None:
-            prim, u, v = _cast(occluders.scene, o, d, occluders.normals, eps)
+            prim, u, v = _cast(occluders.scene, o, d, occluders.normals, eps, one_way=occluders.one_way)
             w = (prim < 0).astype(np.float64)
             back[s0:s0 + chunk] = _covered(occluders, prim, u, v, o, d).reshape(len(n), rays).mean(axis=1)
-        prim_t, _, _ = _cast(see_through.scene, o, d, see_through.normals, eps)
+        prim_t, _, _ = _cast(see_through.scene, o, d, see_through.normals, eps, one_way=see_through.one_way)
         w = w * np.where(prim_t < 0, 1.0, through_of_triangle[np.maximum(prim_t, 0)])
         free[s0:s0 + chunk] = w.reshape(len(n), rays)
         open_sum[s0:s0 + chunk] = (d * w[:, None]).reshape(len(n), rays, 3).sum(axis=1)
@@ -818,13 +862,16 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     through = np.zeros(len(mesh.parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
     tris = [np.asarray(p.positions, np.float64)[np.asarray(p.indices, np.int64)] for p in mesh.parts]
     clear = through > 0.0
+    sided = [single_sided(p) for p in mesh.parts]
+    one_way = [np.full(len(t), s) for t, s in zip(tris, sided)]
     outside = [_outside_sign(p.positions, p.normals, np.asarray(p.indices, np.int64)) for p in mesh.parts]
     opaque = [t for t, c in zip(tris, clear) if not c]
-    occluders = _Occluders(np.concatenate(opaque), np.concatenate([o for o, c in zip(outside, clear) if not c])) \
-        if opaque else None
+    occluders = _Occluders(np.concatenate(opaque), np.concatenate([o for o, c in zip(outside, clear) if not c]),
+                           np.concatenate([w for w, c in zip(one_way, clear) if not c])) if opaque else None
     see_through = None
     if clear.any():
-        see_through = _Occluders(np.concatenate([t for t, c in zip(tris, clear) if c]))
+        see_through = _Occluders(np.concatenate([t for t, c in zip(tris, clear) if c]),
+                                 one_way=np.concatenate([w for w, c in zip(one_way, clear) if c]))
         through_of_triangle = np.concatenate([np.full(len(t), k) for t, c, k in zip(tris, clear, through) if c])
     else:
         through_of_triangle = None
@@ -894,7 +941,8 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     all_n = all_n / np.maximum(np.linalg.norm(all_n, axis=1, keepdims=True), 1e-30)
     all_f = np.concatenate([f + o for (_, _, f), o in zip(state, offsets[:-1])])
     all_values = np.concatenate(values).astype(np.float32)
-    refined = _Occluders(all_p[all_f])
+    refined = _Occluders(all_p[all_f],
+                         one_way=np.concatenate([np.full(len(f), s) for (_, _, f), s in zip(state, sided)]))
     origins = np.concatenate([_origins(d[:, :3], all_n[a:b], f, eps)
                               for (d, _, f), a, b in zip(state, offsets[:-1], offsets[1:])])
     hit, uv, _ = refined.hemisphere(origins, all_n.astype(np.float32), bounce_rays, rng, eps)
@@ -913,7 +961,7 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
         filled = _copies_averaged(_fill_covered(np.column_stack([bounce_dir[a:z], bounce_weight[a:z]]), f, b), f, d)
         bounce_dir[a:z], bounce_weight[a:z] = filled[:, :3], filled[:, 3]
     parts = []
-    for (data, widths, faces), part, val, a, b in zip(state, mesh.parts, values, offsets[:-1], offsets[1:]):
+    for (data, widths, faces), part, val, a, b, s in zip(state, mesh.parts, values, offsets[:-1], offsets[1:], sided):
         cols_ = np.split(data, np.cumsum(widths)[:-1], axis=1)
         cols_[1] = cols_[1] / np.maximum(np.linalg.norm(cols_[1], axis=1, keepdims=True), 1e-30)
         extra = cols_[4:]
@@ -926,14 +974,21 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
             colors=None if colors is None else colors.astype(np.float32),
             visibility=val[:, 3].astype(np.float32), bent_normal=val[:, :3].astype(np.float32),
             bounce_direction=bounce_dir[a:b].astype(np.float32),
-            bounce_weight=bounce_weight[a:b].astype(np.float32)))
+            bounce_weight=bounce_weight[a:b].astype(np.float32), one_way=s))
     return MeshVisibility(parts, seconds=time.perf_counter() - start, rays=int(cast))
 
 
 # ---- the suns on the occluders ------------------------------------------------------------------
 
 MAX_SUNS = 4          # shaders/common/suns.glsl's MAX_SUNS: one vec4 per vertex holds them
-SUN_BOUNCE_VERSION = 2   # 2: the second bounce (B2)
+SUN_BOUNCE_VERSION = 3   # 2: the second bounce (B2); 3: single-sided parts one-way (_cast)
+
+
+def one_way_triangles(parts) -> np.ndarray:
+    """(M,) bool over the merged faces of a bake's refined parts: the single-sided parts'
+    (PartVisibility.one_way; _cast)."""
+    return np.concatenate([np.full(len(np.asarray(p.indices).reshape(-1, 3)), bool(getattr(p, "one_way", False)))
+                           for p in parts]) if parts else np.zeros(0, bool)
 
 
 def merged_parts(parts):
@@ -973,13 +1028,14 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
     if not len(directions) or not parts:
         return out
     positions, eps, offsets, faces, all_f, all_n = merged_parts(parts)
-    refined = _Occluders(positions[all_f])
+    one_way = one_way_triangles(parts)
+    refined = _Occluders(positions[all_f], one_way=one_way)
     through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
     part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
     clear = through > 0.0
     opaque_tri = ~clear[part_of_triangle]
-    blockers = _Occluders(positions[all_f[opaque_tri]]) if opaque_tri.any() else None
-    see_through = _Occluders(positions[all_f[~opaque_tri]]) if clear.any() else None
+    blockers = _Occluders(positions[all_f[opaque_tri]], one_way=one_way[opaque_tri]) if opaque_tri.any() else None
+    see_through = _Occluders(positions[all_f[~opaque_tri]], one_way=one_way[~opaque_tri]) if clear.any() else None
     through_of_see_through = through[part_of_triangle[~opaque_tri]]
     origins = np.concatenate([_origins(positions[a:b], all_n[a:b], f, eps)
                               for f, a, b in zip(faces, offsets[:-1], offsets[1:])])
@@ -993,7 +1049,7 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
     for s0 in range(0, count, chunk):
         n = all_n[s0:s0 + chunk].astype(np.float32)
         d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
-        prim, u, v = _cast(refined.scene, o, d, refined.normals, eps)
+        prim, u, v = _cast(refined.scene, o, d, refined.normals, eps, one_way=refined.one_way)
         ray = np.nonzero(prim >= 0)[0]
         if not len(ray):
             continue
@@ -1014,10 +1070,10 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
             d2 = np.ascontiguousarray(np.broadcast_to(l.astype(np.float32), (len(lit), 3)))
             shadow = np.ones(len(lit))
             if blockers is not None:
-                p2, _, _ = _cast(blockers.scene, o2, d2, blockers.normals, eps)
+                p2, _, _ = _cast(blockers.scene, o2, d2, blockers.normals, eps, one_way=blockers.one_way)
                 shadow = (p2 < 0).astype(np.float64)
             if see_through is not None:
-                p3, _, _ = _cast(see_through.scene, o2, d2, see_through.normals, eps)
+                p3, _, _ = _cast(see_through.scene, o2, d2, see_through.normals, eps, one_way=see_through.one_way)
                 shadow = shadow * np.where(p3 < 0, 1.0, through_of_see_through[np.maximum(p3, 0)])
             total[:, k] += np.bincount(vertex[lit], shadow * cos[lit] / math.pi, minlength=count)
     first = total / np.maximum(hits, 1)[:, None]                       # B1 per vertex
@@ -1074,6 +1130,8 @@ def visibility_key(mesh, rays: int, edge_fraction: float, max_vertices: int,
                    "threshold": DEFAULT_THRESHOLD}
     if light_through is not None and any(float(t) > 0.0 for t in light_through):
         description["light_through"] = [round(float(t), 6) for t in light_through]
+    # The geometry's digest leaves the materials out: which parts are single-sided is said here.
+    description["single_sided"] = [i for i, p in enumerate(mesh.parts) if single_sided(p)]
     text = json.dumps(description, sort_keys=True)
     return "alight-visibility-" + hashlib.sha256(text.encode()).hexdigest(), description
 

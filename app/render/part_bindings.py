@@ -7,6 +7,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from alight.core.mesh import single_sided
 from alight.core.scene import Camera
 from alight.core.shader_names import MATERIAL_MAPS
 from alight.core.texture_maps import TextureMaps
@@ -40,7 +41,7 @@ def set_culling(ctx, gpu_part: GpuPart, part) -> None:
     """Back-face culling for the part, as its file or its closedness decides."""
     if part.element.startswith("meshes["):
         # A glTF primitive: the file decides (the default material is single-sided).
-        cull = not (part.material is not None and part.material.double_sided)
+        cull = single_sided(part)
     else:
         # A closed mesh's back faces are hidden: culling them halves the triangles
         # rasterised and stops back faces drawn first from being shaded and then

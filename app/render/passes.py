@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from alight.core.mesh import single_sided
 from alight.core.scene import Camera, Display
 from alight.core.shader_names import BackgroundMode, Tonemap, glsl_member
 from alight.core.sphere_lod import impostor_background_ring, impostor_hole_model
@@ -266,14 +267,26 @@ def prepare_shadows(r, scene, maps: IBLMaps | None) -> bool:
     if scene.view == "probe" or scene.mesh is None or not r.shadow_maps.wanted(scene, maps, receivers=ground):
         r.shadow_maps.last_active = False
         return False
-    gpu_parts = [g for g, part, cast in zip(r.meshes.parts(scene.mesh), scene.mesh.parts, shadow_casters(scene))
-                 if cast and not blends(scene, part)]
+    kept = [(g, part) for g, part, cast in zip(r.meshes.parts(scene.mesh), scene.mesh.parts, shadow_casters(scene))
+            if cast and not blends(scene, part)]
+    gpu_parts = [g for g, _ in kept]
+    # A single-sided part (glTF doubleSided false) casts from the faces whose front faces the
+    # light only: its back faces, as the light sees them, are culled (the camera pass's rule,
+    # the light as the camera). Two-sided parts cast from both sides.
+    one_way = {id(g): single_sided(part) for g, part in kept}
 
     def draw_parts(matrix: bytes, parts) -> None:
+        ctx = r.ctx
         prog = r.program("render/shadow_depth.vert", "render/shadow_depth.frag")
         prog["u_view_projection"].write(matrix)
         for gpu_part in parts:
+            if one_way.get(id(gpu_part), False):
+                ctx.front_face = "ccw"
+                ctx.enable(moderngl.CULL_FACE)
+            else:
+                ctx.disable(moderngl.CULL_FACE)
             gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+        ctx.disable(moderngl.CULL_FACE)
 
     bounds = GroundPass.ground_for(scene.mesh).bounds if ground else None
     return r.shadow_maps.prepare(scene, maps, gpu_parts, draw_parts, bounds)

@@ -203,7 +203,10 @@ class ShadowMaps:
         self._fbo.clear(depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        ctx.disable(moderngl.CULL_FACE)      # both sides cast: open meshes, single-sided glTF parts
+        # Both sides cast, but for single-sided parts (draw_parts culls their faces turned away
+        # from the light: alight.core.mesh.single_sided). A closed part's nearest depth is its
+        # lit front either way, so culling changes no closed caster's shadow, nor its acne.
+        ctx.disable(moderngl.CULL_FACE)
         try:
             for view, (x, y, size) in zip(plan.views, plan.rects):
                 ctx.viewport = (x, y, size, size)
@@ -212,6 +215,7 @@ class ShadowMaps:
         finally:
             ctx.scissor = None
             ctx.disable(moderngl.DEPTH_TEST)
+            ctx.disable(moderngl.CULL_FACE)
         self.passes_run += 1
 
     def bind(self, program: moderngl.Program, unit_compare: int, unit_depth: int) -> None:

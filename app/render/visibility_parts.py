@@ -22,6 +22,7 @@ import math
 import numpy as np
 
 from alight.core import sky_weight as sw
+from alight.core.mesh import single_sided
 from alight.core.visibility import (AUTO_MAX_VERTICES, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
                                     VISIBILITY_FIELDS, MeshVisibility, PartVisibility, auto_too_big, bake_sun_bounce,
                                     bake_visibility, embree_available, refined_mesh_part, sun_bounce_key,
@@ -62,7 +63,7 @@ def cached_visibility(mesh, cache=None, rays: int = DEFAULT_RAYS, edge_fraction:
                     values = {f: arrays.get(f"{i}.{f}") for f in VISIBILITY_FIELDS}
                     if any(values[f] is None for f in VISIBILITY_FIELDS if f not in ("uvs1", "colors")):
                         raise BadEntry("a part's arrays are missing")
-                    parts.append(PartVisibility(**values))
+                    parts.append(PartVisibility(**values, one_way=single_sided(mesh.parts[i])))
                 return MeshVisibility(parts, from_cache=True)
             except BadEntry as exc:
                 cache.reject(key, "visibility bake", str(exc))

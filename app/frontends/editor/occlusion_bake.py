@@ -129,7 +129,10 @@ class OcclusionBake:
         token = id(mesh)
         send = token != self._sent_token
         self._sent_token = token
-        geometry = dataclasses.replace(mesh, parts=[dataclasses.replace(p, material=None) for p in mesh.parts],
+        # Of the material only doubleSided goes along: which parts are single-sided is the bake's
+        # too (alight.core.mesh.single_sided; a glTF part without a material is single-sided).
+        geometry = dataclasses.replace(mesh, parts=[dataclasses.replace(p, material=_sidedness(p.material))
+                                                    for p in mesh.parts],
                                        cameras=[], lights=[]) if send else None
         out = self._worker.scratch_file(f"occlusion-{self.jobs}.pickle")
         job_id = self._worker.submit(OcclusionJob(mesh=geometry, mesh_token=token, mode=mode,
@@ -239,5 +242,13 @@ def main() -> int:
     return serve(handle)
 
 
+def _sidedness(material):
+    """A bare FileMaterial holding ``material``'s doubleSided only (None stays None)."""
+    from alight.core.mesh import FileMaterial
+
+    return None if material is None else FileMaterial(double_sided=bool(material.double_sided))
+
+
 if __name__ == "__main__":
     sys.exit(main())
+
