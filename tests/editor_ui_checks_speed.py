@@ -51,6 +51,9 @@ def wait_frames(ctx, until) -> int:
 
 def test_a_new_variant_keeps_the_old_picture_until_it_is_compiled(ctx):
     s, warm = editor().state, editor().variant_warmup
+    # (No presets drawn ahead in this session: the checks below count the warm-up's jobs;
+    # the prefetch has its own check, tests/editor_ui_checks_prefetch.py.)
+    editor().preset_prefetch.cancel()
     ctx.set_ref("alight")
     ctx.item_click("**/copper")
     # (copper's roughness may need a variant of its own, STRETCHED_SPAN: the view settles first)

@@ -46,3 +46,11 @@ def test_the_first_orbit_of_a_material_is_compiled_away_from_the_frames(display,
                             env=env, capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert result.stdout.startswith("ok:"), result.stdout
+
+
+def test_the_presets_are_drawn_ahead_so_a_first_click_needs_no_warm_up(display, tmp_path, monkeypatch):
+    """tests/editor_ui_checks_prefetch.py through the test engine, with an empty Mesa cache."""
+    monkeypatch.setenv("MESA_SHADER_CACHE_DIR", str(tmp_path / "mesa"))
+    result = ui_test(tmp_path, REPO / "tests" / "editor_ui_checks_prefetch.py", "--new")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert "1 passed, 0 failed" in result.stdout, result.stdout

@@ -35,6 +35,11 @@ import time
 from dataclasses import dataclass
 
 CACHE_SETTLE_S = 0.3
+# The presets' variants are drawn once by a niced child this many frames after the view settled
+# (``PresetPrefetch``), so a preset's first click reads Mesa's cache instead of waiting seconds
+# for a compile (a layered preset: 3+ s here with an empty cache).
+PREFETCH_AFTER_FRAMES = 30
+PREFETCH_SIZE = (64, 64)   # llvmpipe's generated code depends on formats and state, not on size
 
 
 @dataclass
@@ -49,6 +54,7 @@ class WarmupJob:
     env_token: int = 0
     direct: bool = False        # drawn straight into the window (draw_display's into), as the view was
     direct_srgb: bool = False   # ... with the window's framebuffer encoding sRGB (into_encodes_srgb)
+    materials: tuple = ()       # the scene drawn once with each of these instead (PresetPrefetch)
 
 
 class VariantWarmup:
@@ -125,6 +131,79 @@ class VariantWarmup:
             self._job_id = self._job_trigger = None
             return self.showing_old
         return False
+
+    def add_drawn(self, keys) -> None:
+        """Program keys another child drew (PresetPrefetch): they pass the gate from now on."""
+        self._warm.update(keys)
+        self.drawn_by_child.update(keys)
+
+    def close(self) -> None:
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
+
+
+class PresetPrefetch:
+    """The panel's presets drawn once, after the view has settled, by a child of their own at a
+    lower priority than the editor (``python -m alight.frontends.editor.variant_warmup --niced``):
+    their programs' keys then pass the view's gate, and a preset's first click compiles from
+    Mesa's cache in its frame instead of waiting for the warm-up process. Once per session, for
+    the first scene drawn with the panel's material; ``step`` each frame."""
+
+    def __init__(self):
+        self._worker = None
+        self._job_id = None
+        self._out = None
+        self._frames = 0
+        self.done = False
+        self.keys: set = set()   # what the child compiled (tests read it)
+
+    def step(self, win, scene, maps, size) -> None:
+        if self.done:
+            return
+        if self._worker is None:
+            warm = win.variant_warmup
+            if warm.pending or warm.showing_old or scene.mesh is None or scene.use_file_materials:
+                self._frames = 0
+                return
+            self._frames += 1
+            if self._frames < PREFETCH_AFTER_FRAMES:
+                return
+            from alight.exchange.presets import list_presets, load_preset
+            from alight.frontends.editor.worker_process import WorkerProcess
+
+            materials = []
+            for name in list_presets():
+                try:
+                    materials.append(load_preset(name))
+                except Exception:   # (a broken preset file is the panel's to report)
+                    continue
+            self._worker = WorkerProcess("alight.frontends.editor.variant_warmup", ("--niced",))
+            self._out = self._worker.scratch_file("prefetch-keys.pickle")
+            env = win.state.env if maps is not None else None
+            self._job_id = self._worker.submit(WarmupJob(
+                scene=scene, env=env, quality=maps.quality if maps is not None else None, size=PREFETCH_SIZE,
+                aa=win.state.aa, out=str(self._out), mesh_token=0 if scene.mesh is None else 1,
+                env_token=0 if env is None else 1, materials=tuple(materials)))
+            return
+        for job_id, word, _text in self._worker.answers():
+            if job_id != self._job_id or word == "progress":
+                continue
+            if word == "done":
+                try:
+                    with open(self._out, "rb") as f:
+                        self.keys = set(pickle.load(f))
+                except (OSError, pickle.UnpicklingError, EOFError):
+                    self.keys = set()
+                win.variant_warmup.add_drawn(self.keys)
+            self.done = True
+            self.close()
+            return
+
+    def cancel(self) -> None:
+        """No prefetch in this session (a stopped one adds nothing)."""
+        self.done = True
+        self.close()
 
     def close(self) -> None:
         if self._worker is not None:
@@ -231,8 +310,14 @@ def main() -> int:
             targets.clear()
             targets[key] = Targets(renderer.ctx, job.size[0], job.size[1], job.aa, 4)
         into = renderer.ctx.screen if job.direct and window is not None else None
-        renderer.draw_display(scene, maps, targets[key], into=into, into_encodes_srgb=job.direct_srgb and into is not None)
-        renderer.ctx.finish()   # the first draw's code generation happens by here
+        for material in job.materials or (None,):
+            if material is not None:
+                if superseded():
+                    return False
+                scene = dataclasses.replace(scene, material=material)
+            renderer.draw_display(scene, maps, targets[key], into=into,
+                                  into_encodes_srgb=job.direct_srgb and into is not None)
+            renderer.ctx.finish()   # the first draw's code generation happens by here
         # Mesa writes its shader disk cache from a thread of its own: a moment for the entries
         # to be on disk when the editor compiles the same programs.
         time.sleep(CACHE_SETTLE_S)
@@ -241,8 +326,11 @@ def main() -> int:
         os.replace(job.out + ".tmp", job.out)
         return True
 
-    # Not below the editor's priority: the view waits for this job (the old picture shows).
-    return serve(handle, niceness=0)
+    # Not below the editor's priority where the view waits for this job (the old picture shows);
+    # the presets' prefetch (--niced) is work ahead of need, below it.
+    from alight.frontends.editor.worker_process import CHILD_NICENESS
+
+    return serve(handle, niceness=CHILD_NICENESS if "--niced" in sys.argv[1:] else 0)
 
 
 if __name__ == "__main__":

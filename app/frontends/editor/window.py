@@ -191,6 +191,9 @@ class EditorWindow:
         from alight.frontends.editor.variant_warmup import VariantWarmup
 
         self.variant_warmup = VariantWarmup()   # new shader variants compiled in a process of their own
+        from alight.frontends.editor.variant_warmup import PresetPrefetch
+
+        self.preset_prefetch = PresetPrefetch()   # the presets' variants drawn ahead, niced
         from alight.frontends.editor.occlusion_bake import OcclusionBake
 
         self.occlusion_bake = OcclusionBake()   # the visibility bake made in a process of its own
@@ -648,6 +651,8 @@ class EditorWindow:
                 keep = set(scene.texture_maps.paths().values()) | set(self.state.compare.a_texture_maps.paths().values())
                 self.renderer.forget_map_textures(keep)
                 self._drawn_maps = scene.texture_maps
+        if not full:
+            self.preset_prefetch.step(self, scene, maps, size)
         if compare:
             targets = self.compare_view.compose(self, scene, maps, targets, moving, finish=full)
         if direct:
@@ -916,6 +921,7 @@ class EditorWindow:
         self._target_cache.clear()
         self.compare_view.release()
         self.variant_warmup.close()
+        self.preset_prefetch.close()
         self.occlusion_bake.close()
         self.pass_warmup.close()
         self._panel_image.release()

@@ -79,12 +79,12 @@ def read_job(f):
 
 
 class WorkerProcess:
-    """The parent's handle on one child process ``python -m MODULE`` (started on the first job,
+    """The parent's handle on one child process ``python -m MODULE ARGS...`` (started on the first job,
     started again if it ended). ``answers()`` returns the lines that came back since the last
     call, as (job id, word, text); none of its calls blocks but ``wait``."""
 
-    def __init__(self, module: str):
-        self.module = module
+    def __init__(self, module: str, args: tuple[str, ...] = ()):
+        self.module, self.args = module, tuple(args)
         self._process = None
         self._answers: queue.Queue = queue.Queue()
         self._next_id = 0
@@ -134,7 +134,7 @@ class WorkerProcess:
         return self._scratch / name
 
     def _start(self) -> None:
-        self._process = subprocess.Popen([sys.executable, "-m", self.module], stdin=subprocess.PIPE,
+        self._process = subprocess.Popen([sys.executable, "-m", self.module, *self.args], stdin=subprocess.PIPE,
                                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
         threading.Thread(target=self._read, args=(self._process,), name=f"alight-{self.module}",
                          daemon=True).start()
