@@ -149,8 +149,8 @@ def _add_shadow_options(p, editor: bool = False) -> None:
                         "something can be shadowed (not for a convex mesh such as the built-in sphere) (default: auto)")
     p.add_argument("--ground", action="store_true",
                    help="a ground under the model's bounding box that catches its shadow, composited over the "
-                        "background (with --background transparent: the shadow in alpha)"
-                        + ("; the panel's 'ground' checkbox" if editor else ""))
+                        + ("background (the panel's 'ground' checkbox)" if editor else
+                           "background (with --background transparent: the shadow in alpha)"))
 
 
 def _add_occlusion_option(p: argparse.ArgumentParser, editor: bool = False) -> None:

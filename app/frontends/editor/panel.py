@@ -630,9 +630,9 @@ class Panel:
                               "baked in the background, the view drawn without it meanwhile)")
         _, s.ground = imgui.checkbox("ground", s.ground)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("a ground under the model's bounding box that catches its shadow and occlusion, "
-                              "as 'alight render --ground' draws it (over the background; with a transparent "
-                              "background the shadow is in the files' alpha)")
+            imgui.set_tooltip("a ground under the model's bounding box that catches its shadow (the lights' and "
+                              "the environment's suns'), as 'alight render --ground' draws it over the background; "
+                              "it needs shadows (not 'off')")
         changed, i = imgui.combo("shadows", SHADOW_MODES.index(s.shadows), list(SHADOW_MODES))
         if changed:
             s.shadows = SHADOW_MODES[i]
