@@ -141,6 +141,18 @@ def _add_material_options(p: argparse.ArgumentParser) -> None:
                                help=field.help)
 
 
+def _add_shadow_options(p, editor: bool = False) -> None:
+    """--shadows and --ground, 'alight render''s and 'alight edit''s (the panel's 'shadows' combo and
+    'ground' checkbox)."""
+    p.add_argument("--shadows", choices=("auto", "on", "off"), default="auto",
+                   help="shadow maps for the lights and the environment's suns: auto draws them only where "
+                        "something can be shadowed (not for a convex mesh such as the built-in sphere) (default: auto)")
+    p.add_argument("--ground", action="store_true",
+                   help="a ground under the model's bounding box that catches its shadow, composited over the "
+                        + ("background (the panel's 'ground' checkbox)" if editor else
+                           "background (with --background transparent: the shadow in alpha)"))
+
+
 def _add_occlusion_option(p: argparse.ArgumentParser, editor: bool = False) -> None:
     """--occlusion, 'alight render''s and 'alight edit''s (the panel's 'occlusion' combo)."""
     p.add_argument("--occlusion", choices=("auto", "on", "off"), default="auto",

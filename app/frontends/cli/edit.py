@@ -3,7 +3,15 @@
 from __future__ import annotations
 
 from alight.errors import AlightError
-from alight.frontends.cli.arguments import QUALITIES, Command, _add_occlusion_option, _add_scene_options, _number, _size
+from alight.frontends.cli.arguments import (
+    QUALITIES,
+    Command,
+    _add_occlusion_option,
+    _add_scene_options,
+    _add_shadow_options,
+    _number,
+    _size,
+)
 
 
 def add_parser(sub) -> None:
@@ -15,6 +23,7 @@ def add_parser(sub) -> None:
                    help="bake quality; auto: the cheapest measured bake within 2%% for the environment and "
                         "the kind of material, shown in the panel (default: medium)")
     _add_occlusion_option(e, editor=True)
+    _add_shadow_options(e, editor=True)
     e.add_argument("--size", type=_size, default=(1280, 720), metavar="W|WxH", help="window size (default: 1280x720)")
     e.add_argument("--aa", choices=("none", "msaa"), default="none",
                    help="anti-aliasing of the preview (default: none; msaa costs ~2x on llvmpipe)")
@@ -32,7 +41,7 @@ def add_parser(sub) -> None:
                         "FIELD: roughness, metallic, ior, base_color, emissive, specular_f0 (R,G,B linear), the "
                         "layers' fields (clearcoat, clearcoat_roughness, sheen_color, ..., as the material flags), "
                         "preset, open, mesh, env (a name or path), exposure, tonemap, env_rotation, env_intensity, "
-                        "ibl (0/1), ibl_model, multiple_scattering (0/1), occlusion, quality, debug_view, debug_mip, "
+                        "ibl (0/1), ibl_model, multiple_scattering (0/1), occlusion, shadows, ground (0/1), quality, debug_view, debug_mip, "
                         "map_SLOT (an image path, '' clears; SLOT: base_color, metallic_roughness, metallic, roughness, normal, emissive, occlusion), "
                         "uv_scale, uv_offset (U,V)")
     e.add_argument("--ui-test", metavar="FILE.py",

@@ -13,6 +13,7 @@ from alight.frontends.cli.arguments import (
     _add_camera_options,
     _add_occlusion_option,
     _add_scene_options,
+    _add_shadow_options,
     _number,
     _size,
     _Size,
@@ -56,12 +57,7 @@ def add_parser(sub) -> None:
                    help=".png: 8-bit sRGB after exposure and tone mapping; .exr: linear float32 RGBA radiance, "
                         "alpha 1 on the surface (docs/conventions.md)")
     d.add_argument("--verbose", "-v", action="store_true", help="print the GL renderer and time per step")
-    d.add_argument("--shadows", choices=("auto", "on", "off"), default="auto",
-                   help="shadow maps for the lights and the environment's suns: auto draws them only where "
-                        "something can be shadowed (not for a convex mesh such as the built-in sphere) (default: auto)")
-    d.add_argument("--ground", action="store_true",
-                   help="a ground under the model's bounding box that catches its shadow, composited over the "
-                        "background (with --background transparent: the shadow in alpha)")
+    _add_shadow_options(d)
 
 
 def run(args) -> int:

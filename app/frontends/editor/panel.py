@@ -25,6 +25,7 @@ from alight.frontends.editor.layer_rows import FINITE_START, SECTIONS, LayerRow
 from alight.frontends.editor.library_panel import ICON, LibraryPanel
 from alight.frontends.editor.state import DEBUG_VIEWS
 from alight.ibl.bake import QUALITY
+from alight.render.shadows import SHADOW_MODES
 
 AA_CHOICES = ("none", "msaa")
 # The status row's colours: an error, a success (a message); bright on the dark theme, told apart.
@@ -627,6 +628,18 @@ class Panel:
             imgui.set_tooltip("occlusion of the environment light and one bounce, from a per-vertex bake as "
                               "'alight render --occlusion' makes (auto: where the mesh occludes itself; "
                               "baked in the background, the view drawn without it meanwhile)")
+        _, s.ground = imgui.checkbox("ground", s.ground)
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("a ground under the model's bounding box that catches its shadow (the lights' and "
+                              "the environment's suns'), as 'alight render --ground' draws it over the background; "
+                              "it needs shadows (not 'off')")
+        changed, i = imgui.combo("shadows", SHADOW_MODES.index(s.shadows), list(SHADOW_MODES))
+        if changed:
+            s.shadows = SHADOW_MODES[i]
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("shadow maps for the lights and the environment's suns, as 'alight render "
+                              "--shadows' draws them (auto: where something can be shadowed, the ground included; "
+                              "not on a convex mesh alone such as the sphere)")
         names = list(QUALITY) + ["auto"]
         changed, i = imgui.combo("bake quality", names.index(s.quality), names)
         if changed:

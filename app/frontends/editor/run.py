@@ -20,7 +20,8 @@ def build_state(args) -> EditorState:
         raise AlightError("edit: --view probe is 'alight render''s; the editor shows the camera view")
     # --motion-scale fixes the scale while moving; without it the scale adapts to hold 30 FPS.
     state = EditorState(quality=args.quality, aa=args.aa, motion_scale=args.motion_scale or 0.5,
-                        adaptive_motion=args.motion_scale is None, occlusion=getattr(args, "occlusion", "auto"))
+                        adaptive_motion=args.motion_scale is None, occlusion=getattr(args, "occlusion", "auto"),
+                        shadows=getattr(args, "shadows", "auto"), ground=getattr(args, "ground", False))
     material, _, maps = build_look(args)
     state.material = material
     _start_maps(state, maps, args)
@@ -138,7 +139,8 @@ def _no_scene_options(args) -> bool:
     return (args.mesh, args.env) == ("sphere", "studio") and all(x is None for x in material_flags) \
         and not args.light and (args.env_rotation, args.env_intensity) == (0.0, 1.0) \
         and not getattr(args, "texture_set", None) and not getattr(args, "map", None) \
-        and getattr(args, "occlusion", "auto") == "auto"
+        and getattr(args, "occlusion", "auto") == "auto" \
+        and getattr(args, "shadows", "auto") == "auto" and not getattr(args, "ground", False)
 
 
 def _benchmark(win, frames: int) -> int:

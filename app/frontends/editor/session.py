@@ -20,7 +20,7 @@ from alight.paths import config_dir
 CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "radius")
 # The view's settings kept beside the material and camera (with the display and the lights).
 SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering",
-                  "lights_follow_env", "occlusion")
+                  "lights_follow_env", "occlusion", "shadows", "ground")
 EDITOR_AA = ("none", "msaa")   # the editor's anti-aliasing (alight edit --aa, the panel's combo)
 
 
@@ -151,6 +151,7 @@ def _read_settings(data: dict):
     from alight.core.ibl_models import IBL_MODELS
     from alight.core.scene import BACKGROUNDS, LIGHT_KINDS, TONEMAPS, Display, Light
     from alight.core.visibility import OCCLUSION_MODES
+    from alight.render.shadows import SHADOW_MODES
 
     def number(v, what):
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
@@ -173,7 +174,10 @@ def _read_settings(data: dict):
               "ibl_model": choice(data["ibl_model"], tuple(IBL_MODELS), "ibl_model"),
               "multiple_scattering": bool(data["multiple_scattering"]),
               "lights_follow_env": bool(data.get("lights_follow_env", False)),   # (older sessions lack it)
-              "occlusion": choice(data.get("occlusion", "auto"), OCCLUSION_MODES, "occlusion")}   # (... and it)
+              "occlusion": choice(data.get("occlusion", "auto"), OCCLUSION_MODES, "occlusion"),   # (... and it)
+              # (... and these: 'alight render''s defaults)
+              "shadows": choice(data.get("shadows", "auto"), SHADOW_MODES, "shadows"),
+              "ground": bool(data.get("ground", False))}
     if "aa" in data:   # the anti-aliasing (older sessions lack it: the command line's stays)
         values["aa"] = choice(data["aa"], EDITOR_AA, "aa")
     d = data["display"]

@@ -25,6 +25,7 @@ from alight.exchange.images import IMAGE_SUFFIXES
 from alight.exchange.texture_sets import load_slot_image
 from alight.frontends.editor.compare import CompareState
 from alight.ibl.bake import QUALITY
+from alight.render.shadows import SHADOW_MODES
 
 ENV_SUFFIXES = (".hdr", ".exr")
 PRESET_SUFFIXES = (".json",)
@@ -61,6 +62,10 @@ class EditorState:
     # Occlusion of the environment light by the mesh (Scene.occlusion), as 'alight render''s
     # default: its bake is made by a child process (occlusion_bake.py), the view drawn without meanwhile.
     occlusion: str = "auto"
+    # Shadow maps (Scene.shadows), 'alight render --shadows''s choices and default, and the ground
+    # under the model that catches its shadow (Scene.ground, 'alight render --ground'), as the renderer draws them.
+    shadows: str = "auto"
+    ground: bool = False
     env_rotation_deg: float = 0.0
     lights_follow_env: bool = False   # turning the environment turns the lights with it (env_turn.py)
     env_intensity: float = 1.0
@@ -99,7 +104,7 @@ class EditorState:
                      lights=self.lights, camera=camera, env_rotation_deg=self.env_rotation_deg,
                      env_intensity=self.env_intensity, ibl_enabled=self.ibl_enabled and self.env is not None,
                      ibl_model=self.ibl_model, multiple_scattering=self.multiple_scattering,
-                     occlusion=self.occlusion,
+                     occlusion=self.occlusion, shadows=self.shadows, ground=self.ground,
                      # Data views are shown as values: no exposure, no tone curve.
                      display=dataclasses.replace(self.display, tonemap="none", exposure=0.0)
                      if self.debug_view in DATA_VIEWS else self.display,
@@ -422,7 +427,7 @@ class EditorState:
         base_color / emissive / specular_f0 and the layers' colours (sheen_color, ...: R,G,B linear),
         preset / open / mesh / env (a name or path), exposure, tonemap,
         env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), occlusion
-        (auto/on/off), quality;
+        (auto/on/off), shadows (auto/on/off), ground (0/1), quality;
         map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
         uv_offset (U,V)."""
         from alight.core.material import parse_color
@@ -465,6 +470,12 @@ class EditorState:
                 if value not in OCCLUSION_MODES:
                     raise AlightError(f"--script: occlusion '{value}' is not one of {', '.join(OCCLUSION_MODES)}")
                 self.occlusion = value
+            elif key == "shadows":
+                if value not in SHADOW_MODES:
+                    raise AlightError(f"--script: shadows '{value}' is not one of {', '.join(SHADOW_MODES)}")
+                self.shadows = value
+            elif key == "ground":
+                self.ground = value not in ("0", "false", "off")
             elif key == "quality":
                 if value not in (*QUALITY, "auto"):
                     raise AlightError(f"--script: quality '{value}' is not one of {', '.join(QUALITY)}, auto")

@@ -577,7 +577,7 @@ class EditorWindow:
         mutated)."""
         return (id(scene.mesh), scene.material, tuple(map(dataclasses.astuple, scene.lights)), scene.camera,
                 scene.display, scene.env_rotation_deg, scene.env_intensity, scene.ibl_enabled, id(maps),
-                scene.ibl_model, scene.multiple_scattering, scene.occlusion,
+                scene.ibl_model, scene.multiple_scattering, scene.occlusion, scene.shadows, scene.ground,
                 size, self.state.aa, scene.debug_view, scene.debug_mip, scene.use_file_materials,
                 scene.texture_maps, tuple(id(scene.texture_images.get(p)) for p in scene.texture_maps.paths().values()))
 
