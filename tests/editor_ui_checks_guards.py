@@ -82,7 +82,11 @@ def test_a_failed_path_leaves_the_loaded_one_in_its_field(ctx):
         assert shown != typed, f"the {field} field still shows the path that failed: {shown}"
     assert panel.mesh_path == s.mesh_spec == good_mesh, (panel.mesh_path, s.mesh_spec)
     assert panel.env_path == "", panel.env_path   # the studio is loaded: no file
+    ctx.combo_click("preview mesh/shader_ball")   # a built-in: the field shows it, not the last file
+    assert s.mesh_spec == "shader_ball", s.error
+    assert panel.mesh_path == "shader_ball", f"the mesh field shows {panel.mesh_path!r} with the shader ball loaded"
     ctx.combo_click("preview mesh/sphere")   # back to the ball the next checks look at
+    assert panel.mesh_path == "sphere", panel.mesh_path
     ctx.item_close("**/Environment")
     checks = (("texture set", "load set", bad, lambda: panel.set_path),
               ("map file", "load##typed", bad + ".png", lambda: panel.map_path),
