@@ -412,8 +412,8 @@ class Panel:
 
     def _export_gltf(self, s) -> None:
         try:
-            s.export_gltf(self.gltf_path)
-            s.error, s.message = "", f"exported {self.gltf_path}"
+            note = s.export_gltf(self.gltf_path)
+            s.error, s.message = "", f"exported {self.gltf_path}{f' ({note})' if note else ''}"
         except AlightError as exc:
             s.fail(exc)
 
