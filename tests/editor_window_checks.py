@@ -357,6 +357,18 @@ def test_orbiting_frame_in_the_window_matches_the_still_view(window):
             .reshape(h, w, 3).astype(int)
 
     window.frame()
+    # The first orbit of a material waits for the warm-up process to compile its window-drawn
+    # variant (variant_warmup.py); the view image is drawn meanwhile. Let that finish first.
+    import time
+
+    deadline = time.monotonic() + 120.0
+    window.orbit.orbit(1.0, 0.0)
+    window.frame()
+    while (window.variant_warmup.pending or window.variant_warmup.showing_old) and time.monotonic() < deadline:
+        time.sleep(0.05)
+        window.orbit.orbit(1.0, 0.0)
+        window.frame()
+    window.frame()
     window.orbit.orbit(7.0, 3.0)
     drawn = window.redraws
     window.draw()                                       # moving: into the window, sRGB by the window
