@@ -54,6 +54,33 @@ def test_save_preset_to_json_with_maps_writes_the_factors_and_says_so(ctx):
     ctx.item_click("**/clear")   # the base colour slot's (the first row's)
 
 
+def test_export_gltf_with_the_files_own_materials_shown_says_what_it_left_out(ctx):
+    """The exporter writes the panel's material on every part: with a textured file's own
+    materials in the view, the status row says in one line that they and their textures were
+    left out (the user's report: it said just 'exported')."""
+    from alight.frontends.editor.ui_test import editor
+
+    s = editor().state
+    shared = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..", "shared", "data")
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/mesh", os.path.join(shared, "models", "Duck.glb"))
+    ctx.item_click("**/open mesh")
+    assert s.use_file_materials, (s.error, s.message)
+    path = os.path.join(OUT, "duck_export.glb")
+    ctx.item_input_value("**/glTF file", path)
+    ctx.item_click("**/export glTF")
+    assert not s.error, s.error
+    assert os.path.isfile(path), s.message
+    assert s.message.startswith(f"exported {path} (") and "\n" not in s.message, s.message
+    assert "1 material and 1 texture left out" in s.message, s.message
+    ctx.item_uncheck("**/mesh file's own materials and maps")   # the view shows what is written
+    ctx.item_click("**/export glTF")
+    assert s.message == f"exported {path}", s.message
+    ctx.combo_click("preview mesh/sphere")
+    ctx.item_close("**/Environment")
+
+
 # --- 3: a path that failed does not stay in its field ----------------------------------------------
 
 def test_a_failed_path_leaves_the_loaded_one_in_its_field(ctx):
@@ -82,7 +109,11 @@ def test_a_failed_path_leaves_the_loaded_one_in_its_field(ctx):
         assert shown != typed, f"the {field} field still shows the path that failed: {shown}"
     assert panel.mesh_path == s.mesh_spec == good_mesh, (panel.mesh_path, s.mesh_spec)
     assert panel.env_path == "", panel.env_path   # the studio is loaded: no file
+    ctx.combo_click("preview mesh/shader_ball")   # a built-in: the field shows it, not the last file
+    assert s.mesh_spec == "shader_ball", s.error
+    assert panel.mesh_path == "shader_ball", f"the mesh field shows {panel.mesh_path!r} with the shader ball loaded"
     ctx.combo_click("preview mesh/sphere")   # back to the ball the next checks look at
+    assert panel.mesh_path == "sphere", panel.mesh_path
     ctx.item_close("**/Environment")
     checks = (("texture set", "load set", bad, lambda: panel.set_path),
               ("map file", "load##typed", bad + ".png", lambda: panel.map_path),

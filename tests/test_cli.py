@@ -151,6 +151,22 @@ def test_transparent_background_png_has_alpha(out_dir):
     assert px[SIZE // 2, SIZE // 2, 3] == 255
 
 
+def test_background_help_says_what_each_output_has(out_dir):
+    """``render --help`` said of --background 'alpha is 0 there in every mode', but a .png with
+    the default background has no alpha: the help now says what each file holds, as written."""
+    text = " ".join(run("render", "--help").stdout.split())
+    assert "alpha is 0 there in every mode" not in text
+    assert "A .png is RGB with the background drawn in, except with transparent: RGBA" in text, text
+    assert "a .exr is RGBA in every mode, alpha 0 there" in text, text
+    png, exr = out_dir / "env.png", out_dir / "env.exr"
+    render(png)   # the default background, env
+    render(exr)
+    assert read(png)[1].nchannels == 3
+    px, spec = read(exr)
+    assert spec.nchannels == 4 and px[0, 0, 3] == 0.0 and px[0, 0, :3].max() > 0.0
+    assert px[SIZE // 2, SIZE // 2, 3] == 1.0
+
+
 def test_background_color_red(out_dir):
     out = out_dir / "red.png"
     render(out, "--background", "color", "--background-color", "1,0,0", "--tonemap", "none")

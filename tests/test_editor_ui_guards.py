@@ -72,6 +72,29 @@ def test_a_press_aimed_at_a_layout_gone_is_dropped_with_its_release():
     late = ("button", 0, PRESS, 0)
     g.pressed(late)
     out, rest = g.sort([release, ("cursor", 150.0, 10.0), late], 2, panel)
-    assert out == [release, ("cursor", 150.0, 10.0)] and rest == [late]
+    assert out == [release] and rest == [("cursor", 150.0, 10.0), late]   # no motion after a change
     out, rest = g.sort(rest, 2, panel)
-    assert out == [late] and g.dropped == 1
+    assert out == [("cursor", 150.0, 10.0), late] and g.dropped == 1
+
+
+def test_a_fast_drag_reaches_imgui_with_its_release_after_its_last_motion():
+    """press_guard.PressGuard.sort: a press, motions and a release that came in one poll reach
+    imgui in three frames (the press; the motions, button down; the release), so a slider sees
+    the last motion before the button goes up (the user's fast drags ended short, or a burst
+    changed nothing)."""
+    from alight.frontends.editor.keys import PRESS, RELEASE
+    from alight.frontends.editor.press_guard import PressGuard
+
+    g = PressGuard()
+    g.built(1, ("a",))
+    g.shown = 1
+    press, release = ("button", 0, PRESS, 0), ("button", 0, RELEASE, 0)
+    g.pressed(press)
+    moves = [("cursor", 100.0 + 10 * i, 10.0) for i in range(4)]
+    events = [("cursor", 90.0, 10.0), press, *moves, release]
+    out, rest = g.sort(events, 1, lambda x, y: True)
+    assert out == [("cursor", 90.0, 10.0), press] and rest == [*moves, release]
+    out, rest = g.sort(rest, 1, lambda x, y: True)
+    assert out == moves and rest == [release]
+    out, rest = g.sort(rest, 1, lambda x, y: True)
+    assert out == [release] and rest == [] and g.dropped == 0

@@ -33,6 +33,20 @@ def test_a_drag_made_during_a_busy_frame_turns_the_camera(display):
     assert result.stdout.startswith("ok: turned"), result.stdout
 
 
+def test_a_fast_slider_drag_counts_to_its_last_motion(display):
+    """Real X events (XTest): the roughness slider dragged from its left end past its right end,
+    all between two frames, or with the last motion and the release queued together, ends at
+    1.000 (tests/editor_x_events_slider.py)."""
+    import os
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, str(REPO / "tests" / "editor_x_events_slider.py")], cwd=REPO,
+                            env=dict(os.environ, DISPLAY=display), capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok:"), result.stdout
+
+
 def test_the_first_orbit_of_a_material_is_compiled_away_from_the_frames(display, tmp_path):
     """A real drag (XTest) starts the first orbit; its window-drawn variant is the warm-up
     process's job, not the frame's, with an empty Mesa shader cache (tests/editor_x_events_first_orbit.py)."""

@@ -43,7 +43,9 @@ def add_parser(sub) -> None:
     d.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
                    help="PNG only (refused with .exr): multiply radiance by 2^EV before tone mapping (default: 0)")
     d.add_argument("--background", choices=("env", "blur", "color", "transparent"), default="env",
-                   help="what lies behind the object (default: env); alpha is 0 there in every mode")
+                   help="what lies behind the object (default: env). A .png is RGB with the background drawn "
+                        "in, except with transparent: RGBA, alpha 0 (and RGB 0) there; a .exr is RGBA in every "
+                        "mode, alpha 0 there (RGB the background's radiance, 0 with transparent)")
     d.add_argument("--background-color", metavar="R,G,B", help="linear colour for --background color")
     d.add_argument("--aa", choices=("none", "msaa", "ssaa"), default="msaa",
                    help="anti-aliasing: msaa (4 samples) or ssaa (2x2 supersampling) (default: msaa; "

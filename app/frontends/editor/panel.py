@@ -269,15 +269,16 @@ class Panel:
         return shown
 
     def _follow_loaded(self, s) -> None:
-        """The mesh and env path fields show the file loaded (a restored session, a drop), not
-        what was typed before it; a built-in mesh or the studio leaves the field as it is."""
+        """The mesh and env path fields show what is loaded (a restored session, a drop, the
+        'preview mesh' list, the 'studio' button), not what was typed before it: a file's path,
+        a built-in mesh's name (which the field opens too), and no file for the studio."""
         specs = (s.mesh_spec, s.env_spec)
         if specs == self._specs_shown:
             return
-        if s.mesh_spec != self._specs_shown[0] and s.mesh_spec not in BUILTIN_MESHES:
-            self.mesh_path = self._good["mesh_path"] = s.mesh_spec
-        if s.env_spec != self._specs_shown[1] and s.env_spec != "studio":
-            self.env_path = self._good["env_path"] = s.env_spec
+        if s.mesh_spec != self._specs_shown[0]:
+            self.mesh_path = self._good["mesh_path"] = s.mesh_spec or ""
+        if s.env_spec != self._specs_shown[1]:
+            self.env_path = self._good["env_path"] = "" if s.env_spec == "studio" else (s.env_spec or "")
         self._specs_shown = specs
 
     def _follow_maps(self, s) -> None:
@@ -412,8 +413,8 @@ class Panel:
 
     def _export_gltf(self, s) -> None:
         try:
-            s.export_gltf(self.gltf_path)
-            s.error, s.message = "", f"exported {self.gltf_path}"
+            note = s.export_gltf(self.gltf_path)
+            s.error, s.message = "", f"exported {self.gltf_path}{f' ({note})' if note else ''}"
         except AlightError as exc:
             s.fail(exc)
 

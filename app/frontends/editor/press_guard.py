@@ -38,16 +38,21 @@ class PressGuard:
 
     def sort(self, events: list[tuple], last_built: int, over_panel) -> tuple[list[tuple], list[tuple]]:
         """(the events to hand imgui this frame, the rest: back to the queue's front). One button
-        change a frame: imgui would spread a press and release that came together over frames of
-        its own (its input trickling), and a press must reach it in the frame after
-        ``last_built``, whose layout it is checked against. A press over the panel (``over_panel``
+        change a frame, with no motion after it, and a release in a frame of its own when motions
+        came before it: each motion is then seen with the button as it was then, so a drag counts
+        to its last motion (imgui's own trickling would spread them over frames while this queue
+        went on feeding it, and a release then joined the last motions in one frame). A press
+        must reach imgui in the frame after ``last_built``, whose layout it is checked against. A press over the panel (``over_panel``
         (x, y) -> bool, window coordinates) aimed at a layout other than ``last_built``'s is
         dropped, with its release."""
         out = []
-        changed = False
+        changed = moved = False
         for i, event in enumerate(events):
             if event[0] == "cursor":
+                if changed:   # a motion after the button changed: the widget sees it next frame
+                    return out, events[i:]
                 self.pointer = (event[1], event[2])
+                moved = True
             if event[0] != "button":
                 out.append(event)
                 continue
@@ -55,7 +60,10 @@ class PressGuard:
             if action == RELEASE and button in self._dropping:
                 self._dropping.discard(button)
                 continue
-            if changed:
+            # One button change a frame; and a release never in the frame of a motion before it:
+            # imgui would apply both before the widgets run, and a slider (any drag) let go
+            # without seeing the button down at the last position (the end of a fast drag lost).
+            if changed or (moved and action == RELEASE):
                 return out, events[i:]
             if action == PRESS:
                 aim = self.aims.pop(id(event), self.shown)

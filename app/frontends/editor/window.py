@@ -251,6 +251,10 @@ class EditorWindow:
         """This frame's key and character events to imgui, in order (keys.KeyEvents says why
         not all of them), less the presses aimed at a panel layout gone (press_guard.py)."""
         io = self.imgui.get_io()
+        if len(self.imgui.get_current_context().input_events_queue):
+            # imgui kept events of the last batch for a frame of their own (its trickling): the
+            # next batch waits, so no release joins motions queued before it (press_guard.sort).
+            return
         guard = self.press_guard
         dropped = guard.dropped
         events, rest = guard.sort(self.key_events.take_frame(), self._frame_no, self._over_panel)

@@ -1,0 +1,130 @@
+"""A fast drag on a panel slider, as real X events (XTest) under Xvfb: run by
+tests/test_editor_ui_speed.py in a fresh interpreter (``python tests/editor_x_events_slider.py``);
+exits 0 when every drag ended the roughness slider at its right end, 1 with a line per drag
+that did not.
+
+The user's report: dragging the roughness slider from its left end quickly past its right end
+(moves every 16 ms, the release right after the last move) ended at 0.935, 0.98, 0.832; a
+press-move-release burst with no frame between its events changed nothing. Each drag here
+starts at the slider's left end with roughness 0 and ends past its right end; what the frames
+see of it differs: all of it queued between two frames (a long frame), or motions polled by
+frames with the last motion and the release queued together."""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import dataclasses
+import sys
+
+
+def main() -> int:
+    from imgui_bundle import imgui
+
+    from alight.frontends.editor.state import EditorState
+    from alight.frontends.editor.window import EditorWindow
+
+    x11 = ctypes.CDLL(ctypes.util.find_library("X11"))
+    xtst = ctypes.CDLL(ctypes.util.find_library("Xtst") or "libXtst.so.6")
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XSync.argtypes = [ctypes.c_void_p, ctypes.c_int]
+    xtst.XTestFakeMotionEvent.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_ulong]
+    xtst.XTestFakeButtonEvent.argtypes = [ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_ulong]
+    display = x11.XOpenDisplay(None)
+
+    rects = {}
+    slider_float = imgui.slider_float
+
+    def recording_slider(label, *args, **kwargs):   # where the roughness slider is drawn
+        result = slider_float(label, *args, **kwargs)
+        if label == "roughness":
+            lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+            rects[label] = (lo.x, lo.y, hi.x, hi.y)
+        return result
+
+    imgui.slider_float = recording_slider
+
+    state = EditorState()
+    state.load_mesh("sphere")
+    state.load_env("studio")
+    win = EditorWindow(state, (900, 1000))   # the slider on screen without scrolling
+    failures = []
+    try:
+        glfw = win.glfw
+        glfw.set_window_pos(win.window, 0, 0)
+        glfw.focus_window(win.window)
+        for _ in range(5):
+            win.frame()
+        x0, y0 = glfw.get_window_pos(win.window)
+        left, top, right, bottom = rects["roughness"]
+        y = int(y0 + (top + bottom) / 2)
+        start_x, end_x = int(x0 + left + 2), int(x0 + right + 40)
+
+        def move(x):
+            xtst.XTestFakeMotionEvent(display, -1, x, y, 0)
+
+        def button(down):
+            xtst.XTestFakeButtonEvent(display, 1, 1 if down else 0, 0)
+
+        def sync(frames=0):
+            x11.XSync(display, 0)
+            for _ in range(frames):
+                win.frame()
+
+        steps = [start_x + (end_x - start_x) * i // 10 for i in range(1, 11)]
+
+        def burst():   # everything between two frames
+            button(True)
+            for x in steps:
+                move(x)
+            button(False)
+            sync()
+
+        def polled():   # frames poll the motions; the last motion and the release come together
+            button(True)
+            sync(1)
+            for x in steps[:-1]:
+                move(x)
+                sync(1)
+            move(steps[-1])
+            button(False)
+            sync()
+
+        def pressed_then_burst():   # the press polled alone; then the rest at once
+            button(True)
+            sync(1)
+            for x in steps:
+                move(x)
+            button(False)
+            sync()
+
+        def slow():   # frames between every event: the baseline
+            button(True)
+            sync(2)
+            for x in steps:
+                move(x)
+                sync(2)
+            button(False)
+            sync(2)
+
+        for name, drag in (("slow", slow), ("burst", burst), ("polled", polled), ("pressed then burst", pressed_then_burst)):
+            state.material = dataclasses.replace(state.material, roughness=0.0)
+            move(start_x)
+            sync(3)
+            drag()
+            sync(8)
+            got = state.material.roughness
+            if got < 0.999:
+                failures.append(f"{name}: the drag ended at roughness {got:.3f}, not 1.000")
+        if failures:
+            print("\n".join(failures))
+            return 1
+        print("ok: every fast drag ended at roughness 1.000")
+        return 0
+    finally:
+        win.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
