@@ -196,6 +196,16 @@ def test_browse_files_and_browse_set(ctx):
 
 # --- Display & camera ----------------------------------------------------------------------------------
 
+def _until_compiled(ctx, frames: int = 6000) -> None:
+    """Frames until no draw of the view waits for the warm-up process."""
+    warm = editor().variant_warmup
+    for _ in range(frames):
+        ctx.yield_()
+        if not warm.pending and not warm.showing_old:
+            return
+    raise AssertionError(f"the view still waited for the warm-up after {frames} frames")
+
+
 def test_render_scale_and_anti_aliasing_in_the_window(ctx):
     """view() draws at full size whatever the scale: the window as shown is what a user sees."""
     s = editor().state
@@ -222,6 +232,9 @@ def test_render_scale_and_anti_aliasing_in_the_window(ctx):
     # MSAA smooths the ball's silhouette against the flat background: edge pixels change.
     ctx.combo_click("anti-aliasing/msaa")
     assert s.aa == "msaa"
+    # MSAA's passes are new programs: the view keeps the last picture until the warm-up process
+    # has drawn them (variant_warmup.py), then shows the smoothed one.
+    _until_compiled(ctx)
     ctx.yield_(3)
     smooth = _view_of(capture(ctx, "aa_msaa.png"))
     moved = (np.abs(smooth - full).max(axis=2) > 8).sum()
