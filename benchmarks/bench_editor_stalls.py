@@ -17,6 +17,8 @@ on the built-in sphere in the built-in studio:
   more; then compare 'reference' at ``--scale`` until A's half is whole and 10 more (the composite
   pass and the reference's tone map pass drawn first); then the tone map changed to neutral. Each
   run has an empty Mesa shader cache of its own. The longest frame of each step.
+- preset: this checkout on both sides, "before" with the presets' prefetch cancelled: velvet's
+  first click after the view settled, frames until the view shows it (``child_preset``).
 - variant: gold, 20 frames, then clearcoat 1.0 (set on the state); frames timed until the view
   shows the clearcoat picture and 10 more. Each run has an empty Mesa shader cache of its own
   (MESA_SHADER_CACHE_DIR), as a first switch on a new machine.
@@ -166,6 +168,35 @@ def child_occlusion(size) -> dict:
         win.close()
 
 
+def child_preset(size, with_prefetch: bool) -> dict:
+    """The built-in sphere in the studio with plastic_high; the view settles (and, with
+    ``with_prefetch``, the presets' prefetch finishes: variant_warmup.PresetPrefetch; without, it is
+    cancelled); then velvet (a sheen layer: a new variant) is set as the panel's click sets it.
+    Frames until the view shows velvet, each frame's wall and main-thread CPU time."""
+    from alight.exchange.presets import load_preset
+
+    state, win = _window(size)
+    warm, prefetch = win.variant_warmup, win.preset_prefetch
+    try:
+        if not with_prefetch:
+            prefetch.cancel()
+        _frames_until(win, lambda: not warm.pending and not warm.showing_old and prefetch.done, after=20,
+                      limit_s=600.0)
+        state.material = load_preset("velvet")
+        frames, start, shown = [], time.perf_counter(), None
+        while time.perf_counter() - start < 300 and shown is None:
+            cpu0 = time.thread_time()
+            t = _timed_frame(win)
+            frames.append((t, time.thread_time() - cpu0))
+            if not warm.pending and not warm.showing_old and win._last_complete_scene.material == state.material:
+                shown = time.perf_counter() - start
+        return {"prefetch": prefetch.done and bool(prefetch.keys), "frames": len(frames), "shown_s": shown,
+                "max_ms": 1000 * max(f[0] for f in frames), "max_cpu_ms": 1000 * max(f[1] for f in frames),
+                "warmup_jobs": warm.jobs}
+    finally:
+        win.close()
+
+
 def _frames_until(win, done, after: int = 10, limit_s: float = 300.0) -> list[float]:
     """Timed frames until ``done()`` and ``after`` more."""
     times, start, extra = [], time.perf_counter(), 0
@@ -214,12 +245,15 @@ def child_split(size, scale: float) -> dict:
 
 def run(side: str, what: str, args) -> dict:
     env = dict(os.environ)
-    if side == "before":
+    child = what
+    if what == "preset":   # this checkout both sides: "before" without the presets' prefetch
+        child = "preset" if side == "after" else "preset-noprefetch"
+    elif side == "before":
         env["PYTHONPATH"] = args.base + os.pathsep + env.get("PYTHONPATH", "")
     with tempfile.TemporaryDirectory(prefix="alight-bench-stalls-", ignore_cleanup_errors=True) as tmp:
         env["MESA_SHADER_CACHE_DIR"] = os.path.join(tmp, "mesa")
         env["ALIGHT_CACHE_DIR"] = os.path.join(tmp, "cache")
-        cmd = [sys.executable, os.path.abspath(__file__), "--child", what, "--size", args.size,
+        cmd = [sys.executable, os.path.abspath(__file__), "--child", child, "--size", args.size,
                "--scale", str(args.scale), "--limit", str(args.limit)]
         out = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=tmp)
     if out.returncode != 0:
@@ -230,12 +264,12 @@ def run(side: str, what: str, args) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--base", help="a folder whose 'alight' is the other checkout's app/")
-    ap.add_argument("--what", choices=("reference", "variant", "split", "occlusion", "both"), default="both")
+    ap.add_argument("--what", choices=("reference", "variant", "split", "occlusion", "preset", "both"), default="both")
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--size", default="800x720")
     ap.add_argument("--scale", type=float, default=0.25)
     ap.add_argument("--limit", type=float, default=600.0, help="seconds a reference run waits at most")
-    ap.add_argument("--child", choices=("reference", "variant", "split", "occlusion"))
+    ap.add_argument("--child", choices=("reference", "variant", "split", "occlusion", "preset", "preset-noprefetch"))
     args = ap.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     if args.child == "reference":
@@ -244,13 +278,16 @@ def main() -> None:
     if args.child == "split":
         print(json.dumps(child_split(size, args.scale)))
         return
+    if args.child in ("preset", "preset-noprefetch"):
+        print(json.dumps(child_preset(size, args.child == "preset")))
+        return
     if args.child == "occlusion":
         print(json.dumps(child_occlusion(size)))
         return
     if args.child == "variant":
         print(json.dumps(child_variant(size)))
         return
-    if not args.base:
+    if not args.base and args.what != "preset":
         raise SystemExit("--base is required (the 'before' checkout)")
     whats = ("reference", "variant") if args.what == "both" else (args.what,)
     for what in whats:
@@ -262,7 +299,8 @@ def main() -> None:
                 print(f"{what} round {r + 1} {side}: " + ", ".join(
                     f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in res.items()), flush=True)
         for side, runs in results.items():
-            for field in (("median_ms", "max_ms") if what not in ("split", "occlusion") else
+            for field in (("shown_s", "max_ms", "max_cpu_ms") if what == "preset" else
+                          ("median_ms", "max_ms") if what not in ("split", "occlusion") else
                           ("other_max_wall_ms", "other_max_cpu_ms", "other_max_process_cpu_ms") if what == "occlusion" else
                           ("plain_tonemap_max_ms", "split_open_max_ms", "split_tonemap_max_ms")):
                 xs = [x[field] for x in runs]
