@@ -109,6 +109,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "PUNCTUAL_RANGE": "some light has a range (KHR_lights_punctual's range attenuation)",
     # The material and the mesh's attributes.
     "ALPHA_MODE": "the part's alpha mode (an AlphaMode value)",
+    "ALPHA_TO_COVERAGE": "MASK under MSAA: the alpha test per sample, this many samples a pixel "
+                         "(common/mesh_material.glsl alpha_coverage_mask)",
     "UNLIT": "KHR_materials_unlit: base colour only",
     "HAS_VERTEX_COLOR": "the mesh has COLOR_0",
     "HAS_UV1": "a map of the mesh reads TEXCOORD_1 (u_map_uv1 picks each map's set)",
