@@ -10,23 +10,18 @@ compile comes after, a read of the shader cache."""
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
+import os
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
+from x_events import XTest, place_window  # noqa: E402
 
 
 def main() -> int:
     from alight.frontends.editor.state import EditorState
     from alight.frontends.editor.window import EditorWindow
 
-    x11 = ctypes.CDLL(ctypes.util.find_library("X11"))
-    xtst = ctypes.CDLL(ctypes.util.find_library("Xtst") or "libXtst.so.6")
-    x11.XOpenDisplay.restype = ctypes.c_void_p
-    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
-    x11.XSync.argtypes = [ctypes.c_void_p, ctypes.c_int]
-    xtst.XTestFakeMotionEvent.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_ulong]
-    xtst.XTestFakeButtonEvent.argtypes = [ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_ulong]
-    display = x11.XOpenDisplay(None)
+    pointer = XTest()
 
     state = EditorState()
     state.load_mesh("sphere")
@@ -37,9 +32,7 @@ def main() -> int:
         if win.direct_target()[0] is None:
             print("ok: skipped (the window has no depth buffer: orbits are drawn into the view image)")
             return 0
-        glfw = win.glfw
-        glfw.set_window_pos(win.window, 0, 0)
-        glfw.focus_window(win.window)
+        x0, y0 = place_window(win, frames=0)
         # The view settles first, as before an artist's drag: the opening camera's ease-in done,
         # the still view's programs compiled (the warm-up's jobs where gated), its image drawn.
         for _ in range(600):
@@ -47,21 +40,20 @@ def main() -> int:
             if (not warm.pending and not warm.showing_old and win._drawn_targets is not None
                     and win.orbit.camera() == win._last_camera):
                 break
-        x0, y0 = glfw.get_window_pos(win.window)
         start = (x0 + (win.size[0] - win.panel_width()) // 4, y0 + 200)
-        xtst.XTestFakeMotionEvent(display, -1, start[0], start[1], 0)
-        x11.XSync(display, 0)
+        pointer.move(start[0], start[1])
+        pointer.sync()
         for _ in range(3):
             win.frame()
         before, jobs = set(shaders.compiled_keys()), warm.jobs
-        xtst.XTestFakeButtonEvent(display, 1, 1, 0)
-        x11.XSync(display, 0)
+        pointer.button(True)
+        pointer.sync()
         compiled_in_frame, frames, step, settled = [], 0, 0, False
         # The hand keeps dragging, a motion a frame, until the view is drawn into the window.
         while frames < 600:
             step += 1
-            xtst.XTestFakeMotionEvent(display, -1, start[0] + (step % 40) * 4, start[1], 0)
-            x11.XSync(display, 0)
+            pointer.move(start[0] + (step % 40) * 4, start[1])
+            pointer.sync()
             win.frame()
             frames += 1
             new = set(shaders.compiled_keys()) - before
@@ -71,8 +63,8 @@ def main() -> int:
             settled = warm.jobs > jobs and not warm.pending and not warm.showing_old
             if settled:
                 break
-        xtst.XTestFakeButtonEvent(display, 1, 0, 0)
-        x11.XSync(display, 0)
+        pointer.button(False)
+        pointer.sync()
         win.frame()
         if warm.jobs == jobs:
             print("the first orbit asked the warm-up process for nothing (its program was compiled in the frame, "

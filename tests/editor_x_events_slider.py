@@ -12,10 +12,12 @@ frames with the last motion and the release queued together."""
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import dataclasses
+import os
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
+from x_events import XTest, place_window  # noqa: E402
 
 
 def main() -> int:
@@ -24,14 +26,7 @@ def main() -> int:
     from alight.frontends.editor.state import EditorState
     from alight.frontends.editor.window import EditorWindow
 
-    x11 = ctypes.CDLL(ctypes.util.find_library("X11"))
-    xtst = ctypes.CDLL(ctypes.util.find_library("Xtst") or "libXtst.so.6")
-    x11.XOpenDisplay.restype = ctypes.c_void_p
-    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
-    x11.XSync.argtypes = [ctypes.c_void_p, ctypes.c_int]
-    xtst.XTestFakeMotionEvent.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_ulong]
-    xtst.XTestFakeButtonEvent.argtypes = [ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_ulong]
-    display = x11.XOpenDisplay(None)
+    pointer = XTest()
 
     rects = {}
     slider_float = imgui.slider_float
@@ -51,24 +46,19 @@ def main() -> int:
     win = EditorWindow(state, (900, 1000))   # the slider on screen without scrolling
     failures = []
     try:
-        glfw = win.glfw
-        glfw.set_window_pos(win.window, 0, 0)
-        glfw.focus_window(win.window)
-        for _ in range(5):
-            win.frame()
-        x0, y0 = glfw.get_window_pos(win.window)
+        x0, y0 = place_window(win)
         left, top, right, bottom = rects["roughness"]
         y = int(y0 + (top + bottom) / 2)
         start_x, end_x = int(x0 + left + 2), int(x0 + right + 40)
 
         def move(x):
-            xtst.XTestFakeMotionEvent(display, -1, x, y, 0)
+            pointer.move(x, y)
 
         def button(down):
-            xtst.XTestFakeButtonEvent(display, 1, 1 if down else 0, 0)
+            pointer.button(down)
 
         def sync(frames=0):
-            x11.XSync(display, 0)
+            pointer.sync()
             for _ in range(frames):
                 win.frame()
 

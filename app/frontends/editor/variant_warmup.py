@@ -57,6 +57,15 @@ class WarmupJob:
     materials: tuple = ()       # the scene drawn once with each of these instead (PresetPrefetch)
 
 
+def _compiled_keys(path) -> set:
+    """The program keys a child wrote to ``path`` (nothing where it could not be read)."""
+    try:
+        with open(path, "rb") as f:
+            return set(pickle.load(f))
+    except (OSError, pickle.UnpicklingError, EOFError):
+        return set()
+
+
 class VariantWarmup:
     """The parent's side: ``gate`` for the view's draws, ``request`` when one was held back,
     ``step`` each frame. ``pending``: a draw waits for the child now."""
@@ -115,13 +124,7 @@ class VariantWarmup:
             if job_id != self._job_id or word == "progress":
                 continue
             if word == "done":
-                try:
-                    with open(self._out, "rb") as f:
-                        keys = pickle.load(f)
-                    self._warm.update(keys)
-                    self.drawn_by_child.update(keys)
-                except (OSError, pickle.UnpicklingError, EOFError):
-                    pass
+                self.add_drawn(_compiled_keys(self._out))
                 self._out.unlink(missing_ok=True)
             else:   # the child may have restarted: send the mesh and environment again
                 self._sent = (None, None)
@@ -190,11 +193,7 @@ class PresetPrefetch:
             if job_id != self._job_id or word == "progress":
                 continue
             if word == "done":
-                try:
-                    with open(self._out, "rb") as f:
-                        self.keys = set(pickle.load(f))
-                except (OSError, pickle.UnpicklingError, EOFError):
-                    self.keys = set()
+                self.keys = _compiled_keys(self._out)
                 win.variant_warmup.add_drawn(self.keys)
             self.done = True
             self.close()
@@ -285,7 +284,8 @@ def main() -> int:
 
     # A hidden window as the editor's (where a display is), for the view's moving frames; its
     # context serves the offscreen draws too (the same llvmpipe, the same shader cache).
-    window = hidden_window_context()
+    prefetch = "--niced" in sys.argv[1:]   # (PresetPrefetch's child: offscreen draws only, no window)
+    window = None if prefetch else hidden_window_context()
     renderer = ForwardRenderer(window[1] if window is not None else None)
     targets = {}
     have = {"mesh": (None, None), "env": (None, None)}   # token -> the object last sent
@@ -330,7 +330,7 @@ def main() -> int:
     # the presets' prefetch (--niced) is work ahead of need, below it.
     from alight.frontends.editor.worker_process import CHILD_NICENESS
 
-    return serve(handle, niceness=CHILD_NICENESS if "--niced" in sys.argv[1:] else 0)
+    return serve(handle, niceness=CHILD_NICENESS if prefetch else 0)
 
 
 if __name__ == "__main__":
