@@ -5,6 +5,7 @@ forward pass."""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from pathlib import Path
 
@@ -266,11 +267,13 @@ def _estimate(scene: Scene, size: int) -> float:
 def test_auto_takes_the_visibility_buffer_on_a_dense_mesh_only(tmp_path):
     """A grid of 28,800 triangles over a few thousand pixels takes the visibility buffer, with
     the forward pass's picture; a grid of 32 triangles in the same place keeps the forward pass."""
-    from alight.render.vbuffer import AUTO_PIXELS_PER_TRIANGLE
+    from alight.render.vbuffer import auto_threshold
+    from tests.gpu import renderer
 
     dense = Scene(mesh=load_mesh(str(_checker_grid(tmp_path, 120))), camera=CAMERA, lights=list(LIGHTS))
     sparse = Scene(mesh=load_mesh(str(_checker_grid(tmp_path, 4))), camera=CAMERA, lights=list(LIGHTS))
-    assert _estimate(dense, 160) < AUTO_PIXELS_PER_TRIANGLE < _estimate(sparse, 160)
+    threshold = auto_threshold(renderer(), sparse, _maps())[0]
+    assert _estimate(dense, 160) < threshold < _estimate(sparse, 160)
     frame, used = _auto(dense, 160)
     forward = both(dense, 160)[0]
     assert_same(forward, frame, used, limit=REL_LIMIT_GRID)
@@ -279,12 +282,39 @@ def test_auto_takes_the_visibility_buffer_on_a_dense_mesh_only(tmp_path):
     np.testing.assert_array_equal(frame.linear, both(sparse, 160)[0].linear)
 
 
-@pytest.mark.parametrize("size", [1024, 512])
-def test_auto_keeps_the_helmet_forward(size):
-    """DamagedHelmet at the command line's default size (1024) and the API's (512) keeps the
-    forward pass: its triangles are too large there for the visibility buffer to pay."""
+def test_auto_follows_the_pixels_cost_on_the_helmet():
+    """DamagedHelmet at 512 pixels (about 9.6 estimated pixels per triangle): with its own five
+    maps the pixel is heavy enough for the visibility buffer to pay (auto_threshold's textured
+    factor; measured 0.82x the forward frame), in the grey panel material it is not (the
+    untextured threshold, 3); at 1024 (about 38) both keep the forward pass."""
+    from alight.core.material import Material
+
+    textured = Scene(mesh=load_mesh(str(HELMET)))
+    assert _auto(textured, 512)[1]
+    grey = Scene(mesh=load_mesh(str(HELMET)), use_file_materials=False, material=Material())
+    assert not _auto(grey, 512)[1]
+    assert not _auto(textured, 1024)[1]
+
+
+def test_auto_counts_a_suns_soft_shadows():
+    """A sun's shadow (PCSS) doubles the threshold: the helmet's density at 768 pixels (about 21.6)
+    is above the textured threshold (12) and below it with the sun's shadows (24)."""
+    from alight.render.vbuffer import auto_threshold, pixels_per_triangle
+    from tests.gpu import renderer
+
+    from alight.ibl.environment import load_environment
+
+    r = renderer()
+    quarry = r.bake(load_environment(str(SHARED / "env" / "quarry_01_1k.hdr")), "low")
+    assert quarry.suns, "quarry_01 has a sun"
     scene = Scene(mesh=load_mesh(str(HELMET)))
-    assert not _auto(scene, size)[1]
+    r.render(scene, quarry, 64, 64)      # the parts uploaded, as a frame has them
+    density = pixels_per_triangle(r, scene, r.camera_for(scene, 1.0).view_projection(1.0), (768, 768))
+    plain, _ = auto_threshold(r, scene, None)
+    with_sun, why = auto_threshold(r, scene, quarry)
+    assert plain < density < with_sun and "soft shadows" in why
+    no_shadows, _ = auto_threshold(r, dataclasses.replace(scene, shadows="off"), quarry)
+    assert no_shadows == plain
 
 
 def test_auto_keeps_the_builtin_sphere_forward():

@@ -179,7 +179,7 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         frame.impostor_samples = 0
     if frame.impostor_model is None:    # (without an impostor only 4x msaa is eligible: vbuffer.choose)
         use, r.last_mesh_shading_reason = vbuffer.choose(r, scene, targets, fbo, background, view_projection,
-                                                         (view.width, view.height))
+                                                         (view.width, view.height), maps)
     else:
         use, r.last_mesh_shading_reason = False, "the built-in sphere has its own impostor"
     r.last_vbuffer = use

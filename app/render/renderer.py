@@ -130,7 +130,8 @@ class ForwardRenderer:
         # once per triangle covering a pixel's samples, "vbuffer" from a visibility buffer, each
         # 2x2 block once per visible triangle in it, where the scene allows it; "auto" (the
         # default) the visibility buffer only where the mesh is dense on screen (vbuffer.dense:
-        # fewer than AUTO_PIXELS_PER_TRIANGLE covered pixels per triangle), where it is faster.
+        # fewer covered pixels per triangle than vbuffer.auto_threshold, which grows with the
+        # pixel's cost), where it is faster.
         self.mesh_shading = "auto"
         # How the user named mesh_shading, for the one warning a render gives where "vbuffer" was
         # asked for and the forward pass drew (passes.note_mesh_shading; the CLI: --mesh-shading).

@@ -157,7 +157,7 @@ class ShadowMaps:
         mode = getattr(scene, "shadows", "auto")
         if mode == "off" or scene.view == "probe" or scene.mesh is None or not scene.mesh.parts:
             return False
-        suns = _shadowed_suns(scene, maps)
+        suns = shadowed_suns(scene, maps)
         if not scene.lights and not suns:
             return False
         return mode == "on" or receivers or self.mesh_can_shadow_itself(scene.mesh)
@@ -171,7 +171,7 @@ class ShadowMaps:
         self.last_active = self.wanted(scene, maps, receivers)
         if not self.last_active:
             return False
-        suns = _shadowed_suns(scene, maps)
+        suns = shadowed_suns(scene, maps)
         centre, radius = bounds if bounds is not None else scene.mesh.bounding_sphere()
         key = (id(scene.mesh), bool(scene.use_file_materials), tuple(id(g) for g in gpu_parts), tuple(_light_key(x) for x in scene.lights),
                tuple((tuple(np.round(s.direction, 9)), round(float(s.spread), 9)) for s in suns),
@@ -271,7 +271,7 @@ def casters(scene) -> list[bool]:
     return cast
 
 
-def _shadowed_suns(scene, maps) -> list:
+def shadowed_suns(scene, maps) -> list:
     """The compact sources the frame shades exactly, hence can shadow: none for the models that
     keep them baked into the maps (alight.core.ibl_models.SUNS_AS_BAKED)."""
     if maps is None or not scene.ibl_enabled or scene.ibl_model in SUNS_AS_BAKED:

@@ -31,14 +31,15 @@ and nothing but opaque and masked parts (``eligible``): blended, transmissive, t
 built-in sphere and debug views keep the forward pass. Under ``mesh_shading = "auto"`` (the
 default) only where the mesh is dense on screen as well (``dense``: fewer than
 AUTO_PIXELS_PER_TRIANGLE = 3 estimated covered pixels per triangle, about 1.5 counted on a
-sphere), since the visibility pass, the vertex fetches and the id exchange cost about 0.17 s of
+sphere, for an untextured material; more where the pixel costs more, ``auto_threshold``), since the visibility pass, the vertex fetches and the id exchange cost about 0.17 s of
 CPU time a 1024x1024 frame whatever the mesh: on large triangles that is pure overhead (1.5-1.9x
 the forward frame on a sphere of 56-15 pixels per triangle), on small ones it is less than the
-forward pass's overshading and per-triangle work (0.66x at 0.44 pixels per triangle). The
+forward pass's overshading and per-triangle work (0.66x at 0.44 pixels per triangle). The base
 threshold was measured on untextured spheres (benchmarks/results/vbuffer.md); a heavier
-material moves the crossover toward more pixels per triangle (DamagedHelmet: 0.71x at 4.3 pixels
-per triangle, even at 17), which the one threshold does not follow, so the helmet at 512 to
-1024 pixels keeps the forward pass. The visibility bake's per-vertex occlusion
+pixel moves the crossover toward larger triangles, so textured materials and a sun's soft
+shadows raise it (``auto_threshold``, benchmarks/results/vbuffer_cost.md): DamagedHelmet with
+its own maps takes the visibility buffer at 512 pixels (0.82x the forward frame) and keeps the
+forward pass at 1024 (where the visibility buffer is 1.18x). The visibility bake's per-vertex occlusion
 (Scene.occlusion) is read in the shading pass from the baked parts' buffers.
 """
 
@@ -64,6 +65,15 @@ MESH_SHADING = ("auto", "forward", "vbuffer")   # ForwardRenderer.mesh_shading
 # take it; a textured, normal-mapped mesh gains at more pixels per triangle (DamagedHelmet 0.71x
 # at 9.6 estimated), which this one threshold leaves to the forward pass.
 AUTO_PIXELS_PER_TRIANGLE = 3.0
+# A heavier pixel moves the crossover toward larger triangles: what the visibility buffer saves
+# is shading (overdraw, per-triangle set-up), what it costs is per frame. Measured on
+# DamagedHelmet (benchmarks/results/vbuffer_cost.md, CPU time vbuffer/forward, alternated):
+# its own five maps 0.74x at 5.4, 0.82x at 9.6, 1.02x at 21.6, 1.18x at 38 estimated pixels per
+# triangle; with a sun's soft shadows (PCSS: 20 depth fetches a lit pixel) 0.56x, 0.67x, 0.80x,
+# 0.93-1.03x. So auto's threshold is multiplied where a drawn material reads maps and again
+# where a compact source's shadow is drawn, each factor about 0.6 of the measured crossover.
+AUTO_TEXTURED_FACTOR = 4.0
+AUTO_SOFT_SHADOW_FACTOR = 2.0
 VBUFFER_SAMPLES = 4                     # render/vbuffer_shade.frag's sample pattern
 # render/vbuffer_shade.frag passes triangle ids between a block's pixels as floats (exact below
 # 2^24, one id kept for "none"): a part with more triangles keeps the forward pass.
@@ -71,17 +81,17 @@ MAX_TRIANGLES = (1 << 24) - 2
 
 
 def wanted(r, scene, targets, fbo, background: bool, view_projection: np.ndarray | None = None,
-           image_size: tuple[int, int] | None = None) -> bool:
+           image_size: tuple[int, int] | None = None, maps=None) -> bool:
     """Whether this scene pass shades its mesh from the visibility buffer: ``r.mesh_shading``
     asks for it ("vbuffer"; "auto": where the mesh is dense enough on screen, ``dense``) and the
     pass is the fused MSAA resolve's (4 samples, no background drawn, so no blended parts) of a
     mesh file with no transmissive part, ground or debug view. ``view_projection`` and
     ``image_size``: the whole image's (a tile's pass too), for "auto"."""
-    return choose(r, scene, targets, fbo, background, view_projection, image_size)[0]
+    return choose(r, scene, targets, fbo, background, view_projection, image_size, maps)[0]
 
 
 def choose(r, scene, targets, fbo, background: bool, view_projection: np.ndarray | None = None,
-           image_size: tuple[int, int] | None = None) -> tuple[bool, str]:
+           image_size: tuple[int, int] | None = None, maps=None) -> tuple[bool, str]:
     """``wanted`` and why: (True, why the visibility buffer) or (False, why the forward pass),
     the reason a phrase for a message ("the scene has blended parts"; ForwardRenderer's
     last_mesh_shading_reason, the CLI's warning and --verbose line)."""
@@ -99,11 +109,40 @@ def choose(r, scene, targets, fbo, background: bool, view_projection: np.ndarray
     if density is None:
         return False, "the camera is at or inside the mesh" if view_projection is not None else \
             "no view to estimate the mesh's density"
-    if density < AUTO_PIXELS_PER_TRIANGLE:
+    threshold, why = auto_threshold(r, scene, maps)
+    if density < threshold:
         return True, f"the mesh is dense on screen, about {density:.1f} pixels per triangle, " \
-                     f"below {AUTO_PIXELS_PER_TRIANGLE:g}"
+                     f"below {threshold:g}{why}"
     return False, f"the mesh is not dense on screen, about {density:.1f} pixels per triangle; " \
-                  f"auto takes the visibility buffer below {AUTO_PIXELS_PER_TRIANGLE:g}"
+                  f"auto takes the visibility buffer below {threshold:g}{why}"
+
+
+def auto_threshold(r, scene, maps=None) -> tuple[float, str]:
+    """"auto"'s pixels-per-triangle threshold for this scene's shading and, for a message, what
+    raised it ('' or " (textured materials, a sun's soft shadows)"): AUTO_PIXELS_PER_TRIANGLE,
+    times AUTO_TEXTURED_FACTOR where a drawn material reads a map, times AUTO_SOFT_SHADOW_FACTOR
+    where a compact source's shadow is drawn on the mesh (``maps``' suns, alight.render.shadows)."""
+    from alight.render.shadows import shadowed_suns
+
+    threshold, reasons = AUTO_PIXELS_PER_TRIANGLE, []
+    if textured(r, scene):
+        threshold *= AUTO_TEXTURED_FACTOR
+        reasons.append("textured materials")
+    if shadowed_suns(scene, maps) and r.shadow_maps.wanted(scene, maps):
+        threshold *= AUTO_SOFT_SHADOW_FACTOR
+        reasons.append("a sun's soft shadows")
+    return threshold, (f" ({', '.join(reasons)})" if reasons else "")
+
+
+def textured(r, scene) -> bool:
+    """Whether a material the mesh is drawn with reads a texture map: a file material's own maps
+    (where the view shows them) or the user's loaded maps on the panel's material."""
+    if user_maps_present(scene):
+        return True
+    if not scene.use_file_materials:
+        return False
+    return any(part.material is not None and gpu_part.infos
+               for gpu_part, part in zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
 
 
 def eligible(r, scene, targets, fbo, background: bool) -> bool:
@@ -186,11 +225,11 @@ def pixels_per_triangle(r, scene, view_projection: np.ndarray, image_size: tuple
     return area / triangles if triangles else None
 
 
-def dense(r, scene, view_projection: np.ndarray, image_size: tuple[int, int]) -> bool:
-    """"auto"'s choice: the visibility buffer where the mesh has fewer than
-    AUTO_PIXELS_PER_TRIANGLE estimated covered pixels per triangle (``pixels_per_triangle``)."""
+def dense(r, scene, view_projection: np.ndarray, image_size: tuple[int, int], maps=None) -> bool:
+    """"auto"'s choice: the visibility buffer where the mesh has fewer estimated covered pixels
+    per triangle (``pixels_per_triangle``) than ``auto_threshold`` for its shading."""
     density = pixels_per_triangle(r, scene, view_projection, image_size)
-    return density is not None and density < AUTO_PIXELS_PER_TRIANGLE
+    return density is not None and density < auto_threshold(r, scene, maps)[0]
 
 
 def max_viewport(ctx) -> int:
