@@ -64,6 +64,20 @@ def sample_table(part: np.ndarray, n_dot_v, roughness) -> np.ndarray:
     return top * (1 - fy) + bottom * fy
 
 
+def pole_fade(n_dot_v, columns: int):
+    """The fetches' angles' share at ``n_dot_v`` (shaders/common/ibl.glsl pole_fade): 1 up to the
+    table's last n.v texel centre (1 - 0.5 / columns), 0 at n.v = 1, as sqrt(1 - n.v) ~ theta
+    between. At normal incidence the lobe is round about n and the direction "toward the horizon"
+    turns about the pole with the view, so an offset held there draws a pinch at the front of a
+    ball (seen on a rough metal, r 0.6). An offset in proportion to theta (the lobe's asymmetry
+    near the pole) is a smooth vector field over the ball's front. Cost, measured against the
+    exact answer on the probe (4 maps x gold, silver, water x r 0.4/0.6/0.9, the twins of
+    tests/test_ibl_models.py): mean relMAE 4.04% -> 4.11% (a linear fade: 4.15%), worst newport_loft
+    silver r 0.6 4.99% -> 5.7%; the lecture's mean is 33.4%. The pinch's error was small in area
+    and the probe's metric cannot see it; the eye does."""
+    return np.sqrt(np.clip((1.0 - np.asarray(n_dot_v, np.float64)) * 2.0 * columns, 0.0, 1.0))
+
+
 def stretched_fetches(n, v, d, f0, lut_a, lut_b, roughness):
     """The two fetches of ``stretched_prefiltered_radiance`` for points with normals ``n``, views
     ``v``, mean directions ``d`` (P, 3) and the BRDF LUT's A, B (P,): (d_lo, d_hi (P, 3), w_hi
@@ -78,6 +92,7 @@ def stretched_fetches(n, v, d, f0, lut_a, lut_b, roughness):
     toward = d * np.sum(n * d, -1, keepdims=True) - n
     length = np.linalg.norm(toward, axis=-1, keepdims=True)
     toward = np.where(length * length > 1e-10, toward / np.maximum(length, 1e-300), 0.0)
-    d_lo = np.cos(fit[:, :1]) * d + np.sin(fit[:, :1]) * toward
-    d_hi = np.cos(fit[:, 1:2]) * d + np.sin(fit[:, 1:2]) * toward
+    offsets = fit[:, :2] * pole_fade(n_dot_v, table.shape[2])[:, None]
+    d_lo = np.cos(offsets[:, :1]) * d + np.sin(offsets[:, :1]) * toward
+    d_hi = np.cos(offsets[:, 1:2]) * d + np.sin(offsets[:, 1:2]) * toward
     return d_lo, d_hi, fit[:, 2], float(roughness) * np.sqrt(fit[:, 3])

@@ -158,6 +158,12 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
 uniform sampler2D u_stretched_lobe_a;
 uniform sampler2D u_stretched_lobe_b;
 
+// The fetches' angles' share at n.v (the table has `columns` texel centres over n.v): 1 up to
+// the last column's centre, falling to 0 at n.v = 1 as sqrt(1 - n.v) ~ theta, the lobe's asymmetry near the pole (stretched_lobe.py pole_fade).
+float pole_fade(float n_dot_v, float columns) {
+    return sqrt(clamp((1.0 - n_dot_v) * 2.0 * columns, 0.0, 1.0));
+}
+
 // The prefiltered radiance for the real lobe around its mean direction d: the two fitted
 // fetches, the parts' fits mixed by their weights as specular_dominant_direction mixes t_A, t_B.
 vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float roughness, vec3 d, bool with_suns) {
@@ -176,8 +182,12 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
     vec3 toward_horizon = d * dot(n, d) - n;
     toward_horizon = dot(toward_horizon, toward_horizon) > 1e-10 ? normalize(toward_horizon) : vec3(0.0);
     float fetch_roughness = roughness * sqrt(fit.w);
-    vec3 d_lo = cos(fit.x) * d + sin(fit.x) * toward_horizon;
-    vec3 d_hi = cos(fit.y) * d + sin(fit.y) * toward_horizon;
+    // Toward normal incidence the lobe turns round about n, and "toward the horizon" turns about
+    // the pole with the view: offsets held at the last column's would draw a pinch there (a star
+    // at the front of a rough metal ball), so they shrink to 0 at n.v = 1 (in proportion to theta: the offset vector is then smooth).
+    vec2 offsets = fit.xy * pole_fade(coord.x, float(textureSize(u_stretched_lobe_a, 0).x));
+    vec3 d_lo = cos(offsets.x) * d + sin(offsets.x) * toward_horizon;
+    vec3 d_hi = cos(offsets.y) * d + sin(offsets.y) * toward_horizon;
     vec3 stretched = mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
                          prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
 #if STRETCHED_SPAN == 1
