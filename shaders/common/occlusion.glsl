@@ -171,6 +171,19 @@ float combined_visibility(Surface s, vec3 n) {
 // Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
 // the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
 // The compact sources' direct light (with_suns) stays unoccluded here (shadows are theirs).
+#ifdef HAS_SCREEN_AO
+#include "common/gtao.glsl"
+// Screen-space GTAO (app/render/screen_ao.py): the cosine-weighted visibility at this pixel, from
+// the depth of the opaque parts drawn this frame.
+uniform sampler2D u_screen_ao;
+
+// As combined_visibility: the smaller of GTAO's and the glTF occlusion texture's (the texture is
+// the mesh's own baked AO: a product would darken the same crease twice), clamped to [0, 1].
+float screen_visibility(Surface s) {
+    return clamp(min(texelFetch(u_screen_ao, ivec2(gl_FragCoord.xy), 0).r, s.occlusion), 0.0, 1.0);
+}
+#endif
+
 #ifdef HAS_VISIBILITY
 // What the occluded directions send this point (the occluders' bounce and the suns on them),
 // which occlude_environment works out for the base; the layers' lobes above it (clearcoat_ibl,
@@ -210,6 +223,20 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
     prefiltered = so * prefiltered + (1.0 - so) * occluder;
     g_occluder_radiance = occluder;
+#elif defined(HAS_SCREEN_AO)
+    // GTAO knows no bent normal and no occluders' radiance: V scales E(n)/pi (with the paper's
+    // multi-bounce fit, GTAO_MULTI_BOUNCE, for the light the occluders pass on), and the
+    // specular lobe keeps its share inside the visibility cone about n (specular_occlusion, the
+    // bake's cone-cone term with the bent normal taken as n); the blocked share is black.
+    float visibility = screen_visibility(s);
+#ifdef GTAO_MULTI_BOUNCE
+    vec3 lit = gtao_multi_bounce(visibility, s.base_color * (1.0 - s.metallic));
+#else
+    vec3 lit = vec3(visibility);
+#endif
+    irradiance = lit * irradiance_at(n, false);
+    if (with_suns) irradiance += suns_irradiance_over_pi(n);
+    prefiltered *= specular_occlusion(dot(n, r), dot(n, r), visibility, s.roughness);
 #endif
 }
 
@@ -222,6 +249,8 @@ vec3 occluded_layer_radiance(Surface s, vec3 n, vec3 d, float roughness, vec3 pr
 #ifdef HAS_VISIBILITY
     float so = specular_occlusion(dot(bent_normal(n), d), dot(n, d), combined_visibility(s, n), roughness);
     return so * prefiltered + (1.0 - so) * g_occluder_radiance;
+#elif defined(HAS_SCREEN_AO)
+    return specular_occlusion(dot(n, d), dot(n, d), screen_visibility(s), roughness) * prefiltered;
 #else
     return prefiltered;
 #endif
@@ -230,7 +259,7 @@ vec3 occluded_layer_radiance(Surface s, vec3 n, vec3 d, float roughness, vec3 pr
 // What multiplies the whole IBL result (layers too): the occlusion texture alone without a bake;
 // with one it is already in the base's terms above.
 float ibl_outer_occlusion(Surface s) {
-#ifdef HAS_VISIBILITY
+#if defined(HAS_VISIBILITY) || defined(HAS_SCREEN_AO)
     return 1.0;
 #else
     return s.occlusion;

@@ -1,0 +1,120 @@
+"""Screen-space ground-truth ambient occlusion (``--occlusion gtao``; alight.core.gtao, Jimenez et
+al. 2016) for the forward pass: a depth prepass of the opaque parts, the horizon search
+(render/gtao.frag) and its 4x4 depth-aware denoise (render/gtao_denoise.frag), at the scene pass's
+draw size; the forward pass reads the result per pixel (HAS_SCREEN_AO, common/occlusion.glsl).
+
+Per frame and tile, so it follows a moving view with no bake; an occluder outside the tile or
+behind the first surface is not seen (docs/explanation/occlusion.md, "Screen-space GTAO").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from alight.core import gtao
+from alight.render.bindings import UNIT_SCREEN_AO, UNIT_SCREEN_AO_WORK
+
+
+@dataclass
+class ScreenAOTargets:
+    """The pass's textures at one draw size: the prepass's depth, the raw and the denoised visibility."""
+
+    size: tuple[int, int]
+    depth: moderngl.Texture
+    depth_fbo: moderngl.Framebuffer
+    raw: moderngl.Texture
+    raw_fbo: moderngl.Framebuffer
+    visibility: moderngl.Texture
+    visibility_fbo: moderngl.Framebuffer
+
+    def release(self) -> None:
+        for x in (self.depth_fbo, self.raw_fbo, self.visibility_fbo, self.depth, self.raw, self.visibility):
+            x.release()
+
+
+def defines(multi_bounce: bool = True) -> dict:
+    """The forward pass's defines that read the visibility (common/occlusion.glsl)."""
+    d = {"HAS_SCREEN_AO": None}
+    if multi_bounce:
+        d["GTAO_MULTI_BOUNCE"] = None
+    return d
+
+
+class ScreenAO:
+    """The GTAO pass's targets (kept while the draw size stays) and its draw."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.targets: ScreenAOTargets | None = None
+        self.multi_bounce = True     # GTAO_MULTI_BOUNCE: the paper's albedo fit (False: the benchmarks' plain V)
+        self.radius_fraction = gtao.RADIUS_FRACTION
+
+    def _targets(self, size: tuple[int, int]) -> ScreenAOTargets:
+        t = self.targets
+        if t is None or t.size != size:
+            if t is not None:
+                t.release()
+            depth = self.ctx.depth_texture(size)
+            raw = self.ctx.texture(size, 1, dtype="f4")
+            visibility = self.ctx.texture(size, 1, dtype="f4")
+            depth.compare_func = ""     # read as depths, not compared
+            for tex in (depth, raw, visibility):
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.targets = t = ScreenAOTargets(
+                size, depth, self.ctx.framebuffer(depth_attachment=depth), raw,
+                self.ctx.framebuffer(color_attachments=[raw]), visibility,
+                self.ctx.framebuffer(color_attachments=[visibility]))
+        return t
+
+    def draw(self, r, gpu_parts, parts, size: tuple[int, int], view_projection: np.ndarray,
+             inverse_vp: np.ndarray, camera, pixel_scale: float, radius: float) -> moderngl.Texture:
+        """The denoised visibility of the opaque ``gpu_parts`` (with their MeshParts ``parts``)
+        seen through ``view_projection`` at ``size`` (the draw size); returns its texture. Leaves
+        the framebuffer binding and viewport to the caller."""
+        ctx = self.ctx
+        t = self._targets(size)
+        ctx.viewport = (0, 0, size[0], size[1])
+        t.depth_fbo.use()
+        t.depth_fbo.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        prog = r.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+        prog["u_view_projection"].write(np.ascontiguousarray(view_projection, np.float32).tobytes())
+        from alight.render.part_bindings import set_culling
+
+        for gpu_part, part in zip(gpu_parts, parts):
+            set_culling(ctx, gpu_part, part)     # the forward pass's culling: the same front surface
+            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.disable(moderngl.DEPTH_TEST)
+        vp = np.ascontiguousarray(view_projection, np.float32).tobytes()
+        ivp = np.ascontiguousarray(inverse_vp, np.float32).tobytes()
+        search = r.program("render/fullscreen.vert", "render/gtao.frag",
+                           {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS})
+        t.depth.use(UNIT_SCREEN_AO_WORK)
+        search["u_depth"] = UNIT_SCREEN_AO_WORK
+        search["u_inverse_vp"].write(ivp)
+        search["u_view_projection"].write(vp)
+        search["u_camera_position"] = tuple(float(x) for x in camera.position)
+        search["u_radius"] = float(radius)
+        search["u_pixel_scale"] = float(pixel_scale)
+        search["u_max_radius_px"] = float(gtao.MAX_RADIUS_PX)
+        t.raw_fbo.use()
+        r.fullscreen(search)
+        denoise = r.program("render/fullscreen.vert", "render/gtao_denoise.frag")
+        t.raw.use(UNIT_SCREEN_AO)
+        denoise["u_raw"] = UNIT_SCREEN_AO
+        denoise["u_depth"] = UNIT_SCREEN_AO_WORK
+        denoise["u_inverse_vp"].write(ivp)
+        t.visibility_fbo.use()
+        r.fullscreen(denoise)
+        t.visibility.use(UNIT_SCREEN_AO)    # what the forward pass reads (u_screen_ao)
+        return t.visibility
+
+    def release(self) -> None:
+        if self.targets is not None:
+            self.targets.release()
+            self.targets = None
