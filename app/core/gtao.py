@@ -21,7 +21,7 @@ import numpy as np
 # Quality choices (named defines of shaders/render/gtao.frag; app/core/shader_names.py).
 SLICES = 2          # GTAO_SLICES: slice directions per pixel (x 16 rotations over the 4x4 denoise)
 STEPS = 8           # GTAO_STEPS: depth samples per side of a slice
-RADIUS_FRACTION = 0.25   # the search radius in world units, as a share of the mesh's bounding-box diagonal
+RADIUS_FRACTION = 1.0    # the search radius in world units, as a share of the mesh's bounding-box diagonal (the bake reaches the whole mesh; 0.25: corner 15.9%, bowl 22.4% under royal_esplanade, 1.0: 13.8, 17.0%)
 MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen (the cost grows with it: cache misses)
 
 
@@ -84,3 +84,43 @@ def multi_bounce(visibility, albedo):
     b = -4.7951 * albedo + 0.6417
     c = 2.7552 * albedo + 0.6903
     return np.maximum(v, ((v * a + b) * v + c) * v)
+
+
+def _direction_antiderivative(theta, gamma):
+    """H(theta) = int_0^theta (sin t, cos t) cos(t - gamma) |sin t| dt: the (slice direction, v)
+    components of the cosine-weighted directions from v up to angle theta (signed side)."""
+    theta = np.asarray(theta, np.float64)
+    gamma = np.asarray(gamma, np.float64)
+
+    def f(t):
+        s, c = np.sin(t), np.cos(t)
+        return (np.cos(gamma) * s ** 3 / 3.0 + np.sin(gamma) * (c ** 3 / 3.0 - c),
+                -np.cos(gamma) * c ** 3 / 3.0 + np.sin(gamma) * s ** 3 / 3.0)
+
+    f0 = f(np.zeros_like(theta))
+    ft = f(theta)
+    sign = np.sign(theta)
+    return sign * (ft[0] - f0[0]), sign * (ft[1] - f0[1])
+
+
+def slice_occluded_direction(cos_h1, cos_h2, gamma, projected_length=1.0):
+    """The cosine-weighted sum of the occluded directions of one slice, as (along the slice
+    direction, along v) times |n_p|: the parts of the normal's half-disc beyond the horizons,
+    [gamma - pi/2, h1] and [h2, gamma + pi/2]. Its mean over slices points at the occluders, whose
+    surfaces face back along it (the forward pass reads E there: common/gtao.glsl)."""
+    h1, h2 = clamped_horizons(cos_h1, cos_h2, gamma)
+    lo = _direction_antiderivative(np.asarray(gamma) - 0.5 * np.pi, gamma)
+    hi = _direction_antiderivative(np.asarray(gamma) + 0.5 * np.pi, gamma)
+    a = _direction_antiderivative(h1, gamma)
+    b = _direction_antiderivative(h2, gamma)
+    return tuple(np.asarray(projected_length) * ((a[k] - lo[k]) + (hi[k] - b[k])) for k in range(2))
+
+
+def bent_normal(n, occluded_sum):
+    """The mean unoccluded direction from the occluded directions' sum (mean over slices of
+    ``slice_occluded_direction``, in the world): the whole hemisphere sums to 2/3 n in this
+    measure, so the visible directions sum to 2/3 n - occluded; n where that leaves n's side."""
+    n = np.asarray(n, np.float64)
+    b = 2.0 / 3.0 * n - np.asarray(occluded_sum, np.float64)
+    d = float(np.dot(b, n))
+    return b / np.linalg.norm(b) if d > 1e-6 else n

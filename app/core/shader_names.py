@@ -138,6 +138,8 @@ SHADER_OPTIONS: dict[str, str] = {
                       "(app/core/sky_weight.py, common/occlusion.glsl)",
     "HAS_SCREEN_AO": "screen-space GTAO's visibility is read per pixel (app/render/screen_ao.py, "
                      "common/occlusion.glsl)",
+    "GTAO_OCCLUDERS": "GTAO's occluded share sees the occluders' radiance, E/pi facing back along the mean "
+                      "occluded direction (common/occlusion.glsl)",
     "GTAO_MULTI_BOUNCE": "GTAO's visibility takes the paper's albedo fit of the occluders' interreflections "
                          "(common/gtao.glsl)",
     "GTAO_SLICES": "GTAO's slice directions per pixel (render/gtao.frag; app/core/gtao.py SLICES)",

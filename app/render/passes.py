@@ -451,7 +451,7 @@ def screen_ao_program(r, frame: FrameContext, scene, camera: Camera, view_projec
     r.ctx.viewport = viewport
     r.ctx.enable(moderngl.DEPTH_TEST)
     r.ctx.depth_func = "<="
-    extra = screen_defines(r.screen_ao.multi_bounce)
+    extra = screen_defines(r.screen_ao.occluded)
     return lambda variant, *args: program_for({**variant, **extra}, *args)
 
 

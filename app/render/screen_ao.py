@@ -35,10 +35,18 @@ class ScreenAOTargets:
             x.release()
 
 
-def defines(multi_bounce: bool = True) -> dict:
+# What the occluded share of the light sees (common/occlusion.glsl): "occluders" (the default:
+# the occluders' radiance, GTAO_OCCLUDERS), "multi_bounce" (the paper's albedo fit of V,
+# GTAO_MULTI_BOUNCE) or "black" (V alone). benchmarks/results/gtao.md compares them.
+OCCLUDED_LIGHT = ("occluders", "multi_bounce", "black")
+
+
+def defines(occluded: str = "occluders") -> dict:
     """The forward pass's defines that read the visibility (common/occlusion.glsl)."""
     d = {"HAS_SCREEN_AO": None}
-    if multi_bounce:
+    if occluded == "occluders":
+        d["GTAO_OCCLUDERS"] = None
+    elif occluded == "multi_bounce":
         d["GTAO_MULTI_BOUNCE"] = None
     return d
 
@@ -49,7 +57,7 @@ class ScreenAO:
     def __init__(self, ctx):
         self.ctx = ctx
         self.targets: ScreenAOTargets | None = None
-        self.multi_bounce = True     # GTAO_MULTI_BOUNCE: the paper's albedo fit (False: the benchmarks' plain V)
+        self.occluded = "occluders"  # OCCLUDED_LIGHT (the benchmarks compare them)
         self.radius_fraction = gtao.RADIUS_FRACTION
 
     def _targets(self, size: tuple[int, int]) -> ScreenAOTargets:
@@ -58,8 +66,9 @@ class ScreenAO:
             if t is not None:
                 t.release()
             depth = self.ctx.depth_texture(size)
-            raw = self.ctx.texture(size, 1, dtype="f4")
-            visibility = self.ctx.texture(size, 1, dtype="f4")
+            # (the occluded directions' sum in xyz, V in w: render/gtao.frag)
+            raw = self.ctx.texture(size, 4, dtype="f4")
+            visibility = self.ctx.texture(size, 4, dtype="f4")
             depth.compare_func = ""     # read as depths, not compared
             for tex in (depth, raw, visibility):
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)

@@ -27,3 +27,29 @@ vec3 gtao_multi_bounce(float visibility, vec3 albedo) {
     vec3 c = 2.7552 * albedo + 0.6903;
     return max(vec3(visibility), ((visibility * a + b) * visibility + c) * visibility);
 }
+
+// int_0^theta (sin t, cos t) cos(t - gamma) |sin t| dt: the (slice direction, v) parts of the
+// cosine-weighted directions from v up to the signed angle theta.
+vec2 gtao_direction_antiderivative(float theta, float gamma) {
+    float s = sin(theta), c = cos(theta);
+    vec2 at_theta = vec2(cos(gamma) * s * s * s / 3.0 + sin(gamma) * (c * c * c / 3.0 - c),
+                         -cos(gamma) * c * c * c / 3.0 + sin(gamma) * s * s * s / 3.0);
+    vec2 at_zero = vec2(sin(gamma) * (1.0 / 3.0 - 1.0), -cos(gamma) / 3.0);
+    return sign(theta) * (at_theta - at_zero);
+}
+
+// One slice's cosine-weighted sum of occluded directions, (along the slice direction, along v)
+// times |n_p|: the normal's half-disc beyond the horizons. Summed over slices it points at the
+// occluders, whose surfaces face back along it (occlude_environment reads E there, as the bake
+// reads it along its bounce rays).
+vec2 gtao_slice_occluded_direction(float cos_h1, float cos_h2, float gamma, float projected_length) {
+    const float HALF_PI = 1.5707963;
+    float h1 = -acos(clamp(cos_h1, -1.0, 1.0));
+    float h2 = acos(clamp(cos_h2, -1.0, 1.0));
+    h1 = gamma + max(h1 - gamma, -HALF_PI);
+    h2 = gamma + min(h2 - gamma, HALF_PI);
+    vec2 lo = gtao_direction_antiderivative(gamma - HALF_PI, gamma);
+    vec2 hi = gtao_direction_antiderivative(gamma + HALF_PI, gamma);
+    return projected_length * ((gtao_direction_antiderivative(h1, gamma) - lo)
+                               + (hi - gtao_direction_antiderivative(h2, gamma)));
+}

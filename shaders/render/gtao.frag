@@ -1,7 +1,7 @@
 #version 450 core
 // Screen-space ground-truth ambient occlusion (app/render/screen_ao.py): per pixel the
 // cosine-weighted visibility from the opaque parts' depth (GTAO_SLICES slice directions, GTAO_STEPS
-// depth samples a side, horizons within u_radius world units), rotated by a 4x4 pattern that
+// depth samples a side, horizons within u_radius world units) and the occluded directions' sum, rotated by a 4x4 pattern that
 // render/gtao_denoise.frag averages out. Jimenez et al. 2016, Algorithm 1, in world space.
 #include "common/gtao.glsl"
 
@@ -13,7 +13,7 @@ uniform float u_radius;          // world units
 uniform float u_pixel_scale;     // pixels per world unit at clip w = 1 (half the image's height times P[1][1])
 uniform float u_max_radius_px;
 
-layout(location = 0) out float out_visibility;
+layout(location = 0) out vec4 out_visibility;   // the occluded directions' cosine-weighted sum (world), V
 
 vec3 world_at(vec2 pixel, float depth) {
     vec2 size = vec2(textureSize(u_depth, 0));
@@ -79,7 +79,7 @@ void main() {
     float depth;
     vec3 centre = position_at(p, depth);
     if (depth >= 1.0) {
-        out_visibility = 1.0;
+        out_visibility = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
     vec3 v = normalize(u_camera_position - centre);
@@ -89,6 +89,7 @@ void main() {
     vec2 noise = pattern_noise(p);
     vec2 origin = vec2(p) + 0.5;
     float visibility = 0.0;
+    vec3 occluded = vec3(0.0);
     for (int i = 0; i < GTAO_SLICES; ++i) {
         float phi = (float(i) + noise.x) * 3.14159265 / float(GTAO_SLICES);
         vec2 omega = vec2(cos(phi), sin(phi));
@@ -105,6 +106,8 @@ void main() {
         float c2 = horizon_cos(origin, step_px, centre, v, noise.y);
         float c1 = horizon_cos(origin, -step_px, centre, v, noise.y);
         visibility += gtao_slice_visibility(c1, c2, gamma, length_n);
+        vec2 o = gtao_slice_occluded_direction(c1, c2, gamma, length_n);
+        occluded += direction * o.x + v * o.y;
     }
-    out_visibility = clamp(visibility / float(GTAO_SLICES), 0.0, 1.0);
+    out_visibility = vec4(occluded / float(GTAO_SLICES), clamp(visibility / float(GTAO_SLICES), 0.0, 1.0));
 }
