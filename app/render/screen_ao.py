@@ -1,6 +1,6 @@
 """Screen-space ground-truth ambient occlusion (``--occlusion gtao``; alight.core.gtao, Jimenez et
 al. 2016) for the forward pass: a depth prepass of the opaque parts, the horizon search
-(render/gtao.frag) and its 4x4 depth-aware denoise (render/gtao_denoise.frag), at the scene pass's
+(render/gtao_depth.*: world positions; render/gtao.frag) and its 4x4 depth-aware denoise (render/gtao_denoise.frag), at the scene pass's
 draw size; the forward pass reads the result per pixel (HAS_SCREEN_AO, common/occlusion.glsl).
 
 Per frame and tile, so it follows a moving view with no bake; an occluder outside the tile or
@@ -20,10 +20,12 @@ from alight.render.bindings import UNIT_SCREEN_AO, UNIT_SCREEN_AO_WORK
 
 @dataclass
 class ScreenAOTargets:
-    """The pass's textures at one draw size: the prepass's depth, the raw and the denoised visibility."""
+    """The pass's textures at one draw size: the prepass's world positions (and its depth
+    buffer), the raw and the denoised visibility."""
 
     size: tuple[int, int]
-    depth: moderngl.Texture
+    depth: moderngl.Renderbuffer
+    positions: moderngl.Texture
     depth_fbo: moderngl.Framebuffer
     raw: moderngl.Texture
     raw_fbo: moderngl.Framebuffer
@@ -31,7 +33,8 @@ class ScreenAOTargets:
     visibility_fbo: moderngl.Framebuffer
 
     def release(self) -> None:
-        for x in (self.depth_fbo, self.raw_fbo, self.visibility_fbo, self.depth, self.raw, self.visibility):
+        for x in (self.depth_fbo, self.raw_fbo, self.visibility_fbo, self.depth, self.positions, self.raw,
+                  self.visibility):
             x.release()
 
 
@@ -65,15 +68,19 @@ class ScreenAO:
         if t is None or t.size != size:
             if t is not None:
                 t.release()
-            depth = self.ctx.depth_texture(size)
+            depth = self.ctx.depth_renderbuffer(size)
+            # World positions in float32 (render/gtao_depth.frag: a 24-bit depth unprojected
+            # made an open floor occlude itself).
+            positions = self.ctx.texture(size, 4, dtype="f4")
             # (the occluded directions' sum in xyz, V in w: render/gtao.frag)
             raw = self.ctx.texture(size, 4, dtype="f4")
             visibility = self.ctx.texture(size, 4, dtype="f4")
-            depth.compare_func = ""     # read as depths, not compared
-            for tex in (depth, raw, visibility):
+            for tex in (raw, visibility):
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            positions.filter = (moderngl.LINEAR, moderngl.LINEAR)    # (the samples: gtao.frag)
+            positions.repeat_x = positions.repeat_y = False
             self.targets = t = ScreenAOTargets(
-                size, depth, self.ctx.framebuffer(depth_attachment=depth), raw,
+                size, depth, positions, self.ctx.framebuffer(color_attachments=[positions], depth_attachment=depth), raw,
                 self.ctx.framebuffer(color_attachments=[raw]), visibility,
                 self.ctx.framebuffer(color_attachments=[visibility]))
         return t
@@ -87,10 +94,10 @@ class ScreenAO:
         t = self._targets(size)
         ctx.viewport = (0, 0, size[0], size[1])
         t.depth_fbo.use()
-        t.depth_fbo.clear(depth=1.0)
+        t.depth_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<="
-        prog = r.program("render/shadow_depth.vert", "render/shadow_depth.frag")
+        prog = r.program("render/gtao_depth.vert", "render/gtao_depth.frag")
         prog["u_view_projection"].write(np.ascontiguousarray(view_projection, np.float32).tobytes())
         from alight.render.part_bindings import set_culling
 
@@ -103,8 +110,8 @@ class ScreenAO:
         ivp = np.ascontiguousarray(inverse_vp, np.float32).tobytes()
         search = r.program("render/fullscreen.vert", "render/gtao.frag",
                            {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS})
-        t.depth.use(UNIT_SCREEN_AO_WORK)
-        search["u_depth"] = UNIT_SCREEN_AO_WORK
+        t.positions.use(UNIT_SCREEN_AO_WORK)
+        search["u_positions"] = UNIT_SCREEN_AO_WORK
         search["u_inverse_vp"].write(ivp)
         search["u_view_projection"].write(vp)
         search["u_camera_position"] = tuple(float(x) for x in camera.position)
@@ -116,8 +123,8 @@ class ScreenAO:
         denoise = r.program("render/fullscreen.vert", "render/gtao_denoise.frag")
         t.raw.use(UNIT_SCREEN_AO)
         denoise["u_raw"] = UNIT_SCREEN_AO
-        denoise["u_depth"] = UNIT_SCREEN_AO_WORK
-        denoise["u_inverse_vp"].write(ivp)
+        denoise["u_positions"] = UNIT_SCREEN_AO_WORK
+        denoise["u_camera_position"] = tuple(float(x) for x in camera.position)
         t.visibility_fbo.use()
         r.fullscreen(denoise)
         t.visibility.use(UNIT_SCREEN_AO)    # what the forward pass reads (u_screen_ao)
