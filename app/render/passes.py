@@ -185,7 +185,10 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         # Half the image's height in draw pixels times the projection's P[1][1] (a tile's view
         # keeps the whole image's projection).
         frame.ao_pixel_scale = 0.5 * view.height * scale * float(camera.projection_matrix(aspect)[1][1])
+    r.last_occlusion_reason = ""
     if frame.screen_ao:
+        r.last_occlusion_reason = "gtao" if scene.occlusion == "gtao" else \
+            "gtao (auto: the mesh has more vertices than auto bakes, AUTO_MAX_VERTICES)"
         use, r.last_mesh_shading_reason = False, "--occlusion gtao reads its visibility in the forward pass"
     elif frame.impostor_model is None:    # (without an impostor only 4x msaa is eligible: vbuffer.choose)
         use, r.last_mesh_shading_reason = vbuffer.choose(r, scene, targets, fbo, background, view_projection,
