@@ -189,8 +189,7 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
     if frame.screen_ao:
         r.last_occlusion_reason = "gtao" if scene.occlusion == "gtao" else \
             "gtao (auto: the mesh has more vertices than auto bakes, AUTO_MAX_VERTICES)"
-        use, r.last_mesh_shading_reason = False, "--occlusion gtao reads its visibility in the forward pass"
-    elif frame.impostor_model is None:    # (without an impostor only 4x msaa is eligible: vbuffer.choose)
+    if frame.impostor_model is None:    # (without an impostor only 4x msaa is eligible: vbuffer.choose)
         use, r.last_mesh_shading_reason = vbuffer.choose(r, scene, targets, fbo, background, view_projection,
                                                          (view.width, view.height))
     else:
@@ -400,7 +399,11 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
         # The baked parts where Scene.occlusion wants them, as draw_mesh_parts draws them.
         # (with the environment drawn, so they keep their visible sky weight)
         drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions, frame.maps)
-        vbuffer.draw(r, frame, scene, camera, view_projection, targets, program_for, image_size, drawn)
+        shading_program = program_for
+        if frame.screen_ao:    # (its shading pass reads the visibility at gl_FragCoord as the forward pass does)
+            shading_program = screen_ao_program(r, frame, scene, camera, view_projection, fbo,
+                                                list(range(len(scene.mesh.parts))), program_for)
+        vbuffer.draw(r, frame, scene, camera, view_projection, targets, shading_program, image_size, drawn)
         return
     transmissive = transmissive_parts(scene)
     opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
