@@ -301,3 +301,21 @@ def test_the_visibility_buffer_path_reads_gtao_as_the_forward_pass(renderer, tmp
     scale = out["forward"][..., :3].mean()
     assert np.abs(out["vbuffer"][..., :3] - out["forward"][..., :3]).mean() < 1e-4 * scale
     assert np.abs(off[..., :3] - out["forward"][..., :3]).mean() > 1e-2 * scale   # (gtao is there)
+
+
+def test_the_editor_sends_no_bake_for_gtao(tmp_path):
+    """The editor's 'occlusion' combo lists gtao (OCCLUSION_MODES), and its bake driver draws a
+    gtao scene as it is, with no job for its child process and nothing in the status row (the
+    renderer draws GTAO per frame)."""
+    from alight.accuracy.scenes import write_scene
+    from alight.core.material import Material
+    from alight.core.scene import Scene
+    from alight.core.visibility import OCCLUSION_MODES
+    from alight.exchange.meshes import load_mesh
+    from alight.frontends.editor.occlusion_bake import OcclusionBake
+
+    assert "gtao" in OCCLUSION_MODES
+    scene = Scene(mesh=load_mesh(str(write_scene("corner", tmp_path))), material=Material(), occlusion="gtao")
+    bake = OcclusionBake()
+    shown, held = bake.view_scene(None, scene, None)
+    assert shown is scene and not held and bake.jobs == 0 and bake.status == ""
