@@ -1,7 +1,8 @@
 """Screen-space ground-truth ambient occlusion (``--occlusion gtao``; alight.core.gtao, Jimenez et
-al. 2016) for the forward pass: a depth prepass of the opaque parts, the horizon search
-(render/gtao_depth.*: world positions; render/gtao.frag) and its 4x4 depth-aware denoise (render/gtao_denoise.frag), at the scene pass's
-draw size; the forward pass reads the result per pixel (HAS_SCREEN_AO, common/occlusion.glsl).
+al. 2016) for the scene pass: a prepass of the opaque parts' world positions
+(render/gtao_depth.*), the horizon search (render/gtao.frag) and its 4x4 depth-aware denoise
+(render/gtao_denoise.frag), at the pass's draw size; the forward pass and the visibility buffer's
+shading pass read the result at gl_FragCoord (HAS_SCREEN_AO, common/occlusion.glsl).
 
 Per frame and tile, so it follows a moving view with no bake; an occluder outside the tile or
 behind the first surface is not seen (docs/explanation/occlusion.md, "Screen-space GTAO").

@@ -1,8 +1,9 @@
 #version 450 core
 // Screen-space ground-truth ambient occlusion (app/render/screen_ao.py): per pixel the
-// cosine-weighted visibility from the opaque parts' positions (GTAO_SLICES slice directions, GTAO_STEPS
-// depth samples a side, horizons within u_radius world units) and the occluded directions' sum, rotated by a 4x4 pattern that
-// render/gtao_denoise.frag averages out. Jimenez et al. 2016, Algorithm 1, in world space.
+// cosine-weighted visibility and the occluded directions' sum from the opaque parts' positions
+// (GTAO_SLICES slice directions, GTAO_STEPS samples a side, horizons within u_radius world
+// units), the slices turned by a 4x4 pattern that render/gtao_denoise.frag averages out.
+// Jimenez et al. 2016, Algorithm 1, in world space.
 #include "common/gtao.glsl"
 
 uniform sampler2D u_positions;   // the prepass's world positions (w = 1 where a surface is)
