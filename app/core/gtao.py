@@ -22,7 +22,8 @@ import numpy as np
 SLICES = 2          # GTAO_SLICES: slice directions per pixel (x 16 rotations over the 4x4 denoise)
 STEPS = 8           # GTAO_STEPS: depth samples per side of a slice
 RADIUS_FRACTION = 1.0    # the search radius in world units, as a share of the mesh's bounding-box diagonal (the bake reaches the whole mesh; 0.25: corner 15.9%, bowl 22.4% under royal_esplanade, 1.0: 13.8, 17.0%)
-MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen (the cost grows with it: cache misses)
+MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS_HEIGHT of the draw height where more
+MAX_RADIUS_HEIGHT = 0.2  # (the editor's 720 rows: 144 px; the samples stay GTAO_STEPS, spread wider)
 
 
 def inner_integral(h, gamma):

@@ -118,7 +118,7 @@ class ScreenAO:
         search["u_camera_position"] = tuple(float(x) for x in camera.position)
         search["u_radius"] = float(radius)
         search["u_pixel_scale"] = float(pixel_scale)
-        search["u_max_radius_px"] = float(gtao.MAX_RADIUS_PX)
+        search["u_max_radius_px"] = max(float(gtao.MAX_RADIUS_PX), gtao.MAX_RADIUS_HEIGHT * size[1])
         t.raw_fbo.use()
         r.fullscreen(search)
         denoise = r.program("render/fullscreen.vert", "render/gtao_denoise.frag")

@@ -59,8 +59,8 @@ vec2 pattern_noise(ivec2 p) {
 }
 
 // The largest horizon cosine to v along one side of the slice; occluders fade out between 0.75
-// and 1 times the radius, so that the search's end does not draw a line.
-float horizon_cos(vec2 origin, vec2 step_px, vec3 centre, vec3 v, float jitter) {
+// and 1 times `radius` (world units), so that the search's end does not draw a line.
+float horizon_cos(vec2 origin, vec2 step_px, vec3 centre, vec3 v, float jitter, float radius) {
     float best = -1.0;
     vec2 size = vec2(textureSize(u_positions, 0));
     for (int j = 0; j < GTAO_STEPS; ++j) {
@@ -76,7 +76,7 @@ float horizon_cos(vec2 origin, vec2 step_px, vec3 centre, vec3 v, float jitter) 
         vec3 delta = s - centre;
         float dist = length(delta);
         if (dist < 1e-6) continue;
-        float weight = clamp((u_radius - dist) / (0.25 * u_radius), 0.0, 1.0);
+        float weight = clamp((radius - dist) / (0.25 * radius), 0.0, 1.0);
         best = max(best, mix(-1.0, dot(delta, v) / dist, weight));
     }
     return best;
@@ -95,6 +95,10 @@ void main() {
     vec4 clip = u_view_projection * vec4(centre, 1.0);
     float ndc_depth = clip.z / clip.w;
     float radius_px = min(u_radius * u_pixel_scale / max(clip.w, 1e-6), u_max_radius_px);
+    // The world radius the pixels reach: the fade-out follows it, so that where the pixel cap
+    // cuts the search short the occluders fade rather than stop (a hard vertical band on the
+    // corner's back wall in the editor at 1280x720).
+    float radius = radius_px * max(clip.w, 1e-6) / u_pixel_scale;
     vec2 noise = pattern_noise(p);
     vec2 origin = vec2(p) + 0.5;
     float visibility = 0.0;
@@ -112,8 +116,8 @@ void main() {
         float cos_n = clamp(dot(projected, v) / max(length_n, 1e-6), -1.0, 1.0);
         float gamma = sign(dot(projected, direction)) * acos(cos_n);
         vec2 step_px = omega * max(radius_px / float(GTAO_STEPS), 1.0);
-        float c2 = horizon_cos(origin, step_px, centre, v, noise.y);
-        float c1 = horizon_cos(origin, -step_px, centre, v, noise.y);
+        float c2 = horizon_cos(origin, step_px, centre, v, noise.y, radius);
+        float c1 = horizon_cos(origin, -step_px, centre, v, noise.y, radius);
         visibility += gtao_slice_visibility(c1, c2, gamma, length_n);
         vec2 o = gtao_slice_occluded_direction(c1, c2, gamma, length_n);
         occluded += direction * o.x + v * o.y;
