@@ -303,7 +303,10 @@ def test_auto_leaves_a_huge_mesh_unbaked_and_says_so(corner_obj, monkeypatch, ca
     r.render(Scene(mesh=mesh, material=Material(), occlusion="auto"), maps, 32, 32)
     assert r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded == runs
     err = capsys.readouterr().err
-    assert "without occlusion" in err and "--occlusion on" in err and len(err.strip().splitlines()) == 1
+    # (since GTAO: drawn with screen-space occlusion instead of none, in one warning line)
+    assert "in screen space (gtao) instead of the visibility bake" in err and "--occlusion on" in err \
+        and len(err.strip().splitlines()) == 1
+    assert r.last_occlusion_reason.startswith("gtao (auto")
 
 
 def test_cli_default_is_auto(corner_obj, tmp_path):
@@ -374,18 +377,21 @@ def _big_sphere_ply(path: Path, bump) -> Path:
 
 @pytest.mark.parametrize("shape", ["bumpy", "lobed"])
 def test_cli_warns_of_a_huge_mesh_only_where_it_would_need_occlusion(tmp_path, shape):
-    """--occlusion auto on a mesh over AUTO_MAX_VERTICES: the 'rendered without occlusion' warning
-    only where the mesh would plausibly need occlusion (occlusion_estimate above
+    """--occlusion auto on a mesh over AUTO_MAX_VERTICES: drawn with screen-space GTAO, said in
+    one warning line and the --verbose reason, only where the mesh would plausibly need occlusion (occlusion_estimate above
     AUTO_MIN_OCCLUSION), not for a nearly convex sphere whose bumps of 0.2% of its radius made
     self_occludes true."""
     bump = {"bumpy": lambda t, p: 1.0 + 0.002 * np.sin(40.0 * t) * np.sin(40.0 * p),
             "lobed": lambda t, p: 1.0 + 0.45 * np.sin(5.0 * t) * np.sin(5.0 * p)}[shape]
     mesh = _big_sphere_ply(tmp_path, bump)
-    p = _cli("render", "--mesh", mesh, "--size", "32", "--quality", "low", "--occlusion", "auto",
+    p = _cli("render", "--mesh", mesh, "--size", "32", "--quality", "low", "--occlusion", "auto", "--verbose",
              "--out", tmp_path / "x.png", cache=tmp_path / "cache")
     assert p.returncode == 0, p.stderr
-    warned = [x for x in p.stderr.splitlines() if "rendered without occlusion" in x]
+    # (since GTAO: drawn with screen-space occlusion instead of none, and said so)
+    warned = [x for x in p.stderr.splitlines() if "in screen space (gtao) instead of the visibility bake" in x]
     if shape == "bumpy":
         assert not warned, p.stderr
+        assert "occlusion: gtao" not in p.stderr
     else:
         assert len(warned) == 1 and "--occlusion on bakes it" in warned[0], p.stderr
+        assert "occlusion: gtao (auto: the mesh has more vertices than auto bakes" in p.stderr, p.stderr

@@ -253,8 +253,9 @@ class Scene:
     texture_maps: "TextureMaps | None" = None
     texture_images: dict = field(default_factory=dict)
     # Occlusion of the environment light by the mesh itself (alight.core.visibility): 'auto'
-    # bakes it where the mesh occludes enough of itself, 'on' for every mesh but the built-in
-    # sphere. The still previews ('alight render', alight.Renderer) default to 'auto', and so
+    # bakes it where the mesh occludes enough of itself (screen-space GTAO for a mesh too big to
+    # bake), 'on' for every mesh but the built-in sphere, 'gtao' screen-space GTAO per frame
+    # (alight.render.screen_ao), no bake. The still previews ('alight render', alight.Renderer) default to 'auto', and so
     # does the editor's 'occlusion' combo (its bake made by a child process,
     # app/frontends/editor/occlusion_bake.py); a bare Scene (batch) stays 'off'.
     occlusion: str = "off"

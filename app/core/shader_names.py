@@ -136,6 +136,14 @@ SHADER_OPTIONS: dict[str, str] = {
                       "(app/core/visibility.py, common/occlusion.glsl)",
     "HAS_SKY_WEIGHT": "the visible sky weight of the environment drawn is read with the visibility bake "
                       "(app/core/sky_weight.py, common/occlusion.glsl)",
+    "HAS_SCREEN_AO": "screen-space GTAO's visibility is read per pixel (app/render/screen_ao.py, "
+                     "common/occlusion.glsl)",
+    "GTAO_OCCLUDERS": "GTAO's occluded share sees the occluders' radiance, E/pi facing back along the mean "
+                      "occluded direction (common/occlusion.glsl)",
+    "GTAO_MULTI_BOUNCE": "GTAO's visibility takes the paper's albedo fit of the occluders' interreflections "
+                         "(common/gtao.glsl)",
+    "GTAO_SLICES": "GTAO's slice directions per pixel (render/gtao.frag; app/core/gtao.py SLICES)",
+    "GTAO_STEPS": "GTAO's depth samples per side of a slice (render/gtao.frag; app/core/gtao.py STEPS)",
     # Views and passes.
     "DEBUG_VIEW": "the editor's debug views are compiled in (u_debug_view picks one)",
     "SPHERE_IMPOSTOR": "the built-in sphere drawn as an impostor with this many samples a pixel",

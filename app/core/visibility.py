@@ -80,11 +80,14 @@ INTERPOLATION_TEST = True
 # open neighbours' values (_fill_covered). Inside a closed part every ray hits its inside.
 COVERED_SHARE = 0.9
 COVERED_DISTANCE = 0.25
-OCCLUSION_MODES = ("auto", "on", "off")
+OCCLUSION_MODES = ("auto", "on", "off", "gtao")   # gtao: screen space, no bake (alight.render.screen_ao)
 # --occlusion auto: bake where the mesh's mean occlusion (occlusion_statistic) is above this.
 AUTO_MIN_OCCLUSION = 0.03
 AUTO_SAMPLES = 1024           # surface points of the statistic
 AUTO_RAYS = 32                # rays per point
+# 'auto' draws a mesh over AUTO_MAX_VERTICES that would need occlusion with screen-space GTAO
+# instead of none (benchmarks/results/gtao.md: its cost and error against the path tracer).
+AUTO_SCREEN_AO = True
 AUTO_MAX_VERTICES = 250_000   # auto bakes no bigger mesh (MetalRoughSpheresNoTextures' 1M triangles: 97 s)
 # A bigger mesh's statistic, for its warning only, is taken on a copy merged to a grid of this
 # many cells along its longest side (occlusion_estimate).
@@ -362,8 +365,8 @@ def wants_occlusion(mesh, mode: str) -> bool:
     AUTO_MIN_OCCLUSION; convex and flat meshes are decided without a ray)."""
     if mode not in OCCLUSION_MODES:
         raise AlightError(f"--occlusion: '{mode}' is not one of {', '.join(OCCLUSION_MODES)}")
-    if mode == "off" or mesh is None or mesh.lod_sphere is not None:
-        return False
+    if mode in ("off", "gtao") or mesh is None or mesh.lod_sphere is not None:
+        return False    # (gtao: screen_occlusion)
     if mode == "on":
         return True
     if not embree_available():
@@ -374,6 +377,18 @@ def wants_occlusion(mesh, mode: str) -> bool:
         # true for nearly every big mesh (a scan's noise, a bump of 1e-4 of its size).
         return occlusion_estimate(mesh.parts) > AUTO_MIN_OCCLUSION
     return occlusion_statistic(mesh.parts) > AUTO_MIN_OCCLUSION
+
+
+def screen_occlusion(mesh, mode: str, baked_wanted: bool = False) -> bool:
+    """Whether ``mesh`` is drawn with screen-space GTAO (alight.render.screen_ao): under 'gtao'
+    (never the built-in sphere, which is convex), and under 'auto' where the bake is wanted
+    (``baked_wanted``: ``wants_occlusion``) but the mesh is too big for auto to bake
+    (``auto_too_big``; AUTO_SCREEN_AO, measured in benchmarks/results/gtao.md)."""
+    if mesh is None or mesh.lod_sphere is not None:
+        return False
+    if mode == "gtao":
+        return True
+    return mode == "auto" and AUTO_SCREEN_AO and baked_wanted and auto_too_big(mesh)
 
 
 def occlusion_estimate(parts, cells: int = AUTO_ESTIMATE_CELLS) -> float:

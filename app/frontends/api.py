@@ -295,15 +295,16 @@ class Renderer:
             self.scene.multiple_scattering = bool(multiple_scattering)
         return self
 
-    def set_occlusion(self, mode: Literal["auto", "on", "off"]) -> "Renderer":
+    def set_occlusion(self, mode: Literal["auto", "on", "off", "gtao"]) -> "Renderer":
         """Occlusion of the environment light by the mesh itself, with one diffuse bounce
         (alight.core.visibility: a per-vertex ray-traced bake, cached like the IBL bake): 'auto'
         (the default) bakes it where the mesh occludes enough of its own surface
         (alight.core.visibility.wants_occlusion: never the built-in sphere or a convex mesh), 'on'
-        for every mesh but the built-in sphere, 'off' never.
+        for every mesh but the built-in sphere, 'off' never, 'gtao' screen-space ambient occlusion
+        per frame with no bake (alight.render.screen_ao; 'auto' uses it for a mesh too big to bake).
         Raises AlightError for another mode."""
-        if mode not in ("auto", "on", "off"):
-            raise AlightError(f"occlusion: {mode!r} is not 'auto', 'on' or 'off'")
+        if mode not in ("auto", "on", "off", "gtao"):
+            raise AlightError(f"occlusion: {mode!r} is not 'auto', 'on', 'off' or 'gtao'")
         self.scene.occlusion = mode
         return self
 

@@ -81,6 +81,8 @@ class FrameContext:
     image_size: tuple[int, int] = (0, 0)        # the targets' output size (width, height)
     sun_directions: np.ndarray | None = None    # (K, 3) world: the compact sources (the bake's sun bounce)
     maps: IBLMaps | None = None                 # the environment drawn (the bake's visible sky weight)
+    screen_ao: bool = False                     # the opaque parts read screen-space GTAO (alight.render.screen_ao)
+    ao_pixel_scale: float = 0.0                 # pixels per world unit at clip w = 1, at the draw size
 
 
 # --- a frame: the passes for each anti-aliasing mode, tile by tile -------------------------
@@ -177,6 +179,16 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         fbo = targets.single()[1]
     else:
         frame.impostor_samples = 0
+    frame.screen_ao = frame.impostor_model is None and scene.view != "probe" and scene.mesh is not None \
+        and r.visibility_parts.screen_wanted(scene.mesh, scene.occlusion)
+    if frame.screen_ao:
+        # Half the image's height in draw pixels times the projection's P[1][1] (a tile's view
+        # keeps the whole image's projection).
+        frame.ao_pixel_scale = 0.5 * view.height * scale * float(camera.projection_matrix(aspect)[1][1])
+    r.last_occlusion_reason = ""
+    if frame.screen_ao:
+        r.last_occlusion_reason = "gtao" if scene.occlusion == "gtao" else \
+            "gtao (auto: the mesh has more vertices than auto bakes, AUTO_MAX_VERTICES)"
     if frame.impostor_model is None:    # (without an impostor only 4x msaa is eligible: vbuffer.choose)
         use, r.last_mesh_shading_reason = vbuffer.choose(r, scene, targets, fbo, background, view_projection,
                                                          (view.width, view.height), maps)
@@ -387,12 +399,19 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
         # The baked parts where Scene.occlusion wants them, as draw_mesh_parts draws them.
         # (with the environment drawn, so they keep their visible sky weight)
         drawn = occluded_parts(r, scene, r.meshes.parts(scene.mesh), frame.sun_directions, frame.maps)
-        vbuffer.draw(r, frame, scene, camera, view_projection, targets, program_for, image_size, drawn)
+        shading_program = program_for
+        if frame.screen_ao:    # (its shading pass reads the visibility at gl_FragCoord as the forward pass does)
+            shading_program = screen_ao_program(r, frame, scene, camera, view_projection, fbo,
+                                                list(range(len(scene.mesh.parts))), program_for)
+        vbuffer.draw(r, frame, scene, camera, view_projection, targets, shading_program, image_size, drawn)
         return
     transmissive = transmissive_parts(scene)
     opaque = [i for i in range(len(scene.mesh.parts)) if i not in transmissive]
+    opaque_program = program_for
+    if opaque and frame.screen_ao:
+        opaque_program = screen_ao_program(r, frame, scene, camera, view_projection, fbo, opaque, program_for)
     if opaque:
-        draw_mesh_parts(r, frame, scene, program_for, camera, view_projection, blend=False, parts=opaque,
+        draw_mesh_parts(r, frame, scene, opaque_program, camera, view_projection, blend=False, parts=opaque,
                         image_size=image_size)
     if not transmissive:
         return
@@ -415,6 +434,31 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
 
     draw_mesh_parts(r, frame, scene, transmissive_program, camera, view_projection, blend=False, parts=transmissive,
                     image_size=image_size)
+
+
+def screen_ao_program(r, frame: FrameContext, scene, camera: Camera, view_projection: np.ndarray,
+                      fbo: moderngl.Framebuffer, opaque: list[int], program_for):
+    """Screen-space GTAO of the ``opaque`` parts that do not blend (alight.render.screen_ao), drawn
+    at ``fbo``'s draw size before them; returns ``program_for`` with the defines that read it.
+    ``fbo`` is bound again, with its viewport, afterwards."""
+    from alight.render.screen_ao import ScreenAO, defines as screen_defines
+
+    if getattr(r, "screen_ao", None) is None:
+        r.screen_ao = ScreenAO(r.ctx)
+    viewport = r.ctx.viewport
+    items = [(g, p) for i, (g, p) in enumerate(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
+             if i in opaque and not blends(scene, p)]
+    lo = np.min([g.lo for g, _ in items], axis=0) if items else np.zeros(3)
+    hi = np.max([g.hi for g, _ in items], axis=0) if items else np.zeros(3)
+    radius = r.screen_ao.radius_fraction * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
+    r.screen_ao.draw(r, [g for g, _ in items], [p for _, p in items], (viewport[2], viewport[3]), view_projection,
+                     frame.inverse_vp, camera, frame.ao_pixel_scale, max(radius, 1e-6))
+    fbo.use()
+    r.ctx.viewport = viewport
+    r.ctx.enable(moderngl.DEPTH_TEST)
+    r.ctx.depth_func = "<="
+    extra = screen_defines(r.screen_ao.occluded)
+    return lambda variant, *args: program_for({**variant, **extra}, *args)
 
 
 def draw_mesh_parts(r, frame: FrameContext, scene, prog, camera: Camera, view_projection: np.ndarray,

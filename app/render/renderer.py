@@ -115,6 +115,8 @@ class ForwardRenderer:
         self.lights = LightsBlock(self.ctx)    # punctual.glsl's Lights block
         # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.visibility_parts).
         self.visibility_parts = OcclusionParts(self.ctx, self.bake_cache)
+        self.screen_ao = None     # alight.render.screen_ao.ScreenAO, made by the first frame with --occlusion gtao
+        self.last_occlusion_reason = ""   # "gtao ..." where the last scene pass drew screen-space GTAO
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self.ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
         # How far the built-in sphere's outline may fall inside the true one, in output pixels
@@ -247,6 +249,9 @@ class ForwardRenderer:
         self._bakes.clear()
         self.meshes.release()
         self.visibility_parts.release()
+        if self.screen_ao is not None:
+            self.screen_ao.release()
+            self.screen_ao = None
         if self._targets:
             self._targets.release()
             self._targets = None

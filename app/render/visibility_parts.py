@@ -25,7 +25,7 @@ from alight.core import sky_weight as sw
 from alight.core.mesh import single_sided
 from alight.core.visibility import (AUTO_MAX_VERTICES, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
                                     VISIBILITY_FIELDS, MeshVisibility, PartVisibility, auto_too_big, bake_sun_bounce,
-                                    bake_visibility, embree_available, refined_mesh_part, sun_bounce_key,
+                                    bake_visibility, embree_available, refined_mesh_part, screen_occlusion, sun_bounce_key,
                                     visibility_key, wants_occlusion)
 from alight.errors import warn
 from alight.ibl.bake_cache import BadEntry, encode_entry
@@ -185,6 +185,15 @@ class OcclusionParts:
             entry = self._wanted[(id(mesh), mode)] = (mesh, wants_occlusion(mesh, mode))
         return entry[1]
 
+    def screen_wanted(self, mesh, mode: str) -> bool:
+        """Whether ``mesh`` is drawn with screen-space GTAO under ``mode``
+        (alight.core.visibility.screen_occlusion; 'auto' decides as ``wanted`` does, once)."""
+        if mode == "gtao":
+            return screen_occlusion(mesh, mode)
+        if mode != "auto" or mesh is None or not auto_too_big(mesh):
+            return False
+        return screen_occlusion(mesh, mode, self.wanted(mesh, mode))
+
     def parts_for(self, mesh, mode: str, drawn: list, make_part, through=None, sun_directions=None, sky=None) -> list:
         """The GPU parts to draw for ``mesh``: its baked ones where it is wanted, else ``drawn``.
         ``make_part(part)`` uploads a MeshPart (alight.render.gpu_mesh.GpuPart, the mesh's
@@ -202,9 +211,10 @@ class OcclusionParts:
                  f"needs embreex (pip install embreex)")
             return drawn
         if mode == "auto" and auto_too_big(mesh):
-            warn(f"{mesh.source}: rendered without occlusion of the environment light: "
-                 f"{sum(len(p.positions) for p in mesh.parts)} vertices are more than --occlusion auto bakes "
-                 f"({AUTO_MAX_VERTICES}); --occlusion on bakes it")
+            # (the scene pass draws it with screen-space GTAO instead: screen_wanted)
+            warn(f"{mesh.source}: occlusion of the environment light in screen space (gtao) instead of the "
+                 f"visibility bake: {sum(len(p.positions) for p in mesh.parts)} vertices are more than "
+                 f"--occlusion auto bakes ({AUTO_MAX_VERTICES}); --occlusion on bakes it")
             return drawn
         entry = self._parts.get(id(mesh))
         if entry is None or entry[0] is not mesh or entry[2] != through:

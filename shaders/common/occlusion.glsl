@@ -171,7 +171,40 @@ float combined_visibility(Surface s, vec3 n) {
 // Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
 // the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
 // The compact sources' direct light (with_suns) stays unoccluded here (shadows are theirs).
-#ifdef HAS_VISIBILITY
+#ifdef HAS_SCREEN_AO
+#include "common/gtao.glsl"
+// Screen-space GTAO (app/render/screen_ao.py): the cosine-weighted visibility at this pixel, from
+// the depth of the opaque parts drawn this frame.
+uniform sampler2D u_screen_ao;
+
+// As combined_visibility: the smaller of GTAO's and the glTF occlusion texture's (the texture is
+// the mesh's own baked AO: a product would darken the same crease twice), clamped to [0, 1].
+float screen_visibility(Surface s) {
+    return clamp(min(texelFetch(u_screen_ao, ivec2(gl_FragCoord.xy), 0).a, s.occlusion), 0.0, 1.0);
+}
+
+// The mean occluded direction (GTAO's sum of them, normalised); -n where nothing is occluded.
+vec3 screen_occluded_direction(vec3 n) {
+    vec3 o = texelFetch(u_screen_ao, ivec2(gl_FragCoord.xy), 0).xyz;
+    return dot(o, o) > 1e-12 ? normalize(o) : -n;
+}
+
+// The bent normal (the mean unoccluded direction): the whole hemisphere's cosine-weighted sum
+// of directions is 2/3 n in GTAO's measure, so the visible ones sum to 2/3 n minus the occluded
+// sum (app/core/gtao.py bent_normal). n where open or where the sum leaves n's hemisphere.
+vec3 screen_bent_normal(vec3 n) {
+    vec3 b = (2.0 / 3.0) * n - texelFetch(u_screen_ao, ivec2(gl_FragCoord.xy), 0).xyz;
+    return dot(b, n) > 1e-6 ? normalize(b) : n;
+}
+#endif
+
+// The occluders' albedo as the bake takes it: this surface's (one material per scene), the
+// diffuse lobe weighted by 1 - F (docs/conventions.md) plus the specular albedo.
+vec3 occluder_albedo(Surface s, vec3 specular_albedo) {
+    return min(s.base_color * (1.0 - s.metallic) * (1.0 - specular_albedo) + specular_albedo, vec3(1.0));
+}
+
+#if defined(HAS_VISIBILITY) || defined(HAS_SCREEN_AO)
 // What the occluded directions send this point (the occluders' bounce and the suns on them),
 // which occlude_environment works out for the base; the layers' lobes above it (clearcoat_ibl,
 // sheen_ibl) see the same surroundings, and the base's IBL always runs before layered_ibl, so
@@ -188,7 +221,7 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     vec3 bent = bent_normal(n);
     vec3 occluder = vec3(0.0);
     if (baked) {
-        vec3 hit_albedo = min(s.base_color * (1.0 - s.metallic) * (1.0 - specular_albedo) + specular_albedo, vec3(1.0));
+        vec3 hit_albedo = occluder_albedo(s, specular_albedo);
         float hit_visibility = occluder_visibility(v_bounce.w, baked_visibility);
         if (v_bounce.w > 0.0) {
             occluder = occluders_reflectance(hit_albedo, hit_visibility) * irradiance_at(normalize(v_bounce.xyz), false);
@@ -210,6 +243,35 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
     prefiltered = so * prefiltered + (1.0 - so) * occluder;
     g_occluder_radiance = occluder;
+#elif defined(HAS_SCREEN_AO)
+    // GTAO's V and mean occluded direction d. GTAO_OCCLUDERS, the bake's terms: the visible share
+    // sees the visible cone's radiance about the bent normal (visible_cone_radiance: a bowl's floor
+    // sees the bright sky overhead, not the map's dark ground), the occluded share the
+    // occluders' radiance as the bake's bounce does, their surfaces taken to face back along d
+    // (E(-d)/pi with the suns, lit with this surface's albedo through the bake's series, occluders_reflectance,
+    // their visibility taken as V): the corner's walls see the sunlit floor, not the map's dark
+    // ground. Else V scales E(n)/pi, with the paper's multi-bounce fit where GTAO_MULTI_BOUNCE.
+    // The specular lobe keeps its share inside the visibility cone about the bent normal (n
+    // without GTAO_OCCLUDERS; specular_occlusion, the bake's cone-cone term), the rest sees the
+    // occluders (black without GTAO_OCCLUDERS).
+    float visibility = screen_visibility(s);
+    vec3 occluder = vec3(0.0);
+    vec3 bent = n;
+#if defined(GTAO_OCCLUDERS)
+    // (E with the compact sources, unshadowed: the occluders' own shadows are not known here)
+    occluder = occluders_reflectance(occluder_albedo(s, specular_albedo), visibility)
+               * irradiance_at(-screen_occluded_direction(n), true);
+    bent = screen_bent_normal(n);
+    irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
+#elif defined(GTAO_MULTI_BOUNCE)
+    irradiance = gtao_multi_bounce(visibility, s.base_color * (1.0 - s.metallic)) * irradiance_at(n, false);
+#else
+    irradiance = visibility * irradiance_at(n, false);
+#endif
+    if (with_suns) irradiance += suns_irradiance_over_pi(n);
+    float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
+    prefiltered = so * prefiltered + (1.0 - so) * occluder;
+    g_occluder_radiance = occluder;
 #endif
 }
 
@@ -222,6 +284,14 @@ vec3 occluded_layer_radiance(Surface s, vec3 n, vec3 d, float roughness, vec3 pr
 #ifdef HAS_VISIBILITY
     float so = specular_occlusion(dot(bent_normal(n), d), dot(n, d), combined_visibility(s, n), roughness);
     return so * prefiltered + (1.0 - so) * g_occluder_radiance;
+#elif defined(HAS_SCREEN_AO)
+#ifdef GTAO_OCCLUDERS
+    vec3 bent = screen_bent_normal(n);
+#else
+    vec3 bent = n;
+#endif
+    float so = specular_occlusion(dot(bent, d), dot(n, d), screen_visibility(s), roughness);
+    return so * prefiltered + (1.0 - so) * g_occluder_radiance;
 #else
     return prefiltered;
 #endif
@@ -230,7 +300,7 @@ vec3 occluded_layer_radiance(Surface s, vec3 n, vec3 d, float roughness, vec3 pr
 // What multiplies the whole IBL result (layers too): the occlusion texture alone without a bake;
 // with one it is already in the base's terms above.
 float ibl_outer_occlusion(Surface s) {
-#ifdef HAS_VISIBILITY
+#if defined(HAS_VISIBILITY) || defined(HAS_SCREEN_AO)
     return 1.0;
 #else
     return s.occlusion;

@@ -155,11 +155,12 @@ def _add_shadow_options(p, editor: bool = False) -> None:
 
 def _add_occlusion_option(p: argparse.ArgumentParser, editor: bool = False) -> None:
     """--occlusion, 'alight render''s and 'alight edit''s (the panel's 'occlusion' combo)."""
-    p.add_argument("--occlusion", choices=("auto", "on", "off"), default="auto",
+    p.add_argument("--occlusion", choices=("auto", "on", "off", "gtao"), default="auto",
                    help="occlusion of the environment light and one diffuse bounce from a per-vertex "
                         "ray-traced visibility bake (cached like the IBL bake): auto bakes it where the mesh "
-                        "occludes more than 3%% of its own surface (never the built-in sphere or a convex mesh; "
-                        "docs/explanation/occlusion.md"
+                        "occludes more than 3%% of its own surface (never the built-in sphere or a convex mesh), "
+                        "and draws a mesh too big to bake (over 250k vertices) with gtao; gtao: screen-space "
+                        "ambient occlusion per frame from the depth buffer, no bake (docs/explanation/occlusion.md"
                         + ("; the editor bakes it in a background process and draws the view without it "
                            "meanwhile" if editor else "") + ") (default: auto)")
 

@@ -104,6 +104,8 @@ def run(args) -> int:
         # Which shading the mesh took (--mesh-shading auto decides per scene, alight.render.vbuffer).
         print(f"mesh shading: {'vbuffer' if renderer.last_vbuffer else 'forward'} (--mesh-shading {args.mesh_shading}: "
               f"{renderer.last_mesh_shading_reason})", file=sys.stderr)
+        if getattr(renderer, "last_occlusion_reason", ""):
+            print(f"occlusion: {renderer.last_occlusion_reason}", file=sys.stderr)
         if maps is not None:
             print("bake passes: " + ", ".join(f"{k} {v * 1000:.0f}ms" for k, v in maps.pass_seconds.items()),
                   file=sys.stderr)

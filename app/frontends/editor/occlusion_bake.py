@@ -69,7 +69,7 @@ class OcclusionBake:
         waits for a running bake as it waits for the IBL's (``finish_bake``) and is drawn with
         occlusion as ``alight render`` draws it (the renderer bakes what the cache lacks)."""
         mode = scene.occlusion
-        if mode == "off" or scene.mesh is None or scene.mesh.lod_sphere is not None:
+        if mode in ("off", "gtao") or scene.mesh is None or scene.mesh.lod_sphere is not None:   # (gtao: no bake)
             self.status = ""
             return scene, False
         from alight.render.bindings import sun_world_directions

@@ -1,0 +1,127 @@
+"""Screen-space ground-truth ambient occlusion (GTAO; Jimenez, Wu, Pesce and Jarabo 2016,
+"Practical Realtime Strategies for Accurate Indirect Occlusion"): the numpy twins of the GLSL in
+shaders/common/gtao.glsl, and the pass's settings.
+
+Per pixel, the cosine-weighted visibility is an integral over slices (half-planes about the view
+vector v, one per screen direction phi) of an inner integral over the angle theta from v inside
+the slice, between the two horizons h1 <= 0 <= h2 found in the depth buffer:
+
+    V = (1/pi) int_0^pi |n_p| a(h1, h2, gamma) dphi,
+    a = 1/4 (-cos(2 h1 - gamma) + cos gamma + 2 h1 sin gamma)
+      + 1/4 (-cos(2 h2 - gamma) + cos gamma + 2 h2 sin gamma)
+
+with n_p the normal projected into the slice and gamma its angle from v. Each horizon is clamped
+to the normal's hemisphere (gamma -/+ pi/2), so an open point gets V = 1 at any orientation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# Quality choices (named defines of shaders/render/gtao.frag; app/core/shader_names.py).
+SLICES = 2          # GTAO_SLICES: slice directions per pixel (x 16 rotations over the 4x4 denoise)
+STEPS = 8           # GTAO_STEPS: depth samples per side of a slice
+RADIUS_FRACTION = 1.0    # the search radius in world units, as a share of the mesh's bounding-box diagonal (the bake reaches the whole mesh; 0.25: corner 15.9%, bowl 22.4% under royal_esplanade, 1.0: 13.8, 17.0%)
+MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS_HEIGHT of the draw height where more
+MAX_RADIUS_HEIGHT = 0.2  # (the editor's 720 rows: 144 px; the samples stay GTAO_STEPS, spread wider)
+
+
+def inner_integral(h, gamma):
+    """The cosine-weighted visibility one horizon angle ``h`` (from v, in the slice) passes, for
+    the projected normal at angle ``gamma``: 1/4 (-cos(2h - gamma) + cos gamma + 2 h sin gamma),
+    which is int_0^h cos(theta - gamma) |sin theta| dtheta (signed: h < 0 counts the other side)."""
+    h = np.asarray(h, np.float64)
+    gamma = np.asarray(gamma, np.float64)
+    return 0.25 * (-np.cos(2.0 * h - gamma) + np.cos(gamma) + 2.0 * h * np.sin(gamma))
+
+
+def clamped_horizons(cos_h1, cos_h2, gamma):
+    """The two horizon angles from their cosines (h1 on the -phi side, negative), each clamped to
+    the hemisphere of the projected normal (gamma -/+ pi/2), as the paper's Algorithm 1."""
+    gamma = np.asarray(gamma, np.float64)
+    h1 = -np.arccos(np.clip(cos_h1, -1.0, 1.0))
+    h2 = np.arccos(np.clip(cos_h2, -1.0, 1.0))
+    h1 = gamma + np.maximum(h1 - gamma, -0.5 * np.pi)
+    h2 = gamma + np.minimum(h2 - gamma, 0.5 * np.pi)
+    return h1, h2
+
+
+def slice_visibility(cos_h1, cos_h2, gamma, projected_length=1.0):
+    """One slice's share: |n_p| (a(h1) + a(h2)), the horizons given by their cosines to v."""
+    h1, h2 = clamped_horizons(cos_h1, cos_h2, gamma)
+    return np.asarray(projected_length) * (inner_integral(h1, gamma) + inner_integral(h2, gamma))
+
+
+def slice_frame(n, v, phi):
+    """For unit normal ``n`` and view vector ``v`` = (0, 0, 1) (view space), the slice at screen
+    angle ``phi``: (gamma, |n_p|) as the shader computes them."""
+    n = np.asarray(n, np.float64)
+    direction = np.array([np.cos(phi), np.sin(phi), 0.0])
+    axis = np.cross(direction, v)
+    projected = n - axis * np.dot(n, axis)
+    length = np.linalg.norm(projected)
+    cos_n = np.clip(np.dot(projected, v) / max(length, 1e-12), -1.0, 1.0)
+    gamma = np.sign(np.dot(projected, direction)) * np.arccos(cos_n)
+    return gamma, length
+
+
+def open_visibility(n, slices: int = 64) -> float:
+    """V of an unoccluded point with normal ``n`` (view space, v = +Z), over ``slices`` slices:
+    every horizon at the normal's hemisphere. 1 up to the slice quadrature."""
+    v = np.array([0.0, 0.0, 1.0])
+    total = 0.0
+    for phi in (np.arange(slices) + 0.5) * np.pi / slices:
+        gamma, length = slice_frame(n, v, phi)
+        total += float(slice_visibility(-1.0, -1.0, gamma, length))
+    return total / slices
+
+
+def multi_bounce(visibility, albedo):
+    """The paper's fit of the occluders' interreflections (its section 5): the visibility seen by
+    light that bounces between surfaces of ``albedo``, max(V, ((V a + b) V + c) V)."""
+    v = np.asarray(visibility, np.float64)[..., None]
+    albedo = np.asarray(albedo, np.float64)
+    a = 2.0404 * albedo - 0.3324
+    b = -4.7951 * albedo + 0.6417
+    c = 2.7552 * albedo + 0.6903
+    return np.maximum(v, ((v * a + b) * v + c) * v)
+
+
+def _direction_antiderivative(theta, gamma):
+    """H(theta) = int_0^theta (sin t, cos t) cos(t - gamma) |sin t| dt: the (slice direction, v)
+    components of the cosine-weighted directions from v up to angle theta (signed side)."""
+    theta = np.asarray(theta, np.float64)
+    gamma = np.asarray(gamma, np.float64)
+
+    def f(t):
+        s, c = np.sin(t), np.cos(t)
+        return (np.cos(gamma) * s ** 3 / 3.0 + np.sin(gamma) * (c ** 3 / 3.0 - c),
+                -np.cos(gamma) * c ** 3 / 3.0 + np.sin(gamma) * s ** 3 / 3.0)
+
+    f0 = f(np.zeros_like(theta))
+    ft = f(theta)
+    sign = np.sign(theta)
+    return sign * (ft[0] - f0[0]), sign * (ft[1] - f0[1])
+
+
+def slice_occluded_direction(cos_h1, cos_h2, gamma, projected_length=1.0):
+    """The cosine-weighted sum of the occluded directions of one slice, as (along the slice
+    direction, along v) times |n_p|: the parts of the normal's half-disc beyond the horizons,
+    [gamma - pi/2, h1] and [h2, gamma + pi/2]. Its mean over slices points at the occluders, whose
+    surfaces face back along it (the forward pass reads E there: common/gtao.glsl)."""
+    h1, h2 = clamped_horizons(cos_h1, cos_h2, gamma)
+    lo = _direction_antiderivative(np.asarray(gamma) - 0.5 * np.pi, gamma)
+    hi = _direction_antiderivative(np.asarray(gamma) + 0.5 * np.pi, gamma)
+    a = _direction_antiderivative(h1, gamma)
+    b = _direction_antiderivative(h2, gamma)
+    return tuple(np.asarray(projected_length) * ((a[k] - lo[k]) + (hi[k] - b[k])) for k in range(2))
+
+
+def bent_normal(n, occluded_sum):
+    """The mean unoccluded direction from the occluded directions' sum (mean over slices of
+    ``slice_occluded_direction``, in the world): the whole hemisphere sums to 2/3 n in this
+    measure, so the visible directions sum to 2/3 n - occluded; n where that leaves n's side."""
+    n = np.asarray(n, np.float64)
+    b = 2.0 / 3.0 * n - np.asarray(occluded_sum, np.float64)
+    d = float(np.dot(b, n))
+    return b / np.linalg.norm(b) if d > 1e-6 else n

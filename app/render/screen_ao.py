@@ -1,0 +1,137 @@
+"""Screen-space ground-truth ambient occlusion (``--occlusion gtao``; alight.core.gtao, Jimenez et
+al. 2016) for the scene pass: a prepass of the opaque parts' world positions
+(render/gtao_depth.*), the horizon search (render/gtao.frag) and its 4x4 depth-aware denoise
+(render/gtao_denoise.frag), at the pass's draw size; the forward pass and the visibility buffer's
+shading pass read the result at gl_FragCoord (HAS_SCREEN_AO, common/occlusion.glsl).
+
+Per frame and tile, so it follows a moving view with no bake; an occluder outside the tile or
+behind the first surface is not seen (docs/explanation/occlusion.md, "Screen-space GTAO").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from alight.core import gtao
+from alight.render.bindings import UNIT_SCREEN_AO, UNIT_SCREEN_AO_WORK
+
+
+@dataclass
+class ScreenAOTargets:
+    """The pass's textures at one draw size: the prepass's world positions (and its depth
+    buffer), the raw and the denoised visibility."""
+
+    size: tuple[int, int]
+    depth: moderngl.Renderbuffer
+    positions: moderngl.Texture
+    depth_fbo: moderngl.Framebuffer
+    raw: moderngl.Texture
+    raw_fbo: moderngl.Framebuffer
+    visibility: moderngl.Texture
+    visibility_fbo: moderngl.Framebuffer
+
+    def release(self) -> None:
+        for x in (self.depth_fbo, self.raw_fbo, self.visibility_fbo, self.depth, self.positions, self.raw,
+                  self.visibility):
+            x.release()
+
+
+# What the occluded share of the light sees (common/occlusion.glsl): "occluders" (the default:
+# the occluders' radiance, GTAO_OCCLUDERS), "multi_bounce" (the paper's albedo fit of V,
+# GTAO_MULTI_BOUNCE) or "black" (V alone). benchmarks/results/gtao.md compares them.
+OCCLUDED_LIGHT = ("occluders", "multi_bounce", "black")
+
+
+def defines(occluded: str = "occluders") -> dict:
+    """The forward pass's defines that read the visibility (common/occlusion.glsl)."""
+    d = {"HAS_SCREEN_AO": None}
+    if occluded == "occluders":
+        d["GTAO_OCCLUDERS"] = None
+    elif occluded == "multi_bounce":
+        d["GTAO_MULTI_BOUNCE"] = None
+    return d
+
+
+class ScreenAO:
+    """The GTAO pass's targets (kept while the draw size stays) and its draw."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.targets: ScreenAOTargets | None = None
+        self.occluded = "occluders"  # OCCLUDED_LIGHT (the benchmarks compare them)
+        self.radius_fraction = gtao.RADIUS_FRACTION
+
+    def _targets(self, size: tuple[int, int]) -> ScreenAOTargets:
+        t = self.targets
+        if t is None or t.size != size:
+            if t is not None:
+                t.release()
+            depth = self.ctx.depth_renderbuffer(size)
+            # World positions in float32 (render/gtao_depth.frag: a 24-bit depth unprojected
+            # made an open floor occlude itself).
+            positions = self.ctx.texture(size, 4, dtype="f4")
+            # (the occluded directions' sum in xyz, V in w: render/gtao.frag)
+            raw = self.ctx.texture(size, 4, dtype="f4")
+            visibility = self.ctx.texture(size, 4, dtype="f4")
+            for tex in (raw, visibility):
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            positions.filter = (moderngl.LINEAR, moderngl.LINEAR)    # (the samples: gtao.frag)
+            positions.repeat_x = positions.repeat_y = False
+            self.targets = t = ScreenAOTargets(
+                size, depth, positions, self.ctx.framebuffer(color_attachments=[positions], depth_attachment=depth), raw,
+                self.ctx.framebuffer(color_attachments=[raw]), visibility,
+                self.ctx.framebuffer(color_attachments=[visibility]))
+        return t
+
+    def draw(self, r, gpu_parts, parts, size: tuple[int, int], view_projection: np.ndarray,
+             inverse_vp: np.ndarray, camera, pixel_scale: float, radius: float) -> moderngl.Texture:
+        """The denoised visibility of the opaque ``gpu_parts`` (with their MeshParts ``parts``)
+        seen through ``view_projection`` at ``size`` (the draw size); returns its texture. Leaves
+        the framebuffer binding and viewport to the caller."""
+        ctx = self.ctx
+        t = self._targets(size)
+        ctx.viewport = (0, 0, size[0], size[1])
+        t.depth_fbo.use()
+        t.depth_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+        prog = r.program("render/gtao_depth.vert", "render/gtao_depth.frag")
+        prog["u_view_projection"].write(np.ascontiguousarray(view_projection, np.float32).tobytes())
+        from alight.render.part_bindings import set_culling
+
+        for gpu_part, part in zip(gpu_parts, parts):
+            set_culling(ctx, gpu_part, part)     # the forward pass's culling: the same front surface
+            gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.disable(moderngl.DEPTH_TEST)
+        vp = np.ascontiguousarray(view_projection, np.float32).tobytes()
+        ivp = np.ascontiguousarray(inverse_vp, np.float32).tobytes()
+        search = r.program("render/fullscreen.vert", "render/gtao.frag",
+                           {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS})
+        t.positions.use(UNIT_SCREEN_AO_WORK)
+        search["u_positions"] = UNIT_SCREEN_AO_WORK
+        search["u_inverse_vp"].write(ivp)
+        search["u_view_projection"].write(vp)
+        search["u_camera_position"] = tuple(float(x) for x in camera.position)
+        search["u_radius"] = float(radius)
+        search["u_pixel_scale"] = float(pixel_scale)
+        search["u_max_radius_px"] = max(float(gtao.MAX_RADIUS_PX), gtao.MAX_RADIUS_HEIGHT * size[1])
+        t.raw_fbo.use()
+        r.fullscreen(search)
+        denoise = r.program("render/fullscreen.vert", "render/gtao_denoise.frag")
+        t.raw.use(UNIT_SCREEN_AO)
+        denoise["u_raw"] = UNIT_SCREEN_AO
+        denoise["u_positions"] = UNIT_SCREEN_AO_WORK
+        denoise["u_camera_position"] = tuple(float(x) for x in camera.position)
+        t.visibility_fbo.use()
+        r.fullscreen(denoise)
+        t.visibility.use(UNIT_SCREEN_AO)    # what the forward pass reads (u_screen_ao)
+        return t.visibility
+
+    def release(self) -> None:
+        if self.targets is not None:
+            self.targets.release()
+            self.targets = None

@@ -1,0 +1,55 @@
+// Ground-truth ambient occlusion's terms (Jimenez, Wu, Pesce and Jarabo 2016, "Practical
+// Realtime Strategies for Accurate Indirect Occlusion"); numpy twins in app/core/gtao.py.
+
+// The cosine-weighted visibility up to horizon angle h (from v, in the slice; negative on the
+// slice's other side) for the projected normal at angle gamma: the paper's closed-form inner
+// integral, int_0^h cos(theta - gamma) |sin theta| dtheta.
+float gtao_inner_integral(float h, float gamma) {
+    return 0.25 * (-cos(2.0 * h - gamma) + cos(gamma) + 2.0 * h * sin(gamma));
+}
+
+// One slice: the horizons (their cosines to v, h1 on the -phi side) clamped to the projected
+// normal's hemisphere, weighted by the projected normal's length (paper, Algorithm 1).
+float gtao_slice_visibility(float cos_h1, float cos_h2, float gamma, float projected_length) {
+    const float HALF_PI = 1.5707963;
+    float h1 = -acos(clamp(cos_h1, -1.0, 1.0));
+    float h2 = acos(clamp(cos_h2, -1.0, 1.0));
+    h1 = gamma + max(h1 - gamma, -HALF_PI);
+    h2 = gamma + min(h2 - gamma, HALF_PI);
+    return projected_length * (gtao_inner_integral(h1, gamma) + gtao_inner_integral(h2, gamma));
+}
+
+// The paper's fit of the interreflections between occluders of this albedo (its section 5):
+// the visibility the light that bounces sees, never below V itself.
+vec3 gtao_multi_bounce(float visibility, vec3 albedo) {
+    vec3 a = 2.0404 * albedo - 0.3324;
+    vec3 b = -4.7951 * albedo + 0.6417;
+    vec3 c = 2.7552 * albedo + 0.6903;
+    return max(vec3(visibility), ((visibility * a + b) * visibility + c) * visibility);
+}
+
+// int_0^theta (sin t, cos t) cos(t - gamma) |sin t| dt: the (slice direction, v) parts of the
+// cosine-weighted directions from v up to the signed angle theta.
+vec2 gtao_direction_antiderivative(float theta, float gamma) {
+    float s = sin(theta), c = cos(theta);
+    vec2 at_theta = vec2(cos(gamma) * s * s * s / 3.0 + sin(gamma) * (c * c * c / 3.0 - c),
+                         -cos(gamma) * c * c * c / 3.0 + sin(gamma) * s * s * s / 3.0);
+    vec2 at_zero = vec2(sin(gamma) * (1.0 / 3.0 - 1.0), -cos(gamma) / 3.0);
+    return sign(theta) * (at_theta - at_zero);
+}
+
+// One slice's cosine-weighted sum of occluded directions, (along the slice direction, along v)
+// times |n_p|: the normal's half-disc beyond the horizons. Summed over slices it points at the
+// occluders, whose surfaces face back along it (occlude_environment reads E there, as the bake
+// reads it along its bounce rays).
+vec2 gtao_slice_occluded_direction(float cos_h1, float cos_h2, float gamma, float projected_length) {
+    const float HALF_PI = 1.5707963;
+    float h1 = -acos(clamp(cos_h1, -1.0, 1.0));
+    float h2 = acos(clamp(cos_h2, -1.0, 1.0));
+    h1 = gamma + max(h1 - gamma, -HALF_PI);
+    h2 = gamma + min(h2 - gamma, HALF_PI);
+    vec2 lo = gtao_direction_antiderivative(gamma - HALF_PI, gamma);
+    vec2 hi = gtao_direction_antiderivative(gamma + HALF_PI, gamma);
+    return projected_length * ((gtao_direction_antiderivative(h1, gamma) - lo)
+                               + (hi - gtao_direction_antiderivative(h2, gamma)));
+}

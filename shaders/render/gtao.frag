@@ -1,0 +1,129 @@
+#version 450 core
+// Screen-space ground-truth ambient occlusion (app/render/screen_ao.py): per pixel the
+// cosine-weighted visibility and the occluded directions' sum from the opaque parts' positions
+// (GTAO_SLICES slice directions, GTAO_STEPS samples a side, horizons within u_radius world
+// units), the slices turned by a 4x4 pattern that render/gtao_denoise.frag averages out.
+// Jimenez et al. 2016, Algorithm 1, in world space.
+#include "common/gtao.glsl"
+
+uniform sampler2D u_positions;   // the prepass's world positions (w = 1 where a surface is)
+uniform mat4 u_inverse_vp;       // NDC -> world (a tile's: the whole image's, off centre)
+uniform vec3 u_camera_position;
+uniform mat4 u_view_projection;
+uniform float u_radius;          // world units
+uniform float u_pixel_scale;     // pixels per world unit at clip w = 1 (half the image's height times P[1][1])
+uniform float u_max_radius_px;
+
+layout(location = 0) out vec4 out_visibility;   // the occluded directions' cosine-weighted sum (world), V
+
+vec3 world_at(vec2 pixel, float ndc_depth) {
+    vec2 size = vec2(textureSize(u_positions, 0));
+    vec4 w = u_inverse_vp * vec4(pixel / size * 2.0 - 1.0, ndc_depth, 1.0);
+    return w.xyz / w.w;
+}
+
+// The surface's position at a pixel; `covered` false where there is none.
+vec3 position_at(ivec2 p, out bool covered) {
+    vec4 x = texelFetch(u_positions, p, 0);
+    covered = x.w > 0.5;
+    return x.xyz;
+}
+
+// The geometric normal from the positions: of the two neighbours on each axis the one nearer to
+// this pixel (across an edge the other belongs to another surface), facing the eye.
+vec3 screen_normal(ivec2 p, vec3 centre, vec3 v) {
+    ivec2 last = textureSize(u_positions, 0) - 1;
+    bool c1, c2;
+    vec3 right = position_at(min(p + ivec2(1, 0), last), c1);
+    vec3 left = position_at(max(p - ivec2(1, 0), ivec2(0)), c2);
+    // (at the image's border the clamped neighbour is this pixel: not a neighbour)
+    float dr = c1 && p.x < last.x ? distance(right, centre) : 1e30;
+    float dl = c2 && p.x > 0 ? distance(left, centre) : 1e30;
+    vec3 dx = dl < dr ? centre - left : right - centre;
+    vec3 up = position_at(min(p + ivec2(0, 1), last), c1);
+    vec3 down = position_at(max(p - ivec2(0, 1), ivec2(0)), c2);
+    float du = c1 && p.y < last.y ? distance(up, centre) : 1e30;
+    float dd = c2 && p.y > 0 ? distance(down, centre) : 1e30;
+    vec3 dy = dd < du ? centre - down : up - centre;
+    vec3 n = cross(dx, dy);
+    n = dot(n, n) > 0.0 ? normalize(n) : v;
+    return dot(n, v) < 0.0 ? -n : n;
+}
+
+// The 4x4 pattern's rotation (0..15)/16 and step offset, so that 16 neighbours hold 16 rotations.
+vec2 pattern_noise(ivec2 p) {
+    const float BAYER[16] = float[](0.0, 8.0, 2.0, 10.0, 12.0, 4.0, 14.0, 6.0,
+                                    3.0, 11.0, 1.0, 9.0, 15.0, 7.0, 13.0, 5.0);
+    int i = (p.x & 3) + 4 * (p.y & 3);
+    return vec2(BAYER[i] / 16.0, fract(float(i) * 0.618034));
+}
+
+// The largest horizon cosine to v along one side of the slice; occluders fade out between 0.75
+// and 1 times `radius` (world units), so that the search's end does not draw a line.
+float horizon_cos(vec2 origin, vec2 step_px, vec3 centre, vec3 v, float jitter, float radius) {
+    float best = -1.0;
+    vec2 size = vec2(textureSize(u_positions, 0));
+    for (int j = 0; j < GTAO_STEPS; ++j) {
+        vec2 q = origin + step_px * (float(j) + jitter + 1.0);
+        if (any(lessThan(q, vec2(0.0))) || any(greaterThanEqual(q, size))) break;
+        // Bilinear between the 4 texels about q: on a plane the point at q itself, so it lies in
+        // the slice (the nearest texel's centre, up to half a pixel off it, rose above an open
+        // floor's tangent in some slices: V 0.9 there). Where a texel is uncovered, the nearest.
+        vec4 at = textureLod(u_positions, q / size, 0.0);
+        if (at.w < 0.999) at = texelFetch(u_positions, ivec2(q), 0);
+        if (at.w < 0.5) continue;
+        vec3 s = at.xyz;
+        vec3 delta = s - centre;
+        float dist = length(delta);
+        if (dist < 1e-6) continue;
+        float weight = clamp((radius - dist) / (0.25 * radius), 0.0, 1.0);
+        best = max(best, mix(-1.0, dot(delta, v) / dist, weight));
+    }
+    return best;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    bool covered;
+    vec3 centre = position_at(p, covered);
+    if (!covered) {
+        out_visibility = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
+    vec3 v = normalize(u_camera_position - centre);
+    vec3 n = screen_normal(p, centre, v);
+    vec4 clip = u_view_projection * vec4(centre, 1.0);
+    float ndc_depth = clip.z / clip.w;
+    float radius_px = min(u_radius * u_pixel_scale / max(clip.w, 1e-6), u_max_radius_px);
+    // The world radius the pixels reach: the fade-out follows it, so that where the pixel cap
+    // cuts the search short the occluders fade rather than stop (a hard vertical band on the
+    // corner's back wall in the editor at 1280x720).
+    float radius = radius_px * max(clip.w, 1e-6) / u_pixel_scale;
+    vec2 noise = pattern_noise(p);
+    vec2 origin = vec2(p) + 0.5;
+    float visibility = 0.0;
+    vec3 occluded = vec3(0.0);
+    for (int i = 0; i < GTAO_SLICES; ++i) {
+        float phi = (float(i) + noise.x) * 3.14159265 / float(GTAO_SLICES);
+        vec2 omega = vec2(cos(phi), sin(phi));
+        // The slice's direction in the world: one pixel along omega at this depth, off v.
+        vec3 direction = world_at(origin + omega, ndc_depth) - centre;
+        direction -= dot(direction, v) * v;
+        direction = normalize(direction);
+        vec3 axis = normalize(cross(direction, v));
+        vec3 projected = n - axis * dot(n, axis);
+        float length_n = length(projected);
+        float cos_n = clamp(dot(projected, v) / max(length_n, 1e-6), -1.0, 1.0);
+        float gamma = sign(dot(projected, direction)) * acos(cos_n);
+        vec2 step_px = omega * max(radius_px / float(GTAO_STEPS), 1.0);
+        float c2 = horizon_cos(origin, step_px, centre, v, noise.y, radius);
+        float c1 = horizon_cos(origin, -step_px, centre, v, noise.y, radius);
+        visibility += gtao_slice_visibility(c1, c2, gamma, length_n);
+        vec2 o = gtao_slice_occluded_direction(c1, c2, gamma, length_n);
+        occluded += direction * o.x + v * o.y;
+    }
+    // Not clamped here: the mean of 2 slices is 1 over an open pixel only on average (1.07 for
+    // a normal 69 degrees from v), and render/gtao_denoise.frag's mean over 16 rotations is the
+    // estimate (clamped per pixel first, an open floor seen at a slant came out 0.96).
+    out_visibility = vec4(occluded, visibility) / float(GTAO_SLICES);
+}

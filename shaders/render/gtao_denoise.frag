@@ -1,0 +1,33 @@
+#version 450 core
+// GTAO's spatial denoise (app/render/screen_ao.py): the mean over the 4x4 block that holds each
+// of render/gtao.frag's 16 rotations once, of the pixels on the same surface (distance to the eye
+// within 5% of this one's), so edges stay sharp (the paper's 4x4 bilateral filter).
+uniform sampler2D u_raw;         // gtao.frag's visibility
+uniform sampler2D u_positions;   // the prepass's world positions (w = 1 where a surface is)
+uniform vec3 u_camera_position;
+
+layout(location = 0) out vec4 out_visibility;   // as gtao.frag's
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    ivec2 last = textureSize(u_raw, 0) - 1;
+    if (texelFetch(u_positions, p, 0).w < 0.5) {
+        out_visibility = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
+    float here = distance(texelFetch(u_positions, p, 0).xyz, u_camera_position);
+    vec4 sum = vec4(0.0);
+    float weight = 0.0;
+    for (int y = -1; y <= 2; ++y) {
+        for (int x = -1; x <= 2; ++x) {
+            ivec2 q = clamp(p + ivec2(x, y), ivec2(0), last);
+            vec4 at = texelFetch(u_positions, q, 0);
+            if (at.w < 0.5) continue;
+            float w = abs(distance(at.xyz, u_camera_position) - here) < 0.05 * here ? 1.0 : 0.0;
+            sum += w * texelFetch(u_raw, q, 0);
+            weight += w;
+        }
+    }
+    out_visibility = weight > 0.0 ? sum / weight : texelFetch(u_raw, p, 0);
+    out_visibility.w = clamp(out_visibility.w, 0.0, 1.0);
+}
