@@ -1,0 +1,123 @@
+"""Export glTF with the mesh file's own materials (app/exchange/gltf_file_materials.py): a file
+rendered with its own materials, exported through the editor's 'export glTF' control (the UI test
+engine, tests/editor_ui_checks_export.py) and through the API the CLI and the panel share,
+renders the same picture as the original; the validator reports no error."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gltf_builder import Gltf, checker, grid_plane
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED = REPO.parent / "shared" / "data"
+KHRONOS = SHARED / "models" / "khronos"
+# Differences allowed between the two renders (8-bit sRGB, 0..255): the geometry is written in
+# world space (one node a part) and the tangents as computed, so a few edge pixels may move.
+MAX_MEAN, MAX_PIXEL_SHARE = 0.5, 0.01
+
+
+def two_part_file(path: Path) -> Path:
+    """Two tilted planes, two materials: a checker base colour (KHR_texture_transform: offset,
+    rotation, scale; a nearest/clamp sampler) and a normal + metallicRoughness map (REPEAT,
+    TEXCOORD_1 for the metallicRoughness map)."""
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(4, size=1.6)
+    y, x = np.mgrid[0:32, 0:32] / 32.0
+    bumps = np.stack([0.5 + 0.35 * np.sin(x * 12.0), 0.5 + 0.35 * np.cos(y * 9.0), np.full_like(x, 0.8)], -1)
+    normal_map = (bumps / np.linalg.norm(bumps - 0.5, axis=-1, keepdims=True) * 0.5 + 0.5).clip(0, 1) * 255
+    mr = np.stack([np.full_like(x, 255), 40 + 200 * x, 255 * (y > 0.5)], -1)
+    checker_tex = g.image(checker(4, 32), {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648})
+    normal_tex = g.image(normal_map.astype(np.uint8))
+    mr_tex = g.image(mr.astype(np.uint8), {"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497})
+    g.use("KHR_texture_transform")
+    painted = g.material(name="painted", pbrMetallicRoughness={
+        "baseColorFactor": [1.0, 0.9, 0.8, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6,
+        "baseColorTexture": {"index": checker_tex, "extensions": {"KHR_texture_transform": {
+            "offset": [0.1, -0.2], "rotation": 0.4, "scale": [1.5, 2.0]}}}})
+    metal = g.material(name="bumpy metal", normalTexture={"index": normal_tex, "scale": 0.8},
+                       pbrMetallicRoughness={"baseColorFactor": [0.9, 0.6, 0.3, 1.0], "metallicFactor": 1.0,
+                                             "roughnessFactor": 0.9,
+                                             "metallicRoughnessTexture": {"index": mr_tex, "texCoord": 1}})
+    uvs1 = uvs[:, ::-1].copy()   # a second uv set that differs from the first
+    for material, x0, turn in ((painted, -0.85, 0.3), (metal, 0.85, -0.3)):
+        attrs = {"POSITION": g.accessor(positions, bounds=True), "NORMAL": g.accessor(normals),
+                 "TEXCOORD_0": g.accessor(uvs), "TEXCOORD_1": g.accessor(uvs1)}
+        g.mesh([{"attributes": attrs, "indices": g.accessor(idx.reshape(-1), component=5125), "material": material}],
+               translation=[x0, 0.0, 0.0], rotation=[0.0, math.sin(turn / 2), 0.0, math.cos(turn / 2)])
+    return g.save(path)
+
+
+def alight(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "alight", *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=600)
+
+
+def render(mesh: Path, out: Path) -> np.ndarray:
+    from PIL import Image
+
+    r = alight("render", "--mesh", str(mesh), "--size", "160x96", "--occlusion", "off", "--shadows", "off",
+               "--out", str(out), cwd=out.parent)
+    assert r.returncode == 0, r.stderr
+    return np.asarray(Image.open(out).convert("RGB"), np.float64)
+
+
+def difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    """(max, mean, share of pixels off by more than 8 of 255)."""
+    d = np.abs(a - b)
+    return float(d.max()), float(d.mean()), float((d.max(axis=-1) > 8).mean())
+
+
+def assert_same_picture(original: Path, exported: Path, tmp: Path) -> tuple[float, float, float]:
+    a = render(original, tmp / f"{original.stem}_original.png")
+    b = render(exported, tmp / f"{exported.stem}_exported.png")
+    got = difference(a, b)
+    assert got[1] <= MAX_MEAN and got[2] <= MAX_PIXEL_SHARE, (original, got)
+    return got
+
+
+def export_api(mesh_path: Path, out: Path) -> list[str]:
+    from alight.core.material import Material
+    from alight.exchange.gltf_export import export_gltf
+    from alight.exchange.meshes import load_mesh
+
+    return export_gltf(Material(), out, None, load_mesh(str(mesh_path)), file_materials=True)[1]
+
+
+def test_two_materials_with_textures_export_as_they_render(tmp_path):
+    original = two_part_file(tmp_path / "two_parts.glb")
+    for out in (tmp_path / "two_parts_out.gltf", tmp_path / "two_parts_out.glb"):
+        notes = export_api(original, out)
+        assert not [n for n in notes if "left out" in n], notes
+        got = assert_same_picture(original, out, tmp_path)
+        print(out.name, "max %.0f mean %.3f share %.4f" % got)
+    doc = json.loads((tmp_path / "two_parts_out.gltf").read_text())
+    names = [doc["materials"][m["primitives"][0]["material"]]["name"] for m in doc["meshes"]]
+    assert names == ["painted", "bumpy metal"], names
+    painted, metal = doc["materials"]
+    t = painted["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]
+    assert t == {"offset": [0.1, -0.2], "rotation": 0.4, "scale": [1.5, 2.0]}, t
+    assert metal["pbrMetallicRoughness"]["metallicRoughnessTexture"]["texCoord"] == 1
+    assert metal["normalTexture"]["scale"] == 0.8
+    sampler = doc["samplers"][doc["textures"][painted["pbrMetallicRoughness"]["baseColorTexture"]["index"]]["sampler"]]
+    assert sampler == {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648}, sampler
+    assert len(doc["images"]) == 3 and all((tmp_path / i["uri"]).is_file() for i in doc["images"])
+
+
+@pytest.mark.parametrize("model", ["TextureTransformTest/glTF/TextureTransformTest.gltf",
+                                   "TextureSettingsTest/glTF-Binary/TextureSettingsTest.glb"])
+def test_a_khronos_model_exports_as_it_renders(tmp_path, model):
+    original = KHRONOS / model
+    if not original.is_file():
+        pytest.skip(f"{original} is not in the shared data")
+    out = tmp_path / "exported.glb"
+    export_api(original, out)
+    got = assert_same_picture(original, out, tmp_path)
+    print(model, "max %.0f mean %.3f share %.4f" % got)
