@@ -15,10 +15,14 @@ import numpy as np
 import pytest
 
 from gltf_builder import Gltf, checker, grid_plane
+from test_editor import display  # noqa: F401  (the Xvfb fixture)
+from test_editor_ui import ui_test
+from test_gltf_material import validate  # noqa: F401  (the Khronos validator fixture)
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared" / "data"
 KHRONOS = SHARED / "models" / "khronos"
+CHECKS = REPO / "tests" / "editor_ui_checks_export.py"
 # Differences allowed between the two renders (8-bit sRGB, 0..255): the geometry is written in
 # world space (one node a part) and the tangents as computed, so a few edge pixels may move.
 MAX_MEAN, MAX_PIXEL_SHARE = 0.5, 0.01
@@ -83,21 +87,37 @@ def assert_same_picture(original: Path, exported: Path, tmp: Path) -> tuple[floa
     return got
 
 
-def export_api(mesh_path: Path, out: Path) -> list[str]:
-    from alight.core.material import Material
-    from alight.exchange.gltf_export import export_gltf
-    from alight.exchange.meshes import load_mesh
+def export_cli(mesh_path: Path, out: Path) -> str:
+    """`alight export --mesh FILE` (no preset, maps or field flags: the file's own materials);
+    returns its stderr."""
+    r = alight("export", "--mesh", str(mesh_path), "--out", str(out), cwd=out.parent)
+    assert r.returncode == 0 and r.stdout.strip() == str(out), r.stderr
+    return r.stderr
 
-    return export_gltf(Material(), out, None, load_mesh(str(mesh_path)), file_materials=True)[1]
+
+def test_the_editors_export_renders_as_the_file_it_opened(display, tmp_path, validate):
+    """The panel's 'export glTF' with the file's own materials shown writes a file that renders
+    as the original; with them off, the panel's material on every part (a different picture)."""
+    original = two_part_file(tmp_path / "two_parts.glb")
+    result = ui_test(tmp_path, CHECKS, "--new", size="1280x720")
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert "1 passed, 0 failed" in result.stdout, result.stdout
+    got = assert_same_picture(original, tmp_path / "from_editor.gltf", tmp_path)
+    print("editor export: max %.0f mean %.3f share %.4f" % got)
+    panel = render(tmp_path / "panel_material.glb", tmp_path / "panel_material.png")
+    assert difference(render(original, tmp_path / "again.png"), panel)[1] > 5.0   # the comparison can fail
+    reports = validate(tmp_path / "from_editor.gltf", tmp_path / "panel_material.glb")
+    assert all((r["errors"], r["warnings"]) == (0, 0) for r in reports), reports
 
 
-def test_two_materials_with_textures_export_as_they_render(tmp_path):
+def test_two_materials_with_textures_export_as_they_render(tmp_path, validate):
     original = two_part_file(tmp_path / "two_parts.glb")
     for out in (tmp_path / "two_parts_out.gltf", tmp_path / "two_parts_out.glb"):
-        notes = export_api(original, out)
-        assert not [n for n in notes if "left out" in n], notes
+        assert "left out" not in export_cli(original, out)
         got = assert_same_picture(original, out, tmp_path)
         print(out.name, "max %.0f mean %.3f share %.4f" % got)
+        (report,) = validate(out)
+        assert (report["errors"], report["warnings"]) == (0, 0), report["messages"]
     doc = json.loads((tmp_path / "two_parts_out.gltf").read_text())
     names = [doc["materials"][m["primitives"][0]["material"]]["name"] for m in doc["meshes"]]
     assert names == ["painted", "bumpy metal"], names
@@ -113,11 +133,25 @@ def test_two_materials_with_textures_export_as_they_render(tmp_path):
 
 @pytest.mark.parametrize("model", ["TextureTransformTest/glTF/TextureTransformTest.gltf",
                                    "TextureSettingsTest/glTF-Binary/TextureSettingsTest.glb"])
-def test_a_khronos_model_exports_as_it_renders(tmp_path, model):
+def test_a_khronos_model_exports_as_it_renders(tmp_path, model, validate):
     original = KHRONOS / model
     if not original.is_file():
         pytest.skip(f"{original} is not in the shared data")
     out = tmp_path / "exported.glb"
-    export_api(original, out)
+    export_cli(original, out)
     got = assert_same_picture(original, out, tmp_path)
     print(model, "max %.0f mean %.3f share %.4f" % got)
+    (report,) = validate(out)
+    assert (report["errors"], report["warnings"]) == (0, 0), report["messages"]
+
+
+def test_field_flags_export_the_flag_built_material_on_every_part(tmp_path):
+    """`alight export --mesh FILE --roughness X`: the material the flags build, on every part
+    (the export of a file's own materials takes no edits)."""
+    original = two_part_file(tmp_path / "two_parts.glb")
+    out = tmp_path / "flags.gltf"
+    r = alight("export", "--mesh", str(original), "--roughness", "0.3", "--out", str(out), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(out.read_text())
+    assert len(doc["materials"]) == 1 and doc["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] == 0.3
+    assert "images" not in doc
