@@ -28,10 +28,11 @@ CHECKS = REPO / "tests" / "editor_ui_checks_export.py"
 MAX_MEAN, MAX_PIXEL_SHARE = 0.5, 0.01
 
 
-def two_part_file(path: Path) -> Path:
+def two_part_file(path: Path, second_material: bool = True) -> Path:
     """Two tilted planes, two materials: a checker base colour (KHR_texture_transform: offset,
     rotation, scale; a nearest/clamp sampler) and a normal + metallicRoughness map (REPEAT,
-    TEXCOORD_1 for the metallicRoughness map)."""
+    TEXCOORD_1 for the metallicRoughness map); ``second_material`` False: the second part has
+    none (drawn with the panel's material)."""
     g = Gltf()
     positions, normals, uvs, idx = grid_plane(4, size=1.6)
     y, x = np.mgrid[0:32, 0:32] / 32.0
@@ -54,7 +55,10 @@ def two_part_file(path: Path) -> Path:
     for material, x0, turn in ((painted, -0.85, 0.3), (metal, 0.85, -0.3)):
         attrs = {"POSITION": g.accessor(positions, bounds=True), "NORMAL": g.accessor(normals),
                  "TEXCOORD_0": g.accessor(uvs), "TEXCOORD_1": g.accessor(uvs1)}
-        g.mesh([{"attributes": attrs, "indices": g.accessor(idx.reshape(-1), component=5125), "material": material}],
+        prim = {"attributes": attrs, "indices": g.accessor(idx.reshape(-1), component=5125), "material": material}
+        if material == metal and not second_material:
+            del prim["material"]
+        g.mesh([prim],
                translation=[x0, 0.0, 0.0], rotation=[0.0, math.sin(turn / 2), 0.0, math.cos(turn / 2)])
     return g.save(path)
 
@@ -141,6 +145,21 @@ def test_a_khronos_model_exports_as_it_renders(tmp_path, model, validate):
     export_cli(original, out)
     got = assert_same_picture(original, out, tmp_path)
     print(model, "max %.0f mean %.3f share %.4f" % got)
+    (report,) = validate(out)
+    assert (report["errors"], report["warnings"]) == (0, 0), report["messages"]
+
+
+def test_a_part_without_a_material_gets_the_panels_after_one_with_its_own(tmp_path, validate):
+    """The first part has its own material, the second none (the panel's is drawn on it): both
+    go out, in that order, and the export renders as the original."""
+    original = two_part_file(tmp_path / "one_bare.glb", second_material=False)
+    out = tmp_path / "one_bare_out.glb"
+    export_cli(original, out)
+    assert_same_picture(original, out, tmp_path)
+    from alight.exchange.gltf_material import read_gltf_json
+
+    doc = read_gltf_json(out)
+    assert [doc["materials"][m["primitives"][0]["material"]]["name"] for m in doc["meshes"]] == ["painted", "default"]
     (report,) = validate(out)
     assert (report["errors"], report["warnings"]) == (0, 0), report["messages"]
 

@@ -217,17 +217,18 @@ def _tangents(normals: np.ndarray, tangents: np.ndarray) -> np.ndarray:
 
 def _add_file_materials(b: _Builder, mesh, stem: str, glb: bool) -> list[int]:
     """Each part's material index: its own material (one glTF material per distinct
-    FileMaterial, in the parts' order), the panel's (index 0) for a part without one, as drawn."""
+    FileMaterial, in the parts' order), the panel's for a part without one, as drawn."""
     from alight.exchange.gltf_file_materials import file_material_to_gltf
 
-    index: dict[int, int] = {}
+    index: dict[int, int] = {}   # id(FileMaterial) or id(None) (the panel's, added on first use) -> index
     out = []
     for part in mesh.parts:
         fm = part.material
         if fm is None:
-            if not b.materials:   # index 0 is the panel's, added on first use
+            if id(None) not in index:
                 b.materials.append(b.material)
-            out.append(b.materials.index(b.material))
+                index[id(None)] = len(b.materials) - 1
+            out.append(index[id(None)])
             continue
         if id(fm) not in index:
             n = len(b.materials)
