@@ -174,3 +174,48 @@ def test_field_flags_export_the_flag_built_material_on_every_part(tmp_path):
     doc = json.loads(out.read_text())
     assert len(doc["materials"]) == 1 and doc["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] == 0.3
     assert "images" not in doc
+
+
+def _jpeg_file(path: Path) -> tuple[Path, bytes]:
+    """One plane whose base colour is a JPEG (the bytes returned)."""
+    import io
+
+    from PIL import Image
+
+    g = Gltf()
+    positions, normals, uvs, idx = grid_plane(2)
+    buf = io.BytesIO()
+    Image.fromarray(checker(4, 32)).save(buf, "JPEG", quality=80)
+    jpeg = buf.getvalue()
+    g.doc.setdefault("images", []).append({"bufferView": g._view(jpeg), "mimeType": "image/jpeg"})
+    g.doc.setdefault("textures", []).append({"source": 0})
+    m = g.material(name="jpeg", pbrMetallicRoughness={"baseColorTexture": {"index": 0}, "metallicFactor": 0.0})
+    g.mesh([{"attributes": {"POSITION": g.accessor(positions, bounds=True), "NORMAL": g.accessor(normals),
+                            "TEXCOORD_0": g.accessor(uvs)},
+             "indices": g.accessor(idx.reshape(-1), component=5125), "material": m}])
+    return g.save(path), jpeg
+
+
+def test_images_go_out_as_the_file_had_them_unless_their_pixels_changed(tmp_path):
+    """A JPEG texture is written back as the same bytes (not a PNG four times its size); where
+    the pixels drawn are no longer what those bytes decode to, the pixels go out as PNG."""
+    from alight.core.material import Material
+    from alight.exchange.gltf_export import export_gltf
+    from alight.exchange.images import decode_texture
+    from alight.exchange.meshes import load_mesh
+
+    original, jpeg = _jpeg_file(tmp_path / "jpeg.gltf")
+    out = tmp_path / "jpeg_out.gltf"
+    export_cli(original, out)
+    doc = json.loads(out.read_text())
+    assert [i["uri"] for i in doc["images"]] == ["jpeg_out_m0_base_color.jpg"], doc["images"]
+    assert (tmp_path / "jpeg_out_m0_base_color.jpg").read_bytes() == jpeg
+    assert_same_picture(original, out, tmp_path)
+
+    mesh = load_mesh(str(original))
+    info = mesh.parts[0].material.base_color_texture
+    info.image = info.image.copy()
+    info.image[0, 0] = (1, 2, 3, 255)   # drawn now, and not what the JPEG decodes to
+    export_gltf(Material(), tmp_path / "changed.gltf", None, mesh, file_materials=True)
+    written = tmp_path / "changed_m0_base_color.png"
+    assert np.array_equal(decode_texture(written.read_bytes(), str(written)), info.image)

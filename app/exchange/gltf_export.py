@@ -15,7 +15,10 @@ The maps are ``alight.core.texture_maps.TextureMaps``; what goes out is what ali
 Images are written as PNG with the 8-bit values alight decoded (no re-encoding loss), so a file
 written here renders the same pixels through ``alight render --mesh`` (the file's material) and
 ``--preset`` (alight.exchange.material_files). The factors come from
-``alight.exchange.gltf_material.material_to_gltf``. Every file is written atomically; the
+``alight.exchange.gltf_material.material_to_gltf``. With ``file_materials`` each part of a mesh
+file keeps its own material instead (alight.exchange.gltf_file_materials: textures, samplers,
+texCoord and KHR_texture_transform as loaded; TEXCOORD_1 and COLOR_0 go out with the parts).
+Every file is written atomically; the
 .gltf's JSON last, so a failure never leaves a document pointing at missing files.
 """
 
@@ -112,7 +115,7 @@ class _Builder:
         self.materials: list[dict] = []
         self._by_hash: dict[tuple[str, int], int] = {}
         self._images_by_hash: dict[str, int] = {}
-        self._pngs: dict[int, bytes] = {}      # id(decoded image) -> its PNG (a shared image encoded once)
+        self._encoded: dict[int, tuple[bytes, str]] = {}   # id(decoded image) -> (bytes, mimeType): once each
 
     def view(self, data: bytes, target: int | None = None) -> int:
         while len(self.blob) % 4:
@@ -139,15 +142,15 @@ class _Builder:
             self.samplers.append(dict(sampler))
         return self.samplers.index(sampler)
 
-    def texture(self, png: bytes, name: str, glb: bool, sampler: dict = SAMPLER) -> int:
-        """A texture for this PNG and sampler (one image per distinct content, one texture per
-        image and sampler)."""
-        digest = hashlib.sha1(png).hexdigest()
+    def texture(self, data: bytes, name: str, glb: bool, sampler: dict = SAMPLER, mime: str = "image/png") -> int:
+        """A texture for this encoded image (PNG or JPEG) and sampler (one image per distinct
+        content, one texture per image and sampler)."""
+        digest = hashlib.sha1(data).hexdigest()
         if digest not in self._images_by_hash:
             if glb:
-                self.images.append({"bufferView": self.view(png), "mimeType": "image/png"})
+                self.images.append({"bufferView": self.view(data), "mimeType": mime})
             else:
-                self.files[name] = png
+                self.files[name] = data
                 self.images.append({"uri": name})
             self._images_by_hash[digest] = len(self.images) - 1
         key = (digest, self.sampler(sampler))
@@ -156,17 +159,35 @@ class _Builder:
             self._by_hash[key] = len(self.textures) - 1
         return self._by_hash[key]
 
-    def file_texture(self, info, name: str, glb: bool) -> int:
-        """A texture for a mesh file's TextureInfo: its decoded pixels as PNG (RGB where every
-        alpha is 255), its sampler as loaded."""
+    def file_texture(self, info, stem: str, glb: bool) -> int:
+        """A texture for a mesh file's TextureInfo with its sampler as loaded: the file's own
+        PNG or JPEG bytes where they still decode to the pixels drawn, else those pixels as PNG
+        (RGB where every alpha is 255). ``stem``: the image file's name without its suffix."""
         from alight.exchange.gltf_file_materials import gltf_sampler
 
-        png = self._pngs.get(id(info.image))
-        if png is None:
-            image = np.asarray(info.image)
-            png = _png(image, 3 if image.shape[2] < 4 or bool((image[:, :, 3] == 255).all()) else 4)
-            self._pngs[id(info.image)] = png
-        return self.texture(png, name, glb, gltf_sampler(info.sampler))
+        encoded = self._encoded.get(id(info.image))
+        if encoded is None:
+            encoded = _as_loaded(info) or (_png(info.image, 3 if bool((info.image[:, :, 3] == 255).all()) else 4),
+                                           "image/png")
+            self._encoded[id(info.image)] = encoded
+        data, mime = encoded
+        suffix = ".jpg" if mime == "image/jpeg" else ".png"
+        return self.texture(data, stem + suffix, glb, gltf_sampler(info.sampler), mime)
+
+
+def _as_loaded(info) -> tuple[bytes, str] | None:
+    """(the file's bytes, their mimeType) where ``info.encoded`` decodes to ``info.image`` (a
+    decode is much cheaper than a PNG encode of the same pixels); else None."""
+    from alight.exchange.gltf import JPEG_MAGIC, decode_image
+
+    data = info.encoded
+    if not data:
+        return None
+    try:
+        same = np.array_equal(decode_image(data, "export"), info.image)
+    except AlightError:
+        return None
+    return (data, "image/jpeg" if data[:3] == JPEG_MAGIC else "image/png") if same else None
 
 
 def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]:
@@ -233,7 +254,7 @@ def _add_file_materials(b: _Builder, mesh, stem: str, glb: bool) -> list[int]:
         if id(fm) not in index:
             n = len(b.materials)
             gm, used = file_material_to_gltf(
-                fm, lambda info, slot: b.file_texture(info, f"{stem}_m{n}_{slot}.png", glb))
+                fm, lambda info, slot: b.file_texture(info, f"{stem}_m{n}_{slot}", glb))
             b.used.update(used)
             b.materials.append(gm)
             index[id(fm)] = n

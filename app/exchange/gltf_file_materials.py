@@ -5,11 +5,12 @@ them.
 The factors go through ``alight.exchange.gltf_material.material_to_gltf`` (the layers'
 extensions included); then what only a file's material has: baseColorFactor's alpha,
 alphaMode/alphaCutoff, doubleSided, KHR_materials_unlit, KHR_materials_specular's factor (F90)
-and every texture slot alight draws with its texCoord, KHR_texture_transform and sampler. alight
-keeps a texture only as its decoded RGBA pixels (never the file's encoded bytes), so each image
-goes out as a PNG of those pixels: what alight draws, exactly (8 bits a channel, no re-encoding
-loss), though a JPEG source is written larger. The diffuse transmission pair alight packs into
-one texture (alight.exchange.packed_textures) goes out as that one image under both keys
+and every texture slot alight draws with its texCoord, KHR_texture_transform and sampler.
+Each image goes out as the file's own PNG or JPEG bytes where alight kept them
+(TextureInfo.encoded) and they still decode to the pixels drawn; else (KTX2, WebP, an image
+alight changed, e.g. the diffuse transmission pair packed into one by
+alight.exchange.packed_textures) as a PNG of the decoded pixels: what alight draws, 8 bits a
+channel, no loss. That packed pair goes out as its one image under both keys
 (diffuseTransmissionTexture reads its A, diffuseTransmissionColorTexture its RGB).
 """
 
