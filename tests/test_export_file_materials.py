@@ -216,6 +216,9 @@ def test_images_go_out_as_the_file_had_them_unless_their_pixels_changed(tmp_path
     info = mesh.parts[0].material.base_color_texture
     info.image = info.image.copy()
     info.image[0, 0] = (1, 2, 3, 255)   # drawn now, and not what the JPEG decodes to
-    export_gltf(Material(), tmp_path / "changed.gltf", None, mesh, file_materials=True)
+    # the panel's material (a clearcoat) is on no part: neither it nor its extension is written
+    export_gltf(Material(clearcoat=1.0), tmp_path / "changed.gltf", None, mesh, file_materials=True)
     written = tmp_path / "changed_m0_base_color.png"
     assert np.array_equal(decode_texture(written.read_bytes(), str(written)), info.image)
+    doc = json.loads((tmp_path / "changed.gltf").read_text())
+    assert [m["name"] for m in doc["materials"]] == ["jpeg"] and "extensionsUsed" not in doc, doc

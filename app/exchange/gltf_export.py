@@ -303,6 +303,8 @@ def export_gltf(material: Material, path: str | os.PathLike, maps: TextureMaps |
     own = file_materials and mesh is not None and any(p.material is not None for p in mesh.parts)
     needs_panel = not own or any(p.material is None for p in mesh.parts)
     notes = _add_maps(b, maps or TextureMaps(), out.stem, glb) if needs_panel else []
+    if not needs_panel:
+        b.used.clear()   # the panel's material is not written: its extensions are not used
     if not own:
         b.materials.append(b.material)
     if mesh is not None:
