@@ -1,4 +1,4 @@
-"""``alight export``: the material as glTF 2.0 (app/exchange/gltf_material.py), material-only or on a mesh."""
+"""``alight export``: the material as glTF 2.0 (app/exchange/gltf_material.py), material-only or on a mesh; a mesh file alone with its own materials (app/exchange/gltf_file_materials.py)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,9 @@ def add_parser(sub) -> None:
                        description="Export a material (the default, a preset, or a glTF file's material, with "
                                    "the field flags on top) as glTF 2.0: a material-only .gltf, or --mesh with "
                                    "the material as .glb. A dielectric F0 other than 0.04 is written with "
-                                   "KHR_materials_ior (and KHR_materials_specular when coloured).")
+                                   "KHR_materials_ior (and KHR_materials_specular when coloured). A --mesh file given "
+                                   "alone is written with its own materials and textures, as 'alight render' "
+                                   "draws it.")
     e.add_argument("--mesh", help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh "
                                   "file (default: none for .gltf, a material only; "
                                   "sphere for .glb); written with UVs, tangents and the maps. A mesh file "
