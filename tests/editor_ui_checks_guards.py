@@ -54,10 +54,11 @@ def test_save_preset_to_json_with_maps_writes_the_factors_and_says_so(ctx):
     ctx.item_click("**/clear")   # the base colour slot's (the first row's)
 
 
-def test_export_gltf_with_the_files_own_materials_shown_says_what_it_left_out(ctx):
-    """The exporter writes the panel's material on every part: with a textured file's own
-    materials in the view, the status row says in one line that they and their textures were
-    left out (the user's report: it said just 'exported')."""
+def test_export_gltf_with_the_files_own_materials_shown_keeps_them_and_says_what_it_left_out(ctx):
+    """With a textured file's own materials in the view, the export keeps them (the Duck's
+    material and its texture) and the status row says in one line what the file brought that
+    did not go out (its camera); with them off, the panel's material on every part, no note."""
+    from alight.exchange.gltf_material import read_gltf_json
     from alight.frontends.editor.ui_test import editor
 
     s = editor().state
@@ -72,11 +73,14 @@ def test_export_gltf_with_the_files_own_materials_shown_says_what_it_left_out(ct
     ctx.item_click("**/export glTF")
     assert not s.error, s.error
     assert os.path.isfile(path), s.message
-    assert s.message.startswith(f"exported {path} (") and "\n" not in s.message, s.message
-    assert "1 material and 1 texture left out" in s.message, s.message
+    assert s.message == f"exported {path} (the mesh file's 1 camera left out)", s.message
+    doc = read_gltf_json(path)
+    assert len(doc["materials"]) == 1 and len(doc["images"]) == 1, doc["materials"]
+    assert doc["materials"][0]["name"] != s.material.name, doc["materials"]
     ctx.item_uncheck("**/mesh file's own materials and maps")   # the view shows what is written
     ctx.item_click("**/export glTF")
     assert s.message == f"exported {path}", s.message
+    assert read_gltf_json(path)["materials"][0]["name"] == s.material.name
     ctx.combo_click("preview mesh/sphere")
     ctx.item_close("**/Environment")
 

@@ -83,6 +83,11 @@ class TextureInfo:
     tex_coord: int = 0
     transform: TextureTransform | None = None
     sampler: Sampler = field(default_factory=Sampler)
+    # The file's PNG or JPEG bytes ``image`` was decoded from (None: another format, or made
+    # here), so an export can write the image back as it came instead of a larger PNG. A copy
+    # with another image (dataclasses.replace) keeps them: the exporter uses them only where
+    # they still decode to ``image`` (alight.exchange.gltf_export).
+    encoded: bytes | None = field(default=None, repr=False, compare=False)
 
 
 TEXTURE_SLOTS = ("base_color", "metallic_roughness", "normal", "emissive", "occlusion")

@@ -74,6 +74,7 @@ LAYER_TEXTURES = {
 # Compression a file cannot be read without: refused in one line when no library decodes it.
 COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu"}
 
+PNG_MAGIC, JPEG_MAGIC = b"\x89PNG\r\n\x1a\n", b"\xff\xd8\xff"
 _WRAP = {10497: "repeat", 33071: "clamp_to_edge", 33648: "mirrored_repeat"}
 _MAG = {9728: "nearest", 9729: "linear"}
 _MIN = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest", 9985: "linear_mipmap_nearest",
@@ -229,6 +230,7 @@ class _Reader:
         self.warnings: list[str] = []
         self._warned: set[str] = set()
         self._images: dict[int, np.ndarray] = {}
+        self._encoded: dict[int, bytes] = {}   # the PNG and JPEG images' bytes (TextureInfo.encoded)
         self._materials: dict[int, FileMaterial] = {}
         self._locals: dict[tuple, _Local | None] = {}
         self._check_extensions()
@@ -288,6 +290,9 @@ class _Reader:
         for i in [i for i, blob in zip(todo, blobs) if blob is None]:   # a missing file: no texture
             self._images[i] = None
         todo, blobs = [i for i, b in zip(todo, blobs) if b is not None], [b for b in blobs if b is not None]
+        for i, blob in zip(todo, blobs):
+            if bytes(blob[:8]) == PNG_MAGIC or bytes(blob[:3]) == JPEG_MAGIC:
+                self._encoded[i] = bytes(blob)
         if not todo:
             return
         wheres = [f"{self.source}: images[{i}]" for i in todo]
@@ -427,6 +432,7 @@ class _Reader:
             if self._images[image_index] is None:   # its file is missing (warned)
                 continue
             info.image = self._images[image_index]
+            info.encoded = self._encoded.get(image_index)
             textures[f"{slot}_texture"] = info
         if "diffuse_transmission_color_texture" in textures or "diffuse_transmission_texture" in textures:
             # one texture holds both (alight.exchange.packed_textures)

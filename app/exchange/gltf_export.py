@@ -15,7 +15,10 @@ The maps are ``alight.core.texture_maps.TextureMaps``; what goes out is what ali
 Images are written as PNG with the 8-bit values alight decoded (no re-encoding loss), so a file
 written here renders the same pixels through ``alight render --mesh`` (the file's material) and
 ``--preset`` (alight.exchange.material_files). The factors come from
-``alight.exchange.gltf_material.material_to_gltf``. Every file is written atomically; the
+``alight.exchange.gltf_material.material_to_gltf``. With ``file_materials`` each part of a mesh
+file keeps its own material instead (alight.exchange.gltf_file_materials: textures, samplers,
+texCoord and KHR_texture_transform as loaded; TEXCOORD_1 and COLOR_0 go out with the parts).
+Every file is written atomically; the
 .gltf's JSON last, so a failure never leaves a document pointing at missing files.
 """
 
@@ -108,7 +111,11 @@ class _Builder:
         self.images: list[dict] = []
         self.textures: list[dict] = []
         self.files: dict[str, bytes] = {}     # image files beside a .gltf: name -> bytes
-        self._by_hash: dict[str, int] = {}
+        self.samplers: list[dict] = []
+        self.materials: list[dict] = []
+        self._by_hash: dict[tuple[str, int], int] = {}
+        self._images_by_hash: dict[str, int] = {}
+        self._encoded: dict[int, tuple[bytes, str]] = {}   # id(decoded image) -> (bytes, mimeType): once each
 
     def view(self, data: bytes, target: int | None = None) -> int:
         while len(self.blob) % 4:
@@ -130,19 +137,57 @@ class _Builder:
         self.accessors.append(acc)
         return len(self.accessors) - 1
 
-    def texture(self, png: bytes, name: str, glb: bool) -> int:
-        """A texture for this PNG (one image and texture per distinct content)."""
-        key = hashlib.sha1(png).hexdigest()
-        if key in self._by_hash:
-            return self._by_hash[key]
-        if glb:
-            self.images.append({"bufferView": self.view(png), "mimeType": "image/png"})
-        else:
-            self.files[name] = png
-            self.images.append({"uri": name})
-        self.textures.append({"sampler": 0, "source": len(self.images) - 1})
-        self._by_hash[key] = len(self.textures) - 1
+    def sampler(self, sampler: dict) -> int:
+        if sampler not in self.samplers:
+            self.samplers.append(dict(sampler))
+        return self.samplers.index(sampler)
+
+    def texture(self, data: bytes, name: str, glb: bool, sampler: dict = SAMPLER, mime: str = "image/png") -> int:
+        """A texture for this encoded image (PNG or JPEG) and sampler (one image per distinct
+        content, one texture per image and sampler)."""
+        digest = hashlib.sha1(data).hexdigest()
+        if digest not in self._images_by_hash:
+            if glb:
+                self.images.append({"bufferView": self.view(data), "mimeType": mime})
+            else:
+                self.files[name] = data
+                self.images.append({"uri": name})
+            self._images_by_hash[digest] = len(self.images) - 1
+        key = (digest, self.sampler(sampler))
+        if key not in self._by_hash:
+            self.textures.append({"sampler": key[1], "source": self._images_by_hash[digest]})
+            self._by_hash[key] = len(self.textures) - 1
         return self._by_hash[key]
+
+    def file_texture(self, info, stem: str, glb: bool) -> int:
+        """A texture for a mesh file's TextureInfo with its sampler as loaded: the file's own
+        PNG or JPEG bytes where they still decode to the pixels drawn, else those pixels as PNG
+        (RGB where every alpha is 255). ``stem``: the image file's name without its suffix."""
+        from alight.exchange.gltf_file_materials import gltf_sampler
+
+        encoded = self._encoded.get(id(info.image))
+        if encoded is None:
+            encoded = _as_loaded(info) or (_png(info.image, 3 if bool((info.image[:, :, 3] == 255).all()) else 4),
+                                           "image/png")
+            self._encoded[id(info.image)] = encoded
+        data, mime = encoded
+        suffix = ".jpg" if mime == "image/jpeg" else ".png"
+        return self.texture(data, stem + suffix, glb, gltf_sampler(info.sampler), mime)
+
+
+def _as_loaded(info) -> tuple[bytes, str] | None:
+    """(the file's bytes, their mimeType) where ``info.encoded`` decodes to ``info.image`` (a
+    decode is much cheaper than a PNG encode of the same pixels); else None."""
+    from alight.exchange.gltf import JPEG_MAGIC, decode_image
+
+    data = info.encoded
+    if not data:
+        return None
+    try:
+        same = np.array_equal(decode_image(data, "export"), info.image)
+    except AlightError:
+        return None
+    return (data, "image/jpeg" if data[:3] == JPEG_MAGIC else "image/png") if same else None
 
 
 def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]:
@@ -161,7 +206,6 @@ def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]
             pbr["metallicRoughnessTexture"] = info
         else:
             gm[f"{slot}Texture"] = info
-    b.doc["samplers"] = [dict(SAMPLER)]
     if any("extensions" in info for info in _infos(gm)):
         b.used.add(EXT_TRANSFORM)
     return notes
@@ -192,9 +236,37 @@ def _tangents(normals: np.ndarray, tangents: np.ndarray) -> np.ndarray:
     return np.concatenate([_unit(t), w[:, None]], axis=1).astype(np.float32)
 
 
-def _add_mesh(b: _Builder, mesh) -> None:
-    meshes, nodes = [], []
+def _add_file_materials(b: _Builder, mesh, stem: str, glb: bool) -> list[int]:
+    """Each part's material index: its own material (one glTF material per distinct
+    FileMaterial, in the parts' order), the panel's for a part without one, as drawn."""
+    from alight.exchange.gltf_file_materials import file_material_to_gltf
+
+    index: dict[int, int] = {}   # id(FileMaterial) or id(None) (the panel's, added on first use) -> index
+    out = []
     for part in mesh.parts:
+        fm = part.material
+        if fm is None:
+            if id(None) not in index:
+                b.materials.append(b.material)
+                index[id(None)] = len(b.materials) - 1
+            out.append(index[id(None)])
+            continue
+        if id(fm) not in index:
+            n = len(b.materials)
+            gm, used = file_material_to_gltf(
+                fm, lambda info, slot: b.file_texture(info, f"{stem}_m{n}_{slot}", glb))
+            b.used.update(used)
+            b.materials.append(gm)
+            index[id(fm)] = n
+        out.append(index[id(fm)])
+    return out
+
+
+def _add_mesh(b: _Builder, mesh, materials: list[int] | None = None, extra: bool = False) -> None:
+    """The parts as one node each (world space); ``materials``: each part's material index (None:
+    0); ``extra``: TEXCOORD_1 and COLOR_0 too where a part has them (a file's materials read them)."""
+    meshes, nodes = [], []
+    for i, part in enumerate(mesh.parts):
         positions = np.asarray(part.positions, np.float32)
         normals = _unit(part.normals)
         uvs = np.asarray(part.uvs, np.float32).copy()
@@ -203,32 +275,49 @@ def _add_mesh(b: _Builder, mesh) -> None:
                  "NORMAL": b.accessor(normals.astype(np.float32), 5126, "VEC3", 34962, False),
                  "TANGENT": b.accessor(_tangents(normals, part.tangents), 5126, "VEC4", 34962, False),
                  "TEXCOORD_0": b.accessor(uvs, 5126, "VEC2", 34962, False)}
+        if extra and part.uvs1 is not None:
+            uvs1 = np.asarray(part.uvs1, np.float32).copy()
+            uvs1[:, 1] = 1.0 - uvs1[:, 1]
+            attrs["TEXCOORD_1"] = b.accessor(uvs1, 5126, "VEC2", 34962, False)
+        if extra and part.colors is not None:
+            attrs["COLOR_0"] = b.accessor(np.asarray(part.colors, np.float32), 5126, "VEC4", 34962, False)
         idx = b.accessor(np.asarray(part.indices, np.uint32).reshape(-1), 5125, "SCALAR", 34963, False)
-        meshes.append({"name": part.name, "primitives": [{"attributes": attrs, "indices": idx, "material": 0}]})
+        material = materials[i] if materials is not None else 0
+        meshes.append({"name": part.name, "primitives": [{"attributes": attrs, "indices": idx, "material": material}]})
         nodes.append({"name": part.name, "mesh": len(meshes) - 1})
     b.doc.update({"scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes, "meshes": meshes})
 
 
 def export_gltf(material: Material, path: str | os.PathLike, maps: TextureMaps | None = None,
-                mesh=None) -> tuple[Path, list[str]]:
+                mesh=None, file_materials: bool = False) -> tuple[Path, list[str]]:
     """Write ``material`` with ``maps`` (and ``mesh``, an alight.core.mesh.Mesh, when given)
     to ``path`` (.gltf: images ``STEM_SLOT.png`` and ``STEM.bin`` beside it; .glb: one file).
-    Returns the path and one-line notes on what was converted. Errors: AlightError naming the
-    file (an unwritable folder, a map that does not read)."""
+    ``file_materials``: each part of ``mesh`` keeps the material the mesh file gave it (its
+    textures, samplers, transforms; alight.exchange.gltf_file_materials), as the view draws with
+    the file's own materials on; ``material`` and ``maps`` then go only on parts without one
+    (images ``STEM_mN_SLOT.png``). Returns the path and one-line notes on what was converted or
+    left out. Errors: AlightError naming the file (an unwritable folder, a map that does not read)."""
     out = check_output_path(path, (".gltf", ".glb"))
     glb = out.suffix.lower() == ".glb"
     b = _Builder(material)
-    notes = _add_maps(b, maps or TextureMaps(), out.stem, glb)
+    own = file_materials and mesh is not None and any(p.material is not None for p in mesh.parts)
+    needs_panel = not own or any(p.material is None for p in mesh.parts)
+    notes = _add_maps(b, maps or TextureMaps(), out.stem, glb) if needs_panel else []
+    if not needs_panel:
+        b.used.clear()   # the panel's material is not written: its extensions are not used
+    if not own:
+        b.materials.append(b.material)
     if mesh is not None:
-        _add_mesh(b, mesh)
+        _add_mesh(b, mesh, _add_file_materials(b, mesh, out.stem, glb) if own else None, extra=own)
+        notes += _left_out(mesh) if own else []
     while len(b.blob) % 4:
         b.blob.append(0)
     doc = b.doc
-    doc["materials"] = [b.material]
+    doc["materials"] = b.materials
     if b.used:
         doc["extensionsUsed"] = sorted(b.used)
     for key, value in (("accessors", b.accessors), ("bufferViews", b.views), ("images", b.images),
-                       ("textures", b.textures)):
+                       ("samplers", b.samplers), ("textures", b.textures)):
         if value:
             doc[key] = value
     if b.blob:
@@ -245,6 +334,14 @@ def export_gltf(material: Material, path: str | os.PathLike, maps: TextureMaps |
     except OSError as e:
         raise AlightError(f"{out}: cannot write ({e.strerror or e})") from None
     return out, notes
+
+
+def _left_out(mesh) -> list[str]:
+    """What a mesh file brought that the export does not write (the parts go out in world space,
+    one node each)."""
+    what = [f"{len(x)} {name}{'s' if len(x) > 1 else ''}" for x, name in
+            ((mesh.cameras, "camera"), (mesh.lights, "light")) if x]
+    return [f"the mesh file's {' and '.join(what)} left out"] if what else []
 
 
 def export_mesh_glb(mesh, m: Material, path: str | os.PathLike) -> Path:

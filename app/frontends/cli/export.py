@@ -1,4 +1,4 @@
-"""``alight export``: the material as glTF 2.0 (app/exchange/gltf_material.py), material-only or on a mesh."""
+"""``alight export``: the material as glTF 2.0 (app/exchange/gltf_material.py), material-only or on a mesh; a mesh file alone with its own materials (app/exchange/gltf_file_materials.py)."""
 
 from __future__ import annotations
 
@@ -14,10 +14,14 @@ def add_parser(sub) -> None:
                        description="Export a material (the default, a preset, or a glTF file's material, with "
                                    "the field flags on top) as glTF 2.0: a material-only .gltf, or --mesh with "
                                    "the material as .glb. A dielectric F0 other than 0.04 is written with "
-                                   "KHR_materials_ior (and KHR_materials_specular when coloured).")
+                                   "KHR_materials_ior (and KHR_materials_specular when coloured). A --mesh file given "
+                                   "alone is written with its own materials and textures, as 'alight render' "
+                                   "draws it.")
     e.add_argument("--mesh", help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh "
                                   "file (default: none for .gltf, a material only; "
-                                  "sphere for .glb); written with UVs, tangents and the maps")
+                                  "sphere for .glb); written with UVs, tangents and the maps. A mesh file "
+                                  "given without --preset, --material-from, maps or field flags keeps its own "
+                                  "materials and textures, as 'alight render --mesh' draws them")
     e.add_argument("--material-from", metavar="FILE.gltf|FILE.glb",
                    help="start from this glTF file's material instead of a preset")
     e.add_argument("--material-index", type=int, default=0, metavar="N",
@@ -49,9 +53,12 @@ def run(args) -> int:
         from alight.exchange.meshes import load_mesh
 
         mesh = load_mesh(args.mesh or "sphere")
-    _, notes = export_gltf(material, out, texture_maps, mesh)
-    if args.verbose:
-        for line in notes:
+    # As `alight render` decides (scene_setup): no preset and no maps draw the file's own
+    # materials; field flags, which render lays over each of them, select the flag-built one here.
+    own = args.preset is None and texture_maps is None and not overrides
+    _, notes = export_gltf(material, out, texture_maps, mesh, file_materials=own)
+    for line in notes:
+        if args.verbose or "left out" in line:   # what the file lost is always said
             print(f"alight: {line}", file=sys.stderr)
     print(out)
     return 0

@@ -305,29 +305,16 @@ class EditorState:
                 f"({', '.join(left_out)}); save as .gltf or .glb to keep them")
 
     def export_gltf(self, path: str) -> str:
-        """The edited material, its maps and the mesh (UVs, tangents) as .gltf or .glb
-        (alight.exchange.gltf_export: F0 other than 0.04 goes out as KHR_materials_ior/specular).
-        The exporter writes one material, the panel's, on every part: where the view shows the
-        mesh file's own materials, the returned note (else '') says they and their textures
-        were left out, as 'save preset' says which maps it left out."""
+        """The mesh with what the view draws on it, and the edited material with its maps, as
+        .gltf or .glb (alight.exchange.gltf_export: F0 other than 0.04 goes out as
+        KHR_materials_ior/specular). Where the view shows the mesh file's own materials, each
+        part keeps its own (textures, samplers and transforms included); else the panel's goes on
+        every part. The returned note (else '') says in one line what was left out."""
         from alight.exchange.gltf_export import export_gltf
 
-        export_gltf(self.material, path, self.texture_maps, self.mesh)
-        return self.file_materials_left_out()
-
-    def file_materials_left_out(self) -> str:
-        """'' unless the view shows the mesh file's own materials; then one line on what an
-        export with the panel's material leaves out of what is drawn."""
-        if not self.use_file_materials or self.mesh is None:
-            return ""
-        materials = {id(p.material): p.material for p in self.mesh.parts if p.material is not None}
-        if not materials:
-            return ""
-        images = {id(info.image) for m in materials.values() for f in dataclasses.fields(m)
-                  if f.name.endswith("_texture") and (info := getattr(m, f.name)) is not None}
-        n, t = len(materials), len(images)
-        what = f"{n} material{'s' if n > 1 else ''}" + (f" and {t} texture{'s' if t > 1 else ''}" if t else "")
-        return f"with the panel's material: the mesh file's own {what} left out"
+        _, notes = export_gltf(self.material, path, self.texture_maps, self.mesh,
+                               file_materials=self.use_file_materials)
+        return "; ".join(n for n in notes if "left out" in n)
 
     def open_texture_set(self, paths, folder: str = "") -> list[str]:
         """Image files dropped together (or ``folder``'s), assigned to slots by their names
