@@ -127,3 +127,24 @@ def test_the_readme_links_every_page_of_the_site():
     linked = {target.split("#")[0] for target in LINK.findall(readme)}
     pages = {p.relative_to(REPO).as_posix() for p in (REPO / "docs").rglob("*.md")}
     assert pages - linked == set(), "README.md does not link: " + ", ".join(sorted(pages - linked))
+
+
+def test_the_accuracy_pages_worked_example_prints_what_it_says(tmp_path):
+    """docs/explanation/accuracy.md's render / reference / compare example quotes its output; a
+    new user ran it and got another number (the page still quoted an older default IBL model).
+    Run the page's three commands as written and compare with the quoted relMAE."""
+    page = (REPO / "docs" / "explanation" / "accuracy.md").read_text()
+    block = page[page.index("## Error measures and the chart"):]
+    env = re.search(r"^E=(\S+)$", block, re.M).group(1)
+    quoted = float(re.search(r"^#\s+relMAE ([0-9.]+)%", block, re.M).group(1))
+    lines = [ln for ln in block.splitlines() if ln.startswith(".venv/bin/alight ")][:3]
+    assert [ln.split()[1] for ln in lines] == ["render", "reference", "compare"]
+    printed = ""
+    for line in lines:
+        words = [w.replace("$E", str((REPO / env).resolve())) for w in line.split()[1:]]
+        words = [w.split("#")[0] for w in words if not w.startswith("#")]
+        run = subprocess.run([sys.executable, "-m", "alight", *words], cwd=tmp_path, capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        printed = run.stdout
+    got = float(re.search(r"relMAE ([0-9.]+)%", printed).group(1))
+    assert abs(got - quoted) < 0.05, f"the page quotes {quoted}%, the commands print {got}%"
