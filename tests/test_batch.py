@@ -49,7 +49,10 @@ def test_plan_names_are_predictable(folder):
     assert p.out_dir == folder / "spec" and not p.frames
 
 
-def test_batch_renders_reports_failures_and_goes_on(folder):
+def test_batch_renders_reports_failures_and_goes_on(folder, shared_data):
+    # A file that is there but cannot be read fails its items, and the batch goes on (a missing
+    # one stops the plan before anything renders: test_a_missing_input_stops_the_plan).
+    shutil.copy(shared_data / "bad" / "empty.obj", folder / "missing.obj")
     spec = write_spec(folder, SPEC.replace('"duck.glb"]', '"duck.glb", "missing.obj"]'))
     log = io.StringIO()
     status = main(str(spec), executor="local", workers=2, log=log)
@@ -61,7 +64,7 @@ def test_batch_renders_reports_failures_and_goes_on(folder):
         assert im.size == (40, 32)
     assert "12/12" in out and "left" in out  # progress: count and time left
     assert "8 rendered, 0 up to date, 4 failed" in out
-    assert out.count("FAILED missing__studio__") == 4 and "missing.obj: no such file" in out
+    assert out.count("FAILED missing__studio__") == 4 and "missing.obj: no triangles in the file" in out
     with Image.open(folder / "spec" / "contact_sheet.png") as sheet:
         assert sheet.size[0] > 0 and sheet.size[1] > 0
         # 12 cells (failed ones blank but labelled): a 4 x 3 grid of 160-pixel thumbnails
@@ -125,6 +128,35 @@ def test_bad_specs_are_one_line_errors(folder, text, problem):
         plan(write_spec(folder, text))
 
 
+@pytest.mark.parametrize("line, where", [
+    ('materials = ["gold", "water.gltf"]', "materials[1]: "),
+    ('materials = [{preset = "gold", maps = {base_color = "nosuch.png"}}]', "materials[0]: "),
+    ('materials = [{name = "set", texture_set = "no_folder"}]', "materials[0]: "),
+    ('meshes = ["sphere", "nosuch.glb"]', "meshes[1]: "),
+    ('environments = ["studio", "nosuch.hdr"]', "environments[1]: "),
+])
+def test_a_missing_input_stops_the_plan(folder, line, where):
+    """A new user ran the batch guide's example, whose water.gltf is not shipped: every item that
+    used it failed in turn (212 FAILED lines). Every file the spec names is looked for first;
+    one missing stops the plan with one line naming the entry and the path, exit 2, nothing
+    rendered."""
+    write_spec(folder, 'size = 32\nquality = "low"\n' + line + "\n")
+    r = cli("spec.toml", cwd=folder)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert where in r.stderr and "no such file" in r.stderr
+    assert not (folder / "spec").exists()
+
+
+def test_the_guides_example_spec_plans(folder, shared_data):
+    """docs/guides/batch.md's example spec, its ../shared paths pointed at the shared data,
+    plans without an error (every file it names exists)."""
+    page = (REPO / "docs" / "guides" / "batch.md").read_text()
+    text = page.split("```toml\n", 1)[1].split("```", 1)[0]
+    text = text.replace("../shared/data/", str(shared_data).rstrip("/") + "/")
+    p = plan(write_spec(folder, text))
+    assert p.stills and p.frames
+
+
 def cli(*args, cwd):
     env = dict(os.environ)
     return subprocess.run([sys.executable, "-m", "alight", "batch", *args], capture_output=True, text=True,
@@ -149,16 +181,18 @@ def test_cli_batch_with_process_pool(folder):
     assert not list(folder.rglob("*.tmp*"))  # atomic writes leave no temporaries
 
 
-def test_failed_animation_and_summary_lines(folder):
+def test_failed_animation_and_summary_lines(folder, shared_data):
+    shutil.copy(shared_data / "bad" / "empty.obj", folder / "missing.obj")   # there, unreadable
     text = 'size = 16\nquality = "low"\nmeshes = ["missing.obj"]\n[turntable]\nframes = 2\n'
     result = run(plan(write_spec(folder, text)), executor="inline", log=io.StringIO())
     text = summary(result)
     assert "0 rendered" in text and "missing__studio__gold.gif" in text and "not written" in text
 
 
-def test_ray_executor_on_a_local_two_worker_cluster(folder):
+def test_ray_executor_on_a_local_two_worker_cluster(folder, shared_data):
     """A real Ray cluster (head + 2 CPUs) started by this test; two actors, each its own GL context."""
     ray = pytest.importorskip("ray", reason="Ray is not installed (pip install 'alight[ray]')")
+    shutil.copy(shared_data / "bad" / "empty.obj", folder / "missing.obj")   # there, unreadable
     spec = write_spec(folder, SPEC.replace('"duck.glb"]', '"duck.glb", "missing.obj"]'))
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, object_store_memory=80 * 1024 * 1024)
     try:
@@ -168,7 +202,7 @@ def test_ray_executor_on_a_local_two_worker_cluster(folder):
     finally:
         ray.shutdown()
     assert len(result.rendered) == 8 and len(result.failed) == 4
-    assert all("missing.obj: no such file" in reason for _, reason in result.failed)
+    assert all("missing.obj: no triangles in the file" in reason for _, reason in result.failed)
     # The same images as an in-process render.
     ray_images = {p.name: Image.open(p).tobytes() for p in (folder / "spec").glob("*__cam*.png")}
     assert len(ray_images) == 8

@@ -211,6 +211,7 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
     mesh_names, env_names, mat_names = _output_names(meshes, envs, materials, source)
 
     spec_deps = [str(source)]
+    _check_inputs_exist(source, base, meshes, envs, materials)
 
     def item(mi, ei, ki, cam, env_deg, out_path: Path, label: str) -> Item:
         mesh = _resolve(base, meshes[mi], BUILTIN_MESHES)
@@ -244,6 +245,24 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
                 paths.append(p)
             animations.append(Animation(out_dir / "turntable" / f"{stem}.{fmt}", paths, float(fps)))
     return Plan(source, out_dir, stills, frames, animations, bool(spec.get("contact_sheet", True)))
+
+
+def _check_inputs_exist(source: Path, base: Path, meshes: list, envs: list, materials: list) -> None:
+    """Every file or folder the spec names, found before anything renders: a missing one stops
+    the plan with one line naming the spec, the entry and the path (else each of its items
+    would fail in turn, hundreds of lines for one typo)."""
+    from alight.core.mesh import BUILTIN_MESHES
+
+    named = [(f"meshes[{i}]", _resolve(base, m, BUILTIN_MESHES)) for i, m in enumerate(meshes)
+             if m not in BUILTIN_MESHES]
+    named += [(f"environments[{i}]", _resolve(base, e, ("studio",))) for i, e in enumerate(envs) if e != "studio"]
+    for i, m in enumerate(materials):
+        material, deps = _material_inputs(m, base)
+        folder = material.get("texture_set") if isinstance(material, dict) else None
+        named += [(f"materials[{i}]", d) for d in deps] + ([(f"materials[{i}]", folder)] if folder else [])
+    for where, path in named:
+        if not Path(path).exists():
+            raise AlightError(f"{source}: {where}: {path}: no such file or folder (paths are relative to the spec's folder)")
 
 
 def _size_and_quality(spec: dict, source: Path) -> tuple[list[int], str]:
