@@ -131,3 +131,19 @@ def test_the_occluded_view_is_left_for_alight_render(ctx):
         json.dump({"size": [w, h], "orbit": o.yaw_deg, "elevation": o.pitch_deg, "distance": o.distance,
                    "fov": o.fov_y_deg, "target": list(map(float, o.target))}, f)
     assert shown.std() > 5.0
+
+
+def test_gtao_draws_at_once_without_a_bake(ctx):
+    """The combo's 'gtao' (screen-space occlusion, alight.render.screen_ao): no bake job, the
+    occluded view as soon as its programs are warm, another picture than 'off' inside the bowl;
+    the view is left (same camera as the last check's) for the runner's ``alight render
+    --occlusion gtao``."""
+    win = editor()
+    ctx.set_ref("alight")
+    jobs = win.occlusion_bake.jobs
+    ctx.combo_click("occlusion/gtao")
+    assert win.state.occlusion == "gtao" and win.state.scene(win.orbit.camera()).occlusion == "gtao"
+    until_seconds(ctx, lambda: _settled(win), BAKE_LIMIT_S)
+    assert win.occlusion_bake.jobs == jobs and not win.occlusion_bake.status   # screen space: nothing baked
+    shown = _shown_view(ctx, win, "occlusion_gtao.png")
+    assert shown.std() > 5.0
