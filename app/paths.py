@@ -57,3 +57,19 @@ def data_dir() -> Path:
     import platformdirs
 
     return Path(platformdirs.user_data_dir("alight", appauthor=False))
+
+
+def absolute(path: str) -> str:
+    """``path`` made absolute against the working directory now ('' stays ''); '~' expanded.
+    What the editor keeps (its session, the fields it restores, the maps it watches) is stored
+    so: a relative path would name another file once the editor is started from another folder."""
+    if not path:
+        return path
+    return os.path.abspath(os.path.expanduser(os.fspath(path)))
+
+
+def absolute_maps(maps):
+    """A TextureMaps with every slot's path ``absolute`` (a ``FILE#images[N]`` keeps its part)."""
+    for slot, path in maps.paths().items():
+        maps = maps.with_slot(slot, absolute(path))
+    return maps

@@ -18,7 +18,7 @@ import numpy as np
 from alight.frontends.editor.ui_test import editor, view
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
-from editor_ui_helpers import ball, capture, changed, checker_levels, contrast, until_seconds  # noqa: E402
+from editor_ui_helpers import ball, capture, changed, checker_levels, contrast, type_path, until_seconds  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
 
@@ -360,7 +360,8 @@ def test_add_a_spot_light_and_aim_it(ctx):
 
 # --- more of the panel: layers, lighting settings, display, files ------------------------------------
 
-SHARED = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data")
+# (normalized: the editor keeps a path absolute and normalized, as os.path.abspath makes it)
+SHARED = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data"))
 
 
 def test_clearcoat_layer_section(ctx):
@@ -411,7 +412,7 @@ def test_open_env_typed_and_studio_button(ctx):
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
     studio = view(ctx).astype(np.float64)
-    ctx.item_input_value("**/env file", path)
+    type_path(ctx, "**/env file", path)
     ctx.item_click("**/open env")
     assert s.env_spec == path, (s.env_spec, s.error)
     assert np.abs(view(ctx).astype(np.float64) - studio).mean() > 5.0
@@ -420,7 +421,7 @@ def test_open_env_typed_and_studio_button(ctx):
     np.testing.assert_allclose(view(ctx).astype(np.float64).mean(), studio.mean(), atol=0.5)
     # A 2:1 PNG typed there is the environment too (it went to the base colour map by its suffix).
     png = os.path.join(SHARED, "cases", "with_controls", "ldr_srgb.png")
-    ctx.item_input_value("**/env file", png)
+    type_path(ctx, "**/env file", png)
     ctx.item_click("**/open env")
     assert s.env_spec == png and "as the environment" in s.message, (s.env_spec, s.message, s.error)
     assert not (s.texture_maps and s.texture_maps.base_color), s.texture_maps
@@ -432,11 +433,11 @@ def test_open_mesh_typed(ctx):
     s = editor().state
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
-    ctx.item_input_value("**/mesh", "cube")
+    type_path(ctx, "**/mesh", "cube")
     ctx.item_click("**/open mesh")
     assert s.mesh_spec == "cube", s.error
     cube = view(ctx)
-    ctx.item_input_value("**/mesh", "sphere")
+    type_path(ctx, "**/mesh", "sphere")
     ctx.item_click("**/open mesh")
     assert s.mesh_spec == "sphere" and np.abs(view(ctx).astype(np.float64) - cube).mean() > 1.0
     ctx.item_close("**/Environment")
@@ -508,7 +509,7 @@ def test_base_colour_map_typed_load_and_clear(ctx):
     ctx.item_input_value("**/base colour (sRGB)/##Z", 255)
     white = ball(view(ctx)).mean(axis=0)
     ctx.item_click("texture maps/base_color/##armed")
-    ctx.item_input_value("**/map file", path)
+    type_path(ctx, "**/map file", path)
     ctx.item_click("**/load##typed")
     assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
     mapped = ball(view(ctx)).mean(axis=0)
@@ -534,7 +535,7 @@ def test_texture_set_folder_typed_into_the_map_field(ctx):
     ctx.set_ref("alight")
     ctx.item_click("**/gold")
     gold = ball(view(ctx)).mean(axis=0)
-    ctx.item_input_value("**/map file", folder)
+    type_path(ctx, "**/map file", folder)
     ctx.item_click("**/load##typed")
     paths = s.texture_maps.paths()
     assert paths.get("base_color", "").endswith("wood_BaseColor.png"), (paths, s.error)
@@ -564,7 +565,7 @@ def test_hot_reload_of_a_map_and_the_environment(ctx):
     ctx.set_ref("alight")
     ctx.item_click("**/plastic_high")
     ctx.item_click("texture maps/base_color/##armed")
-    ctx.item_input_value("**/map file", path)
+    type_path(ctx, "**/map file", path)
     ctx.item_click("**/load##typed")
     assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)
     red = ball(view(ctx)).mean(axis=0)
@@ -580,7 +581,7 @@ def test_hot_reload_of_a_map_and_the_environment(ctx):
     env = os.path.join(OUT, "hot.hdr")
     _write_atomically(env, np.full((32, 64, 3), (1.0, 0.6, 0.3), np.float32))
     ctx.item_open("**/Environment")
-    ctx.item_input_value("**/env file", env)
+    type_path(ctx, "**/env file", env)
     ctx.item_click("**/open env")
     assert s.env_spec == env, (s.env_spec, s.error)
     warm = ball(view(ctx)).mean(axis=0)
@@ -747,7 +748,7 @@ def test_file_materials_checkbox_and_motion_settings(ctx):
     s = editor().state
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
-    ctx.item_input_value("**/mesh", os.path.join(SHARED, "models", "Duck.glb"))
+    type_path(ctx, "**/mesh", os.path.join(SHARED, "models", "Duck.glb"))
     ctx.item_click("**/open mesh")
     assert s.use_file_materials, s.error
     own = ball(view(ctx)).mean(axis=0)
@@ -756,7 +757,7 @@ def test_file_materials_checkbox_and_motion_settings(ctx):
     ctx.item_click("**/water")
     panel = ball(view(ctx)).mean(axis=0)
     assert panel[0] < own[0] - 20, (panel, own)
-    ctx.item_input_value("**/mesh", "sphere")
+    type_path(ctx, "**/mesh", "sphere")
     ctx.item_click("**/open mesh")
     ctx.item_close("**/Environment")
     ctx.item_open("**/Display & camera")
@@ -781,7 +782,7 @@ def test_uv_tiling_of_a_map(ctx):
     oiio.ImageBuf(halves).write(path)
     ctx.set_ref("alight")
     ctx.item_click("**/plastic_high")
-    ctx.item_input_value("**/map file", path)
+    type_path(ctx, "**/map file", path)
     ctx.item_click("texture maps/base_color/##armed")
     ctx.item_click("**/load##typed")
     assert s.texture_maps.paths().get("base_color") == path, (s.texture_maps, s.error)

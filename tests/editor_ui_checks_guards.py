@@ -20,6 +20,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import type_path  # noqa: E402
+
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")
 
 
@@ -39,7 +42,7 @@ def test_save_preset_to_json_with_maps_writes_the_factors_and_says_so(ctx):
     ctx.set_ref("alight")
     ctx.item_click("**/copper")
     ctx.item_input_value("**/roughness", 0.35)
-    ctx.item_input_value("**/map file", _png(os.path.join(OUT, "tint_BaseColor.png"), (200, 120, 60)))
+    type_path(ctx, "**/map file", _png(os.path.join(OUT, "tint_BaseColor.png"), (200, 120, 60)))
     ctx.item_click("**/load##typed")
     assert s.texture_maps.base_color, (s.error, s.message)
     path = os.path.join(OUT, "with_maps.json")
@@ -65,7 +68,7 @@ def test_export_gltf_with_the_files_own_materials_shown_keeps_them_and_says_what
     shared = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..", "shared", "data")
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
-    ctx.item_input_value("**/mesh", os.path.join(shared, "models", "Duck.glb"))
+    type_path(ctx, "**/mesh", os.path.join(shared, "models", "Duck.glb"))
     ctx.item_click("**/open mesh")
     assert s.use_file_materials, (s.error, s.message)
     path = os.path.join(OUT, "duck_export.glb")
@@ -102,11 +105,11 @@ def test_a_failed_path_leaves_the_loaded_one_in_its_field(ctx):
     bad = os.path.join(OUT, "no_such_dir", "broken")
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
-    ctx.item_input_value("**/mesh", good_mesh)
+    type_path(ctx, "**/mesh", good_mesh)
     ctx.item_click("**/open mesh")
     assert s.mesh_spec == good_mesh, s.error
     for field, button, typed in (("mesh", "open mesh", bad + ".obj"), ("env file", "open env", bad + ".hdr")):
-        ctx.item_input_value(f"**/{field}", typed)
+        type_path(ctx, f"**/{field}", typed)
         ctx.item_click(f"**/{button}")
         assert typed in s.error, (field, s.error)
         shown = {"mesh": panel.mesh_path, "env file": panel.env_path}[field]
@@ -126,7 +129,7 @@ def test_a_failed_path_leaves_the_loaded_one_in_its_field(ctx):
               ("glTF file", "export glTF", bad + ".gltf", lambda: panel.gltf_path))
     for field, button, typed, shown in checks:
         before = shown()
-        ctx.item_input_value(f"**/{field}", typed)
+        type_path(ctx, f"**/{field}", typed)
         ctx.item_click(f"**/{button}")
         assert s.error, (field, button, s.message)
         assert shown() == before, f"{field} after a failed '{button}' shows {shown()!r}, not {before!r}"

@@ -18,11 +18,15 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 
 import numpy as np
 from PIL import Image
 
 from alight.frontends.editor.ui_test import editor, view
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import type_path  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # the run's folder (the editor's cwd too)
 
@@ -55,7 +59,7 @@ def _sets() -> tuple[str, str]:
 
 
 def _load_set(ctx, folder: str) -> None:
-    ctx.item_input_value("**/texture set", folder)
+    type_path(ctx, "**/texture set", folder)
     ctx.item_click("**/load set")
     ctx.yield_(3)
 
@@ -86,7 +90,7 @@ def test_the_set_fields_name_what_is_loaded(ctx):
     ctx.set_ref("alight")
     ctx.item_open("**/texture maps")
     _load_set(ctx, wood)
-    ctx.item_input_value("**/map file", rock)   # a folder typed into 'map file' is a set too
+    type_path(ctx, "**/map file", rock)   # a folder typed into 'map file' is a set too
     ctx.item_click("**/load##typed")
     ctx.yield_(2)
     assert set(s.texture_maps.paths()) == {"base_color", "roughness"}, s.texture_maps

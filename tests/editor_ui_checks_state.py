@@ -20,7 +20,7 @@ import numpy as np
 from alight.frontends.editor.ui_test import editor, on_main_thread, view
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
-from editor_ui_helpers import ball  # noqa: E402
+from editor_ui_helpers import ball, type_path  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where the files these checks write go
 ERROR_RGB = (255, 89, 77)      # panel.ERROR_RGBA in 8 bits
@@ -126,7 +126,7 @@ def test_a_preset_click_replaces_the_texture_maps(ctx):
     ctx.set_ref("alight")
     ctx.item_click("**/silver")
     plain = ball(view(ctx))
-    ctx.item_input_value("**/map file", os.path.dirname(files["base_color"]))   # the set, loaded
+    type_path(ctx, "**/map file", os.path.dirname(files["base_color"]))   # the set, loaded
     ctx.item_click("**/load##typed")
     assert s.texture_maps.paths() == files, (s.texture_maps.paths(), s.error)
     textured = ball(view(ctx))
@@ -234,7 +234,7 @@ def test_a_texture_set_names_the_material_undoably(ctx):
     wood_set(folder, "oak")
     ctx.set_ref("alight")
     ctx.item_click("**/gold")
-    ctx.item_input_value("**/map file", folder)   # the older route, a folder typed into 'map file'
+    type_path(ctx, "**/map file", folder)   # the older route, a folder typed into 'map file'
     ctx.item_click("**/load##typed")
     assert s.texture_maps.paths(), s.error
     assert s.material.name == "oak_planks", s.material.name
@@ -247,7 +247,7 @@ def test_a_texture_set_names_the_material_undoably(ctx):
     assert s.material.name == "gold" and not s.texture_maps.paths(), (s.material.name, s.texture_maps)
     ctx.item_click("**/gold")
     ctx.item_input_value("**/name", "my oak")
-    ctx.item_input_value("**/texture set", folder)
+    type_path(ctx, "**/texture set", folder)
     ctx.item_click("**/load set")
     assert s.texture_maps.paths() and s.material.name == "my oak", (s.material.name, s.error)
 
@@ -260,7 +260,7 @@ def test_revert_after_an_undone_preset_click_is_the_look_before_it(ctx):
     files = wood_set(os.path.join(OUT, "wood_revert"))
     ctx.set_ref("alight")
     ctx.item_click("**/gold")
-    ctx.item_input_value("**/texture set", os.path.dirname(files["base_color"]))
+    type_path(ctx, "**/texture set", os.path.dirname(files["base_color"]))
     ctx.item_click("**/load set")
     start = s.look
     assert start[1].paths() == files, (start, s.error)
@@ -296,7 +296,7 @@ def test_compare_a_keeps_the_maps_of_its_snapshot(ctx):
     ctx.item_click("**/gold")
     gold = view(ctx)
     ctx.item_click("**/silver")
-    ctx.item_input_value("**/texture set", folder)
+    type_path(ctx, "**/texture set", folder)
     ctx.item_click("**/load set")
     wood = view(ctx)
     ctx.item_open("**/Compare")
@@ -307,7 +307,7 @@ def test_compare_a_keeps_the_maps_of_its_snapshot(ctx):
     divider = s.compare.divider
     a = _left_of_divider(view(ctx), divider)
     assert np.abs(a - _left_of_divider(wood, divider)).max() <= 1, "A lost its snapshot's maps"
-    ctx.item_input_value("**/texture set", folder)   # B with maps; A a preset
+    type_path(ctx, "**/texture set", folder)   # B with maps; A a preset
     ctx.item_click("**/load set")
     ctx.combo_click("A preset/gold")
     a = _left_of_divider(view(ctx), divider)
@@ -324,7 +324,7 @@ def test_the_library_name_follows_the_material(ctx):
     wood_set(folder, "walnut")
     ctx.set_ref("alight")
     ctx.item_click("**/gold")
-    ctx.item_input_value("**/texture set", folder)
+    type_path(ctx, "**/texture set", folder)
     ctx.item_click("**/load set")
     assert s.material.name == "walnut", s.material.name
     ctx.item_click("**/save to library")
@@ -348,7 +348,7 @@ def test_the_texture_set_row_takes_a_folder_or_several_files(ctx):
     ctx.set_ref("alight")
     ctx.item_click("**/plastic_high")
     white = ball(view(ctx)).mean(axis=0)
-    ctx.item_input_value("**/texture set", f"{color};{rough}")
+    type_path(ctx, "**/texture set", f"{color};{rough}")
     ctx.item_click("**/load set")
     assert s.texture_maps.paths() == {"base_color": color, "roughness": rough}, (s.texture_maps.paths(), s.error)
     assert s.material.name == "Bricks012", s.material.name
@@ -356,10 +356,10 @@ def test_the_texture_set_row_takes_a_folder_or_several_files(ctx):
     mapped = ball(view(ctx)).mean(axis=0)
     assert mapped[0] > 1.5 * mapped[1] and white[0] < 1.3 * white[1], (mapped, white)
     ctx.item_click("**/plastic_high")
-    ctx.item_input_value("**/texture set", folder)   # the folder: its name
+    type_path(ctx, "**/texture set", folder)   # the folder: its name
     ctx.item_click("**/load set")
     assert s.texture_maps.paths() == {"base_color": color, "roughness": rough} and s.material.name == "maps_mixed"
-    ctx.item_input_value("**/texture set", os.path.join(folder, "missing_Normal.png"))
+    type_path(ctx, "**/texture set", os.path.join(folder, "missing_Normal.png"))
     ctx.item_click("**/load set")
     assert "missing_Normal.png" in s.error and s.texture_maps.paths()["base_color"] == color, s.error
     ctx.item_click("**/plastic_high")
@@ -386,7 +386,7 @@ def test_open_mesh_confirms_in_the_message_row(ctx):
     ctx.item_click("**/load preset")
     assert s.error
     ctx.item_open("**/Environment")
-    ctx.item_input_value("**/mesh", mesh_file())
+    type_path(ctx, "**/mesh", mesh_file())
     ctx.item_click("**/open mesh")
     assert s.mesh_spec == mesh_file(), (s.mesh_spec, s.error)
     assert not s.error and s.message == f"opened mesh {mesh_file()}", (s.error, s.message)

@@ -18,7 +18,7 @@ import numpy as np
 from alight.frontends.editor.ui_test import editor
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
-from editor_ui_helpers import capture, checker_levels, until  # noqa: E402
+from editor_ui_helpers import capture, checker_levels, type_path, until  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # where files written by the panel go
 BAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "bad"   # ../shared/data/bad
@@ -107,7 +107,7 @@ def test_a_mesh_warning_is_in_the_status_row(ctx):
     for name in ("nancolor.obj", "notenoughindices.obj"):
         path = str(BAD / name)
         expected = load_mesh(path).warnings
-        ctx.item_input_value("**/mesh", path)
+        type_path(ctx, "**/mesh", path)
         ctx.item_click("**/open mesh")
         ctx.yield_(2)
         shown = getattr(win.panel, "shown_status", s.message)   # (a panel that kept none showed the message)
@@ -131,7 +131,7 @@ def test_the_f0_line_says_it_is_the_factors_with_a_metallic_map(ctx):
     ctx.yield_(2)
     assert win.panel.shown_f0.startswith("F0 = "), win.panel.shown_f0
     ctx.item_click("texture maps/metallic/##armed")
-    ctx.item_input_value("**/map file", path)
+    type_path(ctx, "**/map file", path)
     ctx.item_click("**/load##typed")
     ctx.yield_(2)
     assert win.state.texture_maps.metallic == path, win.state.error

@@ -87,3 +87,11 @@ def checker_levels(corner: np.ndarray) -> tuple[float, float]:
     light = (grey & (np.abs(v[:, :, 0] - 204) <= 2)).mean()
     dark = (grey & (np.abs(v[:, :, 0] - 153) <= 2)).mean()
     return float(light), float(dark)
+
+
+def type_path(ctx, ref: str, text: str) -> None:
+    """Type ``text`` into the field ``ref`` without Enter (the engine's item_input_value ends
+    with Enter, which in the env, mesh, map and texture-set fields applies the field: a check of
+    the button beside the field types with this, then clicks the button)."""
+    ctx.item_click(ref)
+    ctx.key_chars_replace(text)

@@ -67,11 +67,27 @@ class FakeImgui:
     def is_item_hovered(self):
         return True
 
-    def set_tooltip(self, text):
+    # A tooltip (widgets.tooltip): its text is recorded for the widget drawn last.
+    def text_unformatted(self, text):
         if isinstance(self._last, tuple):
             self.sections[self._last[1]] = text
         else:
             self.tooltips[self._last] = text
+
+    def begin_tooltip(self):
+        pass
+
+    end_tooltip = pop_text_wrap_pos = begin_tooltip
+
+    def push_text_wrap_pos(self, _):
+        pass
+
+    def get_font_size(self):
+        return 13.0
+
+    def get_io(self):
+        io = types.SimpleNamespace(display_size=self._Vec(1280.0, 720.0))
+        return io
 
     def set_next_item_open(self, *_):
         pass
@@ -85,7 +101,7 @@ class FakeImgui:
             self.x, self.y = x, y
 
     class _Style:
-        item_inner_spacing = None
+        item_inner_spacing = window_padding = None
 
     def calc_text_size(self, text):
         return self._Vec(7.0 * len(text), 13.0)
@@ -95,7 +111,7 @@ class FakeImgui:
 
     def get_style(self):
         style = self._Style()
-        style.item_inner_spacing = self._Vec(4.0, 4.0)
+        style.item_inner_spacing = style.window_padding = self._Vec(4.0, 4.0)
         return style
 
     def push_item_width(self, _):

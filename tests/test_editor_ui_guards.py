@@ -98,3 +98,45 @@ def test_a_fast_drag_reaches_imgui_with_its_release_after_its_last_motion():
     assert out == moves and rest == [release]
     out, rest = g.sort(rest, 1, lambda x, y: True)
     assert out == [release] and rest == [] and g.dropped == 0
+
+
+def test_a_click_after_typing_a_path_is_applied(display, tmp_path):
+    """Real X events into the editor's own loop, a CPU burner beside it: a click on 'open env'
+    0.4 s after the path was typed opens it, every try (the typed keys held the click back for
+    tens of frames, and the guard had forgotten the frame it was aimed at: refused, 4 in 4 here
+    before; tests/editor_x_events_type_click.py)."""
+    # (In the run's folder: a key that missed the field would reach the view's shortcuts, T a turntable.)
+    env = dict(os.environ, DISPLAY=display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+               ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
+    result = subprocess.run([sys.executable, str(REPO / "tests" / "editor_x_events_type_click.py")], cwd=tmp_path,
+                            env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok:"), result.stdout
+
+
+def test_a_press_is_refused_only_where_the_controls_under_it_moved():
+    """press_guard.moved_under on the panel's layouts: a change below the pointer's section (a
+    line in Performance) moves nothing under it; a header above, its section's end or the
+    scroll does. And a press queued behind many frames keeps the layout it was aimed at."""
+    from alight.frontends.editor.keys import PRESS
+    from alight.frontends.editor.press_guard import KEPT_LAYOUTS, PanelLayout, PressGuard, moved_under
+
+    a = PanelLayout(0, (40, 300, 500, 600), 900)
+    assert not moved_under(a, a._replace(end=920), 350.0)                 # a line at the bottom came
+    assert not moved_under(a, a._replace(headers=(40, 300, 500, 620), end=920), 350.0)  # below the next header
+    assert moved_under(a, a._replace(headers=(40, 300, 520, 620)), 350.0)   # its own section grew
+    assert moved_under(a, a._replace(headers=(40, 320, 520, 620)), 350.0)   # a section above grew
+    assert moved_under(a, a._replace(scroll=10), 350.0)
+    assert moved_under(a, a._replace(end=920), 700.0)                     # the last section's end moved
+    assert not moved_under(a, a._replace(headers=(40, 300, 500, 620)), 20.0)   # above every header
+    g = PressGuard()
+    g.built(1, a)
+    g.shown = 1
+    press = ("button", 0, PRESS, 0)
+    g.pressed(press)
+    for frame in range(2, 3 * KEPT_LAYOUTS):   # typed keys trickled a frame each before it
+        g.built(frame, a)
+    out, rest = g.sort([("cursor", 900.0, 350.0), press], 3 * KEPT_LAYOUTS - 1, lambda x, y: True)
+    assert out == [("cursor", 900.0, 350.0), press] and g.dropped == 0
+    g.built(3 * KEPT_LAYOUTS, a)
+    assert len(g.layouts) <= KEPT_LAYOUTS   # with no press queued the old frames go

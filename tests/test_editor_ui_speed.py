@@ -33,6 +33,22 @@ def test_a_drag_made_during_a_busy_frame_turns_the_camera(display):
     assert result.stdout.startswith("ok: turned"), result.stdout
 
 
+def test_an_idle_editor_sleeps_and_wakes_for_a_real_drag(display, tmp_path):
+    """The editor's own loop (EditorWindow.tick) left alone draws (almost) no frames over a wait
+    once its start-up work is done, and a real drag afterwards still turns the camera
+    (tests/editor_x_events_idle.py)."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, DISPLAY=display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+               ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
+    result = subprocess.run([sys.executable, str(REPO / "tests" / "editor_x_events_idle.py")], cwd=REPO,
+                            env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: idle"), result.stdout
+
+
 def test_a_fast_slider_drag_counts_to_its_last_motion(display):
     """Real X events (XTest): the roughness slider dragged from its left end past its right end,
     all between two frames, or with the last motion and the release queued together, ends at

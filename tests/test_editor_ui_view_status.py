@@ -7,6 +7,7 @@ here too, as the other session tests do."""
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from test_editor import display  # noqa: F401  (the Xvfb fixture)
@@ -49,7 +50,8 @@ def test_the_session_keeps_the_turntable_and_the_anti_aliasing(tmp_path, monkeyp
     save_session(state, OrbitCamera(), TurntableSettings(frames=72, path="spin.png"))
     fresh, turntable = EditorState(), TurntableSettings()
     assert restore_session(fresh, OrbitCamera(), turntable) == ""
-    assert (fresh.aa, turntable.frames, turntable.path) == ("msaa", 72, "spin.png")
+    # (the file kept absolute: the session reopens it from any folder)
+    assert (fresh.aa, turntable.frames, turntable.path) == ("msaa", 72, os.path.abspath("spin.png"))
     # A session from before these were kept: the command line's anti-aliasing and the defaults stay.
     data = json.loads(session_path().read_text())
     del data["turntable"], data["settings"]["aa"]

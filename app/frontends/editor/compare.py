@@ -25,6 +25,7 @@ from alight.core.ibl_models import IBL_MODELS
 from alight.core.material import Material
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
+from alight.frontends.editor.widgets import tooltip
 
 MODES = ("off", "material", "ibl model", "reference")
 # A left-button press this close to the divider (window pixels) drags it instead of orbiting.
@@ -212,7 +213,7 @@ def draw_section(win, presets) -> None:
         if imgui.button("snapshot A"):
             take_snapshot(c, s)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("A keeps the material as it is now; edit on, B follows the panel")
+            tooltip("A keeps the material as it is now; edit on, B follows the panel")
         names = [name for name, *_ in presets]
         current = next((k for k, (_, m, *_) in enumerate(presets) if m == c.a_material), -1)
         imgui.same_line()
@@ -236,7 +237,7 @@ def draw_section(win, presets) -> None:
             imgui.text_wrapped(problem)
         changed, v = imgui.slider_float("reference scale", c.reference_scale, 0.05, 1.0)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("the reference's resolution relative to the view's (each summed pixel "
+            tooltip("the reference's resolution relative to the view's (each summed pixel "
                               "a block): the exact sum costs per pixel, 46 s for 4400 on the sphere on llvmpipe")
         if changed:
             c.reference_scale = v

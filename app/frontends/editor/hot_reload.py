@@ -84,6 +84,7 @@ class FileWatcher:
         self._paths: frozenset[str] = frozenset()
         self._stamps: dict[str, tuple | None] = {}
         self._changed: set[str] = set()
+        self.on_change = None   # called (on the watcher's thread) when a file changed
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="alight-file-watcher", daemon=True)
         self._thread.start()
@@ -121,6 +122,13 @@ class FileWatcher:
                     self._stamps[p] = stamp
                     if stamp is not None:
                         self._changed.add(p)
+                        if self.on_change is not None:   # an idle editor's wait ends (window.py)
+                            self.on_change()
+
+    def has_changed(self) -> bool:
+        """Whether a watched file changed since the last ``take_changed`` (takes nothing)."""
+        with self._lock:
+            return bool(self._changed)
 
     def take_changed(self) -> set[str]:
         """The watched files changed since the last call (and present now)."""

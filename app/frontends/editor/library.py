@@ -27,11 +27,11 @@ def library_dir() -> Path:
     """Where library entries live: ``ALIGHT_LIBRARY_DIR``, else ``DATA/library`` (platformdirs'
     user data folder, ``~/.local/share/alight`` on Linux)."""
     explicit = os.environ.get("ALIGHT_LIBRARY_DIR")
-    if explicit:
-        return Path(explicit)
+    if explicit:   # absolute: the entries' paths (kept in a session) name them from any folder
+        return Path(explicit).absolute()
     from alight.paths import data_dir
 
-    return data_dir() / "library"
+    return data_dir().absolute() / "library"
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ import time
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
 from alight.frontends.editor import library
+from alight.frontends.editor.widgets import tooltip
 
 ICON = 24              # a thumbnail's side in the list, pixels
 LIST_ROWS = 4          # the entries' box shows this many rows and scrolls beyond them
@@ -77,7 +78,7 @@ class LibraryPanel:
             if imgui.selectable(f"{entry.name}##library", current, 0, imgui.ImVec2(0, ICON))[0]:
                 self.clicked = entry
             if imgui.is_item_hovered():
-                imgui.set_tooltip(entry.path)
+                tooltip(entry.path)
         if not self.entries:
             imgui.text_disabled("empty: 'save to library' or\n'save preset' adds the material")
         for line in self.problems:

@@ -23,7 +23,9 @@ from alight.exchange.presets import list_presets, load_preset
 from alight.frontends.editor.file_browser import FileBrowser
 from alight.frontends.editor.layer_rows import FINITE_START, SECTIONS, LayerRow
 from alight.frontends.editor.library_panel import ICON, LibraryPanel
+from alight.frontends.editor.press_guard import PanelLayout
 from alight.frontends.editor.state import DEBUG_VIEWS
+from alight.frontends.editor.widgets import text_field, tooltip
 from alight.ibl.bake import QUALITY
 from alight.render.shadows import SHADOW_MODES
 
@@ -93,7 +95,7 @@ def layer_row(row: LayerRow, m):
         if row.switch:   # the field's infinite default is 'off': a checkbox, then the drag when on
             changed, on = imgui.checkbox(row.switch, value != float("inf"))
             if imgui.is_item_hovered():
-                imgui.set_tooltip(row.help)
+                tooltip(row.help)
             if changed:
                 return dataclasses.replace(m, **{row.field: FINITE_START if on else float("inf")})
             if not on:
@@ -103,7 +105,7 @@ def layer_row(row: LayerRow, m):
                                         row.high if np.isfinite(row.high) else _DRAG_MAX, row.fmt)
         new = min(max(new, row.low), row.high)
     if imgui.is_item_hovered():
-        imgui.set_tooltip(row.help)
+        tooltip(row.help)
     return dataclasses.replace(m, **{row.field: new}) if changed else m
 
 
@@ -205,7 +207,7 @@ class Panel:
             self.chart_view = getattr(self, "chart_view", None) or ChartView()
             self.chart_view.draw()
         # Where the controls are this frame: a press aimed at another layout is not delivered.
-        self.layout = (round(imgui.get_scroll_y()), tuple(headers), round(imgui.get_cursor_pos_y()))
+        self.layout = PanelLayout(round(imgui.get_scroll_y()), tuple(headers), round(imgui.get_cursor_pos_y()))
         imgui.end()
         imgui.pop_style_color(3)
         imgui.pop_style_var()
@@ -342,7 +344,7 @@ class Panel:
             m = _edited(m, specular_f0=tuple(min(max(x, 0.0), 1.0) for x in v))
         changed, v = imgui.drag_float("ior", m.ior, 0.005, 1.0, 4.0)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("index of refraction (KHR_materials_ior): F0 = ((ior-1)/(ior+1))^2 times the "
+            tooltip("index of refraction (KHR_materials_ior): F0 = ((ior-1)/(ior+1))^2 times the "
                               "specular colour; specular F0 and ior follow each other")
         if changed:
             m = _edited(m, ior=max(v, 1.0))
@@ -379,6 +381,7 @@ class Panel:
         imgui.same_line()
         if imgui.button("redo"):
             s.step_history(win.history, redo=True)
+        # A file to write (save, export): Enter does nothing here (widgets.text_field says why).
         _, self.preset_path = imgui.input_text("preset file", self.preset_path)
         if imgui.button("save preset"):
             self._attempt(s, "preset_path", lambda: self._save_preset(s))
@@ -457,7 +460,7 @@ class Panel:
             opened = imgui.tree_node_ex(f"{section.title}{' (on)' if section.layer in used else ''}"
                                         f"###layer_{section.layer}")
             if imgui.is_item_hovered():
-                imgui.set_tooltip(section.extension)
+                tooltip(section.extension)
             if opened:
                 if section.note:
                     imgui.text_disabled(section.note)
@@ -496,12 +499,12 @@ class Panel:
         if s.use_file_materials:
             imgui.text_disabled("parts with a material of their own use the file's maps")
         # A whole set at once, each file to its slot by its name (as a drop of several files).
-        _, self.set_path = imgui.input_text("texture set", self.set_path)
+        self.set_path, set_entered = text_field("texture set", self.set_path)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("a folder of maps, or image files separated by ';' (or drop them on the view "
+            tooltip("a folder of maps, or image files separated by ';' (or drop them on the view "
                               "together): each goes to its slot by its name (NAME_BaseColor, _Normal, "
                               "_Roughness, _Metallic, _AO, _ORM, ...); the material takes the set's name")
-        if imgui.button("load set") and self.set_path.strip():
+        if (imgui.button("load set") or set_entered) and self.set_path.strip():
             self._attempt(s, "set_path", lambda: self._load_texture_set(s, self.set_path))
         imgui.same_line()
         if imgui.button("browse set"):   # any image of the set: its folder is loaded
@@ -514,7 +517,7 @@ class Panel:
             if imgui.radio_button("##armed", s.armed_slot == slot):
                 s.armed_slot = slot
             if imgui.is_item_hovered():
-                imgui.set_tooltip("a dropped image file goes into this slot")
+                tooltip("a dropped image file goes into this slot")
             imgui.same_line()
             if imgui.small_button("load"):
                 self.browser.open(f"load {SLOT_LABELS[slot]} map", IMAGE_SUFFIXES, loader(slot))
@@ -528,12 +531,12 @@ class Panel:
                 imgui.same_line()
                 imgui.text_disabled(os.path.basename(path))
             imgui.pop_id()
-        _, self.map_path = imgui.input_text("map file", self.map_path)
+        self.map_path, entered = text_field("map file", self.map_path)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("an image goes into the armed slot; a folder is read as a texture set by its "
+            tooltip("an image goes into the armed slot; a folder is read as a texture set by its "
                               "files' names (NAME_BaseColor, _Normal, _Roughness, ...)")
         imgui.same_line()
-        if imgui.button("load##typed") and self.map_path:
+        if (imgui.button("load##typed") or entered) and self.map_path:
             if os.path.isdir(self.map_path):
                 self._attempt(s, "map_path", lambda: self._load_texture_set(s, self.map_path))
             else:
@@ -573,8 +576,8 @@ class Panel:
         from imgui_bundle import imgui
 
         imgui.text(f"environment: {s.env_spec}")
-        _, self.env_path = imgui.input_text("env file", self.env_path)
-        if imgui.button("open env"):
+        self.env_path, entered = text_field("env file", self.env_path)
+        if imgui.button("open env") or entered:
             self._attempt(s, "env_path", lambda: s.open_environment(self.env_path))
         imgui.same_line()
         self._browse("browse env", (".hdr", ".exr"), s.open_environment)
@@ -595,17 +598,17 @@ class Panel:
             except AlightError as exc:
                 s.fail(exc)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("a built-in mesh, framed from its 3/4 view; or type a mesh file below")
-        _, self.mesh_path = imgui.input_text("mesh", self.mesh_path)
-        if imgui.button("open mesh"):
+            tooltip("a built-in mesh, framed from its 3/4 view; or type a mesh file below")
+        self.mesh_path, entered = text_field("mesh", self.mesh_path)
+        if imgui.button("open mesh") or entered:
             self._attempt(s, "mesh_path", lambda: self._open_mesh(s))
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("or Shift + right drag in the view")
+            tooltip("or Shift + right drag in the view")
         imgui.text_disabled("turn the environment: Shift + right drag in the view")
         _, s.lights_follow_env = imgui.checkbox("lights turn with the environment", s.lights_follow_env)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("the drag and the rotation slider turn every light about the vertical axis "
+            tooltip("the drag and the rotation slider turn every light about the vertical axis "
                               "by the same angle, so a key light stays on the environment's sun")
         _, s.env_intensity = imgui.slider_float("intensity", s.env_intensity, 0.0, 4.0)
         d = s.display
@@ -617,28 +620,28 @@ class Panel:
         if changed:
             s.ibl_model = models[i]
         if imgui.is_item_hovered():
-            imgui.set_tooltip(IBL_MODELS[s.ibl_model])
+            tooltip(IBL_MODELS[s.ibl_model])
         _, s.multiple_scattering = imgui.checkbox("multiple scattering", s.multiple_scattering)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("Fdez-Aguera 2019: the energy single scattering loses on rough surfaces "
+            tooltip("Fdez-Aguera 2019: the energy single scattering loses on rough surfaces "
                               "(a white furnace gives 1; the single-scattering ground truth does not)")
         changed, i = imgui.combo("occlusion", OCCLUSION_MODES.index(s.occlusion), list(OCCLUSION_MODES))
         if changed:
             s.occlusion = OCCLUSION_MODES[i]
         if imgui.is_item_hovered():
-            imgui.set_tooltip("occlusion of the environment light and one bounce, from a per-vertex bake as "
+            tooltip("occlusion of the environment light and one bounce, from a per-vertex bake as "
                               "'alight render --occlusion' makes (auto: where the mesh occludes itself; "
                               "baked in the background, the view drawn without it meanwhile)")
         _, s.ground = imgui.checkbox("ground", s.ground)
         if imgui.is_item_hovered():
-            imgui.set_tooltip("a ground under the model's bounding box that catches its shadow (the lights' and "
+            tooltip("a ground under the model's bounding box that catches its shadow (the lights' and "
                               "the environment's suns'), as 'alight render --ground' draws it over the background; "
                               "it needs shadows (not 'off')")
         changed, i = imgui.combo("shadows", SHADOW_MODES.index(s.shadows), list(SHADOW_MODES))
         if changed:
             s.shadows = SHADOW_MODES[i]
         if imgui.is_item_hovered():
-            imgui.set_tooltip("shadow maps for the lights and the environment's suns, as 'alight render "
+            tooltip("shadow maps for the lights and the environment's suns, as 'alight render "
                               "--shadows' draws them (auto: where something can be shadowed, the ground included; "
                               "not on a convex mesh alone such as the sphere)")
         names = list(QUALITY) + ["auto"]
@@ -681,7 +684,7 @@ class Panel:
             # Linear RGB, shown as 0-1 floats: 0-255 bytes would read as sRGB, as the base colour's do.
             c2, col = imgui.color_edit3("colour", list(light.color), imgui.ColorEditFlags_.float)
             if imgui.is_item_hovered():
-                imgui.set_tooltip("the light's colour, linear RGB (times its intensity)")
+                tooltip("the light's colour, linear RGB (times its intensity)")
             c3, inten = imgui.drag_float("intensity", light.intensity, 0.1, 0.0, 1000.0)
             if c1 or c2 or c3:
                 if light.kind == "directional" and not any(vec):

@@ -5,17 +5,50 @@ after the panel's controls moved: a section collapsed, a library entry appeared,
 scrolled; it then lands on whatever control moved under the pointer (once it overwrote a library
 entry). Each mouse press is stamped with the frame on screen when it arrived (the editor's loop
 polls its events once more just before each swap, so a press that came while frame N-1 was shown
-is told from one after frame N was), and is handed to imgui only if the panel's layout (the
-``Panel.layout`` signature: the scroll, each section header's height and the content's end) in
-the last frame built equals the layout of that frame on screen. Otherwise the press and its
+is told from one after frame N was), and is handed to imgui only if the controls under the pointer are where they were in that frame on
+screen (``moved_under`` on the ``Panel.layout``: the scroll, the section headers above the
+pointer and the end of its section) in the last frame built. Otherwise the press and its
 release are dropped and the status row says so. Pure: no imgui, no glfw.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from alight.frontends.editor.keys import PRESS, RELEASE
 
-KEPT_LAYOUTS = 8   # frames whose layout is remembered (a press is aimed at one of the last two)
+# Frames whose layout is remembered, besides those a queued press is aimed at: a press can wait
+# many frames behind typed keys (imgui trickles a burst of typing over a frame per repeated key),
+# and a press whose frame was forgotten was refused though nothing had moved (a user's 'open
+# env' clicked 0.3-0.5 s after typing the path, 3 in 15 on a busy machine).
+KEPT_LAYOUTS = 8
+
+
+class PanelLayout(NamedTuple):
+    """Where the panel's controls are in a frame: its scroll, the top of each section's header
+    (window coordinates, top to bottom) and the content's end."""
+
+    scroll: int
+    headers: tuple
+    end: int
+
+
+def moved_under(aimed, now, y: float) -> bool:
+    """Whether a control at window height ``y`` in layout ``aimed`` may be elsewhere in ``now``.
+    PanelLayouts: the scroll, the headers above ``y`` and the end of the section under it (the
+    next header, else the content's end); a change below that section moves nothing under the
+    pointer (the Performance section's lines came and went under a click far above them).
+    Other layouts (tests) by equality; an unknown one (None) moves nothing."""
+    if aimed is None or now is None:
+        return False
+    if not (isinstance(aimed, PanelLayout) and isinstance(now, PanelLayout)):
+        return aimed != now
+    if aimed.scroll != now.scroll or len(aimed.headers) != len(now.headers):
+        return True
+    above = sum(1 for top in aimed.headers if top <= y)
+    if aimed.headers[:above + 1] != now.headers[:above + 1]:
+        return True
+    return above >= len(aimed.headers) and aimed.end != now.end
 
 
 class PressGuard:
@@ -33,7 +66,8 @@ class PressGuard:
 
     def built(self, frame: int, layout) -> None:
         self.layouts[frame] = layout
-        for old in [k for k in self.layouts if k <= frame - KEPT_LAYOUTS]:
+        oldest = min(self.aims.values(), default=frame)   # a queued press's frame is kept
+        for old in [k for k in self.layouts if k <= frame - KEPT_LAYOUTS and k < oldest]:
             del self.layouts[old]
 
     def sort(self, events: list[tuple], last_built: int, over_panel) -> tuple[list[tuple], list[tuple]]:
@@ -67,7 +101,8 @@ class PressGuard:
                 return out, events[i:]
             if action == PRESS:
                 aim = self.aims.pop(id(event), self.shown)
-                if over_panel(*self.pointer) and self.layouts.get(aim) != self.layouts.get(last_built):
+                if over_panel(*self.pointer) and \
+                        moved_under(self.layouts.get(aim), self.layouts.get(last_built), self.pointer[1]):
                     self._dropping.add(button)
                     self.dropped += 1
                     continue

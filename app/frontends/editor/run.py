@@ -92,8 +92,7 @@ def run(args) -> int:
         from alight.frontends.editor.session import save_session
 
         try:
-            while not win.should_close():
-                win.frame()
+            win.run()   # frames while something changes, a wait for events while nothing does
         except KeyboardInterrupt:
             # Ctrl+C, or SIGTERM (the CLI raises its Terminated, a KeyboardInterrupt: a logout,
             # a kill): the session is kept as after a normal close, then the CLI says which.
@@ -121,7 +120,9 @@ def _start_maps(state: EditorState, maps, args) -> None:
     --texture-set without --preset names the material after the set, as the panel's row does."""
     if maps is not None:
         from alight.exchange.texture_sets import load_map_images, set_name
+        from alight.paths import absolute_maps
 
+        maps = absolute_maps(maps)   # kept by absolute paths, as the panel's loads are (state.set_map)
         state.map_images = load_map_images(maps)
         state.texture_maps = maps
         texture_set = getattr(args, "texture_set", None)

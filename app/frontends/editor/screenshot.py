@@ -14,6 +14,8 @@ import sys
 import time
 from dataclasses import dataclass
 
+from alight.frontends.editor.widgets import tooltip
+
 MAX_SIDE = 16384          # the renderer's limit (GL_MAX_TEXTURE_SIZE guaranteed by OpenGL 4.1)
 STEP_BUDGET_S = 0.05      # time a frame gives the screenshot being written, beyond one strip
 
@@ -126,7 +128,7 @@ def draw_controls(win) -> None:
         if changed:
             choice.width, choice.height = clamp_side(v[0]), clamp_side(v[1])
         if imgui.is_item_hovered():
-            imgui.set_tooltip(f"pixels, up to {MAX_SIDE} a side; a big one is drawn in tiles and "
+            tooltip(f"pixels, up to {MAX_SIDE} a side; a big one is drawn in tiles and "
                               "written a strip a frame")
     if imgui.button("screenshot (F12)"):
         win.screenshot_request = win.next_screenshot_name()   # the window writes it after the frame

@@ -30,22 +30,31 @@ def session_path() -> Path:
 
 def save_session(state, orbit, turntable=None, panel=None) -> None:
     """``turntable``: the window's turntable.TurntableSettings, ``panel``: its panel.Panel (the
-    'preset file' and 'glTF file' fields), each kept when given."""
-    data = {"mesh": state.mesh_spec, "env": state.env_spec, "material": state.material.to_dict(),
-            "texture_maps": state.texture_maps.to_dict(),
+    'preset file' and 'glTF file' fields), each kept when given. Every path is written absolute
+    (the loaders keep them so; the rest are made so here, against the folder the editor ran in,
+    which it never leaves): a session reopened from another folder names the same files."""
+    from alight.core.mesh import BUILTIN_MESHES
+    from alight.paths import absolute, absolute_maps
+
+    compare_dict = compare.to_dict(state.compare)
+    compare_dict["a_texture_maps"] = absolute_maps(state.compare.a_texture_maps).to_dict()
+    data = {"mesh": state.mesh_spec if state.mesh_spec in BUILTIN_MESHES else absolute(state.mesh_spec),
+            "env": state.env_spec if state.env_spec == "studio" else absolute(state.env_spec),
+            "material": state.material.to_dict(),
+            "texture_maps": absolute_maps(state.texture_maps).to_dict(),
             # The folder the set was read from (the 'texture set' field names it) and the slot a
             # dropped image fills: older sessions lack both.
-            "texture_set_folder": state.texture_set_folder, "armed_slot": state.armed_slot,
+            "texture_set_folder": absolute(state.texture_set_folder), "armed_slot": state.armed_slot,
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
                          "use_file_materials": state.use_file_materials, "aa": state.aa,
                          "display": dataclasses.asdict(state.display),
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
-            "compare": compare.to_dict(state.compare)}
+            "compare": compare_dict}
     if turntable is not None:
-        data["turntable"] = {"frames": turntable.frames, "path": turntable.path}
+        data["turntable"] = {"frames": turntable.frames, "path": absolute(turntable.path)}
     if panel is not None:
-        data["files"] = panel.kept_paths()
+        data["files"] = {k: absolute(v) if isinstance(v, str) else v for k, v in panel.kept_paths().items()}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))

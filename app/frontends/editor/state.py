@@ -118,8 +118,12 @@ class EditorState:
     def load_mesh(self, spec: str) -> None:
         from alight.exchange.meshes import load_mesh
 
+        from alight.core.mesh import BUILTIN_MESHES
+        from alight.paths import absolute
+
         mesh = load_mesh(spec)
-        self.mesh, self.mesh_spec = mesh, spec
+        # A file kept by its absolute path: the session reopens it from any folder.
+        self.mesh, self.mesh_spec = mesh, spec if spec in BUILTIN_MESHES else absolute(spec)
         # As 'alight render' draws a file: its own materials where it has any (the panel's
         # checkbox switches to the panel's material), the panel's where it has none.
         self.use_file_materials = any(part.material is not None for part in mesh.parts)
@@ -128,8 +132,10 @@ class EditorState:
     def load_env(self, spec: str) -> None:
         from alight.ibl.environment import load_environment
 
+        from alight.paths import absolute
+
         env = load_environment(spec)
-        self.env, self.env_spec = env, spec
+        self.env, self.env_spec = env, spec if spec == "studio" else absolute(spec)   # (as load_mesh)
         self._say(env.warnings)
 
     def _say(self, warnings) -> None:
@@ -157,7 +163,9 @@ class EditorState:
         The slot's factor becomes 1 (glTF's convention: the map is the value), unless
         ``factor_to_1`` is False (a restored session keeps the factors it saved)."""
         from alight.core.texture_maps import map_factors
+        from alight.paths import absolute
 
+        path = absolute(path)   # kept so: the session, the watcher and undo name one file from any folder
         maps = self.texture_maps.with_slot(slot, path)
         image = load_slot_image(maps, slot)
         self.map_images = {p: self.map_images[p] for p in maps.paths().values() if p in self.map_images}
@@ -278,7 +286,10 @@ class EditorState:
         from alight.exchange.material_files import load_material_file
         from alight.exchange.texture_sets import load_map_images
 
+        from alight.paths import absolute_maps
+
         m, maps, warnings = load_material_file(name_or_path, mesh_hint=EDITOR_MESH_HINT)
+        maps = absolute_maps(maps)   # (a relative preset's maps are relative to where it was read from)
         images = load_map_images(maps)   # read first: a bad map changes nothing
         self._say(warnings)
         self.material = self.saved_material = m
@@ -324,7 +335,9 @@ class EditorState:
         lines, also shown as the panel's message."""
         from alight.core.texture_maps import map_factors
         from alight.exchange.texture_sets import assign_files, load_map_images, set_name
+        from alight.paths import absolute
 
+        paths, folder = [absolute(p) for p in paths], absolute(folder)   # (as set_map)
         before = self.texture_maps
         # A set is whole: it replaces the maps before it (a slot it leaves empty is empty, not the
         # last set's map, which would tint it), keeping only the UV tiling.

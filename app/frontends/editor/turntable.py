@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from alight.errors import AlightError
+from alight.frontends.editor.widgets import tooltip
 
 SUFFIXES = (".png", ".webp", ".mp4")
 MAX_FRAMES = 720
@@ -258,7 +259,7 @@ def draw_controls(win) -> None:
         t.frames = max(2, min(MAX_FRAMES, n))
     _, t.path = imgui.input_text("turntable file", t.path)
     if imgui.is_item_hovered():
-        imgui.set_tooltip("NAME.webp: one animated WebP (lossless); NAME.mp4: one H.264 video (lossy, CRF 18); NAME.png: NAME_000.png, NAME_001.png, ...; "
+        tooltip("NAME.webp: one animated WebP (lossless); NAME.mp4: one H.264 video (lossy, CRF 18); NAME.png: NAME_000.png, NAME_001.png, ...; "
                           "the camera orbits once about the vertical axis, at the view's size")
     if imgui.button("turntable (T)"):
         win.turntable_request = True   # the window starts it after the frame

@@ -199,6 +199,12 @@ class PresetPrefetch:
             self.close()
             return
 
+    @property
+    def busy(self) -> bool:
+        """Counting the frames before it starts, or its child drawing: the editor keeps drawing
+        frames (at the idle loop's background rate, window.py) until it is done."""
+        return not self.done and (self._worker is not None or self._frames > 0)
+
     def cancel(self) -> None:
         """No prefetch in this session (a stopped one adds nothing)."""
         self.done = True

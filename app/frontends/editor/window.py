@@ -43,6 +43,16 @@ PANEL_WIDTH = 480
 TARGET_FPS = 30.0
 ADAPTIVE_MIN_SCALE, ADAPTIVE_STEP = 0.25, 1.0 / 16.0
 TARGET_CACHE = 4   # view framebuffers kept, by size
+# The interactive loop (``run``) sleeps when nothing changes: a still editor redrew ~75 frames a
+# second and kept a core 60-87% busy. Frames at full rate while input comes, the camera moves, a
+# bake, screenshot or turntable runs, and for IDLE_AFTER_S after (imgui's hover and the view's
+# sharp still frame settle); at most every BACKGROUND_FRAME_S while background work is pending
+# (a child's job, thumbnails, the presets' prefetch, a text field's blinking cursor); else none:
+# the loop waits for events (glfw.wait_events_timeout), which input, a child's answer and a
+# watched file's change end at once, and every IDLE_WAIT_S looks at the shaders (hot reload).
+IDLE_AFTER_S = 0.5
+BACKGROUND_FRAME_S = 0.08
+IDLE_WAIT_S = 0.1
 CHECKER_SQUARE = 8.0   # pixels a side of the checkerboard under a transparent background
 
 
@@ -107,13 +117,14 @@ class EditorWindow:
             glfw.set_mouse_button_callback(self.window, self._button_callback)
             glfw.set_scroll_callback(self.window, lambda _w, dx, dy: self.key_events.scroll(dx, dy))
             self._native_imgui = self._start_native_imgui(imgui)
+            self._watch_window_events(glfw)
         from alight.frontends.editor.panel_image import PanelImage
 
         # The side bar's pixels, drawn again only when imgui's draw data changes (panel_image.py);
         # False draws it every frame (the tests compare). The runner draws imgui itself.
         self.keep_panel_pixels = not hosted
         self._panel_image = PanelImage(self.ctx, self._render_imgui_direct)
-        glfw.set_drop_callback(self.window, lambda _w, paths: self.drop(list(paths)))
+        glfw.set_drop_callback(self.window, self._drop_callback)
         self._init_state(state, show_panel)
         # The probes above (depth bits, the sRGB pixel) may leave a GL error pending; hello_imgui
         # checks glGetError after its first frame and would report it as its own.
@@ -131,6 +142,28 @@ class EditorWindow:
             raise AlightError("editor: cannot create an OpenGL 4.5 core window")
         glfw.make_context_current(self.window)
         glfw.swap_interval(0)  # frame times measure our work, not the display's refresh
+
+    def _drop_callback(self, _window, paths) -> None:
+        self._woken = True
+        self.drop(list(paths))
+
+    def _watch_window_events(self, glfw) -> None:
+        """Window events that ask for a frame though they are no input (exposed, resized,
+        focus, the pointer entering or leaving): they end an idle wait (``tick``). The
+        callbacks imgui's backend installed are chained."""
+        def chain(setter):
+            previous = None
+
+            def callback(*args):
+                self._woken = True
+                if previous is not None:
+                    previous(*args)
+            previous = setter(self.window, callback)
+
+        for setter in (glfw.set_window_refresh_callback, glfw.set_framebuffer_size_callback,
+                       glfw.set_window_focus_callback, glfw.set_cursor_enter_callback,
+                       glfw.set_window_iconify_callback):
+            chain(setter)
 
     def _open_hosted(self, glfw) -> None:
         """hello_imgui's glfw window, through pyGLFW on the same libglfw (imgui_bundle sets
@@ -181,6 +214,14 @@ class EditorWindow:
         from alight.frontends.editor.hot_reload import FileWatcher
 
         self.file_watcher = FileWatcher()   # maps and the environment file changed on disk
+        self._woken = False       # an event that needs a frame came during an idle wait (tick)
+        self._last_active = time.monotonic()   # the last input or change that needs frames at full rate
+        self.idle_waits = 0       # the idle loop's waits so far (tests and the benchmark read it)
+        if not self.hosted:   # (the test engine's runner draws every frame: no waits there)
+            from alight.frontends.editor import worker_process
+
+            worker_process.set_waker(self.glfw.post_empty_event)
+            self.file_watcher.on_change = self.glfw.post_empty_event
 
         self.panel = Panel()
         from alight.frontends.editor.compare_view import CompareView
@@ -419,18 +460,20 @@ class EditorWindow:
         window_w = max(1, self._sizes()[1][0])
         return max(1, w - round(self.panel_width() * w / window_w)), h
 
-    def check_shaders(self, force: bool = False) -> None:
-        """Hot reload: rebuild the programs when a file under shaders/ changed."""
+    def check_shaders(self, force: bool = False) -> bool:
+        """Hot reload: rebuild the programs when a file under shaders/ changed (returns whether
+        it did: an idle loop then draws a frame)."""
         from alight.frontends.editor.hot_reload import rebuild
 
         if not self.shader_watcher.changed(force):
-            return
+            return False
         error = rebuild(self.renderer, self.shader_watcher.root)
         if error:
             self.state.error, self.state.message = error, ""
         else:
             self.state.error, self.state.message = "", "shaders reloaded"
             self._drawn_key = None   # redraw with the new programs
+        return True
 
     def check_files(self) -> None:
         """Hot reload of the maps and the environment: what the watcher thread saw change is
@@ -916,7 +959,53 @@ class EditorWindow:
     def should_close(self) -> bool:
         return bool(self.glfw.window_should_close(self.window))
 
+    def run(self) -> None:
+        """The interactive loop: ``tick`` until the window is closed."""
+        while not self.should_close():
+            self.tick()
+
+    def tick(self) -> bool:
+        """One turn of the interactive loop: a frame when something needs one, else a wait for
+        events (IDLE_AFTER_S says when). Returns whether a frame was drawn."""
+        now = time.monotonic()
+        if self._needs_full_rate():
+            self._last_active = now
+        if now - self._last_active < IDLE_AFTER_S:
+            self.frame()
+            return True
+        background = self._background_pending()
+        self._woken = False
+        self.idle_waits += 1
+        self.glfw.wait_events_timeout(BACKGROUND_FRAME_S if background else IDLE_WAIT_S)
+        if self.key_events.pending:   # input: frames at full rate from this one
+            self._last_active = time.monotonic()
+        if self._woken or self.key_events.pending or background or self.file_watcher.has_changed() \
+                or self.check_shaders() or self.should_close():
+            self.frame()
+            return True
+        return False
+
+    def _needs_full_rate(self) -> bool:
+        """Input waiting, the camera moving, or a job that advances a slice a frame."""
+        return bool(self.key_events.pending or len(self.imgui.get_current_context().input_events_queue)
+                    or self._was_moving or self._bake_job is not None or self.screenshot_job is not None
+                    or self.screenshot_request or self.turntable_job is not None or self.turntable_request
+                    or self.imgui.is_any_item_active())
+
+    def _background_pending(self) -> bool:
+        """Work whose results come without input: a child's job, thumbnails asked for, the
+        presets' prefetch, the split view's warm-up; and a text field's blinking cursor."""
+        from alight.frontends.editor import worker_process
+
+        return bool(worker_process.busy() or self.thumbnails.pending() or self.preset_prefetch.busy
+                    or not self.pass_warmup.done or self.imgui.get_io().want_text_input)
+
     def close(self) -> None:
+        if not self.hosted:
+            from alight.frontends.editor import worker_process
+
+            worker_process.set_waker(None)   # (no empty events posted to a glfw being closed)
+        self.file_watcher.on_change = None
         self.file_watcher.stop()
         if self.turntable_job is not None:   # unfinished: its temporary files go
             self.turntable_job.cancel()

@@ -37,12 +37,30 @@ import sys
 import tempfile
 import threading
 import time
+import weakref
 from pathlib import Path
 
 # A long job (the reference's sum) runs below the editor's priority: the frames first.
 CHILD_NICENESS = 10
 
 _JOB_MAGIC = b"ALJOB5\0\0"
+
+# The parent's workers with their jobs (``busy``), and what a child's answer calls (``set_waker``):
+# an idle editor waits for events rather than drawing frames, and wakes when an answer comes.
+_LIVE: weakref.WeakSet = weakref.WeakSet()
+_waker = None
+
+
+def set_waker(function) -> None:
+    """``function()`` is called (on a reader thread) whenever a child answers; None: nothing.
+    The editor's window passes glfw.post_empty_event, which ends its wait for events."""
+    global _waker
+    _waker = function
+
+
+def busy() -> bool:
+    """Whether any worker of this process has a job not answered yet (or answered, not taken)."""
+    return any(w._files for w in list(_LIVE))
 
 
 def job_pickle(job) -> tuple[bytes, list]:
@@ -92,6 +110,7 @@ class WorkerProcess:
         self._files: dict[int, Path] = {}
         self._outbox: queue.Queue = queue.Queue()   # jobs for the writer thread, in order
         self._writer = None
+        _LIVE.add(self)
 
     def submit(self, job) -> int:
         """Send ``job`` (picklable; its arrays left unchanged from now on); returns its id. The
@@ -147,8 +166,10 @@ class WorkerProcess:
                 self._answers.put((int(job_id), word, text))
             except ValueError:
                 continue
+            _wake()
         # The child ended: every job it had not answered fails (the parent may start another).
         self._answers.put((0, "ended", ""))
+        _wake()
 
     def answers(self) -> list[tuple[int, str, str]]:
         out = []
@@ -207,6 +228,15 @@ class WorkerProcess:
         try:
             self._scratch.rmdir()
         except OSError:
+            pass
+
+
+def _wake() -> None:
+    waker = _waker
+    if waker is not None:
+        try:
+            waker()
+        except Exception:   # (the window closing meanwhile: its loop is gone anyway)
             pass
 
 
