@@ -262,6 +262,12 @@ def _check_inputs_exist(source: Path, base: Path, meshes: list, envs: list, mate
         named += [(f"materials[{i}]", d) for d in deps] + ([(f"materials[{i}]", folder)] if folder else [])
     for where, path in named:
         if not Path(path).exists():
+            text = Path(path).name
+            if where.startswith("materials") and "." not in text:   # a name, not a file: a preset?
+                from alight.paths import preset_dir
+
+                names = ", ".join(sorted(p.stem for p in preset_dir().glob("*.json")))
+                raise AlightError(f"{source}: {where}: {text!r} is neither a preset ({names}) nor a file")
             raise AlightError(f"{source}: {where}: {path}: no such file or folder (paths are relative to the spec's folder)")
 
 
