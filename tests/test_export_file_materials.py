@@ -222,3 +222,11 @@ def test_images_go_out_as_the_file_had_them_unless_their_pixels_changed(tmp_path
     assert np.array_equal(decode_texture(written.read_bytes(), str(written)), info.image)
     doc = json.loads((tmp_path / "changed.gltf").read_text())
     assert [m["name"] for m in doc["materials"]] == ["jpeg"] and "extensionsUsed" not in doc, doc
+
+
+def test_what_the_file_brought_and_the_export_drops_is_said(tmp_path):
+    """CesiumMilkTruck's animation is not written (the parts go out in the pose drawn): the one
+    note says so, as it says a camera or a light (a new user saw it dropped in silence)."""
+    truck = SHARED / "models" / "CesiumMilkTruck.glb"
+    note = export_cli(truck, tmp_path / "truck.glb")
+    assert "1 animation left out" in note, note

@@ -249,6 +249,7 @@ class Mesh:
     cameras: list = field(default_factory=list)
     lights: list = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    animations: int = 0   # the file's animations (not played: the rest pose is drawn)
     # The built-in UV sphere's (radius, segments), centred at the origin, its part's geometry as
     # ``sphere`` made it: a renderer may draw it with fewer segments where its size on screen
     # allows (alight.core.sphere_lod), never more. None for every other mesh: drawn as given.

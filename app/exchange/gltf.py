@@ -719,7 +719,8 @@ class _Reader:
         for light in lights:
             if light.kind != "directional":
                 light.vector = tuple(float(x) for x in np.asarray(light.vector, np.float64) - origin)
-        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings, origin=tuple(map(float, origin)))
+        mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings, origin=tuple(map(float, origin)),
+                    animations=len(doc.animations or []))
         mesh.cameras = [self._camera(i, shift @ world, mesh) for i, world in cameras]
         return mesh
 

@@ -341,6 +341,9 @@ def _left_out(mesh) -> list[str]:
     one node each)."""
     what = [f"{len(x)} {name}{'s' if len(x) > 1 else ''}" for x, name in
             ((mesh.cameras, "camera"), (mesh.lights, "light")) if x]
+    animations = getattr(mesh, "animations", 0)
+    if animations:      # (the parts go out in the pose drawn, the rest pose)
+        what.append(f"{animations} animation{'s' if animations > 1 else ''}")
     return [f"the mesh file's {' and '.join(what)} left out"] if what else []
 
 

@@ -110,6 +110,20 @@ class OcclusionBake:
         self.status = "baking occlusion: the view is drawn without it meanwhile"
         return dataclasses.replace(scene, occlusion="off"), False
 
+    @staticmethod
+    def _say_screen_occlusion(win, mesh, mode: str, wanted: bool) -> None:
+        """'auto' on a mesh too big to bake draws it with screen-space GTAO: the status row says
+        so, as the command line's warning does (a new user saw only 'baking occlusion')."""
+        from alight.core.visibility import AUTO_MAX_VERTICES, screen_occlusion
+
+        if not screen_occlusion(mesh, mode, wanted):
+            return
+        note = (f"occlusion: gtao (screen space) for this mesh of more than {AUTO_MAX_VERTICES} vertices; "
+                f"'on' bakes it")
+        state = win.state
+        if note not in state.message:
+            state.message = f"{state.message}; {note}" if state.message else note
+
     def _forget_meshes(self, keep: set) -> None:
         """Drop what is known of meshes no longer shown, so a new mesh given a dead one's id is
         never taken for it (the cache on disk keeps their bakes)."""
@@ -169,6 +183,7 @@ class OcclusionBake:
                     self._ready.add(sent.key)
                     self.last_seconds = float(text or 0.0)
                     redraw = True
+                    self._say_screen_occlusion(win, mesh, mesh_key[1], answer["wanted"])
             elif word == "error":
                 # Drawn without occlusion, and said once ('on' needs embreex, a bake that failed).
                 self._decided[mesh_key] = False

@@ -47,7 +47,7 @@ TARGET_CACHE = 4   # view framebuffers kept, by size
 # second and kept a core 60-87% busy. Frames at full rate while input comes, the camera moves, a
 # bake, screenshot or turntable runs, and for IDLE_AFTER_S after (imgui's hover and the view's
 # sharp still frame settle); at most every BACKGROUND_FRAME_S while background work is pending
-# (a child's job, thumbnails, the presets' prefetch, a text field's blinking cursor); else none:
+# (a child's job, thumbnails, the presets' prefetch; a text field's cursor does not blink); else none:
 # the loop waits for events (glfw.wait_events_timeout), which input, a child's answer and a
 # watched file's change end at once, and every IDLE_WAIT_S looks at the shaders (hot reload).
 IDLE_AFTER_S = 0.5
@@ -143,6 +143,13 @@ class EditorWindow:
         glfw.make_context_current(self.window)
         glfw.swap_interval(0)  # frame times measure our work, not the display's refresh
 
+    def _answer_came(self) -> None:
+        """A child's answer or a watched file's change (called on another thread): the idle wait
+        ends, and two frames follow (``tick``): one takes the answer, the next shows what it
+        changed (the status row is drawn before the frame takes it) without waiting for input."""
+        self._answered = 2
+        self.glfw.post_empty_event()
+
     def _drop_callback(self, _window, paths) -> None:
         self._woken = True
         self.drop(list(paths))
@@ -215,13 +222,18 @@ class EditorWindow:
 
         self.file_watcher = FileWatcher()   # maps and the environment file changed on disk
         self._woken = False       # an event that needs a frame came during an idle wait (tick)
+        self._answered = 0        # frames owed to a child's answer or a watched file's change (_answer_came)
         self._last_active = time.monotonic()   # the last input or change that needs frames at full rate
         self.idle_waits = 0       # the idle loop's waits so far (tests and the benchmark read it)
         if not self.hosted:   # (the test engine's runner draws every frame: no waits there)
             from alight.frontends.editor import worker_process
 
-            worker_process.set_waker(self.glfw.post_empty_event)
-            self.file_watcher.on_change = self.glfw.post_empty_event
+            worker_process.set_waker(self._answer_came)
+            self.file_watcher.on_change = self._answer_came
+            # A blinking text cursor would need a frame every half second for as long as a field
+            # holds the focus (a new user saw a focused field keep the idle editor at a core):
+            # the cursor stays lit instead, and typing brings its own frames.
+            self.imgui.get_io().config_input_text_cursor_blink = False
 
         self.panel = Panel()
         from alight.frontends.editor.compare_view import CompareView
@@ -979,7 +991,10 @@ class EditorWindow:
         self.glfw.wait_events_timeout(BACKGROUND_FRAME_S if background else IDLE_WAIT_S)
         if self.key_events.pending:   # input: frames at full rate from this one
             self._last_active = time.monotonic()
-        if self._woken or self.key_events.pending or background or self.file_watcher.has_changed() \
+        answered = self._answered > 0
+        if answered:
+            self._answered -= 1
+        if self._woken or answered or self.key_events.pending or background or self.file_watcher.has_changed() \
                 or self.check_shaders() or self.should_close():
             self.frame()
             return True
@@ -990,15 +1005,16 @@ class EditorWindow:
         return bool(self.key_events.pending or len(self.imgui.get_current_context().input_events_queue)
                     or self._was_moving or self._bake_job is not None or self.screenshot_job is not None
                     or self.screenshot_request or self.turntable_job is not None or self.turntable_request
-                    or self.imgui.is_any_item_active())
+                    or (self.imgui.is_any_item_active() and not self.imgui.get_io().want_text_input))
 
     def _background_pending(self) -> bool:
         """Work whose results come without input: a child's job, thumbnails asked for, the
-        presets' prefetch, the split view's warm-up; and a text field's blinking cursor."""
+        presets' prefetch, the split view's warm-up. (A focused text field needs none: its cursor
+        does not blink, and keys bring frames.)"""
         from alight.frontends.editor import worker_process
 
         return bool(worker_process.busy() or self.thumbnails.pending() or self.preset_prefetch.busy
-                    or not self.pass_warmup.done or self.imgui.get_io().want_text_input)
+                    or not self.pass_warmup.done)
 
     def close(self) -> None:
         if not self.hosted:
