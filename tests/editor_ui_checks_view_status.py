@@ -118,6 +118,30 @@ def test_a_mesh_warning_is_in_the_status_row(ctx):
     assert s.mesh_spec == "sphere", s.mesh_spec
 
 
+def test_a_cut_status_line_is_shown_whole_when_hovered(ctx):
+    """A bad file's error is longer than the panel's row and is cut at its edge; hovering the row
+    shows it whole in a tooltip (a new user hovered it and saw nothing)."""
+    from imgui_bundle import imgui
+
+    win, s = editor(), editor().state
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    path = str(BAD / "empty_nodes.glb")
+    type_path(ctx, "**/mesh", path)
+    ctx.item_click("**/open mesh")
+    ctx.yield_(2)
+    assert s.error and path in s.error, s.error
+    panel = imgui.internal.find_window_by_name("alight")
+    row = panel.menu_bar_rect()
+    ctx.mouse_move_to_pos(imgui.ImVec2(row.min.x + 40.0, (row.min.y + row.max.y) / 2.0))
+    ctx.yield_(3)
+    tip = imgui.internal.find_window_by_name("##Tooltip_00")
+    assert tip is not None and tip.active, "no tooltip over the status row"
+    s.error = ""
+    ctx.mouse_move("**/Lights")
+    ctx.item_close("**/Environment")
+
+
 def test_the_f0_line_says_it_is_the_factors_with_a_metallic_map(ctx):
     """With a metallic map the F0 line names the factors' F0 and the maps (it read 'F0 = 1.000
     1.000 1.000', which is not what is drawn); cleared, it is the F0 again."""
