@@ -1,7 +1,7 @@
 """Each mesh file exported with its own materials (`alight export --mesh FILE`), rendered beside
 the original (`alight render --mesh`, 128x96, occlusion and shadows off) and compared: one line a
 file with the max and mean difference (of 255), the share of pixels off by more than 8, the
-sizes of the original and the export, and the export's stderr (what it left out).
+distinct materials alight loads from each, the sizes of the original and the export, and the export's stderr (what it left out).
 
     .venv/bin/python tools/export_roundtrip.py --out /tmp/roundtrip [FILE ...]
 
@@ -32,6 +32,13 @@ def _size(path: Path) -> int:
     return sum(p.stat().st_size for p in path.parent.iterdir()) if path.suffix == ".gltf" else path.stat().st_size
 
 
+def _materials(path: Path) -> int:
+    """How many distinct materials the file's parts are drawn with, as alight loads it."""
+    from alight.exchange.meshes import load_mesh
+
+    return len({id(p.material) for p in load_mesh(str(path)).parts if p.material is not None})
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, type=Path)
@@ -58,6 +65,7 @@ def main() -> int:
         if len(pictures) == 2:
             d = np.abs(pictures[0] - pictures[1])
             print(f"{model.stem}: max {d.max():.0f} mean {d.mean():.3f} off>8 {(d.max(-1) > 8).mean():.4f} "
+                  f"| materials {_materials(model)} -> {_materials(out)} "
                   f"| {_size(model)} -> {out.stat().st_size} bytes | {r.stderr.strip()}", flush=True)
     return 0
 
