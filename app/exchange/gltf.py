@@ -75,10 +75,11 @@ LAYER_TEXTURES = {
 COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu"}
 
 PNG_MAGIC, JPEG_MAGIC = b"\x89PNG\r\n\x1a\n", b"\xff\xd8\xff"
-_WRAP = {10497: "repeat", 33071: "clamp_to_edge", 33648: "mirrored_repeat"}
-_MAG = {9728: "nearest", 9729: "linear"}
-_MIN = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest", 9985: "linear_mipmap_nearest",
-        9986: "nearest_mipmap_linear", 9987: "linear_mipmap_linear"}
+# glTF sampler codes -> alight.core.mesh.Sampler's names (gltf_file_materials inverts them).
+SAMPLER_WRAP = {10497: "repeat", 33071: "clamp_to_edge", 33648: "mirrored_repeat"}
+SAMPLER_MAG = {9728: "nearest", 9729: "linear"}
+SAMPLER_MIN = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest", 9985: "linear_mipmap_nearest",
+               9986: "nearest_mipmap_linear", 9987: "linear_mipmap_linear"}
 _SRGB_SLOTS = ("base_color", "emissive")
 _MODE_NAMES = {0: "POINTS", 1: "LINES", 2: "LINE_LOOP", 3: "LINE_STRIP"}
 
@@ -332,13 +333,13 @@ class _Reader:
             raise fail(self.source, f"textures[{texture_index}]", f"samplers[{tex.sampler}] does not exist")
         s = samplers[tex.sampler]
         where = f"samplers[{tex.sampler}]"
-        for name, value, table in (("wrapS", s.wrapS, _WRAP), ("wrapT", s.wrapT, _WRAP)):
+        for name, value, table in (("wrapS", s.wrapS, SAMPLER_WRAP), ("wrapT", s.wrapT, SAMPLER_WRAP)):
             if value is not None and value not in table:
                 raise fail(self.source, where, f"{name} {value} is not a glTF wrap mode")
-        return Sampler(wrap_s=_WRAP.get(s.wrapS if s.wrapS is not None else 10497, "repeat"),
-                       wrap_t=_WRAP.get(s.wrapT if s.wrapT is not None else 10497, "repeat"),
-                       mag_filter=_MAG.get(s.magFilter, "linear"),
-                       min_filter=_MIN.get(s.minFilter, "linear_mipmap_linear"))
+        return Sampler(wrap_s=SAMPLER_WRAP.get(s.wrapS if s.wrapS is not None else 10497, "repeat"),
+                       wrap_t=SAMPLER_WRAP.get(s.wrapT if s.wrapT is not None else 10497, "repeat"),
+                       mag_filter=SAMPLER_MAG.get(s.magFilter, "linear"),
+                       min_filter=SAMPLER_MIN.get(s.minFilter, "linear_mipmap_linear"))
 
     def _texture_info(self, info, element: str) -> tuple[TextureInfo, int] | None:
         """A material's textureInfo: (TextureInfo without its image yet, image index)."""

@@ -20,34 +20,25 @@ from typing import Any, Callable
 
 from alight.core.material import DEFAULT_IOR, Material, f0_from_ior
 from alight.core.mesh import FileMaterial, Sampler, TextureInfo
+from alight.exchange.gltf import LAYER_TEXTURES, SAMPLER_MAG, SAMPLER_MIN, SAMPLER_WRAP
 from alight.exchange.gltf_material import EXT_SPECULAR, material_to_gltf
 
 EXT_TRANSFORM = "KHR_texture_transform"
 EXT_UNLIT = "KHR_materials_unlit"
-# FileMaterial slot -> where its textureInfo goes: (extension or None for the core, key).
+# FileMaterial slot -> where its textureInfo goes: (extension or None for the core, key); the
+# layers' from the reader's own table, so a slot the reader learns is written back too.
 SLOT_KEYS: dict[str, tuple[str | None, str]] = {
     "base_color": (None, "baseColorTexture"),
     "metallic_roughness": (None, "metallicRoughnessTexture"),
     "normal": (None, "normalTexture"),
     "emissive": (None, "emissiveTexture"),
     "occlusion": (None, "occlusionTexture"),
-    "clearcoat": ("KHR_materials_clearcoat", "clearcoatTexture"),
-    "clearcoat_roughness": ("KHR_materials_clearcoat", "clearcoatRoughnessTexture"),
-    "clearcoat_normal": ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
-    "sheen_color": ("KHR_materials_sheen", "sheenColorTexture"),
-    "sheen_roughness": ("KHR_materials_sheen", "sheenRoughnessTexture"),
-    "anisotropy": ("KHR_materials_anisotropy", "anisotropyTexture"),
-    "transmission": ("KHR_materials_transmission", "transmissionTexture"),
-    "thickness": ("KHR_materials_volume", "thicknessTexture"),
-    "iridescence": ("KHR_materials_iridescence", "iridescenceTexture"),
-    "iridescence_thickness": ("KHR_materials_iridescence", "iridescenceThicknessTexture"),
-    "specular": (EXT_SPECULAR, "specularTexture"),
-    "specular_color": (EXT_SPECULAR, "specularColorTexture"),
+    **LAYER_TEXTURES,
 }
-_WRAP = {"repeat": 10497, "clamp_to_edge": 33071, "mirrored_repeat": 33648}
-_MAG = {"nearest": 9728, "linear": 9729}
-_MIN = {"nearest": 9728, "linear": 9729, "nearest_mipmap_nearest": 9984, "linear_mipmap_nearest": 9985,
-        "nearest_mipmap_linear": 9986, "linear_mipmap_linear": 9987}
+# The sampler's codes: the reader's tables inverted.
+_WRAP = {name: code for code, name in SAMPLER_WRAP.items()}
+_MAG = {name: code for code, name in SAMPLER_MAG.items()}
+_MIN = {name: code for code, name in SAMPLER_MIN.items()}
 
 
 def gltf_sampler(s: Sampler) -> dict:
