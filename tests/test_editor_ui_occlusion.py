@@ -34,19 +34,25 @@ def test_occlusion_through_the_panel_and_the_view_equals_alight_render(display, 
             print(line)
     view = json.loads((tmp_path / "occlusion_view.json").read_text())
     w, h = view["size"]
-    out = tmp_path / "render.png"
     env = dict(os.environ, ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_CONFIG_DIR=str(tmp_path / "config"))
-    done = subprocess.run([sys.executable, "-m", "alight", "render", "--mesh", str(bowl), "--light", LIGHT,
-                           "--occlusion", "auto", "--size", f"{w}x{h}", "--orbit", str(view["orbit"]),
-                           "--elevation", str(view["elevation"]), "--distance", str(view["distance"]),
-                           "--fov", str(view["fov"]), "--target", ",".join(map(str, view["target"])),
-                           "--aa", "none", "--out", str(out)], env=env, capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
     import OpenImageIO as oiio
 
-    rendered = oiio.ImageBuf(str(out)).get_pixels(oiio.UINT8)[:, :, :3].astype(np.float64)
-    shown = oiio.ImageBuf(str(tmp_path / "occlusion_view.png")).get_pixels(oiio.UINT8)[:h, :w, :3].astype(np.float64)
-    off = oiio.ImageBuf(str(tmp_path / "occlusion_off.png")).get_pixels(oiio.UINT8)[:h, :w, :3].astype(np.float64)
+    def read(name: str) -> np.ndarray:
+        return oiio.ImageBuf(str(tmp_path / name)).get_pixels(oiio.UINT8)[:h, :w, :3].astype(np.float64)
+
+    def render(occlusion: str) -> np.ndarray:
+        """`alight render` of the bowl with the view's camera and size."""
+        out = f"render_{occlusion}.png"
+        done = subprocess.run([sys.executable, "-m", "alight", "render", "--mesh", str(bowl), "--light", LIGHT,
+                               "--occlusion", occlusion, "--size", f"{w}x{h}", "--orbit", str(view["orbit"]),
+                               "--elevation", str(view["elevation"]), "--distance", str(view["distance"]),
+                               "--fov", str(view["fov"]), "--target", ",".join(map(str, view["target"])),
+                               "--aa", "none", "--out", str(tmp_path / out)],
+                              env=env, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr[-3000:]
+        return read(out)
+
+    rendered, shown, off = render("auto"), read("occlusion_view.png"), read("occlusion_off.png")
     diff = np.abs(shown - rendered)
     print(f"EDITOR_VS_RENDER mean={diff.mean():.4f} max={diff.max():.0f} over2={(diff.max(axis=2) > 2).mean():.5f}; "
           f"off vs render mean={np.abs(off - rendered).mean():.4f}")
@@ -55,15 +61,7 @@ def test_occlusion_through_the_panel_and_the_view_equals_alight_render(display, 
     assert diff.max() <= 1.0, (diff.mean(), diff.max(), (diff.max(axis=2) > 1).mean())
     assert np.abs(off - rendered).mean() > 5 * diff.mean() + 0.5
     # The combo's gtao (the last check, same camera) against `alight render --occlusion gtao`.
-    out = tmp_path / "render_gtao.png"
-    done = subprocess.run([sys.executable, "-m", "alight", "render", "--mesh", str(bowl), "--light", LIGHT,
-                           "--occlusion", "gtao", "--size", f"{w}x{h}", "--orbit", str(view["orbit"]),
-                           "--elevation", str(view["elevation"]), "--distance", str(view["distance"]),
-                           "--fov", str(view["fov"]), "--target", ",".join(map(str, view["target"])),
-                           "--aa", "none", "--out", str(out)], env=env, capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    gtao_rendered = oiio.ImageBuf(str(out)).get_pixels(oiio.UINT8)[:, :, :3].astype(np.float64)
-    gtao_shown = oiio.ImageBuf(str(tmp_path / "occlusion_gtao.png")).get_pixels(oiio.UINT8)[:h, :w, :3].astype(np.float64)
+    gtao_rendered, gtao_shown = render("gtao"), read("occlusion_gtao.png")
     gdiff = np.abs(gtao_shown - gtao_rendered)
     print(f"EDITOR_VS_RENDER_GTAO mean={gdiff.mean():.4f} max={gdiff.max():.0f}; "
           f"off vs gtao render mean={np.abs(off - gtao_rendered).mean():.4f}")
