@@ -145,5 +145,14 @@ def test_gtao_draws_at_once_without_a_bake(ctx):
     assert win.state.occlusion == "gtao" and win.state.scene(win.orbit.camera()).occlusion == "gtao"
     until_seconds(ctx, lambda: _settled(win), BAKE_LIMIT_S)
     assert win.occlusion_bake.jobs == jobs and not win.occlusion_bake.status   # screen space: nothing baked
+    # The still view is drawn again until GTAO's passes are in (alight.core.gtao.TEMPORAL_FRAMES),
+    # with no input: then the frames stop refining and search nothing.
+    from alight.core import gtao
+
+    until_seconds(ctx, lambda: not win.renderer.refining(), 120.0)
+    assert win.renderer.screen_ao.passes == gtao.TEMPORAL_FRAMES
+    redraws = win.redraws
+    ctx.yield_(5)
+    assert win.redraws == redraws and win.renderer.screen_ao.passes == gtao.TEMPORAL_FRAMES   # refined: a still view
     shown = _shown_view(ctx, win, "occlusion_gtao.png")
     assert shown.std() > 5.0

@@ -24,6 +24,14 @@ STEPS = 8           # GTAO_STEPS: depth samples per side of a slice
 RADIUS_FRACTION = 1.0    # the search radius in world units, as a share of the mesh's bounding-box diagonal (the bake reaches the whole mesh; 0.25: corner 15.9%, bowl 22.4% under royal_esplanade, 1.0: 13.8, 17.0%)
 MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS_HEIGHT of the draw height where more
 MAX_RADIUS_HEIGHT = 0.2  # (the editor's 720 rows: 144 px; the samples stay GTAO_STEPS, spread wider)
+# More rotations than the 4x4 pattern's 16, over passes (the paper's temporal accumulation, its
+# section 6: 6 rotations x 16 spatial offsets): each pass turns the pattern by a further fraction of
+# its step and the estimate is the passes' mean. `alight render` takes STILL_FRAMES passes in one
+# frame (2 left faint lines on the corner's walls at 860x720, 4 none); a still view in the editor
+# refines over TEMPORAL_FRAMES frames, then costs no search at all, and rests at the same picture
+# as `alight render` of its camera. benchmarks/bench_gtao_temporal.py measures both.
+STILL_FRAMES = 4
+TEMPORAL_FRAMES = STILL_FRAMES
 
 
 def inner_integral(h, gamma):
@@ -125,3 +133,16 @@ def bent_normal(n, occluded_sum):
     b = 2.0 / 3.0 * n - np.asarray(occluded_sum, np.float64)
     d = float(np.dot(b, n))
     return b / np.linalg.norm(b) if d > 1e-6 else n
+
+
+def rotation_offset(k: int, passes: int) -> tuple[float, float]:
+    """Pass ``k`` of ``passes``' turn of the 4x4 pattern: (added to the slice angle, in units of
+    pi / SLICES; added to the step jitter), render/gtao.frag's ``u_rotation_offset``. The angles
+    fill the pattern's step of 1/16 evenly in bit-reversed order, so that any first few passes
+    are spread over it; the jitter follows the golden ratio's sequence."""
+    if passes <= 1:
+        return 0.0, 0.0
+    bits = max(int(passes - 1).bit_length(), 1)
+    reversed_k = int(format(k % (1 << bits), f"0{bits}b")[::-1], 2)
+    return reversed_k / float(1 << bits) / 16.0, (k * 0.6180339887) % 1.0
+

@@ -37,13 +37,14 @@ UNIT_STRETCHED_LOBE_A, UNIT_STRETCHED_LOBE_B = UNIT_SCENE_BEHIND + 3, UNIT_SCENE
 UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH = UNIT_SCENE_BEHIND + 5, UNIT_SCENE_BEHIND + 6
 UNIT_VISIBILITY = UNIT_SCENE_BEHIND + 7   # the visibility buffer (alight.render.vbuffer)
 # Screen-space GTAO (alight.render.screen_ao): the visibility the forward pass reads, and the unit
-# its own passes read the depth and the raw visibility from.
+# its own passes read the depth and the raw visibility from, and the earlier passes' mean.
 UNIT_SCREEN_AO, UNIT_SCREEN_AO_WORK = UNIT_SCENE_BEHIND + 8, UNIT_SCENE_BEHIND + 9
+UNIT_SCREEN_AO_HISTORY = UNIT_SCREEN_AO_WORK + 1
 # moderngl binds every texture it creates or writes on ctx.default_texture_unit (its scratch unit,
 # by default the last fragment unit: 31 here, which was UNIT_STRETCHED_LOBE_A: a clearcoat map
 # uploaded at its first draw replaced the lobe table). ForwardRenderer moves it past every unit above
 # (GL 4.5 guarantees 80 combined units).
-UNIT_SCRATCH = UNIT_SCREEN_AO_WORK + 1
+UNIT_SCRATCH = UNIT_SCREEN_AO_HISTORY + 1
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {

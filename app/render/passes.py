@@ -83,6 +83,7 @@ class FrameContext:
     maps: IBLMaps | None = None                 # the environment drawn (the bake's visible sky weight)
     screen_ao: bool = False                     # the opaque parts read screen-space GTAO (alight.render.screen_ao)
     ao_pixel_scale: float = 0.0                 # pixels per world unit at clip w = 1, at the draw size
+    still: bool = False                         # a still image (render_strips): GTAO takes all its passes now
 
 
 # --- a frame: the passes for each anti-aliasing mode, tile by tile -------------------------
@@ -103,13 +104,13 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
             view = None if plan.single else View(width, height, tile_matrix(plan, t), tile_origin(plan, t))
             # Only the images that are read are made.
             if aa == "msaa" and not blending:
-                frame = draw_scene(r, scene, maps, targets, targets.draw, view=view, background=False)
+                frame = draw_scene(r, scene, maps, targets, targets.draw, view=view, background=False, still=True)
                 resolve(r, frame, scene, maps, targets, read_linear, read_srgb)
             elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe" \
                     and not scene.ground:   # (the ground darkens radiance: it blends before the tone map)
-                draw_scene(r, scene, maps, targets, targets.display_draw(), scene.display, view=view)
+                draw_scene(r, scene, maps, targets, targets.display_draw(), scene.display, view=view, still=True)
             else:
-                draw_scene(r, scene, maps, targets, targets.draw, view=view)
+                draw_scene(r, scene, maps, targets, targets.draw, view=view, still=True)
                 if read_srgb:
                     tonemap(r, targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
             shading.append((r.last_vbuffer, r.last_mesh_shading_reason))
@@ -150,12 +151,13 @@ def note_mesh_shading(r, shading: list[tuple[bool, str]]) -> None:
 
 def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.Framebuffer,
                display: Display | None = None, view: View | None = None, background: bool = True,
-               srgb_by_framebuffer: bool = False) -> FrameContext:
+               srgb_by_framebuffer: bool = False, still: bool = False) -> FrameContext:
     """One scene pass into ``fbo`` (at the targets' draw size): the surfaces, and with
     ``background`` the background, the ground and the blended parts; ``display``: written tone
-    mapped (DISPLAY_OUTPUT). Returns what it decided, for the resolve."""
+    mapped (DISPLAY_OUTPUT); ``still``: a still image, not a frame of a view that may stay
+    (FrameContext.still). Returns what it decided, for the resolve."""
     ctx = r.ctx
-    frame = FrameContext(display=display, srgb_by_framebuffer=srgb_by_framebuffer,
+    frame = FrameContext(display=display, srgb_by_framebuffer=srgb_by_framebuffer, still=still,
                          half_output=targets.half and fbo is targets.draw,
                          image_size=(targets.width, targets.height), sun_directions=sun_world_directions(scene, maps),
                          maps=maps)
@@ -452,7 +454,8 @@ def screen_ao_program(r, frame: FrameContext, scene, camera: Camera, view_projec
     hi = np.max([g.hi for g, _ in items], axis=0) if items else np.zeros(3)
     radius = r.screen_ao.radius_fraction * float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)))
     r.screen_ao.draw(r, [g for g, _ in items], [p for _, p in items], (viewport[2], viewport[3]), view_projection,
-                     frame.inverse_vp, camera, frame.ao_pixel_scale, max(radius, 1e-6))
+                     frame.inverse_vp, camera, frame.ao_pixel_scale, max(radius, 1e-6),
+                     keep=getattr(r, "screen_ao_temporal", False) and not frame.still)
     fbo.use()
     r.ctx.viewport = viewport
     r.ctx.enable(moderngl.DEPTH_TEST)

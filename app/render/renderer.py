@@ -116,6 +116,9 @@ class ForwardRenderer:
         # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.visibility_parts).
         self.visibility_parts = OcclusionParts(self.ctx, self.bake_cache)
         self.screen_ao = None     # alight.render.screen_ao.ScreenAO, made by the first frame with --occlusion gtao
+        # draw_hdr/draw_display refine screen-space GTAO over frames of an unchanged view (the
+        # editor; ``refining`` says whether another frame would), where a still takes its passes at once.
+        self.screen_ao_temporal = False
         self.last_occlusion_reason = ""   # "gtao ..." where the last scene pass drew screen-space GTAO
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self.ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
@@ -379,6 +382,11 @@ class ForwardRenderer:
             if srgb:
                 self.ctx.disable_direct(GL_FRAMEBUFFER_SRGB)
         return into or targets.display_fbo
+
+    def refining(self) -> bool:
+        """Whether drawing the last frame's view again would refine it: screen-space GTAO's passes
+        not all taken yet (``screen_ao_temporal``). An interactive loop draws until it is false."""
+        return self.screen_ao is not None and self.screen_ao.refining and self.last_occlusion_reason.startswith("gtao")
 
     def draw_mesh_parts(self, scene: Scene, prog, camera: Camera, view_projection: np.ndarray,
                         blend: bool | None = None, parts: list[int] | None = None,

@@ -6,6 +6,10 @@ shading pass read the result at gl_FragCoord (HAS_SCREEN_AO, common/occlusion.gl
 
 Per frame and tile, so it follows a moving view with no bake; an occluder outside the tile or
 behind the first surface is not seen (docs/explanation/occlusion.md, "Screen-space GTAO").
+More rotations than the 4x4 pattern holds come from passes averaged (alight.core.gtao.rotation_offset):
+a still image takes STILL_FRAMES in one draw; with ``keep`` (the editor's view) each frame of an
+unchanged view adds one, up to TEMPORAL_FRAMES, after which the frame reuses the mean and searches
+nothing.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ import moderngl
 import numpy as np
 
 from alight.core import gtao
-from alight.render.bindings import UNIT_SCREEN_AO, UNIT_SCREEN_AO_WORK
+from alight.render.bindings import UNIT_SCREEN_AO, UNIT_SCREEN_AO_HISTORY, UNIT_SCREEN_AO_WORK
 
 
 @dataclass
@@ -30,12 +34,12 @@ class ScreenAOTargets:
     depth_fbo: moderngl.Framebuffer
     raw: moderngl.Texture
     raw_fbo: moderngl.Framebuffer
-    visibility: moderngl.Texture
-    visibility_fbo: moderngl.Framebuffer
+    visibility: list          # two textures: the passes' mean so far and the next one (ping-pong)
+    visibility_fbo: list
 
     def release(self) -> None:
-        for x in (self.depth_fbo, self.raw_fbo, self.visibility_fbo, self.depth, self.positions, self.raw,
-                  self.visibility):
+        for x in (self.depth_fbo, self.raw_fbo, *self.visibility_fbo, self.depth, self.positions, self.raw,
+                  *self.visibility):
             x.release()
 
 
@@ -63,6 +67,10 @@ class ScreenAO:
         self.targets: ScreenAOTargets | None = None
         self.occluded = "occluders"  # OCCLUDED_LIGHT (the benchmarks compare them)
         self.radius_fraction = gtao.RADIUS_FRACTION
+        self.passes = 0          # passes in the mean that visibility[latest] holds
+        self.latest = 0
+        self._keys = (None, None)   # the last two kept views' keys (the latest first)
+        self.refining = False    # the last draw kept its view and another frame would add a pass
 
     def _targets(self, size: tuple[int, int]) -> ScreenAOTargets:
         t = self.targets
@@ -75,25 +83,68 @@ class ScreenAO:
             positions = self.ctx.texture(size, 4, dtype="f4")
             # (the occluded directions' sum in xyz, V in w: render/gtao.frag)
             raw = self.ctx.texture(size, 4, dtype="f4")
-            visibility = self.ctx.texture(size, 4, dtype="f4")
-            for tex in (raw, visibility):
+            visibility = [self.ctx.texture(size, 4, dtype="f4") for _ in range(2)]
+            for tex in (raw, *visibility):
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             positions.filter = (moderngl.LINEAR, moderngl.LINEAR)    # (the samples: gtao.frag)
             positions.repeat_x = positions.repeat_y = False
             self.targets = t = ScreenAOTargets(
                 size, depth, positions, self.ctx.framebuffer(color_attachments=[positions], depth_attachment=depth), raw,
                 self.ctx.framebuffer(color_attachments=[raw]), visibility,
-                self.ctx.framebuffer(color_attachments=[visibility]))
+                [self.ctx.framebuffer(color_attachments=[v]) for v in visibility])
+            self.passes = 0
         return t
 
     def draw(self, r, gpu_parts, parts, size: tuple[int, int], view_projection: np.ndarray,
-             inverse_vp: np.ndarray, camera, pixel_scale: float, radius: float) -> moderngl.Texture:
+             inverse_vp: np.ndarray, camera, pixel_scale: float, radius: float, keep: bool = False) -> moderngl.Texture:
         """The denoised visibility of the opaque ``gpu_parts`` (with their MeshParts ``parts``)
         seen through ``view_projection`` at ``size`` (the draw size); returns its texture. Leaves
-        the framebuffer binding and viewport to the caller."""
+        the framebuffer binding and viewport to the caller.
+
+        ``keep`` false: the mean of gtao.STILL_FRAMES passes, nothing kept for the next call (the
+        same picture every time). True: one more pass into the mean kept from the last call where
+        the view (size, matrices, camera, radius and parts) is the same, up to
+        gtao.TEMPORAL_FRAMES, then none; else a new mean of one pass. ``refining`` then says
+        whether another call would add one (false also where the views alternate, A B A: the
+        editor's split view, which would otherwise never settle)."""
         ctx = self.ctx
         t = self._targets(size)
+        key = None
+        if keep:
+            key = (size, np.asarray(view_projection, np.float32).tobytes(), np.asarray(inverse_vp, np.float32).tobytes(),
+                   tuple(float(x) for x in camera.position), float(radius), float(pixel_scale),
+                   tuple(id(g) for g in gpu_parts))
+            alternating = key == self._keys[1] and key != self._keys[0]
+            continued = key == self._keys[0] and self.passes > 0
+            self._keys = (key, self._keys[0])
+            if not continued:
+                self.passes = 0
+            passes, total = (0 if self.passes >= gtao.TEMPORAL_FRAMES else 1), gtao.TEMPORAL_FRAMES
+            self.refining = self.passes + passes < total and not alternating
+        else:
+            self._keys = (None, None)
+            self.passes, continued = 0, False
+            passes = total = gtao.STILL_FRAMES
+            self.refining = False
+        if passes == 0:
+            t.visibility[self.latest].use(UNIT_SCREEN_AO)
+            return t.visibility[self.latest]
         ctx.viewport = (0, 0, size[0], size[1])
+        if not continued:
+            self._positions(r, t, gpu_parts, parts, view_projection)
+        for _ in range(passes):
+            self._pass(r, t, view_projection, inverse_vp, camera, pixel_scale, radius, total)
+        t.visibility[self.latest].use(UNIT_SCREEN_AO)    # what the forward pass reads (u_screen_ao)
+        return t.visibility[self.latest]
+
+    @property
+    def visibility(self) -> moderngl.Texture | None:
+        """The last draw's visibility (the passes' mean): occluded directions' sum in xyz, V in w."""
+        return None if self.targets is None else self.targets.visibility[self.latest]
+
+    def _positions(self, r, t: ScreenAOTargets, gpu_parts, parts, view_projection) -> None:
+        """The prepass: the opaque parts' world positions at each pixel."""
+        ctx = self.ctx
         t.depth_fbo.use()
         t.depth_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -107,6 +158,12 @@ class ScreenAO:
             gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
         ctx.disable(moderngl.CULL_FACE)
         ctx.disable(moderngl.DEPTH_TEST)
+
+    def _pass(self, r, t: ScreenAOTargets, view_projection, inverse_vp, camera, pixel_scale: float,
+              radius: float, total: int) -> None:
+        """One turn of the pattern (pass ``self.passes`` of ``total``) searched, denoised and
+        averaged into the mean so far."""
+        k = self.passes
         vp = np.ascontiguousarray(view_projection, np.float32).tobytes()
         ivp = np.ascontiguousarray(inverse_vp, np.float32).tobytes()
         search = r.program("render/fullscreen.vert", "render/gtao.frag",
@@ -118,7 +175,8 @@ class ScreenAO:
         search["u_camera_position"] = tuple(float(x) for x in camera.position)
         search["u_radius"] = float(radius)
         search["u_pixel_scale"] = float(pixel_scale)
-        search["u_max_radius_px"] = max(float(gtao.MAX_RADIUS_PX), gtao.MAX_RADIUS_HEIGHT * size[1])
+        search["u_max_radius_px"] = max(float(gtao.MAX_RADIUS_PX), gtao.MAX_RADIUS_HEIGHT * t.size[1])
+        search["u_rotation_offset"] = gtao.rotation_offset(k, total)
         t.raw_fbo.use()
         r.fullscreen(search)
         denoise = r.program("render/fullscreen.vert", "render/gtao_denoise.frag")
@@ -126,10 +184,14 @@ class ScreenAO:
         denoise["u_raw"] = UNIT_SCREEN_AO
         denoise["u_positions"] = UNIT_SCREEN_AO_WORK
         denoise["u_camera_position"] = tuple(float(x) for x in camera.position)
-        t.visibility_fbo.use()
+        history = self.latest
+        t.visibility[history].use(UNIT_SCREEN_AO_HISTORY)
+        denoise["u_history"] = UNIT_SCREEN_AO_HISTORY
+        denoise["u_history_weight"] = k / (k + 1.0)
+        self.latest = 1 - history
+        t.visibility_fbo[self.latest].use()
         r.fullscreen(denoise)
-        t.visibility.use(UNIT_SCREEN_AO)    # what the forward pass reads (u_screen_ao)
-        return t.visibility
+        self.passes = k + 1
 
     def release(self) -> None:
         if self.targets is not None:

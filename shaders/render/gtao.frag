@@ -2,7 +2,8 @@
 // Screen-space ground-truth ambient occlusion (app/render/screen_ao.py): per pixel the
 // cosine-weighted visibility and the occluded directions' sum from the opaque parts' positions
 // (GTAO_SLICES slice directions, GTAO_STEPS samples a side, horizons within u_radius world
-// units), the slices turned by a 4x4 pattern that render/gtao_denoise.frag averages out.
+// units), the slices turned by a 4x4 pattern that render/gtao_denoise.frag averages out, and
+// the whole pattern by u_rotation_offset from pass to pass (alight.core.gtao.rotation_offset).
 // Jimenez et al. 2016, Algorithm 1, in world space.
 #include "common/gtao.glsl"
 
@@ -13,6 +14,7 @@ uniform mat4 u_view_projection;
 uniform float u_radius;          // world units
 uniform float u_pixel_scale;     // pixels per world unit at clip w = 1 (half the image's height times P[1][1])
 uniform float u_max_radius_px;
+uniform vec2 u_rotation_offset;  // this pass's turn of the pattern: slice angle (x pi / GTAO_SLICES), step jitter
 
 layout(location = 0) out vec4 out_visibility;   // the occluded directions' cosine-weighted sum (world), V
 
@@ -100,6 +102,7 @@ void main() {
     // corner's back wall in the editor at 1280x720).
     float radius = radius_px * max(clip.w, 1e-6) / u_pixel_scale;
     vec2 noise = pattern_noise(p);
+    noise = vec2(noise.x + u_rotation_offset.x, fract(noise.y + u_rotation_offset.y));
     vec2 origin = vec2(p) + 0.5;
     float visibility = 0.0;
     vec3 occluded = vec3(0.0);

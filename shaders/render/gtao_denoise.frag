@@ -1,8 +1,12 @@
 #version 450 core
 // GTAO's spatial denoise (app/render/screen_ao.py): the mean over the 4x4 block that holds each
 // of render/gtao.frag's 16 rotations once, of the pixels on the same surface (distance to the eye
-// within 5% of this one's), so edges stay sharp (the paper's 4x4 bilateral filter).
+// within 5% of this one's), so edges stay sharp (the paper's 4x4 bilateral filter); then the
+// running mean with the earlier passes of the same view (u_history, weight n / (n + 1) after n),
+// the paper's temporal accumulation for a view that does not move.
 uniform sampler2D u_raw;         // gtao.frag's visibility
+uniform sampler2D u_history;     // the mean of the earlier passes (any texture when the weight is 0)
+uniform float u_history_weight;
 uniform sampler2D u_positions;   // the prepass's world positions (w = 1 where a surface is)
 uniform vec3 u_camera_position;
 
@@ -30,4 +34,6 @@ void main() {
     }
     out_visibility = weight > 0.0 ? sum / weight : texelFetch(u_raw, p, 0);
     out_visibility.w = clamp(out_visibility.w, 0.0, 1.0);
+    if (u_history_weight > 0.0)
+        out_visibility = mix(out_visibility, texelFetch(u_history, p, 0), u_history_weight);
 }

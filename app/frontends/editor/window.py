@@ -85,6 +85,7 @@ class EditorWindow:
             self._open_window(glfw, size, title)
         self.ctx = moderngl.create_context(require=450)
         self.renderer = ForwardRenderer(self.ctx)
+        self.renderer.screen_ao_temporal = True   # GTAO refines over the frames of a still view
         # A session that visits environment after environment would keep every bake on the GPU:
         # the last few stay (the one shown and a step or two back), older ones reload from the
         # disk cache. The window holds no maps older than the one shown.
@@ -687,10 +688,17 @@ class EditorWindow:
         direct = False     # drawn into the window (the renderer may not: draw_display)
         if self.variant_warmup.step():   # a new variant compiled in the warm-up process: draw it now
             self._drawn_key = None
-        if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets:
+        # A still view is drawn again while the renderer refines it (screen-space GTAO's passes);
+        # a screenshot is a still, with all its passes at once (ForwardRenderer.screen_ao_temporal).
+        refining = not full and self.renderer.refining()
+        if force or into is not None or key != self._drawn_key or targets is not self._drawn_targets or refining:
             try:   # the scene tone mapped as it is drawn: one pass into the 8-bit view
                 # (a variant not compiled yet: the last picture's scene meanwhile, variant_warmup.py)
-                drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
+                self.renderer.screen_ao_temporal = not full
+                try:
+                    drawn_into, _complete = draw_view(self, scene, maps, targets, into, into_srgb, gated=not full)
+                finally:
+                    self.renderer.screen_ao_temporal = True
                 direct = into is not None and drawn_into is into
             except ShaderCompileError as exc:   # a program first compiled now (a debug view)
                 self.state.fail(exc)
@@ -1001,9 +1009,11 @@ class EditorWindow:
         return False
 
     def _needs_full_rate(self) -> bool:
-        """Input waiting, the camera moving, or a job that advances a slice a frame."""
+        """Input waiting, the camera moving, a job that advances a slice a frame, or a view that
+        another frame refines (screen-space GTAO's passes, ForwardRenderer.refining)."""
         return bool(self.key_events.pending or len(self.imgui.get_current_context().input_events_queue)
                     or self._was_moving or self._bake_job is not None or self.screenshot_job is not None
+                    or self.renderer.refining()
                     or self.screenshot_request or self.turntable_job is not None or self.turntable_request
                     or (self.imgui.is_any_item_active() and not self.imgui.get_io().want_text_input))
 
