@@ -233,3 +233,50 @@ def test_the_presets_readme_names_every_layer_field():
     text = (REPO / "presets" / "README.md").read_text(encoding="utf-8")
     row = next(line for line in text.splitlines() if line.startswith("| the layers' fields"))
     assert set(re.findall(r"`(\w+)`", row)) == set(LAYER_FIELDS)
+
+
+def layout_block() -> dict[str, str]:
+    """docs/development.md's layout block, the app/ tree: each entry's path under app/ (as
+    "core/layers/", "core/gpu.py") -> its line. An entry is a line indented by two spaces per
+    level, its first word the name; deeper-indented lines continue the one above."""
+    text = (REPO / "docs" / "development.md").read_text(encoding="utf-8")
+    block = text[text.index("```\napp/ ") + 4:]
+    block = block[:block.index("```")]
+    entries: dict[str, str] = {}
+    stack: list[str] = []                       # the folders open at each depth
+    for line in block.splitlines():
+        indent = len(line) - len(line.lstrip(" "))
+        if not line.strip() or indent >= 24:    # a continuation of the line above
+            continue
+        if indent == 0 and stack and line.split()[0] != "app/":
+            break                               # shaders/, presets/, ...: outside the package
+        depth, name = indent // 2, line.split()[0]
+        if indent == 0:
+            stack = []
+            continue
+        stack = stack[:depth - 1]
+        entries["".join(stack) + name] = line
+        if name.endswith("/"):
+            stack.append(name)
+    return entries
+
+
+def test_the_layout_names_every_module():
+    """A newcomer found 26 modules missing from the layout block: a module added without a line
+    there fails this, and so does a line whose module is gone."""
+    app = REPO / "app"
+    on_disk = set()
+    for path in app.rglob("*"):
+        rel = path.relative_to(app).as_posix()
+        if "__pycache__" in rel:
+            continue
+        if path.is_dir():
+            on_disk.add(rel + "/")
+        elif path.suffix == ".py" and path.name not in ("__init__.py", "__main__.py"):
+            on_disk.add(rel)
+    listed = layout_block()
+    assert "core/layers/stack.py" in listed and "frontends/editor/" in listed     # the parser works
+    missing = sorted(on_disk - set(listed))
+    gone = sorted(name for name in listed if not (app / name).exists())
+    assert not missing, f"docs/development.md's layout has no line for {missing}"
+    assert not gone, f"docs/development.md's layout names what app/ does not hold: {gone}"
