@@ -193,7 +193,7 @@ def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:
                    help="diffuse irradiance by the lecture's hemisphere convolution or by 9 spherical "
                         "harmonics (default: the quality's choice)")
     g.add_argument("--ibl", choices=tuple(IBL_MODELS), default=DEFAULT_IBL_MODEL,
-                   help="IBL shading model (app/core/ibl_models.py): 'lecture' is the seed lecture's split sum "
+                   help="IBL shading model (app/core/ibl_models.py): 'lecture' is the lecture's split sum "
                         f"(default: {DEFAULT_IBL_MODEL})")
     g.add_argument("--multiple-scattering", action="store_true",
                    help="add the energy that single scattering loses on rough surfaces (Fdez-Aguera 2019): "
