@@ -36,6 +36,7 @@ def relative(a, b) -> float:
     return float(np.abs(a - b).sum() / np.abs(b).sum())
 
 
+@functools.lru_cache(maxsize=None)
 def term_indices(shader: str = "accuracy/evaluate_terms.comp") -> dict[str, int]:
     """An evaluator's term names and indices, read from its ``const int TERM_<NAME> = <i>;``
     lines, so the tests' names cannot drift from the shader's switch."""
