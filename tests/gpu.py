@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import re
 
 import numpy as np
 
@@ -35,11 +36,18 @@ def relative(a, b) -> float:
     return float(np.abs(a - b).sum() / np.abs(b).sum())
 
 
-TERMS = {name: i for i, name in enumerate([
-    "D_GGX", "G1", "G_SMITH", "F_SCHLICK", "F_SCHLICK_ROUGHNESS", "DIRECTION_TO_EQUIRECT",
-    "EQUIRECT_TO_DIRECTION", "ROTATE_WORLD_TO_MAP", "HAMMERSLEY", "IMPORTANCE_SAMPLE_GGX", "ACES",
-    "NEUTRAL", "SRGB", "K", "GRID_STEP", "CUBE_TEXEL_DIRECTION", "PUNCTUAL", "SPOT_RANGE", "SPHERE_SURFACE", "SPHERE_UV",
-    "F_SCHLICK_F90"])}
+@functools.lru_cache(maxsize=None)
+def term_indices(shader: str = "accuracy/evaluate_terms.comp") -> dict[str, int]:
+    """An evaluator's term names and indices, read from its ``const int TERM_<NAME> = <i>;``
+    lines, so the tests' names cannot drift from the shader's switch."""
+    from alight.paths import shader_dir
+    text = (shader_dir() / shader).read_text(encoding="utf-8")
+    found = {name: int(i) for name, i in re.findall(r"^const int TERM_(\w+) = (\d+);", text, re.M)}
+    assert found, f"{shader} declares no TERM_ constants"
+    return found
+
+
+TERMS = term_indices()
 
 
 def evaluate(term: str | int, inputs: np.ndarray, uniforms: dict | None = None,
@@ -60,7 +68,7 @@ def evaluate(term: str | int, inputs: np.ndarray, uniforms: dict | None = None,
     src.bind_to_storage_buffer(0)
     dst.bind_to_storage_buffer(1)
     prog["u_count"] = len(rows)
-    prog["u_term"] = TERMS[term] if isinstance(term, str) else int(term)
+    prog["u_term"] = term_indices(shader)[term] if isinstance(term, str) else int(term)
     for name, value in (uniforms or {}).items():
         if name in prog:
             prog[name] = value

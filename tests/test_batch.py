@@ -134,7 +134,7 @@ def test_bad_specs_are_one_line_errors(folder, text, problem):
     ('materials = [{name = "set", texture_set = "no_folder"}]', "materials[0]: "),
     ('meshes = ["sphere", "nosuch.glb"]', "meshes[1]: "),
     ('environments = ["studio", "nosuch.hdr"]', "environments[1]: "),
-    ('materials = ["gold", "goldd"]', "materials[1]: 'goldd' is neither a preset (aluminium, "),
+    ('materials = ["gold", "goldd"]', "materials[1]: 'goldd' is neither a preset nor a file (did you mean gold?) (presets: aluminium, "),
 ])
 def test_a_missing_input_stops_the_plan(folder, line, where):
     """A new user ran the batch guide's example, whose water.gltf is not shipped: every item that

@@ -325,6 +325,16 @@ def test_edit_help_names_every_script_field():
         assert re.search(rf"\b{name}\b", text), name
 
 
+def test_a_misspelt_preset_names_the_closest(tmp_path):
+    """A newcomer typed --preset gld: the error listed all sixteen presets and left the match to
+    them. The one line now names the closest preset first."""
+    out = tmp_path / "x.png"
+    proc = run("render", "--preset", "gld", "--size", "8", "--out", str(out))
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "gld: no preset or file of that name (did you mean gold?)" in proc.stderr, proc.stderr
+    assert not out.exists()
+
+
 def test_presets_lists_all_ten():
     proc = run("presets")
     assert proc.returncode == 0, proc.stderr

@@ -148,3 +148,145 @@ def test_the_accuracy_pages_worked_example_prints_what_it_says(tmp_path):
         printed = run.stdout
     got = float(re.search(r"relMAE ([0-9.]+)%", printed).group(1))
     assert abs(got - quoted) < 0.05, f"the page quotes {quoted}%, the commands print {got}%"
+
+
+# The prose that names Python objects by their dotted path: the pages above, every folder's
+# README, and pyproject.toml's comments.
+DOTTED_SOURCES = sorted({*PAGES, *REPO.glob("*/README.md")})
+DOTTED = re.compile(r"\balight(?:\.\w+)+")
+
+
+def _dotted_names() -> dict[str, set[str]]:
+    """Each dotted alight name (alight.exchange.presets.load_preset) -> the files naming it."""
+    found: dict[str, set[str]] = {}
+    texts = [(p.relative_to(REPO).as_posix(), p.read_text(encoding="utf-8")) for p in DOTTED_SOURCES]
+    comments = [line for line in (REPO / "pyproject.toml").read_text(encoding="utf-8").splitlines()
+                if line.lstrip().startswith("#")]
+    texts.append(("pyproject.toml", "\n".join(comments)))
+    for where, text in texts:
+        for name in DOTTED.findall(text):
+            found.setdefault(name, set()).add(where)
+    return found
+
+
+def _resolves(name: str) -> bool:
+    """Whether a dotted name imports: the longest importable module, then attributes."""
+    import importlib
+    parts = name.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        for attr in parts[i:]:
+            if not hasattr(obj, attr):
+                return False
+            obj = getattr(obj, attr)
+        return True
+    return False
+
+
+def test_every_dotted_name_in_the_docs_imports():
+    """A newcomer grepped for alight.core.material.load_preset (presets/README.md) and
+    alight.ibl.environment.box_reduce; both had moved. Every alight.x.y the docs, the READMEs and
+    pyproject.toml's comments name must import."""
+    names = _dotted_names()
+    assert "alight.exchange.presets.load_preset" in names      # the check sees what it should
+    assert not _resolves("alight.core.material.load_preset")
+    stale = {name: sorted(where) for name, where in names.items() if not _resolves(name)}
+    assert not stale, f"dotted names that do not import: {stale}"
+
+
+def _nav_pages(nav) -> set[str]:
+    """Every page file in mkdocs.yml's nav (nested sections included)."""
+    if isinstance(nav, str):
+        return {nav}
+    if isinstance(nav, dict):
+        return {page for value in nav.values() for page in _nav_pages(value)}
+    return {page for item in nav for page in _nav_pages(item)}
+
+
+def test_the_home_page_links_every_page_of_the_nav():
+    """docs/index.md sorts the pages by reader (Use it / Understand it / Look it up / Change it);
+    a newcomer found 17 of 33 pages missing from it. Every page in the nav is linked from it."""
+    import yaml
+    text = (REPO / "mkdocs.yml").read_text(encoding="utf-8")
+    nav = yaml.safe_load(text[text.index("\nnav:"):])["nav"]
+    pages = _nav_pages(nav) - {"index.md"}
+    linked = {target.split("#")[0] for target in LINK.findall((REPO / "docs" / "index.md").read_text(encoding="utf-8"))}
+    assert pages - linked == set(), "docs/index.md does not link: " + ", ".join(sorted(pages - linked))
+
+
+def test_the_pages_that_list_the_layers_name_every_layer():
+    """The front page, the home page and the layers guide list the glTF layers; each listed only
+    the first five after iridescence, dispersion and diffuse transmission came."""
+    from alight.core.material import LAYERS
+    for page in ("README.md", "docs/index.md", "docs/guides/material-layers.md"):
+        text = " ".join((REPO / page).read_text(encoding="utf-8").split())
+        missing = [layer for layer in LAYERS if layer.replace("_", " ") not in text and f"_{layer}" not in text]
+        assert not missing, f"{page} does not name the layers {missing}"
+
+
+def test_the_presets_readme_names_every_layer_field():
+    """presets/README.md's field table lists the layers' fields a preset file may carry."""
+    from alight.core.material import LAYER_FIELDS
+    text = (REPO / "presets" / "README.md").read_text(encoding="utf-8")
+    row = next(line for line in text.splitlines() if line.startswith("| the layers' fields"))
+    assert set(re.findall(r"`(\w+)`", row)) == set(LAYER_FIELDS)
+
+
+def layout_block() -> dict[str, str]:
+    """docs/development.md's layout block, the app/ tree: each entry's path under app/ (as
+    "core/layers/", "core/gpu.py") -> its line. An entry is a line indented by two spaces per
+    level, its first word the name; deeper-indented lines continue the one above."""
+    text = (REPO / "docs" / "development.md").read_text(encoding="utf-8")
+    block = text[text.index("```\napp/ ") + 4:]
+    block = block[:block.index("```")]
+    entries: dict[str, str] = {}
+    stack: list[str] = []                       # the folders open at each depth
+    for line in block.splitlines():
+        indent = len(line) - len(line.lstrip(" "))
+        if not line.strip() or indent >= 24:    # a continuation of the line above
+            continue
+        if indent == 0 and stack and line.split()[0] != "app/":
+            break                               # shaders/, presets/, ...: outside the package
+        depth, name = indent // 2, line.split()[0]
+        if indent == 0:
+            stack = []
+            continue
+        stack = stack[:depth - 1]
+        entries["".join(stack) + name] = line
+        if name.endswith("/"):
+            stack.append(name)
+    return entries
+
+
+def test_the_layout_names_every_module():
+    """A newcomer found 26 modules missing from the layout block: a module added without a line
+    there fails this, and so does a line whose module is gone."""
+    app = REPO / "app"
+    on_disk = set()
+    for path in app.rglob("*"):
+        rel = path.relative_to(app).as_posix()
+        if "__pycache__" in rel:
+            continue
+        if path.is_dir():
+            on_disk.add(rel + "/")
+        elif path.suffix == ".py" and path.name not in ("__init__.py", "__main__.py"):
+            on_disk.add(rel)
+    listed = layout_block()
+    assert "core/layers/stack.py" in listed and "frontends/editor/" in listed     # the parser works
+    missing = sorted(on_disk - set(listed))
+    gone = sorted(name for name in listed if not (app / name).exists())
+    assert not missing, f"docs/development.md's layout has no line for {missing}"
+    assert not gone, f"docs/development.md's layout names what app/ does not hold: {gone}"
+
+
+def test_the_benchmarks_readme_lists_every_script():
+    """benchmarks/README.md's "Every script" table names exactly the bench_*.py files on disk (a
+    newcomer found 24 of 51 undescribed, while docs/performance.md said every one was)."""
+    text = (REPO / "benchmarks" / "README.md").read_text(encoding="utf-8")
+    section = re.search(r"^## Every script\n(.*?)(?=^## |\Z)", text, re.M | re.S).group(1)
+    listed = set(re.findall(r"^\| `(bench_\w+\.py)` \|", section, re.M))
+    on_disk = {p.name for p in (REPO / "benchmarks").glob("bench_*.py")}
+    assert listed == on_disk, f"not listed: {sorted(on_disk - listed)}, no such script: {sorted(listed - on_disk)}"

@@ -9,7 +9,7 @@ import pytest
 
 from alight.core import btdf, shading
 from alight.ibl.bake import roughness_to_grid_step
-from tests.gpu import evaluate
+from tests.gpu import evaluate, term_indices
 
 rng = np.random.default_rng(7)
 
@@ -119,8 +119,7 @@ def test_spot_and_range_attenuation():
 # --- the transmission BTDF and layer (common/btdf.glsl and transmission.glsl against
 # app/core/btdf.py and app/core/layers/transmission.py) -------------------------------------
 
-TRANSMISSION_TERMS = {"BTDF_THIN": 0, "BTDF_REFRACTION": 1, "BEER_LAMBERT": 2, "TRANSMISSION_LIGHT": 3,
-                      "DISPERSION_IORS": 4, "DIFFUSE_BTDF_COS": 5, "DIFFUSE_TRANSMISSION_LIGHT": 6}
+TRANSMISSION_TERMS = term_indices("accuracy/evaluate_transmission.comp")
 
 
 def evaluate_transmission(term, inputs, uniforms=None, dispersion=False, diffuse=False):
@@ -197,7 +196,7 @@ def test_transmission_light(ior, thickness, punctual):
 # --- KHR_materials_iridescence (common/iridescence_terms.glsl and iridescence.glsl against
 # app/core/layers/iridescence.py; the base BRDF with the film against app/core/layers/stack.py) ---
 
-IRIDESCENCE_TERMS = {"SENSITIVITY": 0, "FRESNEL": 1, "BASE_BRDF": 2, "IBL_WEIGHTS": 3}
+IRIDESCENCE_TERMS = term_indices("accuracy/evaluate_iridescence.comp")
 
 
 def evaluate_iridescence(term, inputs, material=None, outside_ior=1.0):

@@ -18,7 +18,7 @@ total).
     a GPU watchdog), accumulating into an rgba32f image.
 
 Environment level: level L sums over the map box-reduced by 2^L in both axes (area-weighted,
-``alight.ibl.environment.box_reduce``, on the CPU, uploaded as its own texture): 4^L times fewer
+``alight.core.equirect.box_reduce``, on the CPU, uploaded as its own texture): 4^L times fewer
 texels. The change level 1 makes against level 0, measured with this module on 32x32 probes
 (relative error over the disk / worst pixel):
     royal_esplanade_1k (a 6% sun): r = 0.25: dielectric 1.7e-5 / 2.3e-4, gold 1.5e-4 / 1.0e-3;
@@ -132,7 +132,7 @@ def choose_env_level(radiance: np.ndarray, roughnesses) -> int:
 
 
 def env_level_radiance(radiance: np.ndarray, level: int) -> np.ndarray:
-    """The map box-reduced by 2^level (area-weighted, alight.ibl.environment.box_reduce)."""
+    """The map box-reduced by 2^level (area-weighted, alight.core.equirect.box_reduce)."""
     from alight.core.equirect import box_reduce
 
     factor = 1 << int(level)

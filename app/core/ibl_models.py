@@ -10,7 +10,7 @@ Each model after it adds one fix, so the chart (``alight chart``) shows what eac
 from __future__ import annotations
 
 IBL_MODELS: dict[str, str] = {
-    "lecture": "the seed lecture's cook_torrance_IBL: kd and F from fresnel_schlick_roughness(n.v), "
+    "lecture": "the lecture's cook_torrance_IBL: kd and F from fresnel_schlick_roughness(n.v), "
                "specular = prefiltered(R) (F A + B)",
     "lecture-schlick": "the lecture with plain Fresnel-Schlick at n.v for kd and F (no roughness term)",
     "karis": "Karis' split as published: specular prefiltered(R) (F0 A + B), diffuse weight "

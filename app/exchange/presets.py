@@ -7,6 +7,7 @@ never replaces a good file.
 
 from __future__ import annotations
 
+import difflib
 import json
 import os
 from pathlib import Path
@@ -28,6 +29,13 @@ def list_presets() -> list[str]:
     """Table order first (the order people learn them in), then any extra files alphabetically."""
     found = {p.stem for p in preset_dir().glob("*.json") if p.is_file()}
     return [n for n in PRESET_NAMES if n in found] + sorted(found - set(PRESET_NAMES))
+
+
+def did_you_mean(text: str) -> str:
+    """' (did you mean gold?)' for a misspelt preset name ('gld'), else '': a user who mistyped
+    one name should not have to find it in the list of all of them."""
+    close = difflib.get_close_matches(Path(text).stem.lower(), list_presets(), n=1)
+    return f" (did you mean {close[0]}?)" if close else ""
 
 
 def _read_json(path: Path, source: str) -> Any:
@@ -58,7 +66,8 @@ def load_preset(name_or_path: str | os.PathLike) -> Material:
     if path is None:
         path = Path(text)
         if not text or not os.path.lexists(path):
-            raise _fail(text or "''", f"no preset or file of that name (presets: {', '.join(list_presets())})")
+            raise _fail(text or "''", f"no preset or file of that name{did_you_mean(text)} "
+                                       f"(presets: {', '.join(list_presets())})")
     source = str(path) if path.parent != preset_dir() else f"presets/{path.name}"
     return material_from_dict(_read_json(path, source), source)
 

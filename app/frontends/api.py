@@ -284,7 +284,7 @@ class Renderer:
         return self
 
     def set_ibl_model(self, model: str, *, multiple_scattering: bool | None = None) -> "Renderer":
-        """An IBL model of app/core/ibl_models.py ('alight' by default, 'lecture' for the seed lecture's
+        """An IBL model of app/core/ibl_models.py ('alight' by default, 'lecture' for the lecture's
         split sum), and optionally Fdez-Aguera's multiple-scattering compensation."""
         from alight.core.ibl_models import IBL_MODELS
 

@@ -264,10 +264,12 @@ def _check_inputs_exist(source: Path, base: Path, meshes: list, envs: list, mate
         if not Path(path).exists():
             text = Path(path).name
             if where.startswith("materials") and "." not in text:   # a name, not a file: a preset?
+                from alight.exchange.presets import did_you_mean
                 from alight.paths import preset_dir
 
                 names = ", ".join(sorted(p.stem for p in preset_dir().glob("*.json")))
-                raise AlightError(f"{source}: {where}: {text!r} is neither a preset ({names}) nor a file")
+                raise AlightError(f"{source}: {where}: {text!r} is neither a preset nor a file{did_you_mean(text)} "
+                                  f"(presets: {names})")
             raise AlightError(f"{source}: {where}: {path}: no such file or folder (paths are relative to the spec's folder)")
 
 

@@ -1,5 +1,5 @@
 """The image-based-lighting bake: GLSL compute passes that turn an environment into the
-split sum's maps (Karis 2013, as the seed lecture teaches it).
+split sum's maps (Karis 2013, as the lecture teaches it).
 
     equirect --equirect_to_cube--> source cube (+ box mip chain, for filtered importance sampling)
              --irradiance | sh9--> irradiance cube (E/pi)

@@ -1,4 +1,4 @@
-// The Cook-Torrance terms of the seed lecture, one function per term (after Filament's brdf.fs).
+// The Cook-Torrance terms of the lecture, one function per term (after Filament's brdf.fs).
 // Numpy twins: app/core/shading.py (same names). Conventions: docs/conventions.md.
 
 const float PI = 3.14159265358979323846;

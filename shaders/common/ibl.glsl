@@ -1,4 +1,4 @@
-// Image-based lighting: the seed lecture's split sum (Karis 2013) and the models that improve on
+// Image-based lighting: the lecture's split sum (Karis 2013) and the models that improve on
 // it, measured against docs/conventions.md's ground truth (app/core/ibl_models.py lists them).
 // Maps are baked in the environment map's own frame; lookups rotate world directions into it.
 // Compact bright sources (the sun) are not in the irradiance and prefiltered maps (app/ibl/sun.py):

@@ -4,7 +4,7 @@
 // TONEMAPS: the Khronos glTF Sample Viewer's curves by their names there, and AgX
 // (docs/guides/users-files.md says which peer uses which).
 
-// Exposed radiance is limited to this before a curve: both curves are white (to 1/255) far
+// Exposed radiance is limited to this before a curve: every curve is white (to 1/255) far
 // below it, so no pixel changes, and the ACES fit's v*v stays finite in float32 (a 1e30 texel,
 // or 1e10 at +32 EV, made it inf/inf = NaN: a black PNG).
 const float TONEMAP_INPUT_MAX = 1.0e6;
@@ -92,8 +92,8 @@ vec3 tonemap_agx(vec3 c) {
     return clamp(rec2020_to_srgb * c, 0.0, 1.0);
 }
 
-// The curve a pass applies is compiled in (app/render/renderer.py sets TONEMAP_MODE from the
-// display): llvmpipe runs both sides of a branch, so a uniform mode paid for both curves at
+// The curve a pass applies is compiled in (app/render/passes.py sets TONEMAP_MODE from the
+// display): llvmpipe runs both sides of a branch, so a uniform mode paid for every curve at
 // every pixel. (The default serves only programs compiled to check them, as the hot reload does.)
 #ifndef TONEMAP_MODE
 #define TONEMAP_MODE TONEMAP_ACES

@@ -1,5 +1,5 @@
 #version 450 core
-// Specular prefiltering, one roughness per grid step, as the seed lecture: N = V = R, half
+// Specular prefiltering, one roughness per grid step, as the lecture: N = V = R, half
 // vectors by GGX importance sampling of Hammersley points, each reflected sample weighted by n.l,
 // with filtered importance sampling (Krivanek and Colbert 2008, GPU Gems 3 ch. 20).
 #include "common/brdf.glsl"

@@ -16,8 +16,19 @@ from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 from alight.core.material_fields import FIELDS
 
 QUALITIES = ("low", "medium", "high")
-# alight.core.scene.TONEMAPS, written out so that --help needs no numpy (a test keeps them equal).
-TONEMAP_CHOICES = ("none", "aces", "neutral", "aces-narkowicz", "aces-hill", "aces-hill-exposure-boost", "agx")
+# alight.core.scene.TONEMAPS with a few words each for --help, written out so that --help needs no
+# numpy; tests/test_tonemaps.py keeps the names and their order equal to TONEMAPS, so a new curve
+# cannot reach the command without its line in --help.
+TONEMAP_HELP = {
+    "none": "clamp",
+    "aces": "Hill's ACES fit",
+    "neutral": "Khronos PBR Neutral",
+    "aces-narkowicz": "Narkowicz's ACES fit",
+    "aces-hill": "= aces",
+    "aces-hill-exposure-boost": "Hill after /0.6: three.js's, model-viewer's and the glTF Sample Viewer's ACES",
+    "agx": "Blender's default view since 4.0",
+}
+TONEMAP_CHOICES = tuple(TONEMAP_HELP)
 
 
 @dataclass(frozen=True)
@@ -182,7 +193,7 @@ def _add_bake_options(p: argparse.ArgumentParser, auto: bool = False) -> None:
                    help="diffuse irradiance by the lecture's hemisphere convolution or by 9 spherical "
                         "harmonics (default: the quality's choice)")
     g.add_argument("--ibl", choices=tuple(IBL_MODELS), default=DEFAULT_IBL_MODEL,
-                   help="IBL shading model (app/core/ibl_models.py): 'lecture' is the seed lecture's split sum "
+                   help="IBL shading model (app/core/ibl_models.py): 'lecture' is the lecture's split sum "
                         f"(default: {DEFAULT_IBL_MODEL})")
     g.add_argument("--multiple-scattering", action="store_true",
                    help="add the energy that single scattering loses on rough surfaces (Fdez-Aguera 2019): "

@@ -8,6 +8,7 @@ import time
 from alight.errors import AlightError
 from alight.frontends.cli.arguments import (
     TONEMAP_CHOICES,
+    TONEMAP_HELP,
     Command,
     _add_bake_options,
     _add_camera_options,
@@ -36,10 +37,9 @@ def add_parser(sub) -> None:
                    help="image size; W alone is square, or with --camera gltf the camera's aspect ratio "
                         "(default: 1024)")
     d.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None,
-                   help="PNG only (refused with .exr, which is linear): none (clamp); aces = aces-hill, Hill's "
-                        "ACES fit; neutral, Khronos PBR Neutral; aces-narkowicz; aces-hill-exposure-boost (Hill "
-                        "after /0.6: three.js's, model-viewer's and the glTF Sample Viewer's ACES); agx "
-                        "(Blender's default view since 4.0) (default: aces)")
+                   help="PNG only (refused with .exr, which is linear): "
+                        + "; ".join(f"{name} ({words})" for name, words in TONEMAP_HELP.items())
+                        + " (default: aces)")
     d.add_argument("--exposure", type=_number("--exposure", -32.0, 32.0), default=0.0, metavar="EV",
                    help="PNG only (refused with .exr): multiply radiance by 2^EV before tone mapping (default: 0)")
     d.add_argument("--background", choices=("env", "blur", "color", "transparent"), default="env",
