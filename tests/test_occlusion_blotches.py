@@ -11,6 +11,7 @@ The test writes its own files (trimesh) and reads them with alight's loader."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -200,11 +201,15 @@ def test_copies_of_a_vertex_share_their_occlusion(tmp_path, shared_data):
 
 
 def test_welded_keeps_creases_apart():
-    """Copies at one position within 30 degrees of their mean normal share an index; a cube's
-    corner (three faces' copies, 55 degrees from their mean) keeps three."""
+    """Copies at one position within 10 degrees of their mean normal share an index; a cube's
+    corner (three faces' copies, 55 degrees from their mean) keeps three, and so does an authored
+    hard edge of 30 degrees (DamagedHelmet's split normals: merged, they lit specks under spot1Lux)."""
     from alight.core.visibility import welded
 
     smooth = welded([[0, 0, 0], [0, 0, 0], [1, 0, 0]], [[0, 0, 1], [0.02, 0, 1], [0, 0, 1]])
     assert smooth[0] == smooth[1] != smooth[2]
     corner = welded([[0, 0, 0]] * 3, [[1, 0, 0], [0, 1, 0], [0, 0, 1]])
     assert len(set(corner.tolist())) == 3
+    c, s = math.cos(math.radians(30.0)), math.sin(math.radians(30.0))
+    edge = welded([[0, 0, 0]] * 2, [[0, 0, 1], [s, 0, c]])
+    assert edge[0] != edge[1]

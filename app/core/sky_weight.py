@@ -47,7 +47,8 @@ from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_d
 from alight.core.visibility import on_welded, welded  # noqa: F401  (the weight's fill and smoothing run welded)
 from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
-SKY_WEIGHT_VERSION = 3   # 2: filled and smoothed on the welded mesh (welded); 3: single-sided parts one-way
+SKY_WEIGHT_VERSION = 4   # 2: filled and smoothed on the welded mesh (welded); 3: single-sided parts one-way;
+                         # 4: welded's crease angle 30 -> 10 degrees
 SKY_TEXELS = 16          # texels per cube face read back (the source cube's box mip of that size)
 SMOOTHING_ROUNDS = 2     # rounds of averaging over mesh neighbours
 SKY_SEED = 7             # the rays' own seed (another set than the bake's)
