@@ -388,16 +388,25 @@ def test_sun_of_the_map_casts_the_box_shadow(rotation):
 
 
 def test_glsl_taps_are_vogel_disks():
+    """The 4-tap table, and the 8 and 12 taps the soft shadows' loops walk (a turn by the golden
+    angle per step, radius sqrt((k + 0.5) / n)), against their numpy twin."""
     import re
 
     from alight.core.shadow_fit import vogel_disk
     from alight.paths import shader_dir
 
     text = (shader_dir() / "common" / "shadows.glsl").read_text()
-    for n in (4, 8, 12):
-        body = re.search(rf"SHADOW_TAPS_{n}\[{n}\] = vec2\[\]\((.*?)\);", text, re.S).group(1)
-        values = np.array([float(x) for x in re.findall(r"-?\d+\.\d+", body)]).reshape(-1, 2)
-        np.testing.assert_allclose(values, vogel_disk(n), atol=1e-6)
+    body = re.search(r"SHADOW_TAPS_4\[4\] = vec2\[\]\((.*?)\);", text, re.S).group(1)
+    values = np.array([float(x) for x in re.findall(r"-?\d+\.\d+", body)]).reshape(-1, 2)
+    np.testing.assert_allclose(values, vogel_disk(4), atol=1e-6)
+    turn = [float(x) for x in re.search(r"SHADOW_GOLDEN_TURN = vec2\((\S+), (\S+)\);", text).groups()]
+    for n in (8, 12):
+        assert f"sqrt((float(k) + 0.5) / {n}.0)" in text
+        d, walked = np.array([1.0, 0.0], np.float32), []
+        for k in range(n):
+            walked.append(d * np.sqrt((k + 0.5) / n))
+            d = np.array([d[0] * turn[0] - d[1] * turn[1], d[0] * turn[1] + d[1] * turn[0]], np.float32)
+        np.testing.assert_allclose(walked, vogel_disk(n), atol=1e-5)
 
 
 def test_ground_catches_the_sphere_shadow_where_it_falls():

@@ -40,19 +40,20 @@ void set_shadow_receiver(vec3 position, vec3 geometric_normal) {
 }
 
 // Taps on the unit disk: Vogel's spiral (golden-angle steps, radius sqrt((k + 0.5) / n)), even at
-// any n (app/core/shadow_fit.py vogel_disk prints them).
+// any n (app/core/shadow_fit.py vogel_disk prints them; tests/test_shadows.py checks both forms).
 const vec2 SHADOW_TAPS_4[4] = vec2[](
     vec2(0.353553, 0.000000), vec2(-0.451544, 0.413652), vec2(0.069116, -0.787542),
     vec2(0.569142, 0.742346));
-const vec2 SHADOW_TAPS_8[8] = vec2[](
-    vec2(0.250000, 0.000000), vec2(-0.319290, 0.292496), vec2(0.048872, -0.556877),
-    vec2(0.402444, 0.524918), vec2(-0.738535, -0.130636), vec2(0.699605, -0.445031),
-    vec2(-0.234004, 0.870484), vec2(-0.446271, -0.859268));
-const vec2 SHADOW_TAPS_12[12] = vec2[](
-    vec2(0.204124, 0.000000), vec2(-0.260699, 0.238822), vec2(0.039904, -0.454688),
-    vec2(0.328595, 0.428593), vec2(-0.603011, -0.106664), vec2(0.571225, -0.363367),
-    vec2(-0.191064, 0.710747), vec2(-0.364379, -0.701590), vec2(0.790557, 0.288710),
-    vec2(-0.822442, 0.339492), vec2(0.396472, -0.847237), vec2(0.292982, 0.934074));
+// The soft shadows' 8 and 12 taps are walked, not read from tables: a constant array indexed by
+// a loop's counter cost llvmpipe about as much as the loops' taps, at every pixel, even where the
+// loop ran no iteration (benchmarks/results/sun_shadow_cost.md). Each step turns the direction
+// by the golden angle; tap k of n lies at radius sqrt((k + 0.5) / n), as in the tables.
+const vec2 SHADOW_GOLDEN_TURN = vec2(-0.737369, 0.675490);   // cos, sin of 2.39996323
+
+vec2 shadow_turn(vec2 d) {
+    return vec2(d.x * SHADOW_GOLDEN_TURN.x - d.y * SHADOW_GOLDEN_TURN.y,
+                d.x * SHADOW_GOLDEN_TURN.y + d.y * SHADOW_GOLDEN_TURN.x);
+}
 
 // World distance along the view from a depth in [0, 1], and back.
 float shadow_linear_depth(int view, float z) {
@@ -139,8 +140,10 @@ float shadow_soft(int view, vec3 l) {
     float reach = ortho ? (look.receiver - near) * params.z : params.z * (look.receiver - near) / look.receiver;
     float search = clamp(reach / look.texel, 1.0, SHADOW_MAX_RADIUS);
     float blockers = 0.0, count = 0.0;
+    vec2 dir = vec2(1.0, 0.0);
     for (int k = 0; k < searches; ++k) {
-        vec2 o = SHADOW_TAPS_8[k] * search;
+        vec2 o = dir * (sqrt((float(k) + 0.5) / 8.0) * search);
+        dir = shadow_turn(dir);
         vec2 uv = clamp(look.uv + o / u_shadow_atlas_size, look.lo, look.hi);
         float stored = shadow_linear_depth(view, textureLod(u_shadow_depth, uv, 0.0).r);
         bool blocks = stored < look.receiver + dot(look.slope, o) - look.bias;
@@ -153,7 +156,11 @@ float shadow_soft(int view, vec3 l) {
     float radius = clamp(penumbra / look.texel, 1.0, SHADOW_MAX_RADIUS);
     int taps = count > 0.0 ? 12 : 0;
     float lit = 0.0;
-    for (int k = 0; k < taps; ++k) lit += shadow_tap_lit(view, look, SHADOW_TAPS_12[k] * radius);
+    dir = vec2(1.0, 0.0);
+    for (int k = 0; k < taps; ++k) {
+        lit += shadow_tap_lit(view, look, dir * (sqrt((float(k) + 0.5) / 12.0) * radius));
+        dir = shadow_turn(dir);
+    }
     return count > 0.0 ? lit / 12.0 : 1.0;
 }
 
