@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 
-from alight.frontends.editor.ui_test import editor, view
+from alight.frontends.editor.ui_test import editor, files_done, view
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
 from editor_ui_helpers import ball, capture, changed, checker_levels, contrast, type_path, until_seconds  # noqa: E402
@@ -174,6 +174,7 @@ def test_export_gltf_button_writes_a_gltf(ctx):
     ctx.set_ref("alight")
     ctx.item_input_value("**/glTF file", path)
     ctx.item_click("**/export glTF")
+    files_done(ctx)
     data = json.loads(open(path, encoding="utf-8").read())
     assert data["asset"]["version"] == "2.0" and data["materials"], data
 
@@ -435,10 +436,12 @@ def test_open_mesh_typed(ctx):
     ctx.item_open("**/Environment")
     type_path(ctx, "**/mesh", "cube")
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     assert s.mesh_spec == "cube", s.error
     cube = view(ctx)
     type_path(ctx, "**/mesh", "sphere")
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     assert s.mesh_spec == "sphere" and np.abs(view(ctx).astype(np.float64) - cube).mean() > 1.0
     ctx.item_close("**/Environment")
 
@@ -750,6 +753,7 @@ def test_file_materials_checkbox_and_motion_settings(ctx):
     ctx.item_open("**/Environment")
     type_path(ctx, "**/mesh", os.path.join(SHARED, "models", "Duck.glb"))
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     assert s.use_file_materials, s.error
     own = ball(view(ctx)).mean(axis=0)
     assert own[0] > own[2] + 30, own   # the duck's own yellow texture
@@ -759,6 +763,7 @@ def test_file_materials_checkbox_and_motion_settings(ctx):
     assert panel[0] < own[0] - 20, (panel, own)
     type_path(ctx, "**/mesh", "sphere")
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     ctx.item_close("**/Environment")
     ctx.item_open("**/Display & camera")
     adaptive = s.adaptive_motion

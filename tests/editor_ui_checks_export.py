@@ -16,17 +16,19 @@ OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")
 
 
 def test_export_keeps_the_files_own_materials_and_the_panels_when_they_are_off(ctx):
-    from alight.frontends.editor.ui_test import editor
+    from alight.frontends.editor.ui_test import editor, files_done
 
     s = editor().state
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
     ctx.item_input_value("**/mesh", os.path.join(OUT, "two_parts.glb"))
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     assert s.use_file_materials and not s.error, (s.error, s.message)
     own = os.path.join(OUT, "from_editor.gltf")
     ctx.item_input_value("**/glTF file", own)
     ctx.item_click("**/export glTF")
+    files_done(ctx)
     assert not s.error, s.error
     assert s.message == f"exported {own}", s.message   # nothing left out: no note
     doc = json.loads(open(own, encoding="utf-8").read())
@@ -35,6 +37,7 @@ def test_export_keeps_the_files_own_materials_and_the_panels_when_they_are_off(c
     panel = os.path.join(OUT, "panel_material.glb")
     ctx.item_input_value("**/glTF file", panel)
     ctx.item_click("**/export glTF")
+    files_done(ctx)
     assert s.message == f"exported {panel}", s.message
     ctx.combo_click("preview mesh/sphere")
     ctx.item_close("**/Environment")

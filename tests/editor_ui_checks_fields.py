@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 
-from alight.frontends.editor.ui_test import editor
+from alight.frontends.editor.ui_test import editor, files_done
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")
 SHARED = "/work/shared/data"
@@ -33,10 +33,10 @@ def test_enter_in_the_mesh_field_opens_it(ctx):
     ctx.set_ref("alight")
     ctx.item_open("**/Environment")
     ctx.item_input_value("**/mesh", path)
-    ctx.yield_(2)
+    files_done(ctx)
     assert s.mesh_spec == path and not s.error, (s.mesh_spec, s.error)
     ctx.item_input_value("**/mesh", "sphere")   # a built-in's name too
-    ctx.yield_(2)
+    files_done(ctx)
     assert s.mesh_spec == "sphere", (s.mesh_spec, s.error)
 
 

@@ -17,7 +17,7 @@ import sys
 
 import numpy as np
 
-from alight.frontends.editor.ui_test import editor, on_main_thread, view
+from alight.frontends.editor.ui_test import editor, files_done, on_main_thread, view
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
 from editor_ui_helpers import ball, type_path  # noqa: E402
@@ -169,7 +169,7 @@ def test_the_status_row_stays_in_view_when_the_panel_is_scrolled(ctx):
     ctx.yield_(2)
     before = content_y(ctx, "**/export glTF")
     ctx.item_click("**/export glTF")
-    ctx.yield_(2)
+    files_done(ctx)
     assert os.path.isfile(os.path.join(OUT, "scrolled.gltf")) and s.message.startswith("exported"), s.message
     assert content_y(ctx, "**/export glTF") == before
     scroll = ctx.get_window_by_ref("//alight").scroll.y
@@ -181,7 +181,7 @@ def test_the_status_row_stays_in_view_when_the_panel_is_scrolled(ctx):
     ctx.yield_(2)
     before = content_y(ctx, "**/export glTF")
     ctx.item_click("**/export glTF")
-    ctx.yield_(2)
+    files_done(ctx)
     assert s.error and not s.message, (s.error, s.message)
     band = status_band(ctx, capture(ctx, "status_scrolled_error.png"))
     assert colour_pixels(band, ERROR_RGB) > 20 and colour_pixels(band, MESSAGE_RGB) == 0, \
@@ -241,6 +241,7 @@ def test_a_texture_set_names_the_material_undoably(ctx):
     path = os.path.join(OUT, "oak.gltf")
     ctx.item_input_value("**/glTF file", path)
     ctx.item_click("**/export glTF")
+    files_done(ctx)
     data = json.loads(open(path, encoding="utf-8").read())
     assert [m["name"] for m in data["materials"]] == ["oak_planks"], data["materials"]
     undo(ctx)
@@ -388,6 +389,7 @@ def test_open_mesh_confirms_in_the_message_row(ctx):
     ctx.item_open("**/Environment")
     type_path(ctx, "**/mesh", mesh_file())
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     assert s.mesh_spec == mesh_file(), (s.mesh_spec, s.error)
     assert not s.error and s.message == f"opened mesh {mesh_file()}", (s.error, s.message)
     ctx.yield_(2)
@@ -407,5 +409,6 @@ def reopened_mesh_field_shows_the_path(ctx):
     assert editor().panel.mesh_path == mesh_file(), repr(editor().panel.mesh_path)
     # What the field shows is what 'open mesh' opens: pressed now, the same mesh, confirmed.
     ctx.item_click("**/open mesh")
+    files_done(ctx)
     assert s.mesh_spec == mesh_file() and s.message == f"opened mesh {mesh_file()}", (s.mesh_spec, s.message, s.error)
     ctx.item_close("**/Environment")

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from alight.frontends.editor.ui_test import editor
+from alight.frontends.editor.ui_test import editor, files_done
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
 from editor_ui_helpers import capture, checker_levels, type_path, until  # noqa: E402
@@ -109,7 +109,7 @@ def test_a_mesh_warning_is_in_the_status_row(ctx):
         expected = load_mesh(path).warnings
         type_path(ctx, "**/mesh", path)
         ctx.item_click("**/open mesh")
-        ctx.yield_(2)
+        files_done(ctx)
         shown = getattr(win.panel, "shown_status", s.message)   # (a panel that kept none showed the message)
         assert f"opened mesh {path}" in shown, (shown, s.error)   # (after the compile note, if any)
         assert all(w in shown for w in expected) and "on stderr" not in shown, (shown, expected)
@@ -129,7 +129,7 @@ def test_a_cut_status_line_is_shown_whole_when_hovered(ctx):
     path = str(BAD / "empty_nodes.glb")
     type_path(ctx, "**/mesh", path)
     ctx.item_click("**/open mesh")
-    ctx.yield_(2)
+    files_done(ctx)
     assert s.error and path in s.error, s.error
     panel = imgui.internal.find_window_by_name("alight")
     row = panel.menu_bar_rect()
@@ -181,6 +181,7 @@ def test_leave_turntable_settings_and_msaa_for_the_next_session(ctx):
     ctx.item_click("**/save preset")
     ctx.item_input_value("**/glTF file", os.path.join(OUT, LAST_GLTF))
     ctx.item_click("**/export glTF")
+    files_done(ctx)
     until(ctx, lambda: os.path.isfile(os.path.join(OUT, LAST_PRESET)) and os.path.isfile(os.path.join(OUT, LAST_GLTF)))
 
 
@@ -207,4 +208,5 @@ def reopened_turntable_and_aa_are_restored(ctx):
         os.remove(kept)
         ctx.item_click(f"**/{button}")
         until(ctx, lambda: os.path.isfile(kept))
+        files_done(ctx)
         assert not win.state.error, win.state.error

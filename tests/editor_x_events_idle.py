@@ -11,40 +11,28 @@ from __future__ import annotations
 
 import os
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
-from x_events import XTest, place_window  # noqa: E402
+from x_events import XTest, frames_over, open_editor, place_window, settle  # noqa: E402
 
 WAIT_S = 2.0   # the wait frames are counted over: ~20 idle waits; the old loop drew ~150 frames
 
 
 def main() -> int:
-    from alight.frontends.editor.state import EditorState
-    from alight.frontends.editor.window import IDLE_WAIT_S, EditorWindow
+    from alight.frontends.editor.window import IDLE_WAIT_S
 
     pointer = XTest()
-    state = EditorState()
-    state.load_mesh("sphere")
-    state.load_env("studio")
-    win = EditorWindow(state, (640, 400))
+    win = open_editor()
     try:
         x0, y0 = place_window(win)
         w, h = win.glfw.get_window_size(win.window)
         pointer.move(x0 + w + 200, y0 + h + 200)   # outside the window
         pointer.sync()
         # The start-up's background work ends (bounded by turns of the loop, not by time).
-        for _ in range(20000):
-            if not win.tick() and not win._background_pending():
-                break
-        else:
+        if not settle(win):
             print("the editor never went idle (background work pending after 20000 turns)")
             return 1
-        frames, waits = win._frame_no, win.idle_waits
-        end = time.monotonic() + WAIT_S
-        while time.monotonic() < end:
-            win.tick()
-        frames, waits = win._frame_no - frames, win.idle_waits - waits
+        frames, waits = frames_over(win, WAIT_S)
         if frames > 2 or waits < 0.25 * WAIT_S / IDLE_WAIT_S:
             print(f"idle for {WAIT_S} s the editor drew {frames} frames ({waits} waits for events)")
             return 1

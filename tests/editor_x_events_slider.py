@@ -17,33 +17,14 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
-from x_events import XTest, place_window  # noqa: E402
+from x_events import XTest, open_editor, place_window, record_rects  # noqa: E402
 
 
 def main() -> int:
-    from imgui_bundle import imgui
-
-    from alight.frontends.editor.state import EditorState
-    from alight.frontends.editor.window import EditorWindow
-
     pointer = XTest()
-
-    rects = {}
-    slider_float = imgui.slider_float
-
-    def recording_slider(label, *args, **kwargs):   # where the roughness slider is drawn
-        result = slider_float(label, *args, **kwargs)
-        if label == "roughness":
-            lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
-            rects[label] = (lo.x, lo.y, hi.x, hi.y)
-        return result
-
-    imgui.slider_float = recording_slider
-
-    state = EditorState()
-    state.load_mesh("sphere")
-    state.load_env("studio")
-    win = EditorWindow(state, (900, 1000))   # the slider on screen without scrolling
+    rects = record_rects("slider_float", ("roughness",))   # where the roughness slider is drawn
+    win = open_editor((900, 1000))   # the slider on screen without scrolling
+    state = win.state
     failures = []
     try:
         x0, y0 = place_window(win)

@@ -12,19 +12,12 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
-from x_events import XTest, place_window  # noqa: E402
+from x_events import XTest, open_editor, place_window  # noqa: E402
 
 
 def main() -> int:
-    from alight.frontends.editor.state import EditorState
-    from alight.frontends.editor.window import EditorWindow
-
     pointer = XTest()
-
-    state = EditorState()
-    state.load_mesh("sphere")
-    state.load_env("studio")
-    win = EditorWindow(state, (640, 400))
+    win = open_editor()
     try:
         x0, y0 = place_window(win)
         view_w = win.size[0] - win.panel_width()

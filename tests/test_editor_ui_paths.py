@@ -1,4 +1,5 @@
-"""Paths the editor keeps are absolute: a session saved by an editor started in one folder
+"""Paths the editor keeps are absolute (but the output fields left at their defaults, which stay
+relative to the folder the editor runs in): a session saved by an editor started in one folder
 reopens its mesh, environment, maps and file fields in an editor started from another (a fresh
 user's report: the session kept '../models/...' relative to the first folder, and the second
 editor showed 'no such file' and the built-in sphere). Both editors start as a user starts
@@ -20,12 +21,13 @@ from test_editor import display  # noqa: F401  (the Xvfb fixture)
 SHARED = Path("/work/shared/data")
 
 FIRST = """
-from alight.frontends.editor.ui_test import editor
+from alight.frontends.editor.ui_test import editor, files_done
 
 def test_export_to_a_relative_file(ctx):
     ctx.set_ref("alight")
     ctx.item_input_value("**/glTF file", "exported.glb")
     ctx.item_click("**/export glTF")
+    files_done(ctx)
     s = editor().state
     assert not s.error and s.message.startswith("exported"), (s.error, s.message)
 """
@@ -42,6 +44,12 @@ def test_the_first_folders_files_came_back(ctx):
     assert s.env_spec == {env!r}, s.env_spec
     assert s.texture_maps.base_color == {png!r} and {png!r} in s.map_images, s.texture_maps
     assert win.panel.gltf_path == {glb!r}, win.panel.gltf_path
+    # The fields left at their defaults name files in this folder, not in the first one.
+    assert (win.panel.preset_path, win.turntable.path) == ("material.json", "turntable.webp"), \
+        (win.panel.preset_path, win.turntable.path)
+    ctx.set_ref("alight")
+    ctx.item_click("**/save preset")
+    assert not s.error and os.path.isfile(os.path.join(os.getcwd(), "material.json")), (s.error, s.message)
 """
 
 
@@ -72,9 +80,12 @@ def test_a_session_from_one_folder_reopens_its_files_from_another(display, tmp_p
     png, glb = str(files / "gold_BaseColor.png"), str(first / "exported.glb")
     assert (session["mesh"], session["env"], session["texture_maps"]["base_color"], session["files"]["gltf_path"]) \
         == (mesh, env, png, glb), session
-    assert os.path.isabs(session["turntable"]["path"]), session["turntable"]
+    # Output fields at their defaults stay relative: the folder of the moment, not this one.
+    assert session["turntable"]["path"] == "turntable.webp", session["turntable"]
+    assert session["files"]["preset_path"] == "material.json", session["files"]
     # From a folder where '../../files' is nothing: the real startup restores the session.
     (tmp_path / "second.py").write_text(SECOND.format(mesh=mesh, env=env, png=png, glb=glb))
     reopened = _edit(second, tmp_path, "--ui-test", str(tmp_path / "second.py"))
     assert reopened.returncode == 0, reopened.stdout[-3000:] + reopened.stderr[-3000:]
     assert "1 passed, 0 failed" in reopened.stdout, reopened.stdout
+    assert (second / "material.json").is_file() and not (first / "material.json").exists()

@@ -62,3 +62,68 @@ def place_window(win, frames: int = 5) -> tuple[int, int]:
     for _ in range(frames):
         win.frame()
     return glfw.get_window_pos(win.window)
+
+
+def open_editor(size: tuple[int, int] = (640, 400)):
+    """The editor's window as the X-event checks start it: the built-in sphere in the studio."""
+    from alight.frontends.editor.state import EditorState
+    from alight.frontends.editor.window import EditorWindow
+
+    state = EditorState()
+    state.load_mesh("sphere")
+    state.load_env("studio")
+    return EditorWindow(state, size)
+
+
+def record_rects(function_name: str, labels) -> dict:
+    """Where imgui draws the items of ``labels`` made by ``imgui.<function_name>`` (the editor's
+    panel calls it by that name): {label: (x0, y0, x1, y1)}, window coordinates, filled in as
+    frames are drawn. Call before the window is opened."""
+    from imgui_bundle import imgui
+
+    rects: dict = {}
+    original = getattr(imgui, function_name)
+
+    def recording(label, *args, **kwargs):
+        result = original(label, *args, **kwargs)
+        if label in labels:
+            lo, hi = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+            rects[label] = (lo.x, lo.y, hi.x, hi.y)
+        return result
+
+    setattr(imgui, function_name, recording)
+    return rects
+
+
+def settle(win, turns: int = 20000) -> bool:
+    """Turns of the editor's own loop until it waits with no background work left (the
+    start-up's warm-up children, thumbnails, the presets' prefetch): whether it got there."""
+    for _ in range(turns):
+        if not win.tick() and not win._background_pending():
+            return True
+    return False
+
+
+def frames_over(win, wait_s: float) -> tuple[int, int]:
+    """Turns of the editor's own loop for ``wait_s`` seconds: (frames drawn, waits for events)."""
+    import time
+
+    frames, waits = win._frame_no, win.idle_waits
+    end = time.monotonic() + wait_s
+    while time.monotonic() < end:
+        win.tick()
+    return win._frame_no - frames, win.idle_waits - waits
+
+
+def run_check(name: str, display: str, cwd=None, timeout: int = 600, **env):
+    """``python tests/NAME`` (an X-event check) in a fresh interpreter on ``display``, with
+    ``env`` added to the environment: the CompletedProcess (the pytest side of these checks)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parent
+    return subprocess.run([sys.executable, str(here / name)], cwd=cwd or here.parent,
+                          env=dict(os.environ, DISPLAY=display, **env), capture_output=True, text=True,
+                          timeout=timeout)

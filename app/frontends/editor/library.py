@@ -106,6 +106,16 @@ def list_entries(folder: Path | None = None) -> tuple[list[Entry], list[str]]:
     return entries, problems
 
 
+def preset_clashes(entries: list[Entry], presets) -> list[str]:
+    """One warning line per entry named as a built-in preset (``presets``: their names; compared
+    without case, as ``load_preset`` finds a preset): the panel lists such an entry as
+    'NAME (library)', so the F0 table's NAME stays the preset and neither hides the other."""
+    names = {p.lower() for p in presets}
+    return [f"{e.path}: the library entry '{e.name}' has a built-in preset's name: listed as "
+            f"'{e.name} (library)'; the F0 table's '{e.name}' is the preset"
+            for e in entries if e.name.lower() in names]
+
+
 def folder_stamp(folder: Path | None = None) -> tuple:
     """What changes when an entry is added, replaced or removed (names, mtimes, sizes): the
     panel lists the folder again only then."""

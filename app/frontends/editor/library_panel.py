@@ -25,6 +25,7 @@ class LibraryPanel:
         self.name = ""
         self.entries: list[library.Entry] = []
         self.problems: list[str] = []
+        self.clashes: list[str] = []      # entries named as a built-in preset (library.preset_clashes)
         self._stamp = None
         self._scanned = -1e9
         self.clicked = None               # the entry clicked this frame, applied by apply_click
@@ -40,6 +41,17 @@ class LibraryPanel:
         if force or stamp != self._stamp:
             self._stamp = stamp
             self.entries, self.problems = library.list_entries()
+            from alight.errors import warn
+            from alight.exchange.presets import list_presets
+
+            self.clashes = library.preset_clashes(self.entries, list_presets())
+            for line in self.clashes:
+                warn(line)   # on stderr, once per process; the box shows it too
+
+    def label(self, entry) -> str:
+        """The entry's name in the list: 'NAME (library)' where a built-in preset has that name."""
+        clash = any(line.startswith(f"{entry.path}: ") for line in self.clashes)
+        return f"{entry.name} (library)" if clash else entry.name
 
     def icon(self, win, label: str, material, maps=_NO_MAPS, fallback_rgb=None) -> None:
         """The thumbnail, or (until it is rendered) a swatch of ``fallback_rgb`` the same size.
@@ -75,7 +87,8 @@ class LibraryPanel:
             self.icon(win, f"##lib_icon_{entry.name}", entry.material, entry.maps)
             imgui.same_line()
             current = s.material == entry.material and s.texture_maps == entry.maps
-            if imgui.selectable(f"{entry.name}##library", current, 0, imgui.ImVec2(0, ICON))[0]:
+            shown = self.label(entry)
+            if imgui.selectable(f"{shown}##library", current, 0, imgui.ImVec2(0, ICON))[0]:
                 self.clicked = entry
             if imgui.is_item_hovered():
                 tooltip(entry.path)
@@ -83,6 +96,10 @@ class LibraryPanel:
             imgui.text_disabled("empty: 'save to library' or\n'save preset' adds the material")
         for line in self.problems:
             imgui.text_disabled(line)
+        for line in self.clashes:   # wrapped: the box's width, the line whole
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_colored(imgui.ImVec4(0.95, 0.75, 0.3, 1.0), f"warning: {line}")
+            imgui.pop_text_wrap_pos()
         imgui.end_child()
         changed, typed = imgui.input_text("library name", self.name or s.material.name)
         if changed:

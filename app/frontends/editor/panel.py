@@ -123,6 +123,9 @@ def close_popup_on_escape() -> None:
 
 # The path fields kept across sessions (the others follow what is loaded: mesh, env, maps).
 KEPT_PATH_FIELDS = ("preset_path", "gltf_path")
+# Their defaults: names in the working folder of the moment, kept so in the session (an editor
+# started from another folder writes there, not into the first launch's folder).
+DEFAULT_PATHS = {"preset_path": "material.json", "gltf_path": "material.gltf"}
 
 
 class Panel:
@@ -138,8 +141,8 @@ class Panel:
             self.presets.append((name, m, f0, _srgb(f0)))
         self.env_path = ""
         self.mesh_path = ""
-        self.preset_path = "material.json"
-        self.gltf_path = "material.gltf"
+        self.preset_path = DEFAULT_PATHS["preset_path"]
+        self.gltf_path = DEFAULT_PATHS["gltf_path"]
         self.map_path = ""
         self.set_path = ""      # the 'texture set' field: a folder, or image files separated by ';'
         self._specs_shown = (None, None)   # the mesh and environment the path fields were last set from
@@ -147,6 +150,7 @@ class Panel:
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.shown_status = ""  # the status row's text drawn last frame (tests read it)
         self.shown_f0 = ""      # the F0 line drawn last frame (tests read it)
+        self.shown_job_status = ""   # the status row's last "opening .../exporting ..." (tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
         self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
@@ -154,6 +158,9 @@ class Panel:
         self._removed = []   # (index, light, height): removed lights' places, kept while the pointer is there
         # Each path field's last path that worked (_attempt): a failed one is not left showing.
         self._good = {"preset_path": self.preset_path, "gltf_path": self.gltf_path}
+        from alight.frontends.editor.file_jobs import FileJobs
+
+        self.file_jobs = FileJobs()   # 'open mesh' and 'export glTF' on a worker thread (file_jobs.py)
 
     def draw(self, win) -> None:
         from imgui_bundle import imgui
@@ -174,6 +181,7 @@ class Panel:
         # The status row is the window's menu bar: it stays in view whatever the panel's scroll.
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
+        self.take_file_jobs(s)
         self.shown_error = s.error
         self.shown_status = self._status_line(s, win)
         self._follow_loaded(s)
@@ -215,8 +223,7 @@ class Panel:
         self.browser.draw()
         close_popup_on_escape()
 
-    @staticmethod
-    def _status_line(s, win) -> str:
+    def _status_line(self, s, win) -> str:
         """The panel's menu bar, one row of a fixed height that never scrolls: the error (red),
         else the bake's or turntable's progress, else that the view waits for a new look's
         shaders, else the last message (green), else nothing; so a save or an
@@ -228,9 +235,13 @@ class Panel:
         if not imgui.begin_menu_bar():
             return ""
         shown = ""
+        jobs = self.file_jobs.status()
         if s.error:
             shown = f"error: {s.error}"
             imgui.text_colored(imgui.ImVec4(*ERROR_RGBA), shown)
+        elif jobs:   # 'open mesh' or 'export glTF' on its worker thread (file_jobs.py)
+            shown = self.shown_job_status = jobs
+            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
         elif win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
             fraction, label = win.bake_progress
             shown = f"baking {s.quality}: {label}"
@@ -393,7 +404,7 @@ class Panel:
                      s.open_file)
         _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
         if imgui.button("export glTF"):   # the mesh with the material and its maps (.gltf or .glb)
-            self._attempt(s, "gltf_path", lambda: self._export_gltf(s))
+            self._export_gltf(s)
 
     def _save_preset(self, s) -> None:
         """'save preset': the file (a .json with maps loaded: the factors, and the status row
@@ -415,11 +426,45 @@ class Panel:
             s.message = f"{done} and {s.message.removeprefix('saved ')}" if saved else f"{done}; {s.message}"
 
     def _export_gltf(self, s) -> None:
-        try:
-            note = s.export_gltf(self.gltf_path)
-            s.error, s.message = "", f"exported {self.gltf_path}{f' ({note})' if note else ''}"
-        except AlightError as exc:
-            s.fail(exc)
+        """'export glTF': written by a worker thread (file_jobs.py) from what is shown now; the
+        frame that takes its end says so (``take_file_jobs``). One export at a time: a second
+        click while one writes is refused in the status row, the field keeps its text."""
+        busy = self.file_jobs.exporting
+        if busy:
+            s.error = (f"{self.gltf_path}: not exported: {busy} is still being written "
+                       f"(export again when the status row says it is done)")
+            s.message = ""
+            return
+        s.error = ""
+        self.file_jobs.export(self.gltf_path, s.export_job(self.gltf_path))
+
+    def _open_mesh(self, s) -> None:
+        """'open mesh' (or Enter in its field): the file read by a worker thread (file_jobs.py),
+        assigned when a frame takes it; a second open while one runs wins."""
+        s.error = ""
+        from alight.frontends.editor.state import read_mesh
+
+        self.file_jobs.open_mesh(self.mesh_path, read_mesh)
+
+    def take_file_jobs(self, s) -> None:
+        """The worker thread's finished opens and exports, taken on the GL thread once a frame:
+        a mesh read is assigned here (the renderer uploads it when it draws it), a failure is
+        the one-line error with the previous mesh kept and the field back on the path that last
+        worked, as ``_attempt`` does."""
+        for done in self.file_jobs.take():
+            field = "mesh_path" if done.kind == "open" else "gltf_path"
+            if done.error is not None:
+                s.fail(done.error)
+                if getattr(self, field) == done.target:   # (a path typed since stays)
+                    setattr(self, field, self._good.get(field, ""))
+                continue
+            if done.kind == "open":
+                s.apply_mesh(done.target, done.value)
+                s.error, s.message = "", s.with_warnings(f"opened mesh {done.target}")
+            else:
+                note = done.value
+                s.error, s.message = "", f"exported {done.target}{f' ({note})' if note else ''}"
+            self._good[field] = done.target
 
     def kept_paths(self) -> dict:
         """The 'preset file' and 'glTF file' fields for the next session: the paths that last
@@ -433,17 +478,19 @@ class Panel:
                 setattr(self, field, paths[field])
                 self._good[field] = paths[field]
 
-    def _attempt(self, s, field: str, action) -> None:
+    def _attempt(self, s, field: str, action, keep_typed: bool = False) -> None:
         """Run a path field's action (open, load, save); where it fails the field goes back to
         the path that last worked (what is loaded or saved), and the status row names the path
-        that failed: a field never shows a file that is not what the editor holds."""
+        that failed: a field never shows a file that is not what the editor holds. With
+        ``keep_typed`` (the 'map file' field, whose slot rows name the loaded maps) the typed
+        path stays for the artist to fix."""
         typed = getattr(self, field)
         s.error = ""
         action()
-        if s.error:
-            setattr(self, field, self._good.get(field, ""))
-        else:
+        if not s.error:
             self._good[field] = typed
+        elif not keep_typed:
+            setattr(self, field, self._good.get(field, ""))
 
     def _layers(self, s, m):
         """A collapsible section per layer of the material-field registry (layer_rows.py), open
@@ -537,10 +584,12 @@ class Panel:
                               "files' names (NAME_BaseColor, _Normal, _Roughness, ...)")
         imgui.same_line()
         if (imgui.button("load##typed") or entered) and self.map_path:
+            # A path that fails stays typed (a new user's typo was wiped with the error, to be
+            # typed again); the slot keeps its last good map, whose name the slot's row shows.
             if os.path.isdir(self.map_path):
-                self._attempt(s, "map_path", lambda: self._load_texture_set(s, self.map_path))
+                self._attempt(s, "map_path", lambda: self._load_texture_set(s, self.map_path), keep_typed=True)
             else:
-                self._attempt(s, "map_path", lambda: loader(s.armed_slot)(self.map_path))
+                self._attempt(s, "map_path", lambda: loader(s.armed_slot)(self.map_path), keep_typed=True)
         changed, v = imgui.drag_float2("UV tiling", list(maps.uv_scale), 0.02, -64.0, 64.0)
         if changed:
             s.texture_maps = dataclasses.replace(s.texture_maps, uv_scale=tuple(v))
@@ -592,6 +641,7 @@ class Panel:
         current = names.index(s.mesh_spec) if s.mesh_spec in names else -1   # -1: a file, none shown
         changed, i = imgui.combo("preview mesh", current, names)
         if changed and 0 <= i < len(names):
+            self.file_jobs.drop_open()   # the list's pick is the latest: a file still being read is not shown
             try:
                 s.load_mesh(names[i])
                 s.error, s.message = "", f"mesh: {names[i]}"
@@ -601,7 +651,7 @@ class Panel:
             tooltip("a built-in mesh, framed from its 3/4 view; or type a mesh file below")
         self.mesh_path, entered = text_field("mesh", self.mesh_path)
         if imgui.button("open mesh") or entered:
-            self._attempt(s, "mesh_path", lambda: self._open_mesh(s))
+            self._open_mesh(s)
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
         if imgui.is_item_hovered():
             tooltip("or Shift + right drag in the view")
@@ -654,12 +704,6 @@ class Panel:
         if win.bake_seconds:
             imgui.text(f"last bake: {sum(win.bake_seconds.values()) * 1000:.0f} ms")
 
-    def _open_mesh(self, s) -> None:
-        try:
-            s.load_mesh(self.mesh_path)
-            s.error, s.message = "", s.with_warnings(f"opened mesh {self.mesh_path}")
-        except AlightError as exc:
-            s.fail(exc)
 
     def _lights(self, s) -> None:
         from imgui_bundle import imgui

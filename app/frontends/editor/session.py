@@ -32,9 +32,17 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
     """``turntable``: the window's turntable.TurntableSettings, ``panel``: its panel.Panel (the
     'preset file' and 'glTF file' fields), each kept when given. Every path is written absolute
     (the loaders keep them so; the rest are made so here, against the folder the editor ran in,
-    which it never leaves): a session reopened from another folder names the same files."""
+    which it never leaves): a session reopened from another folder names the same files. The
+    output fields left at their defaults (material.json, material.gltf, turntable.webp) stay
+    relative: they name a file in the folder the editor runs in when it writes, as on a first
+    start, not in the folder of the session that saved them."""
     from alight.core.mesh import BUILTIN_MESHES
+    from alight.frontends.editor.panel import DEFAULT_PATHS
+    from alight.frontends.editor.turntable import DEFAULT_PATH
     from alight.paths import absolute, absolute_maps
+
+    def output(path, default):
+        return path if path == default else absolute(path)
 
     compare_dict = compare.to_dict(state.compare)
     compare_dict["a_texture_maps"] = absolute_maps(state.compare.a_texture_maps).to_dict()
@@ -52,9 +60,10 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
             "compare": compare_dict}
     if turntable is not None:
-        data["turntable"] = {"frames": turntable.frames, "path": absolute(turntable.path)}
+        data["turntable"] = {"frames": turntable.frames, "path": output(turntable.path, DEFAULT_PATH)}
     if panel is not None:
-        data["files"] = {k: absolute(v) if isinstance(v, str) else v for k, v in panel.kept_paths().items()}
+        data["files"] = {k: output(v, DEFAULT_PATHS.get(k)) if isinstance(v, str) else v
+                         for k, v in panel.kept_paths().items()}
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))

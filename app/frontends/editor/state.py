@@ -44,6 +44,14 @@ def default_lights() -> list[Light]:
             Light("directional", (-0.3, -1.0, -0.5), (1.0, 1.0, 1.0), 1.0)]
 
 
+def read_mesh(spec: str):
+    """A built-in mesh or a mesh file, read and decoded (CPU only, no GL, no state: safe on a
+    worker thread). Errors: AlightError of one line."""
+    from alight.exchange.meshes import load_mesh
+
+    return load_mesh(spec)
+
+
 @dataclass
 class EditorState:
     mesh_spec: str = "sphere"
@@ -116,12 +124,13 @@ class EditorState:
     # --- loading (all or nothing) -----------------------------------------------------------
 
     def load_mesh(self, spec: str) -> None:
-        from alight.exchange.meshes import load_mesh
+        self.apply_mesh(spec, read_mesh(spec))
 
+    def apply_mesh(self, spec: str, mesh) -> None:
+        """A mesh read by ``read_mesh`` (here, or on the panel's worker thread: file_jobs.py)."""
         from alight.core.mesh import BUILTIN_MESHES
         from alight.paths import absolute
 
-        mesh = load_mesh(spec)
         # A file kept by its absolute path: the session reopens it from any folder.
         self.mesh, self.mesh_spec = mesh, spec if spec in BUILTIN_MESHES else absolute(spec)
         # As 'alight render' draws a file: its own materials where it has any (the panel's
@@ -321,11 +330,20 @@ class EditorState:
         KHR_materials_ior/specular). Where the view shows the mesh file's own materials, each
         part keeps its own (textures, samplers and transforms included); else the panel's goes on
         every part. The returned note (else '') says in one line what was left out."""
+        return self.export_job(path)()
+
+    def export_job(self, path: str):
+        """``export_gltf``'s work as a function of what is shown now (the material, its maps, the
+        mesh: all replaced, never changed in place), to run on a worker thread (file_jobs.py):
+        it returns the note."""
         from alight.exchange.gltf_export import export_gltf
 
-        _, notes = export_gltf(self.material, path, self.texture_maps, self.mesh,
-                               file_materials=self.use_file_materials)
-        return "; ".join(n for n in notes if "left out" in n)
+        material, maps, mesh, own = self.material, self.texture_maps, self.mesh, self.use_file_materials
+
+        def run() -> str:
+            _, notes = export_gltf(material, path, maps, mesh, file_materials=own)
+            return "; ".join(n for n in notes if "left out" in n)
+        return run
 
     def open_texture_set(self, paths, folder: str = "") -> list[str]:
         """Image files dropped together (or ``folder``'s), assigned to slots by their names

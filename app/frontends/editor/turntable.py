@@ -49,7 +49,10 @@ class TurntableSettings:
     ``NAME.webp``, ``NAME.mp4``: one animated file)."""
 
     frames: int = 36
-    path: str = "turntable.webp"
+    path: str = "turntable.webp"   # DEFAULT_PATH: relative, so the working folder of the moment
+
+
+DEFAULT_PATH = TurntableSettings.path
 
 
 def frame_paths(path: str, frames: int) -> list[Path]:

@@ -60,6 +60,19 @@ def view(ctx):
     return on_main_thread(ctx, lambda: editor().view_pixels())
 
 
+def files_done(ctx, frames: int = 20000) -> int:
+    """Frames until the panel's 'open mesh' and 'export glTF' (run on a worker thread:
+    file_jobs.py) have finished and a frame has taken their result; their count."""
+    jobs = editor().panel.file_jobs
+    ctx.yield_()   # the frame that starts a job asked for by the last key or click
+    for n in range(frames):
+        if not jobs.busy:
+            ctx.yield_()   # the frame that took it has drawn the status row
+            return n
+        ctx.yield_()
+    raise AssertionError(f"the panel's file job still runs after {frames} frames")
+
+
 def load_tests(path: str) -> list[tuple[str, object]]:
     """The ``test_*`` functions of a Python file, in the order written. Errors: AlightError,
     one line naming the file (missing, does not import, no test functions)."""

@@ -237,6 +237,8 @@ class EditorWindow:
             self.imgui.get_io().config_input_text_cursor_blink = False
 
         self.panel = Panel()
+        if not self.hosted:   # a finished open or export ends the idle wait (file_jobs.py)
+            self.panel.file_jobs.wake = self._answer_came
         from alight.frontends.editor.compare_view import CompareView
         from alight.frontends.editor.thumbnails import Thumbnails
 
@@ -1019,12 +1021,13 @@ class EditorWindow:
 
     def _background_pending(self) -> bool:
         """Work whose results come without input: a child's job, thumbnails asked for, the
-        presets' prefetch, the split view's warm-up. (A focused text field needs none: its cursor
+        presets' prefetch, the split view's warm-up, a mesh opened or a glTF exported on the
+        panel's worker thread. (A focused text field needs none: its cursor
         does not blink, and keys bring frames.)"""
         from alight.frontends.editor import worker_process
 
         return bool(worker_process.busy() or self.thumbnails.pending() or self.preset_prefetch.busy
-                    or not self.pass_warmup.done)
+                    or not self.pass_warmup.done or self.panel.file_jobs.busy)
 
     def close(self) -> None:
         if not self.hosted:

@@ -1,0 +1,140 @@
+"""Opening a mesh file and exporting glTF off the editor's UI thread.
+
+A new user saw the window freeze for seconds, no frame drawn, while 'open mesh' read
+DamagedHelmet (its JSON, buffers and five 2048x2048 textures decoded) and while 'export glTF'
+encoded and wrote it. Both now run on a worker thread: the thread does the file's CPU work
+(``state.read_mesh``: parse, decode, tangents; ``EditorState.export_job``: encode, write
+atomically through ``alight.exchange.output``), and the window's frame takes the result
+(``Panel.take_file_jobs``): a mesh read is assigned to the state on the GL thread, where the
+renderer uploads it when it next draws it (GL objects are made on the GL thread only).
+
+Meanwhile the status row says "opening NAME..." / "exporting NAME...", frames keep coming and the
+view orbits. A second 'open mesh' while one runs wins: the earlier one's result is dropped when
+it comes (its thread cannot be stopped, and finishes unseen). A second 'export glTF' while one
+runs is refused with a line in the status row: the first is writing a file, and a second write
+to the same name would race it. A failure gives the usual one-line error and leaves the previous
+mesh in place (nothing is assigned before the read is whole).
+
+The numpy and image decoding release the GIL for much of the read; the rest is Python, which the
+interpreter shares between the frame and the thread (benchmarks/bench_editor_open_mesh.py
+measures the frames drawn and the longest gap during the helmet's open).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from dataclasses import dataclass
+
+
+@dataclass
+class Done:
+    """A finished job: ``kind`` 'open' or 'export', what it was for (the mesh's spec, the file
+    written), and its value (the mesh, the export's note) or the exception it raised."""
+    kind: str
+    target: str
+    value: object = None
+    error: Exception | None = None
+
+
+class FileJobs:
+    """The panel's file work on worker threads: one open (the latest) and one export at a time."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._open_id = 0              # the latest open asked for; an older one's result is dropped
+        self._opening = ""             # its spec, '' when none runs
+        self._exporting = ""           # the file an export writes, '' when none runs
+        self._done: list[Done] = []    # finished, not yet taken by a frame
+        self.wake = None               # called on the worker thread when a job ends (the window's idle wait)
+        self.started = 0               # jobs started so far (tests and the benchmark read it)
+        self.threads = 0               # worker threads alive, superseded ones included
+        self.frames_while_running = 0  # frames that found a job running (``take``): drawn meanwhile
+
+    @property
+    def busy(self) -> bool:
+        """Whether a job runs or a result waits for a frame to take it."""
+        with self._lock:
+            return bool(self._opening or self._exporting or self._done)
+
+    def status(self) -> str:
+        """The status row's line while a job runs, else ''."""
+        with self._lock:
+            parts = [f"{verb} {os.path.basename(target) or target}..."
+                     for verb, target in (("opening", self._opening), ("exporting", self._exporting)) if target]
+        return "; ".join(parts)
+
+    def open_mesh(self, spec: str, read) -> None:
+        """Read ``spec`` with ``read(spec)`` on a thread; a later call supersedes this one."""
+        with self._lock:
+            self._open_id += 1
+            job, self._opening = self._open_id, spec
+        self._start(lambda: self._run_open(job, spec, read))
+
+    def drop_open(self) -> None:
+        """Forget the open that runs (another mesh was chosen since): its result is dropped."""
+        with self._lock:
+            self._open_id += 1
+            self._opening = ""
+
+    def export(self, path: str, run) -> bool:
+        """Run ``run()`` (the export, writing ``path``) on a thread. Returns False, starting
+        nothing, while another export runs."""
+        with self._lock:
+            if self._exporting:
+                return False
+            self._exporting = path
+        self._start(lambda: self._run_export(path, run))
+        return True
+
+    @property
+    def exporting(self) -> str:
+        with self._lock:
+            return self._exporting
+
+    def take(self) -> list[Done]:
+        """The jobs finished since the last call (on the GL thread, once a frame)."""
+        with self._lock:
+            done, self._done = self._done, []
+            if self._opening or self._exporting:
+                self.frames_while_running += 1
+        return done
+
+    def _start(self, target) -> None:
+        self.started += 1
+        with self._lock:
+            self.threads += 1
+
+        def run():
+            try:
+                target()
+            finally:
+                with self._lock:
+                    self.threads -= 1
+        threading.Thread(target=run, name="alight-file-job", daemon=True).start()
+
+    def _run_open(self, job: int, spec: str, read) -> None:
+        try:
+            result = Done("open", spec, value=read(spec))
+        except Exception as exc:   # reported as one line by the frame that takes it
+            result = Done("open", spec, error=exc)
+        with self._lock:
+            if job != self._open_id:
+                return   # superseded: a later open is what the user asked for
+            self._opening = ""
+            self._done.append(result)
+        self._wake()
+
+    def _run_export(self, path: str, run) -> None:
+        try:
+            result = Done("export", path, value=run())
+        except Exception as exc:
+            result = Done("export", path, error=exc)
+        with self._lock:
+            self._exporting = ""
+            self._done.append(result)
+        self._wake()
+
+    def _wake(self) -> None:
+        if self.wake is not None:
+            self.wake()
