@@ -85,8 +85,10 @@ def measure(folder: Path, size: int, samples: int, maps: list[str], keys: list[s
                 img = renderer.render(scene_for(mesh, scene, key, size, mode), maps_, size, size,
                                       read_linear=True, read_srgb=False).linear
                 errors[mode] = 100.0 * binned_relative_mae(img, ref, 4)
+                errors[mode + " bias"] = 100.0 * (float(img[..., :3].mean()) / max(float(ref[..., :3].mean()), 1e-9) - 1.0)
             rows.append((scene, env_name, key, errors["off"], errors["on"]))
-            print(f"{scene} {env_name:24s} {key:9s} off {errors['off']:5.1f}%  {label} {errors['on']:5.1f}%", flush=True)
+            print(f"{scene} {env_name:24s} {key:9s} off {errors['off']:5.1f}%  {label} {errors['on']:5.1f}% "
+                  f"(mean {errors['off bias']:+.0f}% / {errors['on bias']:+.0f}%)", flush=True)
     if trace_only:
         return rows
     lines = [f"# The bowl's metals against the path tracer ({label})", "",
