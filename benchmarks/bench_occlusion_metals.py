@@ -2,8 +2,9 @@
 and iron at roughness 0.3, 0.6 and 0.9, and the grey dielectric (0.7, roughness 0.5) for
 comparison, under newport_loft and royal_esplanade, alight with --occlusion off and on against the
 path tracer (app/accuracy/path_trace.py), binned 4x4 linear relMAE (app/accuracy/binned.py, as
-`alight compare --bin 4`). Prints a table and writes benchmarks/results/<--out> (default
-occlusion-metals.md); asserts nothing.
+`alight compare --bin 4`), and each image's mean against the reference's (signed). Prints a
+table, and with --out writes it to benchmarks/results/<--out> (results/occlusion-metals.md was
+put together from its runs by hand: before and after, and the variants tried); asserts nothing.
 
     .venv/bin/python benchmarks/bench_occlusion_metals.py --references DIR [--maps a,b] [--materials gold-0.6,grey]
 

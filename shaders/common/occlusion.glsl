@@ -1,7 +1,7 @@
 // Occlusion of the environment light and one diffuse bounce, from the per-vertex visibility bake
 // (app/core/visibility.py; its numpy twins there: cone_aperture_cos, spherical_caps_intersection,
-// specular_occlusion, combined_visibility, occluded_environment; sky_visibility's in
-// app/core/sky_weight.py). Compiled only with HAS_VISIBILITY, which app/render/visibility_parts.py
+// specular_occlusion, combined_visibility, occluded_environment, visible_sky_radiance,
+// visible_lobe_radiance; sky_visibility's in app/core/sky_weight.py). Compiled only with HAS_VISIBILITY, which app/render/visibility_parts.py
 // sets for a mesh that was baked: every other mesh reads the glTF occlusion texture alone,
 // exactly as before. HAS_SKY_WEIGHT (with it): the visible sky weight of the environment drawn
 // (app/core/sky_weight.py) is in the vertices too.
@@ -124,9 +124,10 @@ vec3 visible_sky_radiance(vec3 sky, float ray_visibility, vec3 irradiance) {
 // lobe's middle only where the whole lobe is (so = 1); as less of it is, it moves toward the mean
 // radiance of the sky the point sees (visible_sky_radiance), by so^2. The prefiltered fetch holds
 // the blocked part's light too: inside the bowl under newport_loft the windows near the horizon
-// the walls hide (the gold bowl r 0.6 35% -> 28% against the path tracer); under
+// the walls hide (the gold bowl r 0.6 35.0% -> 21.7% against the path tracer); under
 // royal_esplanade a rough metal's floor sees the bright sky overhead, brighter than its lobe's
-// middle (gold r 0.9 34.5% -> 15.9%). Under a uniform environment: so times it, as before.
+// middle (gold r 0.9 34.5% -> 15.9%; benchmarks/results/occlusion-metals.md). Under a uniform
+// environment: so times it, as before.
 vec3 visible_lobe_radiance(vec3 prefiltered, vec3 visible_sky, float so) {
     return so * mix(visible_sky, prefiltered, so * so);
 }
