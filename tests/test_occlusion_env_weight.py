@@ -150,6 +150,30 @@ def test_the_shader_term_matches_its_numpy_twin():
     np.testing.assert_array_equal(vis.combined_visibility([0.5, 1.2, 0.3], [-0.4, 1.5, 0.6]), [0.0, 1.0, 0.3])
 
 
+def test_the_visible_lobe_term_matches_its_numpy_twin():
+    """occlusion.glsl's visible_lobe_radiance(prefiltered, visible_sky_radiance(W, V_rays, E), so)
+    against the twins in alight.core.visibility (V_rays 0 and a negative W included); the whole
+    lobe visible (so = 1) keeps the prefiltered radiance, a uniform sky (W = V_rays, E = the
+    prefiltered radiance) gives so times it, as before the term."""
+    rng = np.random.default_rng(5)
+    rows = np.column_stack([rng.uniform(-0.1, 1, 400), rng.uniform(0, 1, 400), rng.uniform(0, 1, 400),
+                            rng.uniform(0, 1, 400)])
+    rows[:20, 2] = 0.0
+    rows[20:40, 3] = 1.0
+    gpu = evaluate(9, rows, shader="accuracy/evaluate_occlusion.comp")[:, :3]
+    sky = np.column_stack([rows[:, 0], rows[:, 1], 0.5 * (rows[:, 0] + rows[:, 1])])
+    irradiance = np.tile([0.8, 0.5, 0.3], (len(rows), 1))
+    prefiltered = np.tile([1.5, 0.2, 0.7], (len(rows), 1))
+    cpu = vis.visible_lobe_radiance(prefiltered, vis.visible_sky_radiance(sky, rows[:, 2], irradiance), rows[:, 3])
+    np.testing.assert_allclose(gpu, cpu, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(cpu[20:40], prefiltered[20:40], rtol=1e-12)
+    v = rng.uniform(0.01, 1, 50)
+    so = rng.uniform(0, 1, 50)
+    e = np.full((50, 3), 0.6)
+    uniform = vis.visible_lobe_radiance(e, vis.visible_sky_radiance(np.repeat(v[:, None], 3, axis=1), v, e), so)
+    np.testing.assert_allclose(uniform, so[:, None] * e, rtol=1e-12)
+
+
 def _bowl_scene(tmp_path, occlusion="on"):
     from alight.accuracy.scenes import write_scene
     from alight.core.material import Material

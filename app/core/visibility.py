@@ -247,6 +247,25 @@ def sky_visibility(visibility, sky, ray_visibility):
     return np.minimum(v * ratio, 1.0)
 
 
+def visible_sky_radiance(sky, ray_visibility, irradiance):
+    """occlusion.glsl's visible_sky_radiance: the mean radiance of the sky the vertex's rays see,
+    (W / V_rays) E(n)/pi per channel (N, 3), from the visible sky weight W (N, 3), its rays' V
+    (N,) and E/pi at the shading normal (N, 3); E(n)/pi where V_rays is 0."""
+    rv = np.asarray(ray_visibility, np.float64)[..., None]
+    ratio = np.where(rv > 1e-4, np.maximum(np.asarray(sky, np.float64), 0.0) / np.maximum(rv, 1e-4), 1.0)
+    return ratio * np.asarray(irradiance, np.float64)
+
+
+def visible_lobe_radiance(prefiltered, visible_sky, so):
+    """occlusion.glsl's visible_lobe_radiance: the radiance the visible share ``so`` (N,) of the
+    specular lobe brings, so (visible_sky + (prefiltered - visible_sky) so^2) (N, 3): the
+    prefiltered radiance at the lobe's middle where the whole lobe is visible, the mean radiance
+    of the sky the point sees (``visible_sky_radiance``) as less of it is."""
+    so = np.asarray(so, np.float64)[..., None]
+    sky = np.asarray(visible_sky, np.float64)
+    return so * (sky + (np.asarray(prefiltered, np.float64) - sky) * (so * so))
+
+
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
                          hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None,
                          sky=None):
@@ -261,7 +280,9 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     E(bent)/pi by ``cone_blend`` (occlusion.glsl's visible_cone_radiance). ``sky``: (W (N, 3),
     the rays' V (N,), E/pi at the shading normal (N, 3)) of the visible sky weight
     (HAS_SKY_WEIGHT, app/core/sky_weight.py): the visible part is then
-    sky_visibility(V, W, V_rays) E(n)/pi instead of V times the cone's radiance."""
+    sky_visibility(V, W, V_rays) E(n)/pi instead of V times the cone's radiance, and the visible
+    part of the specular lobe visible_lobe_radiance(prefiltered, visible_sky_radiance(W, V_rays,
+    E(n)/pi), so) instead of so times the prefiltered radiance."""
     v = np.asarray(visibility, np.float64)[..., None]
     albedo = np.minimum(hit_albedo, 1.0)
     hit_visibility = occluder_visibility(bounce_weight, baked_visibility)
@@ -273,12 +294,14 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     cone = bent if cone_radiance is None else np.asarray(cone_radiance, np.float64)
     blend = cone_blend(visibility)[..., None]
     visible = cone + (bent - cone) * blend
+    specular = so * prefiltered
     if sky is not None:
         w, ray_visibility, irradiance_n = sky
         diffuse = sky_visibility(visibility, w, ray_visibility) * np.asarray(irradiance_n, np.float64)
+        specular = visible_lobe_radiance(prefiltered, visible_sky_radiance(w, ray_visibility, irradiance_n), so[..., 0])
     else:
         diffuse = v * visible
-    return diffuse + (1.0 - v) * occluder, so * prefiltered + (1.0 - so) * occluder
+    return diffuse + (1.0 - v) * occluder, specular + (1.0 - so) * occluder
 
 
 # ---- which meshes need it -----------------------------------------------------------------------

@@ -19,6 +19,10 @@ const int TERM_OCCLUDERS_REFLECTANCE = 5; // (hit albedo rgb, hit visibility)
 const int TERM_SUNS_ON_OCCLUDERS = 6;     // (hit albedo rgb, hit visibility; first = 1, second = 1)
 const int TERM_CONE = 7;                  // (V): cone_roughness, cone_blend
 const int TERM_SKY_VISIBILITY = 8;        // (W r, W g, V_rays, V); W b = (W r + W g) / 2
+const int TERM_VISIBLE_LOBE = 9;          // (W r, W g, V_rays, so); W b as above, E(n)/pi and the
+                                          // prefiltered radiance the constants below
+const vec3 LOBE_IRRADIANCE = vec3(0.8, 0.5, 0.3);
+const vec3 LOBE_PREFILTERED = vec3(1.5, 0.2, 0.7);
 
 vec3 polar_direction(float theta, float phi) {
     return vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
@@ -57,6 +61,10 @@ void main() {
             break;
         case TERM_SKY_VISIBILITY:
             o.xyz = sky_visibility(a.w, vec3(a.x, a.y, 0.5 * (a.x + a.y)), a.z);
+            break;
+        case TERM_VISIBLE_LOBE:
+            o.xyz = visible_lobe_radiance(LOBE_PREFILTERED,
+                visible_sky_radiance(vec3(a.x, a.y, 0.5 * (a.x + a.y)), a.z, LOBE_IRRADIANCE), a.w);
             break;
     }
     u_outputs[i] = o;

@@ -1,7 +1,7 @@
 // Occlusion of the environment light and one diffuse bounce, from the per-vertex visibility bake
 // (app/core/visibility.py; its numpy twins there: cone_aperture_cos, spherical_caps_intersection,
-// specular_occlusion, combined_visibility, occluded_environment; sky_visibility's in
-// app/core/sky_weight.py). Compiled only with HAS_VISIBILITY, which app/render/visibility_parts.py
+// specular_occlusion, combined_visibility, occluded_environment, visible_sky_radiance,
+// visible_lobe_radiance; sky_visibility's in app/core/sky_weight.py). Compiled only with HAS_VISIBILITY, which app/render/visibility_parts.py
 // sets for a mesh that was baked: every other mesh reads the glTF occlusion texture alone,
 // exactly as before. HAS_SKY_WEIGHT (with it): the visible sky weight of the environment drawn
 // (app/core/sky_weight.py) is in the vertices too.
@@ -109,6 +109,27 @@ vec3 visible_cone_radiance(vec3 bent, float visibility) {
 vec3 sky_visibility(float visibility, vec3 sky, float ray_visibility) {
     vec3 ratio = ray_visibility > 1e-4 ? max(sky, vec3(0.0)) / ray_visibility : vec3(1.0);
     return min(visibility * ratio, vec3(1.0));
+}
+
+// The mean radiance of the sky the vertex's rays see, per channel: (W / V_rays) E(n)/pi (the
+// visible sky weight's rays' sum of free L over their sum of free, times the hemisphere's cosine
+// mean E(n)/pi); E(n)/pi where the rays' V is 0. Under a uniform environment it is E/pi.
+vec3 visible_sky_radiance(vec3 sky, float ray_visibility, vec3 irradiance) {
+    vec3 ratio = ray_visibility > 1e-4 ? max(sky, vec3(0.0)) / ray_visibility : vec3(1.0);
+    return ratio * irradiance;
+}
+
+// The radiance the visible part of the specular lobe brings (HAS_SKY_WEIGHT): the share so of the
+// lobe is visible (specular_occlusion), and its radiance is the prefiltered radiance at the
+// lobe's middle only where the whole lobe is (so = 1); as less of it is, it moves toward the mean
+// radiance of the sky the point sees (visible_sky_radiance), by so^2. The prefiltered fetch holds
+// the blocked part's light too: inside the bowl under newport_loft the windows near the horizon
+// the walls hide (the gold bowl r 0.6 35.0% -> 21.7% against the path tracer); under
+// royal_esplanade a rough metal's floor sees the bright sky overhead, brighter than its lobe's
+// middle (gold r 0.9 34.5% -> 15.9%; benchmarks/results/occlusion-metals.md). Under a uniform
+// environment: so times it, as before.
+vec3 visible_lobe_radiance(vec3 prefiltered, vec3 visible_sky, float so) {
+    return so * mix(visible_sky, prefiltered, so * so);
 }
 
 #ifdef HAS_VISIBILITY
@@ -235,13 +256,21 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     // suns) that the vertex's rays see, per channel (sky_visibility). The occluded share of the
     // directions, 1 - V, still sees the occluders.
     vec3 sky = baked ? sky_visibility(visibility, v_sky_weight.rgb, v_sky_weight.w) : vec3(visibility);
-    irradiance = sky * irradiance_at(n, false) + (1.0 - visibility) * occluder;
+    vec3 irradiance_n = irradiance_at(n, false);
+    irradiance = sky * irradiance_n + (1.0 - visibility) * occluder;
 #else
     irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
 #endif
     if (with_suns) irradiance += suns_irradiance_over_pi(n);
     float so = specular_occlusion(dot(bent, r), dot(n, r), visibility, s.roughness);
+#ifdef HAS_SKY_WEIGHT
+    // The visible part of the lobe as the sky the point sees (visible_lobe_radiance); the blocked
+    // part, 1 - so, sees the occluders as before.
+    vec3 visible_sky = baked ? visible_sky_radiance(v_sky_weight.rgb, v_sky_weight.w, irradiance_n) : prefiltered;
+    prefiltered = visible_lobe_radiance(prefiltered, visible_sky, so) + (1.0 - so) * occluder;
+#else
     prefiltered = so * prefiltered + (1.0 - so) * occluder;
+#endif
     g_occluder_radiance = occluder;
 #elif defined(HAS_SCREEN_AO)
     // GTAO's V and mean occluded direction d. GTAO_OCCLUDERS, the bake's terms: the visible share
