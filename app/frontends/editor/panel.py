@@ -225,8 +225,9 @@ class Panel:
 
     def _status_line(self, s, win) -> str:
         """The panel's menu bar, one row of a fixed height that never scrolls: the error (red),
-        else the bake's or turntable's progress, else that the view waits for a new look's
-        shaders, else the last message (green), else nothing; so a save or an
+        else a file job's, the IBL bake's or the turntable's progress, else the last message
+        (green) followed by what runs in the background (grey: the occlusion bake, a new look's
+        shaders compiling), else nothing; so a save or an
         error is seen wherever the panel is scrolled, and the rows below never move when one
         appears or goes. A long line is cut at the panel's edge; hovering it shows it whole.
         Returns the row's text."""
@@ -234,7 +235,7 @@ class Panel:
 
         if not imgui.begin_menu_bar():
             return ""
-        shown = ""
+        shown, hovered = "", False
         jobs = self.file_jobs.status()
         if s.error:
             shown = f"error: {s.error}"
@@ -250,32 +251,34 @@ class Panel:
             shown = win.turntable_job.progress()
             imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
         else:
+            # The last message first (green: a file's warnings are not seen again later), then
+            # what runs in the background (grey): the child's occlusion bake, a new look's
+            # shaders compiling in the warm-up process (the view holds the last picture
+            # meanwhile, which must not pass for the new one). A new user saw both cut at the
+            # panel's edge with the message last.
             baking = getattr(getattr(win, "occlusion_bake", None), "status", "")
-            if baking:   # the child process bakes (occlusion_bake.py): the view is drawn without meanwhile
-                shown = baking
-                imgui.text_disabled(shown)
-                if s.message or getattr(getattr(win, "variant_warmup", None), "showing_old", False):
+            compiling = "compiling shaders: the view shows the last look" \
+                if getattr(getattr(win, "variant_warmup", None), "showing_old", False) else ""
+            parts = [(text, kind) for text, kind in ((s.message, "message"), (baking, "note"), (compiling, "note"))
+                     if text]
+            for i, (text, kind) in enumerate(parts):
+                if i:
                     imgui.same_line()
-            if getattr(getattr(win, "variant_warmup", None), "showing_old", False):
-                # A new look's program compiles in the warm-up process (variant_warmup.py): the
-                # view holds the last picture meanwhile, which must not pass for the new one. The
-                # message (a file's warnings) stays beside it: it is not seen again later.
-                compiling = "compiling shaders: the view shows the last look"
-                shown = f"{shown} | {compiling}" if shown else compiling
-                imgui.text_disabled(compiling)
-                if s.message:
-                    imgui.same_line()
-            if s.message:
-                shown = f"{shown} | {s.message}" if shown else s.message
-                imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), s.message)
-        if (s.error or s.message) and imgui.is_item_hovered():
+                if kind == "message":
+                    imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), text)
+                else:
+                    imgui.text_disabled(text)
+                hovered = hovered or imgui.is_item_hovered()
+            shown = " | ".join(text for text, _ in parts)
+        hovered = hovered or imgui.is_item_hovered()
+        if shown and hovered:
             # The line whole, wrapped to the window's width (a set's assignment outgrew it); a
-            # file's several warnings one a line.
+            # file's several warnings, and each background note, one a line.
             width = imgui.get_io().display_size.x
             imgui.set_next_window_pos(imgui.ImVec2(0.0, imgui.get_item_rect_max().y + 2.0))
             imgui.begin_tooltip()
             imgui.push_text_wrap_pos(width - 2.0 * imgui.get_style().window_padding.x)
-            imgui.text_unformatted(s.error or s.message.replace(" | ", "\n"))
+            imgui.text_unformatted(s.error if s.error else shown.replace(" | ", "\n"))
             imgui.pop_text_wrap_pos()
             imgui.end_tooltip()
         imgui.end_menu_bar()
