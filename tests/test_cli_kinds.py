@@ -218,7 +218,8 @@ def test_gltf_camera_without_aspect_keeps_the_square(tmp_path, out_dir):
 @pytest.mark.parametrize("command, args, names", [
     ("reference", ["--view", "probe", "--camera", "gltf"], ["--camera gltf: not with --view probe"]),
     ("reference", ["--view", "probe", "--mesh", "cube"], ["--mesh cube: not with --view probe"]),
-    ("reference", ["--mesh", "cube", "--camera", "gltf:1"], ["--camera gltf:1: the built-in mesh 'cube' has no glTF camera"]),
+    ("reference", ["--mesh", "cube", "--camera", "gltf:1"],
+     ["--camera gltf:1: the built-in mesh 'cube' has no glTF camera"]),
     ("render", ["--view", "probe", "--fov", "40"], ["--fov: not with --view probe"]),
 ], ids=["reference-probe-gltf", "reference-probe-mesh", "reference-builtin-gltf", "render-probe-fov"])
 def test_probe_and_builtin_camera_conflicts_are_one_line(out_dir, command, args, names):
