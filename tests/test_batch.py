@@ -223,3 +223,23 @@ def test_file_warnings_are_printed_once_per_batch(folder):
     assert main(str(spec), executor="local", workers=2, log=log) == 0
     lines = [line for line in log.getvalue().splitlines() if line.startswith("alight: warning:")]
     assert len(lines) == 1 and "mtllib 'gone.mtl' not found" in lines[0], lines
+
+
+@pytest.mark.parametrize("text, said", [
+    ('environments = ["stuido"]\n', "environments[0]: {folder}/stuido: no such file or folder; did you mean studio?"),
+    ('environments = ["maps/venise.hdr"]\n', "did you mean {folder}/maps/venice.hdr?"),
+    ('materail = ["gold"]\n', "unknown key 'materail'; did you mean materials?"),
+    ('size = 9000\n', "'size' must be an integer or [W, H], 1..8192 (each batch worker holds its whole image"),
+], ids=["env-studio", "env-file-in-folder", "key", "size-cap-says-why"])
+def test_cli_spec_typos_name_the_closest(folder, text, said):
+    """One line naming the spec, the entry and the closest valid name; exit 2; nothing written."""
+    (folder / "maps").mkdir()
+    (folder / "maps" / "venice.hdr").write_bytes(b"")
+    (folder / "maps" / "quarry.exr").write_bytes(b"")
+    spec = write_spec(folder, 'size = 16\nquality = "low"\n' * ("size" not in text) + text)
+    r = cli(str(spec), cwd=folder)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("alight: error: ") and "Traceback" not in r.stderr, lines
+    assert str(spec) in lines[0] and said.replace("{folder}", str(folder.resolve())) in lines[0], lines[0]
+    assert not (folder / "spec").exists()

@@ -365,6 +365,8 @@ def _make_inputs(inp: Path, shared: Path) -> None:
     (inp / "missing_field.json").write_text(json.dumps(missing))
     (inp / "rough.json").write_text(json.dumps({**good, "roughness": 1.5}))
     (inp / "notjson.json").write_text("{ this is not json\n")
+    (inp / "short_vertex.obj").write_text("v 1 2\nf 1 2 3\n")            # a vertex of two coordinates
+    (inp / "word_normal.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 zero 1\nf 1//1 2//1 3//1\n")
 
 
 # (args, things the one error line must name). {in}: the inputs folder, {data}: shared data,
@@ -390,6 +392,23 @@ BAD_INPUT = [
     pytest.param(["--out", "{out}/x.jpg"], ["{out}/x.jpg"], id="out-jpg"),
     pytest.param(["--out", "{out}/no_such_folder/x.png"], ["{out}/no_such_folder"], id="out-missing-folder"),
     pytest.param(["--view", "probe", "--size", "64x32"], ["--size"], id="probe-not-square"),
+    # --view probe draws the material on its unit sphere through its own camera: what it would ignore is refused
+    pytest.param(["--mesh", "{data}/models/Duck.glb", "--camera", "gltf", "--view", "probe"],
+                 ["--camera gltf: not with --view probe", "orthographic camera"], id="probe-gltf-camera"),
+    pytest.param(["--view", "probe", "--orbit", "30"], ["--orbit: not with --view probe"], id="probe-orbit"),
+    pytest.param(["--view", "probe", "--ground"], ["--ground: not with --view probe"], id="probe-ground"),
+    pytest.param(["--view", "probe", "--mesh", "cube"], ["--mesh cube: not with --view probe"], id="probe-mesh"),
+    pytest.param(["--view", "probe", "--shadows", "on"], ["--shadows on: not with --view probe"], id="probe-shadows"),
+    pytest.param(["--view", "probe", "--occlusion", "gtao"], ["--occlusion gtao: not with --view probe"],
+                 id="probe-occlusion"),
+    pytest.param(["--view", "probe", "--mesh-shading", "vbuffer"], ["--mesh-shading vbuffer: not with --view probe"],
+                 id="probe-mesh-shading"),
+    pytest.param(["--mesh", "sphere", "--camera", "gltf"],
+                 ["--camera gltf: the built-in mesh 'sphere' has no glTF camera"], id="builtin-gltf-camera"),
+    pytest.param(["--mesh", "{in}/short_vertex.obj"], ["{in}/short_vertex.obj: line 1: a vertex needs 3 coordinates"],
+                 id="obj-short-vertex"),
+    pytest.param(["--mesh", "{in}/word_normal.obj"], ["{in}/word_normal.obj: line 4: 'zero' is not a number"],
+                 id="obj-word-in-normal"),
 ]
 
 

@@ -213,3 +213,15 @@ def test_gltf_camera_without_aspect_keeps_the_square(tmp_path, out_dir):
                "--out", out)
     assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
     assert _size_of(out) == (32, 32)
+
+
+@pytest.mark.parametrize("command, args, names", [
+    ("reference", ["--view", "probe", "--camera", "gltf"], ["--camera gltf: not with --view probe"]),
+    ("reference", ["--view", "probe", "--mesh", "cube"], ["--mesh cube: not with --view probe"]),
+    ("reference", ["--mesh", "cube", "--camera", "gltf:1"],
+     ["--camera gltf:1: the built-in mesh 'cube' has no glTF camera"]),
+    ("render", ["--view", "probe", "--fov", "40"], ["--fov: not with --view probe"]),
+], ids=["reference-probe-gltf", "reference-probe-mesh", "reference-builtin-gltf", "render-probe-fov"])
+def test_probe_and_builtin_camera_conflicts_are_one_line(out_dir, command, args, names):
+    """alight reference reads the scene and camera flags as alight render does: the same refusals."""
+    assert_refused(run(command, "--size", "16", *args, "--out", out_dir / "x.exr"), names, out_dir)

@@ -39,6 +39,11 @@ _BUILDERS: dict[str, Callable[[], Mesh]] = {"sphere": sphere, "cube": cube, "pla
                                             "drape": drape}
 
 
+def is_builtin(spec: str) -> bool:
+    """Whether ``spec`` names a built-in mesh (not a file)."""
+    return spec in _BUILDERS
+
+
 def _one_line(exc: BaseException) -> str:
     text = " ".join(str(exc).split()) or type(exc).__name__
     return text if len(text) <= 160 else text[:157] + "..."
@@ -77,7 +82,8 @@ def load_mesh(spec: str) -> Mesh:
         else:
             scene = trimesh.load(str(path), force="scene", process=False)
     except Exception as exc:  # trimesh raises anything from ValueError to KeyError on bad files
-        raise AlightError(f"{spec}: cannot read the file ({_one_line(exc)})") from None
+        problem = _obj_syntax_problem(path) if ext == ".obj" else None   # what line, where the text can tell
+        raise AlightError(f"{spec}: {problem or f'cannot read the file ({_one_line(exc)})'}") from None
     try:
         extras: dict[str, dict] = {}
         textures: dict[int, np.ndarray] = {}
@@ -261,6 +267,37 @@ def _obj_text_checks(path: Path) -> tuple[tuple[int, int], tuple[int, int]]:
             if len(tokens) >= 7 and not all(_finite_token(t) for t in tokens[4:7]):
                 colours.append(number)
     return (len(short), short[0] if short else 0), (len(colours), colours[0] if colours else 0)
+
+
+# An OBJ vertex statement's numbers (Wavefront OBJ): v x y z [w] or v x y z r g b (a colour,
+# alight.exchange.meshes' docstring), vn i j k, vt u [v [w]].
+_OBJ_NUMBERS = {b"v": ((3, 4, 6, 7), "a vertex needs 3 coordinates (x y z, or x y z r g b)"),
+                b"vn": ((3,), "a normal needs 3 numbers (i j k)"),
+                b"vt": ((1, 2, 3), "a texture coordinate needs 1 to 3 numbers (u v)")}
+
+
+def _obj_syntax_problem(path: Path) -> str | None:
+    """The first v/vn/vt line of an OBJ whose numbers are too few, too many or not numbers, as
+    'line N: ...' (None: the text looks right and trimesh's own message is all there is). Read
+    only after trimesh has failed, whose message names no line."""
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    for number, line in enumerate(data.split(b"\n"), 1):
+        tokens = line.split(b"#", 1)[0].split()
+        if not tokens or tokens[0] not in _OBJ_NUMBERS:
+            continue
+        counts, need = _OBJ_NUMBERS[tokens[0]]
+        values = tokens[1:]
+        for token in values:
+            try:
+                float(token)
+            except ValueError:
+                return f"line {number}: '{token.decode('utf-8', 'replace')}' is not a number ({need})"
+        if len(values) not in counts:
+            return f"line {number}: {need}; got {len(values)}"
+    return None
 
 
 def _ply_nonfinite_colours(geom) -> int:

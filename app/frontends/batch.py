@@ -28,6 +28,7 @@ Items run in a process pool (``spawn``: one GL context per worker process, creat
 from __future__ import annotations
 
 import concurrent.futures
+import difflib
 import itertools
 import json
 import math
@@ -43,6 +44,7 @@ from typing import Any, TextIO
 from alight.errors import AlightError
 from alight.frontends.batch_worker import MATERIAL_FIELDS, render_item
 
+BATCH_MAX_SIDE = 8192   # _size_and_quality says why it is below alight render's 16384
 _KEYS = {"out", "size", "quality", "meshes", "environments", "materials", "camera_angles",
          "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background", "shadows", "ground",
          "mesh_shading"}
@@ -198,7 +200,10 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
     spec = load_spec(source)
     unknown = set(spec) - _KEYS
     if unknown:
-        raise AlightError(f"{source}: unknown key {sorted(unknown)[0]!r} (known: {', '.join(sorted(_KEYS))})")
+        key = sorted(unknown)[0]
+        close = difflib.get_close_matches(str(key), sorted(_KEYS), n=1)
+        hint = f"; did you mean {close[0]}?" if close else ""
+        raise AlightError(f"{source}: unknown key {key!r}{hint} (known: {', '.join(sorted(_KEYS))})")
     base = source.resolve().parent
     size, quality = _size_and_quality(spec, source)
     meshes = _list(spec, "meshes", ["sphere"], source)
@@ -270,15 +275,42 @@ def _check_inputs_exist(source: Path, base: Path, meshes: list, envs: list, mate
                 names = ", ".join(sorted(p.stem for p in preset_dir().glob("*.json")))
                 raise AlightError(f"{source}: {where}: {text!r} is neither a preset nor a file{did_you_mean(text)} "
                                   f"(presets: {names})")
-            raise AlightError(f"{source}: {where}: {path}: no such file or folder (paths are relative to the spec's folder)")
+            hint = _closest_environment(path) if where.startswith("environments") else ""
+            raise AlightError(f"{source}: {where}: {path}: no such file or folder{hint} "
+                              f"(paths are relative to the spec's folder)")
+
+
+def _closest_environment(path: str) -> str:
+    """'; did you mean studio?' (or the closest .hdr/.exr in the folder the entry names) for a
+    misspelt environment, else ''."""
+    wanted = Path(path)
+    folder = wanted.parent
+    try:
+        files = [p.name for p in folder.iterdir() if p.suffix.lower() in (".hdr", ".exr")] if folder.is_dir() else []
+    except OSError:
+        files = []
+    close = difflib.get_close_matches(wanted.name, files, n=1) or \
+        difflib.get_close_matches(wanted.stem, [Path(f).stem for f in files], n=1)
+    if close:
+        match = next((f for f in files if f == close[0] or Path(f).stem == close[0]), close[0])
+        return f"; did you mean {folder / match}?"
+    if difflib.get_close_matches(wanted.name.lower(), ["studio"], n=1):
+        return "; did you mean studio?"
+    return ""
 
 
 def _size_and_quality(spec: dict, source: Path) -> tuple[list[int], str]:
     """The spec's size ([W, H]) and bake quality, checked."""
     size = spec.get("size", 256)
     size = [size, size] if isinstance(size, int) and not isinstance(size, bool) else size
-    if not (isinstance(size, list) and len(size) == 2 and all(isinstance(x, int) and 1 <= x <= 8192 for x in size)):
-        raise AlightError(f"{source}: 'size' must be an integer or [W, H], 1..8192")
+    # Lower than alight render's 16384: a batch worker renders each image whole in memory
+    # (Renderer.save) where alight render draws and writes strip by strip, and several workers run
+    # at once; 16384x16384 float RGBA is 4 GiB per worker before the PNG's copy.
+    if not (isinstance(size, list) and len(size) == 2
+            and all(isinstance(x, int) and not isinstance(x, bool) and 1 <= x <= BATCH_MAX_SIDE for x in size)):
+        raise AlightError(f"{source}: 'size' must be an integer or [W, H], 1..{BATCH_MAX_SIDE} (each batch worker "
+                          f"holds its whole image in memory, 1 GiB of float RGBA at 8192x8192; 'alight render "
+                          f"--size' writes strip by strip up to 16384)")
     quality = spec.get("quality", "medium")
     if quality not in ("low", "medium", "high"):
         raise AlightError(f"{source}: 'quality' must be low, medium or high")

@@ -41,6 +41,7 @@ def scene_from_flags(args, size: tuple[int, int], look, report: Report, **fields
     from alight.exchange.texture_sets import load_map_images
 
     material, overrides, texture_maps = look
+    check_probe_flags(args)
     lights = [parse_light(spec) for spec in args.light]
     mesh = load_scene_mesh(args.mesh, report) if args.view == "camera" else None
     if mesh is not None and not args.light and not args.no_file_lights:
@@ -56,6 +57,35 @@ def scene_from_flags(args, size: tuple[int, int], look, report: Report, **fields
                   env_rotation_deg=args.env_rotation, env_intensity=args.env_intensity,
                   ibl_enabled=env is not None, **fields)
     return SceneSetup(scene, env, width, height)
+
+
+PROBE_CAMERA = "the probe view has its own orthographic camera on the unit sphere"
+
+
+def check_probe_flags(args) -> None:
+    """--view probe draws the material on a unit sphere through its own orthographic camera
+    (docs/conventions.md): a flag that asks for a mesh, a camera or what a mesh brings (a ground,
+    shadows, occlusion, a mesh-shading path) would be silently ignored, so it is refused in one
+    line, as the camera flags always were. Only flags given (not at their defaults) are refused."""
+    if getattr(args, "view", "camera") != "probe":
+        return
+    asked = [("--camera " + str(args.camera), getattr(args, "camera", "auto") != "auto", PROBE_CAMERA)]
+    for flag in ("orbit", "elevation", "distance", "fov", "target"):
+        asked.append((f"--{flag}", getattr(args, flag, None) is not None, PROBE_CAMERA))
+    asked += [
+        (f"--mesh {getattr(args, 'mesh', 'sphere')}", getattr(args, "mesh", "sphere") != "sphere",
+         "the probe view draws no mesh, only the material on its unit sphere"),
+        ("--ground", bool(getattr(args, "ground", False)), "the probe view draws no ground"),
+        (f"--shadows {getattr(args, 'shadows', 'auto')}", getattr(args, "shadows", "auto") == "on",
+         "the probe view draws no shadows (there is no mesh to cast them)"),
+        (f"--occlusion {getattr(args, 'occlusion', 'auto')}", getattr(args, "occlusion", "auto") in ("on", "gtao"),
+         "the probe view has no mesh to occlude"),
+        (f"--mesh-shading {getattr(args, 'mesh_shading', 'auto')}",
+         getattr(args, "mesh_shading", "auto") != "auto", "the probe view draws no mesh"),
+    ]
+    for flag, given, why in asked:
+        if given:
+            raise AlightError(f"{flag}: not with --view probe ({why}); use --view camera")
 
 
 def load_scene_mesh(spec: str, report: Report):
@@ -111,7 +141,7 @@ def flag_camera(args, mesh, aspect: float):
                 target = ()
             if len(target) != 3 or not all(math.isfinite(x) for x in target):
                 raise AlightError(f"--target: '{args.target}' is not three comma-separated numbers")
-        if mesh is None:
+        if mesh is None:   # (check_probe_flags refuses these first, naming the flag)
             raise AlightError("--orbit/--elevation/--distance/--fov/--target: only with --view camera")
         if target is not None:   # the file's coordinates, where the mesh was moved from (Mesh.origin)
             target = tuple(t - o for t, o in zip(target, getattr(mesh, "origin", (0.0, 0.0, 0.0))))
@@ -133,7 +163,12 @@ def flag_camera(args, mesh, aspect: float):
         raise AlightError(f"--camera: '{spec}': N must be a whole number") from None
     cameras = getattr(mesh, "cameras", []) if mesh is not None else []
     if not cameras:
-        raise AlightError(f"--camera: {args.mesh}: the file has no camera")
+        from alight.exchange.meshes import is_builtin
+
+        if is_builtin(args.mesh):
+            raise AlightError(f"--camera {spec}: the built-in mesh '{args.mesh}' has no glTF camera; "
+                              f"give a .gltf/.glb file with --mesh, or use --camera auto")
+        raise AlightError(f"--camera {spec}: {args.mesh}: the file has no camera")
     if not 0 <= n < len(cameras):
         raise AlightError(f"--camera: {args.mesh}: camera {n} does not exist (the file has {len(cameras)})")
     camera = cameras[n]
