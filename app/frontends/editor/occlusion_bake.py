@@ -21,6 +21,7 @@ import dataclasses
 import os
 import pickle
 import sys
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,6 +45,7 @@ class _Sent:
     key: tuple       # (mesh key, lighting key) this job makes
     job_id: int
     out: object      # pathlib.Path
+    started: float = 0.0   # time.monotonic() when sent: the status row counts the seconds
 
 
 class OcclusionBake:
@@ -107,7 +109,11 @@ class OcclusionBake:
         if wanted:   # the bake is in the cache: drawn with the last lighting meanwhile
             self.status = "occlusion: the environment's light on it follows in a moment"
             return scene, True
-        self.status = "baking occlusion: the view is drawn without it meanwhile"
+        # The seconds so far: a big mesh's bake takes minutes, and a row that never changes
+        # looked stuck to a new user.
+        running = self._running
+        seconds = f" ({time.monotonic() - running.started:.0f} s)" if running is not None and running.started else ""
+        self.status = f"baking occlusion{seconds}: the view is drawn without it meanwhile"
         return dataclasses.replace(scene, occlusion="off"), False
 
     @staticmethod
@@ -153,7 +159,7 @@ class OcclusionBake:
                                                   through=through, suns=np.asarray(suns, np.float64),
                                                   texels=texels, digest=digest, rotation_deg=rotation,
                                                   out=str(out)))
-        self._running, self._next = _Sent(key, job_id, out), None
+        self._running, self._next = _Sent(key, job_id, out, time.monotonic()), None
         self.jobs += 1
 
     def step(self, win, answers=None) -> bool:
