@@ -180,9 +180,14 @@ def test_the_screenshot_with_the_ground_is_left_for_alight_render(ctx):
     shot = screenshot(ctx)
     h, w = shot.shape[:2]
     assert (w, h) == tuple(win.view_area()), ((w, h), win.view_area())   # ('at the view's size', the default)
-    o = win.orbit
+    # The camera as a user takes it to the command line: the panel's button, then the clipboard.
+    from imgui_bundle import imgui
+
+    ctx.item_click("**/copy camera as flags")
+    flags = imgui.get_clipboard_text()
+    assert flags.startswith("--orbit ") and f"--size {w}x{h}" in flags, flags
+    assert win.state.message == f"copied to the clipboard: {flags}", win.state.message
     with open(os.path.join(OUT, "ground_view.json"), "w") as f:
-        json.dump({"size": [w, h], "orbit": o.yaw_deg, "elevation": o.pitch_deg, "distance": o.distance,
-                   "fov": o.fov_y_deg, "target": list(map(float, o.target)),
+        json.dump({"size": [w, h], "flags": flags,
                    "file": sorted(n for n in os.listdir(".") if n.startswith("alight-screenshot-"))[-1]}, f)
     assert shot[:, :, :3].astype(np.float64).std() > 5.0

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -46,11 +47,9 @@ def test_ground_and_shadows_through_the_panel_and_the_screenshot_equals_alight_r
 
     def render(name: str, *extra: str) -> np.ndarray:
         out = tmp_path / name
+        # The flags the panel's 'copy camera as flags' put on the clipboard, as a user pastes them.
         done = subprocess.run([sys.executable, "-m", "alight", "render", "--light", LIGHT, "--occlusion", "off",
-                               "--size", f"{w}x{h}", "--orbit", str(view["orbit"]),
-                               "--elevation", str(view["elevation"]), "--distance", str(view["distance"]),
-                               "--fov", str(view["fov"]), "--target", ",".join(map(str, view["target"])),
-                               "--aa", "none", *extra, "--out", str(out)],
+                               *shlex.split(view["flags"]), "--aa", "none", *extra, "--out", str(out)],
                               env=env, capture_output=True, text=True, timeout=600)
         assert done.returncode == 0, done.stderr[-3000:]
         return _read(out)

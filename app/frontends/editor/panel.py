@@ -831,6 +831,18 @@ class Panel:
         _, win.orbit.fov_y_deg = imgui.slider_float("field of view", win.orbit.fov_y_deg, 10.0, 90.0)
         if imgui.button("frame mesh (F)"):
             win.frame_mesh()
+        imgui.same_line()
+        if imgui.button("copy camera as flags"):
+            # The view's camera and size for `alight render` (the editor frames a mesh for its
+            # own aspect: a new user could not make the command line draw the view's picture).
+            import shlex
+
+            text = shlex.join(win.orbit.render_flags(win.view_area()))
+            imgui.set_clipboard_text(text)
+            s.error, s.message = "", f"copied to the clipboard: {text}"
+        if imgui.is_item_hovered():
+            tooltip("the view's camera and size as `alight render` flags (--orbit --elevation --distance "
+                    "--fov --target --size), onto the clipboard")
         from alight.frontends.editor.screenshot import draw_controls
 
         draw_controls(win)   # size, the button (F12), progress
