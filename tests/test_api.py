@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 
@@ -183,3 +184,20 @@ def test_file_warnings_reach_the_api_user_once(tmp_path, capfd):
         f"alight: warning: {tmp_path / 'tri2.obj'}: mtllib 'nowhere.mtl' not found; its materials are drawn "
         "with the default material"]
     r.close()
+
+
+def test_the_probe_view_refuses_what_it_would_ignore(tmp_path):
+    """set_view('probe') with a ground, shadows 'on' or occlusion 'on'/'gtao': one AlightError
+    naming the setter at render (the probe draws the material on its unit sphere; these were
+    silently ignored), as `alight render --view probe` refuses the flags; and nothing written."""
+    with Renderer(16, quality="low") as r:
+        r.set_view("probe")
+        for setup, setter in ((lambda: r.set_shadows(ground=True), "set_shadows(ground=True)"),
+                              (lambda: r.set_shadows("on"), "set_shadows('on')"),
+                              (lambda: r.set_occlusion("gtao"), "set_occlusion('gtao')")):
+            setup()
+            with pytest.raises(AlightError, match=r"^" + re.escape(setter) + r": not with set_view\('probe'\)"):
+                r.save(tmp_path / "probe.png")
+            r.set_shadows("auto", ground=False, occlusion="auto")
+        assert not (tmp_path / "probe.png").exists()
+        assert r.render().shape == (16, 16, 4)     # the defaults draw

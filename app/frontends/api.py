@@ -334,6 +334,7 @@ class Renderer:
         w, h = _size(width or self.width, height or (self.height if width is None else width))
         if self.scene.view == "probe" and w != h:
             raise AlightError(f"size: the probe view is square; got {w}x{h}")
+        self._check_probe()
         if self.scene.view == "camera" and self.scene.camera is None and self._framing_checked is not self._mesh:
             self._framing_checked = self._mesh   # once per mesh: flat_normal reads every vertex
             for line in framing_warnings(self._mesh, self._mesh.source, None,
@@ -341,6 +342,22 @@ class Renderer:
                 warn(line)   # as alight render says it (app/frontends/scene_setup.py)
         frame = self._frame(w, h, linear=linear, srgb=not linear)
         return frame.linear if linear else frame.srgb
+
+    def _check_probe(self) -> None:
+        """The probe view draws the material on its unit sphere (docs/conventions.md): a ground,
+        shadows 'on' or occlusion 'on'/'gtao' asked for with it would be silently ignored, so they
+        are refused in one line naming the setter, as ``alight render --view probe`` refuses the
+        flags (app/frontends/scene_setup.py check_probe_flags)."""
+        if self.scene.view != "probe":
+            return
+        asked = [("set_shadows(ground=True)", self.scene.ground, "the probe view draws no ground"),
+                 (f"set_shadows({self.scene.shadows!r})", self.scene.shadows == "on",
+                  "the probe view draws no shadows (there is no mesh to cast them)"),
+                 (f"set_occlusion({self.scene.occlusion!r})", self.scene.occlusion in ("on", "gtao"),
+                  "the probe view has no mesh to occlude")]
+        for setter, given, why in asked:
+            if given:
+                raise AlightError(f"{setter}: not with set_view('probe') ({why}); use set_view('camera')")
 
     def save(self, path: str | os.PathLike, width: int | None = None, height: int | None = None) -> Path:
         """Render and write ``path`` atomically: .png (sRGB, tone mapped) or .exr (linear float32)."""
