@@ -84,8 +84,17 @@ class FileJobs:
             if self._exporting:
                 return False
             self._exporting = path
-        self._start(lambda: self._run_export(path, run))
+        self._export_thread = self._start(lambda: self._run_export(path, run))
         return True
+
+    def finish_export(self, timeout: float | None = None) -> str:
+        """Wait for the export that runs (the window closing: a daemon thread stopped at exit
+        left its temporary file and no export). Returns the file it writes, '' when none ran."""
+        path = self.exporting
+        thread = getattr(self, "_export_thread", None)
+        if path and thread is not None:
+            thread.join(timeout)
+        return path
 
     @property
     def exporting(self) -> str:
@@ -100,7 +109,7 @@ class FileJobs:
                 self.frames_while_running += 1
         return done
 
-    def _start(self, target) -> None:
+    def _start(self, target) -> threading.Thread:
         self.started += 1
         with self._lock:
             self.threads += 1
@@ -111,7 +120,9 @@ class FileJobs:
             finally:
                 with self._lock:
                     self.threads -= 1
-        threading.Thread(target=run, name="alight-file-job", daemon=True).start()
+        thread = threading.Thread(target=run, name="alight-file-job", daemon=True)
+        thread.start()
+        return thread
 
     def _run_open(self, job: int, spec: str, read) -> None:
         try:

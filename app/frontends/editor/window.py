@@ -20,6 +20,7 @@ import collections
 import dataclasses
 import math
 import os
+import sys
 import time
 
 from alight.core.gpu import ShaderCompileError
@@ -1030,6 +1031,11 @@ class EditorWindow:
                     or not self.pass_warmup.done or self.panel.file_jobs.busy)
 
     def close(self) -> None:
+        # An export still writing is finished first: closing must not lose the file asked for.
+        writing = self.panel.file_jobs.exporting
+        if writing:
+            print(f"alight: finishing the export of {writing} before closing", file=sys.stderr)
+            self.panel.file_jobs.finish_export()
         if not self.hosted:
             from alight.frontends.editor import worker_process
 
