@@ -1,6 +1,7 @@
 """DamagedHelmet's steady frame (bench_peers_assets.py's: its own materials, royal_esplanade_1k
 as light and background, 4x MSAA, 1024x1024, sRGB read back, the camera orbiting 1 degree a frame)
 drawn with this checkout's shaders and with other shaders/ folders side by side; not a test.
+``--sphere``: the built-in sphere instead (a check that its frame is unchanged).
 
     git archive HEAD shaders | tar -x -C /tmp/base          # the other side's shaders/
     .venv/bin/python benchmarks/bench_helmet_frame.py --other base=/tmp/base/shaders [--rounds 5]
@@ -18,6 +19,9 @@ between the sides' frames at the same camera (0: the same picture).
 ``--split`` first prints where this side's frame goes: the scene pass, the resolve and the read
 back, each between ``ctx.finish()`` calls (finishing changes the overlap, so the parts are close
 to, not exactly, the whole), and the CPU time per thread (Python's and llvmpipe's).
+``--features`` then prints what the sun's shadows and the occlusion bake cost this side's frame:
+the frame with ``set_shadows("off")``, ``set_occlusion("off")`` and both, alternated with the
+defaults in the same way (other pictures: a measure of their cost, not a speed-up).
 """
 
 from __future__ import annotations
@@ -97,6 +101,35 @@ def split(renderer, frames: int = 6) -> None:
           f"shadow maps: {r.shadow_maps.last_active}; anisotropy: {r.last_anisotropy}")
 
 
+FEATURES = {"defaults": ("auto", "auto"), "shadows off": ("off", "auto"), "occlusion off": ("auto", "off"),
+            "both off": ("off", "off")}   # name: (set_shadows, set_occlusion)
+
+
+def features(renderer, rounds: int) -> None:
+    """Print the frame's CPU time with the sun's shadows and/or the occlusion bake off, alternated."""
+    cpu: dict[str, list[float]] = {name: [] for name in FEATURES}
+    names = list(FEATURES)
+    for k in range(rounds):
+        for name in (names if k % 2 == 0 else names[::-1]):
+            shadows, occlusion = FEATURES[name]
+            renderer.set_shadows(shadows).set_occlusion(occlusion)
+            renderer.render()                    # (a bake or a shadow map drawn anew stays out of the timing)
+            times = []
+            for j in range(3):
+                renderer.set_camera(orbit_deg=float(3 * k + j))
+                c = time.process_time()
+                renderer.render()
+                times.append(time.process_time() - c)
+            cpu[name].append(statistics.median(times))
+    renderer.set_shadows("auto").set_occlusion("auto")
+    print(f"what the features cost ({rounds} rounds of 3 frames, alternated; CPU ms, median [min-max], / defaults per round):")
+    for name in names:
+        v = cpu[name]
+        ratios = [a / b for a, b in zip(v, cpu["defaults"])]
+        print(f"  {name:14s} {statistics.median(v) * 1e3:6.0f} [{min(v) * 1e3:.0f}-{max(v) * 1e3:.0f}]  "
+              f"{statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f})")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=1024)
@@ -104,6 +137,10 @@ def main(argv=None) -> int:
     ap.add_argument("--other", action="append", default=[], metavar="NAME=DIR",
                     help="another shaders/ folder to draw the same frames with (repeatable)")
     ap.add_argument("--split", action="store_true", help="first print where this side's frame goes")
+    ap.add_argument("--features", action="store_true",
+                    help="first print what the sun's shadows and the occlusion bake cost this side's frame")
+    ap.add_argument("--sphere", action="store_true",
+                    help="the built-in sphere (its default material, its impostor) instead of DamagedHelmet: a check that it is unchanged")
     args = ap.parse_args(argv)
 
     import numpy as np
@@ -119,7 +156,9 @@ def main(argv=None) -> int:
             return 2
         sides[name] = alight.Renderer(args.size, args.size, aa="msaa")
     for name, r in sides.items():
-        r.set_mesh(str(HELMET)).set_environment(str(ENV))
+        if not args.sphere:
+            r.set_mesh(str(HELMET))
+        r.set_environment(str(ENV))
         r.open()
         if name != "this":
             folder = dict(item.partition("=")[::2] for item in args.other)[name]
@@ -130,6 +169,8 @@ def main(argv=None) -> int:
             r.render()
     if args.split:
         split(sides["this"])
+    if args.features:
+        features(sides["this"], args.rounds)
     cpu: dict[str, list[float]] = {name: [] for name in sides}
     largest = {name: 0 for name in sides}
     names = list(sides)
@@ -148,7 +189,7 @@ def main(argv=None) -> int:
         for name in names:
             largest[name] = max(largest[name], int(np.abs(images[name] - images["this"]).max()))
         print(f"round {k + 1}: " + ", ".join(f"{name} {cpu[name][-1] * 1e3:.0f}" for name in names), flush=True)
-    print(f"\nDamagedHelmet {args.size}x{args.size}, royal_esplanade_1k, 4x MSAA, sRGB read back; "
+    print(f"\n{'the built-in sphere' if args.sphere else 'DamagedHelmet'} {args.size}x{args.size}, royal_esplanade_1k, 4x MSAA, sRGB read back; "
           f"{args.rounds} rounds of 3 frames, sides alternated; CPU ms a frame, median [min-max] of round medians")
     for name in names:
         v = cpu[name]
