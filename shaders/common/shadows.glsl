@@ -128,11 +128,13 @@ float shadow_hard(int view, vec3 l) {
 }
 
 // A source of angular (orthographic) or world (perspective) radius u_shadow_params[view].z: PCSS.
-float shadow_soft(int view, vec3 l) {
+// ``wanted`` false: the caller multiplies the result by 0, so no tap is taken (it returns 1).
+float shadow_soft(int view, vec3 l, bool wanted) {
     ShadowLookup look = shadow_lookup(view, l);
-    // Loops with counts that a block of pixels may share as 0 (outside the map, no blocker):
-    // llvmpipe runs both sides of a branch, but leaves a loop once no pixel of a block is in it.
-    int searches = look.inside ? 8 : 0;
+    // Loops with counts that a block of pixels may share as 0 (outside the map, no blocker,
+    // not wanted): llvmpipe runs both sides of a branch, but leaves a loop once no pixel of a
+    // block is in it.
+    int searches = look.inside && wanted ? 8 : 0;
     vec4 params = u_shadow_params[view];
     float near = u_shadow_range[view].x;
     bool ortho = params.x < 0.5;
@@ -178,9 +180,14 @@ float light_shadow(int i, int kind, vec3 l, vec3 light_position) {
     return shadow_hard(first, l);      // punctual lights have no size
 }
 
-float sun_shadow(int i, vec3 l) {
+// ``wanted``: whether the caller reads the result (false: 1, no tap taken; shadow_soft).
+float sun_shadow_where(int i, vec3 l, bool wanted) {
     int view = u_sun_shadow[i];
-    return view < 0 ? 1.0 : shadow_soft(view, l);
+    return view < 0 ? 1.0 : shadow_soft(view, l, wanted);
+}
+
+float sun_shadow(int i, vec3 l) {
+    return sun_shadow_where(i, l, true);
 }
 
 #endif
