@@ -197,6 +197,25 @@ def test_every_dotted_name_in_the_docs_imports():
     assert not stale, f"dotted names that do not import: {stale}"
 
 
+FROM_IMPORT = re.compile(r"^[ \t]*from[ \t]+(alight(?:\.\w+)*)[ \t]+import[ \t]+(?:\(([\w\s,]+)\)|([\w \t,]+))", re.M)
+
+
+def test_every_from_import_in_the_docs_imports():
+    """A new user pasted docs/guides/gltf-export.md's `from alight.exchange.gltf_material import
+    ..., export_mesh_glb` and got an ImportError (the function lives in gltf_export); the dotted
+    names check above does not see names after `import`. Every `from alight.x import a, b` in the
+    docs and READMEs must import each name."""
+    bad = []
+    for path in DOTTED_SOURCES:
+        for module, grouped, names in FROM_IMPORT.findall(path.read_text(encoding="utf-8")):
+            for name in (n.strip() for n in (grouped or names).split(",")):
+                if name and name.isidentifier() and not _resolves(f"{module}.{name}"):
+                    bad.append(f"{path.relative_to(REPO).as_posix()}: from {module} import {name}")
+    assert FROM_IMPORT.findall("from alight.x import (a,\n  b)\nfrom alight.y import c  # d\n") == [
+        ("alight.x", "a,\n  b", ""), ("alight.y", "", "c  ")]
+    assert not bad, bad
+
+
 def _nav_pages(nav) -> set[str]:
     """Every page file in mkdocs.yml's nav (nested sections included)."""
     if isinstance(nav, str):
