@@ -196,15 +196,39 @@ def material_from_gltf(gm: dict, source: str, name: str = "material") -> Materia
     return validate_material(m, source)
 
 
-def import_material(path: str | os.PathLike, index: int = 0) -> Material:
-    """The ``index``-th material of a .gltf/.glb file (a file without one is an error)."""
+def import_material(path: str | os.PathLike, index: int = 0, warn_textures: bool = True) -> Material:
+    """The ``index``-th material of a .gltf/.glb file (a file without one is an error): its
+    factors and extensions' values. Its textures are not part of a Material: where it has any,
+    one warning line names them (``warn_textures``; alight.exchange.material_files.load_material_file
+    reads them as TextureMaps and says what it cannot take itself)."""
     doc = read_gltf_json(path)
     materials = doc.get("materials") or []
     if not isinstance(materials, list) or not materials:
         raise _fail(str(path), "no materials in the file")
     if not 0 <= index < len(materials):
         raise _fail(str(path), f"material {index} does not exist (the file has {len(materials)})")
-    return material_from_gltf(materials[index], str(path), name=Path(path).stem)
+    material = material_from_gltf(materials[index], str(path), name=Path(path).stem)
+    textures = _texture_keys(materials[index]) if warn_textures else []
+    if textures:
+        from alight.errors import warn
+
+        warn(f"{Path(path).name}: materials[{index}]: {', '.join(textures)} not taken (import_material reads "
+             "factors; alight.exchange.material_files.load_material_file reads the maps too, or render the "
+             "file with --mesh)")
+    return material
+
+
+def _texture_keys(node, prefix: str = "") -> list[str]:
+    """The texture slots a glTF material object uses (baseColorTexture, KHR_materials_clearcoat
+    .clearcoatTexture, ...), in the file's order."""
+    out = []
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key.endswith("Texture") and isinstance(value, dict) and "index" in value:
+                out.append(prefix + key)
+            elif isinstance(value, dict):
+                out += _texture_keys(value, prefix if key in ("pbrMetallicRoughness", "extensions") else f"{prefix}{key}.")
+    return out
 
 
 # --- writing ---------------------------------------------------------------------------------

@@ -49,7 +49,7 @@ def load_material_file(name_or_path: str | os.PathLike, index: int = 0,
         return load_preset(text), TextureMaps(), []
     from alight.exchange.gltf_material import import_material, read_gltf_json
 
-    material = import_material(text, index)
+    material = import_material(text, index, warn_textures=False)   # (its maps are read below)
     doc = read_gltf_json(text)
     maps, warnings = _maps(doc["materials"][index], doc, text, index, mesh_hint)
     return material, maps, warnings
