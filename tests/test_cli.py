@@ -383,6 +383,10 @@ BAD_INPUT = [
     pytest.param(["--preset", "no_such_preset"], ["no_such_preset"], id="unknown-preset"),
     pytest.param(["--preset", ""], ["no preset"], id="empty-preset"),
     pytest.param(["--mesh", "{in}/missing.obj"], ["{in}/missing.obj"], id="missing-mesh"),
+    # a folder or a file of the wrong kind: what the flag takes, not the reader library's words
+    pytest.param(["--mesh", "{in}"], ["{in}: is a folder, not a mesh file", ".glb"], id="mesh-folder"),
+    pytest.param(["--env", "{data}/bad/empty.obj"], ["{data}/bad/empty.obj: not an image alight reads", ".hdr or .exr"],
+                 id="env-not-an-image"),
     pytest.param(["--mesh", "{in}/corrupt.glb"], ["{in}/corrupt.glb"], id="corrupt-glb"),
     pytest.param(["--roughness", "1.5"], ["--roughness"], id="roughness-range"),
     pytest.param(["--metallic", "abc"], ["--metallic"], id="metallic-nan"),

@@ -248,7 +248,12 @@ def read_equirect(path: str, max_width: int) -> tuple[np.ndarray, list[str]]:
 
     inp = oiio.ImageInput.open(path)
     if inp is None:
-        raise AlightError(f"{path}: cannot read environment map ({_one_line(oiio.geterror())})")
+        error = _one_line(oiio.geterror())
+        if "format reader" in error:     # (OpenImageIO's words for a kind of file it has no reader for)
+            raise AlightError(f"{path}: not an image alight reads as an environment (use an equirectangular "
+                              ".hdr or .exr; .png, .jpg and other images OpenImageIO reads are taken as "
+                              "display-referred)")
+        raise AlightError(f"{path}: cannot read environment map ({error})")
     try:
         part, warnings = _choose_part(inp, path)
         inp.seek_subimage(part.index, 0)

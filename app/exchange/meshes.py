@@ -55,6 +55,8 @@ def load_mesh(spec: str) -> Mesh:
         return _BUILDERS[spec]()
     path = Path(spec)
     ext = path.suffix.lower()
+    if path.is_dir():
+        raise AlightError(f"{spec}: is a folder, not a mesh file (use {', '.join(MESH_EXTENSIONS)})")
     if ext not in MESH_EXTENSIONS:
         if not ext and not path.exists():
             raise AlightError(f"{spec}: neither a built-in mesh ({', '.join(BUILTIN_MESHES)}) nor a file")
