@@ -160,6 +160,13 @@ def test_without_a_display(tmp_path):
                            text=True, timeout=60)
     assert edit_.returncode == 2 and edit_.stderr.startswith("alight: error: editor: no display")
     assert edit_.stderr.count("\n") == 1
+    # A DISPLAY that names no server: glfw's own words in the one line (pyGLFW printed them as a
+    # two-line Python warning before it)
+    gone = subprocess.run([sys.executable, "-m", "alight", "edit"], cwd=REPO, env={**env, "DISPLAY": ":987"},
+                          capture_output=True, text=True, timeout=60)
+    assert gone.returncode == 2 and gone.stderr.count("\n") == 1, gone.stderr
+    assert gone.stderr.startswith("alight: error: editor: cannot open a window (") and ":987" in gone.stderr
+    assert "GLFWError" not in gone.stderr and "b'" not in gone.stderr, gone.stderr
     bad = subprocess.run([sys.executable, "-m", "alight", "edit", "--screenshot", str(tmp_path / "x.jpg")], cwd=REPO,
                          env=env, capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "unsupported output format" in bad.stderr

@@ -134,8 +134,22 @@ class EditorWindow:
 
     def _open_window(self, glfw, size, title) -> None:
         """Our own glfw window with an OpenGL 4.5 core context, current on this thread."""
-        if not glfw.init():
-            raise AlightError("editor: cannot open a window (no display? set DISPLAY, or run under xvfb-run -a)")
+        import warnings
+
+        # pyGLFW reports glfw's own error as a Python warning (two raw lines before ours): its
+        # words go into the one error line instead.
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ok = glfw.init()
+        if not ok:
+            import re
+
+            # ("(65550) b'X11: Failed to open display :9'" -> "X11: Failed to open display :9")
+            said = "; ".join(re.sub(r"^\(\d+\)\s*b?['\"]?|['\"]$", "", " ".join(str(w.message).split()))
+                             for w in caught) or "no display?"
+            raise AlightError(f"editor: cannot open a window ({said}; set DISPLAY, or run under xvfb-run -a)")
+        for w in caught:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         set_window_hints(glfw)   # (gl_window.py: the variant warm-up's hidden window has the same)
         self.window = glfw.create_window(size[0], size[1], title, None, None)
         self._size_cache: tuple[tuple[int, int], tuple[int, int]] | None = None   # _sizes
