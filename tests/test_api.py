@@ -134,6 +134,21 @@ def test_bad_input_is_one_alight_error(call):
     r.close()
 
 
+@pytest.mark.parametrize("call, said", [
+    (lambda r: r.set_material(roughnes=0.3), r"^set_material: unknown field 'roughnes' \(did you mean 'roughness'\?"),
+    (lambda r: r.add_light("foo"), r"^add_light: 'foo': the kind must be"),
+    (lambda r: r.add_light("point:pos=1,2"), r"^add_light: pos '1,2' is not 3"),
+    (lambda r: r.set_lights(["spot:pos=0,1,0"]), r"^set_lights: 'spot:pos=0,1,0': a spot light needs dir="),
+])
+def test_bad_input_names_the_call(call, said):
+    """A script's mistake is named by the call it made (not the CLI's flag: add_light said
+    '--light:') and a misspelt field gets the near name, as the CLI's presets do."""
+    r = Renderer(8, quality="low")
+    with pytest.raises(AlightError, match=said):
+        call(r)
+    r.close()
+
+
 def test_every_preset_loads_by_name():
     r = Renderer(8, quality="low")
     for name in list_presets():

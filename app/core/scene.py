@@ -142,13 +142,13 @@ class Light:
     range: float | None = None
 
 
-def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
+def _floats(text: str, n: int, what: str, where: str = "--light") -> tuple[float, ...]:
     try:
         values = tuple(float(x) for x in text.split(","))
     except ValueError:
-        raise AlightError(f"--light: {what} '{text}' is not {n} comma-separated numbers") from None
+        raise AlightError(f"{where}: {what} '{text}' is not {n} comma-separated numbers") from None
     if len(values) != n or not all(math.isfinite(v) for v in values):
-        raise AlightError(f"--light: {what} '{text}' is not {n} finite comma-separated numbers")
+        raise AlightError(f"{where}: {what} '{text}' is not {n} finite comma-separated numbers")
     return values
 
 
@@ -156,20 +156,20 @@ def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
 _LIGHT_NEEDS = {"point": ("pos",), "spot": ("pos", "dir"), "directional": ("dir",)}
 
 
-def parse_light(spec: str) -> Light:
+def parse_light(spec: str, where: str = "--light") -> Light:
     """``point:pos=X,Y,Z[:color=R,G,B][:intensity=I][:range=R]``, ``directional:dir=X,Y,Z[:...]``
     or ``spot:pos=X,Y,Z:dir=X,Y,Z[:inner=DEG][:outer=DEG][:...]`` (cone half-angles, default 0
     and 45 degrees, as KHR_lights_punctual's defaults). What places a light has no default and
     must be given: a point's ``pos``, a spot's ``pos`` and ``dir``, a directional light's ``dir``
     (a point at the origin sits inside the mesh and lights nothing: a black image, exit 0).
 
-    Raises AlightError (one line naming the spec) for an unknown kind or field, a bad number, or
-    a missing required field."""
+    Raises AlightError (one line naming the spec, after ``where``: the flag, or the API call) for
+    an unknown kind or field, a bad number, or a missing required field."""
     fields = spec.split(":")
     kind = {"point": "point", "dir": "directional", "directional": "directional", "sun": "directional",
             "spot": "spot"}.get(fields[0])
     if kind is None:
-        raise AlightError(f"--light: '{spec}': the kind must be point, directional or spot")
+        raise AlightError(f"{where}: '{spec}': the kind must be point, directional or spot")
     light = Light(kind=kind, vector=(0.0, -1.0, 0.0) if kind == "directional" else (0.0, 0.0, 0.0),
                   intensity=3.0 if kind == "directional" else 10.0)
     given = set()
@@ -177,43 +177,43 @@ def parse_light(spec: str) -> Light:
         key, _, value = item.partition("=")
         given.add({"position": "pos", "direction": "dir"}.get(key, key))
         if key in ("pos", "position") and kind != "directional":
-            light.vector = _floats(value, 3, key)
+            light.vector = _floats(value, 3, key, where)
         elif key in ("dir", "direction") and kind != "point":
-            direction = _floats(value, 3, key)
+            direction = _floats(value, 3, key, where)
             if np.linalg.norm(direction) == 0.0:
-                raise AlightError(f"--light: '{spec}': the direction is zero")
+                raise AlightError(f"{where}: '{spec}': the direction is zero")
             if kind == "spot":
                 light.direction = direction
             else:
                 light.vector = direction
         elif key in ("inner", "outer") and kind == "spot":
-            (angle,) = _floats(value, 1, key)
+            (angle,) = _floats(value, 1, key, where)
             if not 0.0 <= angle <= 90.0:
-                raise AlightError(f"--light: '{spec}': {key} must be from 0 to 90 degrees")
+                raise AlightError(f"{where}: '{spec}': {key} must be from 0 to 90 degrees")
             setattr(light, f"{key}_cone_deg", angle)
         elif key == "range" and kind != "directional":
-            (light.range,) = _floats(value, 1, key)
+            (light.range,) = _floats(value, 1, key, where)
             if light.range <= 0:
-                raise AlightError(f"--light: '{spec}': range must be > 0")
+                raise AlightError(f"{where}: '{spec}': range must be > 0")
         elif key in ("color", "colour"):
-            light.color = _floats(value, 3, key)
+            light.color = _floats(value, 3, key, where)
             if min(light.color) < 0:
-                raise AlightError(f"--light: '{spec}': colour components must be >= 0")
+                raise AlightError(f"{where}: '{spec}': colour components must be >= 0")
         elif key == "intensity":
-            (light.intensity,) = _floats(value, 1, key)
+            (light.intensity,) = _floats(value, 1, key, where)
             if light.intensity < 0:
-                raise AlightError(f"--light: '{spec}': intensity must be >= 0")
+                raise AlightError(f"{where}: '{spec}': intensity must be >= 0")
         else:
-            raise AlightError(f"--light: '{spec}': unknown field '{key}' (point takes pos=, directional "
+            raise AlightError(f"{where}: '{spec}': unknown field '{key}' (point takes pos=, directional "
                               f"dir=, spot pos=, dir=, inner=, outer=; all take color= and intensity=)")
     missing = [k for k in _LIGHT_NEEDS[kind] if k not in given]
     if missing:
         form = {"point": "point:pos=X,Y,Z", "directional": "directional:dir=X,Y,Z",
                 "spot": "spot:pos=X,Y,Z:dir=X,Y,Z"}[kind]
-        raise AlightError(f"--light: '{spec}': a {kind} light needs {' and '.join(k + '=' for k in missing)} "
+        raise AlightError(f"{where}: '{spec}': a {kind} light needs {' and '.join(k + '=' for k in missing)} "
                           f"(the form is {form}[:...])")
     if kind == "spot" and light.inner_cone_deg >= light.outer_cone_deg:
-        raise AlightError(f"--light: '{spec}': inner must be below outer")
+        raise AlightError(f"{where}: '{spec}': inner must be below outer")
     return light
 
 

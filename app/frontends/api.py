@@ -176,7 +176,11 @@ class Renderer:
 
         for key in fields:
             if key not in NAMES and key != "name":
-                raise AlightError(f"set_material: unknown field {key!r} (the fields: {', '.join(NAMES)}, name)")
+                import difflib
+
+                close = difflib.get_close_matches(key, [*NAMES, "name"], n=1)
+                hint = f"did you mean {close[0]!r}? " if close else ""
+                raise AlightError(f"set_material: unknown field {key!r} ({hint}the fields: {', '.join(NAMES)}, name)")
         from alight.exchange.texture_sets import apply_map, assign_files, assign_folder, load_map_images
 
         current = self.scene.texture_maps
@@ -230,7 +234,7 @@ class Renderer:
 
     def set_lights(self, lights: Iterable[Light | str]) -> "Renderer":
         """Punctual lights: Light objects or CLI specs such as 'point:pos=2,3,4:intensity=30'."""
-        self.scene.lights = [parse_light(x) if isinstance(x, str) else x for x in lights]
+        self.scene.lights = [parse_light(x, "set_lights") if isinstance(x, str) else x for x in lights]
         return self
 
     def set_shadows(self, mode: str | None = None, *, ground: bool | None = None,
@@ -252,7 +256,7 @@ class Renderer:
         return self
 
     def add_light(self, light: Light | str) -> "Renderer":
-        self.scene.lights.append(parse_light(light) if isinstance(light, str) else light)
+        self.scene.lights.append(parse_light(light, "add_light") if isinstance(light, str) else light)
         return self
 
     def set_camera(self, camera: Camera | None = None, *, orbit_deg: float | None = None,
