@@ -529,3 +529,19 @@ def test_sigterm_during_a_write_leaves_nothing_behind(tmp_path):
     assert proc.returncode == 128 + 15, err
     assert err.strip().splitlines()[-1] == "alight: terminated"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_ground_with_nothing_to_catch_says_so(shared_data, out_dir):
+    """--ground in the built-in studio with no light draws nothing (no shadow to catch): one
+    warning line says so and how to get one (a new user's transparent render equalled the one
+    without --ground, silently); with a directional light, no such line."""
+    duck = str(shared_data / "models" / "Duck.glb")
+    bare = run("render", "--mesh", duck, "--ground", "--background", "transparent", "--quality", "low",
+               "--size", "48", "--out", str(out_dir / "a.png"))
+    assert bare.returncode == 0, bare.stderr
+    lines = [x for x in bare.stderr.splitlines() if "--ground" in x]
+    assert len(lines) == 1 and lines[0].startswith("alight: warning: --ground: nothing casts a shadow"), bare.stderr
+    assert "--light" in lines[0]
+    lit = run("render", "--mesh", duck, "--ground", "--light", "directional:dir=-0.5,-1,-0.3", "--quality", "low",
+              "--size", "48", "--out", str(out_dir / "b.png"))
+    assert lit.returncode == 0 and "--ground" not in lit.stderr, lit.stderr
