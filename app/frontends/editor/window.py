@@ -781,7 +781,8 @@ class EditorWindow:
         self.after_swap()
 
     def after_swap(self) -> None:
-        """After the frame is shown: the screenshot asked for during it, the frame time."""
+        """After the frame is shown: the screenshot asked for during it, the frame time (from the
+        last swap, or the end of the last wait for events: ``tick``)."""
         if not self.hosted:
             self.press_guard.shown = self._frame_no
         if self.screenshot_request and self.screenshot_job is None:
@@ -1014,6 +1015,10 @@ class EditorWindow:
         self._woken = False
         self.idle_waits += 1
         self.glfw.wait_events_timeout(BACKGROUND_FRAME_S if background else IDLE_WAIT_S)
+        if self._last_swap is not None:
+            # The next frame's time starts here: a wait for input is not the frame's (the
+            # performance plot showed a 20 s idle stretch as a 20 000 ms frame).
+            self._last_swap = max(self._last_swap, time.perf_counter())
         if self.key_events.pending:   # input: frames at full rate from this one
             self._last_active = time.monotonic()
         answered = self._answered > 0
