@@ -33,11 +33,11 @@ SHARED = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))
 BROWSER = "###file browser"   # the built-in browser's window (its title changes, its ID does not)
 
 
-def _png(path: str, rgb) -> str:
+def _png(path: str, rgb, size=(8, 8)) -> str:
     from PIL import Image
 
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    Image.fromarray(np.full((8, 8, 3), rgb, np.uint8)).save(path)
+    Image.fromarray(np.full((size[1], size[0], 3), rgb, np.uint8)).save(path)
     return path
 
 
@@ -137,6 +137,19 @@ def test_browse_env_and_a_slots_load_through_the_built_in_browser(ctx):
     assert tinted[0] > tinted[1] + 40 and tinted[1] < white[1] - 40, (tinted, white)
     ctx.set_ref("alight")
     ctx.item_click("texture maps/base_color/clear")
+    # 'browse env' lists LDR images too (an environment, display-referred, as `alight render
+    # --env` takes them; a new user found only .hdr/.exr there): the red PNG picked by its row.
+    sky = _png(os.path.join(OUT, "browse", "skies", "red_sky.png"), (230, 20, 20), (32, 16))
+    ctx.item_open("**/Environment")
+    ctx.item_click("**/browse env")
+    ctx.set_ref(BROWSER)
+    ctx.item_input_value("path", os.path.dirname(sky))
+    ctx.item_click("**/red_sky.png")
+    assert not browser.visible and os.path.abspath(s.env_spec) == os.path.abspath(sky), \
+        (s.env_spec, s.error, browser.visible, str(browser.directory), browser.suffixes)
+    ctx.set_ref("alight")
+    ctx.item_click("**/studio")
+    ctx.item_close("**/Environment")
 
 
 def test_file_browser_up_home_and_cancel(ctx):

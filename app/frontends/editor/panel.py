@@ -632,7 +632,10 @@ class Panel:
         if imgui.button("open env") or entered:
             self._attempt(s, "env_path", lambda: s.open_environment(self.env_path))
         imgui.same_line()
-        self._browse("browse env", (".hdr", ".exr"), s.open_environment)
+        # (an LDR image is an environment too, display-referred, as `alight render --env` takes it)
+        from alight.exchange.images import IMAGE_SUFFIXES
+
+        self._browse("browse env", (".hdr", ".exr", *(x for x in IMAGE_SUFFIXES if x != ".exr")), s.open_environment)
         imgui.same_line()
         if imgui.button("studio"):
             try:
