@@ -15,8 +15,9 @@ vertex gets
   bent_hit. The occluders' radiance is then hit albedo * w / (1 - V) * E(bounce_direction)/pi:
   exact under a uniform environment, and close elsewhere since E/pi is smooth (its first two SH
   bands are linear in the direction). It replaces the sky in the occluded directions of both the
-  diffuse and the specular lobe. The hit's albedo is taken to be the shading point's, diffuse
-  plus specular (one material per scene, as the test scenes and most product shots).
+  diffuse and the specular lobe. The hit's albedo and emission are recorded by a pass of their
+  own (``bake_occluder_materials``, keyed by the parts' materials too); where it recorded none
+  the shading point's albedo stands in, diffuse plus specular.
 - the suns' bounce (``bake_sun_bounce``, a second pass keyed by the suns' directions too): what
   the occluders receive from each compact source of the environment (app/ibl/sun.py), which the
   bounce above leaves out (E there is the map without its suns). For every bounce ray that hits,
@@ -38,8 +39,9 @@ shader takes in place of V's share of directions for the diffuse term (HAS_SKY_W
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
-``cone_blend``, ``suns_on_occluders``, ``sky_visibility`` and ``occluded_environment`` here (tests/test_occlusion.py,
-test_occlusion_cone.py and test_occlusion_suns.py hold them equal).
+``cone_blend``, ``suns_on_occluders``, ``sky_visibility``, ``occluder_base_albedo``,
+``recorded_occluder_albedo`` and ``occluded_environment`` here (tests/test_occlusion.py,
+test_occlusion_cone.py, test_occlusion_suns.py and test_occlusion_materials.py hold them equal).
 """
 
 from __future__ import annotations
