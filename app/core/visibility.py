@@ -15,8 +15,9 @@ vertex gets
   bent_hit. The occluders' radiance is then hit albedo * w / (1 - V) * E(bounce_direction)/pi:
   exact under a uniform environment, and close elsewhere since E/pi is smooth (its first two SH
   bands are linear in the direction). It replaces the sky in the occluded directions of both the
-  diffuse and the specular lobe. The hit's albedo is taken to be the shading point's, diffuse
-  plus specular (one material per scene, as the test scenes and most product shots).
+  diffuse and the specular lobe. The hit's albedo and emission are recorded by a pass of their
+  own (``bake_occluder_materials``, keyed by the parts' materials too); where it recorded none
+  the shading point's albedo stands in, diffuse plus specular.
 - the suns' bounce (``bake_sun_bounce``, a second pass keyed by the suns' directions too): what
   the occluders receive from each compact source of the environment (app/ibl/sun.py), which the
   bounce above leaves out (E there is the map without its suns). For every bounce ray that hits,
@@ -38,8 +39,9 @@ shader takes in place of V's share of directions for the diffuse term (HAS_SKY_W
 
 The shader side is shaders/common/occlusion.glsl; its numpy twins are ``cone_aperture_cos``,
 ``spherical_caps_intersection``, ``specular_occlusion``, ``combined_visibility``, ``cone_roughness``,
-``cone_blend``, ``suns_on_occluders``, ``sky_visibility`` and ``occluded_environment`` here (tests/test_occlusion.py,
-test_occlusion_cone.py and test_occlusion_suns.py hold them equal).
+``cone_blend``, ``suns_on_occluders``, ``sky_visibility``, ``occluder_base_albedo``,
+``recorded_occluder_albedo`` and ``occluded_environment`` here (tests/test_occlusion.py,
+test_occlusion_cone.py, test_occlusion_suns.py and test_occlusion_materials.py hold them equal).
 """
 
 from __future__ import annotations
@@ -237,6 +239,32 @@ def suns_on_occluders(hit_albedo, hit_visibility, first, second):
     return a * b1 + a * a * b2 / np.maximum(1.0 - a * (1.0 - v), 1e-3)
 
 
+def occluder_base_albedo(base_color, metallic, specular_f0=0.04):
+    """The albedo an occluder's material is recorded with (``bake_occluder_materials``): its
+    diffuse lobe weighted by 1 - F0 plus F0 (the split sum's specular albedo at normal incidence
+    with A + B = 1), F0 = mix(specular_f0, base colour, metallic) (docs/conventions.md). One rule
+    for every hit, with no view: the shader's own albedo (``occluder_albedo``) holds the view's
+    Fresnel, which ``recorded_occluder_albedo`` carries over. base_color (..., 3), metallic (...),
+    specular_f0 scalar or (..., 3); returns (..., 3), at most 1."""
+    base = np.asarray(base_color, np.float64)
+    m = np.asarray(metallic, np.float64)[..., None]
+    f0 = np.asarray(specular_f0, np.float64)
+    f0 = f0 + (base - f0) * m
+    return np.minimum(base * (1.0 - m) * (1.0 - f0) + f0, 1.0)
+
+
+def recorded_occluder_albedo(own_albedo, own_recorded, hit_recorded):
+    """occlusion.glsl's recorded_occluder_albedo: the occluders' albedo from what the bake recorded
+    of the surfaces its bounce rays hit (``hit_recorded``, (N, 3), ``occluder_base_albedo``'s rule),
+    times how this surface's own albedo in the shader (``own_albedo``, occluder_albedo's: with the
+    view's Fresnel) departs from the same rule at this surface (``own_recorded``), one ratio over
+    the channels' sums (grey: a coloured ratio would tint the hit by this surface's colour). So
+    where the hits are this surface's material the result is its own albedo as before (exactly for
+    a grey one); beside a red part it is red. At most 1."""
+    own = np.asarray(own_albedo, np.float64)
+    ratio = own.sum(axis=-1) / np.maximum(np.asarray(own_recorded, np.float64).sum(axis=-1), 1e-4)
+    return np.minimum(np.asarray(hit_recorded, np.float64) * ratio[..., None], 1.0)
+
 def sky_visibility(visibility, sky, ray_visibility):
     """occlusion.glsl's sky_visibility: the combined V (N,) made a per-channel share of the light,
     min(V W / V_rays, 1) (N, 3), W (N, 3) and V_rays (N,) the visible sky weight's
@@ -268,7 +296,7 @@ def visible_lobe_radiance(prefiltered, visible_sky, so):
 
 def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance_bent, irradiance_bounce,
                          hit_albedo, so, prefiltered, sun_first=None, sun_second=None, cone_radiance=None,
-                         sky=None):
+                         sky=None, hit_emission=None):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
     and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
@@ -282,13 +310,16 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
     (HAS_SKY_WEIGHT, app/core/sky_weight.py): the visible part is then
     sky_visibility(V, W, V_rays) E(n)/pi instead of V times the cone's radiance, and the visible
     part of the specular lobe visible_lobe_radiance(prefiltered, visible_sky_radiance(W, V_rays,
-    E(n)/pi), so) instead of so times the prefiltered radiance."""
+    E(n)/pi), so) instead of so times the prefiltered radiance. ``hit_emission`` (N, 3): the mean
+    radiance the occluders emit (``bake_occluder_materials``), added to their radiance."""
     v = np.asarray(visibility, np.float64)[..., None]
     albedo = np.minimum(hit_albedo, 1.0)
     hit_visibility = occluder_visibility(bounce_weight, baked_visibility)
     occluder = occluders_reflectance(albedo, hit_visibility) * irradiance_bounce
     if sun_first is not None:
         occluder = occluder + suns_on_occluders(albedo, hit_visibility, sun_first, sun_second)
+    if hit_emission is not None:
+        occluder = occluder + np.asarray(hit_emission, np.float64)
     so = np.asarray(so, np.float64)[..., None]
     bent = np.asarray(irradiance_bent, np.float64)
     cone = bent if cone_radiance is None else np.asarray(cone_radiance, np.float64)
@@ -1147,6 +1178,111 @@ def sun_bounce_key(visibility_key_: str, directions, bounce_rays: int = DEFAULT_
     text = json.dumps(description, sort_keys=True)
     return "alight-sun-bounce-" + hashlib.sha256(text.encode()).hexdigest(), description
 
+
+# ---- the occluders' materials -------------------------------------------------------------------
+
+OCCLUDER_MATERIAL_VERSION = 1   # bumped when bake_occluder_materials records other data
+
+
+@dataclass(frozen=True)
+class OccluderMaterial:
+    """A part's material as the occluders' pass reads it (alight.render.visibility_parts.
+    occluder_materials): the base colour (linear RGB, its texture's mean colour multiplied in),
+    metallic (its texture's mean too), the dielectric F0, the emitted radiance (emissiveFactor
+    times KHR_materials_emissive_strength times its texture's mean) and whether the part's vertex
+    colours (COLOR_0) multiply the base colour."""
+
+    base_color: tuple = (0.8, 0.8, 0.8)
+    metallic: float = 0.0
+    specular_f0: tuple = (0.04, 0.04, 0.04)
+    emission: tuple = (0.0, 0.0, 0.0)
+    vertex_colors: bool = False
+
+    def described(self) -> list:
+        return [round(float(x), 6) for x in (*self.base_color, self.metallic, *self.specular_f0, *self.emission)] \
+            + [bool(self.vertex_colors)]
+
+
+def bake_occluder_materials(parts: list[PartVisibility], materials, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
+                            seed: int = 0) -> list[np.ndarray]:
+    """Per part of a bake (``bake_visibility``'s refined parts), (N, 8) float32: what the vertex's
+    ``bounce_rays`` cosine-weighted rays hit, by the hit part's material (``materials``: one
+    OccluderMaterial per part), interpolated at the hit from its triangle's vertices:
+    - columns 0..2: the hits' albedo by ``occluder_base_albedo`` (their vertex colours in where
+      they have them), each hit weighted by its V (the baked visibility there) plus 1e-3: the
+      shader multiplies the albedo by the hits' mean V and E/pi, so the mean of a V is
+      (sum a V / sum V) times the mean V; the 1e-3 gives the plain mean where every hit is dark;
+    - column 3: 1 where a ray hit, else 0 (the shader keeps this surface's own albedo there, as
+      it does for every vertex of a mesh drawn before this pass ran);
+    - columns 4..6: the mean radiance the hits emit, over the rays that hit (what the occluded
+      directions see of emission: the shader adds it to the occluders' radiance, which the
+      occluded share 1 - V multiplies, as the bounce's; its light on further occluders is left
+      out);
+    - column 7: the share of the rays that hit.
+    Before this pass the shader took every occluder to be this surface's material (one material
+    per scene): a grey box lent its albedo to the red arrows on it (a bluish-white halo where the
+    path tracer has a faint red glow), and emissive parts lit nothing. Seeded; copies of a vertex
+    (``welded``) share their values. Where every part has one material (and no vertex colours)
+    no ray is cast: the flag is V < 1 and the share of hits 1 - V."""
+    out = [np.zeros((len(p.positions), 8), np.float32) for p in parts]
+    if not parts:
+        return out
+    materials = list(materials)
+    if all(m == materials[0] and not m.vertex_colors for m in materials):
+        # One material (a single-material asset, the scene's material on every part): every hit
+        # records the same values, so no ray is needed (DamagedHelmet's pass took 3.7 s). The
+        # flag where the vertex is occluded at all (V < 1); the share of hits as 1 - V.
+        m = materials[0]
+        albedo = occluder_base_albedo(np.asarray(m.base_color, np.float64), float(m.metallic), np.asarray(m.specular_f0))
+        for k, p in enumerate(parts):
+            hit = (np.asarray(p.visibility, np.float64) < 1.0)[:, None]
+            out[k] = np.column_stack([hit * albedo, hit, hit * np.asarray(m.emission, np.float64),
+                                      1.0 - np.asarray(p.visibility, np.float64)]).astype(np.float32)
+        return out
+    positions, eps, offsets, faces, all_f, all_n = merged_parts(parts)
+    albedo, emission = [], []
+    for p, m in zip(parts, materials):
+        base = np.broadcast_to(np.asarray(m.base_color, np.float64), (len(p.positions), 3))
+        if m.vertex_colors and p.colors is not None:
+            base = base * np.asarray(p.colors, np.float64)[:, :3]
+        albedo.append(occluder_base_albedo(base, np.full(len(p.positions), float(m.metallic)), np.asarray(m.specular_f0)))
+        emission.append(np.broadcast_to(np.asarray(m.emission, np.float64), (len(p.positions), 3)))
+    albedo, emission = np.concatenate(albedo), np.concatenate(emission)
+    visibility = np.concatenate([p.visibility for p in parts]).astype(np.float64)
+    refined = _Occluders(positions[all_f], one_way=one_way_triangles(parts))
+    origins = np.concatenate([_origins(positions[a:b], all_n[a:b], f, eps)
+                              for f, a, b in zip(faces, offsets[:-1], offsets[1:])])
+    hit, uv, _ = refined.hemisphere(origins, all_n.astype(np.float32), bounce_rays, np.random.default_rng(seed), eps)
+    count = len(positions)
+    rows, cols = np.nonzero(hit >= 0)
+    corners = all_f[hit[rows, cols]]
+    huv = uv[rows, cols].astype(np.float64)
+    w = np.column_stack([1.0 - huv[:, 0] - huv[:, 1], huv[:, 0], huv[:, 1]])
+    weight = np.einsum("hk,hk->h", w, visibility[corners]) + 1e-3
+    a_hit = np.einsum("hk,hkc->hc", w, albedo[corners])
+    e_hit = np.einsum("hk,hkc->hc", w, emission[corners])
+    hits = np.bincount(rows, minlength=count).astype(np.float64)
+    total = np.bincount(rows, weight, minlength=count)
+    values = np.zeros((count, 8))
+    for c in range(3):
+        values[:, c] = np.bincount(rows, weight * a_hit[:, c], minlength=count) / np.maximum(total, 1e-30)
+        values[:, 4 + c] = np.bincount(rows, e_hit[:, c], minlength=count) / np.maximum(hits, 1.0)
+    values[:, 3] = hits > 0
+    values[:, 7] = hits / bounce_rays
+    for k, (p, f, a, b) in enumerate(zip(parts, faces, offsets[:-1], offsets[1:])):
+        ids = welded(p.positions, p.normals)
+        out[k] = on_welded(values[a:b], f, ids, lambda v, _f: v).astype(np.float32)
+    return out
+
+
+def occluder_materials_key(visibility_key_: str, materials, bounce_rays: int = DEFAULT_BOUNCE_RAYS) -> tuple[str, dict]:
+    """The cache key of ``bake_occluder_materials`` over the bake ``visibility_key_`` for these
+    ``materials`` (a new colour or emission is a new key; the geometry's bake is kept)."""
+    description = {"what": "occluder-materials", "version": OCCLUDER_MATERIAL_VERSION,
+                   "visibility": visibility_key_, "materials": [m.described() for m in materials],
+                   "bounce_rays": bounce_rays}
+    text = json.dumps(description, sort_keys=True)
+    return "alight-occluder-materials-" + hashlib.sha256(text.encode()).hexdigest(), description
 
 # ---- the cache ----------------------------------------------------------------------------------
 

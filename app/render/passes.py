@@ -40,7 +40,7 @@ from alight.render import vbuffer
 from alight.render.part_bindings import _bind_view, bind_part, set_culling
 from alight.render.ground import GroundPass
 from alight.render.shadows import casters as shadow_casters
-from alight.render.visibility_parts import environment_texels, light_through
+from alight.render.visibility_parts import environment_texels, light_through, occluder_materials
 from alight.render.sphere_impostor import impostor_placement, lod_parts, proxy_part
 from alight.render.targets import Targets, View, read_tile
 from alight.render.tiles import TilePlan, tile_matrix, tile_origin
@@ -545,7 +545,7 @@ def occluded_parts(r, scene, drawn: list[GpuPart], sun_directions=None, maps: IB
         sky = (lambda: environment_texels(r.shaders, maps), float(scene.env_rotation_deg))
     return r.visibility_parts.parts_for(scene.mesh, scene.occlusion, drawn,
                                         lambda part: GpuPart(r.ctx, part, textures), light_through(scene),
-                                        sun_directions, sky)
+                                        sun_directions, sky, occluder_materials(scene))
 
 
 # --- after the scene pass: resolve, reduce, tone map ------------------------------------

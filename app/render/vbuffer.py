@@ -362,6 +362,8 @@ def draw(r, frame, scene, camera, view_projection: np.ndarray, targets, program_
                         buffer.bind_to_storage_buffer(4)
                     elif "in_sky_weight" in names and gpu_part.has_sky_weight:
                         buffer.bind_to_storage_buffer(5)
+                    elif "in_hit_albedo" in names:
+                        buffer.bind_to_storage_buffer(6)
             ctx.scissor = (0, 0, width, height) if rect is None else rect
             # One unclipped triangle over a viewport twice the image's size (render/vbuffer_shade.vert):
             # every 2x2 block inside the scissor is whole, and runs once.

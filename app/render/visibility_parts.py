@@ -1,7 +1,9 @@
 """The forward pass's side of the visibility bake (alight.core.visibility): which meshes get one,
 and their refined parts on the GPU with the baked values as two more vertex attributes
-(pbr.vert's in_visibility, in_bounce; HAS_VISIBILITY in shaders/common/occlusion.glsl), and the
-suns' light on the occluders (in_sun_bounce: alight.core.visibility.bake_sun_bounce, for the
+(pbr.vert's in_visibility, in_bounce; HAS_VISIBILITY in shaders/common/occlusion.glsl), what the
+bounce rays hit by material (in_hit_albedo, in_hit_emission: alight.core.visibility.
+bake_occluder_materials, keyed by the parts' materials too, so a colour edit reruns that pass
+only), and the suns' light on the occluders (in_sun_bounce: alight.core.visibility.bake_sun_bounce, for the
 environment's compact sources in world space; a new map or rotation reruns that pass only), and
 the visible sky weight (in_sky_weight: alight.core.sky_weight, HAS_SKY_WEIGHT): its rays cast and
 cached once per bake (``cached_sky_rays``), the weight read along them from the environment drawn
@@ -24,8 +26,9 @@ import numpy as np
 from alight.core import sky_weight as sw
 from alight.core.mesh import single_sided
 from alight.core.visibility import (AUTO_MAX_VERTICES, DEFAULT_EDGE_FRACTION, DEFAULT_MAX_VERTICES, DEFAULT_RAYS,
-                                    VISIBILITY_FIELDS, MeshVisibility, PartVisibility, auto_too_big, bake_sun_bounce,
-                                    bake_visibility, embree_available, refined_mesh_part, screen_occlusion, sun_bounce_key,
+                                    VISIBILITY_FIELDS, MeshVisibility, OccluderMaterial, PartVisibility, auto_too_big,
+                                    bake_occluder_materials, bake_sun_bounce, bake_visibility, embree_available,
+                                    occluder_materials_key, refined_mesh_part, screen_occlusion, sun_bounce_key,
                                     visibility_key, wants_occlusion)
 from alight.errors import warn
 from alight.ibl.bake_cache import BadEntry, encode_entry
@@ -46,6 +49,75 @@ def light_through(scene) -> tuple[float, ...] | None:
             t = max(t, 1.0 - float(part.material.alpha))
         values.append(min(max(t, 0.0), 1.0))
     return tuple(values) if any(v > 0.0 for v in values) else None
+
+
+# id(image) -> (image, its mean colour): a texture's mean is read once, not per frame.
+_TEXTURE_MEANS: dict[int, tuple] = {}
+
+
+def texture_mean(image: np.ndarray, srgb: bool) -> np.ndarray:
+    """The mean RGB of an (H, W, 4) uint8 texture, linear (decoded first where ``srgb``)."""
+    kept = _TEXTURE_MEANS.get(id(image))
+    if kept is not None and kept[0] is image:
+        return kept[1]
+    from alight.core.shading import srgb_to_linear
+
+    rgb = np.asarray(image)[..., :3].reshape(-1, 3)
+    table = np.arange(256) / 255.0
+    table = srgb_to_linear(table) if srgb else table
+    mean = np.array([np.bincount(rgb[:, c], minlength=256) @ table for c in range(3)]) / max(len(rgb), 1)
+    if len(_TEXTURE_MEANS) > 256:
+        _TEXTURE_MEANS.clear()
+    _TEXTURE_MEANS[id(image)] = (image, mean)
+    return mean
+
+
+def occluder_materials(scene) -> tuple[OccluderMaterial, ...]:
+    """Per part of ``scene.mesh``, its material as the occluders' pass reads it
+    (alight.core.visibility.bake_occluder_materials): the factors the part draws with
+    (alight.render.variants.part_material) and, where the file's maps apply, the mean colour of
+    its base colour, metallic-roughness (B) and emissive textures multiplied in (one colour per
+    map: the hit's uv is not looked up), and its vertex colours."""
+    from alight.render.variants import part_material
+
+    out = []
+    for part in scene.mesh.parts:
+        m, textured = part_material(scene, part)
+        base = np.asarray(m.base_color, np.float64)
+        metallic = float(m.metallic)
+        emission = np.asarray(m.emissive, np.float64)
+        fm = part.material if textured else None
+        if fm is not None and fm.base_color_texture is not None:
+            base = base * texture_mean(fm.base_color_texture.image, True)
+        if fm is not None and fm.metallic_roughness_texture is not None:
+            metallic *= float(texture_mean(fm.metallic_roughness_texture.image, False)[2])
+        if fm is not None and fm.emissive_texture is not None:
+            emission = emission * texture_mean(fm.emissive_texture.image, True)
+        f0 = np.broadcast_to(np.asarray(m.specular_f0, np.float64), (3,))
+        out.append(OccluderMaterial(tuple(float(x) for x in base), metallic, tuple(float(x) for x in f0),
+                                    tuple(float(x) for x in emission), bool(textured and part.colors is not None)))
+    return tuple(out)
+
+
+def cached_occluder_materials(mesh, baked: MeshVisibility, materials, cache=None, rays: int = DEFAULT_RAYS,
+                              edge_fraction: float = DEFAULT_EDGE_FRACTION, max_vertices: int = DEFAULT_MAX_VERTICES,
+                              light_through=None) -> tuple[list[np.ndarray], bool]:
+    """``bake_occluder_materials`` of ``baked`` (the bake of ``mesh`` with these settings) for
+    ``materials`` (one OccluderMaterial per part), through ``cache`` (``occluder_materials_key``):
+    (per part (N, 8) float32, whether it came from the cache)."""
+    bake_key, _ = visibility_key(mesh, rays, edge_fraction, max_vertices, light_through)
+    key, description = occluder_materials_key(bake_key, materials)
+    if cache is not None:
+        arrays = cache.load(key, description, "occluder materials")
+        if arrays is not None:
+            values = [arrays.get(f"{i}.occluders") for i in range(len(baked.parts))]
+            if all(v is not None and v.shape == (len(p.positions), 8) for v, p in zip(values, baked.parts)):
+                return [np.asarray(v, np.float32) for v in values], True
+            cache.reject(key, "occluder materials", "a part's arrays are missing or of another size")
+    values = bake_occluder_materials(baked.parts, materials)
+    if cache is not None:
+        cache.save(key, encode_entry(description, {f"{i}.occluders": v for i, v in enumerate(values)}))
+    return values, False
 
 
 def cached_visibility(mesh, cache=None, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAULT_EDGE_FRACTION,
@@ -168,6 +240,8 @@ class OcclusionParts:
         self.sky_weights_run = 0
         self.sky_weights_loaded = 0
         self.last_sky_seconds = 0.0
+        self.occluder_bakes_run = 0      # the occluders' materials (bake_occluder_materials)
+        self.occluder_bakes_loaded = 0
         # True: a mesh already drawn baked keeps its suns' and sky's values (a few degrees of
         # rotation stale) instead of making new ones in this draw: the editor sets it while its
         # child process makes them (alight.frontends.editor.occlusion_bake), as each takes seconds.
@@ -194,7 +268,8 @@ class OcclusionParts:
             return False
         return screen_occlusion(mesh, mode, self.wanted(mesh, mode))
 
-    def parts_for(self, mesh, mode: str, drawn: list, make_part, through=None, sun_directions=None, sky=None) -> list:
+    def parts_for(self, mesh, mode: str, drawn: list, make_part, through=None, sun_directions=None, sky=None,
+                  materials=None) -> list:
         """The GPU parts to draw for ``mesh``: its baked ones where it is wanted, else ``drawn``.
         ``make_part(part)`` uploads a MeshPart (alight.render.gpu_mesh.GpuPart, the mesh's
         textures shared); ``through``: the parts' light_through (None: all opaque);
@@ -202,7 +277,9 @@ class OcclusionParts:
         none), whose light on the occluders is baked (``cached_sun_bounce``) when they change;
         ``sky``: (a callable giving the environment's read-back texels and their digest,
         ``environment_texels``; the rotation in degrees) or None: the parts' visible sky weight,
-        made (``cached_sky_weight``) when they change."""
+        made (``cached_sky_weight``) when they change; ``materials``: the parts' OccluderMaterial
+        (``occluder_materials``; None: every occluder taken as the surface's own material), what
+        the bounce rays hit made of them (``cached_occluder_materials``) when they change."""
         if not self.wanted(mesh, mode):
             return drawn
         if mode == "auto" and not embree_available():
@@ -235,9 +312,20 @@ class OcclusionParts:
                 g.extra_buffers.append((self.ctx.buffer(reserve=len(vis.positions) * 32), "4f 4f", "in_sun_bounce",
                                         "in_sun_bounce2"))
                 g.extra_buffers.append((self.ctx.buffer(reserve=len(vis.positions) * 16), "4f", "in_sky_weight"))
+                # The occluders' materials (zeros until written: this surface's own albedo, no emission).
+                g.extra_buffers.append((self.ctx.buffer(reserve=len(vis.positions) * 32), "4f 4f", "in_hit_albedo",
+                                        "in_hit_emission"))
                 g.has_visibility = True
                 gpu.append(g)
-            entry = self._parts[id(mesh)] = [mesh, gpu, through, baked, None, None]
+            entry = self._parts[id(mesh)] = [mesh, gpu, through, baked, None, None, None]
+        if materials is not None and entry[6] != materials and not self.hold_lighting:
+            values, loaded = cached_occluder_materials(mesh, entry[3], materials, self.cache, self.rays,
+                                                       self.edge_fraction, self.max_vertices, through)
+            self.occluder_bakes_loaded += int(loaded)
+            self.occluder_bakes_run += int(not loaded)
+            for g, v in zip(entry[1], values):
+                g.extra_buffers[3][0].write(np.ascontiguousarray(v, np.float32).tobytes())
+            entry[6] = materials
         suns = np.zeros((0, 3)) if sun_directions is None or not self.sun_bounce else np.asarray(sun_directions, np.float64).reshape(-1, 3)
         sun_key = tuple(np.round(suns, 5).ravel())
         if self.hold_lighting and entry[4] is not None:

@@ -21,6 +21,10 @@ const int TERM_CONE = 7;                  // (V): cone_roughness, cone_blend
 const int TERM_SKY_VISIBILITY = 8;        // (W r, W g, V_rays, V); W b = (W r + W g) / 2
 const int TERM_VISIBLE_LOBE = 9;          // (W r, W g, V_rays, so); W b as above, E(n)/pi and the
                                           // prefiltered radiance the constants below
+const int TERM_OCCLUDER_BASE_ALBEDO = 10;     // (base rgb, metallic), specular_f0 0.04
+const int TERM_RECORDED_OCCLUDER_ALBEDO = 11; // (hit rgb, s): own = s OWN_ALBEDO, own_recorded = OWN_RECORDED
+const vec3 OWN_ALBEDO = vec3(0.3, 0.5, 0.7);
+const vec3 OWN_RECORDED = vec3(0.25, 0.45, 0.6);
 const vec3 LOBE_IRRADIANCE = vec3(0.8, 0.5, 0.3);
 const vec3 LOBE_PREFILTERED = vec3(1.5, 0.2, 0.7);
 
@@ -65,6 +69,12 @@ void main() {
         case TERM_VISIBLE_LOBE:
             o.xyz = visible_lobe_radiance(LOBE_PREFILTERED,
                 visible_sky_radiance(vec3(a.x, a.y, 0.5 * (a.x + a.y)), a.z, LOBE_IRRADIANCE), a.w);
+            break;
+        case TERM_OCCLUDER_BASE_ALBEDO:
+            o.xyz = occluder_base_albedo(a.xyz, a.w, vec3(0.04));
+            break;
+        case TERM_RECORDED_OCCLUDER_ALBEDO:
+            o.xyz = recorded_occluder_albedo(a.w * OWN_ALBEDO, OWN_RECORDED, a.xyz);
             break;
     }
     u_outputs[i] = o;

@@ -145,6 +145,8 @@ VISIBILITY_IN vec4 v_bounce;       // the bounce's mean direction (xyz), its wei
 VISIBILITY_IN vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
 VISIBILITY_IN vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
 VISIBILITY_IN vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
+VISIBILITY_IN vec4 v_hit_albedo;   // what the bounce rays hit: its recorded albedo (rgb, times w), 1 where a ray hit (w)
+VISIBILITY_IN vec4 v_hit_emission; // ... and the radiance it emits (rgb): bake_occluder_materials
 #ifdef HAS_SKY_WEIGHT
 VISIBILITY_IN vec4 v_sky_weight;   // the visible sky weight W (rgb) and its rays' V (w): app/core/sky_weight.py
 #endif
@@ -186,8 +188,9 @@ float combined_visibility(Surface s, vec3 n) {
 // the split sum's E/pi at n (irradiance) and its prefiltered radiance around r, and the
 // surface's specular albedo (the split sum's weight on the prefiltered radiance).
 // What the occluded directions see instead of the sky is the mesh: its radiance, one bounce, is
-// hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo taken as this surface's
-// (diffuse plus specular: a rough metal's walls light each other too).
+// hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo as the bake recorded it
+// (recorded_occluder_albedo; this surface's where it has none: diffuse plus specular, a rough
+// metal's walls light each other too), plus the radiance the hits emit.
 // Plus the suns' light on the occluders (in their own shadows, baked: suns_on_occluders).
 // Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
 // the lobe inside the visibility cone (specular_occlusion), the mesh's radiance for the rest.
@@ -225,6 +228,26 @@ vec3 occluder_albedo(Surface s, vec3 specular_albedo) {
     return min(s.base_color * (1.0 - s.metallic) * (1.0 - specular_albedo) + specular_albedo, vec3(1.0));
 }
 
+// The albedo an occluder's material is recorded with in the bake (app/core/visibility.py
+// bake_occluder_materials, which calls this function's numpy twin): the diffuse lobe weighted by
+// 1 - F0 plus F0, F0 = mix(specular_f0, base, metallic): the split sum's specular albedo at normal
+// incidence with A + B = 1, one rule with no view for every hit.
+vec3 occluder_base_albedo(vec3 base_color, float metallic, vec3 specular_f0) {
+    vec3 f0 = mix(specular_f0, base_color, metallic);
+    return min(base_color * (1.0 - metallic) * (1.0 - f0) + f0, vec3(1.0));
+}
+
+// The occluders' albedo from what the bake recorded of the surfaces its bounce rays hit (hit, by
+// occluder_base_albedo), times how this surface's own albedo (own: occluder_albedo's, with the
+// view's Fresnel) departs from that rule at this surface (own_recorded), one ratio of the
+// channels' sums (a per-channel one would tint the hit with this surface's colour). Where the
+// hits are this surface's material it is its own albedo as before (exactly for a grey one);
+// beside a red part, red: the grey box no longer lends its albedo to the red arrows on it.
+vec3 recorded_occluder_albedo(vec3 own, vec3 own_recorded, vec3 hit) {
+    float ratio = (own.r + own.g + own.b) / max(own_recorded.r + own_recorded.g + own_recorded.b, 1e-4);
+    return min(hit * ratio, vec3(1.0));
+}
+
 #if defined(HAS_VISIBILITY) || defined(HAS_SCREEN_AO)
 // What the occluded directions send this point (the occluders' bounce and the suns on them),
 // which occlude_environment works out for the base; the layers' lobes above it (clearcoat_ibl,
@@ -243,6 +266,13 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     vec3 occluder = vec3(0.0);
     if (baked) {
         vec3 hit_albedo = occluder_albedo(s, specular_albedo);
+        // What the bounce rays hit, by its material (bake_occluder_materials; w 0 where no ray hit
+        // or the pass has not run: this surface's own albedo then). rgb is 0 at such a vertex, so
+        // rgb / w is the mean over the triangle's vertices that have it.
+        if (v_hit_albedo.w > 1e-3) {
+            hit_albedo = recorded_occluder_albedo(hit_albedo, occluder_base_albedo(s.base_color, s.metallic, s.specular_f0),
+                                                  v_hit_albedo.rgb / v_hit_albedo.w);
+        }
         float hit_visibility = occluder_visibility(v_bounce.w, baked_visibility);
         if (v_bounce.w > 0.0) {
             occluder = occluders_reflectance(hit_albedo, hit_visibility) * irradiance_at(normalize(v_bounce.xyz), false);
@@ -250,6 +280,9 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
         // The compact sources on the occluders, which E above (the map without them) leaves out.
         occluder += suns_on_occluders(hit_albedo, hit_visibility, suns_weighted(v_sun_bounce),
                                       suns_weighted(v_sun_bounce2));
+        // What the occluders emit (the mean over the rays that hit; the occluded share 1 - V
+        // multiplies it below, as the bounce): an emissive part lights its neighbours.
+        occluder += max(v_hit_emission.rgb, vec3(0.0));
     }
 #ifdef HAS_SKY_WEIGHT
     // The visible sky's light: the share W / V_rays of the irradiance at n (the map without its

@@ -22,6 +22,10 @@ layout(location = 6) in vec4 in_visibility;
 layout(location = 7) in vec4 in_bounce;
 layout(location = 8) in vec4 in_sun_bounce;    // per sun: its E/pi on the occluders over its power
 layout(location = 9) in vec4 in_sun_bounce2;   // ... and what their sunlit occluders pass them
+layout(location = 11) in vec4 in_hit_albedo;    // what the bounce rays hit: its albedo, and 1 where one hit
+layout(location = 12) in vec4 in_hit_emission;  // ... and its emission (bake_occluder_materials)
+out vec4 v_hit_albedo;
+out vec4 v_hit_emission;
 #ifdef HAS_SKY_WEIGHT
 layout(location = 10) in vec4 in_sky_weight;    // the visible sky weight W (rgb), its rays' V (app/core/sky_weight.py)
 out vec4 v_sky_weight;
@@ -68,6 +72,8 @@ void main() {
     v_bounce = vec4(u_normal_matrix * in_bounce.xyz, in_bounce.w);
     v_sun_bounce = in_sun_bounce;
     v_sun_bounce2 = in_sun_bounce2;
+    v_hit_albedo = in_hit_albedo;
+    v_hit_emission = in_hit_emission;
 #ifdef HAS_SKY_WEIGHT
     v_sky_weight = in_sky_weight;
 #endif

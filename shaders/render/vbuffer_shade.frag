@@ -37,6 +37,8 @@ layout(std430, binding = 2) readonly buffer Tangents { uint tangent_words[]; }; 
 // 8 floats a vertex each: (in_visibility, in_bounce) and (in_sun_bounce, in_sun_bounce2).
 layout(std430, binding = 3) readonly buffer Visibility { vec4 visibility_data[]; };
 layout(std430, binding = 4) readonly buffer SunBounce { vec4 sun_bounce_data[]; };
+// (in_hit_albedo, in_hit_emission): alight.core.visibility.bake_occluder_materials
+layout(std430, binding = 6) readonly buffer HitMaterial { vec4 hit_material_data[]; };
 #ifdef HAS_SKY_WEIGHT
 layout(std430, binding = 5) readonly buffer SkyWeight { vec4 sky_weight_data[]; };
 #endif
@@ -159,6 +161,9 @@ void interpolate(uint triangle, vec2 xy, vec2 at_centroid) {
     v_sun_bounce = w.x * sun_bounce_data[2u * i0] + w.y * sun_bounce_data[2u * i1] + w.z * sun_bounce_data[2u * i2];
     v_sun_bounce2 = w.x * sun_bounce_data[2u * i0 + 1u] + w.y * sun_bounce_data[2u * i1 + 1u]
                     + w.z * sun_bounce_data[2u * i2 + 1u];
+    v_hit_albedo = w.x * hit_material_data[2u * i0] + w.y * hit_material_data[2u * i1] + w.z * hit_material_data[2u * i2];
+    v_hit_emission = w.x * hit_material_data[2u * i0 + 1u] + w.y * hit_material_data[2u * i1 + 1u]
+                     + w.z * hit_material_data[2u * i2 + 1u];
     v_baked_normal = v_normal;
 #ifdef HAS_SKY_WEIGHT
     v_sky_weight = w.x * sky_weight_data[i0] + w.y * sky_weight_data[i1] + w.z * sky_weight_data[i2];

@@ -8,7 +8,7 @@ occluders, 3.2 s for the sky weight's rays and 1.8 s for the weight itself, cold
 machine). So the child process ``python -m alight.frontends.editor.occlusion_bake`` (worker_process.py)
 makes every piece the view's draw needs into the disk bake cache the renderer reads
 (alight.render.visibility_parts: ``cached_visibility``, ``cached_sun_bounce``,
-``OcclusionParts.cached_sky_weight``), and the view draws without occlusion until it answers;
+``OcclusionParts.cached_sky_weight``, ``cached_occluder_materials``), and the view draws without occlusion until it answers;
 then the editor's renderer loads them (a cache read, tens of ms). A new mesh (or occlusion mode,
 or a material that lets light through) supersedes a running bake; a turned environment or
 another map only remakes the suns' and sky's terms, the view keeping the last ones meanwhile
@@ -38,6 +38,7 @@ class OcclusionJob:
     digest: str
     rotation_deg: float
     out: str                # the child writes {'wanted': bool} here (a pickle)
+    materials: tuple | None = None   # visibility_parts.occluder_materials of the view's scene
 
 
 @dataclass
@@ -75,7 +76,7 @@ class OcclusionBake:
             self.status = ""
             return scene, False
         from alight.render.bindings import sun_world_directions
-        from alight.render.visibility_parts import environment_texels, light_through
+        from alight.render.visibility_parts import environment_texels, light_through, occluder_materials
 
         mesh = scene.mesh
         if id(mesh) not in self._meshes:
@@ -96,12 +97,15 @@ class OcclusionBake:
         suns = sun_world_directions(scene, maps)
         texels, digest = environment_texels(win.renderer.shaders, maps) if maps is not None else (None, "")
         rotation = float(scene.env_rotation_deg)
-        light_key = (tuple(np.round(suns, 5).ravel()), digest, round(rotation % 360.0, 6))
+        # The parts' materials as the occluders' pass reads them: a colour edit remakes that pass
+        # only (a few factors each: cheap to compare every frame).
+        materials = occluder_materials(scene)
+        light_key = (tuple(np.round(suns, 5).ravel()), digest, round(rotation % 360.0, 6), materials)
         key = (mesh_key, light_key)
         if key in self._ready:
             self.status = ""
             return scene, False
-        job = (mesh, mode, mesh_key[2], suns, texels, digest, rotation)
+        job = (mesh, mode, mesh_key[2], suns, texels, digest, rotation, materials)
         if self._running is None or self._running.key[0] != mesh_key:
             self._submit(key, job)     # a new mesh or mode supersedes the running bake
         elif self._running.key != key:
@@ -142,7 +146,7 @@ class OcclusionBake:
 
         if self._worker is None:
             self._worker = WorkerProcess("alight.frontends.editor.occlusion_bake")
-        mesh, mode, through, suns, texels, digest, rotation = job
+        mesh, mode, through, suns, texels, digest, rotation, materials = job
         # The mesh is sent once, then named by its token; and its geometry only: the bake and its
         # cache key (visibility.mesh_digest) read nothing else, and DamagedHelmet's decoded
         # textures made an 85 MB pickle (0.9 MB without), written in the frame that sends it.
@@ -158,7 +162,7 @@ class OcclusionBake:
         job_id = self._worker.submit(OcclusionJob(mesh=geometry, mesh_token=token, mode=mode,
                                                   through=through, suns=np.asarray(suns, np.float64),
                                                   texels=texels, digest=digest, rotation_deg=rotation,
-                                                  out=str(out)))
+                                                  out=str(out), materials=materials))
         self._running, self._next = _Sent(key, job_id, out, time.monotonic()), None
         self.jobs += 1
 
@@ -225,7 +229,8 @@ def main() -> int:
     from alight.core.visibility import auto_too_big, embree_available, wants_occlusion
     from alight.frontends.editor.worker_process import serve
     from alight.ibl.bake_cache import BakeCache
-    from alight.render.visibility_parts import OcclusionParts, cached_sun_bounce, cached_visibility
+    from alight.render.visibility_parts import (OcclusionParts, cached_occluder_materials, cached_sun_bounce,
+                                                cached_visibility)
 
     cache = BakeCache()   # the renderer's own (the same folder: ALIGHT_CACHE_DIR or the user's)
     # The same settings as the editor's renderer (ForwardRenderer's OcclusionParts): the same keys.
@@ -246,7 +251,10 @@ def main() -> int:
             steps = ((lambda b: cached_sun_bounce(mesh, b, job.suns, cache, parts.rays, parts.edge_fraction,
                                                   parts.max_vertices, job.through)),
                      (lambda b: None if job.texels is None else
-                      parts.cached_sky_weight(mesh, b, job.texels, job.digest, job.rotation_deg, job.through)))
+                      parts.cached_sky_weight(mesh, b, job.texels, job.digest, job.rotation_deg, job.through)),
+                     (lambda b: None if job.materials is None else
+                      cached_occluder_materials(mesh, b, job.materials, cache, parts.rays, parts.edge_fraction,
+                                                parts.max_vertices, job.through)))
             if superseded():
                 return False
             baked = cached_visibility(mesh, cache, parts.rays, parts.edge_fraction, parts.max_vertices, job.through)
