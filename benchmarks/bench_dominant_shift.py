@@ -127,6 +127,9 @@ def main() -> int:
     for env_path in envs:
         radiance, _ = extract_suns(np.asarray(load_environment(env_path).radiance, np.float32))
         radiance = downsample_equirect(radiance, 4)
+        if not np.any(radiance > 0):   # all of it compact sources (spot1Lux): shaded exactly, nothing to fetch
+            print(f"{Path(env_path).stem}: no light left after the compact sources", flush=True)
+            continue
         for name, n, v in point_sets():
             for model, rough in MODELS:
                 for r in rough:
