@@ -50,32 +50,42 @@ class FileJobs:
         self.started = 0               # jobs started so far (tests and the benchmark read it)
         self.threads = 0               # worker threads alive, superseded ones included
         self.frames_while_running = 0  # frames that found a job running (``take``): drawn meanwhile
+        # A mesh read, its GPU upload going on over frames (the panel's ``take_file_jobs``):
+        # (spec, mesh, alight.render.mesh_upload.MeshUpload), None when none.
+        self.staged = None
 
     @property
     def busy(self) -> bool:
         """Whether a job runs or a result waits for a frame to take it."""
         with self._lock:
-            return bool(self._opening or self._exporting or self._done)
+            return bool(self._opening or self._exporting or self._done or self.staged is not None)
 
     def status(self) -> str:
         """The status row's line while a job runs, else ''."""
         with self._lock:
+            opening = self._opening or (self.staged[0] if self.staged is not None else "")
             parts = [f"{verb} {os.path.basename(target) or target}..."
-                     for verb, target in (("opening", self._opening), ("exporting", self._exporting)) if target]
+                     for verb, target in (("opening", opening), ("exporting", self._exporting)) if target]
         return "; ".join(parts)
 
     def open_mesh(self, spec: str, read) -> None:
-        """Read ``spec`` with ``read(spec)`` on a thread; a later call supersedes this one."""
+        """Read ``spec`` with ``read(spec)`` on a thread; a later call supersedes this one (and a
+        mesh of an earlier one still being uploaded)."""
+        self.drop_open()
         with self._lock:
             self._open_id += 1
             job, self._opening = self._open_id, spec
         self._start(lambda: self._run_open(job, spec, read))
 
     def drop_open(self) -> None:
-        """Forget the open that runs (another mesh was chosen since): its result is dropped."""
+        """Forget the open that runs (another mesh was chosen since): its result is dropped, and
+        so is a mesh still being uploaded (its textures released)."""
         with self._lock:
             self._open_id += 1
             self._opening = ""
+            staged, self.staged = self.staged, None
+        if staged is not None:
+            staged[2].drop()
 
     def export(self, path: str, run) -> bool:
         """Run ``run()`` (the export, writing ``path``) on a thread. Returns False, starting
@@ -105,7 +115,7 @@ class FileJobs:
         """The jobs finished since the last call (on the GL thread, once a frame)."""
         with self._lock:
             done, self._done = self._done, []
-            if self._opening or self._exporting:
+            if self._opening or self._exporting or self.staged is not None:
                 self.frames_while_running += 1
         return done
 
