@@ -5,8 +5,12 @@ DamagedHelmet (its JSON, buffers and five 2048x2048 textures decoded) and while 
 encoded and wrote it. Both now run on a worker thread: the thread does the file's CPU work
 (``state.read_mesh``: parse, decode, tangents; ``EditorState.export_job``: encode, write
 atomically through ``alight.exchange.output``), and the window's frame takes the result
-(``Panel.take_file_jobs``): a mesh read is assigned to the state on the GL thread, where the
-renderer uploads it when it next draws it (GL objects are made on the GL thread only).
+(``Panel.take_file_jobs``). A mesh's read also makes the CPU side of its GPU upload
+(alight.render.mesh_upload: every texture's mip levels, the self-shadowing test), which the frame
+that took the mesh did before (1.2 s for DamagedHelmet, no frame drawn); the frames after write a
+few MiB of its levels each (``staged``, GL objects are made on the GL thread only) and the one that
+completes it assigns the mesh to the state. The thread runs niced (``WORKER_NICE``): the frames
+come first on a busy machine, the open finishing later.
 
 Meanwhile the status row says "opening NAME..." / "exporting NAME...", frames keep coming and the
 view orbits. A second 'open mesh' while one runs wins: the earlier one's result is dropped when
