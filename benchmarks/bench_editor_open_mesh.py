@@ -92,7 +92,8 @@ def main() -> None:
                 runs[name].append(result)
                 print(f"{name} round {r}: {result['frames']} frames, longest gap {result['max_gap_ms']:.0f} ms "
                       f"(while reading {result['max_gap_reading_ms']:.0f} ms; while uploading "
-                      f"{result['max_gap_uploading_ms']:.0f} ms over {result['uploading_frames']} frames; the frames taking and first "
+                      f"{result['max_gap_uploading_ms']:.0f} ms over {result['uploading_frames']} frames; "
+                      f"the frames taking and first "
                       f"drawing it {result['taking_frames_ms']} ms), {result['total_s']:.2f} s to the helmet drawn "
                       f"{result['error']}", flush=True)
     print("\n| tree | runs | frames from the request to the helmet drawn | longest gap (ms) | "

@@ -128,7 +128,6 @@ KEPT_PATH_FIELDS = ("preset_path", "gltf_path")
 DEFAULT_PATHS = {"preset_path": "material.json", "gltf_path": "material.gltf"}
 
 
-
 def read_for_upload(spec: str):
     """On the file-jobs thread: the mesh (EditorState's read_mesh) and the CPU side of its GPU
     upload (alight.render.mesh_upload.prepare_upload)."""
@@ -137,6 +136,7 @@ def read_for_upload(spec: str):
 
     mesh = read_mesh(spec)
     return mesh, prepare_upload(mesh)
+
 
 class Panel:
     def __init__(self):
