@@ -88,6 +88,7 @@ def test_a_staged_mesh_draws_as_render_uploads_it(renderer, shared_data, monkeyp
     got = renderer.render(Scene(mesh=mesh, use_file_materials=True, lights=lights), None, 160, 160).linear
     assert renderer.shadow_maps.last_active
     diff = np.abs(got - expected)
+    print(f"staged vs render(): max {diff.max():.4f}, mean {diff.mean():.2e}")
     assert diff.max() < 0.02 and diff.mean() < 1e-4, (diff.max(), diff.mean())
 
 
