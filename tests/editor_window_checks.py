@@ -56,6 +56,8 @@ def test_drops_keep_previous_state_and_show_the_error(window, tmp_path, shared_d
             should_fail = True
         window.drop([str(path)])   # what glfw's drop callback calls
         window.frame()             # the editor keeps running and draws the panel
+        while window.panel.file_jobs.busy:   # a mesh file is read on the panel's worker thread
+            window.frame()
         window.frame()
         if should_fail:
             errors += 1
@@ -71,6 +73,35 @@ def test_drops_keep_previous_state_and_show_the_error(window, tmp_path, shared_d
     window.drop([str(REPO / "presets" / "copper.json")])
     window.frame()
     assert window.state.error == "" and window.state.material.name == "copper"
+
+
+def test_a_dropped_mesh_and_a_script_open_are_read_on_the_worker(window, shared_data):
+    """A mesh file dropped on the window and --script open= go through the panel's file jobs
+    (a worker thread reads it and makes its upload's CPU side; frames put it on the GPU): the
+    drop returns at once, frames are drawn meanwhile, and the mesh arrives whole."""
+    from alight.frontends.editor import run
+
+    jobs = window.panel.file_jobs
+    duck = str(shared_data / "models" / "Duck.glb")
+    box = str(shared_data / "models" / "BoxTextured.glb")
+    for path, ask in ((duck, lambda p: window.drop([p])), (box, lambda p: window.state.apply_edit(f"open={p}"))):
+        started, frames = jobs.started, jobs.frames_while_running
+        ask(path)
+        assert jobs.started == started + 1, "the file was not read on the panel's worker thread"
+        assert window.state.mesh_spec != path   # not assigned in the call: a frame takes it
+        if path == box:
+            run._finish_open(window)   # what the script loop does after open=
+        while jobs.busy:
+            window.frame()
+        assert window.state.mesh_spec == path and not window.state.error, (window.state.mesh_spec, window.state.error)
+        assert jobs.frames_while_running > frames
+    started = jobs.started   # a script's open= of a broken file stops the script: one line
+    window.state.apply_edit(f"open={shared_data / 'bad' / 'empty.obj'}")
+    with pytest.raises(AlightError, match="empty.obj"):
+        run._finish_open(window)
+    assert jobs.started == started + 1 and window.state.mesh_spec == box
+    window.state.error = ""
+    window.state.load_mesh("sphere")
 
 
 def test_undo_redo_of_material_edits(window):

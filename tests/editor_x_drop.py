@@ -158,6 +158,8 @@ def _checks(env_file: str) -> int:
                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         while proc.poll() is None:
             win.frame()
+        while win.panel.file_jobs.busy:   # a mesh file is read on the panel's worker thread
+            win.frame()
         for _ in range(3):
             win.frame()
         win.finish_bake()

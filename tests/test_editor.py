@@ -96,7 +96,11 @@ def test_a_mesh_opened_by_script_is_drawn_as_the_mesh_option_draws_it(display, t
     duck = str(shared_data / "models" / "Duck.glb")
     opened = screenshot(tmp_path, "opened", "--new", "--script", f"open={duck}")
     given = screenshot(tmp_path, "given", "--new", "--mesh", duck)
-    np.testing.assert_array_equal(opened, given)
+    # open= puts the mesh on the GPU in steps with mip levels made on the CPU (alight.render.mesh_upload:
+    # an sRGB level within 1 of llvmpipe's, whose sRGB encoding is an approximation); --mesh lets
+    # GL make them: a few pixels of the minified texture a hair apart (0.3%, 2/255 at most, here).
+    diff = np.abs(opened.astype(int) - given)
+    assert diff.max() <= 3 and (diff > 0).mean() < 0.01, (diff.max(), (diff > 0).mean())
     assert ball(opened)[:, 0].mean() > ball(opened)[:, 2].mean() + 30   # the duck's yellow, not grey
     missing = edit("--new", "--script", f"open={tmp_path / 'missing.glb'}", "--screenshot", str(tmp_path / "x.png"))
     assert missing.returncode == 2 and missing.stderr.count("\n") == 1 and "missing.glb" in missing.stderr

@@ -256,6 +256,10 @@ GL_TEXTURE_MAX_LEVEL = 0x813D
 GL_RGBA32F = 0x8814
 GL_RGBA = 0x1908
 GL_FLOAT = 0x1406
+GL_TEXTURE_2D = 0x0DE1
+GL_RGBA8 = 0x8058
+GL_SRGB8_ALPHA8 = 0x8C43
+GL_UNSIGNED_BYTE = 0x1401
 
 
 @functools.lru_cache(maxsize=1)
@@ -274,7 +278,8 @@ def _gl():
 
     u, i, p = ctypes.c_uint, ctypes.c_int, ctypes.c_void_p
     return {"TexImage2D": function("glTexImage2D", u, i, i, i, i, i, u, u, p),
-            "TexParameteri": function("glTexParameteri", u, u, i)}
+            "TexParameteri": function("glTexParameteri", u, u, i),
+            "TexSubImage2D": function("glTexSubImage2D", u, i, i, i, i, i, u, u, p)}
 
 
 def float_cube(ctx: moderngl.Context, size: int, levels: int, data=None) -> moderngl.TextureCube:
@@ -305,3 +310,33 @@ def float_cube(ctx: moderngl.Context, size: int, levels: int, data=None) -> mode
     gl["TexParameteri"](GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAX_LEVEL, levels - 1)
     tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR if levels > 1 else moderngl.LINEAR, moderngl.LINEAR)
     return tex
+
+
+def rgba8_texture(ctx: moderngl.Context, size: tuple[int, int], levels: int, srgb: bool) -> moderngl.Texture:
+    """An RGBA8 (or SRGB8_ALPHA8) 2D texture with ``levels`` mip levels allocated, contents
+    undefined: the caller writes each with ``write_rgba8`` (in pieces if it likes; moderngl's own
+    write refuses a level it did not make).
+    For levels made on the CPU beforehand (alight.render.mesh_upload) instead of build_mipmaps,
+    which on llvmpipe filters on the GL thread (about 0.1 s a 2048² map)."""
+    w, h = size
+    tex = ctx.texture((w, h), 4, None, internal_format=GL_SRGB8_ALPHA8 if srgb else None)
+    if levels > 1:
+        gl = _gl()
+        tex.use(ctx.default_texture_unit)     # binds it on moderngl's own scratch unit
+        for n in range(1, levels):
+            gl["TexImage2D"](GL_TEXTURE_2D, n, GL_SRGB8_ALPHA8 if srgb else GL_RGBA8, max(1, w >> n), max(1, h >> n),
+                             0, GL_RGBA, GL_UNSIGNED_BYTE, None)
+        gl["TexParameteri"](GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0)
+        gl["TexParameteri"](GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, levels - 1)
+    return tex
+
+
+def write_rgba8(ctx: moderngl.Context, tex: moderngl.Texture, level: int, y0: int, rows) -> None:
+    """``rows`` ((n, w, 4) uint8, bottom row first) into level ``level`` of ``tex`` (made by
+    ``rgba8_texture``) from row ``y0`` up."""
+    import numpy as np
+
+    data = np.ascontiguousarray(rows, dtype=np.uint8)
+    tex.use(ctx.default_texture_unit)     # binds it on moderngl's own scratch unit
+    _gl()["TexSubImage2D"](GL_TEXTURE_2D, level, 0, y0, data.shape[1], data.shape[0], GL_RGBA, GL_UNSIGNED_BYTE,
+                           data.ctypes.data)

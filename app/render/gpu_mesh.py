@@ -224,20 +224,43 @@ class MeshTextures:
         key = (id(info.image), srgb, sampler)
         tex = self._textures.get(key)
         if tex is None:
-            tex = upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps)
-            tex.filter = (MIN_FILTERS.get(sampler.min_filter, moderngl.LINEAR_MIPMAP_LINEAR),
-                          moderngl.NEAREST if sampler.mag_filter == "nearest" else moderngl.LINEAR)
-            tex.repeat_x = sampler.wrap_s == "repeat"
-            tex.repeat_y = sampler.wrap_t == "repeat"
-            if not sampler.mipmaps or sampler.mag_filter == "nearest":
-                tex.anisotropy = 1.0
-            self._textures[key] = tex
+            tex = self._textures[key] = self.sampled(upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps),
+                                                     sampler)
         return tex
+
+    @staticmethod
+    def sampled(tex: moderngl.Texture, sampler) -> moderngl.Texture:
+        """``tex`` (as upload_image leaves it) with the glTF sampler's filters and wrap."""
+        tex.filter = (MIN_FILTERS.get(sampler.min_filter, moderngl.LINEAR_MIPMAP_LINEAR),
+                      moderngl.NEAREST if sampler.mag_filter == "nearest" else moderngl.LINEAR)
+        tex.repeat_x = sampler.wrap_s == "repeat"
+        tex.repeat_y = sampler.wrap_t == "repeat"
+        if not sampler.mipmaps or sampler.mag_filter == "nearest":
+            tex.anisotropy = 1.0
+        return tex
+
+    def adopt(self, key: tuple, tex: moderngl.Texture) -> None:
+        """A texture uploaded beforehand (alight.render.mesh_upload) under ``get``'s key."""
+        self._textures[key] = tex
 
     def release(self) -> None:
         for tex in self._textures.values():
             tex.release()
         self._textures.clear()
+
+
+def level_texture(ctx: moderngl.Context, size: tuple[int, int], levels: int, srgb: bool) -> moderngl.Texture:
+    """``upload_image``'s texture (format, filter, anisotropy) with its ``levels`` allocated and
+    not yet written: levels made beforehand (alight.render.mesh_upload) are written into it."""
+    from alight.core.gpu import rgba8_texture
+
+    tex = rgba8_texture(ctx, size, levels, srgb)
+    if levels > 1:
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        tex.anisotropy = 8.0
+    else:
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    return tex
 
 
 def upload_image(ctx: moderngl.Context, image: np.ndarray, srgb: bool, mipmaps: bool = True) -> moderngl.Texture:
@@ -304,6 +327,19 @@ class GpuMeshes:
             mark_mesh_uv_features(entry[1])
         self._meshes[id(mesh)] = entry    # last: the most recently drawn
         return entry[1]
+
+    def adopt(self, mesh, textures: "MeshTextures") -> list[GpuPart]:
+        """``mesh`` uploaded with ``textures`` filled beforehand (alight.render.mesh_upload): its
+        parts' buffers made now; drawn from here on as if ``parts`` had uploaded it."""
+        entry = self._meshes.pop(id(mesh), None)
+        if entry is not None:
+            release_mesh(entry)
+        while len(self._meshes) >= MAX_UPLOADED_MESHES:
+            release_mesh(self._meshes.pop(next(iter(self._meshes))))
+        parts = [GpuPart(self.ctx, part, textures) for part in mesh.parts]
+        mark_mesh_uv_features(parts)
+        self._meshes[id(mesh)] = (mesh, parts, textures)
+        return parts
 
     def __len__(self) -> int:
         """How many meshes are uploaded (at most MAX_UPLOADED_MESHES)."""

@@ -444,5 +444,13 @@ class ForwardRenderer:
     def _part_material(scene: Scene, part) -> tuple[Material, bool]:
         return variants.part_material(scene, part)
 
+    def upload_step(self, upload) -> bool:
+        """One step of a staged upload (``upload`` made off the GL thread by
+        alight.render.mesh_upload.prepare_upload): a few MiB of its textures' levels, or once they
+        are all written, the mesh's buffers. Returns True when ``upload.mesh`` is whole on the
+        GPU, drawn from then on with no upload in its frame. For a front end that keeps drawing
+        frames meanwhile (the editor); ``upload.drop()`` releases an upload left unfinished."""
+        return upload.step(self.ctx, self.meshes, self.shadow_maps)
+
     def _gpu_mesh(self, mesh) -> list[GpuPart]:
         return self.meshes.parts(mesh)

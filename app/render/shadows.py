@@ -151,6 +151,11 @@ class ShadowMaps:
             entry = self._self_shadowing[id(mesh)] = (mesh, can_shadow_itself(parts))
         return entry[1]
 
+    def know_self_shadowing(self, mesh, value: bool) -> None:
+        """``mesh_can_shadow_itself``'s answer computed elsewhere (alight.render.mesh_upload, on
+        the editor's worker thread): the frame that first draws ``mesh`` does not compute it."""
+        self._self_shadowing[id(mesh)] = (mesh, bool(value))
+
     def wanted(self, scene, maps, receivers: bool = False) -> bool:
         """Whether ``scene`` is drawn with shadows (``scene.shadows``, the module docstring).
         ``receivers``: a surface that is not the mesh takes shadows (the ground)."""

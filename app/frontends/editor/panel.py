@@ -128,6 +128,16 @@ KEPT_PATH_FIELDS = ("preset_path", "gltf_path")
 DEFAULT_PATHS = {"preset_path": "material.json", "gltf_path": "material.gltf"}
 
 
+def read_for_upload(spec: str):
+    """On the file-jobs thread: the mesh (EditorState's read_mesh) and the CPU side of its GPU
+    upload (alight.render.mesh_upload.prepare_upload)."""
+    from alight.frontends.editor.state import read_mesh
+    from alight.render.mesh_upload import prepare_upload
+
+    mesh = read_mesh(spec)
+    return mesh, prepare_upload(mesh)
+
+
 class Panel:
     def __init__(self):
         # The F0 table, read once: (name, material, linear F0, sRGB F0).
@@ -181,8 +191,7 @@ class Panel:
         # The status row is the window's menu bar: it stays in view whatever the panel's scroll.
         imgui.begin("alight", None, imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize
                     | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
-        self.take_file_jobs(s)
-        self.shown_error = s.error
+        self.shown_error = s.error   # (file jobs: taken by EditorWindow.build_frame before, with or without the panel)
         self.shown_status = self._status_line(s, win)
         self._follow_loaded(s)
         self._follow_maps(s)
@@ -444,16 +453,25 @@ class Panel:
     def _open_mesh(self, s) -> None:
         """'open mesh' (or Enter in its field): the file read by a worker thread (file_jobs.py),
         assigned when a frame takes it; a second open while one runs wins."""
+        self.open_mesh(s, self.mesh_path)
+
+    def open_mesh(self, s, spec: str) -> None:
+        """``spec`` read on the worker thread: the button, a dropped mesh file and --script open=
+        (EditorState.open_mesh_async). Besides the read, the thread does the CPU side of the
+        mesh's upload (alight.render.mesh_upload: the textures' mip levels, the self-shadowing
+        test), which the frame that took the mesh used to do on the GL thread (1.2 s for
+        DamagedHelmet, no frame drawn)."""
         s.error = ""
-        from alight.frontends.editor.state import read_mesh
+        self.file_jobs.open_mesh(spec, read_for_upload)
 
-        self.file_jobs.open_mesh(self.mesh_path, read_mesh)
-
-    def take_file_jobs(self, s) -> None:
-        """The worker thread's finished opens and exports, taken on the GL thread once a frame:
-        a mesh read is assigned here (the renderer uploads it when it draws it), a failure is
-        the one-line error with the previous mesh kept and the field back on the path that last
-        worked, as ``_attempt`` does."""
+    def take_file_jobs(self, s, renderer=None) -> None:
+        """The worker thread's finished opens and exports, taken on the GL thread once a frame
+        (before the panel is drawn). A mesh read is put on the GPU over the next frames, a few MiB
+        of texture levels a frame (``renderer.upload_step``), and assigned to the state in the
+        frame that completes it: until then the previous mesh stays on screen and the status row
+        says "opening NAME..." (an artist sees the new mesh whole at once, never a bare grey
+        helmet whose maps pop in one by one). A failure is the one-line error with the previous
+        mesh kept and the field back on the path that last worked, as ``_attempt`` does."""
         for done in self.file_jobs.take():
             field = "mesh_path" if done.kind == "open" else "gltf_path"
             if done.error is not None:
@@ -462,12 +480,19 @@ class Panel:
                     setattr(self, field, self._good.get(field, ""))
                 continue
             if done.kind == "open":
-                s.apply_mesh(done.target, done.value)
-                s.error, s.message = "", s.with_warnings(f"opened mesh {done.target}")
-            else:
-                note = done.value
-                s.error, s.message = "", f"exported {done.target}{f' ({note})' if note else ''}"
+                mesh, upload = done.value
+                self.file_jobs.staged = (done.target, mesh, upload)
+                continue
+            note = done.value
+            s.error, s.message = "", f"exported {done.target}{f' ({note})' if note else ''}"
             self._good[field] = done.target
+        staged = self.file_jobs.staged
+        if staged is not None and (renderer is None or renderer.upload_step(staged[2])):
+            spec, mesh, _ = staged
+            self.file_jobs.staged = None
+            s.apply_mesh(spec, mesh)
+            s.error, s.message = "", s.with_warnings(f"opened mesh {spec}")
+            self._good["mesh_path"] = spec
 
     def kept_paths(self) -> dict:
         """The 'preset file' and 'glTF file' fields for the next session: the paths that last

@@ -80,7 +80,10 @@ def run(args) -> int:
             return _benchmark(win, args.frames or 120)
         for i, edit in enumerate(args.script):
             win.frame()            # one frame per edit: the editor runs between them
+            started = win.panel.file_jobs.started
             state.apply_edit(edit)
+            if win.panel.file_jobs.started != started:   # open= of a mesh: read on the panel's worker
+                _finish_open(win)
         if args.screenshot:
             for _ in range(args.frames or 1):
                 win.frame()
@@ -102,6 +105,17 @@ def run(args) -> int:
         return 0
     finally:
         win.close()
+
+
+def _finish_open(win) -> None:
+    """Frames until the mesh a script's ``open=`` asked for is read and on screen (the next edit
+    or the screenshot sees it); a file that fails stops the script, as it did when read here."""
+    from alight.errors import AlightError
+
+    while win.panel.file_jobs.busy:
+        win.frame()
+    if win.state.error:
+        raise AlightError(win.state.error)
 
 
 def _imgui_ini():

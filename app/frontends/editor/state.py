@@ -96,6 +96,9 @@ class EditorState:
     env: object = None
     map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
     map_conversions: dict = field(default_factory=dict)   # path -> the conversion its image was decoded with
+    # Set by the window: opens a mesh file off the UI thread (Panel.open_mesh, file_jobs.py) for a
+    # drop and --script open=; None (no window: tests of the state alone) reads it here.
+    open_mesh_async: object = field(default=None, repr=False, compare=False)
 
     @property
     def look(self) -> tuple[Material, TextureMaps]:
@@ -414,7 +417,10 @@ class EditorState:
             if suffix in ENV_SUFFIXES:
                 self.load_env(path)
             elif suffix in MESH_EXTENSIONS and not _material_only(path):
-                self.load_mesh(path)
+                if self.open_mesh_async is not None:
+                    self.open_mesh_async(path)   # read on the panel's worker; its errors come later
+                else:
+                    self.load_mesh(path)
             elif suffix in (".gltf", ".glb"):   # a material without a mesh (alight export --out X.gltf)
                 self.load_material(path)
             elif suffix in PRESET_SUFFIXES:

@@ -252,6 +252,8 @@ class EditorWindow:
             self.imgui.get_io().config_input_text_cursor_blink = False
 
         self.panel = Panel()
+        # A dropped mesh file and --script open= are read on the panel's worker thread too.
+        state.open_mesh_async = lambda spec: self.panel.open_mesh(self.state, spec)
         if not self.hosted:   # a finished open or export ends the idle wait (file_jobs.py)
             self.panel.file_jobs.wake = self._answer_came
         from alight.frontends.editor.compare_view import CompareView
@@ -816,6 +818,9 @@ class EditorWindow:
         if self.hosted:
             self._size_cache = None   # the runner polled the events
         self._frame_no += 1
+        # The panel's opens and exports (file_jobs.py), a step of a new mesh's upload: each frame,
+        # the panel shown or not (--no-panel, a drop, --script open=).
+        self.panel.take_file_jobs(self.state, self.renderer)
         if self.show_panel:
             self.panel.draw(self)
             if not self.hosted:
