@@ -527,7 +527,10 @@ def test_a_flat_mesh_seen_edge_on_is_said(window, shared_data):
     try:
         assert s.open_file(str(shared_data / "bad" / "singlevn.obj"))
         window.frame()
-        assert "edge-on" in s.message
+        while window.panel.file_jobs.busy:   # (a mesh file is read on the panel's worker thread)
+            window.frame()
+        window.frame()
+        assert "edge-on" in s.message, (s.message, s.error)
     finally:
         s.load_mesh("sphere")
         s.message = ""
