@@ -228,7 +228,7 @@ def test_turntable_button_writes_an_animated_webp(ctx):
     still = screenshot(ctx)
     ctx.item_click("**/turntable (T)")
     until(ctx, lambda: win.turntable_job is None and os.path.isfile(path))
-    assert win.state.message.startswith(f"wrote {path} (6 frames"), (win.state.message, win.state.error)
+    assert win.state.message.startswith(f"wrote {os.path.basename(path)} (6 frames"), (win.state.message, win.state.error)
     with Image.open(path) as im:
         assert im.n_frames == 6, im.n_frames
         frames = []

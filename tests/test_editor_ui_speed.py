@@ -73,3 +73,13 @@ def test_the_presets_are_drawn_ahead_so_a_first_click_needs_no_warm_up(display, 
     result = ui_test(tmp_path, REPO / "tests" / "editor_ui_checks_prefetch.py", "--new")
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     assert "1 passed, 0 failed" in result.stdout, result.stdout
+
+
+def test_a_screenshot_clicked_is_named_first_in_the_status_row(display, tmp_path):
+    """Real X events: 'Display & camera' opened and 'screenshot (F12)' clicked twice, the pointer
+    then kept still; each file is written and the status row starts with its name, where the row
+    is not cut (tests/editor_x_events_status.py)."""
+    result = run_check("editor_x_events_status.py", display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+                       ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: the row shows 'wrote alight-screenshot-2.png"), result.stdout

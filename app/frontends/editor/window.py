@@ -57,6 +57,17 @@ IDLE_WAIT_S = 0.1
 CHECKER_SQUARE = 8.0   # pixels a side of the checkerboard under a transparent background
 
 
+
+def wrote_message(path, detail: str) -> str:
+    """'wrote NAME (DETAIL) in FOLDER': the file's name first, where the status row (cut at the
+    panel's edge) shows it; a new user saw 'wrote /long/folder/alight-screenshot-' twice and read
+    the second screenshot as not taken."""
+    text = os.fspath(path)
+    folder, name = os.path.split(os.path.abspath(text.split(" ... ")[0]))
+    if " ... " in text:
+        name = f"{name} ... {text.split(' ... ')[-1]}"
+    return f"wrote {name} ({detail}) in {folder}"
+
 class EditorWindow:
     def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
                  show_panel: bool = True, ini_path=None, hosted: bool = False):
@@ -933,7 +944,7 @@ class EditorWindow:
         if self._step_job(job):
             self.screenshot_job = None
             if os.path.isfile(job.path) and job.rows == job.height:
-                self.state.error, self.state.message = "", f"wrote {job.path} ({job.width}x{job.height})"
+                self.state.error, self.state.message = "", wrote_message(job.path, f"{job.width}x{job.height}")
 
     def start_turntable(self):
         """The panel's turntable: the view's camera orbiting once about the vertical axis
@@ -965,7 +976,7 @@ class EditorWindow:
             self.turntable_job = None
             if job.rows == job.height:
                 where = job.path if job.webp else f"{job.finals[0]} ... {job.finals[-1].name}"
-                self.state.error, self.state.message = "", f"wrote {where} ({job.done} frames, {job.width}x{job.height})"
+                self.state.error, self.state.message = "", wrote_message(where, f"{job.done} frames, {job.width}x{job.height}")
                 if job.mp4 and self.state.display.background == "transparent":
                     # H.264 in yuv420p has no alpha: said, not left to be found in the video.
                     self.state.message += ("; warning: an MP4 has no alpha: the transparent background is black "
