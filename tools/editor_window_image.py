@@ -4,8 +4,12 @@ Run under a display, e.g. ``xvfb-run -a -s "-screen 0 1400x800x24" .venv/bin/pyt
 """
 
 import dataclasses
+import os
 import tempfile
 from pathlib import Path
+
+# The picture shows the editor as a new user first sees it: an empty library (not this machine's).
+os.environ["ALIGHT_LIBRARY_DIR"] = tempfile.mkdtemp(prefix="alight-library-")
 
 import numpy as np
 
@@ -33,6 +37,14 @@ win = EditorWindow(state, (1280, 720))
 try:
     win.finish_bake()   # the bake runs across frames; the picture shows its result
     for _ in range(5):
+        win.frame()
+    # The shader warm-ups and thumbnails finish, so that the status row shows no "compiling shaders".
+    for _ in range(2000):
+        if not win._background_pending():
+            break
+        win.frame()
+    win.state.message = ""
+    for _ in range(3):
         win.frame()
     win.draw()   # one more frame, read back before it would be swapped
     win.ctx.finish()
