@@ -130,5 +130,5 @@ def test_batch_refuses_a_bad_value_before_rendering(tmp_path):
 def test_api_names_the_fields_on_an_unknown_keyword():
     from alight.frontends.api import Renderer
 
-    with pytest.raises(AlightError, match=r"unknown field 'rougness' \(the fields: base_color, .*clearcoat"):
+    with pytest.raises(AlightError, match=r"unknown field 'rougness' \(did you mean 'roughness'\? the fields: base_color, .*clearcoat"):
         Renderer(width=8, height=8).set_material(rougness=0.3)
