@@ -428,7 +428,9 @@ def test_cli_says_why_vbuffer_was_not_used(tmp_path, case):
     mesh, flags, size, reason = {
         "blend": (_blended_file(tmp_path), [], "64", "the scene has blended parts"),
         "odd": (_grid_file(tmp_path, 8), [], "65x64", "the size 65x64 is odd"),
-        "ground": (_grid_file(tmp_path, 8), ["--ground"], "64", "the scene has a ground"),
+        # (a light, so that the ground has a shadow to catch: without one it says so in a line of its own)
+        "ground": (_grid_file(tmp_path, 8), ["--ground", "--light", "directional:dir=-0.5,-1,-0.3"], "64",
+                   "the scene has a ground"),
         "aa": (_grid_file(tmp_path, 8), ["--aa", "ssaa"], "64", "needs 4x msaa, not anti-aliasing ssaa"),
         "sphere": (None, [], "64", "the built-in sphere"),
     }[case]
