@@ -22,6 +22,19 @@ LABEL = "screenshot (F12)"
 WAIT_S = 3.0    # the pointer kept still this long after the click
 
 
+def click(win, pointer, x0: int, y0: int, rect) -> None:
+    """A real press and release at the middle of ``rect`` (window coordinates; the window at
+    x0, y0), a turn of the editor's loop after each."""
+    left, top, right, bottom = rect
+    pointer.move(x0 + int((left + right) / 2), y0 + int((top + bottom) / 2))
+    pointer.sync()
+    win.tick()
+    for down in (True, False):
+        pointer.button(down)
+        pointer.sync()
+        win.tick()
+
+
 def main() -> int:
     pointer = XTest()
     rects = record_rects("button", (LABEL,))
@@ -33,33 +46,17 @@ def main() -> int:
         x0, y0 = place_window(win)
         settle(win)
         for name in ("Material", "Display & camera"):   # the button's section opened, Material closed
-            left, top, right, bottom = headers[name]
-            pointer.move(x0 + int((left + right) / 2), y0 + int((top + bottom) / 2))
-            pointer.sync()
-            win.tick()
-            pointer.button(True)
-            pointer.sync()
-            win.tick()
-            pointer.button(False)
-            pointer.sync()
+            click(win, pointer, x0, y0, headers[name])
             for _ in range(4):
                 win.tick()
         if LABEL not in rects:
             print(f"'{LABEL}' was not drawn")
             return 1
-        left, top, right, bottom = rects[LABEL]
         for attempt in range(2):   # a second screenshot: the row held the first one's name
             for _ in range(3):
                 win.tick()
             before = win.panel.shown_status
-            pointer.move(x0 + int((left + right) / 2), y0 + int((top + bottom) / 2))
-            pointer.sync()
-            win.tick()
-            pointer.button(True)
-            pointer.sync()
-            win.tick()
-            pointer.button(False)
-            pointer.sync()
+            click(win, pointer, x0, y0, rects[LABEL])
             end = time.monotonic() + WAIT_S
             while time.monotonic() < end:
                 win.tick()

@@ -107,16 +107,25 @@ def cached_occluder_materials(mesh, baked: MeshVisibility, materials, cache=None
     (per part (N, 8) float32, whether it came from the cache)."""
     bake_key, _ = visibility_key(mesh, rays, edge_fraction, max_vertices, light_through)
     key, description = occluder_materials_key(bake_key, materials)
+    return _cached_per_vertex(cache, key, description, "occluder materials", "occluders", baked.parts,
+                              lambda: bake_occluder_materials(baked.parts, materials))
+
+
+def _cached_per_vertex(cache, key: str, description, what: str, name: str, parts, compute):
+    """Per part an (N, 8) float32 array (N: the part's vertices) from ``cache`` under ``key``
+    (entries ``{i}.{name}``), else ``compute()``'s, saved there: (the arrays, whether they came
+    from the cache). An entry whose arrays are missing or of another size is rejected (``what``
+    names it in the line) and made again."""
     if cache is not None:
-        arrays = cache.load(key, description, "occluder materials")
+        arrays = cache.load(key, description, what)
         if arrays is not None:
-            values = [arrays.get(f"{i}.occluders") for i in range(len(baked.parts))]
-            if all(v is not None and v.shape == (len(p.positions), 8) for v, p in zip(values, baked.parts)):
+            values = [arrays.get(f"{i}.{name}") for i in range(len(parts))]
+            if all(v is not None and v.shape == (len(p.positions), 8) for v, p in zip(values, parts)):
                 return [np.asarray(v, np.float32) for v in values], True
-            cache.reject(key, "occluder materials", "a part's arrays are missing or of another size")
-    values = bake_occluder_materials(baked.parts, materials)
+            cache.reject(key, what, "a part's arrays are missing or of another size")
+    values = compute()
     if cache is not None:
-        cache.save(key, encode_entry(description, {f"{i}.occluders": v for i, v in enumerate(values)}))
+        cache.save(key, encode_entry(description, {f"{i}.{name}": v for i, v in enumerate(values)}))
     return values, False
 
 
@@ -158,17 +167,8 @@ def cached_sun_bounce(mesh, baked: MeshVisibility, directions, cache=None, rays:
         return [np.zeros((len(p.positions), 8), np.float32) for p in baked.parts], False
     bake_key, _ = visibility_key(mesh, rays, edge_fraction, max_vertices, light_through)
     key, description = sun_bounce_key(bake_key, directions, light_through=light_through)
-    if cache is not None:
-        arrays = cache.load(key, description, "sun bounce bake")
-        if arrays is not None:
-            values = [arrays.get(f"{i}.sun_bounce") for i in range(len(baked.parts))]
-            if all(v is not None and v.shape == (len(p.positions), 8) for v, p in zip(values, baked.parts)):
-                return [np.asarray(v, np.float32) for v in values], True
-            cache.reject(key, "sun bounce bake", "a part's arrays are missing or of another size")
-    values = bake_sun_bounce(baked.parts, directions, light_through=light_through)
-    if cache is not None:
-        cache.save(key, encode_entry(description, {f"{i}.sun_bounce": v for i, v in enumerate(values)}))
-    return values, False
+    return _cached_per_vertex(cache, key, description, "sun bounce bake", "sun_bounce", baked.parts,
+                              lambda: bake_sun_bounce(baked.parts, directions, light_through=light_through))
 
 
 def environment_texels(shaders, maps, size: int = sw.SKY_TEXELS) -> tuple[np.ndarray, str]:
