@@ -58,15 +58,12 @@ CHECKER_SQUARE = 8.0   # pixels a side of the checkerboard under a transparent b
 
 
 
-def wrote_message(path, detail: str) -> str:
-    """'wrote NAME (DETAIL) in FOLDER': the file's name first, where the status row (cut at the
-    panel's edge) shows it; a new user saw 'wrote /long/folder/alight-screenshot-' twice and read
-    the second screenshot as not taken."""
-    text = os.fspath(path)
-    folder, name = os.path.split(os.path.abspath(text.split(" ... ")[0]))
-    if " ... " in text:
-        name = f"{name} ... {text.split(' ... ')[-1]}"
-    return f"wrote {name} ({detail}) in {folder}"
+def wrote_message(path, detail: str, last: str = "") -> str:
+    """'wrote NAME (DETAIL) in FOLDER' ('NAME ... LAST' for a series of files): the file's name
+    first, where the status row (cut at the panel's edge) shows it; a new user saw 'wrote
+    /long/folder/alight-screenshot-' twice and read the second screenshot as not taken."""
+    folder, name = os.path.split(os.path.abspath(os.fspath(path)))
+    return f"wrote {name}{f' ... {last}' if last else ''} ({detail}) in {folder}"
 
 class EditorWindow:
     def __init__(self, state: EditorState, size: tuple[int, int] = (1280, 720), title: str = "alight",
@@ -975,8 +972,9 @@ class EditorWindow:
         if self._step_job(job):
             self.turntable_job = None
             if job.rows == job.height:
-                where = job.path if job.webp else f"{job.finals[0]} ... {job.finals[-1].name}"
-                self.state.error, self.state.message = "", wrote_message(where, f"{job.done} frames, {job.width}x{job.height}")
+                detail = f"{job.done} frames, {job.width}x{job.height}"
+                self.state.error, self.state.message = "", (
+                    wrote_message(job.path, detail) if job.webp else wrote_message(job.finals[0], detail, job.finals[-1].name))
                 if job.mp4 and self.state.display.background == "transparent":
                     # H.264 in yuv420p has no alpha: said, not left to be found in the video.
                     self.state.message += ("; warning: an MP4 has no alpha: the transparent background is black "
