@@ -42,8 +42,7 @@ import math
 import numpy as np
 
 from alight.core.shading import rotate_world_to_map
-from alight.core.visibility import _cast, _frame, _Occluders, _origins, cosine_directions, merged_parts, \
-    one_way_triangles
+from alight.core.visibility import _frame, _origins, _Transmittance, cosine_directions, merged_parts
 from alight.core.visibility import on_welded, welded  # noqa: F401  (the weight's fill and smoothing run welded)
 from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
@@ -122,14 +121,7 @@ def sky_rays(parts, rays: int, seed: int = SKY_SEED, light_through=None) -> list
     if not parts or not sum(len(p.positions) for p in parts):
         return out
     positions, eps, offsets, faces, all_f, all_n = merged_parts(parts)
-    through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
-    part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
-    opaque_tri = ~(through > 0.0)[part_of_triangle]
-    one_way = one_way_triangles(parts)
-    blockers = _Occluders(positions[all_f[opaque_tri]], one_way=one_way[opaque_tri]) if opaque_tri.any() else None
-    see_through = _Occluders(positions[all_f[~opaque_tri]], one_way=one_way[~opaque_tri]) \
-        if (~opaque_tri).any() else None
-    through_of_see_through = through[part_of_triangle[~opaque_tri]]
+    transmittance = _Transmittance(parts, positions, faces, all_f, light_through)
     origins = np.concatenate([_origins(positions[a:b], all_n[a:b], f, eps)
                               for f, a, b in zip(faces, offsets[:-1], offsets[1:])])
     rng = np.random.default_rng(seed)
@@ -141,13 +133,7 @@ def sky_rays(parts, rays: int, seed: int = SKY_SEED, light_through=None) -> list
         s1 = min(s0 + chunk, count)
         d = np.ascontiguousarray(ray_directions(all_n[s0:s1], angles[s0:s1], rays).reshape(-1, 3), np.float32)
         o = np.ascontiguousarray(np.repeat(origins[s0:s1], rays, axis=0))
-        w = np.ones(len(d))
-        if blockers is not None:
-            prim, _, _ = _cast(blockers.scene, o, d, blockers.normals, eps, one_way=blockers.one_way)
-            w = (prim < 0).astype(np.float64)
-        if see_through is not None:
-            prim_t, _, _ = _cast(see_through.scene, o, d, see_through.normals, eps, one_way=see_through.one_way)
-            w = w * np.where(prim_t < 0, 1.0, through_of_see_through[np.maximum(prim_t, 0)])
+        w = transmittance.along(o, d, eps)
         free[s0:s1] = np.round(w * 255.0).astype(np.uint8).reshape(s1 - s0, rays)
     angles = angles.astype(np.float32)
     return [(free[a:b], angles[a:b]) for a, b in zip(offsets[:-1], offsets[1:])]

@@ -1081,6 +1081,34 @@ def merged_parts(parts):
     return positions, eps, offsets, faces, all_f, all_n
 
 
+class _Transmittance:
+    """The merged refined parts (``merged_parts``) split by ``light_through`` (per part, 0 for
+    opaque): an opaque triangle stops a ray; a see-through one passes its part's share, the first
+    one a ray meets (as the bake's ``_free_rays``)."""
+
+    def __init__(self, parts, positions: np.ndarray, faces, all_f: np.ndarray, light_through=None):
+        through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
+        part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
+        opaque = ~(through > 0.0)[part_of_triangle]
+        one_way = one_way_triangles(parts)
+        self.blockers = _Occluders(positions[all_f[opaque]], one_way=one_way[opaque]) if opaque.any() else None
+        self.see_through = _Occluders(positions[all_f[~opaque]], one_way=one_way[~opaque]) if (~opaque).any() else None
+        self.through = through[part_of_triangle[~opaque]]       # per see-through triangle
+
+    def along(self, origins: np.ndarray, dirs: np.ndarray, eps: float) -> np.ndarray:
+        """(R,) float64: the share of light that reaches each origin along its ray."""
+        w = np.ones(len(dirs))
+        if self.blockers is not None:
+            b = self.blockers
+            prim, _, _ = _cast(b.scene, origins, dirs, b.normals, eps, one_way=b.one_way)
+            w = (prim < 0).astype(np.float64)
+        if self.see_through is not None:
+            t = self.see_through
+            prim, _, _ = _cast(t.scene, origins, dirs, t.normals, eps, one_way=t.one_way)
+            w = w * np.where(prim < 0, 1.0, self.through[np.maximum(prim, 0)])
+        return w
+
+
 def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = DEFAULT_BOUNCE_RAYS,
                     seed: int = 0, light_through=None) -> list[np.ndarray]:
     """Per part of a bake (``bake_visibility``'s refined parts, world space), (N, 8) float32: the
@@ -1103,15 +1131,8 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
     if not len(directions) or not parts:
         return out
     positions, eps, offsets, faces, all_f, all_n = merged_parts(parts)
-    one_way = one_way_triangles(parts)
-    refined = _Occluders(positions[all_f], one_way=one_way)
-    through = np.zeros(len(parts)) if light_through is None else np.clip(np.asarray(light_through, float), 0, 1)
-    part_of_triangle = np.concatenate([np.full(len(f), k) for k, f in enumerate(faces)])
-    clear = through > 0.0
-    opaque_tri = ~clear[part_of_triangle]
-    blockers = _Occluders(positions[all_f[opaque_tri]], one_way=one_way[opaque_tri]) if opaque_tri.any() else None
-    see_through = _Occluders(positions[all_f[~opaque_tri]], one_way=one_way[~opaque_tri]) if clear.any() else None
-    through_of_see_through = through[part_of_triangle[~opaque_tri]]
+    refined = _Occluders(positions[all_f], one_way=one_way_triangles(parts))
+    transmittance = _Transmittance(parts, positions, faces, all_f, light_through)
     origins = np.concatenate([_origins(positions[a:b], all_n[a:b], f, eps)
                               for f, a, b in zip(faces, offsets[:-1], offsets[1:])])
     rng = np.random.default_rng(seed)
@@ -1143,13 +1164,7 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
                 continue
             o2 = np.ascontiguousarray(start[lit])
             d2 = np.ascontiguousarray(np.broadcast_to(l.astype(np.float32), (len(lit), 3)))
-            shadow = np.ones(len(lit))
-            if blockers is not None:
-                p2, _, _ = _cast(blockers.scene, o2, d2, blockers.normals, eps, one_way=blockers.one_way)
-                shadow = (p2 < 0).astype(np.float64)
-            if see_through is not None:
-                p3, _, _ = _cast(see_through.scene, o2, d2, see_through.normals, eps, one_way=see_through.one_way)
-                shadow = shadow * np.where(p3 < 0, 1.0, through_of_see_through[np.maximum(p3, 0)])
+            shadow = transmittance.along(o2, d2, eps)
             total[:, k] += np.bincount(vertex[lit], shadow * cos[lit] / math.pi, minlength=count)
     first = total / np.maximum(hits, 1)[:, None]                       # B1 per vertex
     carried = first * (hits / bounce_rays)[:, None]                    # h B1: what a vertex passes on
