@@ -7,6 +7,8 @@ alternate empty and warm (A B A B ...) in fresh processes; asserts nothing.
 
 "empty": ``MESA_SHADER_CACHE_DISABLE=true``; "warm": Mesa's cache in a private folder
 (``MESA_SHADER_CACHE_DIR``) filled by one run first, so the user's own cache is never touched.
+``--fresh`` adds "fresh" to every round: the cache on, in a new empty folder each run (a user's
+first render, which also writes the cache; what another process could fill ahead of a draw).
 alight's bake cache is warm in both (a shared temporary ``ALIGHT_CACHE_DIR``). The default model
 is the Khronos TextureTransformTest (``../shared/data/models/khronos/``), 512x512, 4x MSAA.
 ``--scene multi`` writes a file like Khronos' TextureTransformMultiTest (not in the shared data)
@@ -149,6 +151,8 @@ def main() -> None:
                     help="multi: the nine-material TextureTransformMultiTest-like file (multi_scene)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--against", default=None, help="another git ref, alternated with this tree")
+    ap.add_argument("--fresh", action="store_true",
+                    help="also a run with Mesa's cache on in a new empty folder, every round")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="alight-compile-") as tmp:
         folder = Path(tmp)
@@ -163,10 +167,14 @@ def main() -> None:
             mesa = str(folder / f"mesa-{len(modes)}")
             run(args.model, {"MESA_SHADER_CACHE_DIR": mesa}, path, cache)   # fills the bake and Mesa's cache
             modes[f"{tree}, empty"] = ({"MESA_SHADER_CACHE_DISABLE": "true"}, path)
+            if args.fresh:
+                modes[f"{tree}, fresh"] = ({"MESA_SHADER_CACHE_DIR": None}, path)   # a new folder per run
             modes[f"{tree}, warm"] = ({"MESA_SHADER_CACHE_DIR": mesa}, path)
         results: dict[str, list[dict]] = {name: [] for name in modes}
         for r in range(args.rounds):
             for name, (extra, path) in modes.items():
+                if extra.get("MESA_SHADER_CACHE_DIR", "") is None:
+                    extra = {"MESA_SHADER_CACHE_DIR": str(folder / f"fresh-{r}-{list(modes).index(name)}")}
                 out = run(args.model, extra, path, cache)
                 results[name].append(out)
                 print(f"round {r + 1} {name:22s} process {out['process']:.2f} s first frame {out['first']:.2f} s "
@@ -184,10 +192,12 @@ def main() -> None:
     for name in modes:
         print(f"| {name} | {med(name, 'process')} | {med(name, 'first')} | {med(name, 'compile')} | {med(name, 'second')} |")
     for tree in trees:
-        ratios = [e["process"] / w["process"] for e, w in zip(results[f"{tree}, empty"], results[f"{tree}, warm"])]
-        first = [e["first"] / w["first"] for e, w in zip(results[f"{tree}, empty"], results[f"{tree}, warm"])]
-        print(f"{tree}: empty / warm, process {statistics.median(ratios):.2f}x ({min(ratios):.2f}-{max(ratios):.2f}), "
-              f"first frame {statistics.median(first):.2f}x ({min(first):.2f}-{max(first):.2f})")
+        for cold in ("empty", "fresh") if args.fresh else ("empty",):
+            pairs = list(zip(results[f"{tree}, {cold}"], results[f"{tree}, warm"]))
+            ratios = [e["process"] / w["process"] for e, w in pairs]
+            first = [e["first"] / w["first"] for e, w in pairs]
+            print(f"{tree}: {cold} / warm, process {statistics.median(ratios):.2f}x ({min(ratios):.2f}-{max(ratios):.2f}), "
+                  f"first frame {statistics.median(first):.2f}x ({min(first):.2f}-{max(first):.2f})")
 
 
 if __name__ == "__main__":

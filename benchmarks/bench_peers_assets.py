@@ -37,7 +37,14 @@ load of other work on a shared machine falls on all alike:
   an empty bake cache, then with the bake cached; each peer's script writes its screenshot).
 - **steady frame**: one process per renderer and round; two warm-up frames, then ``--frames``
   frames, each with the camera orbited 1 degree and the 8-bit image read back into numpy.
-Both as wall time and as CPU time of the process and all its threads. Medians, ranges, and the
+Both as wall time and as CPU time of the process and all its threads.
+
+``--alight-features default,off`` runs alight's steady frame both ways before each peer's process:
+``default`` is alight's defaults (its sun's soft shadow and the occlusion bake ``auto``, on for the
+helmet under royal_esplanade_1k), ``off`` sets ``set_shadows("off")`` and ``set_occlusion("off")``,
+the features no peer here draws: the feature-matched comparison. Its rows are labelled
+"alight, shadows+occlusion off"; the default rows stay "alight". The cold part always runs the
+defaults. Medians, ranges, and the
 ratios alight / peer (below 1: alight takes less). The cold PNGs are copied to ``--images``.
 """
 
@@ -239,6 +246,8 @@ with alight.Renderer(w, h, aa="msaa") as r:
         r.set_material("gold", roughness=scene["roughness"])
     if "shadows" in scene:
         r.set_shadows(scene["shadows"])
+    if a.get("features") == "off":          # --alight-features off: what no peer draws, off
+        r.set_shadows("off").set_occlusion("off")
     times, cpu, previous = [], [], None
     for i in range(frames + 2):
         r.set_camera(orbit_deg=float(i))
@@ -306,10 +315,17 @@ def main() -> int:
     parser.add_argument("--frames", type=int, default=5, help="steady frames per process (default: 5)")
     parser.add_argument("--size", type=int, default=1024, help="square image size (default: 1024)")
     parser.add_argument("--parts", default="cold,steady", help="cold, steady or both (default)")
+    parser.add_argument("--alight-features", default="default",
+                        help="alight's steady frame: default (its defaults), off (shadows and occlusion off, "
+                             "as no peer draws them) or default,off (both, alternated; default: default)")
     parser.add_argument("--images", default=str(Path(tempfile.gettempdir()) / "bench_peers_assets"),
                         help="where the cold PNGs are copied (default: $TMPDIR/bench_peers_assets)")
     args = parser.parse_args()
     peers = [p for p in args.peers.split(",") if p]
+    features = [f for f in args.alight_features.split(",") if f]
+    if not features or set(features) - {"default", "off"}:
+        raise SystemExit(f"--alight-features: default, off or both, not {args.alight_features!r}")
+    label = {"default": "alight", "off": "alight, shadows+occlusion off"}
     parts = set(args.parts.split(","))
     images = Path(args.images)
     images.mkdir(parents=True, exist_ok=True)
@@ -318,7 +334,8 @@ def main() -> int:
         load_before = f.read().split()[:3]
     results = {}   # (scene, part, who) -> (walls, cpus)
     failures = {}  # (scene, peer) -> message
-    per_round = {}  # (scene, part, peer) -> [(alight / peer wall, alight / peer CPU) of each round]
+    per_round = {}  # (scene, part, peer, features) -> [(alight / peer wall, alight / peer CPU) of each round]
+    own = []        # alight's frame with shadows and occlusion off / with its defaults, per pair of processes
 
     def add(key, wall, cpu):
         walls, cpus = results.setdefault(key, ([], []))
@@ -377,20 +394,23 @@ def main() -> int:
                     line.append(f"{peer} {wall:.2f}")
                     peer_wall, peer_cpu = wall, cpu
                     wall, cpu, _ = run(render, alight_env)   # alternated: alight (bake cached) after each peer
-                    per_round.setdefault((name, "cold", peer), []).append((wall / peer_wall, cpu / peer_cpu))
+                    per_round.setdefault((name, "cold", peer, "default"), []).append((wall / peer_wall, cpu / peer_cpu))
                     add((name, "cold", "alight"), wall, cpu)
                     add((name, "cold", f"alight/{peer}"), wall, cpu)
                     line.append(f"alight {wall:.2f}")
                 print(f"{name} cold round {i + 1}/{args.rounds}: " + ", ".join(line) + " s", file=sys.stderr)
             for i in range(args.rounds if "steady" in parts else 0):
-                blob = json.dumps({"w": size, "h": size, "frames": args.frames, "scene": scene, "env": str(ENV)})
                 line = []
                 for peer in peers:
                     if (name, peer) in failures:
                         continue
-                    mine = json.loads(run([py, "-c", ALIGHT_STEADY, blob], alight_env)[2])
-                    add((name, "steady", f"alight/{peer}"), mine["frames"], mine["cpu"])
-                    add((name, "steady", "alight"), mine["frames"], mine["cpu"])
+                    mine = {}
+                    for feature in features:
+                        blob = json.dumps({"w": size, "h": size, "frames": args.frames, "scene": scene,
+                                           "env": str(ENV), "features": feature})
+                        mine[feature] = json.loads(run([py, "-c", ALIGHT_STEADY, blob], alight_env)[2])
+                        add((name, "steady", f"{label[feature]}/{peer}"), mine[feature]["frames"], mine[feature]["cpu"])
+                        add((name, "steady", label[feature]), mine[feature]["frames"], mine[feature]["cpu"])
                     try:
                         out = json.loads(run(peer_args(peer, "steady"), peer_env)[2])
                     except RuntimeError as e:
@@ -399,10 +419,14 @@ def main() -> int:
                         continue
                     add((name, "steady", peer), out["frames"], out["cpu"])
                     m = statistics.median
-                    per_round.setdefault((name, "steady", peer), []).append(
-                        (m(mine["frames"]) / m(out["frames"]), m(mine["cpu"]) / m(out["cpu"])))
-                    line.append(f"alight {statistics.median(results[(name, 'steady', f'alight/{peer}')][0]) * 1000:.0f}"
-                                f" / {peer} {statistics.median(out['frames']) * 1000:.0f}")
+                    if len(features) > 1:   # alight's own frame, off / default, side by side in this round
+                        own.append((m(mine["off"]["frames"]) / m(mine["default"]["frames"]),
+                                    m(mine["off"]["cpu"]) / m(mine["default"]["cpu"])))
+                    for feature in features:
+                        per_round.setdefault((name, "steady", peer, feature), []).append(
+                            (m(mine[feature]["frames"]) / m(out["frames"]), m(mine[feature]["cpu"]) / m(out["cpu"])))
+                    line.append(", ".join(f"{label[f]} {m(mine[f]['frames']) * 1000:.0f}" for f in features)
+                                + f" / {peer} {m(out['frames']) * 1000:.0f}")
                 print(f"{name} steady round {i + 1}/{args.rounds} (ms): " + ", ".join(line), file=sys.stderr)
             for who in ["alight"] + peers if "cold" in parts else ():
                 if (tmp / f"{name}_{who}.png").exists():
@@ -423,24 +447,31 @@ def main() -> int:
                 continue
             print(f"{name}, {part} ({'process start to PNG written' if part == 'cold' else 'frame with read-back'}):")
             for who, (walls, cpus) in rows:
-                if who.startswith("alight/"):
+                if who.startswith("alight") and "/" in who:
                     continue
-                print(f"  {who:16s} wall {summary(walls)}\n  {'':16s} CPU  {summary(cpus)}")
+                print(f"  {who:30s} wall {summary(walls)}\n  {'':30s} CPU  {summary(cpus)}")
             print("  ratios of medians alight / peer, wall (CPU), then the range of the rounds' ratios; "
                   "below 1: alight takes less:")
-            for peer in peers:
-                if (name, part, peer) not in results:
-                    continue
-                pw, pc = results[(name, part, peer)]
-                a = results[(name, part, f"alight/{peer}")]   # the alight runs next to this peer's
-                rounds = per_round[(name, part, peer)]
-                print(f"    {peer:10s} {m(a[0]) / m(pw):.2f} ({m(a[1]) / m(pc):.2f})   rounds "
-                      f"{min(r[0] for r in rounds):.2f}-{max(r[0] for r in rounds):.2f} "
-                      f"({min(r[1] for r in rounds):.2f}-{max(r[1] for r in rounds):.2f})", end="")
-                if part == "cold":
-                    first = results[(name, part, "alight first")]
-                    print(f"   empty bake cache: {m(first[0]) / m(pw):.2f} ({m(first[1]) / m(pc):.2f})", end="")
-                print()
+            for feature in features if part == "steady" else ["default"]:
+                if part == "steady" and len(features) > 1:
+                    print(f"   {label[feature]}:")
+                for peer in peers:
+                    if (name, part, peer) not in results:
+                        continue
+                    pw, pc = results[(name, part, peer)]
+                    a = results[(name, part, f"{label[feature]}/{peer}")]   # the alight runs next to this peer's
+                    rounds = per_round[(name, part, peer, feature)]
+                    print(f"    {peer:10s} {m(a[0]) / m(pw):.2f} ({m(a[1]) / m(pc):.2f})   rounds "
+                          f"{min(r[0] for r in rounds):.2f}-{max(r[0] for r in rounds):.2f} "
+                          f"({min(r[1] for r in rounds):.2f}-{max(r[1] for r in rounds):.2f})", end="")
+                    if part == "cold":
+                        first = results[(name, part, "alight first")]
+                        print(f"   empty bake cache: {m(first[0]) / m(pw):.2f} ({m(first[1]) / m(pc):.2f})", end="")
+                    print()
+    if own:
+        print(f"alight's own frame, shadows+occlusion off / defaults (median of {len(own)} process pairs, range): "
+              f"wall {m(r[0] for r in own):.2f} ({min(r[0] for r in own):.2f}-{max(r[0] for r in own):.2f}), "
+              f"CPU {m(r[1] for r in own):.2f} ({min(r[1] for r in own):.2f}-{max(r[1] for r in own):.2f})")
     if "cold" in parts:
         print(f"images: {images}/")
     return 0
