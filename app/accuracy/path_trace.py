@@ -30,8 +30,13 @@ KHR_materials_clearcoat's coat is traced as docs/layer_clearcoat.md defines it (
 and the exact reference's layering, alight.core.layers.clearcoat): f = f_base (1 - c F_c(n.v))
 + c F_c(n.v) D_c G_c / (4 (n.l)(n.v)), F0 = 0.04, the coat's normal the base's (no maps), with a
 third lobe to sample (GGX at the coat's roughness, picked by c F_c(n.v) against the base's albedo).
+The glTF material's maps apply per hit as the renderer applies them (alight.accuracy.path_trace_maps:
+base colour x COLOR_0, metallicRoughness, emissive, normal, the coat's R and G; bilinear, no
+mipmaps), and an alphaMode MASK part's texels below its cutoff are no surface for any ray. The
+occlusion texture is not applied: it is baked visibility, which the paths find themselves.
 Not modelled (refused or said in one warning line): the other layers (sheen, anisotropy,
-iridescence, ...), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
+iridescence, ...), the layers' other maps (transmission, specular, clearcoat normal, ...: their
+factors apply), the user's maps (--map), alpha BLEND (opaque), the probe view.
 """
 
 from __future__ import annotations
@@ -325,7 +330,8 @@ class _Geometry:
 
 
 def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
-    """The scene's triangles and per-part material factors (as the renderer resolves them), and
+    """The scene's triangles, per-part material factors (as the renderer resolves them) and
+    maps (``_Geometry.maps``: None where no part has a traced map, COLOR_0 or alpha mask), and
     one-line warnings about what the path tracer leaves out."""
     from alight.render.variants import part_material
 
