@@ -36,7 +36,8 @@ def _quad(path, material, uvs=None, uvs1=None, colors=None, normals=None, extra=
         attributes["TEXCOORD_1"] = g.accessor(uvs1)
     if colors is not None:
         attributes["COLOR_0"] = g.accessor(colors)
-    prims = [{"attributes": attributes, "indices": g.accessor(idx.ravel(), USHORT), "material": g.material(**material(g))}]
+    prims = [{"attributes": attributes, "indices": g.accessor(idx.ravel(), USHORT),
+              "material": g.material(**material(g))}]
     if extra is not None:
         p2, n2, i2, m2 = extra
         prims.append({"attributes": {"POSITION": g.accessor(p2, bounds=True), "NORMAL": g.accessor(n2)},
@@ -206,9 +207,9 @@ def test_normal_map_tilts_the_shading_normal_as_tilted_vertex_normals(tmp_path):
     m = texel / 255.0 * 2.0 - 1.0
     tilted = m / np.linalg.norm(m)
     light = [parse_light("directional:dir=-0.5,-0.3,-1:intensity=3")]
-    got, warnings = _trace(_quad(tmp_path / "n.glb", lambda g: {"pbrMetallicRoughness": _pbr(roughness=0.4),
-                                                                 "normalTexture": {"index": g.image(_solid((*texel, 255)))}}),
-                           radiance=None, lights=light, samples=4, jitter=False)
+    def mapped(g):
+        return {"pbrMetallicRoughness": _pbr(roughness=0.4), "normalTexture": {"index": g.image(_solid((*texel, 255)))}}
+    got, warnings = _trace(_quad(tmp_path / "n.glb", mapped), radiance=None, lights=light, samples=4, jitter=False)
     want, _ = _trace(_quad(tmp_path / "t.glb", lambda g: {"pbrMetallicRoughness": _pbr(roughness=0.4)},
                            normals=np.tile(tilted, (9, 1))), radiance=None, lights=light, samples=4, jitter=False)
     flat, _ = _trace(_quad(tmp_path / "f.glb", lambda g: {"pbrMetallicRoughness": _pbr(roughness=0.4)}),

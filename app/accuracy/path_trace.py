@@ -47,9 +47,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from alight.accuracy.path_trace_maps import MASK_PASSES, SurfaceMaps, part_maps
 from alight.core.layers.clearcoat import clearcoat_fresnel
 from alight.core.mesh import single_sided
-from alight.accuracy.path_trace_maps import MASK_PASSES, SurfaceMaps, part_maps
 from alight.core.shading import (
     D_GGX,
     MIN_N_DOT_V,
@@ -438,7 +438,8 @@ class _Rays:
         bool, or one per ray): the rays are the camera's; the others, with ``seen``, report the
         first surface they meet where the light is stopped (a bounce), without it what stops the
         light (a shadow ray): the class's docstring. A ray still on a one-way face after
-        ``passes`` re-casts stops there."""
+        ``passes`` re-casts (MASK_PASSES where a part has an alpha mask) stops there; a ray past
+        a masked-out texel goes on as if the triangle were not there, for every kind of ray."""
         prim, t, u, v = self._run(origins, dirs)
         if self.one_way is None and self.masked is None:
             return prim, t, u, v

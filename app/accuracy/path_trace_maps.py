@@ -227,7 +227,7 @@ class SurfaceMaps:
         normal facing the viewer, the other arrays the factors per hit (path_trace's table rows;
         coat arrays None where no part has a coat): the same arrays with the maps applied (new
         arrays; the inputs are not written)."""
-        base, metallic, roughness, emissive, n = base.copy(), metallic.copy(), roughness.copy(), emissive.copy(), n.copy()
+        base, metallic, roughness, emissive, n = (x.copy() for x in (base, metallic, roughness, emissive, n))
         coat = None if coat is None else coat.copy()
         coat_rough = None if coat_rough is None else coat_rough.copy()
         for index in np.unique(m):
