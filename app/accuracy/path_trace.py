@@ -30,8 +30,13 @@ KHR_materials_clearcoat's coat is traced as docs/layer_clearcoat.md defines it (
 and the exact reference's layering, alight.core.layers.clearcoat): f = f_base (1 - c F_c(n.v))
 + c F_c(n.v) D_c G_c / (4 (n.l)(n.v)), F0 = 0.04, the coat's normal the base's (no maps), with a
 third lobe to sample (GGX at the coat's roughness, picked by c F_c(n.v) against the base's albedo).
+The glTF material's maps apply per hit as the renderer applies them (alight.accuracy.path_trace_maps:
+base colour x COLOR_0, metallicRoughness, emissive, normal, the coat's R and G; bilinear, no
+mipmaps), and an alphaMode MASK part's texels below its cutoff are no surface for any ray. The
+occlusion texture is not applied: it is baked visibility, which the paths find themselves.
 Not modelled (refused or said in one warning line): the other layers (sheen, anisotropy,
-iridescence, ...), texture maps (only the factors apply), alpha masks, normal maps, the probe view.
+iridescence, ...), the layers' other maps (transmission, specular, clearcoat normal, ...: their
+factors apply), the user's maps (--map), alpha BLEND (opaque), the probe view.
 """
 
 from __future__ import annotations
@@ -42,6 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from alight.accuracy.path_trace_maps import MASK_PASSES, SurfaceMaps, part_maps
 from alight.core.layers.clearcoat import clearcoat_fresnel
 from alight.core.mesh import single_sided
 from alight.core.shading import (
@@ -320,10 +326,12 @@ class _Geometry:
     table: dict             # name -> (K, ...) arrays: base, metallic, roughness, f0, emissive
     scale: float            # the scene's size, for ray offsets
     one_way: np.ndarray | None = None   # (M,) bool: single-sided triangles (alight.core.mesh.single_sided)
+    maps: SurfaceMaps | None = None     # the parts' texture maps, COLOR_0 and alpha masks (None: factors only)
 
 
 def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
-    """The scene's triangles and per-part material factors (as the renderer resolves them), and
+    """The scene's triangles, per-part material factors (as the renderer resolves them) and
+    maps (``_Geometry.maps``: None where no part has a traced map, COLOR_0 or alpha mask), and
     one-line warnings about what the path tracer leaves out."""
     from alight.render.variants import part_material
 
@@ -332,9 +340,11 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     corners, normals, mats, sided = [], [], [], []
     table = {k: [] for k in ("base", "metallic", "roughness", "f0", "specular_f0", "emissive", "through", "clearcoat",
                              "clearcoat_roughness")}
-    # The user's maps (--map, --texture-set) are left out as a file's are.
-    textured = bool(getattr(scene, "texture_maps", None))
-    layered = masked = False
+    # The user's maps (--map, --texture-set) are not traced.
+    user_maps = bool(getattr(scene, "texture_maps", None))
+    layered = blended = False
+    untraced: set[str] = set()
+    surface_maps = SurfaceMaps()
     for index, part in enumerate(mesh.parts):
         m, maps_apply = part_material(scene, part)
         if m.layers() - {"transmission", "clearcoat"}:
@@ -344,11 +354,11 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
         table["through"].append(float(m.transmission) * (1.0 - float(m.metallic)))
         fm = part.material
         if maps_apply and fm is not None:
-            textured |= bool(fm.textures())
-            masked |= fm.alpha_mode != "OPAQUE"
-        if part.colors is not None and maps_apply:
-            textured = True
+            blended |= fm.alpha_mode == "BLEND"
         tri = np.asarray(part.indices, np.int64).reshape(-1, 3)
+        pm, left_out = part_maps(part, m, maps_apply, scene.use_file_materials)
+        untraced |= left_out
+        surface_maps.add(part, tri, pm)
         pos = np.asarray(part.positions, np.float64)
         corners.append(pos[tri])
         normals.append(np.asarray(part.normals, np.float64)[tri])
@@ -370,11 +380,14 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
                           "iridescence; "
                           "transmission as a thin wall); use the exact reference (--integrator exact) for layered "
                           "materials")
-    if textured:
-        warnings.append(f"{mesh.source}: the path tracer applies the material factors only (no texture maps or "
-                        "vertex colours)")
-    if masked:
-        warnings.append(f"{mesh.source}: the path tracer draws alpha MASK/BLEND parts as opaque")
+    if user_maps:
+        warnings.append(f"{mesh.source}: the path tracer leaves out the user's texture maps (--map, --texture-set): "
+                        "the material factors apply")
+    if untraced:
+        warnings.append(f"{mesh.source}: the path tracer leaves out these texture maps (their factors apply): "
+                        + ", ".join(sorted(untraced)))
+    if blended:
+        warnings.append(f"{mesh.source}: the path tracer draws alpha BLEND parts as opaque")
     tris = np.concatenate(corners)
     v0, v1, v2 = tris[:, 0], tris[:, 1], tris[:, 2]
     ng = np.cross(v1 - v0, v2 - v0)
@@ -383,7 +396,8 @@ def scene_geometry(scene) -> tuple[_Geometry, list[str]]:
     geom = _Geometry(v0=v0[keep], e1=(v1 - v0)[keep], e2=(v2 - v0)[keep], normals=np.concatenate(normals)[keep],
                      ng=_normalize(ng[keep]), material=np.concatenate(mats)[keep],
                      table={k: np.asarray(v, np.float64) for k, v in table.items()},
-                     scale=float(max(np.linalg.norm(hi - lo), 1e-6)), one_way=np.concatenate(sided)[keep])
+                     scale=float(max(np.linalg.norm(hi - lo), 1e-6)), one_way=np.concatenate(sided)[keep],
+                     maps=surface_maps.finish(keep))
     return geom, warnings
 
 
@@ -395,7 +409,8 @@ class _Rays:
     light draws them: a ray from a surface that meets one's front is not stopped by it (the light
     coming back along the ray meets its back). The occlusion bake's rays do the same
     (alight.core.visibility._cast): a bounce that is stopped sees the first surface it met (a
-    closed part's near wall), one that is not escapes."""
+    closed part's near wall), one that is not escapes. Where an alphaMode MASK part's alpha is
+    below its cutoff there is no surface: every ray passes on (``geom.maps.cut_away``)."""
 
     def __init__(self, geom: _Geometry):
         rtcore_scene, TriangleMesh = _import_embree()
@@ -406,6 +421,8 @@ class _Rays:
         self.one_way = one_way if one_way is not None and one_way.any() else None
         self.ng = geom.ng
         self.eps = 1e-5 * geom.scale
+        self.masked = None if geom.maps is None else geom.maps.masked_triangles(geom.material)
+        self._geom = geom
 
     def _run(self, origins, dirs):
         out = self.scene.run(np.ascontiguousarray(origins, np.float32), np.ascontiguousarray(dirs, np.float32),
@@ -421,18 +438,36 @@ class _Rays:
         bool, or one per ray): the rays are the camera's; the others, with ``seen``, report the
         first surface they meet where the light is stopped (a bounce), without it what stops the
         light (a shadow ray): the class's docstring. A ray still on a one-way face after
-        ``passes`` re-casts stops there."""
+        ``passes`` re-casts (MASK_PASSES where a part has an alpha mask) stops there; a ray past
+        a masked-out texel goes on as if the triangle were not there, for every kind of ray."""
         prim, t, u, v = self._run(origins, dirs)
-        if self.one_way is None:
+        if self.one_way is None and self.masked is None:
             return prim, t, u, v
         origins = np.asarray(origins, np.float64)
         dirs = np.asarray(dirs, np.float64)
         camera = np.broadcast_to(np.asarray(camera, bool), (len(prim),))
         first = (prim.copy(), t.copy(), u.copy(), v.copy())
+        # whether ``first`` holds a surface (a masked-out hit is none: the first one past it is)
+        found = np.zeros(len(prim), bool)
+        if self.masked is not None:
+            passes = max(passes, MASK_PASSES)
         for _ in range(passes):
             hit = np.flatnonzero(prim >= 0)
-            facing = np.einsum("ij,ij->i", dirs[hit], self.ng[prim[hit]])
-            skip = self.one_way[prim[hit]] & np.where(camera[hit], facing > 0.0, facing < 0.0)
+            skip = np.zeros(len(hit), bool)
+            if self.one_way is not None:
+                facing = np.einsum("ij,ij->i", dirs[hit], self.ng[prim[hit]])
+                skip = self.one_way[prim[hit]] & np.where(camera[hit], facing > 0.0, facing < 0.0)
+            cut = np.zeros(len(hit), bool)
+            if self.masked is not None:
+                on = np.flatnonzero(self.masked[prim[hit]])
+                if len(on):
+                    h = hit[on]
+                    cut[on] = self._geom.maps.cut_away(prim[h], u[h], v[h], self._geom.material)
+            new = hit[~cut & ~found[hit]]
+            for now, was in zip((prim, t, u, v), first):
+                was[new] = now[new]
+            found[new] = True
+            skip |= cut
             again = hit[skip]
             if not len(again):
                 break
@@ -440,7 +475,7 @@ class _Rays:
             p2, t2, u2, v2 = self._run(origins[again] + dirs[again] * start[:, None], dirs[again])
             prim[again], t[again], u[again], v[again] = p2, t2 + start, u2, v2
         if seen:
-            keep = ~camera & (prim >= 0)
+            keep = ~camera & (prim >= 0) & found
             for now, was in zip((prim, t, u, v), first):
                 now[keep] = was[keep]
         return prim, t, u, v
@@ -615,7 +650,12 @@ def trace(scene, radiance: np.ndarray | None, width: int, height: int,
             base, metal, rough, f0 = tb["base"][m], tb["metallic"][m], tb["roughness"][m], tb["f0"][m]
             # the coat's weight and roughness, or None for every lobe function when no part has one
             coat, coat_rough = (tb["clearcoat"][m], tb["clearcoat_roughness"][m]) if coated else (None, None)
-            radiance_sum[alive] += throughput * tb["emissive"][m]
+            emissive = tb["emissive"][m]
+            if geom.maps is not None:
+                base, metal, rough, emissive, coat, coat_rough, n = geom.maps.shade(
+                    prim, bu, bv, m, n, base, metal, rough, emissive, coat, coat_rough, MIN_TRACE_ROUGHNESS)
+                f0 = tb["specular_f0"][m] * (1.0 - metal)[:, None] + base * metal[:, None]   # Material.f0 per hit
+            radiance_sum[alive] += throughput * emissive
             p_off = p + ng * eps
             last = bounce + 1 >= settings.max_bounces or not settings.visibility
             n_dot_v = _dot(n, v)
