@@ -166,6 +166,8 @@ class Panel:
         self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
         self.layout = None   # the scroll, each section header's height, the content's end (draw)
         self._removed = []   # (index, light, height): removed lights' places, kept while the pointer is there
+        self._place_tops = {}   # each place's top on screen in the frame drawn last (its index in _removed)
+        self._pointer_kept = (0.0, 0.0)   # where the pointer was when last inside the list with places kept
         # Each path field's last path that worked (_attempt): a failed one is not left showing.
         self._good = {"preset_path": self.preset_path, "gltf_path": self.gltf_path}
         from alight.frontends.editor.file_jobs import FileJobs
@@ -787,18 +789,25 @@ class Panel:
             s.lights.insert(j, light)
             self._removed = [(i + (i > j or (i == j and n > k)), lt, h)
                              for n, (i, lt, h) in enumerate(self._removed) if n != k]
+            self._place_tops = {}   # (indexed by place: drawn again next frame)
         if remove is not None:
             # Its place stays (a row 'removed', 'restore') while the pointer is in the section: the
             # lights below do not move up under a second click aimed at this one's 'remove'.
             self._removed = [(j - (j > remove), lt, h) for j, lt, h in self._removed]
             self._removed.append((remove, s.lights[remove], height))
+            self._place_tops = {}
             del s.lights[remove]
         io = imgui.get_io()
         x0 = imgui.get_window_pos().x
-        inside = x0 <= io.mouse_pos.x < x0 + imgui.get_window_width() and \
-            top <= io.mouse_pos.y < imgui.get_cursor_screen_pos().y
-        if self._removed and not inside and not imgui.is_any_mouse_down():
-            self._removed = []   # the pointer left: the list closes up
+        pointer = (io.mouse_pos.x, io.mouse_pos.y)
+        inside = x0 <= pointer[0] < x0 + imgui.get_window_width() and \
+            top <= pointer[1] < imgui.get_cursor_screen_pos().y
+        if inside or not self._removed:
+            self._pointer_kept = pointer
+        # The list closes up once the pointer has moved out of it: a wheel scroll that carries the
+        # list from under a still pointer is not leaving (the rows closed up under it mid-scroll).
+        elif pointer != self._pointer_kept and not imgui.is_any_mouse_down():
+            self._close_up_places()
         added = None
         if imgui.button("add point"):
             added = Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0)
@@ -815,6 +824,21 @@ class Panel:
         if remove is not None:
             s.error, s.message = "", f"removed light {remove} ('restore' while the pointer is here)"
 
+    def _close_up_places(self) -> None:
+        """The removed lights' places go, keeping what the panel shows where it is: the part of a
+        place scrolled above the panel's top is taken off the scroll too (the rows below stayed
+        put only where imgui's clamp at the content's end happened to make up for it; elsewhere
+        all of them jumped up by the place's height); a place in view is filled by the rows after
+        it, the next light's row where the removed one was."""
+        from imgui_bundle import imgui
+
+        visible_top = imgui.get_window_draw_list().get_clip_rect_min().y
+        above = sum(min(height, max(0.0, visible_top - self._place_tops.get(k, visible_top)))
+                    for k, (_, _, height) in enumerate(self._removed))
+        if above > 0:
+            imgui.set_scroll_y(max(0.0, imgui.get_scroll_y() - above))
+        self._removed, self._place_tops = [], {}
+
     def _removed_places(self, s, index: int) -> None:
         """The places of the lights removed just before list position ``index``: as tall as the
         light was, with its kind and a 'restore' button at the row's start (not under 'remove')."""
@@ -824,6 +848,7 @@ class Panel:
             if j != index:
                 continue
             imgui.push_id(f"removed{k}")
+            self._place_tops[k] = imgui.get_cursor_screen_pos().y
             start = imgui.get_cursor_pos_y()
             imgui.separator()
             if imgui.small_button("restore"):
