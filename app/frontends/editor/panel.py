@@ -457,14 +457,15 @@ class Panel:
         assigned when a frame takes it; a second open while one runs wins."""
         self.open_mesh(s, self.mesh_path)
 
-    def open_mesh(self, s, spec: str) -> None:
-        """``spec`` read on the worker thread: the button, a dropped mesh file and --script open=
-        (EditorState.open_mesh_async). Besides the read, the thread does the CPU side of the
+    def open_mesh(self, s, spec: str, then=None) -> None:
+        """``spec`` read on the worker thread: the button, a dropped mesh file, --script open= and
+        mesh=, and the last session's mesh at start-up (EditorState.open_mesh_async; ``then``:
+        FileJobs.open_mesh). Besides the read, the thread does the CPU side of the
         mesh's upload (alight.render.mesh_upload: the textures' mip levels, the self-shadowing
         test), which the frame that took the mesh used to do on the GL thread (1.2 s for
         DamagedHelmet, no frame drawn)."""
         s.error = ""
-        self.file_jobs.open_mesh(spec, read_for_upload)
+        self.file_jobs.open_mesh(spec, read_for_upload, then)
 
     def take_file_jobs(self, s, renderer=None) -> None:
         """The worker thread's finished opens and exports, taken on the GL thread once a frame
@@ -477,6 +478,8 @@ class Panel:
         for done in self.file_jobs.take():
             field = "mesh_path" if done.kind == "open" else "gltf_path"
             if done.error is not None:
+                if done.kind == "open":
+                    self.file_jobs.then = None
                 s.fail(done.error)
                 if getattr(self, field) == done.target:   # (a path typed since stays)
                     setattr(self, field, self._good.get(field, ""))
@@ -495,6 +498,9 @@ class Panel:
             s.apply_mesh(spec, mesh)
             s.error, s.message = "", s.with_warnings(f"opened mesh {spec}")
             self._good["mesh_path"] = spec
+            then, self.file_jobs.then = self.file_jobs.then, None
+            if then is not None:
+                then()
 
     def kept_paths(self) -> dict:
         """The 'preset file' and 'glTF file' fields for the next session: the paths that last

@@ -97,7 +97,8 @@ class EditorState:
     map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
     map_conversions: dict = field(default_factory=dict)   # path -> the conversion its image was decoded with
     # Set by the window: opens a mesh file off the UI thread (Panel.open_mesh, file_jobs.py) for a
-    # drop and --script open=; None (no window: tests of the state alone) reads it here.
+    # drop, --script open= and mesh=, and a restored session's mesh (``f(spec, then=None)``);
+    # None (no window: tests of the state alone) reads it here.
     open_mesh_async: object = field(default=None, repr=False, compare=False)
 
     @property
@@ -504,7 +505,10 @@ class EditorState:
                 if not self.open_file(value):   # (a drop shows it in the panel; a script stops)
                     raise AlightError(self.error)
             elif key == "mesh":
-                self.load_mesh(value)
+                if self.open_mesh_async is not None:   # read on the panel's worker: the script
+                    self.open_mesh_async(value)        # waits for it, as for open= (run.py)
+                else:
+                    self.load_mesh(value)
             elif key == "env":
                 self.load_env(value)
             elif key == "exposure":

@@ -261,7 +261,7 @@ class EditorWindow:
 
         self.panel = Panel()
         # A dropped mesh file and --script open= are read on the panel's worker thread too.
-        state.open_mesh_async = lambda spec: self.panel.open_mesh(self.state, spec)
+        state.open_mesh_async = lambda spec, then=None: self.panel.open_mesh(self.state, spec, then)
         if not self.hosted:   # a finished open or export ends the idle wait (file_jobs.py)
             self.panel.file_jobs.wake = self._answer_came
         from alight.frontends.editor.compare_view import CompareView
@@ -604,6 +604,13 @@ class EditorWindow:
             self.state.fail(exc)
             self._maps_key = key    # not retried until the environment or quality changes
         self._bake_job, self.bake_progress = None, None
+
+    def finish_file_jobs(self) -> None:
+        """Complete the mesh open and export that run now, here (the test engine's runner before
+        its first test: a restored session's mesh in place, as the bake is)."""
+        while self.panel.file_jobs.busy:
+            self.panel.take_file_jobs(self.state, self.renderer)
+            time.sleep(0.005)
 
     def finish_bake(self) -> None:
         """Complete the pending bake now (screenshots, scripts and the benchmark want the final maps)."""
