@@ -284,7 +284,7 @@ class EditorState:
         now = f"{self.material.name}{f' with {maps} map' + ('s' if maps > 1 else '') if maps else ''}"
         # While the view is split, undo acts on B (the live material) alone: A's snapshot or
         # preset and the compare mode are no undo steps, and the row says so.
-        split = self.compare.mode != "off"
+        split = self.compare.active
         where = f"{word} on B" if split else word
         self.error = ""
         if self.look == before:
