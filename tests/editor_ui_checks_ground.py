@@ -170,6 +170,41 @@ def test_shadows_off_takes_the_shadow_away_and_on_brings_it_back(ctx):
     assert win.state.shadows == "auto"
 
 
+def test_a_ground_that_catches_nothing_says_so_in_the_status_row_once(ctx):
+    """The ground with 'shadows' off catches nothing: the status row says so (the renderer's
+    warning went to stderr alone, in the command line's words), once: another message replaces
+    it and it does not come back while nothing changes; ticking the ground again says it again,
+    and a ground that catches the shadow again takes the line away."""
+    from imgui_bundle import imgui
+
+    from alight.frontends.editor.window import GROUND_IDLE
+
+    win = editor()
+    s, panel = win.state, win.panel
+    said = GROUND_IDLE["shadows off"]
+    ctx.set_ref("alight")
+    assert s.ground and s.shadows == "auto"
+    ctx.combo_click("shadows/off")
+    until_seconds(ctx, lambda: _settled(win) and panel.shown_status.startswith(said), SETTLE_LIMIT_S)
+    assert "'shadows' is off (Environment)" in said and "--" not in said   # the panel's names, not the flags
+    ctx.mouse_click_on_void()
+    ctx.key_press(imgui.Key.mod_ctrl | imgui.Key.z)   # (--new: nothing to undo; the scene stays)
+    ctx.yield_(2)
+    assert panel.shown_status.startswith("nothing to undo"), panel.shown_status
+    ctx.yield_(20)
+    assert panel.shown_status.startswith("nothing to undo"), panel.shown_status   # not said again each frame
+    ctx.set_ref("alight")
+    ctx.item_uncheck("**/ground")
+    until_seconds(ctx, lambda: _settled(win), SETTLE_LIMIT_S)
+    assert not panel.shown_status.startswith(said), panel.shown_status
+    ctx.item_check("**/ground")
+    until_seconds(ctx, lambda: _settled(win) and panel.shown_status.startswith(said), SETTLE_LIMIT_S)
+    ctx.combo_click("shadows/auto")
+    until_seconds(ctx, lambda: _settled(win) and win.renderer.shadow_maps.last_active, SETTLE_LIMIT_S)
+    ctx.yield_(2)
+    assert not panel.shown_status.startswith("ground:"), panel.shown_status
+
+
 def test_the_screenshot_with_the_ground_is_left_for_alight_render(ctx):
     """The panel's screenshot button (F12): the view at its size, with the ground's
     shadow; it and its camera are left for the runner's ``alight render --ground``."""

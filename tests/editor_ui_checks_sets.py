@@ -127,10 +127,72 @@ def test_undo_says_where_it_went(ctx):
     ctx.yield_(2)
     assert _message_part(panel).endswith("applied silver"), panel.shown_status
     _ctrl_z(ctx)
-    assert s.material.name == "gold" and _message_part(panel).endswith("undo: gold"), panel.shown_status
+    assert s.material.name == "gold" and _message_part(panel).endswith("undo: gold (was silver)"), panel.shown_status
     ctx.item_click("**/redo")
     ctx.yield_(2)
-    assert s.material.name == "silver" and _message_part(panel).endswith("redo: silver"), panel.shown_status
+    assert s.material.name == "silver" and _message_part(panel).endswith("redo: silver (was gold)"), panel.shown_status
+
+
+def test_ctrl_z_while_compare_splits_the_view_undoes_b_and_says_what(ctx):
+    """With the view split, Ctrl+Z undoes the live material's (B's) last edit and the row says
+    which edit (two roughness steps read 'undo: copper' twice before, nothing seen to change);
+    A's snapshot or preset, A's IBL model and the compare mode stay. In reference mode an undo
+    landing below the reference's minimum roughness names the step before the reference's line
+    (the line alone replaced it)."""
+    s, panel = editor().state, editor().panel
+    c = s.compare
+    ctx.set_ref("alight")
+    for step in (lambda: ctx.item_click("**/gold"), lambda: ctx.item_click("**/copper"),
+                 lambda: ctx.item_input_value("**/roughness", 0.4),
+                 lambda: ctx.item_input_value("**/roughness", 0.55)):
+        step()
+        ctx.yield_(2)   # (each its own undo step, as an artist's edits are)
+    ctx.item_open("**/Compare")
+    ctx.combo_click("compare/material")
+    ctx.item_click("**/snapshot A")
+    snapshot = c.a_material
+    assert snapshot.roughness == 0.55, snapshot
+    _ctrl_z(ctx)
+    assert s.material.roughness == 0.4 and c.a_material is snapshot and c.mode == "material", (s.material, c)
+    assert _message_part(panel) == "undo on B: copper (roughness 0.55 -> 0.4)", panel.shown_status
+    ctx.combo_click("A preset/gold")
+    _ctrl_z(ctx)
+    assert s.material.roughness == 0.3 and c.a_label == "preset gold" and c.mode == "material", (s.material, c)
+    assert _message_part(panel) == "undo on B: copper (roughness 0.4 -> 0.3)", panel.shown_status
+    ctx.combo_click("compare/ibl model")
+    ctx.combo_click("A IBL model/alight")
+    _ctrl_z(ctx)
+    assert s.material.name == "gold" and (c.mode, c.a_ibl_model) == ("ibl model", "alight"), (s.material, c)
+    assert _message_part(panel) == "undo on B: gold (was copper)", panel.shown_status
+    ctx.key_press(imgui_key("mod_ctrl") | imgui_key("mod_shift") | imgui_key("z"))
+    ctx.yield_(2)
+    assert s.material.name == "copper" and _message_part(panel) == "redo on B: copper (was gold)", panel.shown_status
+    # Reference mode below its minimum roughness: no sum starts, the error line says why.
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/roughness", 0.05)
+    ctx.yield_(2)
+    ctx.item_input_value("**/roughness", 0.04)
+    ctx.yield_(2)
+    ctx.combo_click("compare/reference")
+    ctx.yield_(2)
+    assert s.error.startswith("reference compare:"), s.error
+    _ctrl_z(ctx)
+    assert s.material.roughness == 0.05 and c.mode == "reference", (s.material, c)
+    assert panel.shown_status.startswith("error: undo on B: copper (roughness 0.04 -> 0.05); reference compare:"), \
+        panel.shown_status
+    ctx.yield_(4)   # the view's next frames keep the step's line (the reference's check runs again)
+    assert panel.shown_status.startswith("error: undo on B: copper (roughness 0.04 -> 0.05)"), panel.shown_status
+    ctx.combo_click("compare/off")
+    _ctrl_z(ctx)
+    assert s.material.roughness == 0.3 and _message_part(panel) == "undo: copper (roughness 0.05 -> 0.3)", \
+        panel.shown_status
+    ctx.item_close("**/Compare")
+
+
+def imgui_key(name: str):
+    from imgui_bundle import imgui
+
+    return getattr(imgui.Key, name)
 
 
 def test_a_saved_preset_is_named_after_its_file(ctx):

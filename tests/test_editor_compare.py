@@ -175,3 +175,28 @@ def test_a_snapshots_maps_and_the_own_materials_box_survive_the_session(tmp_path
     assert fresh.compare.a_texture_maps.paths() == {"base_color": str(brown)}
     np.testing.assert_array_equal(fresh.compare.a_texture_images[str(brown)],
                                   state.compare.a_texture_images[str(brown)])
+
+
+def test_undo_while_split_names_b_and_what_changed_and_leaves_a():
+    """Undo acts on B alone; the row says the step ('roughness 0.4 -> 0.3'), and with nothing to
+    undo that A's choice and the mode are no undo steps (it said 'nothing to undo' only)."""
+    from alight.frontends.editor.state import History, look_change
+
+    s = EditorState()
+    s.apply_preset(load_preset("copper"))
+    history = History(s.look)
+    s.compare.mode = "material"
+    compare.take_snapshot(s.compare, s)
+    s.step_history(history)
+    assert s.message.startswith("nothing to undo on B (A's snapshot"), s.message
+    s.material = dataclasses.replace(s.material, roughness=0.4)
+    history.settle(s.look, False)
+    s.step_history(history)
+    assert s.message == "undo on B: copper (roughness 0.4 -> 0.3)" and s.compare.a_material.name == "copper"
+    s.compare.mode = "off"
+    s.step_history(history, redo=True)
+    assert s.message == "redo: copper (roughness 0.3 -> 0.4)", s.message
+    gold = (load_preset("gold"), s.texture_maps)
+    assert look_change(s.look, gold) == "was copper"
+    many = dataclasses.replace(s.material, metallic=0.5, roughness=0.9, ior=1.6, transmission=0.5)
+    assert look_change(s.look, (many, s.texture_maps)).endswith(" more")

@@ -28,3 +28,27 @@ def test_every_file_job_check_passes(display, tmp_path):
     assert not [p.name for p in tmp_path.iterdir() if ".tmp" in p.name or p.name.startswith("tmp")]
     if json.loads((tmp_path / "closing_export.json").read_text())["running"]:
         assert f"alight: finishing the export of {export} before closing" in result.stderr, result.stderr[-2000:]
+
+
+def _mesh_loads(mode: str, display: str, tmp_path: Path):
+    from x_events import run_check
+
+    return run_check("editor_window_mesh_loads.py", display, cwd=tmp_path, args=(mode,), timeout=900, PYTHONUNBUFFERED="1",
+                     ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"),
+                     ALIGHT_DATA_DIR=str(tmp_path / "data"))
+
+
+def test_the_restored_sessions_mesh_comes_through_the_worker(display, tmp_path):
+    """`alight edit` reopening a session whose mesh is DamagedHelmet: no read, whole-texture
+    upload or self-shadowing test of it on the main thread, frames from the start (the window
+    drew nothing for seconds), the session's camera and own-materials box kept for the helmet
+    (tests/editor_window_mesh_loads.py)."""
+    result = _mesh_loads("restore", display, tmp_path)
+    assert result.returncode == 0 and "\nok: " in "\n" + result.stdout, result.stdout[-3000:] + result.stderr[-3000:]
+
+
+def test_script_mesh_comes_through_the_worker_and_the_next_edit_sees_it(display, tmp_path):
+    """``--script mesh=HELMET --script roughness=0.4 --screenshot``: read on the worker (it was
+    read between two frames on the main thread), the script waiting for it as for ``open=``."""
+    result = _mesh_loads("script", display, tmp_path)
+    assert result.returncode == 0 and "\nok: " in "\n" + result.stdout, result.stdout[-3000:] + result.stderr[-3000:]

@@ -45,6 +45,20 @@ def test_clicks_aimed_at_a_moved_layout_do_not_land_on_what_moved_there(display,
     assert "own loop: 0 failures in the remove and collapse clicks" in result.stdout, result.stdout
 
 
+def test_a_removed_lights_place_closes_up_without_moving_the_scrolled_panel(display, tmp_path):
+    """Real X wheel and clicks in the own loop (tests/editor_x_events_lights_scroll.py): lights
+    added by 'add point', the panel scrolled, one removed; its place, scrolled above the panel's
+    top, closes up without moving the rows in sight (they jumped up by the light's height), a
+    place in sight is taken by the next light's row, and a wheel scroll under the still pointer
+    does not close it up."""
+    from x_events import run_check
+
+    result = run_check("editor_x_events_lights_scroll.py", display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+                       ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_DATA_DIR=str(tmp_path / "data"), timeout=300)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert result.stdout.startswith("ok: rows kept their place"), result.stdout
+
+
 def test_a_press_aimed_at_a_layout_gone_is_dropped_with_its_release():
     """press_guard.PressGuard: a press aimed at the frame on screen when it came is delivered when
     the last frame built has that frame's layout, dropped (with its release) when not; over the

@@ -115,8 +115,8 @@ def frames_over(win, wait_s: float) -> tuple[int, int]:
     return win._frame_no - frames, win.idle_waits - waits
 
 
-def run_check(name: str, display: str, cwd=None, timeout: int = 600, **env):
-    """``python tests/NAME`` (an X-event check) in a fresh interpreter on ``display``, with
+def run_check(name: str, display: str, cwd=None, timeout: int = 600, args=(), **env):
+    """``python tests/NAME ARGS`` (an X-event check) in a fresh interpreter on ``display``, with
     ``env`` added to the environment: the CompletedProcess (the pytest side of these checks)."""
     import os
     import subprocess
@@ -124,6 +124,6 @@ def run_check(name: str, display: str, cwd=None, timeout: int = 600, **env):
     from pathlib import Path
 
     here = Path(__file__).resolve().parent
-    return subprocess.run([sys.executable, str(here / name)], cwd=cwd or here.parent,
+    return subprocess.run([sys.executable, str(here / name), *args], cwd=cwd or here.parent,
                           env=dict(os.environ, DISPLAY=display, **env), capture_output=True, text=True,
                           timeout=timeout)

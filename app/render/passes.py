@@ -201,8 +201,10 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
         frame.vbuffer = True
         fbo = targets.single()[1]
     frame.shadowed = prepare_shadows(r, scene, maps)    # (its own framebuffer: before this pass's)
+    r.last_ground_idle = ""
     if scene.ground and scene.mesh is not None and not frame.shadowed and scene.view != "probe":
         # (a ground with no shadow to catch draws nothing: the picture equals the one without it)
+        r.last_ground_idle = "shadows off" if scene.shadows == "off" else "no light"
         why = "--shadows off" if scene.shadows == "off" else \
             "no light, and no sun in the map that the IBL model shades exactly (add --light, or use a map with a sun)"
         warn(f"--ground: nothing casts a shadow on it, so it changes nothing: {why}")

@@ -120,6 +120,10 @@ class ForwardRenderer:
         # editor; ``refining`` says whether another frame would), where a still takes its passes at once.
         self.screen_ao_temporal = False
         self.last_occlusion_reason = ""   # "gtao ..." where the last scene pass drew screen-space GTAO
+        # Why the last scene pass's ground caught nothing ('' where it caught a shadow or there was
+        # none): "shadows off" or "no light"; a front end says it in its own words (the CLI's
+        # warning names its flags, the editor's status row its controls).
+        self.last_ground_idle = ""
         self.shadow_maps = ShadowMaps(self.ctx)   # drawn where a scene can be shadowed (alight.render.shadows)
         self.ground_pass: GroundPass | None = None   # Scene.ground's square, made on first use
         # How far the built-in sphere's outline may fall inside the true one, in output pixels

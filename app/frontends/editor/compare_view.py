@@ -192,7 +192,8 @@ class CompareView:
                 self._ref_linear, changed = cached[1], True
                 self.reference_cache_hits += 1
             elif problem:
-                win.state.fail(AlightError(problem))
+                if problem not in win.state.error:   # (an undo's row names the step, then this)
+                    win.state.fail(AlightError(problem))
             else:
                 self._start_reference(win, scene, size, c.reference_scale, key)
         if self._ref_key != key:   # moving: A's half waits for the view to stand still

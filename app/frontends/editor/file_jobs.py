@@ -57,6 +57,9 @@ class FileJobs:
         # A mesh read, its GPU upload going on over frames (the panel's ``take_file_jobs``):
         # (spec, mesh, alight.render.mesh_upload.MeshUpload), None when none.
         self.staged = None
+        # Called once the latest open's mesh is in the state (a restored session's own-materials
+        # box and camera, which the mesh it comes with must find); None when nothing waits.
+        self.then = None
 
     @property
     def busy(self) -> bool:
@@ -72,10 +75,19 @@ class FileJobs:
                      for verb, target in (("opening", opening), ("exporting", self._exporting)) if target]
         return "; ".join(parts)
 
-    def open_mesh(self, spec: str, read) -> None:
+    @property
+    def opening(self) -> str:
+        """The spec of the mesh being read or uploaded, '' when none (the session saved meanwhile
+        keeps it: the mesh the artist is waiting for)."""
+        with self._lock:
+            return self._opening or (self.staged[0] if self.staged is not None else "")
+
+    def open_mesh(self, spec: str, read, then=None) -> None:
         """Read ``spec`` with ``read(spec)`` on a thread; a later call supersedes this one (and a
-        mesh of an earlier one still being uploaded)."""
+        mesh of an earlier one still being uploaded). ``then()`` is called once the mesh is in
+        the state; not where another open superseded this one or the read failed."""
         self.drop_open()
+        self.then = then
         with self._lock:
             self._open_id += 1
             job, self._opening = self._open_id, spec
@@ -84,6 +96,7 @@ class FileJobs:
     def drop_open(self) -> None:
         """Forget the open that runs (another mesh was chosen since): its result is dropped, and
         so is a mesh still being uploaded (its textures released)."""
+        self.then = None
         with self._lock:
             self._open_id += 1
             self._opening = ""

@@ -166,6 +166,8 @@ class Panel:
         self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
         self.layout = None   # the scroll, each section header's height, the content's end (draw)
         self._removed = []   # (index, light, height): removed lights' places, kept while the pointer is there
+        self._place_tops = {}   # each place's top on screen in the frame drawn last (its index in _removed)
+        self._pointer_kept = (0.0, 0.0)   # where the pointer was when last inside the list with places kept
         # Each path field's last path that worked (_attempt): a failed one is not left showing.
         self._good = {"preset_path": self.preset_path, "gltf_path": self.gltf_path}
         from alight.frontends.editor.file_jobs import FileJobs
@@ -455,14 +457,15 @@ class Panel:
         assigned when a frame takes it; a second open while one runs wins."""
         self.open_mesh(s, self.mesh_path)
 
-    def open_mesh(self, s, spec: str) -> None:
-        """``spec`` read on the worker thread: the button, a dropped mesh file and --script open=
-        (EditorState.open_mesh_async). Besides the read, the thread does the CPU side of the
+    def open_mesh(self, s, spec: str, then=None) -> None:
+        """``spec`` read on the worker thread: the button, a dropped mesh file, --script open= and
+        mesh=, and the last session's mesh at start-up (EditorState.open_mesh_async; ``then``:
+        FileJobs.open_mesh). Besides the read, the thread does the CPU side of the
         mesh's upload (alight.render.mesh_upload: the textures' mip levels, the self-shadowing
         test), which the frame that took the mesh used to do on the GL thread (1.2 s for
         DamagedHelmet, no frame drawn)."""
         s.error = ""
-        self.file_jobs.open_mesh(spec, read_for_upload)
+        self.file_jobs.open_mesh(spec, read_for_upload, then)
 
     def take_file_jobs(self, s, renderer=None) -> None:
         """The worker thread's finished opens and exports, taken on the GL thread once a frame
@@ -475,6 +478,8 @@ class Panel:
         for done in self.file_jobs.take():
             field = "mesh_path" if done.kind == "open" else "gltf_path"
             if done.error is not None:
+                if done.kind == "open":
+                    self.file_jobs.then = None
                 s.fail(done.error)
                 if getattr(self, field) == done.target:   # (a path typed since stays)
                     setattr(self, field, self._good.get(field, ""))
@@ -493,6 +498,9 @@ class Panel:
             s.apply_mesh(spec, mesh)
             s.error, s.message = "", s.with_warnings(f"opened mesh {spec}")
             self._good["mesh_path"] = spec
+            then, self.file_jobs.then = self.file_jobs.then, None
+            if then is not None:
+                then()
 
     def kept_paths(self) -> dict:
         """The 'preset file' and 'glTF file' fields for the next session: the paths that last
@@ -787,18 +795,25 @@ class Panel:
             s.lights.insert(j, light)
             self._removed = [(i + (i > j or (i == j and n > k)), lt, h)
                              for n, (i, lt, h) in enumerate(self._removed) if n != k]
+            self._place_tops = {}   # (indexed by place: drawn again next frame)
         if remove is not None:
             # Its place stays (a row 'removed', 'restore') while the pointer is in the section: the
             # lights below do not move up under a second click aimed at this one's 'remove'.
             self._removed = [(j - (j > remove), lt, h) for j, lt, h in self._removed]
             self._removed.append((remove, s.lights[remove], height))
+            self._place_tops = {}
             del s.lights[remove]
         io = imgui.get_io()
         x0 = imgui.get_window_pos().x
-        inside = x0 <= io.mouse_pos.x < x0 + imgui.get_window_width() and \
-            top <= io.mouse_pos.y < imgui.get_cursor_screen_pos().y
-        if self._removed and not inside and not imgui.is_any_mouse_down():
-            self._removed = []   # the pointer left: the list closes up
+        pointer = (io.mouse_pos.x, io.mouse_pos.y)
+        inside = x0 <= pointer[0] < x0 + imgui.get_window_width() and \
+            top <= pointer[1] < imgui.get_cursor_screen_pos().y
+        if inside or not self._removed:
+            self._pointer_kept = pointer
+        # The list closes up once the pointer has moved out of it: a wheel scroll that carries the
+        # list from under a still pointer is not leaving (the rows closed up under it mid-scroll).
+        elif pointer != self._pointer_kept and not imgui.is_any_mouse_down():
+            self._close_up_places()
         added = None
         if imgui.button("add point"):
             added = Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0)
@@ -815,6 +830,21 @@ class Panel:
         if remove is not None:
             s.error, s.message = "", f"removed light {remove} ('restore' while the pointer is here)"
 
+    def _close_up_places(self) -> None:
+        """The removed lights' places go, keeping what the panel shows where it is: the part of a
+        place scrolled above the panel's top is taken off the scroll too (the rows below stayed
+        put only where imgui's clamp at the content's end happened to make up for it; elsewhere
+        all of them jumped up by the place's height); a place in view is filled by the rows after
+        it, the next light's row where the removed one was."""
+        from imgui_bundle import imgui
+
+        visible_top = imgui.get_window_draw_list().get_clip_rect_min().y
+        above = sum(min(height, max(0.0, visible_top - self._place_tops.get(k, visible_top)))
+                    for k, (_, _, height) in enumerate(self._removed))
+        if above > 0:
+            imgui.set_scroll_y(max(0.0, imgui.get_scroll_y() - above))
+        self._removed, self._place_tops = [], {}
+
     def _removed_places(self, s, index: int) -> None:
         """The places of the lights removed just before list position ``index``: as tall as the
         light was, with its kind and a 'restore' button at the row's start (not under 'remove')."""
@@ -824,6 +854,7 @@ class Panel:
             if j != index:
                 continue
             imgui.push_id(f"removed{k}")
+            self._place_tops[k] = imgui.get_cursor_screen_pos().y
             start = imgui.get_cursor_pos_y()
             imgui.separator()
             if imgui.small_button("restore"):

@@ -69,12 +69,7 @@ def run(args) -> int:
     interactive = not (args.benchmark or args.screenshot or args.script)
     win = EditorWindow(state, size, show_panel=not args.no_panel, ini_path=_imgui_ini() if interactive else None)
     if interactive and not args.new and _no_scene_options(args):
-        from alight.frontends.editor.session import restore_session
-
-        warning = restore_session(state, win.orbit, win.turntable, win.panel)
-        if warning:
-            state.error = " ".join(warning.split())
-        win.history.committed = state.look
+        open_last_session(win, state)
     try:
         if args.benchmark:
             return _benchmark(win, args.frames or 120)
@@ -105,6 +100,17 @@ def run(args) -> int:
         return 0
     finally:
         win.close()
+
+
+def open_last_session(win, state) -> None:
+    """The last session reopened into the window's state; its mesh file is read on the panel's
+    worker (the window draws meanwhile, session.restore_session)."""
+    from alight.frontends.editor.session import restore_session
+
+    warning = restore_session(state, win.orbit, win.turntable, win.panel)
+    if warning:
+        state.error = " ".join(warning.split())
+    win.history.committed = state.look
 
 
 def _finish_open(win) -> None:

@@ -46,7 +46,10 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
 
     compare_dict = compare.to_dict(state.compare)
     compare_dict["a_texture_maps"] = absolute_maps(state.compare.a_texture_maps).to_dict()
-    data = {"mesh": state.mesh_spec if state.mesh_spec in BUILTIN_MESHES else absolute(state.mesh_spec),
+    # A mesh still being read (opened just before the close, or the last session's at start-up)
+    # is the one the artist chose: kept, not the one on screen meanwhile.
+    mesh = getattr(getattr(panel, "file_jobs", None), "opening", "") or state.mesh_spec
+    data = {"mesh": mesh if mesh in BUILTIN_MESHES else absolute(mesh),
             "env": state.env_spec if state.env_spec == "studio" else absolute(state.env_spec),
             "material": state.material.to_dict(),
             "texture_maps": absolute_maps(state.texture_maps).to_dict(),
@@ -98,8 +101,15 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
         state.texture_set_folder = data["texture_set_folder"]
     if data.get("armed_slot") in MAP_SLOTS:
         state.armed_slot = data["armed_slot"]
+    from alight.core.mesh import BUILTIN_MESHES
+
     said = ()
-    for loader, spec in ((state.load_mesh, data.get("mesh")), (state.load_env, data.get("env"))):
+    # A mesh file is read on the panel's worker where the window made one (open_mesh_async): the
+    # helmet's read and upload held the first frame for seconds. The own-materials box and the
+    # camera then wait for it (``after_mesh``); a built-in is built here (7-41 ms).
+    mesh_spec, after_mesh = data.get("mesh"), []
+    deferred = isinstance(mesh_spec, str) and mesh_spec not in BUILTIN_MESHES and state.open_mesh_async is not None
+    for loader, spec in ((state.load_mesh, None if deferred else mesh_spec), (state.load_env, data.get("env"))):
         if isinstance(spec, str):
             try:
                 loader(spec)
@@ -122,8 +132,12 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
             # The mesh file's own materials, as the artist left the box (loading the mesh ticked it
             # wherever the file has materials); older sessions lack it: the mesh's default stays.
             own = settings.get("use_file_materials")
-            if isinstance(own, bool) and state.mesh is not None:
-                state.use_file_materials = own and any(part.material is not None for part in state.mesh.parts)
+
+            def own_materials(own=own) -> None:
+                if isinstance(own, bool) and state.mesh is not None:
+                    state.use_file_materials = own and any(part.material is not None for part in state.mesh.parts)
+
+            after_mesh.append(own_materials)
     if "compare" in data:   # the split view: on or off, the divider, what A is
         try:
             state.compare = compare.from_dict(data["compare"], str(path))
@@ -146,8 +160,16 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
             for k, v in values.items():
                 setattr(orbit, k, v)
             orbit.restored = True
+            # The camera is kept for the restored mesh, not framed anew when it arrives (the
+            # frame that showed the mesh before it took the flag).
+            after_mesh.append(lambda: setattr(orbit, "restored", True))
         except (KeyError, TypeError, ValueError):
             pass
+    if deferred:
+        state.open_mesh_async(mesh_spec, then=lambda: [f() for f in after_mesh])
+    else:
+        for f in after_mesh:
+            f()
     return warning
 
 

@@ -97,7 +97,8 @@ class EditorState:
     map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
     map_conversions: dict = field(default_factory=dict)   # path -> the conversion its image was decoded with
     # Set by the window: opens a mesh file off the UI thread (Panel.open_mesh, file_jobs.py) for a
-    # drop and --script open=; None (no window: tests of the state alone) reads it here.
+    # drop, --script open= and mesh=, and a restored session's mesh (``f(spec, then=None)``);
+    # None (no window: tests of the state alone) reads it here.
     open_mesh_async: object = field(default=None, repr=False, compare=False)
 
     @property
@@ -277,11 +278,26 @@ class EditorState:
         self.sync_map_images()
         if leaving_saved:
             self.saved_material, self.saved_texture_maps = self.look
-        # The status row said what the step took back ('applied silver'): it says where it is now.
+        # The status row said what the step took back ('applied silver'): it says where it is now
+        # and what changed, so two steps over one material's fields do not read the same.
         maps = len(self.texture_maps.paths())
         now = f"{self.material.name}{f' with {maps} map' + ('s' if maps > 1 else '') if maps else ''}"
+        # While the view is split, undo acts on B (the live material) alone: A's snapshot or
+        # preset and the compare mode are no undo steps, and the row says so.
+        split = self.compare.active
+        where = f"{word} on B" if split else word
         self.error = ""
-        self.message = f"{word}: {now}" if self.look != before else f"nothing to {word}"
+        if self.look == before:
+            self.message = f"nothing to {where}" + (
+                " (A's snapshot or preset and the compare mode are not undo steps)" if split else "")
+            return
+        self.message = f"{where}: {now} ({look_change(before, self.look)})"
+        if self.compare.mode == "reference":
+            from alight.frontends.editor.compare import reference_problem
+
+            problem = reference_problem(self)
+            if problem:   # the reference's error would replace the row: it follows the step instead
+                self.error = f"{self.message}; {problem}"
 
     def apply_preset(self, preset: Material) -> None:
         """A preset of the F0 table: a whole material, so its factors and no maps (maps loaded
@@ -489,7 +505,10 @@ class EditorState:
                 if not self.open_file(value):   # (a drop shows it in the panel; a script stops)
                     raise AlightError(self.error)
             elif key == "mesh":
-                self.load_mesh(value)
+                if self.open_mesh_async is not None:   # read on the panel's worker: the script
+                    self.open_mesh_async(value)        # waits for it, as for open= (run.py)
+                else:
+                    self.load_mesh(value)
             elif key == "env":
                 self.load_env(value)
             elif key == "exposure":
@@ -557,6 +576,36 @@ def _material_only(path: str) -> bool:
     except AlightError:
         return False   # load_mesh says what is wrong with it
     return not doc.get("meshes") and bool(doc.get("materials"))
+
+
+def _value(v) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def look_change(before: tuple, after: tuple, most: int = 3) -> str:
+    """What an undo or redo step changed, in a few words for the status row: the material it
+    left where the name changed ('was copper'), else the fields that changed, a number's old and
+    new value ('roughness 0.3 -> 0.5'), and the map slots loaded or cleared."""
+    (m0, maps0), (m1, maps1) = before, after
+    if m0.name != m1.name:
+        n = len(maps0.paths())
+        return f"was {m0.name}" + (f" with {n} map{'s' if n > 1 else ''}" if n else "")
+    changes = []
+    for f in dataclasses.fields(m1):
+        a, b = getattr(m0, f.name), getattr(m1, f.name)
+        if a != b:
+            label = f.name.replace("_", " ")
+            changes.append(f"{label} {_value(a)} -> {_value(b)}" if isinstance(b, (int, float)) else label)
+    p0, p1 = maps0.paths(), maps1.paths()
+    for slot in MAP_SLOTS:
+        if p0.get(slot) != p1.get(slot):
+            changes.append(f"{slot.replace('_', ' ')} map " + (
+                "cleared" if not p1.get(slot) else "loaded" if not p0.get(slot) else "replaced"))
+    if maps0 != maps1 and not any(p0.get(k) != p1.get(k) for k in MAP_SLOTS):
+        changes.append("map tiling")
+    if not changes:
+        return "no visible change"
+    return ", ".join(changes[:most]) + (f" and {len(changes) - most} more" if len(changes) > most else "")
 
 
 def _finite(value: str, edit: str) -> float:

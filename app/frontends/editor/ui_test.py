@@ -140,6 +140,8 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
             if warning:
                 state.error = " ".join(warning.split())
             _window.history.committed = state.look
+        # The restored mesh, read on the panel's worker, in place before the first test.
+        _window.finish_file_jobs()
         # The environment's first bake done before the tests start: while it runs, its progress
         # bar tops the panel and every row below moves up a line when it ends, under a click the
         # engine is making (on a loaded machine it clicked the row after the one asked for).

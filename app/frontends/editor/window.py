@@ -55,6 +55,13 @@ IDLE_AFTER_S = 0.5
 BACKGROUND_FRAME_S = 0.08
 IDLE_WAIT_S = 0.1
 CHECKER_SQUARE = 8.0   # pixels a side of the checkerboard under a transparent background
+# The status row's line for a ground that catches nothing (Renderer.last_ground_idle), in the
+# panel's names where 'alight render' warns with its flags.
+GROUND_IDLE = {
+    "shadows off": "ground: nothing casts a shadow on it, so it changes nothing: 'shadows' is off (Environment)",
+    "no light": "ground: nothing casts a shadow on it, so it changes nothing: no light, and no sun in the "
+                "map that the IBL model shades exactly (add a light under Lights, or open a map with a sun)",
+}
 
 
 
@@ -261,7 +268,7 @@ class EditorWindow:
 
         self.panel = Panel()
         # A dropped mesh file and --script open= are read on the panel's worker thread too.
-        state.open_mesh_async = lambda spec: self.panel.open_mesh(self.state, spec)
+        state.open_mesh_async = lambda spec, then=None: self.panel.open_mesh(self.state, spec, then)
         if not self.hosted:   # a finished open or export ends the idle wait (file_jobs.py)
             self.panel.file_jobs.wake = self._answer_came
         from alight.frontends.editor.compare_view import CompareView
@@ -605,6 +612,13 @@ class EditorWindow:
             self._maps_key = key    # not retried until the environment or quality changes
         self._bake_job, self.bake_progress = None, None
 
+    def finish_file_jobs(self) -> None:
+        """Complete the mesh open and export that run now, here (the test engine's runner before
+        its first test: a restored session's mesh in place, as the bake is)."""
+        while self.panel.file_jobs.busy:
+            self.panel.take_file_jobs(self.state, self.renderer)
+            time.sleep(0.005)
+
     def finish_bake(self) -> None:
         """Complete the pending bake now (screenshots, scripts and the benchmark want the final maps)."""
         self.maps()
@@ -846,9 +860,25 @@ class EditorWindow:
     def render_scene(self) -> None:
         """The view into the window's back buffer (under the panel), and a slice of a pending bake."""
         self.render_view()
+        self._say_ground_idle()
         self.advance_bake()
         self.thumbnails.step()
         self.pass_warmup.step(self.state.display)
+
+    def _say_ground_idle(self) -> None:
+        """A ground that catches nothing, in the status row (``GROUND_IDLE``), once each time it
+        comes to be so (the renderer's warning went to stderr alone, once a process, in the
+        command line's words); the line goes when the ground catches a shadow again or is off."""
+        idle = getattr(self.renderer, "last_ground_idle", "") if self.state.ground else ""
+        said = getattr(self, "_ground_said", "")
+        if idle == said:
+            return
+        self._ground_said = idle
+        s = self.state
+        if idle:
+            s.message = GROUND_IDLE[idle]
+        elif s.message == GROUND_IDLE.get(said):
+            s.message = ""
 
     def begin_imgui_frame(self) -> None:
         """imgui's input and new frame (after poll_events)."""
