@@ -9,15 +9,19 @@ vertex gets
   al. 2016 ("Practical Real-Time Strategies for Accurate Indirect Occlusion"): a cone around the
   bent normal holding cosine-weighted visibility V has cos(aperture) = sqrt(1 - V);
 - ``bounce``: one diffuse inter-reflection. A ray that hits the mesh sees the hit point's diffuse
-  radiance, albedo * V_hit * E(bent_hit)/pi (the hit's own occluded irradiance, one bounce). Its
-  mean over all rays is stored as (direction, weight): ``bounce_weight`` = mean of V_hit over
-  all rays (0 for the unoccluded ones) and ``bounce_direction`` = the V_hit-weighted mean of
-  bent_hit. The occluders' radiance is then hit albedo * w / (1 - V) * E(bounce_direction)/pi:
-  exact under a uniform environment, and close elsewhere since E/pi is smooth (its first two SH
-  bands are linear in the direction). It replaces the sky in the occluded directions of both the
-  diffuse and the specular lobe. The hit's albedo and emission are recorded by a pass of their
-  own (``bake_occluder_materials``, keyed by the parts' materials too); where it recorded none
-  the shading point's albedo stands in, diffuse plus specular.
+  radiance, albedo times the hit's visible irradiance / pi (one bounce). Its mean over all rays
+  is stored as (direction, weight): ``bounce_weight`` = mean of V_hit over all rays (0 for the
+  unoccluded ones) and ``bounce_direction`` = the V_hit-weighted mean of bent_hit, each leaned by
+  ``cone_lean`` (a narrow visibility cone's free directions reach further along its bent normal
+  than an open hemisphere's), not normalised: its length says how much the hits agree. The
+  occluders' radiance is then hit albedo * w / (1 - V) times ``bounce_irradiance`` of it, E/pi
+  along the mean's direction and against it mixed by its length: exact under radiance linear in
+  the direction (the hits' V and bent normal standing for their visible sky), and close elsewhere
+  since E/pi is smooth (its first two SH bands are linear in the direction). It replaces the sky
+  in the occluded directions of both the diffuse and the specular lobe. The hit's albedo and
+  emission are recorded by a pass of their own (``bake_occluder_materials``, keyed by the parts'
+  materials too); where it recorded none the shading point's albedo stands in, diffuse plus
+  specular.
 - the suns' bounce (``bake_sun_bounce``, a second pass keyed by the suns' directions too): what
   the occluders receive from each compact source of the environment (app/ibl/sun.py), which the
   bounce above leaves out (E there is the map without its suns). For every bounce ray that hits,
@@ -73,11 +77,12 @@ MAX_LEVELS = 3                        # adaptive levels at most (each halves the
 # and at 30 degrees its copies were merged: V from one side's hemisphere with the sun pass's B1 of
 # the other's own hits lit specks (the helmet under spot1Lux 6.2 -> 12.2% against the path tracer).
 WELD_CREASE_DEG = 10.0
-BAKE_VERSION = 9   # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
+BAKE_VERSION = 11  # 3: ray origins kept in front of their own faces; 4: splits kept where interpolation misses;
                    # 5: vertices covered by a part take their open neighbours' values;
                    # 6: a vertex's copies share V, the bent normal and the bounce (_copies_averaged);
                    # 7, 8: single-sided parts let light through from their back (_cast's one_way; 8: a
-                   # stopped ray reports the first surface it met); 9: WELD_CREASE_DEG 30 -> 10
+                   # stopped ray reports the first surface it met); 9: WELD_CREASE_DEG 30 -> 10;
+                   # 10, 11: bounce_direction the hits' mean bent normal unnormalised, leaned (bounce_irradiance)
 # A ray goes on past at most this many single-sided faces met from the front (_cast's one_way).
 ONE_WAY_PASSES = 4
 # Refinement keeps a split only where the midpoint's value is not the edge's linear interpolation.
@@ -105,7 +110,8 @@ AUTO_ESTIMATE_CELLS = 64
 class PartVisibility:
     """One part's refined geometry (world space, as MeshPart's fields) and its per-vertex
     visibility: ``visibility`` (N,) in [0, 1]; ``bent_normal`` (N, 3) unit; ``bounce_direction``
-    (N, 3) unit; ``bounce_weight`` (N,) in [0, 1]."""
+    (N, 3) the hits' mean bent normal, leaned, of length at most 1.5 (``bounce_irradiance``);
+    ``bounce_weight`` (N,) in [0, 1]."""
 
     positions: np.ndarray
     normals: np.ndarray
@@ -226,6 +232,30 @@ def occluders_reflectance(hit_albedo, hit_visibility):
     return a * v / np.maximum(1.0 - a * (1.0 - v), 1e-3)
 
 
+def bounce_irradiance(mean_length, along, against):
+    """The occluders' visible E/pi per unit V_hit (GLSL ``bounce_irradiance``): E's even part
+    (along + against)/2 plus the bake's mean bent normal's length (``bounce_direction``'s, the
+    hits leaned by ``cone_lean``: at most 1.5) times its odd part (along - against)/2, along and
+    against E/pi at the mean's direction and opposite it; at least 0. Exact for the mean of
+    E(bent_hit) where E/pi is linear in the direction (its first two SH bands). mean_length (N,),
+    along and against (N, 3) or (3,); returns (N, 3)."""
+    k = np.clip(np.asarray(mean_length, np.float64), 0.0, 1.5)[..., None]
+    along, against = (np.asarray(e, np.float64) for e in (along, against))
+    return np.maximum(0.5 * (1.0 + k) * along + 0.5 * (1.0 - k) * against, 0.0)
+
+
+def cone_lean(visibility):
+    """How far the mean free direction of a point with cosine-weighted visibility V reaches along
+    its bent normal, over an open point's 2/3: the cosine-weighted mean of cos over a cone of
+    cos(aperture) c = sqrt(1 - V) (the visibility cone) is (2/3)(1 + c + c^2)/(1 + c), so this is
+    (1 + c + c^2)/(1 + c): 1 open, 3/2 for a narrow cone. A hit's E_vis/pi under radiance linear in
+    the direction, L0 + L1.l, is V L0 + L1.(its mean free direction times V); its E(bent)/pi, L0
+    + (2/3) L1.bent, took only 2/3 of the odd part for a hit that sees a narrow patch of sky
+    (a bowl's wall seeing the bright zenith)."""
+    c = np.sqrt(np.clip(1.0 - np.asarray(visibility, np.float64), 0.0, 1.0))
+    return (1.0 + c + c * c) / (1.0 + c)
+
+
 def suns_on_occluders(hit_albedo, hit_visibility, first, second):
     """What the occluders shine of the suns' light, per unit power: a B1 (direct on them) + a^2 B2
     (from their own sunlit occluders), the further bounces as the tail of the same geometric
@@ -299,10 +329,11 @@ def occluded_environment(visibility, baked_visibility, bounce_weight, irradiance
                          sky=None, hit_emission=None):
     """occlusion.glsl's occlude_environment: (E/pi reaching the diffuse lobe, the prefiltered
     radiance), from the combined V, the baked V, the bounce weight w (N,), E/pi at the bent normal
-    and at the bounce direction (N, 3), the hit's albedo (3,) or (N, 3), the specular occlusion
-    (N,) and the prefiltered radiance (N, 3). The occluders' radiance is
-    hit albedo * min(w / (1 - V_baked), 1) * E(bounce)/pi, plus, with ``sun_first`` and
-    ``sun_second`` (N, 3) (sum_k P_k B1_k and B2_k of bake_sun_bounce), ``suns_on_occluders``.
+    and the hits' E/pi (``bounce_irradiance`` of the bounce direction) (N, 3), the hit's albedo
+    (3,) or (N, 3), the specular occlusion (N,) and the prefiltered radiance (N, 3). The
+    occluders' radiance is hit albedo * min(w / (1 - V_baked), 1) * that, plus, with
+    ``sun_first`` and ``sun_second`` (N, 3) (sum_k P_k B1_k and B2_k of bake_sun_bounce),
+    ``suns_on_occluders``.
     ``cone_radiance`` (N, 3): the prefiltered radiance at the bent normal and ``cone_roughness``
     (default: irradiance_bent, as a uniform environment has it); what V multiplies is its mix with
     E(bent)/pi by ``cone_blend`` (occlusion.glsl's visible_cone_radiance). ``sky``: (W (N, 3),
@@ -827,7 +858,7 @@ def _values_at(data, faces, first: int, occluders, see_through, through_of_trian
     return np.column_stack([bent, free.mean(axis=1), back])
 
 
-def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray) -> np.ndarray:
+def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray, unit: bool = True) -> np.ndarray:
     """``values`` (N, 4: a unit direction and a scalar) of a refined part with its buried
     vertices' rows replaced, ring by ring, by the mean of their neighbours' already known rows
     (the direction renormalised). A buried vertex lies inside another part (a floor vertex under
@@ -836,7 +867,8 @@ def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray) -> 
     its triangles' interpolation, which then ran a black (or, by the bounce, bright) wedge out to
     the next vertex outside the part. Its open neighbours' values are what the visible rest of
     those triangles sees (lightmap bakers dilate valid texels into those inside geometry alike).
-    A buried region with no open neighbour keeps its own values."""
+    A buried region with no open neighbour keeps its own values. ``unit`` False: the direction
+    is a mean of unit vectors (the bounce's), averaged as it is."""
     out = np.array(values, np.float64, copy=True)
     unknown = np.asarray(buried, bool).copy()
     if not unknown.any() or unknown.all():
@@ -852,8 +884,9 @@ def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray) -> 
         sums = np.column_stack([np.bincount(e[:, 1], out[e[:, 0], k], minlength=count) for k in range(out.shape[1])])
         ring = n > 0
         out[ring] = sums[ring] / n[ring, None]
-        length = np.linalg.norm(out[ring, :3], axis=1, keepdims=True)
-        out[ring, :3] = np.where(length > 1e-8, out[ring, :3] / np.maximum(length, 1e-30), values[ring, :3])
+        if unit:
+            length = np.linalg.norm(out[ring, :3], axis=1, keepdims=True)
+            out[ring, :3] = np.where(length > 1e-8, out[ring, :3] / np.maximum(length, 1e-30), values[ring, :3])
         unknown &= ~ring
     return out
 
@@ -899,15 +932,17 @@ def on_welded(values: np.ndarray, faces: np.ndarray, ids: np.ndarray | None, wor
     return work(merged, ids[np.asarray(faces, np.int64).reshape(-1, 3)])[ids]
 
 
-def _copies_averaged(values: np.ndarray, faces: np.ndarray, data: np.ndarray) -> np.ndarray:
+def _copies_averaged(values: np.ndarray, faces: np.ndarray, data: np.ndarray, unit: bool = True) -> np.ndarray:
     """``values`` (N, 4: a direction and a share) averaged over each vertex's copies
     (``welded`` over ``data``'s positions and normals), the direction renormalised. A
     file that repeats a vertex per face around it (an OBJ or STL without shared normals: the
     loader keeps a copy per face) gave each copy rays of its own, so copies at one point drew
     different values: a speckle of triangles over a smooth bowl's inside. Only copies are
     averaged, no neighbours: V's sharp changes (a contact, a slab's foot) stay where the
-    refinement put them."""
+    refinement put them. ``unit`` False: as ``_fill_covered``'s."""
     out = on_welded(values, faces, welded(data[:, :3], data[:, 3:6]), lambda v, f: v)
+    if not unit:
+        return out
     length = np.linalg.norm(out[:, :3], axis=1, keepdims=True)
     out[:, :3] = np.where(length > 1e-12, out[:, :3] / np.maximum(length, 1e-30), values[:, :3])
     return out
@@ -1029,11 +1064,20 @@ def bake_visibility(mesh, rays: int = DEFAULT_RAYS, edge_fraction: float = DEFAU
     w = np.column_stack([1.0 - huv[:, 0] - huv[:, 1], huv[:, 0], huv[:, 1]]).astype(np.float32)
     at_hit = np.einsum("hk,hkc->hc", w, all_values[corners])                # (H, 4): bent, V
     bounce_weight = np.bincount(rows, at_hit[:, 3], minlength=count) / bounce_rays
-    bounce_dir = np.column_stack([np.bincount(rows, at_hit[:, k] * at_hit[:, 3], minlength=count) for k in range(3)])
+    # The V_hit-weighted mean of the hits' bent normals, each leaned by cone_lean (its free
+    # directions' reach along it), not normalised: its length (at most 1.5) says how much they
+    # agree. E/pi is close to linear in the direction, so the hits' mean is E's even part plus the
+    # length times its odd part along the mean (bounce_irradiance); E at the unit direction alone
+    # took the hits on two facing partitions, whose bent normals half cancel, as all facing the
+    # side the mean leans to.
+    lean = at_hit[:, 3] * cone_lean(at_hit[:, 3])
+    bounce_dir = np.column_stack([np.bincount(rows, at_hit[:, k] * lean, minlength=count) for k in range(3)])
+    total = np.bincount(rows, at_hit[:, 3], minlength=count)[:, None]
     length = np.linalg.norm(bounce_dir, axis=1, keepdims=True)
-    bounce_dir = np.where(length > 1e-8, bounce_dir / np.maximum(length, 1e-30), -all_n)
+    bounce_dir = np.where(length > 1e-8, bounce_dir / np.maximum(np.maximum(total, length), 1e-30), -all_n)
     for (d, _, f), b, a, z in zip(state, buried, offsets[:-1], offsets[1:]):
-        filled = _copies_averaged(_fill_covered(np.column_stack([bounce_dir[a:z], bounce_weight[a:z]]), f, b), f, d)
+        bounce = np.column_stack([bounce_dir[a:z], bounce_weight[a:z]])
+        filled = _copies_averaged(_fill_covered(bounce, f, b, unit=False), f, d, unit=False)
         bounce_dir[a:z], bounce_weight[a:z] = filled[:, :3], filled[:, 3]
     parts = []
     for (data, widths, faces), part, val, a, b, s in zip(state, mesh.parts, values, offsets[:-1], offsets[1:], sided):

@@ -23,6 +23,8 @@ const int TERM_VISIBLE_LOBE = 9;          // (W r, W g, V_rays, so); W b as abov
                                           // prefiltered radiance the constants below
 const int TERM_OCCLUDER_BASE_ALBEDO = 10;     // (base rgb, metallic), specular_f0 0.04
 const int TERM_RECORDED_OCCLUDER_ALBEDO = 11; // (hit rgb, s): own = s OWN_ALBEDO, own_recorded = OWN_RECORDED
+const int TERM_BOUNCE_IRRADIANCE = 12;        // (mean length, along r, against, along g): along
+                                              // (r, g, g), against grey
 const vec3 OWN_ALBEDO = vec3(0.3, 0.5, 0.7);
 const vec3 OWN_RECORDED = vec3(0.25, 0.45, 0.6);
 const vec3 LOBE_IRRADIANCE = vec3(0.8, 0.5, 0.3);
@@ -75,6 +77,9 @@ void main() {
             break;
         case TERM_RECORDED_OCCLUDER_ALBEDO:
             o.xyz = recorded_occluder_albedo(a.w * OWN_ALBEDO, OWN_RECORDED, a.xyz);
+            break;
+        case TERM_BOUNCE_IRRADIANCE:
+            o.xyz = bounce_irradiance(a.x, vec3(a.y, a.w, a.w), vec3(a.z, a.z, a.z));
             break;
     }
     u_outputs[i] = o;

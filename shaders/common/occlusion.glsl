@@ -69,6 +69,19 @@ vec3 occluders_reflectance(vec3 hit_albedo, float hit_visibility) {
     return hit_albedo * hit_visibility / max(1.0 - hit_albedo * (1.0 - hit_visibility), vec3(1e-3));
 }
 
+// The occluders' visible irradiance / pi (per unit V_hit), from the bake's mean of the hits' bent
+// normals (visibility.py bake_visibility: each leaned by cone_lean, so mean_length is at most 1.5:
+// near 1.5 where every hit sees a narrow patch of sky the same way, toward 0 where the hits'
+// directions cancel, as on two facing partitions) and E/pi along the mean's direction (along)
+// and against it (against). Under radiance linear in the direction, E's even part (along +
+// against)/2 plus mean_length times its odd part (along - against)/2 is the mean over the hits
+// exactly. E along the unit direction alone counted the hits on both sides of a bay as all
+// facing its brighter side (EmissiveStrengthTest's lit patches beside each partition).
+vec3 bounce_irradiance(float mean_length, vec3 along, vec3 against) {
+    float k = clamp(mean_length, 0.0, 1.5);
+    return max(0.5 * (1.0 + k) * along + 0.5 * (1.0 - k) * against, vec3(0.0));
+}
+
 // What the occluders shine of the suns' light (first: sum_k P_k B1_k, the suns' E/pi on them;
 // second: sum_k P_k B2_k, what their own sunlit occluders pass them, over albedo; from the bake's
 // bake_sun_bounce): a B1 + a^2 B2, the further bounces as the tail of the series above.
@@ -141,7 +154,7 @@ vec3 visible_lobe_radiance(vec3 prefiltered, vec3 visible_sky, float so) {
 #define VISIBILITY_IN in
 #endif
 VISIBILITY_IN vec4 v_visibility;   // bent normal (xyz, interpolated: normalise), cosine-weighted visibility V
-VISIBILITY_IN vec4 v_bounce;       // the bounce's mean direction (xyz), its weight (w)
+VISIBILITY_IN vec4 v_bounce;       // the hits' mean bent normal (xyz, length <= 1.5: bounce_irradiance), weight w
 VISIBILITY_IN vec3 v_baked_normal; // the vertex normal the bake cast about (v_normal, under its own name)
 VISIBILITY_IN vec4 v_sun_bounce;   // per sun k: B1_k, the occluders' shadowed max(n.l_k, 0)/pi (bake_sun_bounce)
 VISIBILITY_IN vec4 v_sun_bounce2;  // per sun k: B2_k, what their sunlit occluders pass them
@@ -188,8 +201,8 @@ float combined_visibility(Surface s, vec3 n) {
 // the split sum's E/pi at n (irradiance) and its prefiltered radiance around r, and the
 // surface's specular albedo (the split sum's weight on the prefiltered radiance).
 // What the occluded directions see instead of the sky is the mesh: its radiance, one bounce, is
-// hit albedo * (w / (1 - V)) * E(bounce direction)/pi, the hit's albedo as the bake recorded it
-// (recorded_occluder_albedo; this surface's where it has none: diffuse plus specular, a rough
+// hit albedo * (w / (1 - V)) * the hits' E/pi (bounce_irradiance), the hit's albedo as the bake
+// recorded it (recorded_occluder_albedo; this surface's where it has none: diffuse plus specular, a rough
 // metal's walls light each other too), plus the radiance the hits emit.
 // Plus the suns' light on the occluders (in their own shadows, baked: suns_on_occluders).
 // Diffuse: V times the visible cone's radiance (visible_cone_radiance) + (1 - V) times that; specular: the prefiltered radiance for the share of
@@ -275,7 +288,10 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
         }
         float hit_visibility = occluder_visibility(v_bounce.w, baked_visibility);
         if (v_bounce.w > 0.0) {
-            occluder = occluders_reflectance(hit_albedo, hit_visibility) * irradiance_at(normalize(v_bounce.xyz), false);
+            float mean_length = length(v_bounce.xyz);
+            vec3 along = mean_length > 1e-6 ? v_bounce.xyz / mean_length : n;
+            occluder = occluders_reflectance(hit_albedo, hit_visibility)
+                       * bounce_irradiance(mean_length, irradiance_at(along, false), irradiance_at(-along, false));
         }
         // The compact sources on the occluders, which E above (the map without them) leaves out.
         occluder += suns_on_occluders(hit_albedo, hit_visibility, suns_weighted(v_sun_bounce),

@@ -69,7 +69,9 @@ void main() {
 #endif
 #ifdef HAS_VISIBILITY
     v_visibility = vec4(u_normal_matrix * in_visibility.xyz, in_visibility.w);
-    v_bounce = vec4(u_normal_matrix * in_bounce.xyz, in_bounce.w);
+    // the mean bent normal's length (bounce_irradiance) kept through a scaling normal matrix
+    vec3 bounce = u_normal_matrix * in_bounce.xyz;
+    v_bounce = vec4(bounce * (length(in_bounce.xyz) / max(length(bounce), 1e-12)), in_bounce.w);
     v_sun_bounce = in_sun_bounce;
     v_sun_bounce2 = in_sun_bounce2;
     v_hit_albedo = in_hit_albedo;

@@ -157,7 +157,8 @@ void interpolate(uint triangle, vec2 xy, vec2 at_centroid) {
     v_visibility = w.x * visibility_data[2u * i0] + w.y * visibility_data[2u * i1] + w.z * visibility_data[2u * i2];
     v_visibility.xyz = u_normal_matrix * v_visibility.xyz;
     v_bounce = w.x * visibility_data[2u * i0 + 1u] + w.y * visibility_data[2u * i1 + 1u] + w.z * visibility_data[2u * i2 + 1u];
-    v_bounce.xyz = u_normal_matrix * v_bounce.xyz;
+    vec3 bounce = u_normal_matrix * v_bounce.xyz;   // its length kept (pbr.vert)
+    v_bounce.xyz = bounce * (length(v_bounce.xyz) / max(length(bounce), 1e-12));
     v_sun_bounce = w.x * sun_bounce_data[2u * i0] + w.y * sun_bounce_data[2u * i1] + w.z * sun_bounce_data[2u * i2];
     v_sun_bounce2 = w.x * sun_bounce_data[2u * i0 + 1u] + w.y * sun_bounce_data[2u * i1 + 1u]
                     + w.z * sun_bounce_data[2u * i2 + 1u];
