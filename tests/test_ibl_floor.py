@@ -9,8 +9,12 @@ What is expected, and why:
   elevation (too bright toward the horizon, too dark under the camera): the real lobe seen
   obliquely is narrower across the plane of incidence and reaches further toward n. The default
   (`stretched`: two round fetches fitted to the real lobe) is within 6%.
-- At r 0.3 the two narrow fetches drew royal_esplanade's lamps twice on the floor from 60 degrees
-  (a ghost arc: 21.7% where one fetch read 2.2%); the default takes the single fetch there.
+- At r 0.3 the two fetches drew a ghost on the floor from 60 degrees (21.7% where one fetch read
+  2.2%, the lecture 4.5%). It was two cells of the lobe table whose far fetch of 1% weight the
+  bilinear lookup carried into the next cell's 12-28% weight; with them set by hand the two
+  fetches read 3.4% there (benchmarks/results/stretched_pair_from_r02.md). The bound is the
+  ghost's: a fetch that draws a bright feature twice is many times the single fetch's error and
+  above the lecture's; the pair's own lobe is allowed up to twice the single fetch.
 """
 
 from dataclasses import replace
@@ -71,5 +75,8 @@ def test_a_rough_gold_floor_is_within_ten_percent(shared_data, elevation):
 def test_no_ghost_of_a_lamp_at_low_roughness(shared_data):
     default = floor_error(shared_data, 0.3, 60.0, DEFAULT_IBL_MODEL)
     single = floor_error(shared_data, 0.3, 60.0, "alight")
-    print(f"r 0.3 from 60 degrees: default {100 * default:.1f}%, single fetch {100 * single:.1f}%")
-    assert default < 1.2 * single + 0.005
+    lecture = floor_error(shared_data, 0.3, 60.0, "lecture")
+    print(f"r 0.3 from 60 degrees: default {100 * default:.1f}%, single fetch {100 * single:.1f}%, "
+          f"lecture {100 * lecture:.1f}%")
+    assert default < 2.0 * single + 0.005
+    assert default < lecture

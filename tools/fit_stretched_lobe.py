@@ -21,6 +21,13 @@ the lobe is narrower than the grid resolves, keep the round lookup). The fit run
 search per cell (scipy), warm-started from its neighbours so the table stays continuous, and
 writes the canonical form (a_lo <= a_hi, w the weight at a_hi). About an hour on 2 cores.
 
+The fit sees each cell at its centre only; the shader reads the table bilinearly, parameter by
+parameter, so a fetch of ~1% weight far from the mean (free in one cell's objective) lands with
+the neighbouring cell's larger weight between them. The checked-in table has two such cells set
+by hand (part A, last n.v column, rows r 0.28 and 0.34: a_lo = the previous column's; the json's
+"about", benchmarks/results/stretched_pair_from_r02.md): a rerun must do the same or bring back
+a ghost on floors seen from 60 degrees at r 0.3.
+
     .venv/bin/pip install scipy            # the fit's only extra dependency (not alight's)
     .venv/bin/python tools/fit_stretched_lobe.py [--out app/core/stretched_lobe.json]
 """

@@ -9,9 +9,11 @@ the lobe's mean direction in the plane of incidence, the second one's weight, an
 alpha over the material's. Rows below r = 0.2 are the round lookup (0, 0, 0, 1).
 
 Below ``ROUGHNESS_START`` the model takes the single round fetch at the mean direction (the
-`alight` model's) and blends to the two fetches by ``ROUGHNESS_FULL`` (``blend_weight``): at
-r 0.3 two narrow fetches draw a compact bright feature twice (benchmarks/results/oblique_ibl.md).
-The blend mixes the fetches' results: mixing the table toward the round lookup instead made lobes
+`alight` model's) and blends to the two fetches by ``ROUGHNESS_FULL`` (``blend_weight``). The
+pair was held back to r 0.3-0.5 for a ghost on a floor seen from 60 degrees at r 0.3; that ghost
+was two cells of the table (their far fetch of 1% weight, carried by the bilinear lookup into the
+neighbouring cell's 12-28% weight, set by hand since), and with them the pair is full from r 0.3
+(benchmarks/results/stretched_pair_from_r02.md). The blend mixes the fetches' results: mixing the table toward the round lookup instead made lobes
 that fit neither (royal_esplanade's floor at r 0.4: 104% off, both ends under 6%).
 """
 
@@ -27,8 +29,8 @@ TABLE_PATH = Path(__file__).with_name("stretched_lobe.json")
 
 # The roughness range over which the single round fetch blends into the two fitted ones
 # (shader defines STRETCHED_ROUGHNESS_START / _FULL, set by alight.render.variants.ibl_defines).
-ROUGHNESS_START = 0.3
-ROUGHNESS_FULL = 0.5
+ROUGHNESS_START = 0.2
+ROUGHNESS_FULL = 0.3
 
 
 def blend_weight(roughness):

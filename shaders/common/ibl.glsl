@@ -141,14 +141,13 @@ vec3 specular_dominant_direction(vec3 n, vec3 r, vec3 f0, vec4 lut) {
 // second weighted w_hi, both at roughness r sqrt(beta). tools/fit_stretched_lobe.py fits them in
 // lobe space (no environment map): the real lobe is narrower across the plane of incidence than
 // the round one the prefiltered map holds, and reaches further toward n.
-// Below STRETCHED_ROUGHNESS_START the two narrow fetches draw a compact bright feature of the map
-// twice (a ghost arc on a flat floor under royal_esplanade at r 0.3: 22% against the single
-// fetch's 2%), so the lobe is the single round fetch there and blends into the two fetches by
-// STRETCHED_ROUGHNESS_FULL (benchmarks/results/oblique_ibl.md). Both come from
-// app/core/stretched_lobe.py (ROUGHNESS_START, ROUGHNESS_FULL) through app/render/variants.py.
+// Below STRETCHED_ROUGHNESS_START (r 0.2: the table's first fitted row) the lobe is the single
+// round fetch at its mean, blending into the two fetches by STRETCHED_ROUGHNESS_FULL (r 0.3: where
+// the probe's gold fails the lecture's half with one fetch; benchmarks/results/stretched_pair_from_r02.md).
+// Both come from app/core/stretched_lobe.py (ROUGHNESS_START, ROUGHNESS_FULL) through app/render/variants.py.
 #ifndef STRETCHED_ROUGHNESS_START
-#define STRETCHED_ROUGHNESS_START 0.3
-#define STRETCHED_ROUGHNESS_FULL 0.5
+#define STRETCHED_ROUGHNESS_START 0.2
+#define STRETCHED_ROUGHNESS_FULL 0.3
 #endif
 // STRETCHED_SPAN (app/render/variants.py stretched_span_defines): 0 the single fetch only (every
 // roughness at or below the start), 2 the two fetches only (all at or above the full), 1 both.
