@@ -187,32 +187,26 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
     vec3 d_lo = cos(offsets.x) * d + sin(offsets.x) * toward_horizon;
     vec3 d_hi = cos(offsets.y) * d + sin(offsets.y) * toward_horizon;
 #if STRETCHED_SPAN == 1
-    int first = weight < 1.0 ? 0 : 1;
-    int last = weight > 0.0 ? 3 : 1;
-#else
-    int first = 1;
-    int last = 3;
-#endif
     // The three lookups (the single lobe's, the stretched pair's) as one loop whose bounds vary
     // per pixel, so the compiler cannot unroll it: llvmpipe generates prefiltered_radiance_at's
-    // code (its log2, exp2 and cube fetches) once instead of three times, 12% less LLVM time for
-    // a new variant (benchmarks/results/compile.md), the same values and the same fetches per pixel.
+    // code (its log2, exp2 and cube fetches) once instead of three times, less LLVM time for a
+    // new variant (benchmarks/results/compile.md, 2026-12-07), the same values per pixel. The
+    // pair alone (STRETCHED_SPAN 2) stays unrolled: as a loop its frame was 1.2x slower there.
     vec3 single = vec3(0.0);
     vec3 lo = vec3(0.0);
     vec3 hi = vec3(0.0);
-    for (int i = first; i < last; ++i) {
+    for (int i = weight < 1.0 ? 0 : 1; i < (weight > 0.0 ? 3 : 1); ++i) {
         vec3 dir = i == 0 ? d : (i == 1 ? d_lo : d_hi);
         vec3 radiance = prefiltered_radiance_at(dir, i == 0 ? roughness : fetch_roughness, with_suns);
         if (i == 0) single = radiance;
         else if (i == 1) lo = radiance;
         else hi = radiance;
     }
-    vec3 stretched = mix(lo, hi, fit.z);
-#if STRETCHED_SPAN == 1
     if (weight <= 0.0) return single;
-    return mix(single, stretched, weight);
+    return mix(single, mix(lo, hi, fit.z), weight);
 #else
-    return stretched;
+    return mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
+               prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
 #endif
 #endif
 }
