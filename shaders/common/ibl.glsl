@@ -172,6 +172,8 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
 #else
 #if STRETCHED_SPAN == 1
     float weight = smoothstep(STRETCHED_ROUGHNESS_START, STRETCHED_ROUGHNESS_FULL, roughness);
+    vec3 single = weight < 1.0 ? prefiltered_radiance_at(d, roughness, with_suns) : vec3(0.0);
+    if (weight <= 0.0) return single;
 #endif
     vec2 coord = vec2(max(dot(n, v), 0.0), roughness);
     float weight_a = dot(f0, vec3(0.2126, 0.7152, 0.0722)) * lut.x;
@@ -186,27 +188,12 @@ vec3 stretched_prefiltered_radiance(vec3 n, vec3 v, vec3 f0, vec4 lut, float rou
     vec2 offsets = fit.xy * pole_fade(coord.x, float(textureSize(u_stretched_lobe_a, 0).x));
     vec3 d_lo = cos(offsets.x) * d + sin(offsets.x) * toward_horizon;
     vec3 d_hi = cos(offsets.y) * d + sin(offsets.y) * toward_horizon;
+    vec3 stretched = mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
+                         prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
 #if STRETCHED_SPAN == 1
-    // The three lookups (the single lobe's, the stretched pair's) as one loop whose bounds vary
-    // per pixel, so the compiler cannot unroll it: llvmpipe generates prefiltered_radiance_at's
-    // code (its log2, exp2 and cube fetches) once instead of three times, less LLVM time for a
-    // new variant (benchmarks/results/compile.md, 2026-12-07), the same values per pixel. The
-    // pair alone (STRETCHED_SPAN 2) stays unrolled: as a loop its frame was 1.2x slower there.
-    vec3 single = vec3(0.0);
-    vec3 lo = vec3(0.0);
-    vec3 hi = vec3(0.0);
-    for (int i = weight < 1.0 ? 0 : 1; i < (weight > 0.0 ? 3 : 1); ++i) {
-        vec3 dir = i == 0 ? d : (i == 1 ? d_lo : d_hi);
-        vec3 radiance = prefiltered_radiance_at(dir, i == 0 ? roughness : fetch_roughness, with_suns);
-        if (i == 0) single = radiance;
-        else if (i == 1) lo = radiance;
-        else hi = radiance;
-    }
-    if (weight <= 0.0) return single;
-    return mix(single, mix(lo, hi, fit.z), weight);
+    return mix(single, stretched, weight);
 #else
-    return mix(prefiltered_radiance_at(d_lo, fetch_roughness, with_suns),
-               prefiltered_radiance_at(d_hi, fetch_roughness, with_suns), fit.z);
+    return stretched;
 #endif
 #endif
 }
