@@ -372,13 +372,30 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     defines.update(light_defines(scene))
     user_maps = user_maps_present(scene)
     parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
-    any_maps = 0
+    # IBL_BELOW_GRID and STRETCHED_SPAN for each variant's own parts (their maps and roughness),
+    # not the whole pass's: one part with a roughness map then leaves the others' variants without
+    # the code those defines leave out (the same variants, as many; less for llvmpipe to compile
+    # at their first draw and to run: benchmarks/results/compile.md, 2026-12-07).
+    groups: dict[frozenset, tuple[int, list]] = {}
+    any_maps, all_materials = 0, []
     for gpu_part, part in parts:
-        any_maps |= part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
-    # (through the renderer, where a test replaces it)
-    materials = [part_material(scene, part)[0] for _, part in parts]
-    defines.update(r._below_grid_defines(scene, maps, materials, any_maps))
-    defines.update(stretched_span_defines(scene, materials, any_maps))
+        variant = part_defines(scene, gpu_part, part, user_maps)
+        key = frozenset(variant.items())
+        mask, materials = groups.get(key, (0, []))
+        material = part_material(scene, part)[0]
+        groups[key] = (mask | variant["MATERIAL_MAPS_MASK"], materials + [material])
+        any_maps |= variant["MATERIAL_MAPS_MASK"]
+        all_materials.append(material)
+
+    def roughness_defines(variant: dict) -> dict:
+        # the parts whose defines the variant holds (extras such as TRANSMISSION_SCENE aside);
+        # else the whole pass's
+        items = set(variant.items())
+        keys = [k for k in groups if k <= items]
+        mask, materials = groups[max(keys, key=len)] if keys else (any_maps, all_materials)
+        # (through the renderer, where a test replaces it)
+        return {**r._below_grid_defines(scene, maps, materials, mask),
+                **stretched_span_defines(scene, materials, mask)}
     if scene.debug_view:
         defines["DEBUG_VIEW"] = None
     if frame.shadowed:
@@ -386,7 +403,7 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     bound: set[int] = set()
 
     def program_for(variant: dict, vertex: str = "render/pbr.vert", fragment: str = "render/pbr.frag") -> moderngl.Program:
-        all_defines = {**defines, **variant}
+        all_defines = {**defines, **roughness_defines(variant), **variant}
         prog = scene_program(r, frame, vertex, fragment, all_defines)
         if id(prog) not in bound:
             bound.add(id(prog))
