@@ -376,26 +376,34 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     # not the whole pass's: one part with a roughness map then leaves the others' variants without
     # the code those defines leave out (the same variants, as many; less for llvmpipe to compile
     # at their first draw and to run: benchmarks/results/compile.md, 2026-12-07).
-    groups: dict[frozenset, tuple[int, list]] = {}
+    groups: dict[frozenset, list] = {}     # a variant's part defines: [its parts' maps, their materials]
     any_maps, all_materials = 0, []
     for gpu_part, part in parts:
         variant = part_defines(scene, gpu_part, part, user_maps)
-        key = frozenset(variant.items())
-        mask, materials = groups.get(key, (0, []))
+        group = groups.setdefault(frozenset(variant.items()), [0, []])
         material = part_material(scene, part)[0]
-        groups[key] = (mask | variant["MATERIAL_MAPS_MASK"], materials + [material])
+        group[0] |= variant["MATERIAL_MAPS_MASK"]
+        group[1].append(material)
         any_maps |= variant["MATERIAL_MAPS_MASK"]
         all_materials.append(material)
+
+    def span_defines(mask: int, materials: list) -> dict:
+        # (through the renderer, where a test replaces it)
+        return {**r._below_grid_defines(scene, maps, materials, mask),
+                **stretched_span_defines(scene, materials, mask)}
+
+    tight = {key: span_defines(mask, materials) for key, (mask, materials) in groups.items()}
 
     def roughness_defines(variant: dict) -> dict:
         # the parts whose defines the variant holds (extras such as TRANSMISSION_SCENE aside);
         # else the whole pass's
+        exact = tight.get(frozenset(variant.items()))
+        if exact is not None:
+            return exact
         items = set(variant.items())
-        keys = [k for k in groups if k <= items]
-        mask, materials = groups[max(keys, key=len)] if keys else (any_maps, all_materials)
-        # (through the renderer, where a test replaces it)
-        return {**r._below_grid_defines(scene, maps, materials, mask),
-                **stretched_span_defines(scene, materials, mask)}
+        keys = [k for k in tight if k <= items]
+        return tight[max(keys, key=len)] if keys else span_defines(any_maps, all_materials)
+
     if scene.debug_view:
         defines["DEBUG_VIEW"] = None
     if frame.shadowed:
