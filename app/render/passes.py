@@ -372,19 +372,20 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     defines.update(light_defines(scene))
     user_maps = user_maps_present(scene)
     parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
-    # IBL_BELOW_GRID and STRETCHED_SPAN for each variant's own parts (their maps and roughness),
-    # not the whole pass's: one part with a roughness map then leaves the others' variants without
-    # the code those defines leave out (the same variants, as many; less for llvmpipe to compile
-    # at their first draw and to run: benchmarks/results/compile.md, 2026-12-07).
-    groups: dict[frozenset, list] = {}     # a variant's part defines: [its parts' maps, their materials]
+    # IBL_BELOW_GRID and STRETCHED_SPAN for the parts that read the same maps (a variant's
+    # MATERIAL_MAPS_MASK), not the whole pass's: one part with a roughness map then leaves the
+    # others' variants without the code those defines leave out (the same variants, as many; less
+    # for llvmpipe to compile at their first draw and to run: benchmarks/results/compile.md,
+    # 2026-12-07). Grouped by the mask alone, which every variant of a part keeps (the
+    # visibility-buffer and screen-AO programs add and drop other defines): parts that share a
+    # mask share the defines, chosen for all of them.
+    by_mask: dict[int, list] = {}     # MATERIAL_MAPS_MASK: the parts' materials
     any_maps, all_materials = 0, []
     for gpu_part, part in parts:
-        variant = part_defines(scene, gpu_part, part, user_maps)
-        group = groups.setdefault(frozenset(variant.items()), [0, []])
+        mask = part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
         material = part_material(scene, part)[0]
-        group[0] |= variant["MATERIAL_MAPS_MASK"]
-        group[1].append(material)
-        any_maps |= variant["MATERIAL_MAPS_MASK"]
+        by_mask.setdefault(mask, []).append(material)
+        any_maps |= mask
         all_materials.append(material)
 
     def span_defines(mask: int, materials: list) -> dict:
@@ -392,17 +393,11 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
         return {**r._below_grid_defines(scene, maps, materials, mask),
                 **stretched_span_defines(scene, materials, mask)}
 
-    tight = {key: span_defines(mask, materials) for key, (mask, materials) in groups.items()}
+    tight = {mask: span_defines(mask, materials) for mask, materials in by_mask.items()}
+    whole = span_defines(any_maps, all_materials)
 
     def roughness_defines(variant: dict) -> dict:
-        # the parts whose defines the variant holds (extras such as TRANSMISSION_SCENE aside);
-        # else the whole pass's
-        exact = tight.get(frozenset(variant.items()))
-        if exact is not None:
-            return exact
-        items = set(variant.items())
-        keys = [k for k in tight if k <= items]
-        return tight[max(keys, key=len)] if keys else span_defines(any_maps, all_materials)
+        return tight.get(variant.get("MATERIAL_MAPS_MASK"), whole)
 
     if scene.debug_view:
         defines["DEBUG_VIEW"] = None
