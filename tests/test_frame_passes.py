@@ -12,7 +12,7 @@ import pytest
 
 from alight.core.material import Material
 from alight.core.mesh import sphere
-from alight.core.scene import Camera, Display, Light, Scene
+from alight.core.scene import Display, Light, Scene
 from alight.exchange.presets import load_preset
 from alight.ibl.bake import grid_roughness
 from alight.ibl.environment import load_environment
@@ -118,53 +118,6 @@ def test_the_lookup_without_its_below_grid_fade_is_chosen_only_where_it_changes_
         assert r._below_grid_defines(scene, maps, [replace(layered, roughness=0.8)]) == {}
     assert r._below_grid_defines(scene, maps, [Material(roughness=0.8)], map_mask=2) == {}   # metallic-roughness map
     assert r._below_grid_defines(scene, maps, [Material(roughness=0.8)], map_mask=1) == {"IBL_BELOW_GRID": 0}
-
-
-def test_the_roughness_defines_follow_each_variants_parts_and_change_nothing(tmp_path, monkeypatch):
-    """IBL_BELOW_GRID and STRETCHED_SPAN are chosen per MATERIAL_MAPS_MASK (passes.draw_mesh): a
-    part with a metallic-roughness map (any roughness) keeps the full stretched blend, a part
-    beside it without one (roughness 0.6) compiles the pair alone, and the image equals the one
-    with the blend compiled into both (as when the defines were chosen for the whole pass)."""
-    from alight.exchange.meshes import load_mesh
-    from alight.render import passes
-    from tests.gltf_builder import USHORT, Gltf, grid_plane
-
-    g = Gltf()
-    positions, normals, uvs, idx = grid_plane(2, size=0.9)
-    y, x = np.mgrid[0:16, 0:16] / 16.0
-    metal_rough = np.stack([np.zeros_like(x), 0.4 + 0.5 * x, 0.2 + 0.8 * y], -1) * 255
-    for k, pbr in enumerate(({"metallicFactor": 1.0, "roughnessFactor": 1.0,
-                              "metallicRoughnessTexture": {"index": g.image(metal_rough.astype(np.uint8))}},
-                             {"metallicFactor": 1.0, "roughnessFactor": 0.6})):
-        mat = g.material(pbrMetallicRoughness=pbr)
-        offset = np.array([k - 0.5, 0.0, 0.0])
-        g.mesh([{"attributes": {"POSITION": g.accessor(positions + offset, bounds=True),
-                                "NORMAL": g.accessor(normals), "TEXCOORD_0": g.accessor(uvs)},
-                 "indices": g.accessor(idx.ravel(), USHORT), "material": mat}])
-    mesh = load_mesh(g.save(tmp_path / "two.glb"))
-    r = renderer()
-    maps = r.bake(load_environment("studio"), "low")
-    camera = Camera(position=(0.3, 0.4, 2.2), target=(0.0, 0.0, 0.0), fov_y_deg=40.0, near=0.1, far=20.0)
-    scene = Scene(mesh=mesh, camera=camera)
-    used = []
-    program = r.shaders.program
-
-    def recording(vertex, fragment, defines=None):
-        if fragment == "render/pbr.frag":
-            used.append(dict(defines or {}))
-        return program(vertex, fragment, defines)
-
-    monkeypatch.setattr(r.shaders, "program", recording)
-    tight = r.render(scene, maps, 96, 64, aa="none", read_srgb=False).linear
-    spans = {d["MATERIAL_MAPS_MASK"]: d.get("STRETCHED_SPAN") for d in used}
-    assert spans == {2: None, 0: 2}, spans
-    monkeypatch.setattr(passes, "stretched_span_defines", lambda *a, **k: {})
-    monkeypatch.setattr(r, "_below_grid_defines", lambda *a, **k: {})
-    used.clear()
-    full = r.render(scene, maps, 96, 64, aa="none", read_srgb=False).linear
-    assert all("STRETCHED_SPAN" not in d for d in used)
-    assert (tight[..., 3] > 0).mean() > 0.3
-    np.testing.assert_array_equal(tight, full)
 
 
 def test_a_frame_with_blended_parts_keeps_the_background_pass_and_equals_it():

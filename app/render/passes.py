@@ -372,33 +372,13 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     defines.update(light_defines(scene))
     user_maps = user_maps_present(scene)
     parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))
-    # IBL_BELOW_GRID and STRETCHED_SPAN for the parts that read the same maps (a variant's
-    # MATERIAL_MAPS_MASK), not the whole pass's: one part with a roughness map then leaves the
-    # others' variants without the code those defines leave out (the same variants, as many; less
-    # for llvmpipe to compile at their first draw and to run: benchmarks/results/compile.md,
-    # 2026-12-07). Grouped by the mask alone, which every variant of a part keeps (the
-    # visibility-buffer and screen-AO programs add and drop other defines): parts that share a
-    # mask share the defines, chosen for all of them.
-    by_mask: dict[int, list] = {}     # MATERIAL_MAPS_MASK: the parts' materials
-    any_maps, all_materials = 0, []
+    any_maps = 0
     for gpu_part, part in parts:
-        mask = part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
-        material = part_material(scene, part)[0]
-        by_mask.setdefault(mask, []).append(material)
-        any_maps |= mask
-        all_materials.append(material)
-
-    def span_defines(mask: int, materials: list) -> dict:
-        # (through the renderer, where a test replaces it)
-        return {**r._below_grid_defines(scene, maps, materials, mask),
-                **stretched_span_defines(scene, materials, mask)}
-
-    tight = {mask: span_defines(mask, materials) for mask, materials in by_mask.items()}
-    whole = span_defines(any_maps, all_materials)
-
-    def roughness_defines(variant: dict) -> dict:
-        return tight.get(variant.get("MATERIAL_MAPS_MASK"), whole)
-
+        any_maps |= part_defines(scene, gpu_part, part, user_maps)["MATERIAL_MAPS_MASK"]
+    # (through the renderer, where a test replaces it)
+    materials = [part_material(scene, part)[0] for _, part in parts]
+    defines.update(r._below_grid_defines(scene, maps, materials, any_maps))
+    defines.update(stretched_span_defines(scene, materials, any_maps))
     if scene.debug_view:
         defines["DEBUG_VIEW"] = None
     if frame.shadowed:
@@ -406,7 +386,7 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     bound: set[int] = set()
 
     def program_for(variant: dict, vertex: str = "render/pbr.vert", fragment: str = "render/pbr.frag") -> moderngl.Program:
-        all_defines = {**defines, **roughness_defines(variant), **variant}
+        all_defines = {**defines, **variant}
         prog = scene_program(r, frame, vertex, fragment, all_defines)
         if id(prog) not in bound:
             bound.add(id(prog))

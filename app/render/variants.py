@@ -191,9 +191,8 @@ ROUGHNESS_FREE_MAPS = {"base_color", "normal", "emissive", "occlusion", "metalli
 
 
 def below_grid_defines(scene, maps: IBLMaps | None, materials, map_mask: int = 0) -> dict:
-    """``{"IBL_BELOW_GRID": 0}`` when no roughness a variant can shade (``materials``: those of the
-    parts it draws, passes.draw_mesh) lies below the prefiltered grid's first step: the
-    materials' roughness (and their coat's) is at or above it, no
+    """``{"IBL_BELOW_GRID": 0}`` when no roughness the pass can shade lies below the prefiltered
+    grid's first step: the materials' roughness (and their coat's) is at or above it, no
     compiled-in map (``map_mask``, MATERIAL_MAPS bits) can lower one, and no layer or IBL model
     reads the maps at a roughness of its own. Else nothing: the shader keeps the fade into the
     source cube (ibl.glsl)."""
@@ -227,9 +226,8 @@ def below_grid_defines(scene, maps: IBLMaps | None, materials, map_mask: int = 0
 
 
 def stretched_span_defines(scene, materials, map_mask: int = 0) -> dict:
-    """The `stretched` model's STRETCHED_SPAN (ibl.glsl), for the parts one variant draws
-    (passes.draw_mesh): 0 where every roughness they shade is at or below ROUGHNESS_START (the
-    single round fetch only), 2 where all are at or above
+    """The `stretched` model's STRETCHED_SPAN (ibl.glsl): 0 where every roughness the pass shades
+    is at or below ROUGHNESS_START (the single round fetch only), 2 where all are at or above
     ROUGHNESS_FULL (the two fitted fetches only), else nothing (1: both, blended). llvmpipe runs
     both sides of a branch, so the blend's three fetches cost every pixel unless compiled out
     (1.5x the built-in sphere's frame)."""
