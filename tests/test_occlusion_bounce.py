@@ -12,28 +12,15 @@ import pytest
 pytest.importorskip("embreex")
 
 from alight.core import visibility as vis  # noqa: E402
-from alight.core.mesh import FileMaterial, Mesh, MeshPart  # noqa: E402
+from alight.core.mesh import FileMaterial, Mesh  # noqa: E402
 from tests.gpu import evaluate  # noqa: E402
+from tests.quad_meshes import quad_part  # noqa: E402
 
 # Radiance linear in the direction: L(l) = 1 + SLOPE l.x (bright at +x), so E(n)/pi = 1 + (2/3) SLOPE n.x.
 SLOPE = 0.9
 
 
-def _part(quads, name: str) -> MeshPart:
-    """Quads (4 corners, counter-clockwise seen from the front) as a flat-shaded, two-sided part."""
-    verts, normals, faces = [], [], []
-    for q in quads:
-        q = np.asarray(q, np.float64)
-        n = np.cross(q[1] - q[0], q[2] - q[0])
-        base = sum(len(v) for v in verts)
-        verts.append(q)
-        normals.append(np.repeat((n / np.linalg.norm(n))[None], 4, axis=0))
-        faces.append(np.array([[0, 1, 2], [0, 2, 3]]) + base)
-    v = np.concatenate(verts).astype(np.float32)
-    material = FileMaterial(base_color=(0.7, 0.7, 0.7), metallic=0.0, roughness=1.0)
-    return MeshPart(name, v, np.concatenate(normals).astype(np.float32), np.zeros((len(v), 2), np.float32),
-                    np.tile(np.float32([1, 0, 0, 1]), (len(v), 1)), np.concatenate(faces).astype(np.uint32),
-                    material)
+GREY_DIFFUSE = FileMaterial(base_color=(0.7, 0.7, 0.7), metallic=0.0, roughness=1.0)
 
 
 def _bay() -> Mesh:
@@ -42,7 +29,7 @@ def _bay() -> Mesh:
     wall = [((-1.5, 0, 0), (1.5, 0, 0), (1.5, 3, 0), (-1.5, 3, 0))]
     left = [((-1.5, 0, 0), (-1.5, 3, 0), (-1.5, 3, 2), (-1.5, 0, 2))]     # faces +x
     right = [((1.5, 0, 0), (1.5, 0, 2), (1.5, 3, 2), (1.5, 3, 0))]        # faces -x
-    return Mesh([_part(wall, "wall"), _part(left + right, "partitions")], "bay")
+    return Mesh([quad_part(wall, "wall", GREY_DIFFUSE), quad_part(left + right, "partitions", GREY_DIFFUSE)], "bay")
 
 
 def _cosine_rays(n: np.ndarray, count: int, rng) -> np.ndarray:

@@ -14,49 +14,23 @@ import pytest
 pytest.importorskip("embreex")
 
 from alight.core import visibility as vis  # noqa: E402
-from alight.core.mesh import FileMaterial, Mesh, MeshPart  # noqa: E402
+from alight.core.mesh import FileMaterial, Mesh  # noqa: E402
 from alight.core.scene import Camera, Scene  # noqa: E402
 from alight.ibl.environment import constant_environment  # noqa: E402
 from tests.gpu import evaluate, renderer  # noqa: E402
+from tests.quad_meshes import box_quads, quad_part  # noqa: E402
 
 GREY = 0.7
 RED = (0.8, 0.05, 0.05)
 BOX = ((-0.3, 0.0, -0.3), (0.3, 0.6, 0.3))
 
 
-def _part(quads, name: str, material: FileMaterial) -> MeshPart:
-    """Quads (4 corners, counter-clockwise seen from the front) as a flat-shaded part."""
-    verts, normals, faces = [], [], []
-    for q in quads:
-        q = np.asarray(q, np.float64)
-        n = np.cross(q[1] - q[0], q[2] - q[0])
-        base = sum(len(v) for v in verts)
-        verts.append(q)
-        normals.append(np.repeat((n / np.linalg.norm(n))[None], 4, axis=0))
-        faces.append(np.array([[0, 1, 2], [0, 2, 3]]) + base)
-    v = np.concatenate(verts).astype(np.float32)
-    return MeshPart(name, v, np.concatenate(normals).astype(np.float32), np.zeros((len(v), 2), np.float32),
-                    np.tile(np.float32([1, 0, 0, 1]), (len(v), 1)), np.concatenate(faces).astype(np.uint32),
-                    material)
-
-
-def _box_quads(lo, hi):
-    """A box's four sides and its top (no bottom: it stands on the floor), facing out."""
-    x0, y0, z0 = lo
-    x1, y1, z1 = hi
-    return [((x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)),
-            ((x1, y0, z0), (x0, y0, z0), (x0, y1, z0), (x1, y1, z0)),
-            ((x1, y0, z1), (x1, y0, z0), (x1, y1, z0), (x1, y1, z1)),
-            ((x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)),
-            ((x0, y1, z1), (x1, y1, z1), (x1, y1, z0), (x0, y1, z0))]
-
-
 def _floor_and_box(box: FileMaterial) -> Mesh:
     """A grey floor y = 0 over [-1, 1]^2 (diffuse, albedo GREY) and a box of material ``box`` in
     its middle: two parts of one file, as a glTF with two materials loads."""
     floor = FileMaterial(base_color=(GREY,) * 3, metallic=0.0, roughness=1.0, specular_f0=(0.0, 0.0, 0.0))
-    return Mesh([_part([((-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1))], "floor", floor),
-                 _part(_box_quads(*BOX), "box", box)], "floor-and-box")
+    return Mesh([quad_part([((-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1))], "floor", floor),
+                 quad_part(box_quads(*BOX), "box", box)], "floor-and-box")
 
 
 def _render(mesh, mode: str, maps, size: int = 96) -> np.ndarray:
