@@ -5,6 +5,7 @@ sample, the blit resolve, the tone map pass) in the same renderer, so the check 
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -13,6 +14,7 @@ import pytest
 from alight.core.material import Material
 from alight.core.mesh import sphere
 from alight.core.scene import Display, Light, Scene
+from alight.core.stretched_lobe import lobe_table
 from alight.exchange.presets import load_preset
 from alight.ibl.bake import grid_roughness
 from alight.ibl.environment import load_environment
@@ -79,9 +81,10 @@ def test_the_display_path_for_srgb_only_frames_equals_the_separate_passes():
 
 @pytest.mark.parametrize("view", ["camera", "probe"])
 def test_the_lookup_without_its_below_grid_fade_is_chosen_only_where_it_changes_nothing(shared_data, view):
-    """At or above grid A's first step (r0 = 0.25 at medium) the fade is compiled out and the
-    image equals the one with it compiled in; below r0 it is kept (the image differs from the
-    grid-only lookup)."""
+    """Where every fetch reads at or above grid A's first step (r0 = 0.25 at medium) the fade is
+    compiled out and the image equals the one with it compiled in; below r0 it is kept (the image
+    differs from the grid-only lookup). The default model's fitted pair (from r 0.2) fetches at
+    r sqrt(beta), down to 0.47 r, so its safe roughness is r0 / sqrt(min beta)."""
     r = renderer()
     maps = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "medium")
     r0 = grid_roughness(0, maps.quality.prefiltered_levels)
@@ -100,9 +103,12 @@ def test_the_lookup_without_its_below_grid_fade_is_chosen_only_where_it_changes_
             r._below_grid_defines = real
         return chosen, image
 
-    chosen, without = frame(r0 + 0.05, False)
-    _, with_fade = frame(r0 + 0.05, True)
+    safe = max(r0 + 0.05, r0 / math.sqrt(float(lobe_table()[..., 3].min())) + 0.02)
+    chosen, without = frame(safe, False)
+    _, with_fade = frame(safe, True)
     assert chosen == {"IBL_BELOW_GRID": 0}
+    chosen, _ = frame(r0 + 0.05, False)
+    assert chosen == {}                                     # the pair's narrowest fetch reads below r0
     np.testing.assert_array_equal(without, with_fade)
     chosen, _ = frame(r0 * 0.5, False)
     assert chosen == {}                                     # a roughness below the grid keeps the fade

@@ -306,21 +306,25 @@ vec3 lecture_split_sum(Surface s, vec3 n, vec3 v, vec3 F) {
 vec3 karis_split_sum(Surface s, vec3 n, vec3 v, bool toward_lobe_mean, bool with_suns) {
     float n_dot_v = max(dot(n, v), 0.0);
     vec3 f0 = surface_f0(s);
+    float f90 = surface_f90(s);
     vec4 lut = brdf_lut_at(n_dot_v, s.roughness);
     vec3 r = reflect(-v, n);
-    vec3 d = toward_lobe_mean ? specular_dominant_direction(n, r, f0, lut) : r;
+    // The lobe's two parts weigh F0 A and F90 B; the mean direction and the stretched fit mix
+    // them by the ratio alone, so they take F0 / F90 (KHR_materials_specular's F90 < 1 scales B:
+    // with F0 as it is, a specularFactor of 0.5 leaned the lobe toward B, no longer half of 1's).
+    vec3 f0_over_f90 = f0 / max(f90, 1e-6);
+    vec3 d = toward_lobe_mean ? specular_dominant_direction(n, r, f0_over_f90, lut) : r;
 #ifdef HAS_ANISOTROPY
     lut.xy *= anisotropic_energy_ratio(s, n, v);
     vec3 prefiltered = anisotropic_prefiltered_radiance(s, n, v, d, with_suns);
 #elif IBL_MODEL == IBL_MODEL_STRETCHED
-    vec3 prefiltered = stretched_prefiltered_radiance(n, v, f0, lut, s.roughness, d, with_suns);
+    vec3 prefiltered = stretched_prefiltered_radiance(n, v, f0_over_f90, lut, s.roughness, d, with_suns);
 #else
     vec3 prefiltered = prefiltered_radiance_at(d, s.roughness, with_suns);
 #endif
     vec3 irradiance = irradiance_at(n, with_suns);
     // With F90 = 1 the diffuse weight is (1 - F0)(1 - Fc); KHR_materials_specular's F90 makes it
     // 1 - F0 - (F90 - F0) Fc, and the split sum's B scales by F90.
-    float f90 = surface_f90(s);
     vec3 spec_albedo = f0 * lut.x + f90 * lut.y;
     vec3 diffuse_weight = 1.0 - f0 - (f90 - f0) * diffuse_fresnel(n_dot_v);
 #ifdef HAS_IRIDESCENCE
