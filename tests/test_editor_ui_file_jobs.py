@@ -4,7 +4,6 @@ Test Engine against a 1280x720 window under Xvfb."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from test_editor import display  # noqa: F401  (the Xvfb fixture)
@@ -19,15 +18,18 @@ def test_every_file_job_check_passes(display, tmp_path):
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]
     assert f"{len(checks)} passed, 0 failed" in result.stdout, result.stdout
-    # The last check clicked 'export glTF' and the window closed: the export is whole, its
-    # temporary file gone, and where it still ran at the close, stderr said it was finished.
+    # The last check clicked 'export glTF' and the window closed: the export is whole and its
+    # temporary file gone whether it still ran at the close or not (a daemon thread stopped at
+    # exit left both wrong); where the close waited for it, stderr names the file. Whether it
+    # waited depends on how soon the runner closes after the check: a flag written at the check's
+    # end said "running" in a CI run where the export then ended before the close.
     from alight.exchange.gltf_material import read_gltf_json
 
     export = tmp_path / "closing_export.glb"
     assert export.is_file() and read_gltf_json(str(export))["meshes"], sorted(p.name for p in tmp_path.iterdir())
     assert not [p.name for p in tmp_path.iterdir() if ".tmp" in p.name or p.name.startswith("tmp")]
-    if json.loads((tmp_path / "closing_export.json").read_text())["running"]:
-        assert f"alight: finishing the export of {export} before closing" in result.stderr, result.stderr[-2000:]
+    finishing = [line for line in result.stderr.splitlines() if line.startswith("alight: finishing the export")]
+    assert finishing in ([], [f"alight: finishing the export of {export} before closing"]), finishing
 
 
 def _mesh_loads(mode: str, display: str, tmp_path: Path):
