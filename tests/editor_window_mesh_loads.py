@@ -9,6 +9,8 @@ interpreter (``python tests/editor_window_mesh_loads.py restore|script``) with D
   whole, with the session's camera and 'mesh file's own materials' box.
 - ``script``: ``--script mesh=HELMET --script roughness=0.4 --screenshot``: the script's next edit
   and the screenshot still see the helmet (the script waits for it, as for ``open=``).
+- ``close``: the window closed before the restored helmet came: the session saved keeps the
+  helmet's own-materials box, not the placeholder's.
 
 Both count what ran on the main thread: no read of the helmet, no texture uploaded whole and no
 self-shadowing test there (whatever the machine's load); and the longest gap between frames is
@@ -185,5 +187,48 @@ def script() -> int:
     return 0
 
 
+def close() -> int:
+    """The window closed while the last session's helmet is still being read: the session saved
+    then keeps the helmet and its own-materials box as saved (ticked), not the box of the
+    placeholder on screen meanwhile (the built-in sphere's, unticked)."""
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import save_session, session_path
+    from alight.frontends.editor.state import EditorState
+
+    last = EditorState()
+    last.load_env("studio")
+    last.mesh_spec, last.use_file_materials = HELMET, True
+    save_session(last, OrbitCamera())
+
+    from alight.frontends.cli import build_parser
+    from alight.frontends.editor.run import build_state, open_last_session
+    from alight.frontends.editor.window import EditorWindow
+
+    args = build_parser().parse_args(["edit", "--size", "320x240"])
+    state = build_state(args)
+    win = EditorWindow(state, args.size)
+    try:
+        open_last_session(win, state)
+        win.frame()
+        waiting = win.panel.file_jobs.opening
+        shown = (state.mesh_spec, state.use_file_materials)
+        # The close as the window manager asks it, and what run.py does after the loop ends.
+        win.glfw.set_window_should_close(win.window, True)
+        win.run()
+        save_session(state, win.orbit, win.turntable, win.panel)
+    finally:
+        win.close()
+    if waiting != HELMET:
+        print(f"the helmet was not still being read at the close (opening {waiting!r}): nothing tested")
+        return 1
+    saved = json.loads(session_path().read_text(encoding="utf-8"))
+    got = (saved["mesh"], saved["settings"]["use_file_materials"])
+    if got != (HELMET, True):
+        print(f"closed while the helmet was read (on screen {shown}): the session saved {got}, not ({HELMET!r}, True)")
+        return 1
+    print(f"ok: closed while the helmet was read (on screen {shown}); saved {got}")
+    return 0
+
+
 if __name__ == "__main__":
-    sys.exit({"restore": restore, "script": script}[sys.argv[1]]())
+    sys.exit({"restore": restore, "script": script, "close": close}[sys.argv[1]]())

@@ -54,3 +54,10 @@ def test_script_mesh_comes_through_the_worker_and_the_next_edit_sees_it(display,
     read between two frames on the main thread), the script waiting for it as for ``open=``."""
     result = _mesh_loads("script", display, tmp_path)
     assert result.returncode == 0 and "\nok: " in "\n" + result.stdout, result.stdout[-3000:] + result.stderr[-3000:]
+
+
+def test_a_close_before_the_restored_mesh_comes_keeps_its_own_materials_box(display, tmp_path):
+    """The window closed while the last session's helmet is still read: the session saved keeps
+    the helmet's ticked own-materials box (it saved the built-in placeholder's unticked one)."""
+    result = _mesh_loads("close", display, tmp_path)
+    assert result.returncode == 0 and "\nok: " in "\n" + result.stdout, result.stdout[-3000:] + result.stderr[-3000:]

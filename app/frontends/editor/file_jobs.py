@@ -60,6 +60,10 @@ class FileJobs:
         # Called once the latest open's mesh is in the state (a restored session's own-materials
         # box and camera, which the mesh it comes with must find); None when nothing waits.
         self.then = None
+        # The 'own materials' box the mesh being opened gets when it comes: ticked wherever the
+        # file has materials, or a restored session's. A session saved meanwhile keeps it (the
+        # placeholder's box on screen is not the artist's choice).
+        self.own_materials = True
 
     @property
     def busy(self) -> bool:
@@ -82,12 +86,13 @@ class FileJobs:
         with self._lock:
             return self._opening or (self.staged[0] if self.staged is not None else "")
 
-    def open_mesh(self, spec: str, read, then=None) -> None:
+    def open_mesh(self, spec: str, read, then=None, own_materials: bool = True) -> None:
         """Read ``spec`` with ``read(spec)`` on a thread; a later call supersedes this one (and a
         mesh of an earlier one still being uploaded). ``then()`` is called once the mesh is in
-        the state; not where another open superseded this one or the read failed."""
+        the state; not where another open superseded this one or the read failed.
+        ``own_materials``: the 'own materials' box ``then`` gives the mesh (``self.own_materials``)."""
         self.drop_open()
-        self.then = then
+        self.then, self.own_materials = then, own_materials
         with self._lock:
             self._open_id += 1
             job, self._opening = self._open_id, spec
@@ -96,7 +101,7 @@ class FileJobs:
     def drop_open(self) -> None:
         """Forget the open that runs (another mesh was chosen since): its result is dropped, and
         so is a mesh still being uploaded (its textures released)."""
-        self.then = None
+        self.then, self.own_materials = None, True
         with self._lock:
             self._open_id += 1
             self._opening = ""

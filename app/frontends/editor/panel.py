@@ -457,7 +457,7 @@ class Panel:
         assigned when a frame takes it; a second open while one runs wins."""
         self.open_mesh(s, self.mesh_path)
 
-    def open_mesh(self, s, spec: str, then=None) -> None:
+    def open_mesh(self, s, spec: str, then=None, own_materials: bool = True) -> None:
         """``spec`` read on the worker thread: the button, a dropped mesh file, --script open= and
         mesh=, and the last session's mesh at start-up (EditorState.open_mesh_async; ``then``:
         FileJobs.open_mesh). Besides the read, the thread does the CPU side of the
@@ -465,7 +465,7 @@ class Panel:
         test), which the frame that took the mesh used to do on the GL thread (1.2 s for
         DamagedHelmet, no frame drawn)."""
         s.error = ""
-        self.file_jobs.open_mesh(spec, read_for_upload, then)
+        self.file_jobs.open_mesh(spec, read_for_upload, then, own_materials)
 
     def take_file_jobs(self, s, renderer=None) -> None:
         """The worker thread's finished opens and exports, taken on the GL thread once a frame

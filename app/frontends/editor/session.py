@@ -48,7 +48,12 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
     compare_dict["a_texture_maps"] = absolute_maps(state.compare.a_texture_maps).to_dict()
     # A mesh still being read (opened just before the close, or the last session's at start-up)
     # is the one the artist chose: kept, not the one on screen meanwhile.
-    mesh = getattr(getattr(panel, "file_jobs", None), "opening", "") or state.mesh_spec
+    # So is the 'own materials' box it will have: the placeholder's on screen meanwhile (the
+    # built-in sphere's, never ticked) unticked the helmet's box in the next session.
+    jobs = getattr(panel, "file_jobs", None)
+    opening = getattr(jobs, "opening", "")
+    mesh = opening or state.mesh_spec
+    own_materials = jobs.own_materials if opening else state.use_file_materials
     data = {"mesh": mesh if mesh in BUILTIN_MESHES else absolute(mesh),
             "env": state.env_spec if state.env_spec == "studio" else absolute(state.env_spec),
             "material": state.material.to_dict(),
@@ -58,7 +63,7 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
             "texture_set_folder": absolute(state.texture_set_folder), "armed_slot": state.armed_slot,
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
-                         "use_file_materials": state.use_file_materials, "aa": state.aa,
+                         "use_file_materials": own_materials, "aa": state.aa,
                          "display": dataclasses.asdict(state.display),
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
             "compare": compare_dict}
@@ -107,7 +112,7 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
     # A mesh file is read on the panel's worker where the window made one (open_mesh_async): the
     # helmet's read and upload held the first frame for seconds. The own-materials box and the
     # camera then wait for it (``after_mesh``); a built-in is built here (7-41 ms).
-    mesh_spec, after_mesh = data.get("mesh"), []
+    mesh_spec, after_mesh, pending_own = data.get("mesh"), [], True
     deferred = isinstance(mesh_spec, str) and mesh_spec not in BUILTIN_MESHES and state.open_mesh_async is not None
     for loader, spec in ((state.load_mesh, None if deferred else mesh_spec), (state.load_env, data.get("env"))):
         if isinstance(spec, str):
@@ -138,6 +143,8 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
                     state.use_file_materials = own and any(part.material is not None for part in state.mesh.parts)
 
             after_mesh.append(own_materials)
+            if isinstance(own, bool):
+                pending_own = own
     if "compare" in data:   # the split view: on or off, the divider, what A is
         try:
             state.compare = compare.from_dict(data["compare"], str(path))
@@ -166,7 +173,7 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
         except (KeyError, TypeError, ValueError):
             pass
     if deferred:
-        state.open_mesh_async(mesh_spec, then=lambda: [f() for f in after_mesh])
+        state.open_mesh_async(mesh_spec, then=lambda: [f() for f in after_mesh], own_materials=pending_own)
     else:
         for f in after_mesh:
             f()

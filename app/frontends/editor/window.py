@@ -268,7 +268,8 @@ class EditorWindow:
 
         self.panel = Panel()
         # A dropped mesh file and --script open= are read on the panel's worker thread too.
-        state.open_mesh_async = lambda spec, then=None: self.panel.open_mesh(self.state, spec, then)
+        state.open_mesh_async = lambda spec, then=None, own_materials=True: self.panel.open_mesh(
+            self.state, spec, then, own_materials)
         if not self.hosted:   # a finished open or export ends the idle wait (file_jobs.py)
             self.panel.file_jobs.wake = self._answer_came
         from alight.frontends.editor.compare_view import CompareView
