@@ -216,3 +216,19 @@ def test_the_probe_view_refuses_what_it_would_ignore(tmp_path):
             r.set_shadows("auto", ground=False, occlusion="auto")
         assert not (tmp_path / "probe.png").exists()
         assert r.render().shape == (16, 16, 4)     # the defaults draw
+
+
+def test_a_ground_with_nothing_to_catch_says_so_in_the_setters_words(shared_data, capsys):
+    """set_shadows(ground=True) in the built-in studio with no light draws nothing: one warning
+    line in the API's words (it said --ground and --light, the command line's); with a
+    directional light, none."""
+    with Renderer(32, quality="low") as r:
+        r.set_mesh(str(shared_data / "models" / "Duck.glb")).set_shadows(ground=True)
+        r.render()
+        lines = [x for x in capsys.readouterr().err.splitlines() if "ground" in x]
+        assert lines == ["alight: warning: set_shadows(ground=True): nothing casts a shadow on it, so it changes "
+                         "nothing: no light, and no sun in the map that the IBL model shades exactly "
+                         "(add_light(...), or use a map with a sun)"], lines
+        r.add_light("directional:dir=-0.5,-1,-0.3")
+        r.render()
+        assert "ground" not in capsys.readouterr().err

@@ -33,6 +33,9 @@ def test_ground_and_shadows_through_the_panel_and_the_screenshot_equals_alight_r
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     checks = [line for line in CHECKS.read_text().splitlines() if line.startswith("def test_")]
     assert f"{len(checks)} passed, 0 failed" in result.stdout, result.stdout
+    # The idle ground is said in the status row in the panel's words; stderr had the command
+    # line's ("--ground: ... --shadows off") from the renderer.
+    assert "--ground" not in result.stderr and "--shadows" not in result.stderr, result.stderr[-3000:]
     for line in result.stdout.splitlines():
         if line.startswith("GROUND_"):
             print(line)

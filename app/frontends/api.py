@@ -345,6 +345,11 @@ class Renderer:
                                          "set_camera(orbit_deg=0, elevation_deg=30)"):
                 warn(line)   # as alight render says it (app/frontends/scene_setup.py)
         frame = self._frame(w, h, linear=linear, srgb=not linear)
+        idle = getattr(self._renderer, "last_ground_idle", "")
+        if idle:   # in the setters' words (the renderer leaves its words to each front end)
+            why = "set_shadows('off')" if idle == "shadows off" else \
+                "no light, and no sun in the map that the IBL model shades exactly (add_light(...), or use a map with a sun)"
+            warn(f"set_shadows(ground=True): nothing casts a shadow on it, so it changes nothing: {why}")
         return frame.linear if linear else frame.srgb
 
     def _check_probe(self) -> None:

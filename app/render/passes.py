@@ -204,10 +204,8 @@ def draw_scene(r, scene, maps: IBLMaps | None, targets: Targets, fbo: moderngl.F
     r.last_ground_idle = ""
     if scene.ground and scene.mesh is not None and not frame.shadowed and scene.view != "probe":
         # (a ground with no shadow to catch draws nothing: the picture equals the one without it)
+        # (the front end says it in its own words: the CLI's flags, the API's setters, the editor's controls)
         r.last_ground_idle = "shadows off" if scene.shadows == "off" else "no light"
-        why = "--shadows off" if scene.shadows == "off" else \
-            "no light, and no sun in the map that the IBL model shades exactly (add --light, or use a map with a sun)"
-        warn(f"--ground: nothing casts a shadow on it, so it changes nothing: {why}")
     fbo.use()
     ctx.viewport = (0, 0, width, height)
     if view.matrix is not None:     # a tile: the whole image's projection, off centre

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
-from alight.errors import AlightError
+from alight.errors import AlightError, warn
 from alight.frontends.cli.arguments import (
     TONEMAP_CHOICES,
     TONEMAP_HELP,
@@ -95,6 +95,10 @@ def run(args) -> int:
     maps = renderer.bake(env, quality) if env is not None else None
     baked = time.perf_counter()
     writing = _write(args, out, renderer, scene, maps, width, height)
+    if renderer.last_ground_idle:
+        why = "--shadows off" if renderer.last_ground_idle == "shadows off" else \
+            "no light, and no sun in the map that the IBL model shades exactly (add --light, or use a map with a sun)"
+        warn(f"--ground: nothing casts a shadow on it, so it changes nothing: {why}")
     if args.verbose:
         from alight.core.gpu import describe
 
