@@ -243,3 +243,18 @@ def test_cli_spec_typos_name_the_closest(folder, text, said):
     assert len(lines) == 1 and lines[0].startswith("alight: error: ") and "Traceback" not in r.stderr, lines
     assert str(spec) in lines[0] and said.replace("{folder}", str(folder.resolve())) in lines[0], lines[0]
     assert not (folder / "spec").exists()
+
+
+def test_the_guides_spec_plans_with_every_key_it_shows(shared_data, tmp_path):
+    """docs/guides/batch.md's spec (every key a spec takes) is a valid spec: it plans, the
+    paths it names resolve from the checkout (relative to the spec's folder, as the page says)."""
+    import re as _re
+
+    from alight.frontends.batch import plan
+
+    page = (REPO / "docs" / "guides" / "batch.md").read_text(encoding="utf-8")
+    text = _re.search(r"```toml\n(.*?)```", page, _re.S).group(1)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(text.replace("../shared/data", str(shared_data)), encoding="utf-8")
+    made = plan(spec, out=tmp_path / "out")
+    assert len(made.stills) == 2 * 2 * 3 * 2 and len(made.animations) == 2 * 2 * 3, (len(made.stills), len(made.animations))

@@ -77,6 +77,12 @@ def packed(c: dict) -> np.ndarray:
     return np.dstack([c["ao"][:, :, 0], c["rough"][:, :, 0], c["metal"][:, :, 0]])
 
 
+def metal_rough(c: dict) -> np.ndarray:
+    """glTF's metallicRoughness image: R unused (here the colour's R, which a grey roughness slot
+    would read), G roughness, B metal."""
+    return np.dstack([c["color"][:, :, 0], c["rough"][:, :, 0], c["metal"][:, :, 0]])
+
+
 def gloss(c: dict) -> np.ndarray:
     return 255 - c["rough"]
 
@@ -104,6 +110,12 @@ SETS = {
     "plain_albedo": {"albedo.png": "color", "normal.png": "normal", "roughness.png": "rough"},
     "plain_diffuse": {"Diffuse.png": "color", "Metallic.png": "metal"},
     "plain_basecolor": {"BASECOLOR.png": "color", "AO.png": "ao"},
+    # As glTF exports and the Khronos samples name them (DamagedHelmet's Default_metalRoughness.jpg
+    # went to the grey roughness slot, which reads R: a mirror).
+    "gltf_metal_rough": {"Default_albedo.png": "color", "Default_normal.png": "normal",
+                         "Default_metalRoughness.png": "mr", "Default_AO.png": "ao", "Default_emissive.png": "emissive"},
+    "gltf_metallic_roughness": {"Mat_baseColor.png": "color", "Mat_metallicRoughness.png": "mr"},
+    "khronos_orm": {"Helmet_BaseColor.png": "color", "Helmet_OcclusionRoughMetal.png": "orm"},
 }
 # The --map options that give the same maps one by one, in glTF's layout.
 SLOT_OF = {"color": "base_color", "normal": "normal", "normal_dx": "normal", "rough": "roughness",
@@ -112,7 +124,7 @@ LEFT_OUT = {"Mat_Height.png", "Mat_Opacity.png", "Rock023_2K_Displacement.png", 
 
 
 def write_set(folder: Path, files: dict[str, str], c: dict) -> None:
-    made = {**c, "normal_dx": dx(c["normal"]), "gloss": gloss(c), "orm": packed(c)}
+    made = {**c, "normal_dx": dx(c["normal"]), "gloss": gloss(c), "orm": packed(c), "mr": metal_rough(c)}
     for name, what in files.items():
         write(folder / name, made[what])
 
@@ -123,8 +135,9 @@ def one_by_one(folder: Path, files: dict[str, str], c: dict) -> list[str]:
     for name, what in files.items():
         if name in LEFT_OUT:
             continue
-        if what == "orm":
-            for part, slot in (("ao", "occlusion"), ("rough", "roughness"), ("metal", "metallic")):
+        if what in ("orm", "mr"):
+            parts = (("ao", "occlusion"),) if what == "orm" else ()
+            for part, slot in (*parts, ("rough", "roughness"), ("metal", "metallic")):
                 args += ["--map", f"{slot}={write(folder / 'twins' / f'{part}.png', c[part])}"]
             continue
         source = "normal" if what == "normal_dx" else "rough" if what == "gloss" else what
@@ -143,7 +156,9 @@ def one_by_one(folder: Path, files: dict[str, str], c: dict) -> list[str]:
     ("Rock_Metalness.png", "metallic"), ("rock_metal_2k.png", "metallic"), ("Mat_AO.png", "occlusion"),
     ("Rock_AmbientOcclusion.png", "occlusion"), ("T_Rock_ORM.png", "orm"), ("rock_arm_1k.png", "orm"),
     ("Mat_Emissive.png", "emissive"), ("Mat_Height.png", "height"), ("Rock_Displacement.png", "height"),
-    ("Mat_Opacity.png", "opacity"),
+    ("Mat_Opacity.png", "opacity"), ("Default_metalRoughness.jpg", "metallic_roughness"),
+    ("Mat_metallicRoughness.png", "metallic_roughness"), ("Helmet_OcclusionRoughMetal.png", "orm"),
+    ("Mat_Occlusion_Roughness_Metallic.png", "orm"), ("T_Rock_RoughnessMetallic.png", "metallic_roughness"),
 ])
 def test_names_of_each_tool(name, role):
     assert role_of(name)[0] == role

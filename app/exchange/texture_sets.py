@@ -9,13 +9,16 @@ resolution (``_2K``, ``_4k``, ``_2048``) is dropped. The suffixes each tool writ
     ambientCG      _Color _NormalGL _NormalDX _Roughness _Metalness _AmbientOcclusion _Displacement
     Poly Haven     _diff _nor_gl _nor_dx _rough _metal _ao _arm
     Quixel/Unreal  _Albedo _Normal _Roughness _Gloss _ORM
+    glTF exports   _baseColor _metallicRoughness _metalRoughness _occlusionRoughnessMetallic (Khronos samples)
     plain          albedo diffuse basecolor (the whole name or its end)
 
 Conversions: a DirectX normal map (green down: ``_NormalDX``, ``_nor_dx``) has its green flipped
 to glTF's OpenGL convention; a gloss map becomes roughness = 1 - gloss; a packed ORM/ARM map
 (R occlusion, G roughness, B metal) fills the occlusion slot (glTF reads R) and the
 metallic-roughness slot (glTF reads G = roughness, B = metal), the layout glTF itself packs, so it
-is split by the channels each slot reads; separate greyscale roughness and metal maps fill their
+is split by the channels each slot reads; a glTF metallic-roughness map (``_metalRoughness``, G
+roughness, B metal) fills that slot (it went to the grey roughness slot by its name's end,
+which reads R: DamagedHelmet's drew as a mirror); separate greyscale roughness and metal maps fill their
 own slots and are packed into glTF's one metallic-roughness image when written
 (``alight.exchange.gltf_export``). Heights, displacement and opacity are left out with a note:
 alight draws no displacement and its maps are opaque.
@@ -43,11 +46,15 @@ for _role, _names in {
     "normal": ("normal", "normalgl", "norgl", "normalopengl", "nor", "nrm"),
     "normal_dx": ("normaldx", "nordx", "normaldirectx"),
     "roughness": ("roughness", "rough"),
+    # glTF's packed layout (G roughness, B metal): matched before 'roughness' by being longer.
+    "metallic_roughness": ("metallicroughness", "metalroughness", "metalrough", "roughmetal", "roughnessmetallic",
+                           "roughnessmetalness", "metalnessroughness", "roughnessmetal"),
     "gloss": ("gloss", "glossiness"),
     "metallic": ("metallic", "metalness", "metal"),
     "occlusion": ("ao", "ambientocclusion", "occlusion"),
     "emissive": ("emissive", "emission", "emit"),
-    "orm": ("orm", "arm"),
+    "orm": ("orm", "arm", "occlusionroughnessmetallic", "occlusionroughnessmetalness", "occlusionroughmetal",
+            "aoroughnessmetallic", "aoroughmetal"),
     "height": ("height", "displacement", "disp", "bump"),
     "opacity": ("opacity", "alpha", "mask"),
 }.items():
@@ -58,6 +65,7 @@ for _role, _names in {
 ROLE_LABELS = {"base_color": "base colour", "normal": "normal", "normal_dx": "normal (DirectX: green flipped)",
                "roughness": "roughness", "gloss": "roughness (gloss inverted)", "metallic": "metallic",
                "occlusion": "occlusion", "emissive": "emissive",
+               "metallic_roughness": "metal-rough (G rough, B metal)",
                "orm": "occlusion (R) + metal-rough (G rough, B metal)"}
 LEFT_OUT = {"height": "heights and displacement are not drawn: alight has no displacement",
             "opacity": "opacity is not drawn: alight's maps are opaque"}
@@ -186,11 +194,19 @@ def assign_files(paths, base: TextureMaps | None = None) -> TextureSet:
     elif gloss:
         put(*gloss, ("roughness",), "gloss: inverted to roughness")
         maps = dataclasses.replace(maps, roughness_gloss=True)
+    packed = take("metallic_roughness")
+    if packed:
+        if (rough or gloss) and by_role.get("metallic"):   # separate greyscale maps win, as over an ORM's
+            files[packed[0]] = Assigned(packed[0], (), packed[1], "separate roughness and metal maps fill its slots")
+        else:
+            put(*packed, ("metallic_roughness",), "packed: G roughness, B metal")
     orm = take("orm")
     if orm:
-        have = {s for s in ("occlusion", "roughness", "metallic") if any(a.slots == (s,) for a in files.values())}
+        have = {s for s in ("occlusion", "roughness", "metallic", "metallic_roughness")
+                if any(a.slots == (s,) for a in files.values())}
         slots = tuple(s for s, needed in (("occlusion", "occlusion" not in have),
-                                          ("metallic_roughness", not {"roughness", "metallic"} <= have)) if needed)
+                                          ("metallic_roughness", not ({"roughness", "metallic"} <= have
+                                                                      or "metallic_roughness" in have))) if needed)
         if slots:
             put(*orm, slots, "packed: R occlusion, G roughness, B metal")
         else:

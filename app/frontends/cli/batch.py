@@ -8,7 +8,7 @@ from alight.frontends.cli.arguments import Command
 
 def add_parser(sub) -> None:
     bt = sub.add_parser("batch", help="render meshes x environments x materials x angles from a spec",
-                        description="Render every combination in a .toml/.json spec (see app/frontends/batch.py), a "
+                        description="Render every combination in a .toml/.json spec (docs/guides/batch.md), a "
                                     "labelled contact sheet and optional turntables. Up-to-date outputs are "
                                     "skipped; failed items are reported and the rest go on (exit 1).")
     bt.add_argument("spec", metavar="SPEC.toml|SPEC.json")
