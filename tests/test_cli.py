@@ -367,6 +367,9 @@ def _make_inputs(inp: Path, shared: Path) -> None:
     (inp / "notjson.json").write_text("{ this is not json\n")
     (inp / "short_vertex.obj").write_text("v 1 2\nf 1 2 3\n")            # a vertex of two coordinates
     (inp / "word_normal.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 zero 1\nf 1//1 2//1 3//1\n")
+    (inp / "face_past_end.obj").write_text("v 0 0 0\nv 1 0 0\nf 1 2 9\n")   # trimesh: numpy's 0-based IndexError
+    # A mesh no node places (no scene, no nodes): it said "no triangles in the file".
+    (inp / "unplaced.gltf").write_text('{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 5}}]}]}')
 
 
 # (args, things the one error line must name). {in}: the inputs folder, {data}: shared data,
@@ -413,6 +416,10 @@ BAD_INPUT = [
                  id="obj-short-vertex"),
     pytest.param(["--mesh", "{in}/word_normal.obj"], ["{in}/word_normal.obj: line 4: 'zero' is not a number"],
                  id="obj-word-in-normal"),
+    pytest.param(["--mesh", "{in}/face_past_end.obj"],
+                 ["{in}/face_past_end.obj: line 3: the face names vertex 9, but the file has 2 vertices"],
+                 id="obj-face-past-the-end"),
+    pytest.param(["--mesh", "{in}/unplaced.gltf"], ["{in}/unplaced.gltf: no node places a mesh"], id="gltf-no-node"),
 ]
 
 

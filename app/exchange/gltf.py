@@ -716,6 +716,11 @@ class _Reader:
             self.warn("animations", f"animations: {n} animation{'s' if n != 1 else ''} not played; "
                                     f"the rest pose the nodes give is drawn")
         if not parts:
+            if doc.meshes and not placed:   # (the meshes' accessors were never read: say what is missing)
+                n = len(doc.meshes)
+                where = f" of scenes[{scene_index}]" if scenes else ""
+                raise AlightError(f"{self.source}: no node places a mesh: {n} mesh{'es' if n != 1 else ''} but no "
+                                  f"node{where} names one (glTF draws what a scene's nodes place)")
             raise AlightError(f"{self.source}: no triangles in the file")
         for light in lights:
             if light.kind != "directional":

@@ -299,6 +299,34 @@ def _obj_syntax_problem(path: Path) -> str | None:
                 return f"line {number}: '{token.decode('utf-8', 'replace')}' is not a number ({need})"
         if len(values) not in counts:
             return f"line {number}: {need}; got {len(values)}"
+    return _obj_index_problem(data)
+
+
+def _obj_index_problem(data: bytes) -> str | None:
+    """The first f line of an OBJ naming a vertex, texture coordinate or normal the file does not
+    have, as 'line N: ...' (trimesh's IndexError named numpy's 0-based index and no line)."""
+    lines = data.split(b"\n")
+    totals = {b"v": 0, b"vt": 0, b"vn": 0}
+    for line in lines:
+        head = line.split(None, 1)[:1]
+        if head and head[0] in totals:
+            totals[head[0]] += 1
+    kinds = ((b"v", "vertex", "vertices"), (b"vt", "texture coordinate", "texture coordinates"),
+             (b"vn", "normal", "normals"))
+    for number, line in enumerate(lines, 1):
+        tokens = line.split(b"#", 1)[0].split()
+        if not tokens or tokens[0] != b"f":
+            continue
+        for corner in tokens[1:]:
+            for token, (key, one, many) in zip(corner.split(b"/"), kinds):
+                try:
+                    index = int(token)
+                except ValueError:
+                    continue   # empty (v//vn) or not a number: another check's to say
+                count = totals[key]
+                if index == 0 or abs(index) > count:
+                    return (f"line {number}: the face names {one} {index}, but the file has {count} {many} "
+                            f"(OBJ counts from 1; negative counts back from the last)")
     return None
 
 
