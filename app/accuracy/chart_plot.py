@@ -72,10 +72,11 @@ def _error_panel(ax, rows, time_key: str, front_key: str, xlabel: str) -> None:
         for k, r in enumerate(front):
             ax.annotate(r["setting"], (r[time_key], r["rel_mae_mean"] * 100), xytext=offsets[k % len(offsets)],
                         textcoords="offset points", fontsize=7, ha="left" if k % 4 < 2 else "right")
-    for r in pts:   # the models (and the baseline, which is the default model) are always named
-        if r["factor"] in ("IBL model", "baseline") and not r[front_key]:
-            ax.annotate(r["setting"].replace("model ", ""), (r[time_key], r["rel_mae_mean"] * 100), xytext=(6, -3),
-                        textcoords="offset points", fontsize=7, color="tab:pink" if r["factor"] == "IBL model" else "black")
+    for r in pts:   # the models (and the baseline, which is the default model) and the layers are always named
+        if r["factor"] in ("IBL model", "baseline", "layer") and not r[front_key]:
+            colour = {"IBL model": "tab:pink", "layer": "tab:olive"}.get(r["factor"], "black")
+            ax.annotate(r["setting"].replace("model ", "").replace("layer ", ""), (r[time_key], r["rel_mae_mean"] * 100),
+                        xytext=(6, -3), textcoords="offset points", fontsize=7, color=colour)
     ax.set_xscale("log")
     ax.set_yscale("log")
     if pts:
@@ -141,7 +142,10 @@ def plot_chart(rows: list[dict], furnace: list[dict], path: Path, title: str, fr
     ax = axes[2]
     cmap = __import__("matplotlib").colormaps["tab10"]
     factor = {r["setting"]: r["factor"] for r in rows}
-    models = []
+    # Models whose furnace curves agree (they share the LUT: a white furnace cannot tell the
+    # split sum's models apart) are one line naming them all: twelve lines drawn over each other
+    # left two visible and a legend of twelve.
+    curves: dict[tuple, list[str]] = {}
     for name in dict.fromkeys(f["setting"] for f in furnace):
         fs = [f for f in furnace if f["setting"] == name]
         if name == "ground truth":
@@ -150,14 +154,19 @@ def plot_chart(rows: list[dict], furnace: list[dict], path: Path, title: str, fr
             continue
         if factor.get(name) not in ("baseline", "IBL model", "multiple scattering"):
             continue
-        model, ms = fs[0]["ibl_model"], bool(fs[0]["multiple_scattering"])
-        if model not in models:
-            models.append(model)
-        colour = cmap(models.index(model) % 10)
-        rs = [f["roughness"] for f in fs]
-        ax.plot(rs, [f["mean"] for f in fs], "--s" if ms else "-o", color=colour, ms=4,
-                label=f"{model}, MS {'on' if ms else 'off'}")
-        ax.fill_between(rs, [f["min"] for f in fs], [f["max"] for f in fs], color=colour, alpha=0.12)
+        key = (bool(fs[0]["multiple_scattering"]),
+               tuple((round(f["roughness"], 4), round(f["mean"], 4), round(f["min"], 4), round(f["max"], 4)) for f in fs))
+        curves.setdefault(key, [])
+        if fs[0]["ibl_model"] not in curves[key]:
+            curves[key].append(fs[0]["ibl_model"])
+    every = {m for names in curves.values() for m in names}
+    for k, ((ms, points), names) in enumerate(curves.items()):
+        colour = cmap(k % 10)
+        rs = [p[0] for p in points]
+        who = f"every IBL model ({len(names)})" if len(every) > 1 and set(names) == every else ", ".join(names)
+        ax.plot(rs, [p[1] for p in points], "--s" if ms else "-o", color=colour, ms=4,
+                label=f"{who}, MS {'on' if ms else 'off'}")
+        ax.fill_between(rs, [p[2] for p in points], [p[3] for p in points], color=colour, alpha=0.12)
     ax.axhline(1.0, color="black", lw=0.8, ls="-", alpha=0.4)
     ax.set_xlabel("roughness")
     ax.set_ylabel("probe radiance, mean over the ball (band: min..max)")
