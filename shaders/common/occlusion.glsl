@@ -226,6 +226,17 @@ vec3 screen_occluded_direction(vec3 n) {
     return dot(o, o) > 1e-12 ? normalize(o) : -n;
 }
 
+// The sky's light the pixel sees (E/pi, without the suns): E(n)/pi less the hidden part's, taken
+// as the radiance of a cone of cosine-weighted share 1 - V about the mean occluded direction
+// (visible_cone_radiance; Jimenez et al. 2016's cone model of the occluded solid angle). The
+// visible part taken as a cone about the bent normal instead gave a floor under an overhang, which
+// sees a band of the horizon, the bright sky overhead (the shader ball's base under its bowl at 2.9
+// times the path tracer's under royal_esplanade: benchmarks/results/gtao.md).
+vec3 screen_visible_irradiance(vec3 n, float visibility) {
+    vec3 hidden = visible_cone_radiance(screen_occluded_direction(n), 1.0 - visibility);
+    return max(irradiance_at(n, false) - (1.0 - visibility) * hidden, vec3(0.0));
+}
+
 // The bent normal (the mean unoccluded direction): the whole hemisphere's cosine-weighted sum
 // of directions is 2/3 n in GTAO's measure, so the visible ones sum to 2/3 n minus the occluded
 // sum (app/core/gtao.py bent_normal). n where open or where the sum leaves n's hemisphere.
@@ -323,12 +334,15 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     g_occluder_radiance = occluder;
 #elif defined(HAS_SCREEN_AO)
     // GTAO's V and mean occluded direction d. GTAO_OCCLUDERS, the bake's terms: the visible share
-    // sees the visible cone's radiance about the bent normal (visible_cone_radiance: a bowl's floor
-    // sees the bright sky overhead, not the map's dark ground), the occluded share the
-    // occluders' radiance as the bake's bounce does, their surfaces taken to face back along d
-    // (E(-d)/pi with the suns, lit with this surface's albedo through the bake's series, occluders_reflectance,
-    // their visibility taken as V): the corner's walls see the sunlit floor, not the map's dark
-    // ground. Else V scales E(n)/pi, with the paper's multi-bounce fit where GTAO_MULTI_BOUNCE.
+    // sees the sky less its hidden part about d (screen_visible_irradiance), the occluded share the
+    // occluders' radiance as the bake's bounce does, lit as this point is (the sky it sees per
+    // unit V: Jimenez et al. 2016's multi-bounce assumption, that the occluders see as the point
+    // does), with this surface's albedo through the bake's series (occluders_reflectance, their
+    // visibility taken as V). Lit by E(-d)/pi instead (surfaces facing back along d, open to the
+    // sky), the occluders in a groove or under the ball's bowl, which see little of it, shone:
+    // rings brighter than --occlusion off on the groove's lip and the neck (up to 1.56 times off
+    // on the neck at 384 px under royal_esplanade). Else V scales E(n)/pi, with the paper's
+    // multi-bounce fit where GTAO_MULTI_BOUNCE.
     // The specular lobe keeps its share inside the visibility cone about the bent normal (n
     // without GTAO_OCCLUDERS; specular_occlusion, the bake's cone-cone term), the rest sees the
     // occluders (black without GTAO_OCCLUDERS).
@@ -336,11 +350,11 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     vec3 occluder = vec3(0.0);
     vec3 bent = n;
 #if defined(GTAO_OCCLUDERS)
-    // (E with the compact sources, unshadowed: the occluders' own shadows are not known here)
-    occluder = occluders_reflectance(occluder_albedo(s, specular_albedo), visibility)
-               * irradiance_at(-screen_occluded_direction(n), true);
+    // (the suns' light on the occluders is left out: their shadows are not known here)
+    vec3 seen = screen_visible_irradiance(n, visibility);
+    occluder = occluders_reflectance(occluder_albedo(s, specular_albedo), visibility) * seen / max(visibility, 1e-3);
     bent = screen_bent_normal(n);
-    irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
+    irradiance = seen + (1.0 - visibility) * occluder;
 #elif defined(GTAO_MULTI_BOUNCE)
     irradiance = gtao_multi_bounce(visibility, s.base_color * (1.0 - s.metallic)) * irradiance_at(n, false);
 #else
