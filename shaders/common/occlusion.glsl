@@ -226,12 +226,10 @@ vec3 screen_occluded_direction(vec3 n) {
     return dot(o, o) > 1e-12 ? normalize(o) : -n;
 }
 
-// The sky's light the pixel sees (E/pi, without the suns): E(n)/pi less the hidden part's, taken
-// as the radiance of a cone of cosine-weighted share 1 - V about the mean occluded direction
-// (visible_cone_radiance; Jimenez et al. 2016's cone model of the occluded solid angle). The
-// visible part taken as a cone about the bent normal instead gave a floor under an overhang, which
-// sees a band of the horizon, the bright sky overhead (the shader ball's base under its bowl at 2.9
-// times the path tracer's under royal_esplanade: benchmarks/results/gtao.md).
+// The sky's light the pixel sees (E/pi, without the suns), as what the occluders around it
+// receive per unit V (occlude_environment): E(n)/pi less the hidden part's, taken as the radiance
+// of a cone of cosine-weighted share 1 - V about the mean occluded direction
+// (visible_cone_radiance; Jimenez et al. 2016's cone model of the occluded solid angle).
 vec3 screen_visible_irradiance(vec3 n, float visibility) {
     vec3 hidden = visible_cone_radiance(screen_occluded_direction(n), 1.0 - visibility);
     return max(irradiance_at(n, false) - (1.0 - visibility) * hidden, vec3(0.0));
@@ -334,15 +332,17 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     g_occluder_radiance = occluder;
 #elif defined(HAS_SCREEN_AO)
     // GTAO's V and mean occluded direction d. GTAO_OCCLUDERS, the bake's terms: the visible share
-    // sees the sky less its hidden part about d (screen_visible_irradiance), the occluded share the
-    // occluders' radiance as the bake's bounce does, lit as this point is (the sky it sees per
-    // unit V: Jimenez et al. 2016's multi-bounce assumption, that the occluders see as the point
-    // does), with this surface's albedo through the bake's series (occluders_reflectance, their
-    // visibility taken as V). Lit by E(-d)/pi instead (surfaces facing back along d, open to the
-    // sky), the occluders in a groove or under the ball's bowl, which see little of it, shone:
-    // rings brighter than --occlusion off on the groove's lip and the neck (up to 1.56 times off
-    // on the neck at 384 px under royal_esplanade). Else V scales E(n)/pi, with the paper's
-    // multi-bounce fit where GTAO_MULTI_BOUNCE.
+    // sees the visible cone's radiance about the bent normal (visible_cone_radiance: a bowl's floor
+    // sees the bright sky overhead, not the map's dark ground), the occluded share the occluders'
+    // radiance as the bake's bounce does, the occluders lit by the sky as this point is (the sky
+    // it sees per unit V, screen_visible_irradiance: Jimenez et al. 2016's multi-bounce
+    // assumption, that the occluders see as the point does) and by the suns as surfaces facing
+    // back along d, with this surface's albedo through the bake's series
+    // (occluders_reflectance, their visibility taken as V). Lit by E(-d)/pi instead (surfaces
+    // facing back along d, open to the sky), the occluders under the shader ball's bowl and in its
+    // groove, which see little of it, shone: rings brighter than --occlusion off on the neck
+    // (up to 1.56x at 384 px under royal_esplanade) and the groove's lip. Else V scales E(n)/pi,
+    // with the paper's multi-bounce fit where GTAO_MULTI_BOUNCE.
     // The specular lobe keeps its share inside the visibility cone about the bent normal (n
     // without GTAO_OCCLUDERS; specular_occlusion, the bake's cone-cone term), the rest sees the
     // occluders (black without GTAO_OCCLUDERS).
@@ -350,11 +350,13 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     vec3 occluder = vec3(0.0);
     vec3 bent = n;
 #if defined(GTAO_OCCLUDERS)
-    // (the suns' light on the occluders is left out: their shadows are not known here)
-    vec3 seen = screen_visible_irradiance(n, visibility);
-    occluder = occluders_reflectance(occluder_albedo(s, specular_albedo), visibility) * seen / max(visibility, 1e-3);
+    // (plus the suns on surfaces facing back along d, unshadowed: the occluders' own shadows are
+    // not known here; the corner's sunlit floor lights its walls)
+    occluder = occluders_reflectance(occluder_albedo(s, specular_albedo), visibility)
+               * (screen_visible_irradiance(n, visibility) / max(visibility, 1e-3)
+                  + suns_irradiance_over_pi(-screen_occluded_direction(n)));
     bent = screen_bent_normal(n);
-    irradiance = seen + (1.0 - visibility) * occluder;
+    irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
 #elif defined(GTAO_MULTI_BOUNCE)
     irradiance = gtao_multi_bounce(visibility, s.base_color * (1.0 - s.metallic)) * irradiance_at(n, false);
 #else
