@@ -23,7 +23,9 @@ SLICES = 2          # GTAO_SLICES: slice directions per pixel (x 16 rotations ov
 STEPS = 8           # GTAO_STEPS: depth samples per side of a slice
 RADIUS_FRACTION = 1.0    # the search radius in world units, as a share of the mesh's bounding-box diagonal (the bake reaches the whole mesh; 0.25: corner 15.9%, bowl 22.4% under royal_esplanade, 1.0: 13.8, 17.0%)
 MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS_HEIGHT of the draw height where more
-MAX_RADIUS_HEIGHT = 0.2  # (the editor's 720 rows: 144 px; the samples stay GTAO_STEPS, spread wider)
+MAX_RADIUS_HEIGHT = 0.5  # (the editor's 720 rows: 360 px; the samples stay GTAO_STEPS, spaced quadratically:
+                         # render/gtao.frag sample_offset_px. 0.2 missed the shader ball's bowl over its base at
+                         # 384 px: V 0.6-0.8 there, 2.6x the path tracer's light; benchmarks/results/gtao.md)
 # More rotations than the 4x4 pattern's 16, over passes (the paper's temporal accumulation, its
 # section 6: 6 rotations x 16 spatial offsets): each pass turns the pattern by a further fraction of
 # its step and the estimate is the passes' mean. `alight render` takes STILL_FRAMES passes in one

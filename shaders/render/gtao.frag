@@ -60,13 +60,22 @@ vec2 pattern_noise(ivec2 p) {
     return vec2(BAYER[i] / 16.0, fract(float(i) * 0.618034));
 }
 
-// The largest horizon cosine to v along one side of the slice; occluders fade out between 0.75
-// and 1 times `radius` (world units), so that the search's end does not draw a line.
-float horizon_cos(vec2 origin, vec2 step_px, vec3 centre, vec3 v, float jitter, float radius) {
+// The offset in pixels of sample j (of GTAO_STEPS, jittered) along a slice: quadratic in j, so
+// that the samples crowd near the pixel, where a groove's or a contact's occluder is, and still
+// reach the far ones (XeGTAO's sample distribution, power 2, of Jimenez et al. 2016's method).
+float sample_offset_px(int j, float jitter, float radius_px) {
+    float s = (float(j) + jitter + 1.0) / float(GTAO_STEPS);
+    return max(radius_px * s * s, 1.0);
+}
+
+// The largest horizon cosine to v along one side of the slice (screen direction omega); the
+// occluders fade out between 0.75 and 1 times `radius` (world units), so that the search's end
+// does not draw a line.
+float horizon_cos(vec2 origin, vec2 omega, float radius_px, vec3 centre, vec3 v, float jitter, float radius) {
     float best = -1.0;
     vec2 size = vec2(textureSize(u_positions, 0));
     for (int j = 0; j < GTAO_STEPS; ++j) {
-        vec2 q = origin + step_px * (float(j) + jitter + 1.0);
+        vec2 q = origin + omega * sample_offset_px(j, jitter, radius_px);
         if (any(lessThan(q, vec2(0.0))) || any(greaterThanEqual(q, size))) break;
         // Bilinear between the 4 texels about q: on a plane the point at q itself, so it lies in
         // the slice (the nearest texel's centre, up to half a pixel off it, rose above an open
@@ -118,9 +127,8 @@ void main() {
         float length_n = length(projected);
         float cos_n = clamp(dot(projected, v) / max(length_n, 1e-6), -1.0, 1.0);
         float gamma = sign(dot(projected, direction)) * acos(cos_n);
-        vec2 step_px = omega * max(radius_px / float(GTAO_STEPS), 1.0);
-        float c2 = horizon_cos(origin, step_px, centre, v, noise.y, radius);
-        float c1 = horizon_cos(origin, -step_px, centre, v, noise.y, radius);
+        float c2 = horizon_cos(origin, omega, radius_px, centre, v, noise.y, radius);
+        float c1 = horizon_cos(origin, -omega, radius_px, centre, v, noise.y, radius);
         visibility += gtao_slice_visibility(c1, c2, gamma, length_n);
         vec2 o = gtao_slice_occluded_direction(c1, c2, gamma, length_n);
         occluded += direction * o.x + v * o.y;
