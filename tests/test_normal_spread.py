@@ -163,3 +163,36 @@ def test_fine_checker_of_tilts_shades_as_the_footprint_average(lit, tmp_path, ti
     err = lambda got: float(np.abs(got - want).sum() / want.sum())   # noqa: E731
     assert err(sharp) > 1.5 * FOOTPRINT_REL          # the shading before: far off
     assert err(widened) < FOOTPRINT_REL, (err(widened), err(sharp))
+
+
+def test_the_define_and_the_upload_only_where_a_part_has_a_normal_map(tmp_path):
+    from alight.render.gpu_mesh import texture_key
+    from alight.render.mesh_upload import prepare_upload
+    from alight.render.variants import part_defines
+
+    r = renderer()
+    image = _map(_texel(10.0), _texel(-10.0))
+    for path, has_map in ((_plane(tmp_path / "m.glb", 0.2, image, scale=0.5), True),
+                          (_plane(tmp_path / "b.glb", 0.2, None), False)):
+        mesh = load_mesh(str(path))
+        for toksvig in (True, False):
+            normal_spread.NORMAL_MAP_TOKSVIG = toksvig
+            try:
+                r.meshes.release_meshes()
+                gpu = r.meshes.parts(mesh)[0]
+                defines = part_defines(Scene(mesh=mesh), gpu, mesh.parts[0], set())
+            finally:
+                normal_spread.NORMAL_MAP_TOKSVIG = True
+            assert ("NORMAL_MAP_TOKSVIG" in defines) == (has_map and toksvig)
+            if has_map and toksvig:
+                # the levels as normal_map_levels makes them at the material's scale, in the
+                # frame's upload (level 0 read back: moderngl reads no level it did not make) and
+                # in the editor's (mesh_upload.prepare_upload), under the same key
+                want = normal_map_levels(image, 0.5)
+                got = np.frombuffer(gpu.textures["normal"].read(), np.uint8).reshape(want[0].shape)
+                assert np.array_equal(got, want[0])
+                assert want[1][..., 3].min() > 0
+                (key, _, _, levels), = prepare_upload(mesh).textures
+                assert key == texture_key(mesh.parts[0].material.textures()["normal"], False, 0.5)
+                assert all(np.array_equal(a, b) for a, b in zip(levels, want))
+    r.meshes.release_meshes()

@@ -14,8 +14,8 @@ of the level-0 normals *renormalised* (after glTF's normalTexture.scale, which s
 before normalising) over the texel's footprint: exactly 1 at level 0 and wherever the normals
 under a texel agree. The result goes in the level's A channel, which glTF's normal texture does
 not use, as the widening's own perceptual roughness, A = (sigma^2)^(1/4) (its alpha is A^2):
-8 bits of a roughness keep the small spreads of near-mirrors (the smallest step is alpha^2 = 2e-10;
-8 bits of sigma^2 itself would start at roughness 0.25). RGB are the levels as GL's
+8 bits of a roughness keep the small spreads of near-mirrors (the least kept, A = 8/255, is
+sigma^2 = 1e-6; 8 bits of sigma^2 itself would start at roughness 0.25). RGB are the levels as GL's
 generate_mipmap makes them (alight.render.mip_levels, bit for bit), so the filtered
 normal is the one the renderer read before. Trilinear and anisotropic filtering then blend A
 between texels and levels like any channel (an estimate: the spread *between* the blended
