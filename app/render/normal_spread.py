@@ -93,11 +93,23 @@ def normal_map_levels(image: np.ndarray, scale: float, mipmaps: bool = True) -> 
     if levels is None:
         return None
     levels[0][..., 3] = 0
-    mean = unit_normals(levels[0], scale)
-    for level in levels[1:]:
-        mean = _halve_mean(mean)
+    if len(levels) == 1:
+        return levels
+    # level 1's means from level 0 in bands of rows: float32 vectors of one band at a time
+    # (BAND_ROWS x 2048 x 12 bytes, not 48 MiB for a 2048^2 map)
+    level0 = levels[0]
+    if level0.shape[0] == 1:
+        level0 = np.concatenate([level0, level0], axis=0)
+    mean = np.concatenate([_halve_mean(unit_normals(level0[y:y + BAND_ROWS], scale))
+                           for y in range(0, len(level0), BAND_ROWS)])
+    for n, level in enumerate(levels[1:]):
+        if n:
+            mean = _halve_mean(mean)
         level[..., 3] = spread_to_alpha_channel(np.sqrt(np.einsum("ijk,ijk->ij", mean, mean)))
     return levels
+
+
+BAND_ROWS = 128   # even
 
 
 def without_spread(image: np.ndarray) -> np.ndarray:

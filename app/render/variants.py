@@ -26,8 +26,8 @@ from alight.core.shader_names import (
     map_mask,
 )
 from alight.ibl.bake import IBLMaps, grid_roughness
-from alight.render.bindings import MAX_LIGHTS
 from alight.render import normal_spread
+from alight.render.bindings import MAX_LIGHTS
 from alight.render.normal_spread import SPREAD_MAPS
 
 
