@@ -5,7 +5,7 @@ drawn with this checkout's shaders and with other shaders/ folders side by side;
 
     git archive HEAD shaders | tar -x -C /tmp/base          # the other side's shaders/
     .venv/bin/python benchmarks/bench_helmet_frame.py --other base=/tmp/base/shaders [--rounds 5]
-        [--size 1024] [--split]
+        [--size 1024] [--split] [--features] [--upload]
 
 Each side is an ``alight.Renderer`` with the defaults (shadows and occlusion ``auto``, mesh
 shading ``auto``); an ``--other`` side's ForwardRenderer reads its folder (``use_shaders``), the
@@ -19,6 +19,8 @@ between the sides' frames at the same camera (0: the same picture).
 ``--split`` first prints where this side's frame goes: the scene pass, the resolve and the read
 back, each between ``ctx.finish()`` calls (finishing changes the overlap, so the parts are close
 to, not exactly, the whole), and the CPU time per thread (Python's and llvmpipe's).
+``--upload`` prints what uploading DamagedHelmet's normal map costs with its spread in A
+(NORMAL_MAP_TOKSVIG: its levels made on the CPU) against GL's own mips, alternated.
 ``--features`` then prints what the sun's shadows and the occlusion bake cost this side's frame:
 the frame with ``set_shadows("off")``, ``set_occlusion("off")`` and both, alternated with the
 defaults in the same way (other pictures: a measure of their cost, not a speed-up).
@@ -101,6 +103,35 @@ def split(renderer, frames: int = 6) -> None:
           f"shadow maps: {r.shadow_maps.last_active}; anisotropy: {r.last_anisotropy}")
 
 
+def upload(renderer, rounds: int) -> None:
+    """Print what uploading DamagedHelmet's normal map costs with its spread in A
+    (gpu_mesh.upload_normal_map: levels made on the CPU) and as before (upload_image: GL's
+    generate_mipmap), alternated; wall and CPU time, the texture finished (ctx.finish)."""
+    from alight.exchange.meshes import load_mesh
+    from alight.render.gpu_mesh import upload_image, upload_normal_map
+
+    ctx = renderer._renderer.ctx
+    info = next(part.material.textures()["normal"] for part in load_mesh(str(HELMET)).parts)
+    ways = {"with spread": lambda: upload_normal_map(ctx, info.image, 1.0),
+            "GL mips": lambda: upload_image(ctx, info.image, False)}
+    wall: dict[str, list[float]] = {name: [] for name in ways}
+    cpu: dict[str, list[float]] = {name: [] for name in ways}
+    for k in range(rounds):
+        for name in (list(ways) if k % 2 == 0 else list(ways)[::-1]):
+            w, c = time.perf_counter(), time.process_time()
+            tex = ways[name]()
+            ctx.finish()
+            wall[name].append(time.perf_counter() - w)
+            cpu[name].append(time.process_time() - c)
+            tex.release()
+    h, w = info.image.shape[:2]
+    print(f"DamagedHelmet's normal map ({w}x{h}) uploaded, {rounds} rounds alternated; ms, median [min-max]:")
+    for name in ways:
+        print(f"  {name:12s} wall {statistics.median(wall[name]) * 1e3:5.0f} [{min(wall[name]) * 1e3:.0f}-"
+              f"{max(wall[name]) * 1e3:.0f}]  CPU {statistics.median(cpu[name]) * 1e3:5.0f} "
+              f"[{min(cpu[name]) * 1e3:.0f}-{max(cpu[name]) * 1e3:.0f}]")
+
+
 FEATURES = {"defaults": ("auto", "auto"), "shadows off": ("off", "auto"), "occlusion off": ("auto", "off"),
             "both off": ("off", "off")}   # name: (set_shadows, set_occlusion)
 
@@ -139,6 +170,8 @@ def main(argv=None) -> int:
     ap.add_argument("--split", action="store_true", help="first print where this side's frame goes")
     ap.add_argument("--features", action="store_true",
                     help="first print what the sun's shadows and the occlusion bake cost this side's frame")
+    ap.add_argument("--upload", action="store_true",
+                    help="first print what uploading the normal map with its spread costs (against GL's mips)")
     ap.add_argument("--sphere", action="store_true",
                     help="the built-in sphere (its default material, its impostor) instead of DamagedHelmet: a check that it is unchanged")
     args = ap.parse_args(argv)
@@ -171,6 +204,8 @@ def main(argv=None) -> int:
         split(sides["this"])
     if args.features:
         features(sides["this"], args.rounds)
+    if args.upload:
+        upload(sides["this"], args.rounds)
     cpu: dict[str, list[float]] = {name: [] for name in sides}
     largest = {name: 0 for name in sides}
     names = list(sides)

@@ -2,6 +2,7 @@
 filtering or the visibility. Prints one table; asserts nothing (results/helmet_split.md).
 
     PYTHONPATH=... .venv/bin/python benchmarks/bench_helmet_split.py [--size 128] [--samples 64] [--no-normal-map]
+        [--toksvig] [--no-toksvig] [--keep DIR]
 
 Six images of the same view (`--orbit 30 --elevation 10`, royal_esplanade_1k, the file's own
 materials), all linear:
@@ -23,7 +24,10 @@ lowest 30% of the helmet's rows): each region's share of the whole error, its ow
 sum against the second image's. --toksvig adds the integral shaded once at the footprint's mean
 inputs (an ideal mip filter) with the roughness widened by Toksvig's variance of the mean normal
 (x0, x1, x2), against nojit. --no-normal-map drops normalTexture from a copy of the .gltf (in a
-temporary folder) for every image.
+temporary folder) for every image. --no-toksvig renders alight's images (render, rendernoaa and
+the G-buffer of nogbuf) without the normal map's widening (NORMAL_MAP_TOKSVIG off: the shading
+before it); the regions always come from the unwidened G-buffer. --keep DIR saves the traced
+images (which alight's shading does not change) and reuses them, with alight's three beside.
 """
 
 from __future__ import annotations
@@ -66,22 +70,48 @@ def scene_setup(mesh: Path, size: int):
     return scene_from_flags(args, args.size, build_look(args), lambda line: None)
 
 
-def render(mesh: Path, size: int, folder: Path, extra: list[str]) -> np.ndarray:
+# `alight` with NORMAL_MAP_TOKSVIG off (alight.render.normal_spread): the shading before it.
+NO_TOKSVIG = ("import sys; import alight.render.normal_spread as s; s.NORMAL_MAP_TOKSVIG = False; "
+              "from alight.frontends.cli import main; sys.exit(main())")
+
+
+def render(mesh: Path, size: int, folder: Path, extra: list[str], toksvig: bool = True) -> np.ndarray:
     from alight.accuracy.metrics import read_linear
 
     out = folder / f"render{'_'.join(extra)}.exr"
-    subprocess.run([sys.executable, "-m", "alight", "render", "--mesh", str(mesh), "--env", str(ENV), *VIEW,
+    alight = ["-m", "alight"] if toksvig else ["-c", NO_TOKSVIG]
+
+    subprocess.run([sys.executable, *alight, "render", "--mesh", str(mesh), "--env", str(ENV), *VIEW,
                     "--size", str(size), "--occlusion", "off", "--out", str(out), *extra],
                    check=True, stdout=subprocess.DEVNULL)
     return read_linear(str(out))
 
 
-def gbuffer(setup) -> dict[str, np.ndarray]:
+def gbuffer(setup, toksvig: bool = True) -> dict[str, np.ndarray]:
     from alight.accuracy.reference import GBUFFER, ReferenceRenderer
+    from alight.render import normal_spread
 
-    texs = ReferenceRenderer().mesh_gbuffer(setup.scene, setup.width, setup.height)
+    was, normal_spread.NORMAL_MAP_TOKSVIG = normal_spread.NORMAL_MAP_TOKSVIG, toksvig
+    try:
+        texs = ReferenceRenderer().mesh_gbuffer(setup.scene, setup.width, setup.height)
+    finally:
+        normal_spread.NORMAL_MAP_TOKSVIG = was
     return {n: np.frombuffer(t.read(), np.float32).reshape(setup.height, setup.width, 4)[::-1].astype(np.float64)
             for n, t in zip(GBUFFER, texs)}
+
+
+def kept(folder: str | None, name: str, make) -> np.ndarray:
+    """``make()``, or its result saved in ``folder`` by an earlier run with the same arguments
+    (--keep: the traced images do not depend on alight's shading)."""
+    if folder is None:
+        return make()
+    path = Path(folder) / f"{name}.npy"
+    if path.is_file():
+        return np.load(path)
+    image = make()
+    Path(folder).mkdir(parents=True, exist_ok=True)
+    np.save(path, image)
+    return image
 
 
 def integrate(n, v, base, metal, rough, f0, env, rng) -> np.ndarray:
@@ -240,25 +270,38 @@ def main() -> int:
     parser.add_argument("--no-normal-map", action="store_true")
     parser.add_argument("--toksvig", action="store_true",
                         help="also shade once at the footprint's mean inputs, without and with Toksvig's widening")
+    parser.add_argument("--no-toksvig", action="store_true",
+                        help="alight's render and G-buffer without the normal map's widening (NORMAL_MAP_TOKSVIG off)")
+    parser.add_argument("--keep", metavar="DIR",
+                        help="keep the traced images (full, nocentre, nojit, mean inputs) in DIR and reuse them")
     args = parser.parse_args()
     from alight.accuracy.path_trace import TraceSettings, trace
 
+    on = not args.no_toksvig
+    tag = f"{args.size}_{args.samples}_{'off' if args.no_normal_map else 'on'}"
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         mesh = helmet_copy(folder, not args.no_normal_map)
         setup = scene_setup(mesh, args.size)
-        g = gbuffer(setup)
-        images = {"render": render(mesh, args.size, folder, []),
-                  "rendernoaa": render(mesh, args.size, folder, ["--aa", "none"]),
-                  "full": trace(setup.scene, setup.environment.radiance, setup.width, setup.height,
-                                TraceSettings(samples=args.samples, seed=0)).linear,
-                  "nogbuf": unoccluded_gbuffer(setup, g, args.samples),
-                  "nocentre": unoccluded_hits(setup, args.samples, False),
-                  "nojit": unoccluded_hits(setup, args.samples, True)}
+        # the regions by the roughness the maps give, unwidened (the same blocks either way)
+        g = gbuffer(setup, toksvig=False)
+        images = {"render": render(mesh, args.size, folder, [], on),
+                  "rendernoaa": render(mesh, args.size, folder, ["--aa", "none"], on),
+                  "full": kept(args.keep, f"full_{tag}", lambda: trace(
+                      setup.scene, setup.environment.radiance, setup.width, setup.height,
+                      TraceSettings(samples=args.samples, seed=0)).linear),
+                  "nogbuf": unoccluded_gbuffer(setup, gbuffer(setup, on) if on else g, args.samples),
+                  "nocentre": kept(args.keep, f"nocentre_{tag}", lambda: unoccluded_hits(setup, args.samples, False)),
+                  "nojit": kept(args.keep, f"nojit_{tag}", lambda: unoccluded_hits(setup, args.samples, True))}
         if args.toksvig:
             for widen in (0.0, 1.0, 2.0):
-                images[f"mean inputs, toksvig x{widen:g}"] = footprint_mean_inputs(setup, args.samples, widen)
-    print(f"DamagedHelmet {args.size} px, {args.samples} samples, normal map {'off' if args.no_normal_map else 'on'}")
+                images[f"mean inputs, toksvig x{widen:g}"] = kept(
+                    args.keep, f"mean{widen:g}_{tag}", lambda: footprint_mean_inputs(setup, args.samples, widen))
+        if args.keep:
+            for name in ("render", "rendernoaa", "nogbuf"):
+                np.save(Path(args.keep) / f"{name}_{tag}_{'toksvig' if on else 'old'}.npy", images[name])
+    print(f"DamagedHelmet {args.size} px, {args.samples} samples, normal map {'off' if args.no_normal_map else 'on'}, "
+          f"NORMAL_MAP_TOKSVIG {'on' if on else 'off'}")
     print("\n".join(table(images, g, max(4, args.size // 32))))
     return 0
 

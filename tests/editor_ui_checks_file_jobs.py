@@ -90,9 +90,10 @@ def test_frames_stay_short_while_a_textured_gltf_opens(ctx):
             return function(*args, **kwargs)
         return call
 
-    saved = gpu_mesh.upload_image, shadows.can_shadow_itself
+    saved = gpu_mesh.upload_image, shadows.can_shadow_itself, gpu_mesh.upload_normal_map
     gpu_mesh.upload_image = counted("upload_image", saved[0])
     shadows.can_shadow_itself = counted("can_shadow_itself", saved[1])
+    gpu_mesh.upload_normal_map = counted("upload_normal_map", saved[2])   # (a normal map's whole upload)
     try:
         type_path(ctx, "**/mesh", HELMET)
         kept, win.frame_times = win.frame_times, collections.deque()   # (unbounded: every frame of the open)
@@ -108,7 +109,7 @@ def test_frames_stay_short_while_a_textured_gltf_opens(ctx):
         ctx.yield_(3)   # the helmet drawn
         gaps = list(win.frame_times)
     finally:
-        gpu_mesh.upload_image, shadows.can_shadow_itself = saved
+        gpu_mesh.upload_image, shadows.can_shadow_itself, gpu_mesh.upload_normal_map = saved
         win.frame_times = collections.deque(kept + win.frame_times, maxlen=kept.maxlen)
     assert s.mesh_spec == HELMET and not s.error, (s.mesh_spec, s.error)
     reading, taking = gaps[:read_end - 1], gaps[read_end - 1:]

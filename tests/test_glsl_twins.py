@@ -46,6 +46,16 @@ def test_fresnel_terms():
           shading.F_SchlickRoughness(y[:, 0], np.repeat(y[:, 1:2], 3, axis=1), y[:, 2]))
 
 
+def test_normal_map_roughness():
+    # surface.glsl's Toksvig widening: alpha^2 + A^4 (alight.render.normal_spread's A)
+    x = np.column_stack([rng.uniform(0, 1, 400), rng.uniform(0, 1, 400)])
+    x[:40, 1] = 0.0
+    got = evaluate("NORMAL_MAP_ROUGHNESS", x)[:, 0]
+    close(got, shading.normal_map_roughness(x[:, 0], x[:, 1]))
+    assert np.array_equal(got[:40], x[:40, 0].astype(np.float32))   # A = 0 leaves the roughness exactly
+    assert shading.normal_map_roughness(0.0, 0.5) == 0.5
+
+
 def test_equirect_mapping_both_ways():
     d = shading._normalize(rng.normal(size=(500, 3)))
     uv = evaluate("DIRECTION_TO_EQUIRECT", d)[:, :2]

@@ -116,6 +116,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "HAS_UV1": "a map of the mesh reads TEXCOORD_1 (u_map_uv1 picks each map's set)",
     "HAS_TEXTURE_TRANSFORM": "a map of the mesh has KHR_texture_transform (u_map_transform, identity for the others)",
     "PACKED_VERTICES": "normals and tangents arrive as int16 snorm (alight.render.gpu_mesh.pack_snorm16)",
+    "NORMAL_MAP_TOKSVIG": "the normal maps' A is their normals' spread, added to the roughness "
+                          "(alight.render.normal_spread, surface.glsl normal_map_roughness)",
     "MATERIAL_MAPS_MASK": "the maps present, a bit each (map_mask)",
     "MAP_MIRROR_S_MASK": "maps whose sampler mirrors in s",
     "MAP_MIRROR_T_MASK": "maps whose sampler mirrors in t",

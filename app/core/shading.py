@@ -31,6 +31,14 @@ def D_GGX(n_dot_h, roughness):
     return a2 / (PI * d * d)
 
 
+def normal_map_roughness(roughness, widening):
+    """A normal map's lost spread added to GGX's alpha^2 (Toksvig 2005): sigma^2 = widening^4
+    (alight.render.normal_spread's A), roughness' = (roughness^4 + widening^4)^(1/4)."""
+    r = np.asarray(roughness, dtype=np.float64)
+    w = np.asarray(widening, dtype=np.float64)
+    return (r ** 4 + w ** 4) ** 0.25
+
+
 def k_direct(roughness):
     """Schlick-GGX k for punctual lights (Karis 2013)."""
     return (np.asarray(roughness, dtype=np.float64) + 1.0) ** 2 / 8.0

@@ -11,6 +11,7 @@ import numpy as np
 
 from alight.core.mesh import is_closed
 from alight.core.texture_footprint import anisotropy_for_view, footprints
+from alight.render.normal_spread import normal_map_levels, spread_scale, without_spread
 
 GL_SRGB8_ALPHA8 = 0x8C43
 SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color", "diffuse_transmission")
@@ -138,7 +139,7 @@ class GpuPart:
         self.hi = positions.max(axis=0).astype(np.float64) if len(positions) else np.zeros(3)
         self.centre = (self.lo + self.hi) / 2.0
         for name, info in self.infos.items():
-            self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS)
+            self.textures[name] = textures.get(info, srgb=name in SRGB_MAPS, spread=spread_scale(name, fm))
 
     @property
     def closed(self) -> bool:
@@ -219,13 +220,18 @@ class MeshTextures:
         self.ctx = ctx
         self._textures: dict[tuple, moderngl.Texture] = {}
 
-    def get(self, info, srgb: bool) -> moderngl.Texture:
+    def get(self, info, srgb: bool, spread: float | None = None) -> moderngl.Texture:
+        """``spread``: a normal map's scale, whose levels then carry their spread in A
+        (alight.render.normal_spread; keyed by it too)."""
         sampler = info.sampler
-        key = (id(info.image), srgb, sampler)
+        key = texture_key(info, srgb, spread)
         tex = self._textures.get(key)
         if tex is None:
-            tex = self._textures[key] = self.sampled(upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps),
-                                                     sampler)
+            if spread is None:
+                tex = upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps)
+            else:
+                tex = upload_normal_map(self.ctx, info.image, spread, mipmaps=sampler.mipmaps)
+            tex = self._textures[key] = self.sampled(tex, sampler)
         return tex
 
     @staticmethod
@@ -247,6 +253,29 @@ class MeshTextures:
         for tex in self._textures.values():
             tex.release()
         self._textures.clear()
+
+
+def texture_key(info, srgb: bool, spread: float | None = None) -> tuple:
+    """MeshTextures' key of a map: one upload per image, colour space and sampler, and for a
+    normal map with its spread in A (``spread``: its scale) per scale too."""
+    key = (id(info.image), srgb, info.sampler)
+    return key if spread is None else (*key, "spread", float(spread))
+
+
+def upload_normal_map(ctx: moderngl.Context, image: np.ndarray, scale: float, mipmaps: bool = True) -> moderngl.Texture:
+    """A normal map as ``upload_image`` makes it (RGB the same), its levels made on the CPU with
+    the spread of its normals at ``scale`` in A (alight.render.normal_spread). A side that is not a
+    power of two: GL's mips with A = 0 (no widening)."""
+    from alight.core.gpu import write_rgba8
+
+    levels = normal_map_levels(image, scale, mipmaps)
+    if levels is None:
+        return upload_image(ctx, without_spread(image), False, mipmaps)
+    h, w = levels[0].shape[:2]
+    tex = level_texture(ctx, (w, h), len(levels), False)
+    for n, level in enumerate(levels):
+        write_rgba8(ctx, tex, n, 0, level)
+    return tex
 
 
 def level_texture(ctx: moderngl.Context, size: tuple[int, int], levels: int, srgb: bool) -> moderngl.Texture:
@@ -372,12 +401,15 @@ class GpuMeshes:
             image = scene.texture_images.get(path)
             if image is None:
                 continue
-            key = (path, slot in SRGB_MAPS)
+            spread = spread_scale(slot, None)
+            key = (path, slot in SRGB_MAPS) if spread is None else (path, False, "spread")
             entry = self._map_textures.get(key)
             if entry is None or entry[0] is not image:
                 if entry is not None:
                     entry[1].release()
-                entry = self._map_textures[key] = (image, upload_image(self.ctx, image, srgb=key[1]))
+                tex = (upload_image(self.ctx, image, srgb=key[1]) if spread is None
+                       else upload_normal_map(self.ctx, image, spread))
+                entry = self._map_textures[key] = (image, tex)
             out[slot] = entry[1]
         return out
 

@@ -7,78 +7,22 @@ five 2048x2048 maps) and, for shadows, the self-shadowing test (0.22 s). Here th
 from the GL work:
 
 * ``prepare_upload(mesh)`` touches no GL and may run on any thread: every texture's levels as
-  the GL upload wants them (flipped, RGBA, ``mip_levels``) and shadow_fit.can_shadow_itself.
+  the GL upload wants them (flipped, RGBA, ``mip_levels``; a normal map's with its spread in A,
+  alight.render.normal_spread) and shadow_fit.can_shadow_itself.
 * ``Renderer.upload_step(upload)`` on the GL thread writes up to STEP_BYTES of those levels per
   call (a band of a big level, or several small levels), then, in a call of its own, the parts'
   buffers; it returns True once the mesh is whole. The renderer then
   draws it with those textures (the same keys, filters and wrap as its own upload) and the
   remembered self-shadowing answer.
 
-The CLI, the API and batch never call these: their upload (``upload_image``) is unchanged.
+The CLI, the API and batch never call these: they upload in the frame (``upload_image``, and
+``upload_normal_map`` for a normal map with its spread).
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from alight.render.gpu_mesh import SRGB_MAPS
-
-
-def _srgb_to_linear_table() -> np.ndarray:
-    c = np.arange(256, dtype=np.float64) / 255.0
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
-
-
-SRGB_TO_LINEAR = _srgb_to_linear_table()
-
-
-def _encode_srgb(linear: np.ndarray) -> np.ndarray:
-    x = np.clip(linear, 0.0, 1.0)
-    return np.rint(np.where(x <= 0.0031308, x * 12.92, 1.055 * np.power(x, 1.0 / 2.4) - 0.055) * 255.0)
-
-
-def _halve_unorm(level: np.ndarray) -> np.ndarray:
-    """A 2x2 box of uint8 values as llvmpipe's generate_mipmap gives it (checked bit for bit on
-    random images): rounded half-sums, (a + b + 1) >> 1, along each row first, then of the rows."""
-    v = level.astype(np.uint16)
-    across = (v[:, 0::2] + v[:, 1::2] + 1) >> 1
-    return ((across[0::2] + across[1::2] + 1) >> 1).astype(np.uint8)
-
-
-def _halve_srgb(level: np.ndarray) -> np.ndarray:
-    """The colour averaged as linear light (GL's rule for sRGB textures), alpha as unorm.
-    llvmpipe's own sRGB encoding is an approximation: this lands within 1 of it per level."""
-    out = _halve_unorm(level)
-    linear = SRGB_TO_LINEAR[level[..., :3]]
-    mean = 0.25 * (linear[0::2, 0::2] + linear[0::2, 1::2] + linear[1::2, 0::2] + linear[1::2, 1::2])
-    out[..., :3] = _encode_srgb(mean).astype(np.uint8)
-    return out
-
-
-def mip_levels(image: np.ndarray, srgb: bool, mipmaps: bool = True) -> list[np.ndarray] | None:
-    """``image`` (rows top first, RGB or RGBA uint8) as the texture's levels, level 0 first, each
-    (h, w, 4) uint8 bottom row first, as ``upload_image`` writes it. Each level from the one
-    before, as GL does. None where a side is not a power of two (GL's halving of an odd side is
-    not a 2x2 box: such a texture is uploaded by ``upload_image`` instead)."""
-    image = np.asarray(image, dtype=np.uint8)
-    if image.shape[2] == 3:
-        image = np.concatenate([image, np.full(image.shape[:2] + (1,), 255, np.uint8)], axis=2)
-    level = np.ascontiguousarray(image[::-1, :, :4])
-    h, w = level.shape[:2]
-    if not mipmaps:
-        return [level]
-    if h & (h - 1) or w & (w - 1):
-        return None
-    levels = [level]
-    halve = _halve_srgb if srgb else _halve_unorm
-    while level.shape[0] > 1 or level.shape[1] > 1:
-        if level.shape[0] == 1:   # one row left: pairs along it (the row repeated as its pair)
-            level = np.concatenate([level, level], axis=0)
-        if level.shape[1] == 1:
-            level = np.concatenate([level, level], axis=1)
-        level = np.ascontiguousarray(halve(level))
-        levels.append(level)
-    return levels
+from alight.render.mip_levels import mip_levels
 
 
 # What one ``step`` writes at most (a piece is never split further than a band of rows): a
@@ -112,6 +56,7 @@ class MeshUpload:
         buffers and hand everything to ``meshes`` (GpuMeshes) and ``shadow_maps``. True when whole."""
         from alight.core.gpu import write_rgba8
         from alight.render.gpu_mesh import MeshTextures, level_texture, upload_image
+        from alight.render.normal_spread import without_spread
 
         if self.done:
             return True
@@ -121,7 +66,9 @@ class MeshUpload:
             t, n, y0, y1 = self.pieces[self.next]
             key, info, srgb, levels = self.textures[t]
             if levels is None:
-                self.made[t] = MeshTextures.sampled(upload_image(ctx, info.image, srgb, info.sampler.mipmaps),
+                # (a normal map with its spread, texture_key's "spread": A = 0, no widening)
+                image = without_spread(info.image) if len(key) > 3 else info.image
+                self.made[t] = MeshTextures.sampled(upload_image(ctx, image, srgb, info.sampler.mipmaps),
                                                     info.sampler)
                 written += info.image.nbytes
             else:
@@ -152,6 +99,8 @@ class MeshUpload:
 def prepare_upload(mesh) -> MeshUpload:
     """The CPU side of ``mesh``'s upload (no GL: any thread)."""
     from alight.core.shadow_fit import can_shadow_itself
+    from alight.render.gpu_mesh import texture_key
+    from alight.render.normal_spread import normal_map_levels, spread_scale
 
     seen, textures = set(), []
     for part in mesh.parts:
@@ -159,10 +108,13 @@ def prepare_upload(mesh) -> MeshUpload:
             continue
         for name, info in part.material.textures().items():
             srgb = name in SRGB_MAPS
-            key = (id(info.image), srgb, info.sampler)
+            spread = spread_scale(name, part.material)
+            key = texture_key(info, srgb, spread)
             if key in seen:
                 continue
             seen.add(key)
-            textures.append((key, info, srgb, mip_levels(info.image, srgb, info.sampler.mipmaps)))
+            levels = (mip_levels(info.image, srgb, info.sampler.mipmaps) if spread is None
+                      else normal_map_levels(info.image, spread, info.sampler.mipmaps))
+            textures.append((key, info, srgb, levels))
     shadowing = bool(mesh.parts) and can_shadow_itself([(p.positions, p.indices) for p in mesh.parts])
     return MeshUpload(mesh, textures, shadowing)

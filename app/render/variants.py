@@ -26,7 +26,9 @@ from alight.core.shader_names import (
     map_mask,
 )
 from alight.ibl.bake import IBLMaps, grid_roughness
+from alight.render import normal_spread
 from alight.render.bindings import MAX_LIGHTS
+from alight.render.normal_spread import SPREAD_MAPS
 
 
 def part_material(scene, part) -> tuple[Material, bool]:
@@ -140,6 +142,9 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
     if getattr(gpu_part, "packed", False):
         defines["PACKED_VERTICES"] = None
     defines["MATERIAL_MAPS_MASK"] = map_mask(present & set(MATERIAL_MAPS))
+    if normal_spread.NORMAL_MAP_TOKSVIG and present & set(SPREAD_MAPS):
+        # the normal map's spread widens the roughness (alight.render.normal_spread)
+        defines["NORMAL_MAP_TOKSVIG"] = 1
     defines.update(material_defines([part_material(scene, part)[0]]))
     return defines
 
@@ -185,8 +190,9 @@ def light_defines(scene) -> dict:
     return defines
 
 
-# The maps that cannot change a roughness (MATERIAL_MAPS bits): any other map compiled in keeps
-# the prefiltered lookup's path below the grid (ibl.glsl IBL_BELOW_GRID).
+# The maps that cannot lower a roughness (MATERIAL_MAPS bits): any other map compiled in keeps
+# the prefiltered lookup's path below the grid (ibl.glsl IBL_BELOW_GRID). (The normal maps'
+# spread, NORMAL_MAP_TOKSVIG, only raises one: stretched_span_defines minds that.)
 ROUGHNESS_FREE_MAPS = {"base_color", "normal", "emissive", "occlusion", "metallic", "specular", "specular_color"}
 
 
@@ -240,7 +246,9 @@ def stretched_span_defines(scene, materials, map_mask: int = 0) -> dict:
         return {}
     # the base layer's roughness only: the layers' own lobes fetch at their roughness directly
     rough = [float(m.roughness) for m in materials]
-    if max(rough) <= ROUGHNESS_START:
+    # a normal map's spread can only raise it (NORMAL_MAP_TOKSVIG): never below ROUGHNESS_START
+    widens = normal_spread.NORMAL_MAP_TOKSVIG and map_mask & map_bit("normal")
+    if max(rough) <= ROUGHNESS_START and not widens:
         return {"STRETCHED_SPAN": 0}
     if min(rough) >= ROUGHNESS_FULL:
         return {"STRETCHED_SPAN": 2}

@@ -34,6 +34,7 @@ const int TERM_SPOT_RANGE = 17;
 const int TERM_SPHERE_SURFACE = 18;
 const int TERM_SPHERE_UV = 19;
 const int TERM_F_SCHLICK_F90 = 20;
+const int TERM_NORMAL_MAP_ROUGHNESS = 21;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -82,6 +83,8 @@ void main() {
         case TERM_SPHERE_UV: o = vec4(sphere_uv(a.xyz), sphere_tangent(a.xyz).xz); break;
         // a = (v.h, grey f0, f90).
         case TERM_F_SCHLICK_F90: o.xyz = F_Schlick(a.x, vec3(a.y), a.z); break;
+        // a = (roughness, the normal map's widening A).
+        case TERM_NORMAL_MAP_ROUGHNESS: o.x = normal_map_roughness(a.x, a.y); break;
     }
     u_outputs[i] = o;
 }

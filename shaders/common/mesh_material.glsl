@@ -302,18 +302,34 @@ mat3 tangent_frame(vec3 n) {
     return mat3(t, b, n);
 }
 
-// A tangent-space normal map's value in world space about n (glTF: xy scaled by scale).
-vec3 normal_from_map(sampler2D map, int bit, int slot, float scale, vec3 n) {
-    vec3 m = sample_map(map, bit, slot).xyz * 2.0 - 1.0;
+// NORMAL_MAP_TOKSVIG (compiled in where a part has a normal map, alight.render.variants): the
+// normal map's texels carry in A the spread of the level-0 normals under them (Toksvig 2005;
+// alight.render.normal_spread: 0 on level 0, so an 8-bit map never widens a mirror), added to
+// the roughness of the layers shaded about that normal (brdf.glsl normal_map_roughness).
+#ifdef NORMAL_MAP_TOKSVIG
+float normal_map_widening = 0.0;   // the base normal map's A, set by shading_normal()
+#endif
+
+// A tangent-space normal map's value in world space about n (glTF: xy scaled by scale), and
+// the texel's A (the spread, under NORMAL_MAP_TOKSVIG).
+vec3 normal_from_map(sampler2D map, int bit, int slot, float scale, vec3 n, out float widening) {
+    vec4 texel = sample_map(map, bit, slot);
+    widening = texel.a;
+    vec3 m = texel.xyz * 2.0 - 1.0;
     m.xy *= scale;
     vec3 mapped = tangent_frame(n) * m;
     return dot(mapped, mapped) > 1e-12 ? normalize(mapped) : n;
 }
 
+// The shading normal. Every caller runs it before material_surface() (which reads the spread).
 vec3 shading_normal() {
     vec3 n = geometric_normal();
     if (has_map(MAP_NORMAL, u_has_normal_map)) {
-        n = normal_from_map(u_normal_map, MAP_NORMAL, 2, u_normal_scale, n);
+        float widening;
+        n = normal_from_map(u_normal_map, MAP_NORMAL, 2, u_normal_scale, n, widening);
+#ifdef NORMAL_MAP_TOKSVIG
+        normal_map_widening = widening;
+#endif
     }
     return n;
 }
@@ -374,6 +390,10 @@ Surface material_surface(vec3 n) {
 #endif
     if (has_map(MAP_OCCLUSION, u_has_occlusion_map)) s.occlusion = 1.0 + u_occlusion_strength * (sample_map(u_occlusion_map, MAP_OCCLUSION, 4).r - 1.0);
     s.roughness = clamp(s.roughness, 0.0, 1.0);
+#ifdef NORMAL_MAP_TOKSVIG
+    // before the layers: anisotropy and transmission shade at this roughness about n too
+    s.roughness = normal_map_roughness(s.roughness, normal_map_widening);
+#endif
     s.metallic = clamp(s.metallic, 0.0, 1.0);
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_ANISOTROPY) || defined(HAS_TRANSMISSION) || defined(HAS_VOLUME) || defined(HAS_DIFFUSE_TRANSMISSION)
     mat3 frame = tangent_frame(n);
@@ -410,8 +430,13 @@ Surface material_surface(vec3 n) {
         s.clearcoat_roughness *= sample_map(u_clearcoat_roughness_map, MAP_CLEARCOAT_ROUGHNESS, 8).g;
     }
     if (has_map(MAP_CLEARCOAT_NORMAL, u_has_clearcoat_normal_map)) {
+        float widening;
         s.clearcoat_normal = normal_from_map(u_clearcoat_normal_map, MAP_CLEARCOAT_NORMAL, 9, u_clearcoat_normal_scale,
-                                             s.clearcoat_normal);
+                                             s.clearcoat_normal, widening);
+#ifdef NORMAL_MAP_TOKSVIG
+        // the coat's own map's spread (the coat never takes the base normal map's)
+        s.clearcoat_roughness = normal_map_roughness(clamp(s.clearcoat_roughness, 0.0, 1.0), widening);
+#endif
     }
 #endif
 #ifdef HAS_SHEEN
