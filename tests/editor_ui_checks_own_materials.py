@@ -6,9 +6,12 @@ under Xvfb); not collected by pytest.
 A preset click unticks 'mesh file's own materials'; Ctrl+Z gives the file's materials back
 (the box ticked again), Ctrl+Shift+Z the preset. An edit of the panel's material or maps while
 the box is ticked (a slider dragged, an F0 channel typed, a layer row, the UV tiling) unticks
-it and says so once in the status row, one undo step with the edit."""
+it and says so once in the status row, one undo step with the edit. An F0 channel typed alone
+sets the ior from the F0's luminance, and the undo row shows numbers as the widgets do."""
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 
@@ -102,3 +105,29 @@ def test_a_panel_edit_while_the_files_materials_show_unticks_them_and_says_so(ct
         assert s.use_file_materials and s.look == look, (name, s.message)
         assert s.message.startswith("undo: the mesh file's own materials (was "), (name, s.message)
 
+
+def test_one_f0_channel_sets_the_ior_from_the_luminance_and_undo_rounds_as_the_widgets(ctx):
+    from alight.core.material import ior_from_f0
+
+    s = editor().state
+    ctx.set_ref("alight")
+    ctx.item_click("**/plastic_high")
+    base = s.material
+    g = base.specular_f0[0]
+    assert base.specular_f0 == (g, g, g) and g < 0.1, base   # a grey F0: the ior's
+    ctx.item_input_value("specular F0/$$0", 0.32)
+    m = s.material
+    assert m.specular_f0 == (0.32, g, g), m.specular_f0   # the tint kept (the specular colour)
+    lum = 0.2126 * 0.32 + (0.7152 + 0.0722) * g
+    assert abs(m.ior - ior_from_f0(lum)) < 1e-4 and m.ior < 2.0, m.ior   # not the red channel's 3.6
+    _undo(ctx)
+    assert s.material.specular_f0 == (g, g, g), s.material
+    # Numbers as the widgets show them ('%.3f'), not the float's six digits.
+    assert s.message == (f"undo: plastic_high (specular f0, ior {round(m.ior, 3):g} -> "
+                         f"{round(base.ior, 3):g})"), s.message
+    assert not re.search(r"\d\.\d{4}", s.message), s.message
+    # The ior dragged keeps the tint, its luminance the ior's F0.
+    ctx.item_input_value("specular F0/$$0", 0.32)
+    ctx.item_input_value("**/ior", 1.5)
+    f0 = s.material.specular_f0
+    assert f0[0] > 2 * f0[1] and abs(0.2126 * f0[0] + 0.7152 * f0[1] + 0.0722 * f0[2] - 0.04) < 1e-3, f0

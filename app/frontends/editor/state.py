@@ -610,7 +610,8 @@ def _material_only(path: str) -> bool:
 
 
 def _value(v) -> str:
-    return f"{v:g}" if isinstance(v, float) else str(v)
+    """A number as the panel's widgets show it (imgui's '%.3f'), without trailing zeros."""
+    return f"{round(v, 3):g}" if isinstance(v, float) else str(v)
 
 
 def look_change(before: tuple, after: tuple, most: int = 3) -> str:
