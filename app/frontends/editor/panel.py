@@ -930,12 +930,15 @@ class Panel:
             # own aspect: a new user could not make the command line draw the view's picture).
             import shlex
 
-            text = shlex.join(win.orbit.render_flags(win.view_area()))
+            text = shlex.join(win.orbit.render_flags(win.view_area()) + s.render_flags())
             imgui.set_clipboard_text(text)
             s.error, s.message = "", f"copied to the clipboard: {text}"
         if imgui.is_item_hovered():
             tooltip("the view's camera and size as `alight render` flags (--orbit --elevation --distance "
-                    "--fov --target --size), onto the clipboard")
+                    "--fov --target --size), with its lights (--light) and each setting that is not the "
+                    "command line's default (environment turn and intensity, tone map, exposure, ground, "
+                    "shadows, occlusion, IBL model, anti-aliasing), onto the clipboard; add --mesh, --env "
+                    "and the material")
         from alight.frontends.editor.screenshot import draw_controls
 
         draw_controls(win)   # size, the button (F12), progress

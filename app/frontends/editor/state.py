@@ -137,6 +137,50 @@ class EditorState:
             return
         self.message = f"{self.message}; {note}" if self.message and self.message != said else note
 
+    def render_flags(self) -> list[str]:
+        """The view's lights and settings as ``alight render``'s flags, those that differ from its
+        defaults: with the camera's (OrbitCamera.render_flags) the command draws the view's
+        picture of the same mesh, environment and material ('copy camera as flags'). Every light
+        is written (the editor's three defaults are not the command line's: it has none); none at
+        all is --no-file-lights, so a glTF file's own lights do not come in."""
+        from alight.core.ibl_models import DEFAULT_IBL_MODEL
+
+        flags = []
+        for light in self.lights:
+            flags += ["--light", light_spec(light)]
+        if not self.lights:
+            flags.append("--no-file-lights")
+        if self.env_rotation_deg % 360.0:
+            flags += ["--env-rotation", _g(self.env_rotation_deg)]
+        if self.env_intensity != 1.0:
+            flags += ["--env-intensity", _g(self.env_intensity)]
+        if not self.ibl_enabled:
+            flags.append("--no-ibl")
+        if self.ibl_model != DEFAULT_IBL_MODEL:
+            flags += ["--ibl", self.ibl_model]
+        if self.multiple_scattering:
+            flags.append("--multiple-scattering")
+        if self.quality != "medium":
+            flags += ["--quality", self.quality]
+        if self.occlusion != "auto":
+            flags += ["--occlusion", self.occlusion]
+        if self.shadows != "auto":
+            flags += ["--shadows", self.shadows]
+        if self.ground:
+            flags.append("--ground")
+        d, default = self.display, Display()
+        if d.tonemap != default.tonemap:
+            flags += ["--tonemap", d.tonemap]
+        if d.exposure != default.exposure:
+            flags += ["--exposure", _g(d.exposure)]
+        if d.background != default.background:
+            flags += ["--background", d.background]
+            if d.background == "color":
+                flags += ["--background-color", ",".join(_g(x) for x in d.background_color)]
+        if self.aa != "msaa":   # (the command line's default)
+            flags += ["--aa", self.aa]
+        return flags
+
     def scene(self, camera) -> Scene:
         # Off by default: the editor's material is what the artist is shaping.
         return Scene(mesh=self.mesh, material=self.material, use_file_materials=self.use_file_materials,
@@ -596,6 +640,28 @@ class EditorState:
                 raise AlightError(f"--script: unknown field '{key}'")
         except ValueError:
             raise AlightError(f"--script: '{edit}': '{value}' is not a number") from None
+
+
+def _g(x: float) -> str:
+    return f"{float(x):.9g}"
+
+
+def light_spec(light: Light) -> str:
+    """``light`` in ``--light``'s syntax (alight.core.scene.parse_light reads it back as it is)."""
+    def xyz(v) -> str:
+        return ",".join(_g(x) for x in v)
+
+    if light.kind == "directional":
+        spec = f"directional:dir={xyz(light.vector)}"
+    elif light.kind == "spot":
+        spec = (f"spot:pos={xyz(light.vector)}:dir={xyz(light.direction)}"
+                f":inner={_g(light.inner_cone_deg)}:outer={_g(light.outer_cone_deg)}")
+    else:
+        spec = f"point:pos={xyz(light.vector)}"
+    spec += f":color={xyz(light.color)}:intensity={_g(light.intensity)}"
+    if light.range is not None and light.kind != "directional":
+        spec += f":range={_g(light.range)}"
+    return spec
 
 
 def _material_only(path: str) -> bool:
