@@ -48,16 +48,19 @@ def test_ground_and_shadows_through_the_panel_and_the_screenshot_equals_alight_r
     env = dict(os.environ, ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
                ALIGHT_DATA_DIR=str(tmp_path / "data"))
 
-    def render(name: str, *extra: str) -> np.ndarray:
+    def render(name: str, *leave_out: str) -> np.ndarray:
         out = tmp_path / name
-        # The flags the panel's 'copy camera as flags' put on the clipboard, as a user pastes them.
-        done = subprocess.run([sys.executable, "-m", "alight", "render", "--light", LIGHT, "--occlusion", "off",
-                               *shlex.split(view["flags"]), "--aa", "none", *extra, "--out", str(out)],
+        # The flags the panel's 'copy camera as flags' put on the clipboard, as a user pastes them
+        # (its light, --occlusion off and --aa none among them).
+        done = subprocess.run([sys.executable, "-m", "alight", "render",
+                               *(f for f in shlex.split(view["flags"]) if f not in leave_out), "--out", str(out)],
                               env=env, capture_output=True, text=True, timeout=600)
         assert done.returncode == 0, done.stderr[-3000:]
         return _read(out)
 
-    grounded, bare = render("render_ground.png", "--ground"), render("render_bare.png")
+    assert view["flags"].count("--light ") == 1, view["flags"]   # the editor's one light
+    assert "--ground" in view["flags"], view["flags"]
+    grounded, bare = render("render_ground.png"), render("render_bare.png", "--ground")   # (bare: without it)
     diff = np.abs(shot - grounded)
     print(f"EDITOR_VS_RENDER_GROUND mean={diff.mean():.4f} max={diff.max():.0f}; "
           f"vs render without ground mean={np.abs(shot - bare).mean():.4f} max={np.abs(shot - bare).max():.0f}")
@@ -86,6 +89,29 @@ def test_ground_and_shadows_through_the_panel_and_the_screenshot_equals_alight_r
     again = np.abs(_read(tmp_path / "alight-screenshot-2.png")[:h, :w] - shot)
     print(f"REOPENED_VS_SHOT max={again.max():.0f} mean={again.mean():.4f}")
     assert again.max() <= 1.0, (again.max(), again.mean())
+
+
+def test_the_copied_flags_alone_draw_the_editors_picture_with_its_default_lights(display, tmp_path):
+    """The editor's three default lights, the ground, the environment turned and the exposure
+    raised in the panel: `alight render` given only the flags 'copy camera as flags' copied draws
+    the screenshot's picture, the lights' shadows on the ground included (the copied flags had
+    the camera alone: the command line drew no light and no shadow)."""
+    checks = REPO / "tests" / "editor_ui_checks_copy_flags.py"
+    result = ui_test(tmp_path, checks, "--new", "--ground", "--occlusion", "off", "--motion-scale", "1", size=SIZE)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert "1 passed, 0 failed" in result.stdout, result.stdout[-3000:]
+    view = json.loads((tmp_path / "copy_flags_view.json").read_text())
+    w, h = view["size"]
+    shot = _read(tmp_path / view["file"])[:h, :w]
+    env = dict(os.environ, ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+               ALIGHT_DATA_DIR=str(tmp_path / "data"))
+    out = tmp_path / "pasted.png"
+    done = subprocess.run([sys.executable, "-m", "alight", "render", *shlex.split(view["flags"]), "--out", str(out)],
+                          env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    diff = np.abs(shot - _read(out))
+    print(f"EDITOR_VS_PASTED_FLAGS mean={diff.mean():.4f} max={diff.max():.0f}")
+    assert diff.max() <= 1.0, (diff.mean(), diff.max(), (diff.max(axis=2) > 1).mean())
 
 
 def test_the_ground_and_shadows_are_kept_in_the_session_and_taken_from_the_command_line(tmp_path, monkeypatch):

@@ -53,6 +53,37 @@ def _edited(m, **fields):
         return dataclasses.replace(m, **fields)
 
 
+# Rec. 709's weights of linear RGB: the grey a coloured F0 reflects as (docs/conventions.md).
+LUMINANCE = (0.2126, 0.7152, 0.0722)
+
+
+def _luminance(c) -> float:
+    return sum(w * x for w, x in zip(LUMINANCE, c))
+
+
+def _f0_edited(m, f0):
+    """Specular F0 typed or dragged (a channel or all): the ior follows the F0's luminance
+    (F0 = ((ior-1)/(ior+1))^2 for a grey F0, as before), and a coloured F0 is kept as typed, its
+    tint the specular colour (KHR_materials_specular's specularColorFactor, F0 / F0(ior)). One
+    channel dragged to 0.32 no longer makes the ior that channel's 3.6."""
+    from alight.core.material import ior_from_f0
+
+    f0 = tuple(min(max(float(x), 0.0), 1.0) for x in f0)
+    return _edited(m, specular_f0=f0, ior=max(ior_from_f0(_luminance(f0)), 1.0))
+
+
+def _ior_edited(m, ior):
+    """The ior typed or dragged: the specular F0 scaled, its tint kept, to the luminance the
+    ior's F0 has (``_f0_edited``'s inverse)."""
+    from alight.core.material import f0_from_ior
+
+    ior = max(float(ior), 1.0)
+    target, old = f0_from_ior(ior), m.specular_f0
+    lum = _luminance(old)
+    f0 = tuple(min(c * target / lum, 1.0) for c in old) if lum > 0.0 else (target,) * 3
+    return _edited(m, ior=ior, specular_f0=f0)
+
+
 def _short_float(x):
     """A widget's float32 as the shortest decimal that reads back as it (0.6, not 0.6000000238)."""
     return float(str(np.float32(x))) if np.isfinite(x) else x
@@ -367,14 +398,17 @@ class Panel:
             m = dataclasses.replace(m, roughness=v)
         # specular F0 and ior are one interface (alight.core.material's rule): editing one sets the other.
         changed, v = imgui.drag_float3("specular F0", list(m.specular_f0), 0.002, 0.0, 1.0)
+        if imgui.is_item_hovered():
+            tooltip("the dielectric's reflectance at normal incidence (linear RGB); the ior follows its "
+                    "luminance, and a coloured F0 is kept as the specular colour (KHR_materials_specular)")
         if changed:
-            m = _edited(m, specular_f0=tuple(min(max(x, 0.0), 1.0) for x in v))
+            m = _f0_edited(m, v)
         changed, v = imgui.drag_float("ior", m.ior, 0.005, 1.0, 4.0)
         if imgui.is_item_hovered():
             tooltip("index of refraction (KHR_materials_ior): F0 = ((ior-1)/(ior+1))^2 times the "
-                              "specular colour; specular F0 and ior follow each other")
+                              "specular colour; the ior and the specular F0's luminance follow each other")
         if changed:
-            m = _edited(m, ior=max(v, 1.0))
+            m = _ior_edited(m, v)
         changed, v = imgui.drag_float3("emissive", list(m.emissive), 0.01, 0.0, 100.0)
         if changed:
             m = dataclasses.replace(m, emissive=tuple(max(x, 0.0) for x in v))
@@ -898,12 +932,15 @@ class Panel:
             # own aspect: a new user could not make the command line draw the view's picture).
             import shlex
 
-            text = shlex.join(win.orbit.render_flags(win.view_area()))
+            text = shlex.join(win.orbit.render_flags(win.view_area()) + s.render_flags())
             imgui.set_clipboard_text(text)
             s.error, s.message = "", f"copied to the clipboard: {text}"
         if imgui.is_item_hovered():
             tooltip("the view's camera and size as `alight render` flags (--orbit --elevation --distance "
-                    "--fov --target --size), onto the clipboard")
+                    "--fov --target --size), with its lights (--light) and each setting that is not the "
+                    "command line's default (environment turn and intensity, tone map, exposure, ground, "
+                    "shadows, occlusion, IBL model, anti-aliasing), onto the clipboard; add --mesh, --env "
+                    "and the material")
         from alight.frontends.editor.screenshot import draw_controls
 
         draw_controls(win)   # size, the button (F12), progress

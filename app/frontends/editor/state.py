@@ -82,6 +82,7 @@ class EditorState:
     motion_scale: float = 1.0     # times render_scale while the camera moves (0.5: a quarter of the pixels)
     adaptive_motion: bool = False  # while moving, the scale that holds TARGET_FPS instead (at least 0.25)
     use_file_materials: bool = False   # a mesh file's own materials and texture maps instead of the panel's
+    history_steps: int = 0   # undo and redo steps taken (untick_own_for_edit tells an edit from a step)
     debug_view: int = 0
     debug_mip: float = 0.0
     compare: CompareState = field(default_factory=CompareState)   # the A/B split view (compare.py)
@@ -102,13 +103,83 @@ class EditorState:
     open_mesh_async: object = field(default=None, repr=False, compare=False)
 
     @property
-    def look(self) -> tuple[Material, TextureMaps]:
-        """What undo/redo and 'revert' act on: the material's factors and its maps."""
-        return (self.material, self.texture_maps)
+    def look(self) -> tuple[Material, TextureMaps, bool]:
+        """What undo/redo acts on: the material's factors, its maps and the 'mesh file's own
+        materials' box (an edit that unticked it is undone with it ticked again)."""
+        return (self.material, self.texture_maps, self.use_file_materials)
 
     @look.setter
-    def look(self, value: tuple[Material, TextureMaps]) -> None:
-        self.material, self.texture_maps = value
+    def look(self, value: tuple) -> None:
+        self.material, self.texture_maps = value[0], value[1]
+        if len(value) > 2:
+            self.use_file_materials = value[2]
+
+    def edit_mark(self) -> tuple:
+        """What ``untick_own_for_edit`` compares with after an edit: the look, the steps, the message."""
+        return (self.look, self.history_steps, self.message)
+
+    def untick_own_for_edit(self, mark: tuple) -> None:
+        """An edit of the panel's material or maps (a slider, a colour, a layer row, a map, a
+        library entry, a drop) while the mesh file's own materials are drawn would change
+        nothing on screen: the box is unticked, so the edit is seen on every part, and the
+        status row says so (after what the edit said, if it said anything). ``mark``:
+        ``edit_mark()`` before the edit (an undo or redo in between restores the box itself).
+        The edit and the untick are one undo step (History), which gives the file's materials back."""
+        before, steps, said = mark
+        # (A new name alone, typed or a library entry's, changes nothing drawn.)
+        renamed = dataclasses.replace(before[0], name=self.material.name)
+        if (steps != self.history_steps or not self.use_file_materials or not before[2]
+                or (self.material, self.texture_maps) == (renamed, before[1])):
+            return
+        self.use_file_materials = False
+        note = "the mesh file's own materials unticked to show the panel's material (Ctrl+Z gives them back)"
+        if self.error:
+            return
+        self.message = f"{self.message}; {note}" if self.message and self.message != said else note
+
+    def render_flags(self) -> list[str]:
+        """The view's lights and settings as ``alight render``'s flags, those that differ from its
+        defaults: with the camera's (OrbitCamera.render_flags) the command draws the view's
+        picture of the same mesh, environment and material ('copy camera as flags'). Every light
+        is written (the editor's three defaults are not the command line's: it has none); none at
+        all is --no-file-lights, so a glTF file's own lights do not come in."""
+        from alight.core.ibl_models import DEFAULT_IBL_MODEL
+
+        flags = []
+        for light in self.lights:
+            flags += ["--light", light_spec(light)]
+        if not self.lights:
+            flags.append("--no-file-lights")
+        if self.env_rotation_deg % 360.0:
+            flags += ["--env-rotation", _g(self.env_rotation_deg)]
+        if self.env_intensity != 1.0:
+            flags += ["--env-intensity", _g(self.env_intensity)]
+        if not self.ibl_enabled:
+            flags.append("--no-ibl")
+        if self.ibl_model != DEFAULT_IBL_MODEL:
+            flags += ["--ibl", self.ibl_model]
+        if self.multiple_scattering:
+            flags.append("--multiple-scattering")
+        if self.quality != "medium":
+            flags += ["--quality", self.quality]
+        if self.occlusion != "auto":
+            flags += ["--occlusion", self.occlusion]
+        if self.shadows != "auto":
+            flags += ["--shadows", self.shadows]
+        if self.ground:
+            flags.append("--ground")
+        d, default = self.display, Display()
+        if d.tonemap != default.tonemap:
+            flags += ["--tonemap", d.tonemap]
+        if d.exposure != default.exposure:
+            flags += ["--exposure", _g(d.exposure)]
+        if d.background != default.background:
+            flags += ["--background", d.background]
+            if d.background == "color":
+                flags += ["--background-color", ",".join(_g(x) for x in d.background_color)]
+        if self.aa != "msaa":   # (the command line's default)
+            flags += ["--aa", self.aa]
+        return flags
 
     def scene(self, camera) -> Scene:
         # Off by default: the editor's material is what the artist is shaping.
@@ -271,17 +342,21 @@ class EditorState:
         """Undo (or redo) one step. Stepping away from the look 'revert' goes back to takes
         'revert' along: after a preset click is undone, 'revert' returns to the look before the
         click, not to the preset the artist took back."""
-        leaving_saved = self.look == (self.saved_material, self.saved_texture_maps)
+        leaving_saved = (self.material, self.texture_maps) == (self.saved_material, self.saved_texture_maps)
         word = "redo" if redo else "undo"
         before = self.look
         self.look = history.redo(self.look) if redo else history.undo(self.look)
+        self.history_steps += 1
         self.sync_map_images()
         if leaving_saved:
-            self.saved_material, self.saved_texture_maps = self.look
+            self.saved_material, self.saved_texture_maps = self.material, self.texture_maps
         # The status row said what the step took back ('applied silver'): it says where it is now
         # and what changed, so two steps over one material's fields do not read the same.
         maps = len(self.texture_maps.paths())
         now = f"{self.material.name}{f' with {maps} map' + ('s' if maps > 1 else '') if maps else ''}"
+        if self.use_file_materials and self.mesh is not None and any(
+                part.material is not None for part in self.mesh.parts):
+            now = "the mesh file's own materials"   # what the view draws, not the panel's hidden material
         # While the view is split, undo acts on B (the live material) alone: A's snapshot or
         # preset and the compare mode are no undo steps, and the row says so.
         split = self.compare.active
@@ -567,6 +642,28 @@ class EditorState:
             raise AlightError(f"--script: '{edit}': '{value}' is not a number") from None
 
 
+def _g(x: float) -> str:
+    return f"{float(x):.9g}"
+
+
+def light_spec(light: Light) -> str:
+    """``light`` in ``--light``'s syntax (alight.core.scene.parse_light reads it back as it is)."""
+    def xyz(v) -> str:
+        return ",".join(_g(x) for x in v)
+
+    if light.kind == "directional":
+        spec = f"directional:dir={xyz(light.vector)}"
+    elif light.kind == "spot":
+        spec = (f"spot:pos={xyz(light.vector)}:dir={xyz(light.direction)}"
+                f":inner={_g(light.inner_cone_deg)}:outer={_g(light.outer_cone_deg)}")
+    else:
+        spec = f"point:pos={xyz(light.vector)}"
+    spec += f":color={xyz(light.color)}:intensity={_g(light.intensity)}"
+    if light.range is not None and light.kind != "directional":
+        spec += f":range={_g(light.range)}"
+    return spec
+
+
 def _material_only(path: str) -> bool:
     """A glTF file with materials and no meshes: opened as a material."""
     from alight.exchange.gltf_material import read_gltf_json
@@ -579,17 +676,29 @@ def _material_only(path: str) -> bool:
 
 
 def _value(v) -> str:
-    return f"{v:g}" if isinstance(v, float) else str(v)
+    """A number as the panel's widgets show it (imgui's '%.3f'), without trailing zeros."""
+    return f"{round(v, 3):g}" if isinstance(v, float) else str(v)
 
 
 def look_change(before: tuple, after: tuple, most: int = 3) -> str:
     """What an undo or redo step changed, in a few words for the status row: the material it
     left where the name changed ('was copper'), else the fields that changed, a number's old and
     new value ('roughness 0.3 -> 0.5'), and the map slots loaded or cleared."""
-    (m0, maps0), (m1, maps1) = before, after
+    (m0, maps0, *own0), (m1, maps1, *own1) = before, after
+    own0, own1 = bool(own0 and own0[0]), bool(own1 and own1[0])
+    n = len(maps0.paths())
+    was = f"was {m0.name}" + (f" with {n} map{'s' if n > 1 else ''}" if n else "")
+    if own1 and not own0:   # the file's materials back: what the step took away was the panel's
+        if m0.name == m1.name:   # an edit of its fields: the values it had ('was default, roughness 0.8')
+            edited = [f"{f.name.replace('_', ' ')} {_value(getattr(m0, f.name))}"
+                      for f in dataclasses.fields(m0) if getattr(m0, f.name) != getattr(m1, f.name)
+                      and isinstance(getattr(m0, f.name), (int, float))][:most]
+            return ", ".join([was, *edited])
+        return was
+    if own0 and not own1:
+        return "was the mesh file's own materials"
     if m0.name != m1.name:
-        n = len(maps0.paths())
-        return f"was {m0.name}" + (f" with {n} map{'s' if n > 1 else ''}" if n else "")
+        return was
     changes = []
     for f in dataclasses.fields(m1):
         a, b = getattr(m0, f.name), getattr(m1, f.name)
@@ -629,6 +738,11 @@ class History:
 
     def settle(self, current, editing: bool) -> None:
         if editing or current == self.committed:
+            return
+        if tuple(current[:2]) == tuple(self.committed[:2]):
+            # The 'own materials' box alone (its click, a mesh opened): no step of its own, but
+            # the snapshot keeps it, so the next edit's undo brings the box back as it was.
+            self.committed = current
             return
         self.undo_stack.append(self.committed)
         self.redo_stack.clear()

@@ -296,6 +296,11 @@ class EditorWindow:
         """glfw's drop callback: each file by its suffix; a bad one keeps the previous state.
         Several image files dropped together are a texture set (``drop_texture_set``), and so is
         a dropped folder (its images, as the 'texture set' field reads a folder)."""
+        mark = self.state.edit_mark()
+        self._drop(paths)
+        self.state.untick_own_for_edit(mark)   # a dropped map or preset is seen on every part
+
+    def _drop(self, paths: list[str]) -> None:
         folders = [p for p in paths if os.path.isdir(p)]
         paths = [p for p in paths if p not in folders]
         images = [p for p in paths if os.path.splitext(p)[1].lower() in IMAGE_SUFFIXES]
@@ -845,7 +850,9 @@ class EditorWindow:
         # the panel shown or not (--no-panel, a drop, --script open=).
         self.panel.take_file_jobs(self.state, self.renderer)
         if self.show_panel:
+            mark = self.state.edit_mark()
             self.panel.draw(self)
+            self.state.untick_own_for_edit(mark)   # a panel edit is seen, not hidden by the file's
             if not self.hosted:
                 self.press_guard.built(self._frame_no, self.panel.layout)
         from alight.frontends.editor.compare import draw_overlay
