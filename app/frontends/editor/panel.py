@@ -297,13 +297,12 @@ class Panel:
             # what runs in the background (grey): the child's occlusion bake, a new look's
             # shaders compiling in the warm-up process (the view holds the last picture
             # meanwhile, which must not pass for the new one). A new user saw both cut at the
-            # panel's edge with the message last. The shaders' note comes first, short: the view
-            # not showing the edit is what an artist dragging a slider must see (another saw
-            # "compiling sha" cut off after a preset's message, and the view still glossy 3 s on).
+            # panel's edge with the message last. The shaders' note is short: another saw
+            # "compiling sha" cut off after a preset's message, the view still glossy 3 s on.
             baking = getattr(getattr(win, "occlusion_bake", None), "status", "")
             compiling = "compiling shaders (view: last look)" \
                 if getattr(getattr(win, "variant_warmup", None), "showing_old", False) else ""
-            parts = [(text, kind) for text, kind in ((compiling, "note"), (s.message, "message"), (baking, "note"))
+            parts = [(text, kind) for text, kind in ((s.message, "message"), (compiling, "note"), (baking, "note"))
                      if text]
             for i, (text, kind) in enumerate(parts):
                 if i:
