@@ -187,3 +187,45 @@ def test_a_mirror_like_ball_has_no_sparkles_on_its_rim_with_msaa(shared_data):
     msaa = r.render(scene, maps, 256, 256, aa="msaa").srgb.astype(int)
     ssaa = r.render(scene, maps, 256, 256, aa="ssaa").srgb.astype(int)
     assert (np.abs(msaa - ssaa).max(axis=2) > 60).sum() == 0
+
+
+@pytest.mark.parametrize("view", ["camera", "probe"])
+def test_the_suns_loop_is_compiled_out_only_for_an_environment_without_a_sun(shared_data, view, monkeypatch):
+    """IBL_SUNS 0 (common/suns.glsl) where the maps hold no compact source: the same pixels as the
+    loop compiled in with a count of 0. One renderer switching between a map with a sun and one
+    without, both ways (as the editor's environment switch and a batch over environments do):
+    the map with a sun always draws with the loop (the image with it compiled out differs), and
+    each map's image is the one it gets alone, before any switch."""
+    from alight.render import passes
+    from alight.render.variants import sun_defines
+
+    r = renderer()
+    sunny = r.bake(load_environment(str(shared_data / "env" / "royal_esplanade_1k.hdr")), "low")
+    plain = r.bake(load_environment("studio"), "low")
+    assert sunny.suns and not plain.suns
+    assert sun_defines(plain) == {"IBL_SUNS": 0} and sun_defines(None) == {"IBL_SUNS": 0}
+    assert sun_defines(sunny) == {}
+    # car paint: the suns through the clear coat's layering (sun_layered); the camera view adds
+    # the ground and its sun shadow (ground.frag's loop) and a point light
+    scene = Scene(mesh=None if view == "probe" else sphere(), view=view, material=load_preset("car_paint"),
+                  lights=[] if view == "probe" else [Light("point", (2.0, 3.0, 4.0))],
+                  shadows="off" if view == "probe" else "on", ground=view == "camera")
+    size = 64
+    real = passes.sun_defines
+
+    def frame(maps, defines=None):
+        monkeypatch.setattr(passes, "sun_defines", real if defines is None else (lambda _maps: defines))
+        return r.render(scene, maps, size, size, aa="none", read_srgb=False).linear
+
+    sunny_alone = frame(sunny)
+    plain_out = frame(plain)
+    sunny_after = frame(sunny)
+    plain_after = frame(plain)
+    plain_loop = frame(plain, {})                     # the loop compiled in, its count a uniform 0
+    sunny_out = frame(sunny, {"IBL_SUNS": 0})         # what a sun drawn without its loop would give
+    keys = {k for k in r.shaders.compiled_keys() if k[2] == f"render/{'probe' if view == 'probe' else 'pbr'}.frag"}
+    assert any(("IBL_SUNS", 0) in k[3] for k in keys) and any(("IBL_SUNS", 0) not in k[3] for k in keys)
+    np.testing.assert_array_equal(plain_out, plain_loop)
+    np.testing.assert_array_equal(plain_after, plain_loop)
+    np.testing.assert_array_equal(sunny_after, sunny_alone)
+    assert np.abs(sunny_out[..., :3] - sunny_alone[..., :3]).max() > 0.05   # the sun shows on the ball

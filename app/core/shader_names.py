@@ -103,6 +103,7 @@ SHADER_OPTIONS: dict[str, str] = {
     # Environment light.
     "IBL_MODEL": "the IBL model compiled in (an IblModel value)",
     "IBL_BELOW_GRID": "the stretched lobe below its fitted grid falls back to the dominant direction",
+    "IBL_SUNS": "0: the environment has no compact source; its loops are compiled out (common/suns.glsl)",
     "MULTIPLE_SCATTERING": "multiple-scattering energy compensation of the specular lobe",
     # Punctual lights.
     "PUNCTUAL_SPOT": "some light is a spot (the cone attenuation is compiled in)",

@@ -55,6 +55,7 @@ from alight.render.variants import (
     part_defines,
     part_material,
     stretched_span_defines,
+    sun_defines,
     transmissive_parts,
     user_maps_present,
 )
@@ -319,7 +320,7 @@ def draw_ground(r, frame: FrameContext, scene, maps: IBLMaps | None, view_projec
         return
     if r.ground_pass is None:
         r.ground_pass = GroundPass(r.ctx)
-    defines = {**light_defines(scene), "HAS_SHADOWS": None}
+    defines = {**light_defines(scene), **sun_defines(maps), "HAS_SHADOWS": None}
     prog = scene_program(r, frame, "render/ground.vert", "render/ground.frag", defines)
     bind_ibl(prog, scene, maps, r.tables)
     r.shadow_maps.bind(prog, UNIT_SHADOW_ATLAS, UNIT_SHADOW_DEPTH)
@@ -346,7 +347,7 @@ def draw_background(r, frame: FrameContext, scene, maps: IBLMaps | None, inverse
 
 def draw_probe(r, scene, maps: IBLMaps | None, size: int, origin: tuple[int, int] = (0, 0)) -> None:
     """The probe view (render/probe.frag): the material on the unit sphere, per pixel centre."""
-    defines = {**ibl_defines(scene), **r._below_grid_defines(scene, maps, [scene.material]),
+    defines = {**ibl_defines(scene), **sun_defines(maps), **r._below_grid_defines(scene, maps, [scene.material]),
                **stretched_span_defines(scene, [scene.material]), **material_defines([scene.material])}
     prog = r.program("render/fullscreen.vert", "render/probe.frag", defines)
     prog["u_size"] = float(size)
@@ -369,6 +370,7 @@ def draw_mesh(r, frame: FrameContext, scene, maps: IBLMaps | None, camera: Camer
     it (TRANSMISSION_SCENE; ``pixels_per_radian``: the image's rows per radian at its centre,
     for the copy's blur)."""
     defines = ibl_defines(scene)
+    defines.update(sun_defines(maps))
     defines.update(light_defines(scene))
     user_maps = user_maps_present(scene)
     parts = list(zip(r.meshes.parts(scene.mesh), scene.mesh.parts))

@@ -2,8 +2,8 @@
 material a part draws with (``part_material``) and the defines it owns (``material_defines``,
 as the Khronos glTF Sample Renderer's ``material.getDefines()``), a part's defines
 (``part_defines``: maps, uv sets, alpha mode, ...), and the scene's (IBL model, lights, the
-below-grid fade). The accuracy modules use the same functions, so the reference shades the
-materials the renderer draws."""
+below-grid fade; the environment's suns: ``sun_defines``). The accuracy modules use the same
+functions, so the reference shades the materials the renderer draws."""
 
 from __future__ import annotations
 
@@ -188,6 +188,15 @@ def light_defines(scene) -> dict:
     if any(light.range is not None and light.kind != "directional" for light in lights):
         defines["PUNCTUAL_RANGE"] = None
     return defines
+
+
+def sun_defines(maps: IBLMaps | None) -> dict:
+    """``{"IBL_SUNS": 0}`` where the environment drawn has no compact source (``maps.suns``, what
+    app/ibl/sun.py took out of the map; no maps: none), so common/suns.glsl compiles its loops
+    out; else nothing (the count is a uniform). Decided from the maps each pass binds, so a
+    switch to an environment with a sun (the editor's, a batch's next map) compiles the variant
+    with the loops before it draws: the suns are never bound to a program without them."""
+    return {} if maps is not None and maps.suns else {"IBL_SUNS": 0}
 
 
 # The maps that cannot lower a roughness (MATERIAL_MAPS bits): any other map compiled in keeps
