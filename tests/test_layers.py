@@ -65,7 +65,8 @@ def test_the_ior_rule():
     # Edits: an ior alone keeps the specular colour; a specular_f0 alone sets the ior.
     coloured = Material(specular_f0=(0.02, 0.04, 0.04))
     edited = with_overrides(coloured, ior=2.0)
-    assert edited.specular_f0 == pytest.approx((f0_from_ior(2.0) / 2, f0_from_ior(2.0), f0_from_ior(2.0)))
+    lum = 0.2126 * 0.5 + 0.7152 + 0.0722   # the colour (0.5, 1, 1)'s luminance: it keeps the ior's F0
+    assert edited.specular_f0 == pytest.approx(tuple(f0_from_ior(2.0) * c / lum for c in (0.5, 1.0, 1.0)))
     assert with_overrides(Material(ior=2.0), specular_f0=(0.02,) * 3).ior == pytest.approx(ior_from_f0(0.02))
     assert with_overrides(Material(ior=2.0), roughness=0.3).ior == 2.0   # other edits leave it
     for f0 in (0.0, 0.01, 0.04, 0.17, 0.5):
@@ -264,3 +265,19 @@ def test_reference_refuses_a_mirror_coat(tmp_path):
     lines = [x for x in proc.stderr.splitlines() if x.strip()]
     assert proc.returncode == 2 and len(lines) == 1 and not out.exists()
     assert lines[0].startswith("alight: error: --clearcoat-roughness: clearcoat_roughness 0.05 < 0.1")
+
+
+def test_a_coloured_specular_f0_gives_the_ior_of_its_luminance_everywhere():
+    """The rule reads a coloured F0 by its luminance (the editor's panel and the command line
+    alike): one channel at 0.32 over 0.04 is ior 1.92, not the red channel's 3.6; an ior edit
+    keeps the tint at the ior's luminance."""
+    from alight.core.material import luminance
+
+    tinted = (0.32, 0.04, 0.04)
+    m = Material(specular_f0=tinted)
+    assert m.ior == pytest.approx(ior_from_f0(luminance(tinted))) and 1.9 < m.ior < 1.95
+    assert with_overrides(Material(), specular_f0=tinted).ior == pytest.approx(m.ior)
+    edited = with_overrides(m, ior=1.5)
+    assert luminance(edited.specular_f0) == pytest.approx(0.04)
+    assert edited.specular_f0[0] / edited.specular_f0[1] == pytest.approx(8.0)
+    assert "ior" not in m.to_dict()   # derived by the rule: left out of a preset file

@@ -39,6 +39,15 @@ DEFAULT_IOR = 1.5  # glTF's; F0 = ((1.5 - 1) / (1.5 + 1))^2 = 0.04
 # Above this F0 the ior grows without bound (F0 = 1 needs ior = inf): ior_from_f0 stops here
 # (ior 37.97), and KHR_materials_specular carries the rest.
 MAX_IOR_F0 = 0.9
+# Rec. 709's weights of linear RGB: the grey a coloured specular F0 reflects as. The ior rule
+# reads a coloured F0 by it (the editor's panel and the command line alike): one channel at 0.32
+# over 0.04 made the brightest channel's ior 3.6, a new user's surprise.
+LUMINANCE = (0.2126, 0.7152, 0.0722)
+
+
+def luminance(c) -> float:
+    """Rec. 709 luminance of linear RGB ``c`` (3 numbers)."""
+    return sum(w * float(x) for w, x in zip(LUMINANCE, c))
 
 
 def f0_from_ior(ior: float) -> float:
@@ -54,13 +63,14 @@ def ior_from_f0(f0: float) -> float:
 
 
 def specular_f0_for_ior(ior: float, like: Vec3 | None = None) -> Vec3:
-    """The specular_f0 of ``ior`` with the specular colour of ``like`` (like / max(like); grey
-    when ``like`` is None or black): the rule's 'ior given alone' case."""
+    """The specular_f0 of ``ior`` with the specular colour of ``like`` (like / luminance(like),
+    each channel at most 1; grey when ``like`` is None or black): the rule's 'ior given alone'
+    case."""
     f0 = f0_from_ior(ior)
-    peak = max(like) if like is not None else 0.0
-    if peak <= 0.0:
+    lum = luminance(like) if like is not None else 0.0
+    if lum <= 0.0:
         return (f0, f0, f0)
-    return tuple(min(f0 * c / peak, 1.0) for c in like)  # type: ignore[return-value]
+    return tuple(min(f0 * c / lum, 1.0) for c in like)  # type: ignore[return-value]
 
 
 @dataclass(frozen=True)
@@ -71,7 +81,7 @@ class Material:
     ``ior`` and ``specular_f0`` describe one dielectric interface (the rule, docs/layers.md):
     ``specular_f0 = ((ior - 1)/(ior + 1))^2 * specular colour`` (KHR_materials_ior times
     KHR_materials_specular). Give one and the other follows: ``Material(specular_f0=...)`` gets
-    ``ior = ior_from_f0(max(specular_f0))``, ``Material(ior=...)`` the grey
+    ``ior = ior_from_f0(luminance(specular_f0))``, ``Material(ior=...)`` the grey
     ``specular_f0 = f0_from_ior(ior)``, neither gives glTF's 1.5 and 0.04; give both for a
     specular colour or strength that is not the ior's. The base layer reflects with
     ``specular_f0``; refraction (transmission, volume) uses ``ior``.
@@ -125,7 +135,7 @@ class Material:
         elif f0 is None:
             f0 = specular_f0_for_ior(ior) if _is_number(ior) else f0
         elif ior is None and _is_vector(f0):
-            ior = ior_from_f0(max(float(c) for c in f0))
+            ior = ior_from_f0(luminance(f0))
         object.__setattr__(self, "specular_f0", f0)
         object.__setattr__(self, "ior", ior)
 
@@ -176,7 +186,7 @@ class Material:
             "specular_f0": list(self.specular_f0),
             "emissive": list(self.emissive),
         }
-        if abs(self.ior - ior_from_f0(max(self.specular_f0))) > 1e-9:
+        if abs(self.ior - ior_from_f0(luminance(self.specular_f0))) > 1e-9:
             d["ior"] = self.ior
         for field in LAYER_FIELDS:
             value = getattr(self, field)

@@ -53,35 +53,23 @@ def _edited(m, **fields):
         return dataclasses.replace(m, **fields)
 
 
-# Rec. 709's weights of linear RGB: the grey a coloured F0 reflects as (docs/conventions.md).
-LUMINANCE = (0.2126, 0.7152, 0.0722)
-
-
-def _luminance(c) -> float:
-    return sum(w * x for w, x in zip(LUMINANCE, c))
-
-
 def _f0_edited(m, f0):
-    """Specular F0 typed or dragged (a channel or all): the ior follows the F0's luminance
-    (F0 = ((ior-1)/(ior+1))^2 for a grey F0, as before), and a coloured F0 is kept as typed, its
-    tint the specular colour (KHR_materials_specular's specularColorFactor, F0 / F0(ior)). One
-    channel dragged to 0.32 no longer makes the ior that channel's 3.6."""
-    from alight.core.material import ior_from_f0
+    """Specular F0 typed or dragged (a channel or all): the ior follows by the rule
+    (alight.core.material: the F0's luminance), a coloured F0 kept as typed, its tint the
+    specular colour (KHR_materials_specular's specularColorFactor, F0 / F0(ior))."""
+    from alight.core.material import ior_from_f0, luminance
 
     f0 = tuple(min(max(float(x), 0.0), 1.0) for x in f0)
-    return _edited(m, specular_f0=f0, ior=max(ior_from_f0(_luminance(f0)), 1.0))
+    return _edited(m, specular_f0=f0, ior=max(ior_from_f0(luminance(f0)), 1.0))
 
 
 def _ior_edited(m, ior):
-    """The ior typed or dragged: the specular F0 scaled, its tint kept, to the luminance the
-    ior's F0 has (``_f0_edited``'s inverse)."""
-    from alight.core.material import f0_from_ior
+    """The ior typed or dragged: the specular F0 of the rule, its tint kept (``_f0_edited``'s
+    inverse)."""
+    from alight.core.material import specular_f0_for_ior
 
     ior = max(float(ior), 1.0)
-    target, old = f0_from_ior(ior), m.specular_f0
-    lum = _luminance(old)
-    f0 = tuple(min(c * target / lum, 1.0) for c in old) if lum > 0.0 else (target,) * 3
-    return _edited(m, ior=ior, specular_f0=f0)
+    return _edited(m, ior=ior, specular_f0=specular_f0_for_ior(ior, m.specular_f0))
 
 
 def _short_float(x):
