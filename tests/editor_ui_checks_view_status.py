@@ -167,6 +167,26 @@ def test_the_f0_line_says_it_is_the_factors_with_a_metallic_map(ctx):
     assert win.panel.shown_f0.startswith("F0 = "), win.panel.shown_f0
 
 
+def test_the_preset_table_fits_a_narrow_panel(ctx):
+    """The window made narrow, as the window manager does it (a new user's 700x500 drew the F0
+    columns over each other, "0.02 0.02 0.0.15 0.15 0"): the table keeps the columns whose
+    digits fit in their cells and drops the others; wide again, all three come back."""
+    win = editor()
+    glfw = win.glfw
+    width, height = glfw.get_window_size(win.window)
+    try:
+        for size, columns in (((1280, 720), 3), ((700, 500), None), ((520, 400), 1)):
+            glfw.set_window_size(win.window, *size)
+            ctx.yield_(4)
+            shown = (win.panel.preset_columns, round(win.panel.preset_overflow, 1))
+            assert win.panel.preset_overflow <= 0.5, (size, shown)
+            assert columns is None or win.panel.preset_columns == columns, (size, shown)
+            print(f"PRESET_TABLE {size}: {shown[0]} columns, widest F0 text {shown[1]:+.1f} px past its cell")
+    finally:
+        glfw.set_window_size(win.window, width, height)
+        ctx.yield_(4)
+
+
 def test_leave_turntable_settings_and_msaa_for_the_next_session(ctx):
     """Set through the panel; the runner reopens the editor on the session saved at the end."""
     win = editor()

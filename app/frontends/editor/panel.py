@@ -179,6 +179,7 @@ class Panel:
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.shown_status = ""  # the status row's text drawn last frame (tests read it)
         self.shown_f0 = ""      # the F0 line drawn last frame (tests read it)
+        self.preset_columns, self.preset_overflow = 3, 0.0   # the preset table drawn last frame (tests read it)
         self.shown_job_status = ""   # the status row's last "opening .../exporting ..." (tests read it)
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
@@ -351,13 +352,20 @@ class Panel:
         m = s.material
         picked = None   # the preset clicked this frame: it also becomes what 'revert' goes back to
         _, s.use_file_materials = imgui.checkbox("mesh file's own materials and maps", s.use_file_materials)
-        if imgui.begin_table("presets", 3, imgui.TableFlags_.borders_inner_h):
-            # The names' column as wide as the longest name and its swatch: the F0 columns take the rest.
-            longest = max((name for name, *_ in self.presets), key=len, default="preset")
-            name_width = imgui.calc_text_size(longest).x + ICON + imgui.get_style().item_spacing.x
+        # The names' column as wide as the longest name and its swatch; the F0 columns where the
+        # panel has room for their digits (a narrow window drew "0.02 0.02 0.0.15 0.15 0", the
+        # columns over each other): sRGB goes first, then linear, each then in the name's tooltip.
+        style = imgui.get_style()
+        longest = max((name for name, *_ in self.presets), key=len, default="preset")
+        name_width = imgui.calc_text_size(longest).x + ICON + style.item_spacing.x
+        digits = imgui.calc_text_size("0.00 0.00 0.00").x + 2.0 * style.cell_padding.x + style.item_spacing.x
+        room = imgui.get_content_region_avail().x - name_width - 2.0 * style.cell_padding.x
+        f0_columns = [c for c, fits in (("F0 linear", room >= digits), ("F0 sRGB", room >= 2.0 * digits)) if fits]
+        overflow = 0.0   # how far the widest F0 text ran past its cell's right edge (px)
+        if imgui.begin_table("presets", 1 + len(f0_columns), imgui.TableFlags_.borders_inner_h):
             imgui.table_setup_column("preset", imgui.TableColumnFlags_.width_fixed, name_width)
-            imgui.table_setup_column("F0 linear")
-            imgui.table_setup_column("F0 sRGB")
+            for column in f0_columns:
+                imgui.table_setup_column(column)
             imgui.table_headers_row()
             for name, preset, f0, f0_srgb in self.presets:
                 imgui.table_next_row()
@@ -367,11 +375,16 @@ class Panel:
                 # Highlighted: the preset the material is now (none once any field is edited or a map loaded).
                 if imgui.selectable(name, m == preset and not s.texture_maps.paths(), 0, imgui.ImVec2(0, ICON))[0]:
                     m = picked = preset
-                imgui.table_next_column()
-                imgui.text(" ".join(f"{x:.2f}" for x in f0))
-                imgui.table_next_column()
-                imgui.text(" ".join(f"{x:.2f}" for x in f0_srgb))
+                if len(f0_columns) < 2 and imgui.is_item_hovered():
+                    imgui.set_tooltip(f"F0 linear {' '.join(f'{x:.2f}' for x in f0)}, "
+                                      f"sRGB {' '.join(f'{x:.2f}' for x in f0_srgb)}")
+                for column, values in zip(f0_columns, (f0, f0_srgb)):
+                    imgui.table_next_column()
+                    right = imgui.get_cursor_screen_pos().x + imgui.get_content_region_avail().x
+                    imgui.text(" ".join(f"{x:.2f}" for x in values))
+                    overflow = max(overflow, imgui.get_item_rect_max().x - right)
             imgui.end_table()
+        self.preset_columns, self.preset_overflow = 1 + len(f0_columns), overflow   # (the checks read them)
         self.library.draw(s, win)   # saved materials; a click is applied after the write-back below
         # Base colour is stored linear (docs/conventions.md) and shown sRGB, as artists pick colours.
         changed, col = imgui.color_edit3("base colour (sRGB)", _srgb(m.base_color))
