@@ -444,7 +444,7 @@ def test_nan_positions_and_bad_indices_refused(tmp_path):
     _refused(nan, "NaN")
     oor_obj = tmp_path / "oor.obj"  # trimesh itself fails on this one
     oor_obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")
-    _refused(oor_obj, "cannot read")
+    _refused(oor_obj, "line 4: the face names vertex 7, but the file has 3 vertices")
     oor_ply = tmp_path / "oor.ply"  # trimesh passes this one through; our check refuses it
     oor_ply.write_text(
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
