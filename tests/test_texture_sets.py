@@ -400,6 +400,7 @@ def test_editor_drop_of_several_files_is_a_texture_set(tmp_path, validate):
     class Fake:
         state = EditorState()
         drop_texture_set = EditorWindow.drop_texture_set
+        _drop = EditorWindow._drop
 
     fake = Fake()
     fake.state.material = fake.state.material.__class__(base_color=(1.0, 0.8, 0.3), metallic=1.0, roughness=0.2)
