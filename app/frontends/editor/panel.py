@@ -376,8 +376,8 @@ class Panel:
                 if imgui.selectable(name, m == preset and not s.texture_maps.paths(), 0, imgui.ImVec2(0, ICON))[0]:
                     m = picked = preset
                 if len(f0_columns) < 2 and imgui.is_item_hovered():
-                    imgui.set_tooltip(f"F0 linear {' '.join(f'{x:.2f}' for x in f0)}, "
-                                      f"sRGB {' '.join(f'{x:.2f}' for x in f0_srgb)}")
+                    tooltip(f"F0 linear {' '.join(f'{x:.2f}' for x in f0)}, "
+                            f"sRGB {' '.join(f'{x:.2f}' for x in f0_srgb)}")
                 for column, values in zip(f0_columns, (f0, f0_srgb)):
                     imgui.table_next_column()
                     right = imgui.get_cursor_screen_pos().x + imgui.get_content_region_avail().x
