@@ -151,3 +151,15 @@ def test_the_api_says_a_flat_mesh_is_seen_edge_on(capfd):
         assert edge_on == [f"alight: warning: {FLAT}: the mesh is flat and the default camera (on +Z) sees it "
                            "edge-on, so it may not show; set_camera(orbit_deg=0, elevation_deg=30) looks at it "
                            "from another side"]
+
+
+def test_light_spec_is_parse_lights_inverse():
+    """The editor's 'copy camera as flags' writes each light with light_spec: --light reads it
+    back as the same light, for every kind and the optional fields."""
+    from alight.core.scene import Light, light_spec, parse_light
+
+    for light in (Light("point", (2.0, 3.0, 4.0), (1.0, 0.95, 0.9), 10.0),
+                  Light("directional", (-0.3, -1.0, -0.5), (1.0, 1.0, 1.0), 1.0),
+                  Light("spot", (1.0, 2.0, 3.0), (0.5, 0.5, 0.5), 30.0, range=12.5, direction=(0.0, -1.0, 0.0),
+                        inner_cone_deg=10.0, outer_cone_deg=35.0)):
+        assert parse_light(light_spec(light)) == light, light_spec(light)

@@ -217,6 +217,28 @@ def parse_light(spec: str, where: str = "--light") -> Light:
     return light
 
 
+def light_spec(light: Light) -> str:
+    """``light`` in ``--light``'s syntax: ``parse_light``'s inverse (it reads the spec back as the
+    same light; numbers to 9 significant digits)."""
+    def g(x: float) -> str:
+        return f"{float(x):.9g}"
+
+    def xyz(v) -> str:
+        return ",".join(g(x) for x in v)
+
+    if light.kind == "directional":
+        spec = f"directional:dir={xyz(light.vector)}"
+    elif light.kind == "spot":
+        spec = (f"spot:pos={xyz(light.vector)}:dir={xyz(light.direction)}"
+                f":inner={g(light.inner_cone_deg)}:outer={g(light.outer_cone_deg)}")
+    else:
+        spec = f"point:pos={xyz(light.vector)}"
+    spec += f":color={xyz(light.color)}:intensity={g(light.intensity)}"
+    if light.range is not None and light.kind != "directional":
+        spec += f":range={g(light.range)}"
+    return spec
+
+
 @dataclass
 class Display:
     tonemap: str = "aces"

@@ -16,7 +16,7 @@ from pathlib import Path
 from alight.core.ibl_models import DEFAULT_IBL_MODEL, IBL_MODELS
 from alight.core.material import Material, validate_material, with_overrides
 from alight.core.material_fields import FIELDS
-from alight.core.scene import TONEMAPS, Display, Light, Scene
+from alight.core.scene import TONEMAPS, Display, Light, Scene, light_spec
 from alight.core.shader_names import DATA_VIEWS, DEBUG_VIEWS
 from alight.core.visibility import OCCLUSION_MODES
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
@@ -147,7 +147,7 @@ class EditorState:
 
         flags = []
         for light in self.lights:
-            flags += ["--light", light_spec(light)]
+            flags += ["--light", light_spec(light)]   # (alight.core.scene: parse_light's inverse)
         if not self.lights:
             flags.append("--no-file-lights")
         if self.env_rotation_deg % 360.0:
@@ -644,24 +644,6 @@ class EditorState:
 
 def _g(x: float) -> str:
     return f"{float(x):.9g}"
-
-
-def light_spec(light: Light) -> str:
-    """``light`` in ``--light``'s syntax (alight.core.scene.parse_light reads it back as it is)."""
-    def xyz(v) -> str:
-        return ",".join(_g(x) for x in v)
-
-    if light.kind == "directional":
-        spec = f"directional:dir={xyz(light.vector)}"
-    elif light.kind == "spot":
-        spec = (f"spot:pos={xyz(light.vector)}:dir={xyz(light.direction)}"
-                f":inner={_g(light.inner_cone_deg)}:outer={_g(light.outer_cone_deg)}")
-    else:
-        spec = f"point:pos={xyz(light.vector)}"
-    spec += f":color={xyz(light.color)}:intensity={_g(light.intensity)}"
-    if light.range is not None and light.kind != "directional":
-        spec += f":range={_g(light.range)}"
-    return spec
 
 
 def _material_only(path: str) -> bool:
