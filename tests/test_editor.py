@@ -107,6 +107,22 @@ def test_a_mesh_opened_by_script_is_drawn_as_the_mesh_option_draws_it(display, t
     assert not (tmp_path / "x.png").exists()
 
 
+def test_a_scripts_material_edit_is_seen_on_a_mesh_with_its_own_materials(display, tmp_path, shared_data):
+    """--script preset= and roughness= after open= untick the mesh file's own materials, as the
+    panel's controls do: the duck is drawn in the scripted material, as --mesh with --preset and
+    --roughness draws it, not in its own yellow with the edit hidden."""
+    duck = str(shared_data / "models" / "Duck.glb")
+    scripted = screenshot(tmp_path, "scripted", "--new", "--script", f"open={duck}", "--script", "preset=gold",
+                          "--script", "roughness=0.3")
+    given = screenshot(tmp_path, "given", "--new", "--mesh", duck, "--preset", "gold", "--roughness", "0.3")
+    assert np.abs(scripted - given).max() <= 3
+    own = screenshot(tmp_path, "own", "--new", "--script", f"open={duck}")
+    assert np.abs(scripted - own).mean() > 5.0
+    plain = ball(screenshot(tmp_path, "plain", "--new", "--script", f"open={duck}", "--script", "roughness=0.3"))
+    # the panel's default material (white), not the duck's yellow texture
+    assert abs(plain[:, 0].mean() - plain[:, 2].mean()) < 15, plain.mean(axis=0)
+
+
 def test_the_editor_takes_renders_scene_options(display, tmp_path):
     """--light replaces the editor's three lights (given as specs here: the same picture),
     --env-rotation is the panel's rotation (as --script sets it); --view probe, which the editor

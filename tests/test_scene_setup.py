@@ -163,3 +163,39 @@ def test_light_spec_is_parse_lights_inverse():
                   Light("spot", (1.0, 2.0, 3.0), (0.5, 0.5, 0.5), 30.0, range=12.5, direction=(0.0, -1.0, 0.0),
                         inner_cone_deg=10.0, outer_cone_deg=35.0)):
         assert parse_light(light_spec(light)) == light, light_spec(light)
+
+
+def test_the_editors_flags_are_read_back_as_its_scene():
+    """'copy camera as flags' (EditorState.render_flags) leaves out each setting that is at
+    'alight render''s default: parsed by the command's own parser and set up by its own code, the
+    flags give the editor's scene back, field by field, for the editor's defaults and for every
+    setting moved off them. (render_flags writes the command's defaults down itself: a default
+    changed in the parser and not there fails here.)"""
+    from alight.core.scene import Display, Light
+    from alight.frontends.cli import build_parser
+    from alight.frontends.cli.render import _scene
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.state import EditorState
+    from alight.frontends.options import build_look
+
+    moved = [{}, {"lights": []}, {"lights": [Light("directional", (0.0, -1.0, 0.0), (1.0, 1.0, 1.0), 2.0)]},
+             {"env_rotation_deg": 90.0}, {"env_intensity": 0.5}, {"ibl_enabled": False}, {"ibl_model": "lecture"},
+             {"multiple_scattering": True}, {"quality": "high"}, {"occlusion": "off"}, {"occlusion": "gtao"},
+             {"shadows": "off"}, {"ground": True}, {"aa": "none"},
+             {"display": Display(tonemap="none", exposure=1.5, background="color", background_color=(0.5, 0.25, 0.125))},
+             {"display": Display(background="blur")}]
+    for fields in moved:
+        state = EditorState(**fields)
+        state.load_mesh("sphere")
+        state.load_env("studio")
+        camera = OrbitCamera()
+        flags = [*camera.render_flags((64, 48)), *state.render_flags()]
+        args = build_parser().parse_args(["render", "--out", "x.png", *flags])
+        got = _scene(args, build_look(args)).scene
+        want = state.scene(camera)
+        for name in ("lights", "env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model",
+                     "multiple_scattering", "occlusion", "shadows", "ground"):
+            assert getattr(got, name) == getattr(want, name), (fields, name, flags)
+        assert dataclasses.replace(got.display, blur_roughness=0) == dataclasses.replace(want.display, blur_roughness=0), \
+            (fields, flags)
+        assert (args.quality, args.aa) == (state.quality, state.aa), (fields, flags)

@@ -35,6 +35,10 @@ EDITOR_MESH_HINT = "open the file as the mesh ('mesh', Environment) with 'mesh f
 # From the registry, so a layer added there is a --script key too (a colour as R,G,B).
 VECTOR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "color")
 SCALAR_LAYER_FIELDS = tuple(f.name for f in FIELDS if f.layer and f.kind == "number")
+# The --script keys that edit the panel's material (with map_SLOT): as the panel's controls, they
+# untick the mesh file's own materials.
+MATERIAL_EDIT_KEYS = ("roughness", "metallic", "ior", "base_color", "emissive", "specular_f0", "preset",
+                      "uv_scale", "uv_offset", *SCALAR_LAYER_FIELDS, *VECTOR_LAYER_FIELDS)
 
 
 def default_lights() -> list[Light]:
@@ -562,13 +566,21 @@ class EditorState:
         env_rotation, env_intensity, ibl (0/1), ibl_model, multiple_scattering (0/1), occlusion
         (auto/on/off), shadows (auto/on/off), ground (0/1), quality;
         map_SLOT (an image path, '' clears; SLOT one of alight.core.texture_maps.MAP_SLOTS), uv_scale /
-        uv_offset (U,V)."""
-        from alight.core.material import parse_color
-
+        uv_offset (U,V). Edits of the material or its maps untick the mesh file's own materials."""
         key, sep, value = edit.partition("=")
         key = key.strip().replace("-", "_")
         if not sep:
             raise AlightError(f"--script: '{edit}' is not FIELD=VALUE")
+        # An edit of the material or its maps unticks the mesh file's own materials as the panel's
+        # controls do (untick_own_for_edit): with the box ticked a script's roughness= drew nothing.
+        mark = self.edit_mark()
+        self._apply_edit(key, value, edit)
+        if key in MATERIAL_EDIT_KEYS or (key.startswith("map_") and key[4:] in MAP_SLOTS):
+            self.untick_own_for_edit(mark)
+
+    def _apply_edit(self, key: str, value: str, edit: str) -> None:
+        from alight.core.material import parse_color
+
         try:
             if key in ("roughness", "metallic", "ior", *SCALAR_LAYER_FIELDS):
                 self.material = with_overrides(self.material, "--script", **{key: _finite(value, edit)})
