@@ -14,7 +14,9 @@ interpreter (``python tests/editor_window_mesh_loads.py restore|script``) with D
 
 Both count what ran on the main thread: no read of the helmet, no texture uploaded whole and no
 self-shadowing test there (whatever the machine's load); and the longest gap between frames is
-bounded loosely (the machine is shared: MAX_GAP_S)."""
+bounded in the main thread's CPU time (MAX_CPU_GAP_S: what the UI thread itself did between two
+frames, which another process's load does not stretch) and loosely in wall time (MAX_GAP_S),
+the latter only where the machine is not overloaded (see ``gap_failure``)."""
 
 from __future__ import annotations
 
@@ -31,6 +33,9 @@ HELMET = os.path.abspath(os.path.join(SHARED, "models", "DamagedHelmet", "Damage
 # decoding and mip levels took 2.5-6 s here; through the worker the frames that draw the new mesh
 # take up to 0.3-0.6 s under load, and one sharing the cores with the read now and then more.
 MAX_GAP_S = 2.0
+# The main thread's CPU time between two frames' ends: the read, decoding and levels it did
+# before were 2.5-6 s of it; a frame drawing the new mesh, its upload steps included, 0.1-0.4 s.
+MAX_CPU_GAP_S = 1.0
 
 
 def counters():
@@ -80,7 +85,8 @@ def on_main_thread(seen: dict, mesh) -> dict:
 
 
 def timed_frames():
-    """Each EditorWindow.frame's end, in order (time.monotonic)."""
+    """Each EditorWindow.frame's end, in order: (time.monotonic, the main thread's
+    time.thread_time)."""
     from alight.frontends.editor.window import EditorWindow
 
     ends: list = []
@@ -88,10 +94,34 @@ def timed_frames():
 
     def timed(self, *args, **kwargs):
         result = frame(self, *args, **kwargs)
-        ends.append(time.monotonic())
+        ends.append(mark())
         return result
     EditorWindow.frame = timed
     return ends
+
+
+def mark() -> tuple[float, float]:
+    return time.monotonic(), time.thread_time()
+
+
+def gap_failure(ends: list, what: str) -> tuple[str | None, str]:
+    """(a line saying which bound the gaps between frames broke, or None; the gaps for the ok
+    line). The CPU bound always holds; the wall bound only where the 1-minute load is at most
+    twice the cores: at load 9-13 on this 2-core machine (other sessions' renders) frames that
+    took 0.3-0.6 s came 2-3 s apart on old and new code alike, with the main thread idle."""
+    wall = [b[0] - a[0] for a, b in zip(ends, ends[1:])]
+    cpu = [b[1] - a[1] for a, b in zip(ends, ends[1:])]
+    load, cores = os.getloadavg()[0], os.cpu_count() or 1
+    said = f"the longest gaps {longest(wall)}; in main-thread CPU {longest(cpu)}; load {load:.1f}"
+    if max(cpu) > MAX_CPU_GAP_S:
+        return (f"the main thread ran {max(cpu):.2f} s of CPU between two frames while {what} "
+                f"(bound {MAX_CPU_GAP_S} s): {longest(cpu)}"), said
+    if max(wall) > MAX_GAP_S:
+        if load <= 2 * cores:
+            return (f"a frame came {max(wall):.2f} s after the one before while {what} "
+                    f"(bound {MAX_GAP_S} s, load {load:.1f}): {longest(wall)}"), said
+        said += f" (the wall bound {MAX_GAP_S} s not checked above load {2 * cores})"
+    return None, said
 
 
 def longest(gaps: list) -> str:
@@ -123,7 +153,7 @@ def restore() -> int:
     state = build_state(args)
     win = EditorWindow(state, args.size)
     try:
-        ends.append(time.monotonic())   # the gap to the first frame holds the session's restore
+        ends.append(mark())   # the gap to the first frame holds the session's restore
         open_last_session(win, state)   # as `alight edit` starts (run.py)
         deadline = time.monotonic() + 600
         while state.mesh_spec != HELMET or win.panel.file_jobs.busy:
@@ -133,7 +163,7 @@ def restore() -> int:
             win.frame()
         for _ in range(3):   # the helmet drawn
             win.frame()
-        gaps = [b - a for a, b in zip(sorted(ends), sorted(ends)[1:])]
+        failed, gaps = gap_failure(sorted(ends), "the restored helmet came")
         own, yaw, distance = state.use_file_materials, win.orbit.yaw_deg, win.orbit.distance
         here = on_main_thread(seen, state.mesh)
     finally:
@@ -141,15 +171,14 @@ def restore() -> int:
     if here:
         print(f"on the main thread while the restored helmet came: {here}")
         return 1
-    if max(gaps) > MAX_GAP_S:
-        print(f"a frame came {max(gaps):.2f} s after the one before while the restored helmet came "
-              f"(bound {MAX_GAP_S} s): {longest(gaps)}")
+    if failed:
+        print(failed)
         return 1
     if own or (yaw, distance) != (61.0, 4.25):
         print(f"the session's own-materials box {own} (saved False) or camera yaw {yaw}, distance {distance} "
               f"(saved 61, 4.25) not kept for the restored mesh")
         return 1
-    print(f"ok: restored helmet in {len(gaps)} frames, the longest gaps {longest(gaps)}")
+    print(f"ok: restored helmet in {len(ends) - 1} frames, {gaps}")
     return 0
 
 
@@ -179,12 +208,11 @@ def script() -> int:
     if applied[-1] != ("roughness=0.4", HELMET):
         print(f"the edit after mesh= did not see the helmet: {applied}")
         return 1
-    gaps = [b - a for a, b in zip(ends, ends[1:])]
-    if max(gaps) > MAX_GAP_S:
-        print(f"a frame came {max(gaps):.2f} s after the one before while mesh= opened the helmet "
-              f"(bound {MAX_GAP_S} s): {longest(gaps)}")
+    failed, gaps = gap_failure(ends, "mesh= opened the helmet")
+    if failed:
+        print(failed)
         return 1
-    print(f"ok: --script mesh= in {len(gaps) + 1} frames, the longest gaps {longest(gaps)}; {json.dumps(applied)}")
+    print(f"ok: --script mesh= in {len(ends)} frames, {gaps}; {json.dumps(applied)}")
     return 0
 
 
