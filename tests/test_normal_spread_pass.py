@@ -90,7 +90,9 @@ def test_the_staged_upload_writes_the_spread_in_bands_of_steps():
     levels = mip_levels(without_spread(image), False)
     upload = MeshUpload(None, [(texture_key(info, False, 0.8), info, False, levels)], False)
     spread = [i for i, p in enumerate(upload.pieces) if p[1] == SPREAD]
-    assert len(spread) == len(spread_bands((2048, 1024), 12)) and spread[0] > 0
+    assert len(spread) == 1 + len(spread_bands((2048, 1024), 12)) and spread[0] > 0
+    assert upload.pieces[spread[0]][2] == -1    # the means made first, in a step of their own
+    spread = spread[1:]
     assert spread == list(range(spread[0], len(upload.pieces)))   # after every level's own pieces
     steps = []
     while upload.next < len(upload.pieces):

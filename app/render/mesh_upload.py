@@ -45,7 +45,8 @@ class MeshUpload:
         self.textures = textures
         self.self_shadowing = self_shadowing
         # The pieces to write, in order: (texture index, level, first row, end row), or for a
-        # band of a normal map's spread pass (texture index, SPREAD, band, band's texels).
+        # band of a normal map's spread pass (texture index, SPREAD, band or -1 for its means
+        # texture made, the band's texels).
         self.pieces = []
         for t, (key, _, _, levels) in enumerate(textures):
             for n, level in enumerate(levels or [None]):
@@ -54,6 +55,8 @@ class MeshUpload:
                 self.pieces += [(t, n, y, min(rows, y + band)) for y in range(0, rows, band)]
             if levels is not None and len(levels) > 1 and spread_of(key) is not None:
                 h, w = levels[0].shape[:2]
+                # first the pass's means texture made (band -1), then its bands
+                self.pieces += [(t, SPREAD, -1, BAND_TEXELS)]
                 self.pieces += [(t, SPREAD, i, (y1 - y0) * (w >> level or 1))
                                 for i, (level, y0, y1) in enumerate(spread_bands((w, h), len(levels)))]
         self.next = 0                    # the next piece
@@ -83,9 +86,12 @@ class MeshUpload:
                     h, w = levels[0].shape[:2]
                     self.spreads[t] = SpreadWriter(ctx, self.made[t], (w, h), len(levels), spread_of(key))
                 writer = self.spreads[t]
-                writer.write(y0)
-                if y0 == len(writer.bands) - 1:
-                    self.spreads.pop(t).release()
+                if y0 < 0:
+                    writer.allocate()
+                else:
+                    writer.write(y0)
+                    if y0 == len(writer.bands) - 1:
+                        self.spreads.pop(t).release()
                 # a band of BAND_TEXELS costs about as much as writing STEP_BYTES (llvmpipe)
                 written += max(1, STEP_BYTES * y1 // BAND_TEXELS)
             elif levels is None:
