@@ -127,3 +127,17 @@ def test_the_shader_takes_the_twins_constants():
     assert float(defines["NORMAL_SPREAD_FLOOR"]) == normal_spread.SPREAD_FLOOR
     assert float(defines["NORMAL_SPREAD_MAX"]) == normal_spread.MAX_SPREAD
     assert float(defines["NORMAL_FLAT_LENGTH"]) == normal_spread.FLAT_LENGTH
+
+
+def test_the_pass_is_compiled_again_when_its_source_changes(monkeypatch):
+    # (the editor's shader reload: the pass is kept per context, with its source's digest)
+    from alight.render import normal_spread, normal_spread_pass
+
+    r = renderer()
+    first = normal_spread_pass._program(r.ctx)
+    assert normal_spread_pass._program(r.ctx) is first
+    monkeypatch.setattr(normal_spread, "SPREAD_FLOOR", 2e-6)   # another define: another text
+    again = normal_spread_pass._program(r.ctx)
+    assert again is not first and type(first.mglo).__name__ == "InvalidObject"
+    monkeypatch.undo()
+    assert normal_spread_pass._program(r.ctx) is not again

@@ -3,9 +3,10 @@ where alight.render.normal_spread is its numpy twin.
 
 The texture arrives with every level's RGB in place (GL's generate_mipmap, or mip_levels' levels
 written by the editor's staged upload) and A = 0; the pass writes A of each level from 1 on, RGB
-kept. Measured on llvmpipe (benchmarks/results/normal_spread.md) this takes a fraction of the
-numpy twin's time for a 2048x2048 map, and it runs where the texture already is: nothing is read
-back, and no 2048^2 float array is made on the CPU.
+kept. On llvmpipe, where the GPU is the same CPU cores, the upload of a 2048x2048 map takes about
+half the time it took with the numpy twin's levels (benchmarks/results/normal_spread.md); on a GPU
+the pass is a few short dispatches. Nothing is read back, and no 2048^2 float array is made on
+the CPU.
 
 Every call here is GL work: it runs on the thread that owns the context (the frame's upload,
 or the editor's ``Renderer.upload_step``). ``SpreadWriter.write`` does one band of one level, so
@@ -30,8 +31,10 @@ GROUP = 8   # the shader's local size, in texels each way
 # a quarter of it per band keeps one band near 10 ms on llvmpipe (four level-0 texels decoded each).
 BAND_TEXELS = 1 << 18
 
-# The compiled pass of each context (compiled on first use; gone with the context).
-_programs: "weakref.WeakKeyDictionary[moderngl.Context, moderngl.ComputeShader]" = weakref.WeakKeyDictionary()
+# The compiled pass of each context with its source's digest (compiled on first use, again when
+# the shader's text changes, as the editor's shader reload expects; gone with the context).
+_programs: "weakref.WeakKeyDictionary[moderngl.Context, tuple[str, moderngl.ComputeShader]]" = \
+    weakref.WeakKeyDictionary()
 
 
 def spread_defines() -> dict[str, str]:
@@ -43,14 +46,18 @@ def spread_defines() -> dict[str, str]:
 
 
 def _program(ctx: moderngl.Context) -> moderngl.ComputeShader:
-    prog = _programs.get(ctx)
-    if prog is None:
-        src = load_source(SHADER, spread_defines())
-        try:
-            prog = ctx.compute_shader(src.text)
-        except Exception as exc:
-            raise ShaderCompileError(first_error_line(translate_log(str(exc), src.files))) from None
-        _programs[ctx] = prog
+    src = load_source(SHADER, spread_defines())
+    digest = src.digest()
+    known = _programs.get(ctx)
+    if known is not None and known[0] == digest:
+        return known[1]
+    try:
+        prog = ctx.compute_shader(src.text)
+    except Exception as exc:
+        raise ShaderCompileError(first_error_line(translate_log(str(exc), src.files))) from None
+    if known is not None:
+        known[1].release()
+    _programs[ctx] = (digest, prog)
     return prog
 
 
@@ -88,6 +95,7 @@ class SpreadWriter:
         self.ctx, self.tex, self.size, self.levels, self.scale = ctx, tex, size, levels, float(scale)
         self.bands = spread_bands(size, levels, band_texels)
         self._means = None
+        self._prog = None    # the pass, looked up by the first band
 
     def allocate(self) -> None:
         """Make the means texture (``write`` does it if not done): 30-70 ms on llvmpipe for a 2048^2
@@ -98,7 +106,7 @@ class SpreadWriter:
     def write(self, band: int) -> None:
         """Band ``band`` of ``bands``: its texels' means into the means texture, their A into the map."""
         level, y0, y1 = self.bands[band]
-        prog = _program(self.ctx)
+        prog = self._prog = self._prog or _program(self.ctx)
         self.allocate()
         first = level == 1
         # the source: level 0's texels for level 1, else the level above's means
