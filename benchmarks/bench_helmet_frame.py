@@ -105,7 +105,8 @@ def split(renderer, frames: int = 6) -> None:
 
 def upload(renderer, rounds: int) -> None:
     """Print what uploading DamagedHelmet's normal map costs with its spread in A
-    (gpu_mesh.upload_normal_map: levels made on the CPU) and as before (upload_image: GL's
+    (gpu_mesh.upload_normal_map: GL's mips, then the spread by a compute pass; bench_normal_spread.py
+    sets it against the numpy twin's levels) and without (upload_image: GL's
     generate_mipmap), alternated; wall and CPU time, the texture finished (ctx.finish)."""
     from alight.exchange.meshes import load_mesh
     from alight.render.gpu_mesh import upload_image, upload_normal_map

@@ -62,7 +62,7 @@ def counters():
     counted(meshes, "load_mesh", helmet)
     counted(editor_state, "read_mesh", helmet)
     counted(gpu_mesh, "upload_image")
-    counted(gpu_mesh, "upload_normal_map")   # (a normal map's whole upload, its spread made on the CPU)
+    counted(gpu_mesh, "upload_normal_map")   # (a normal map's whole upload in the frame, its spread included)
     # The self-shadowing test: its arrays noted (the built-in sphere shown first is tested on the
     # main thread, rightly); ``helmet_tested_here`` looks for the helmet's among them.
     seen["_tested"] = tested = []

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from alight.core import shading
+from alight.core.gpu import read_rgba8
 from alight.core.scene import Camera, Scene
 from alight.exchange.meshes import load_mesh
 from alight.ibl.environment import Environment
@@ -185,14 +186,22 @@ def test_the_define_and_the_upload_only_where_a_part_has_a_normal_map(tmp_path):
                 normal_spread.NORMAL_MAP_TOKSVIG = True
             assert ("NORMAL_MAP_TOKSVIG" in defines) == (has_map and toksvig)
             if has_map and toksvig:
-                # the levels as normal_map_levels makes them at the material's scale, in the
-                # frame's upload (level 0 read back: moderngl reads no level it did not make) and
-                # in the editor's (mesh_upload.prepare_upload), under the same key
+                # the levels as normal_map_levels makes them at the material's scale (the spread
+                # made on the GPU: alight.render.normal_spread_pass), in the frame's upload and in
+                # the editor's (mesh_upload: prepare_upload's RGB levels with A = 0, its steps
+                # the spread), under the same key
                 want = normal_map_levels(image, 0.5)
-                got = np.frombuffer(gpu.textures["normal"].read(), np.uint8).reshape(want[0].shape)
-                assert np.array_equal(got, want[0])
                 assert want[1][..., 3].min() > 0
-                (key, _, _, levels), = prepare_upload(mesh).textures
+                got = [read_rgba8(r.ctx, gpu.textures["normal"], n) for n in range(len(want))]
+                assert all(np.array_equal(a, b) for a, b in zip(got, want))
+                upload = prepare_upload(mesh)
+                (key, _, _, levels), = upload.textures
                 assert key == texture_key(mesh.parts[0].material.textures()["normal"], False, 0.5)
-                assert all(np.array_equal(a, b) for a, b in zip(levels, want))
+                assert all(np.array_equal(a[..., :3], b[..., :3]) and not a[..., 3].any()
+                           for a, b in zip(levels, want))
+                while upload.next < len(upload.pieces):
+                    upload.step(r.ctx, r.meshes, r.shadow_maps)
+                staged = [read_rgba8(r.ctx, upload.made[0], n) for n in range(len(want))]
+                upload.drop()
+                assert all(np.array_equal(a, b) for a, b in zip(staged, want))
     r.meshes.release_meshes()

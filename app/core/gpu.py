@@ -279,7 +279,8 @@ def _gl():
     u, i, p = ctypes.c_uint, ctypes.c_int, ctypes.c_void_p
     return {"TexImage2D": function("glTexImage2D", u, i, i, i, i, i, u, u, p),
             "TexParameteri": function("glTexParameteri", u, u, i),
-            "TexSubImage2D": function("glTexSubImage2D", u, i, i, i, i, i, u, u, p)}
+            "TexSubImage2D": function("glTexSubImage2D", u, i, i, i, i, i, u, u, p),
+            "GetTexImage": function("glGetTexImage", u, i, u, u, p)}
 
 
 def float_cube(ctx: moderngl.Context, size: int, levels: int, data=None) -> moderngl.TextureCube:
@@ -331,6 +332,22 @@ def rgba8_texture(ctx: moderngl.Context, size: tuple[int, int], levels: int, srg
     return tex
 
 
+def rgba32f_texture(ctx: moderngl.Context, size: tuple[int, int], levels: int) -> moderngl.Texture:
+    """An RGBA float32 2D texture with ``levels`` mip levels allocated (complete at that range),
+    contents undefined: a compute pass writes each level as an image (alight.render.normal_spread_pass).
+    moderngl would allocate the levels only by build_mipmaps, a filter pass over garbage."""
+    w, h = size
+    tex = ctx.texture((w, h), 4, None, dtype="f4")
+    gl = _gl()
+    tex.use(ctx.default_texture_unit)     # binds it on moderngl's own scratch unit
+    for n in range(1, levels):
+        gl["TexImage2D"](GL_TEXTURE_2D, n, GL_RGBA32F, max(1, w >> n), max(1, h >> n), 0, GL_RGBA, GL_FLOAT, None)
+    gl["TexParameteri"](GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0)
+    gl["TexParameteri"](GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, levels - 1)
+    tex.filter = (moderngl.NEAREST_MIPMAP_NEAREST if levels > 1 else moderngl.NEAREST, moderngl.NEAREST)
+    return tex
+
+
 def write_rgba8(ctx: moderngl.Context, tex: moderngl.Texture, level: int, y0: int, rows) -> None:
     """``rows`` ((n, w, 4) uint8, bottom row first) into level ``level`` of ``tex`` (made by
     ``rgba8_texture``) from row ``y0`` up."""
@@ -340,3 +357,15 @@ def write_rgba8(ctx: moderngl.Context, tex: moderngl.Texture, level: int, y0: in
     tex.use(ctx.default_texture_unit)     # binds it on moderngl's own scratch unit
     _gl()["TexSubImage2D"](GL_TEXTURE_2D, level, 0, y0, data.shape[1], data.shape[0], GL_RGBA, GL_UNSIGNED_BYTE,
                            data.ctypes.data)
+
+
+def read_rgba8(ctx: moderngl.Context, tex: moderngl.Texture, level: int):
+    """Level ``level`` of an RGBA8 2D texture as an (h, w, 4) uint8 array, bottom row first: also a
+    level moderngl did not make (``rgba8_texture``'s, which its own read refuses). For tests."""
+    import numpy as np
+
+    w, h = max(1, tex.width >> level), max(1, tex.height >> level)
+    out = np.empty((h, w, 4), np.uint8)
+    tex.use(ctx.default_texture_unit)     # binds it on moderngl's own scratch unit
+    _gl()["GetTexImage"](GL_TEXTURE_2D, level, GL_RGBA, GL_UNSIGNED_BYTE, out.ctypes.data)
+    return out

@@ -119,6 +119,12 @@ SHADER_OPTIONS: dict[str, str] = {
     "PACKED_VERTICES": "normals and tangents arrive as int16 snorm (alight.render.gpu_mesh.pack_snorm16)",
     "NORMAL_MAP_TOKSVIG": "the normal maps' A is their normals' spread, added to the roughness "
                           "(alight.render.normal_spread, surface.glsl normal_map_roughness)",
+    "NORMAL_SPREAD_MAX": "the largest spread sigma^2 a normal map's A keeps (render/normal_spread.comp; "
+                         "alight.render.normal_spread MAX_SPREAD)",
+    "NORMAL_SPREAD_FLOOR": "a spread sigma^2 below this is written as 0 (render/normal_spread.comp; "
+                           "alight.render.normal_spread SPREAD_FLOOR)",
+    "NORMAL_FLAT_LENGTH": "a decoded normal this short reads as (0, 0, 1), and |Na| is clipped to it "
+                          "(render/normal_spread.comp; alight.render.normal_spread FLAT_LENGTH)",
     "MATERIAL_MAPS_MASK": "the maps present, a bit each (map_mask)",
     "MAP_MIRROR_S_MASK": "maps whose sampler mirrors in s",
     "MAP_MIRROR_T_MASK": "maps whose sampler mirrors in t",

@@ -11,7 +11,8 @@ import numpy as np
 
 from alight.core.mesh import is_closed
 from alight.core.texture_footprint import anisotropy_for_view, footprints
-from alight.render.normal_spread import normal_map_levels, spread_scale, without_spread
+from alight.render.normal_spread import spread_scale, without_spread
+from alight.render.normal_spread_pass import SpreadWriter, level_count
 
 GL_SRGB8_ALPHA8 = 0x8C43
 SRGB_MAPS = ("base_color", "emissive", "sheen_color", "specular_color", "diffuse_transmission")
@@ -263,18 +264,15 @@ def texture_key(info, srgb: bool, spread: float | None = None) -> tuple:
 
 
 def upload_normal_map(ctx: moderngl.Context, image: np.ndarray, scale: float, mipmaps: bool = True) -> moderngl.Texture:
-    """A normal map as ``upload_image`` makes it (RGB the same), its levels made on the CPU with
-    the spread of its normals at ``scale`` in A (alight.render.normal_spread). A side that is not a
-    power of two: GL's mips with A = 0 (no widening)."""
-    from alight.core.gpu import write_rgba8
-
-    levels = normal_map_levels(image, scale, mipmaps)
-    if levels is None:
-        return upload_image(ctx, without_spread(image), False, mipmaps)
-    h, w = levels[0].shape[:2]
-    tex = level_texture(ctx, (w, h), len(levels), False)
-    for n, level in enumerate(levels):
-        write_rgba8(ctx, tex, n, 0, level)
+    """A normal map as ``upload_image`` makes it (RGB the same: level 0 as the file has it with
+    A = 0, GL's generate_mipmap), then the spread of its normals at ``scale`` written into A of
+    each level from 1 on, on the GPU (alight.render.normal_spread_pass; its numpy twin
+    alight.render.normal_spread). A side that is not a power of two: GL's mips with A = 0 (no
+    widening), as before. GL work: the thread that owns ``ctx``."""
+    tex = upload_image(ctx, without_spread(image), False, mipmaps)
+    h, w = image.shape[:2]
+    if mipmaps and not (h & (h - 1) or w & (w - 1)):
+        SpreadWriter(ctx, tex, (w, h), level_count((w, h)), scale).write_all()
     return tex
 
 

@@ -7,7 +7,7 @@ they disagree the texel's mean unit normal is shorter than 1: Toksvig (2005, "Mi
 Maps") reads a spread from its length |Na|, sigma^2 = (1 - |Na|) / |Na|, which the shader adds to
 GGX's alpha^2 (``shading.normal_map_roughness``, its twin).
 
-The length is measured here, on the CPU, and not from the filtered texel in the shader: a texel
+The length is measured when the map is uploaded, not from the filtered texel in the shader: a texel
 of an 8-bit map decoded as 2c - 1 is not of length 1 (up to about 0.004 off), and that alone
 would give alpha^2 = 0.004 (roughness 0.25) to a perfect mirror. So each level's |Na| is the mean
 of the level-0 normals *renormalised* (after glTF's normalTexture.scale, which scales x and y
@@ -20,6 +20,10 @@ generate_mipmap makes them (alight.render.mip_levels, bit for bit), so the filte
 normal is the one the renderer read before. Trilinear and anisotropic filtering then blend A
 between texels and levels like any channel (an estimate: the spread *between* the blended
 texels is not in it).
+
+The uploads make A on the GPU (alight.render.normal_spread_pass, render/normal_spread.comp: no
+2048^2 float array on the CPU, nothing read back); the functions here are its numpy twin, each
+step the same float32 operation in the same order, which the tests compare level by level.
 """
 
 from __future__ import annotations
@@ -34,6 +38,9 @@ MAX_SPREAD = 1.0
 # otherwise give agreeing normals A = 4 (alpha^2 6e-8: nothing to see, but not exactly a mirror).
 # Above it A >= 8 (roughness 0.03).
 SPREAD_FLOOR = 1e-6
+# A decoded normal this short reads as the unperturbed (0, 0, 1), and |Na| is clipped to it (a mean
+# of opposite normals: sigma^2 at its MAX_SPREAD, never a division by 0).
+FLAT_LENGTH = 1e-6
 # The quality choice, as Filament names its own: False uploads normal maps as before (GL's mips,
 # the file's A) and compiles NORMAL_MAP_TOKSVIG nowhere: the old shading, for measurements
 # (bench_helmet_split.py --no-toksvig, the tests). Set it before a mesh is uploaded.
@@ -61,7 +68,7 @@ def unit_normals(level0: np.ndarray, scale: float) -> np.ndarray:
     m = level0[..., :3].astype(np.float32) * np.float32(2.0 / 255.0) - np.float32(1.0)
     m[..., :2] *= np.float32(scale)
     length = np.sqrt(np.einsum("ijk,ijk->ij", m, m))
-    flat = length <= 1e-6
+    flat = length <= FLAT_LENGTH
     m /= np.where(flat, 1.0, length)[..., None]
     m[flat] = (0.0, 0.0, 1.0)
     return m
@@ -70,7 +77,7 @@ def unit_normals(level0: np.ndarray, scale: float) -> np.ndarray:
 def spread_to_alpha_channel(mean_length: np.ndarray) -> np.ndarray:
     """A as uint8 from |Na|: round(255 * min((1 - |Na|) / |Na|, MAX_SPREAD)^(1/4)); 0 at |Na| = 1
     (and where sigma^2 < SPREAD_FLOOR)."""
-    length = np.clip(mean_length, 1e-6, 1.0)
+    length = np.clip(mean_length, FLAT_LENGTH, 1.0)
     spread = np.minimum((1.0 - length) / length, MAX_SPREAD)
     spread[spread < SPREAD_FLOOR] = 0.0
     return np.rint(255.0 * np.sqrt(np.sqrt(spread))).astype(np.uint8)
