@@ -119,6 +119,8 @@ SHADER_OPTIONS: dict[str, str] = {
     "PACKED_VERTICES": "normals and tangents arrive as int16 snorm (alight.render.gpu_mesh.pack_snorm16)",
     "NORMAL_MAP_TOKSVIG": "the normal maps' A is their normals' spread, added to the roughness "
                           "(alight.render.normal_spread, surface.glsl normal_map_roughness)",
+    "NORMAL_MAP_LOD_BIAS": "the normal maps' level-of-detail bias, log2 (alight.render.normal_spread, "
+                          "common/mesh_material.glsl sample_map_sharper)",
     "MATERIAL_MAPS_MASK": "the maps present, a bit each (map_mask)",
     "MAP_MIRROR_S_MASK": "maps whose sampler mirrors in s",
     "MAP_MIRROR_T_MASK": "maps whose sampler mirrors in t",
