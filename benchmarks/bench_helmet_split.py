@@ -2,7 +2,7 @@
 filtering or the visibility. Prints one table; asserts nothing (results/helmet_split.md).
 
     PYTHONPATH=... .venv/bin/python benchmarks/bench_helmet_split.py [--size 128] [--samples 64] [--no-normal-map]
-        [--toksvig] [--no-toksvig] [--keep DIR]
+        [--toksvig] [--no-toksvig] [--lod-bias LOG2] [--keep DIR]
 
 Six images of the same view (`--orbit 30 --elevation 10`, royal_esplanade_1k, the file's own
 materials), all linear:
@@ -26,7 +26,8 @@ inputs (an ideal mip filter) with the roughness widened by Toksvig's variance of
 (x0, x1, x2), against nojit. --no-normal-map drops normalTexture from a copy of the .gltf (in a
 temporary folder) for every image. --no-toksvig renders alight's images (render, rendernoaa and
 the G-buffer of nogbuf) without the normal map's widening (NORMAL_MAP_TOKSVIG off: the shading
-before it); the regions always come from the unwidened G-buffer. --keep DIR saves the traced
+before it); --lod-bias sets their normal maps' level-of-detail bias (NORMAL_MAP_LOD_BIAS, 0: the
+plain fetch). The regions always come from the G-buffer without either. --keep DIR saves the traced
 images (which alight's shading does not change) and reuses them, with alight's three beside.
 """
 
@@ -70,16 +71,27 @@ def scene_setup(mesh: Path, size: int):
     return scene_from_flags(args, args.size, build_look(args), lambda line: None)
 
 
-# `alight` with NORMAL_MAP_TOKSVIG off (alight.render.normal_spread): the shading before it.
-NO_TOKSVIG = ("import sys; import alight.render.normal_spread as s; s.NORMAL_MAP_TOKSVIG = False; "
-              "from alight.frontends.cli import main; sys.exit(main())")
+# The normal maps' level-of-detail bias alight's images are made with (--lod-bias; None: the
+# renderer's own, alight.render.normal_spread.NORMAL_MAP_LOD_BIAS).
+LOD_BIAS: list[float | None] = [None]
+
+
+def alight_command(toksvig: bool) -> list[str]:
+    """`alight`, with NORMAL_MAP_TOKSVIG off unless ``toksvig`` (the shading before it) and the
+    --lod-bias given (alight.render.normal_spread)."""
+    if toksvig and LOD_BIAS[0] is None:
+        return ["-m", "alight"]
+    return ["-c", "import sys; import alight.render.normal_spread as s; "
+            + ("" if toksvig else "s.NORMAL_MAP_TOKSVIG = False; ")
+            + ("" if LOD_BIAS[0] is None else f"s.NORMAL_MAP_LOD_BIAS = {LOD_BIAS[0]!r}; ")
+            + "from alight.frontends.cli import main; sys.exit(main())"]
 
 
 def render(mesh: Path, size: int, folder: Path, extra: list[str], toksvig: bool = True) -> np.ndarray:
     from alight.accuracy.metrics import read_linear
 
     out = folder / f"render{'_'.join(extra)}.exr"
-    alight = ["-m", "alight"] if toksvig else ["-c", NO_TOKSVIG]
+    alight = alight_command(toksvig)
 
     subprocess.run([sys.executable, *alight, "render", "--mesh", str(mesh), "--env", str(ENV), *VIEW,
                     "--size", str(size), "--occlusion", "off", "--out", str(out), *extra],
@@ -87,15 +99,18 @@ def render(mesh: Path, size: int, folder: Path, extra: list[str], toksvig: bool 
     return read_linear(str(out))
 
 
-def gbuffer(setup, toksvig: bool = True) -> dict[str, np.ndarray]:
+def gbuffer(setup, toksvig: bool = True, lod_bias: float | None = None) -> dict[str, np.ndarray]:
     from alight.accuracy.reference import GBUFFER, ReferenceRenderer
     from alight.render import normal_spread
 
-    was, normal_spread.NORMAL_MAP_TOKSVIG = normal_spread.NORMAL_MAP_TOKSVIG, toksvig
+    was = normal_spread.NORMAL_MAP_TOKSVIG, normal_spread.NORMAL_MAP_LOD_BIAS
+    normal_spread.NORMAL_MAP_TOKSVIG = toksvig
+    if lod_bias is not None:
+        normal_spread.NORMAL_MAP_LOD_BIAS = lod_bias
     try:
         texs = ReferenceRenderer().mesh_gbuffer(setup.scene, setup.width, setup.height)
     finally:
-        normal_spread.NORMAL_MAP_TOKSVIG = was
+        normal_spread.NORMAL_MAP_TOKSVIG, normal_spread.NORMAL_MAP_LOD_BIAS = was
     return {n: np.frombuffer(t.read(), np.float32).reshape(setup.height, setup.width, 4)[::-1].astype(np.float64)
             for n, t in zip(GBUFFER, texs)}
 
@@ -272,25 +287,32 @@ def main() -> int:
                         help="also shade once at the footprint's mean inputs, without and with Toksvig's widening")
     parser.add_argument("--no-toksvig", action="store_true",
                         help="alight's render and G-buffer without the normal map's widening (NORMAL_MAP_TOKSVIG off)")
+    parser.add_argument("--lod-bias", type=float, metavar="LOG2",
+                        help="alight's normal maps fetched with this level-of-detail bias (NORMAL_MAP_LOD_BIAS; "
+                             "0: none; default: the renderer's)")
     parser.add_argument("--keep", metavar="DIR",
                         help="keep the traced images (full, nocentre, nojit, mean inputs) in DIR and reuse them")
     args = parser.parse_args()
     from alight.accuracy.path_trace import TraceSettings, trace
 
     on = not args.no_toksvig
+    LOD_BIAS[0] = args.lod_bias
+    from alight.render.normal_spread import NORMAL_MAP_LOD_BIAS
+
+    bias = NORMAL_MAP_LOD_BIAS if args.lod_bias is None else args.lod_bias
     tag = f"{args.size}_{args.samples}_{'off' if args.no_normal_map else 'on'}"
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         mesh = helmet_copy(folder, not args.no_normal_map)
         setup = scene_setup(mesh, args.size)
         # the regions by the roughness the maps give, unwidened (the same blocks either way)
-        g = gbuffer(setup, toksvig=False)
+        g = gbuffer(setup, toksvig=False, lod_bias=0.0)
         images = {"render": render(mesh, args.size, folder, [], on),
                   "rendernoaa": render(mesh, args.size, folder, ["--aa", "none"], on),
                   "full": kept(args.keep, f"full_{tag}", lambda: trace(
                       setup.scene, setup.environment.radiance, setup.width, setup.height,
                       TraceSettings(samples=args.samples, seed=0)).linear),
-                  "nogbuf": unoccluded_gbuffer(setup, gbuffer(setup, on) if on else g, args.samples),
+                  "nogbuf": unoccluded_gbuffer(setup, gbuffer(setup, on, LOD_BIAS[0]), args.samples),
                   "nocentre": kept(args.keep, f"nocentre_{tag}", lambda: unoccluded_hits(setup, args.samples, False)),
                   "nojit": kept(args.keep, f"nojit_{tag}", lambda: unoccluded_hits(setup, args.samples, True))}
         if args.toksvig:
@@ -299,9 +321,9 @@ def main() -> int:
                     args.keep, f"mean{widen:g}_{tag}", lambda: footprint_mean_inputs(setup, args.samples, widen))
         if args.keep:
             for name in ("render", "rendernoaa", "nogbuf"):
-                np.save(Path(args.keep) / f"{name}_{tag}_{'toksvig' if on else 'old'}.npy", images[name])
+                np.save(Path(args.keep) / f"{name}_{tag}_{'toksvig' if on else 'old'}_bias{bias:g}.npy", images[name])
     print(f"DamagedHelmet {args.size} px, {args.samples} samples, normal map {'off' if args.no_normal_map else 'on'}, "
-          f"NORMAL_MAP_TOKSVIG {'on' if on else 'off'}")
+          f"NORMAL_MAP_TOKSVIG {'on' if on else 'off'}, NORMAL_MAP_LOD_BIAS {bias:g}")
     print("\n".join(table(images, g, max(4, args.size // 32))))
     return 0
 

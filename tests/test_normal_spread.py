@@ -1,7 +1,8 @@
 """The normal map's spread widening the roughness (NORMAL_MAP_TOKSVIG: alight.render.normal_spread,
 mesh_material.glsl, surface.glsl normal_map_roughness): the levels it uploads, a mirror it must
 leave alone, and by equivalence a glossy plane whose fine checker of two tilts, seen minified,
-should shade as the mean of the two tilted planes (the footprint's average)."""
+should shade as the mean of the two tilted planes (the footprint's average). And the normal maps'
+fetch one level finer (NORMAL_MAP_LOD_BIAS)."""
 
 from __future__ import annotations
 
@@ -204,4 +205,56 @@ def test_the_define_and_the_upload_only_where_a_part_has_a_normal_map(tmp_path):
                 staged = [read_rgba8(r.ctx, upload.made[0], n) for n in range(len(want))]
                 upload.drop()
                 assert all(np.array_equal(a, b) for a, b in zip(staged, want))
+    r.meshes.release_meshes()
+
+
+def _stripes(tilt_deg: float, width: int) -> np.ndarray:
+    """A TEXELS^2 RGBA map of stripes ``width`` texels wide across x, tilted +-t in turn."""
+    x = np.arange(TEXELS)[None, :, None] * np.ones((TEXELS, 1, 1), int)
+    rgb = np.where((x // width) % 2 == 0, _texel(tilt_deg), _texel(-tilt_deg))
+    return np.concatenate([rgb, np.full((TEXELS, TEXELS, 1), 255)], axis=2).astype(np.uint8)
+
+
+def _render_bias(lit, path, bias: float, size: int = SIZE):
+    was = normal_spread.NORMAL_MAP_LOD_BIAS
+    normal_spread.NORMAL_MAP_LOD_BIAS = bias
+    try:
+        return _render(lit, path, True, size)
+    finally:
+        normal_spread.NORMAL_MAP_LOD_BIAS = was
+
+
+def test_the_normal_map_is_fetched_one_level_finer(lit, tmp_path):
+    # NORMAL_MAP_LOD_BIAS (mesh_material.glsl sample_map_sharper): stripes 8 texels wide, read
+    # about 3.2 levels up at SIZE. Without the bias the fetch blends level 3 (one stripe a texel)
+    # with level 4 (both stripes' mean: flat), so the tilts fade; one level finer reads levels 2
+    # and 3, both striped, so the pixels see the tilts. Magnified (level 0 either way) the bias
+    # changes nothing.
+    assert normal_spread.NORMAL_MAP_LOD_BIAS == -1.0
+    path = _plane(tmp_path / "stripes.glb", 0.05, _stripes(10.0, 8))
+    contrast = lambda image: float(_quad_pixels(image).mean(axis=(0, 2)).std())   # noqa: E731 (across columns)
+    plain = _render_bias(lit, path, 0.0).linear
+    finer = _render_bias(lit, path, -1.0).linear
+    assert contrast(finer) > 1.3 * contrast(plain), (contrast(finer), contrast(plain))
+    big = [_render_bias(lit, path, b, 512).srgb.astype(int) for b in (0.0, -1.0)]
+    assert np.array_equal(big[0], big[1])
+
+
+def test_the_lod_bias_define_only_where_a_part_has_a_normal_map(tmp_path):
+    from alight.render.variants import part_defines
+
+    r = renderer()
+    image = _map(_texel(10.0), _texel(-10.0))
+    for path, has_map in ((_plane(tmp_path / "m.glb", 0.2, image), True), (_plane(tmp_path / "b.glb", 0.2, None), False)):
+        mesh = load_mesh(str(path))
+        gpu = r.meshes.parts(mesh)[0]
+        for bias in (-1.0, 0.0):
+            was, normal_spread.NORMAL_MAP_LOD_BIAS = normal_spread.NORMAL_MAP_LOD_BIAS, bias
+            try:
+                defines = part_defines(Scene(mesh=mesh), gpu, mesh.parts[0], set())
+            finally:
+                normal_spread.NORMAL_MAP_LOD_BIAS = was
+            assert ("NORMAL_MAP_LOD_BIAS" in defines) == (has_map and bias != 0.0)
+            if has_map and bias:
+                assert float(defines["NORMAL_MAP_LOD_BIAS"]) == bias
     r.meshes.release_meshes()
