@@ -85,6 +85,41 @@ def test_multi_bounce_fit_never_darkens_and_keeps_open_points():
     assert np.allclose(gtao.multi_bounce(1.0, (0.3, 0.6, 0.9)), 1.0, atol=2e-3)
 
 
+@pytest.mark.parametrize("gamma, h1, h2", [(0.0, 0.3, 0.9), (0.4, 0.3, 0.9), (-0.7, 1.2, 0.2), (1.1, 0.05, 1.5)])
+def test_the_bands_sum_to_each_sides_occluded_share(gamma, h1, h2):
+    """render/gtao.frag's horizon_cos weights each sample that raises the horizon by the band it
+    raised it over (gtao_band_weight): from -1 up through rising cosines to a side's horizon the
+    bands sum to that side's occluded share, the open share's complement (the open hemisphere's
+    a(gamma -/+ pi/2) less a(h)); each band against a trapezoid of cos(theta - gamma) |sin theta|."""
+    c1, c2 = np.cos(h1), np.cos(h2)
+    lo, hi = gtao.clamped_horizons(c1, c2, gamma)
+    for side, c, h in ((-1, c1, lo), (1, c2, hi)):
+        steps = [-1.0, c - 0.4, c - 0.1, c]
+        total = sum(float(gtao.band_weight(a, b, gamma, side)) for a, b in zip(steps, steps[1:]))
+        limit = gamma + side * 0.5 * np.pi
+        assert total == pytest.approx(float(gtao.inner_integral(limit, gamma) - gtao.inner_integral(h, gamma)), abs=1e-12)
+        assert total >= -1e-12
+    a, b = 0.2, 0.7      # one band on the + side, inside the normal's hemisphere for gamma 0.4
+    t = np.linspace(np.arccos(b), np.arccos(a), 200001)
+    w = np.cos(t - 0.4) * np.abs(np.sin(t))
+    assert float(gtao.band_weight(a, b, 0.4, 1)) == pytest.approx(np.trapezoid(w, t), abs=1e-9)
+
+
+def test_the_facing_occluders_light_is_held_to_the_points_where_they_see_less():
+    """common/occlusion.glsl screen_facing_light's twin: occluders that see less sky than the point
+    (their V below its V by more than FACING_RAMP's low end) get no more than the point's light;
+    ones that see more (past the high end) their own; the rest lit as the point (share 1 - f)."""
+    own, as_point = np.array([3.0, 2.0, 1.0]), np.array([1.0, 1.0, 1.0])
+    assert np.allclose(gtao.facing_light(own, as_point, 0.3, 0.6), [1.0, 1.0, 1.0])
+    assert np.allclose(gtao.facing_light(own, as_point, 0.9, 0.6), own)
+    assert np.allclose(gtao.facing_light(own * 0.5, as_point, 0.3, 0.6), [1.0, 1.0, 0.5])   # never brighter
+    albedo = np.array([0.7, 0.7, 0.7])
+    assert np.allclose(gtao.occluder_radiance(albedo, 0.0, 0.9, 0.6, own, as_point),
+                       gtao.occluders_reflectance(albedo, 0.6) * as_point)
+    assert np.allclose(gtao.occluder_radiance(albedo, 1.0, 0.9, 0.6, own, as_point),
+                       gtao.occluders_reflectance(albedo, 0.9) * own)
+
+
 # ---- the GLSL pass --------------------------------------------------------------------------
 
 def _quad(a, b, c, d):
@@ -165,7 +200,8 @@ def test_glsl_floor_beside_a_wall_gives_the_form_factor(renderer, tmp_path):
     sees no occluder outside the image): the pass's V, averaged over floor pixels at d (within
     0.03) near the wall's middle, within 0.04 of the ray-cast value (0.003-0.04 off in the runs
     here; the strip rule of an infinite wall is 0.01-0.03 below that), rising with d; and the
-    occluded directions point at the wall (-Z), not sideways."""
+    occluded directions point at the wall (-Z), not sideways; and the occluders' texture there
+    holds the wall facing the floor (render/gtao.frag horizon_cos)."""
     from alight.core.scene import Camera
     from alight.exchange.meshes import load_mesh
 
@@ -174,6 +210,7 @@ def test_glsl_floor_beside_a_wall_gives_the_form_factor(renderer, tmp_path):
     mesh = load_mesh(str(_write_obj(tmp_path / "wall.obj", [floor, wall])))
     cam = Camera(position=(0.0, 1.8, 2.4), target=(0.0, 0.3, -0.4))
     vis, p = _visibility(renderer, mesh, cam, 128)
+    occluders = np.frombuffer(renderer.screen_ao.occluders.read(), np.float16).reshape(128, 128, 4)[::-1].astype(np.float64)
     on_floor = (p[..., 3] > 0.5) & (np.abs(p[..., 1]) < 1e-3) & (np.abs(p[..., 0]) < 0.15)
     d = p[..., 2] + 1.0
     means = []
@@ -184,6 +221,17 @@ def test_glsl_floor_beside_a_wall_gives_the_form_factor(renderer, tmp_path):
         assert means[-1] == pytest.approx(_wall_visibility(at), abs=0.04), (at, means[-1], _wall_visibility(at))
         occ = vis[..., :3][band].mean(axis=0)
         assert occ[2] < 0.0 and abs(occ[0]) < 0.2 * abs(occ[2])
+        # The occluders (the wall, on screen and facing the floor): their share of the occluded
+        # directions near 1 (the bands of gtao_band_weight sum to 1 - V, app/core/gtao.py
+        # band_weight), their mean (V times bent normal) toward the floor (+Z) and up (the wall's
+        # bent normal leans away from the floor that hides its foot), not sideways, of length the
+        # wall's V (0.69-0.80 here: the floor hides at most half of the wall's foot).
+        o = occluders[band]
+        share = float(o[:, 3].mean() / (1.0 - means[-1]))
+        assert share == pytest.approx(1.0, abs=0.05), (at, share)
+        mean = o[:, :3].sum(axis=0) / o[:, 3].sum()
+        assert mean[2] > 0.3 and mean[1] > 0.0 and abs(mean[0]) < 0.2 * mean[2], (at, mean)
+        assert 0.55 < np.linalg.norm(mean) <= 1.0, (at, mean)
     assert means == sorted(means)
 
 

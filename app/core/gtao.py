@@ -129,6 +129,57 @@ def slice_occluded_direction(cos_h1, cos_h2, gamma, projected_length=1.0):
     return tuple(np.asarray(projected_length) * ((a[k] - lo[k]) + (hi[k] - b[k])) for k in range(2))
 
 
+def band_weight(cos_from, cos_to, gamma, side, projected_length=1.0):
+    """The cosine-weighted share (times |n_p|) of one side's band between two horizon cosines
+    (the lower first; ``side`` +1: h = acos, -1: h = -acos), both clamped to the projected
+    normal's hemisphere: what the sample that raised the horizon from the first to the second
+    occludes (render/gtao.frag horizon_cos weights that occluder's normal by it). From -1 up to a
+    side's horizon the bands sum to that side's occluded share."""
+    side = float(side)
+    gamma = np.asarray(gamma, np.float64)
+    a = side * np.arccos(np.clip(cos_from, -1.0, 1.0))
+    b = side * np.arccos(np.clip(cos_to, -1.0, 1.0))
+    limit = gamma + side * 0.5 * np.pi
+    clamp = np.minimum if side > 0 else np.maximum
+    a, b = clamp(a, limit), clamp(b, limit)
+    return np.asarray(projected_length) * (inner_integral(a, gamma) - inner_integral(b, gamma))
+
+
+# The facing occluders' own light is held to the point's where their V is below the point's: ramped
+# in over this range of (their V - the point's) (common/occlusion.glsl screen_facing_light).
+FACING_RAMP = (-0.1, 0.05)
+
+
+def smoothstep(edge0, edge1, x):
+    t = np.clip((np.asarray(x, np.float64) - edge0) / (edge1 - edge0), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def facing_light(by_occluders, as_point, occluder_visibility, visibility):
+    """The light / pi on the occluders that face the point on screen (common/occlusion.glsl
+    screen_facing_light): their own (``by_occluders``, the sky their normals see) where their V
+    is above the point's, no more than the point's own (``as_point``) where it is below."""
+    by_occluders = np.asarray(by_occluders, np.float64)
+    t = smoothstep(*FACING_RAMP, np.asarray(occluder_visibility, np.float64) - visibility)
+    return np.minimum(by_occluders, as_point) * (1.0 - t) + by_occluders * t
+
+
+def occluders_reflectance(albedo, visibility):
+    """a V / (1 - a (1 - V)): what occluders of albedo ``albedo`` and visibility V reflect of the
+    light on them / pi, their own occluders' bounces as a series (common/occlusion.glsl)."""
+    albedo = np.asarray(albedo, np.float64)
+    return albedo * visibility / np.maximum(1.0 - albedo * (1.0 - visibility), 1e-3)
+
+
+def occluder_radiance(albedo, facing_share, occluder_visibility, visibility, by_occluders, as_point):
+    """What the occluded share sees / pi (common/occlusion.glsl screen_occluder_radiance): the
+    facing share lit by facing_light through their V, the rest lit as the point is through its V."""
+    lit = facing_light(by_occluders, as_point, occluder_visibility, visibility)
+    rest = occluders_reflectance(albedo, visibility) * np.asarray(as_point, np.float64)
+    facing = occluders_reflectance(albedo, occluder_visibility) * lit
+    return rest * (1.0 - facing_share) + facing * facing_share
+
+
 def bent_normal(n, occluded_sum):
     """The mean unoccluded direction from the occluded directions' sum (mean over slices of
     ``slice_occluded_direction``, in the world): the whole hemisphere sums to 2/3 n in this

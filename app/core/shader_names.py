@@ -141,8 +141,12 @@ SHADER_OPTIONS: dict[str, str] = {
                       "(app/core/sky_weight.py, common/occlusion.glsl)",
     "HAS_SCREEN_AO": "screen-space GTAO's visibility is read per pixel (app/render/screen_ao.py, "
                      "common/occlusion.glsl)",
-    "GTAO_OCCLUDERS": "GTAO's occluded share sees the occluders' radiance, E/pi facing back along the mean "
-                      "occluded direction (common/occlusion.glsl)",
+    "GTAO_OCCLUDERS": "GTAO's occluded share sees the occluders' radiance, lit by the sky their own normals "
+                      "see where the screen shows them facing the point, else as the point is "
+                      "(common/occlusion.glsl)",
+    "GTAO_FACING_RAMP_LOW": "with GTAO_OCCLUDERS: where the facing occluders' V less the point's is below this, "
+                            "their light is held to the point's (app/core/gtao.py FACING_RAMP)",
+    "GTAO_FACING_RAMP_HIGH": "... and above this, their own",
     "GTAO_MULTI_BOUNCE": "GTAO's visibility takes the paper's albedo fit of the occluders' interreflections "
                          "(common/gtao.glsl)",
     "GTAO_SLICES": "GTAO's slice directions per pixel (render/gtao.frag; app/core/gtao.py SLICES)",

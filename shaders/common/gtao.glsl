@@ -53,3 +53,18 @@ vec2 gtao_slice_occluded_direction(float cos_h1, float cos_h2, float gamma, floa
     return projected_length * ((gtao_direction_antiderivative(h1, gamma) - lo)
                                + (hi - gtao_direction_antiderivative(h2, gamma)));
 }
+
+// The cosine-weighted share (times |n_p|) of the band of one slice's side between two horizon
+// cosines to v, the lower one first (side +1: the +phi side, h = acos; -1: h = -acos), both
+// clamped to the projected normal's hemisphere: the directions that see the sample that raised
+// the horizon from the first to the second (render/gtao.frag: the occluders' light). Over a side
+// the bands sum to what gtao_slice_visibility leaves out there.
+float gtao_band_weight(float cos_from, float cos_to, float gamma, float side, float projected_length) {
+    const float HALF_PI = 1.5707963;
+    float a = side * acos(clamp(cos_from, -1.0, 1.0));
+    float b = side * acos(clamp(cos_to, -1.0, 1.0));
+    float limit = gamma + side * HALF_PI;
+    a = side > 0.0 ? min(a, limit) : max(a, limit);
+    b = side > 0.0 ? min(b, limit) : max(b, limit);
+    return projected_length * (gtao_inner_integral(a, gamma) - gtao_inner_integral(b, gamma));
+}
