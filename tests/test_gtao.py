@@ -508,3 +508,26 @@ def test_the_shader_ball_has_no_bright_rings_and_darkens_under_its_bowl(renderer
         brighter = int((ratio[band] > 1.03).sum())
         assert brighter <= 0.005 * band.sum() and ratio[band].max() < 1.1, (name, brighter, int(band.sum()),
                                                                             float(ratio[band].max()))
+
+
+@pytest.mark.parametrize("occluded", ["occluders", "multi_bounce", "black"])
+def test_every_occluded_light_compiles(renderer, tmp_path, occluded):
+    """Each of screen_ao.OCCLUDED_LIGHT (bench_gtao.py compares them) builds its forward pass (the
+    occluders' functions need GTAO_OCCLUDERS' defines: multi_bounce once failed to compile) and
+    gives a finite image."""
+    from alight.core.material import Material
+    from alight.core.scene import Camera, Scene
+    from alight.exchange.meshes import load_mesh
+
+    floor = _quad((-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1))
+    wall = _quad((-1, 0, -1), (1, 0, -1), (1, 1, -1), (-1, 1, -1))
+    mesh = load_mesh(str(_write_obj(tmp_path / "wall.obj", [floor, wall])))
+    scene = Scene(mesh=mesh, material=Material(), use_file_materials=False,
+                  camera=Camera(position=(0.0, 1.8, 2.4), target=(0.0, 0.3, -0.4)), occlusion="gtao")
+    renderer.render(scene, None, 32, 32, aa="none")
+    renderer.screen_ao.occluded = occluded
+    try:
+        img = renderer.render(scene, None, 32, 32, aa="none", read_linear=True, read_srgb=False).linear
+    finally:
+        renderer.screen_ao.occluded = "occluders"
+    assert np.isfinite(img).all()

@@ -238,6 +238,7 @@ vec3 screen_visible_irradiance(vec3 n, float visibility) {
     return max(irradiance_at(n, false) - (1.0 - visibility) * hidden, vec3(0.0));
 }
 
+#ifdef GTAO_OCCLUDERS
 // The occluders' light / pi (the sky's and the suns', per unit V) as this point's own: the sky
 // it sees per unit V (screen_visible_irradiance: Jimenez et al. 2016's multi-bounce assumption,
 // that the occluders see as the point does) and the suns on surfaces facing back along d
@@ -289,6 +290,7 @@ vec3 screen_occluder_radiance(vec3 albedo, vec3 n, float visibility) {
     return mix(occluders_reflectance(albedo, visibility) * as_point, occluders_reflectance(albedo, facing.y) * lit,
                facing.x);
 }
+#endif
 
 // The bent normal (the mean unoccluded direction): the whole hemisphere's cosine-weighted sum
 // of directions is 2/3 n in GTAO's measure, so the visible ones sum to 2/3 n minus the occluded

@@ -72,25 +72,20 @@ float sample_offset_px(int j, float jitter, float radius_px) {
     return max(radius_px * s * s, 1.0);
 }
 
-// The occluder's normal at pixel p as the point at `centre` sees it, or 0 where its face is
-// turned away (the point then sees a face behind it that the screen does not hold: a bowl's near
-// wall seen from its floor over the rim; common/occlusion.glsl lights that share as before).
-// With the earlier passes of the view its bent normal (app/core/gtao.py bent_normal: the mean
-// direction it sees the sky in), as the bake lights its hits by theirs.
-vec3 occluder_normal(ivec2 p, vec3 s, vec3 centre) {
+// The occluder at pixel p (position s) as the point at `centre` sees it: its V times its normal
+// (V and bent normal, app/core/gtao.py bent_normal, from the view's earlier passes: the bake
+// lights its hits by their bent normals), or 0 where its face is turned away (the point then
+// sees a face behind it that the screen does not hold: a bowl's near wall seen from its floor
+// over the rim; common/occlusion.glsl lights that share as before). In a view's first pass V is
+// 1 and the normal the face's: main then takes this point's V for it, the paper's assumption
+// that the occluders see as the point does.
+vec3 facing_occluder(ivec2 p, vec3 s, vec3 centre) {
     vec3 n = texelFetch(u_normals, p, 0).xyz;
     if (dot(n, centre - s) <= 0.0) return vec3(0.0);
-    if (u_has_history) {
-        vec3 b = (2.0 / 3.0) * n - texelFetch(u_history, p, 0).xyz;
-        n = dot(b, n) > 1e-6 ? normalize(b) : n;
-    }
-    return n;
-}
-
-// The occluder's own V from the earlier passes of the view; 1 in its first pass (main then takes
-// this point's V for it, the paper's assumption that the occluders see as the point does).
-float occluder_visibility_at(ivec2 p) {
-    return u_has_history ? texelFetch(u_history, p, 0).w : 1.0;
+    if (!u_has_history) return n;
+    vec4 earlier = texelFetch(u_history, p, 0);
+    vec3 b = (2.0 / 3.0) * n - earlier.xyz;
+    return max(earlier.w, 1e-3) * (dot(b, n) > 1e-6 ? normalize(b) : n);   // (0 would read as turned away)
 }
 
 // The largest horizon cosine to v along one side of the slice (screen direction omega, side +1
@@ -122,8 +117,8 @@ float horizon_cos(vec2 origin, vec2 omega, float radius_px, vec3 centre, vec3 v,
             float w = gtao_band_weight(best, c, gamma, side, projected_length);
             if (w > 0.0) {
                 ivec2 p = ivec2(q);
-                vec3 facing = occluder_normal(p, s, centre);
-                if (dot(facing, facing) > 0.0) occluders += w * vec4(occluder_visibility_at(p) * facing, 1.0);
+                vec3 facing = facing_occluder(p, s, centre);
+                if (dot(facing, facing) > 0.0) occluders += w * vec4(facing, 1.0);
             }
             best = c;
         }
