@@ -120,6 +120,34 @@ def test_the_facing_occluders_light_is_held_to_the_points_where_they_see_less():
                        gtao.occluders_reflectance(albedo, 0.9) * own)
 
 
+def test_the_glsl_terms_match_their_twins():
+    """common/gtao.glsl's gtao_slice_visibility, gtao_band_weight and gtao_facing_light against
+    app/core/gtao.py's slice_visibility, band_weight and facing_light, in float32
+    (shaders/accuracy/evaluate_gtao.comp)."""
+    from tests.gpu import evaluate
+
+    rng = np.random.default_rng(18)
+    shader = "accuracy/evaluate_gtao.comp"
+    rows = np.column_stack([rng.uniform(-1, 1, 400), rng.uniform(-1, 1, 400), rng.uniform(-1.5, 1.5, 400),
+                            rng.uniform(0.1, 1, 400)])
+    gpu = evaluate("SLICE_VISIBILITY", rows, shader=shader)[:, 0]
+    # (float32 acos near |cos| 1 and the shader's HALF_PI literal: up to 1.2e-4 here)
+    np.testing.assert_allclose(gpu, gtao.slice_visibility(rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]), atol=5e-4)
+    lo = rng.uniform(-1, 1, 400)
+    rows = np.column_stack([lo, lo + rng.uniform(0, 1, 400) * (1 - lo), rng.uniform(-1.5, 1.5, 400),
+                            rng.choice([-1.0, 1.0], 400)])
+    gpu = evaluate("BAND_WEIGHT", rows, shader=shader)[:, 0]
+    cpu = np.array([gtao.band_weight(a, b, g, side, 0.8) for a, b, g, side in rows])
+    np.testing.assert_allclose(gpu, cpu, atol=5e-4)
+    assert (cpu >= -1e-12).all()
+    rows = np.column_stack([rng.uniform(0, 3, 400), rng.uniform(0, 3, 400), rng.uniform(0, 1, 400), rng.uniform(0, 1, 400)])
+    gpu = evaluate("FACING_LIGHT", rows, shader=shader)[:, :3]
+    k = np.array([1.0, 2.0, 0.5])
+    cpu = gtao.facing_light(rows[:, :1] * k, rows[:, 1:2] * k, rows[:, 2:3], rows[:, 3:4])
+    np.testing.assert_allclose(gpu, cpu, rtol=1e-5, atol=1e-5)
+    assert gtao.FACING_RAMP == (-0.1, 0.05)     # (the evaluator's ramp)
+
+
 # ---- the GLSL pass --------------------------------------------------------------------------
 
 def _quad(a, b, c, d):

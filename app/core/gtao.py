@@ -130,11 +130,11 @@ def slice_occluded_direction(cos_h1, cos_h2, gamma, projected_length=1.0):
 
 
 def band_weight(cos_from, cos_to, gamma, side, projected_length=1.0):
-    """The cosine-weighted share (times |n_p|) of one side's band between two horizon cosines
-    (the lower first; ``side`` +1: h = acos, -1: h = -acos), both clamped to the projected
-    normal's hemisphere: what the sample that raised the horizon from the first to the second
-    occludes (render/gtao.frag horizon_cos weights that occluder's normal by it). From -1 up to a
-    side's horizon the bands sum to that side's occluded share."""
+    """common/gtao.glsl gtao_band_weight: the cosine-weighted share (times |n_p|) of one side's
+    band between two horizon cosines (the lower first; ``side`` +1: h = acos, -1: h = -acos),
+    both clamped to the projected normal's hemisphere: what the sample that raised the horizon
+    from the first to the second occludes (render/gtao.frag horizon_cos weights that occluder's
+    normal by it). From -1 up to a side's horizon the bands sum to that side's occluded share."""
     side = float(side)
     gamma = np.asarray(gamma, np.float64)
     a = side * np.arccos(np.clip(cos_from, -1.0, 1.0))
@@ -156,8 +156,8 @@ def smoothstep(edge0, edge1, x):
 
 
 def facing_light(by_occluders, as_point, occluder_visibility, visibility):
-    """The light / pi on the occluders that face the point on screen (common/occlusion.glsl
-    screen_facing_light): their own (``by_occluders``, the sky their normals see) where their V
+    """The light / pi on the occluders that face the point on screen (common/gtao.glsl
+    gtao_facing_light, through common/occlusion.glsl screen_facing_light): their own (``by_occluders``, the sky their normals see) where their V
     is above the point's, no more than the point's own (``as_point``) where it is below."""
     by_occluders = np.asarray(by_occluders, np.float64)
     t = smoothstep(*FACING_RAMP, np.asarray(occluder_visibility, np.float64) - visibility)

@@ -68,3 +68,10 @@ float gtao_band_weight(float cos_from, float cos_to, float gamma, float side, fl
     b = side > 0.0 ? min(b, limit) : max(b, limit);
     return projected_length * (gtao_inner_integral(a, gamma) - gtao_inner_integral(b, gamma));
 }
+
+// The light / pi on the occluders that face the point (common/occlusion.glsl screen_facing_light,
+// which says why): their own (by_occluders) where their V is above the point's, held to the
+// point's (as_point) where below, smoothly over `ramp` (low, high) of their V less the point's.
+vec3 gtao_facing_light(vec3 by_occluders, vec3 as_point, float occluder_visibility, float visibility, vec2 ramp) {
+    return mix(min(by_occluders, as_point), by_occluders, smoothstep(ramp.x, ramp.y, occluder_visibility - visibility));
+}

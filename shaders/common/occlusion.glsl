@@ -273,8 +273,8 @@ vec3 screen_light_by_occluders(vec3 along, float occluder_visibility) {
 // base under the bowl, facing up at its neck: 1.5x the path tracer's light on the neck, brighter
 // than --occlusion off). Where they see more (a corner's floor beside its wall) their own light.
 vec3 screen_facing_light(vec3 by_occluders, vec3 as_point, float occluder_visibility, float visibility) {
-    return mix(min(by_occluders, as_point), by_occluders,
-               smoothstep(GTAO_FACING_RAMP_LOW, GTAO_FACING_RAMP_HIGH, occluder_visibility - visibility));
+    return gtao_facing_light(by_occluders, as_point, occluder_visibility, visibility,
+                             vec2(GTAO_FACING_RAMP_LOW, GTAO_FACING_RAMP_HIGH));
 }
 
 // What the occluded share sees / pi (occlude_environment's GTAO_OCCLUDERS; numpy twin
