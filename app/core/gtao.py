@@ -26,6 +26,12 @@ MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS
 MAX_RADIUS_HEIGHT = 0.5  # (the editor's 720 rows: 360 px; the samples stay GTAO_STEPS, spaced quadratically:
                          # render/gtao.frag sample_offset_px. 0.2 missed the shader ball's bowl over its base at
                          # 384 px: V 0.6-0.8 there, 2.6x the path tracer's light; benchmarks/results/gtao.md)
+# Thin occluders (common/gtao.glsl gtao_falloff_weight; XeGTAO's thin occluder compensation): an
+# occluder more than THICKNESS x the search radius in front of the point in view depth fades out of
+# the horizon as if that excess were 1 + THIN_OCCLUDER times longer.
+THICKNESS = 1.0
+THIN_OCCLUDER = 4.0
+FACING_THICKNESS = 0.12
 # More rotations than the 4x4 pattern's 16, over passes (the paper's temporal accumulation, its
 # section 6: 6 rotations x 16 spatial offsets): each pass turns the pattern by a further fraction of
 # its step and the estimate is the passes' mean. `alight render` takes STILL_FRAMES passes in one
@@ -201,3 +207,15 @@ def rotation_offset(k: int, passes: int) -> tuple[float, float]:
     reversed_k = int(format(k % (1 << bits), f"0{bits}b")[::-1], 2)
     return reversed_k / float(1 << bits) / 16.0, (k * 0.6180339887) % 1.0
 
+
+
+def falloff_weight(delta, v, radius, thickness, thin):
+    """common/gtao.glsl gtao_falloff_weight: how much an occluder at ``delta`` from the point
+    counts (1 within 0.75 ``radius``, 0 beyond it), the part of its distance along ``v`` (toward
+    the eye) beyond ``thickness`` stretched by 1 + ``thin``."""
+    delta = np.asarray(delta, np.float64)
+    v = np.asarray(v, np.float64)
+    along = np.sum(delta * v, axis=-1)
+    across = np.linalg.norm(delta - along[..., None] * v, axis=-1)
+    along = along + thin * np.maximum(along - thickness, 0.0)
+    return np.clip((radius - np.hypot(across, along)) / (0.25 * radius), 0.0, 1.0)

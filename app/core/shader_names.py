@@ -151,6 +151,12 @@ SHADER_OPTIONS: dict[str, str] = {
                          "(common/gtao.glsl)",
     "GTAO_SLICES": "GTAO's slice directions per pixel (render/gtao.frag; app/core/gtao.py SLICES)",
     "GTAO_STEPS": "GTAO's depth samples per side of a slice (render/gtao.frag; app/core/gtao.py STEPS)",
+    "GTAO_THICKNESS": "GTAO's occluders are taken as solid this share of the search radius behind their "
+                      "front in view depth (render/gtao.frag; app/core/gtao.py THICKNESS)",
+    "GTAO_FACING_THICKNESS": "GTAO's facing occluders light the band only down to this share of their part's "
+                             "size behind their front (render/gtao.frag; app/core/gtao.py FACING_THICKNESS)",
+    "GTAO_THIN_OCCLUDER": "GTAO's falloff stretches an occluder's depth in front of the point beyond "
+                          "GTAO_THICKNESS by 1 + this (common/gtao.glsl gtao_falloff_weight; app/core/gtao.py THIN_OCCLUDER)",
     # Views and passes.
     "DEBUG_VIEW": "the editor's debug views are compiled in (u_debug_view picks one)",
     "SPHERE_IMPOSTOR": "the built-in sphere drawn as an impostor with this many samples a pixel",

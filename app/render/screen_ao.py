@@ -64,6 +64,17 @@ def defines(occluded: str = "occluders") -> dict:
     return d
 
 
+def part_size(gpu_part, part) -> float:
+    """A part's bounding-box diagonal (world units), kept with its GPU buffers: as thick as GTAO
+    takes an occluder of it to be (render/gtao.frag; app/core/gtao.py THICKNESS)."""
+    size = getattr(gpu_part, "gtao_size", None)
+    if size is None:
+        p = np.asarray(part.positions, np.float64)
+        size = float(np.linalg.norm(p.max(0) - p.min(0))) if len(p) else 0.0
+        gpu_part.gtao_size = size
+    return size
+
+
 class ScreenAO:
     """The GTAO pass's targets (kept while the draw size stays) and its draw."""
 
@@ -177,6 +188,7 @@ class ScreenAO:
 
         for gpu_part, part in zip(gpu_parts, parts):
             set_culling(ctx, gpu_part, part)     # the forward pass's culling: the same front surface
+            prog["u_part_size"] = part_size(gpu_part, part)
             gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
         ctx.disable(moderngl.CULL_FACE)
         ctx.disable(moderngl.DEPTH_TEST)
@@ -189,7 +201,10 @@ class ScreenAO:
         vp = np.ascontiguousarray(view_projection, np.float32).tobytes()
         ivp = np.ascontiguousarray(inverse_vp, np.float32).tobytes()
         search = r.program("render/fullscreen.vert", "render/gtao.frag",
-                           {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS})
+                           {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS,
+                            "GTAO_THICKNESS": repr(float(gtao.THICKNESS)),
+                            "GTAO_THIN_OCCLUDER": repr(float(gtao.THIN_OCCLUDER)),
+                            "GTAO_FACING_THICKNESS": repr(float(gtao.FACING_THICKNESS))})
         t.positions.use(UNIT_SCREEN_AO_WORK)
         search["u_positions"] = UNIT_SCREEN_AO_WORK
         t.normals.use(UNIT_SCREEN_AO_NORMALS)

@@ -75,3 +75,18 @@ float gtao_band_weight(float cos_from, float cos_to, float gamma, float side, fl
 vec3 gtao_facing_light(vec3 by_occluders, vec3 as_point, float occluder_visibility, float visibility, vec2 ramp) {
     return mix(min(by_occluders, as_point), by_occluders, smoothstep(ramp.x, ramp.y, occluder_visibility - visibility));
 }
+
+// How much an occluder at `delta` from the point (world) counts, 0..1: 1 within 0.75 `radius`,
+// fading to 0 at `radius` (so that the search's end draws no line), the distance measured with
+// the part along v (toward the eye) that exceeds `thickness` stretched by `thin`: an occluder far
+// in front of the point in view depth is taken as a thin object with empty space behind it (a
+// sphere in front of another across a gap), not as the top of a solid height field that claims
+// every direction below it (XeGTAO's "thin occluder compensation" of Jimenez et al. 2016's
+// falloff, applied only in front, where the height field's assumption reaches; app/core/gtao.py
+// falloff_weight).
+float gtao_falloff_weight(vec3 delta, vec3 v, float radius, float thickness, float thin) {
+    float along = dot(delta, v);
+    float across = length(delta - along * v);
+    along += thin * max(along - thickness, 0.0);
+    return clamp((radius - length(vec2(across, along))) / (0.25 * radius), 0.0, 1.0);
+}

@@ -8,7 +8,7 @@
 #include "common/gtao.glsl"
 
 uniform sampler2D u_positions;   // the prepass's world positions (w = 1 where a surface is)
-uniform sampler2D u_normals;     // the prepass's face normals (either side)
+uniform sampler2D u_normals;     // the prepass's face normals (either side); w: their part's size
 uniform sampler2D u_history;     // the earlier passes' mean (render/gtao_denoise.frag): V at the occluders
 uniform bool u_has_history;      // false in a view's first pass
 uniform mat4 u_inverse_vp;       // NDC -> world (a tile's: the whole image's, off centre)
@@ -90,7 +90,10 @@ vec3 facing_occluder(ivec2 p, vec3 s, vec3 centre) {
 
 // The largest horizon cosine to v along one side of the slice (screen direction omega, side +1
 // or -1 for gtao_band_weight); the occluders fade out between 0.75 and 1 times `radius` (world
-// units), so that the search's end does not draw a line. Each sample that raises the horizon and
+// units), so that the search's end does not draw a line, and those more than GTAO_THICKNESS times
+// their part's size in front of the point sooner (common/gtao.glsl gtao_falloff_weight: a sphere of
+// a grid in front of another across a gap is thin, not a height field's top; one mesh's walls,
+// with no part of their own, still are). Each sample that raises the horizon and
 // faces the point adds (its V times its normal, 1) to `occluders`, weighted by the band of
 // directions it raised the horizon over (those that, on a height field, see it): the near
 // occluders count as much as the point sees of them, not only the farthest that sets the horizon.
@@ -111,10 +114,18 @@ float horizon_cos(vec2 origin, vec2 omega, float radius_px, vec3 centre, vec3 v,
         vec3 delta = s - centre;
         float dist = length(delta);
         if (dist < 1e-6) continue;
-        float weight = clamp((radius - dist) / (0.25 * radius), 0.0, 1.0);
+        float thickness = GTAO_THICKNESS * texelFetch(u_normals, ivec2(q), 0).w;   // (its part's size)
+        float weight = gtao_falloff_weight(delta, v, radius, thickness, GTAO_THIN_OCCLUDER);
         float c = mix(-1.0, dot(delta, v) / dist, weight);
         if (c > best) {
-            float w = gtao_band_weight(best, c, gamma, side, projected_length);
+            // The facing occluder's own light reaches only the band from its front down to
+            // GTAO_FACING_THICKNESS of its part's size behind it (along the view ray): below that
+            // the screen does not say what the point sees (the corner's wall above the box sees
+            // the box's dim back face and the gap's floor, not its sunlit top), lit as the point.
+            vec3 back = s + normalize(s - u_camera_position) * (GTAO_FACING_THICKNESS / GTAO_THICKNESS) * thickness;
+            vec3 to_back = back - centre;
+            float c_back = mix(-1.0, dot(to_back, v) / max(length(to_back), 1e-6), weight);
+            float w = gtao_band_weight(max(best, min(c_back, c)), c, gamma, side, projected_length);
             if (w > 0.0) {
                 ivec2 p = ivec2(q);
                 vec3 facing = facing_occluder(p, s, centre);
