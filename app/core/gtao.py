@@ -26,11 +26,24 @@ MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS
 MAX_RADIUS_HEIGHT = 0.5  # (the editor's 720 rows: 360 px; the samples stay GTAO_STEPS, spaced quadratically:
                          # render/gtao.frag sample_offset_px. 0.2 missed the shader ball's bowl over its base at
                          # 384 px: V 0.6-0.8 there, 2.6x the path tracer's light; benchmarks/results/gtao.md)
-# Thin occluders (common/gtao.glsl gtao_falloff_weight; XeGTAO's thin occluder compensation): an
-# occluder more than THICKNESS x the search radius in front of the point in view depth fades out of
-# the horizon as if that excess were 1 + THIN_OCCLUDER times longer.
+# The height field's assumption, limited (benchmarks/results/gtao.md, "Thin occluders"). Screen
+# depth takes every occluder as the top of a solid that claims all directions below it; a grid of
+# spheres in front of another across an empty gap (Khronos' MetalRoughSpheres) then hides the back
+# grid (0.60 of --occlusion off). How thick an occluder is comes from the scene's scale, per part:
+# its part's bounding-box diagonal (render/gtao_depth.frag writes it beside the normal). One that is
+# more than THICKNESS times that in front of the point, in view depth, fades out of the horizon as
+# if the excess were 1 + THIN_OCCLUDER times longer (common/gtao.glsl gtao_falloff_weight; XeGTAO's
+# thin occluder compensation, there scaled by the search radius, which here is the whole mesh's
+# diagonal: 4x a sphere's depth gap, and so it would need a factor that breaks the bowl, whose
+# near rim hides its floor from the same distance; 0.1 of the radius, 4: bowl 8.6 -> 18.9%). A
+# one-part mesh (the corner, the bowl) is as before: no point lies farther than its diagonal.
 THICKNESS = 1.0
-THIN_OCCLUDER = 4.0
+THIN_OCCLUDER = 4.0     # (the back grid 0.93 of --occlusion off; 8: 0.93)
+# A facing occluder's own light (render/gtao.frag horizon_cos) takes the band from its front only
+# down to this share of its part's size behind it along the view ray; below that the screen does
+# not say what the point sees (the corner's wall above the box sees the box's unlit back face and
+# the gap's floor, not its sky-lit top: a halo, 19 bins of 349 above 1.2x the path tracer, 5 with
+# 0.12; 0.2: 12, 0.05: 5 but the corner's relMAE up 0.2-2 points), lit as the point is.
 FACING_THICKNESS = 0.12
 # More rotations than the 4x4 pattern's 16, over passes (the paper's temporal accumulation, its
 # section 6: 6 rotations x 16 spatial offsets): each pass turns the pattern by a further fraction of

@@ -151,8 +151,8 @@ SHADER_OPTIONS: dict[str, str] = {
                          "(common/gtao.glsl)",
     "GTAO_SLICES": "GTAO's slice directions per pixel (render/gtao.frag; app/core/gtao.py SLICES)",
     "GTAO_STEPS": "GTAO's depth samples per side of a slice (render/gtao.frag; app/core/gtao.py STEPS)",
-    "GTAO_THICKNESS": "GTAO's occluders are taken as solid this share of the search radius behind their "
-                      "front in view depth (render/gtao.frag; app/core/gtao.py THICKNESS)",
+    "GTAO_THICKNESS": "GTAO's occluders are taken as solid this share of their part's size (bounding-box "
+                      "diagonal) behind their front in view depth (render/gtao.frag; app/core/gtao.py THICKNESS)",
     "GTAO_FACING_THICKNESS": "GTAO's facing occluders light the band only down to this share of their part's "
                              "size behind their front (render/gtao.frag; app/core/gtao.py FACING_THICKNESS)",
     "GTAO_THIN_OCCLUDER": "GTAO's falloff stretches an occluder's depth in front of the point beyond "

@@ -14,6 +14,7 @@ const int TERM_SLICE_VISIBILITY = 0;  // (cos h1, cos h2, gamma, |n_p|)
 const int TERM_BAND_WEIGHT = 1;       // (cos from, cos to, gamma, side), |n_p| 0.8
 const int TERM_FACING_LIGHT = 2;      // (by_occluders r, as_point r, occluders' V, V): g, b = 2 r, 0.5 r
                                       // of each; ramp (-0.1, 0.05)
+const int TERM_FALLOFF_WEIGHT = 3;    // (delta x, y, z, radius), v = (0, 0.6, 0.8), thickness 0.3, thin 4
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -30,6 +31,9 @@ void main() {
         case TERM_FACING_LIGHT:
             o.xyz = gtao_facing_light(a.x * vec3(1.0, 2.0, 0.5), a.y * vec3(1.0, 2.0, 0.5), a.z, a.w,
                                       vec2(-0.1, 0.05));
+            break;
+        case TERM_FALLOFF_WEIGHT:
+            o.x = gtao_falloff_weight(a.xyz, vec3(0.0, 0.6, 0.8), a.w, 0.3, 4.0);
             break;
     }
     u_outputs[i] = o;
