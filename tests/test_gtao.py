@@ -85,6 +85,86 @@ def test_multi_bounce_fit_never_darkens_and_keeps_open_points():
     assert np.allclose(gtao.multi_bounce(1.0, (0.3, 0.6, 0.9)), 1.0, atol=2e-3)
 
 
+@pytest.mark.parametrize("gamma, h1, h2", [(0.0, 0.3, 0.9), (0.4, 0.3, 0.9), (-0.7, 1.2, 0.2), (1.1, 0.05, 1.5)])
+def test_the_bands_sum_to_each_sides_occluded_share(gamma, h1, h2):
+    """render/gtao.frag's horizon_cos weights each sample that raises the horizon by the band it
+    raised it over (gtao_band_weight): from -1 up through rising cosines to a side's horizon the
+    bands sum to that side's occluded share, the open share's complement (the open hemisphere's
+    a(gamma -/+ pi/2) less a(h)); each band against a trapezoid of cos(theta - gamma) |sin theta|."""
+    c1, c2 = np.cos(h1), np.cos(h2)
+    lo, hi = gtao.clamped_horizons(c1, c2, gamma)
+    for side, c, h in ((-1, c1, lo), (1, c2, hi)):
+        steps = [-1.0, c - 0.4, c - 0.1, c]
+        total = sum(float(gtao.band_weight(a, b, gamma, side)) for a, b in zip(steps, steps[1:]))
+        limit = gamma + side * 0.5 * np.pi
+        assert total == pytest.approx(float(gtao.inner_integral(limit, gamma) - gtao.inner_integral(h, gamma)), abs=1e-12)
+        assert total >= -1e-12
+    a, b = 0.2, 0.7      # one band on the + side, inside the normal's hemisphere for gamma 0.4
+    t = np.linspace(np.arccos(b), np.arccos(a), 200001)
+    w = np.cos(t - 0.4) * np.abs(np.sin(t))
+    assert float(gtao.band_weight(a, b, 0.4, 1)) == pytest.approx(np.trapezoid(w, t), abs=1e-9)
+
+
+def test_the_facing_occluders_light_is_held_to_the_points_where_they_see_less():
+    """common/occlusion.glsl screen_facing_light's twin: occluders that see less sky than the point
+    (their V below its V by more than FACING_RAMP's low end) get no more than the point's light;
+    ones that see more (past the high end) their own; the rest lit as the point (share 1 - f)."""
+    own, as_point = np.array([3.0, 2.0, 1.0]), np.array([1.0, 1.0, 1.0])
+    assert np.allclose(gtao.facing_light(own, as_point, 0.3, 0.6), [1.0, 1.0, 1.0])
+    assert np.allclose(gtao.facing_light(own, as_point, 0.9, 0.6), own)
+    assert np.allclose(gtao.facing_light(own * 0.5, as_point, 0.3, 0.6), [1.0, 1.0, 0.5])   # never brighter
+    albedo = np.array([0.7, 0.7, 0.7])
+    assert np.allclose(gtao.occluder_radiance(albedo, 0.0, 0.9, 0.6, own, as_point),
+                       gtao.occluders_reflectance(albedo, 0.6) * as_point)
+    assert np.allclose(gtao.occluder_radiance(albedo, 1.0, 0.9, 0.6, own, as_point),
+                       gtao.occluders_reflectance(albedo, 0.9) * own)
+
+
+def test_the_glsl_terms_match_their_twins():
+    """common/gtao.glsl's gtao_slice_visibility, gtao_band_weight and gtao_facing_light against
+    app/core/gtao.py's slice_visibility, band_weight and facing_light, in float32
+    (shaders/accuracy/evaluate_gtao.comp)."""
+    from tests.gpu import evaluate
+
+    rng = np.random.default_rng(18)
+    shader = "accuracy/evaluate_gtao.comp"
+    rows = np.column_stack([rng.uniform(-1, 1, 400), rng.uniform(-1, 1, 400), rng.uniform(-1.5, 1.5, 400),
+                            rng.uniform(0.1, 1, 400)])
+    gpu = evaluate("SLICE_VISIBILITY", rows, shader=shader)[:, 0]
+    # (float32 acos near |cos| 1 and the shader's HALF_PI literal: up to 1.2e-4 here)
+    np.testing.assert_allclose(gpu, gtao.slice_visibility(rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]), atol=5e-4)
+    lo = rng.uniform(-1, 1, 400)
+    rows = np.column_stack([lo, lo + rng.uniform(0, 1, 400) * (1 - lo), rng.uniform(-1.5, 1.5, 400),
+                            rng.choice([-1.0, 1.0], 400)])
+    gpu = evaluate("BAND_WEIGHT", rows, shader=shader)[:, 0]
+    cpu = np.array([gtao.band_weight(a, b, g, side, 0.8) for a, b, g, side in rows])
+    np.testing.assert_allclose(gpu, cpu, atol=5e-4)
+    assert (cpu >= -1e-12).all()
+    rows = np.column_stack([rng.uniform(0, 3, 400), rng.uniform(0, 3, 400), rng.uniform(0, 1, 400), rng.uniform(0, 1, 400)])
+    gpu = evaluate("FACING_LIGHT", rows, shader=shader)[:, :3]
+    k = np.array([1.0, 2.0, 0.5])
+    cpu = gtao.facing_light(rows[:, :1] * k, rows[:, 1:2] * k, rows[:, 2:3], rows[:, 3:4])
+    np.testing.assert_allclose(gpu, cpu, rtol=1e-5, atol=1e-5)
+    assert gtao.FACING_RAMP == (-0.1, 0.05)     # (the evaluator's ramp)
+    rows = np.column_stack([rng.uniform(-2, 2, (400, 3)), rng.uniform(0.5, 3, 400)])
+    gpu = evaluate("FALLOFF_WEIGHT", rows, shader=shader)[:, 0]
+    cpu = gtao.falloff_weight(rows[:, :3], np.array([0.0, 0.6, 0.8]), rows[:, 3], 0.3, 4.0)
+    np.testing.assert_allclose(gpu, cpu, atol=1e-4)
+    assert 0 < (cpu == 0).mean() < 1 and 0 < (cpu == 1).mean() < 1
+
+
+def test_an_occluder_far_in_front_fades_sooner_than_one_beside():
+    """gtao_falloff_weight: the same distance counts in full across the view and behind the
+    point, but not where it lies in front, in view depth, well beyond the occluder's thickness."""
+    v = np.array([0.0, 0.0, 1.0])
+    beside = gtao.falloff_weight([0.7, 0.0, 0.0], v, 1.0, 0.2, gtao.THIN_OCCLUDER)
+    behind = gtao.falloff_weight([0.0, 0.0, -0.7], v, 1.0, 0.2, gtao.THIN_OCCLUDER)
+    within = gtao.falloff_weight([0.0, 0.0, 0.2], v, 1.0, 0.2, gtao.THIN_OCCLUDER)
+    ahead = gtao.falloff_weight([0.0, 0.0, 0.7], v, 1.0, 0.2, gtao.THIN_OCCLUDER)
+    assert beside == behind == within == 1.0 and ahead == 0.0
+    assert gtao.falloff_weight([0.0, 0.0, 0.7], v, 1.0, 0.2, 0.0) == 1.0   # (no compensation: the old falloff)
+
+
 # ---- the GLSL pass --------------------------------------------------------------------------
 
 def _quad(a, b, c, d):
@@ -165,7 +245,8 @@ def test_glsl_floor_beside_a_wall_gives_the_form_factor(renderer, tmp_path):
     sees no occluder outside the image): the pass's V, averaged over floor pixels at d (within
     0.03) near the wall's middle, within 0.04 of the ray-cast value (0.003-0.04 off in the runs
     here; the strip rule of an infinite wall is 0.01-0.03 below that), rising with d; and the
-    occluded directions point at the wall (-Z), not sideways."""
+    occluded directions point at the wall (-Z), not sideways; and the occluders' texture there
+    holds the wall facing the floor (render/gtao.frag horizon_cos)."""
     from alight.core.scene import Camera
     from alight.exchange.meshes import load_mesh
 
@@ -174,6 +255,7 @@ def test_glsl_floor_beside_a_wall_gives_the_form_factor(renderer, tmp_path):
     mesh = load_mesh(str(_write_obj(tmp_path / "wall.obj", [floor, wall])))
     cam = Camera(position=(0.0, 1.8, 2.4), target=(0.0, 0.3, -0.4))
     vis, p = _visibility(renderer, mesh, cam, 128)
+    occluders = np.frombuffer(renderer.screen_ao.occluders.read(), np.float16).reshape(128, 128, 4)[::-1].astype(np.float64)
     on_floor = (p[..., 3] > 0.5) & (np.abs(p[..., 1]) < 1e-3) & (np.abs(p[..., 0]) < 0.15)
     d = p[..., 2] + 1.0
     means = []
@@ -184,6 +266,17 @@ def test_glsl_floor_beside_a_wall_gives_the_form_factor(renderer, tmp_path):
         assert means[-1] == pytest.approx(_wall_visibility(at), abs=0.04), (at, means[-1], _wall_visibility(at))
         occ = vis[..., :3][band].mean(axis=0)
         assert occ[2] < 0.0 and abs(occ[0]) < 0.2 * abs(occ[2])
+        # The occluders (the wall, on screen and facing the floor): their share of the occluded
+        # directions near 1 (the bands of gtao_band_weight sum to 1 - V, app/core/gtao.py
+        # band_weight), their mean (V times bent normal) toward the floor (+Z) and up (the wall's
+        # bent normal leans away from the floor that hides its foot), not sideways, of length the
+        # wall's V (0.69-0.80 here: the floor hides at most half of the wall's foot).
+        o = occluders[band]
+        share = float(o[:, 3].mean() / (1.0 - means[-1]))
+        assert share == pytest.approx(1.0, abs=0.05), (at, share)
+        mean = o[:, :3].sum(axis=0) / o[:, 3].sum()
+        assert mean[2] > 0.3 and mean[1] > 0.0 and abs(mean[0]) < 0.2 * mean[2], (at, mean)
+        assert 0.55 < np.linalg.norm(mean) <= 1.0, (at, mean)
     assert means == sorted(means)
 
 
@@ -460,3 +553,67 @@ def test_the_shader_ball_has_no_bright_rings_and_darkens_under_its_bowl(renderer
         brighter = int((ratio[band] > 1.03).sum())
         assert brighter <= 0.005 * band.sum() and ratio[band].max() < 1.1, (name, brighter, int(band.sum()),
                                                                             float(ratio[band].max()))
+
+
+@pytest.mark.parametrize("occluded", ["occluders", "multi_bounce", "black"])
+def test_every_occluded_light_compiles(renderer, tmp_path, occluded):
+    """Each of screen_ao.OCCLUDED_LIGHT (bench_gtao.py compares them) builds its forward pass (the
+    occluders' functions need GTAO_OCCLUDERS' defines: multi_bounce once failed to compile) and
+    gives a finite image."""
+    from alight.core.material import Material
+    from alight.core.scene import Camera, Scene
+    from alight.exchange.meshes import load_mesh
+
+    floor = _quad((-1, 0, 1), (1, 0, 1), (1, 0, -1), (-1, 0, -1))
+    wall = _quad((-1, 0, -1), (1, 0, -1), (1, 1, -1), (-1, 1, -1))
+    mesh = load_mesh(str(_write_obj(tmp_path / "wall.obj", [floor, wall])))
+    scene = Scene(mesh=mesh, material=Material(), use_file_materials=False,
+                  camera=Camera(position=(0.0, 1.8, 2.4), target=(0.0, 0.3, -0.4)), occlusion="gtao")
+    renderer.render(scene, None, 32, 32, aa="none")
+    renderer.screen_ao.occluded = occluded
+    try:
+        img = renderer.render(scene, None, 32, 32, aa="none", read_linear=True, read_srgb=False).linear
+    finally:
+        renderer.screen_ao.occluded = "occluders"
+    assert np.isfinite(img).all()
+
+
+def _spheres_behind_glb(path: Path, radius: float, gap: float) -> Path:
+    """Five spheres, each its own mesh (a part): four white ones in a square, 2.4 radii apart,
+    and a yellow one ``gap`` behind its centre along -Z, which from +Z shows between them (as in
+    Khronos' MetalRoughSpheres)."""
+    import trimesh
+
+    from tests.gltf_builder import UINT, Gltf
+
+    s = trimesh.creation.icosphere(subdivisions=3, radius=radius)
+    g = Gltf()
+    white = [((x * 1.2 * radius, y * 1.2 * radius, 0.0), [0.9, 0.9, 0.9, 1.0]) for x in (-1, 1) for y in (-1, 1)]
+    for centre, colour in white + [((0.0, 0.0, -gap), [0.5, 0.4, 0.02, 1.0])]:
+        mat = g.material(pbrMetallicRoughness={"baseColorFactor": colour, "metallicFactor": 0.0, "roughnessFactor": 0.5})
+        g.mesh([{"attributes": {"POSITION": g.accessor(np.asarray(s.vertices) + centre, bounds=True),
+                                "NORMAL": g.accessor(np.asarray(s.vertex_normals))},
+                 "indices": g.accessor(np.asarray(s.faces).ravel(), UINT), "material": mat}])
+    return g.save(path)
+
+
+def test_a_sphere_far_behind_another_is_not_hidden_by_it(tmp_path):
+    """Screen depth takes the front spheres as the top of a solid reaching back to the far one
+    (Khronos' MetalRoughSpheres: the back grid dark brown for yellow): an occluder farther in
+    front of the point than its part's size fades out (app/core/gtao.py THICKNESS), so the back
+    sphere, 5 radii behind (3 between their surfaces; within the search radius, the mesh's
+    diagonal, and 96 px), renders within 2% of --occlusion off where it shows (0.937 of it with
+    THIN_OCCLUDER 0, its V 0.83; 0.999 with the fade, V 0.999)."""
+    from alight.frontends.api import Renderer
+
+    glb = _spheres_behind_glb(tmp_path / "five.glb", 0.05, 0.25)
+    with Renderer(160, aa="none") as r:
+        r.set_mesh(str(glb))
+        r.set_occlusion("off")
+        off = r.render(linear=True)
+        r.set_occlusion("gtao")
+        on = r.render(linear=True)
+    back = (off[..., 3] > 0.99) & (off[..., 2] < 0.5 * off[..., :2].mean(-1))   # (yellow)
+    assert back.sum() > 40, back.sum()
+    ratio = on[..., :3][back].mean() / off[..., :3][back].mean()
+    assert ratio > 0.98, ratio

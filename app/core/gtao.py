@@ -26,6 +26,25 @@ MAX_RADIUS_PX = 96.0     # and at most this many pixels on screen, or MAX_RADIUS
 MAX_RADIUS_HEIGHT = 0.5  # (the editor's 720 rows: 360 px; the samples stay GTAO_STEPS, spaced quadratically:
                          # render/gtao.frag sample_offset_px. 0.2 missed the shader ball's bowl over its base at
                          # 384 px: V 0.6-0.8 there, 2.6x the path tracer's light; benchmarks/results/gtao.md)
+# The height field's assumption, limited (benchmarks/results/gtao.md, "Thin occluders"). Screen
+# depth takes every occluder as the top of a solid that claims all directions below it; a grid of
+# spheres in front of another across an empty gap (Khronos' MetalRoughSpheres) then hides the back
+# grid (0.60 of --occlusion off). How thick an occluder is comes from the scene's scale, per part:
+# its part's bounding-box diagonal (render/gtao_depth.frag writes it beside the normal). One that is
+# more than THICKNESS times that in front of the point, in view depth, fades out of the horizon as
+# if the excess were 1 + THIN_OCCLUDER times longer (common/gtao.glsl gtao_falloff_weight; XeGTAO's
+# thin occluder compensation, there scaled by the search radius, which here is the whole mesh's
+# diagonal: 4x a sphere's depth gap, and so it would need a factor that breaks the bowl, whose
+# near rim hides its floor from the same distance; 0.1 of the radius, 4: bowl 8.6 -> 18.9%). A
+# one-part mesh (the corner, the bowl) is as before: no point lies farther than its diagonal.
+THICKNESS = 1.0
+THIN_OCCLUDER = 4.0     # (the back grid 0.93 of --occlusion off; 8: 0.93)
+# A facing occluder's own light (render/gtao.frag horizon_cos) takes the band from its front only
+# down to this share of its part's size behind it along the view ray; below that the screen does
+# not say what the point sees (the corner's wall above the box sees the box's unlit back face and
+# the gap's floor, not its sky-lit top: a halo, 19 bins of 349 above 1.2x the path tracer, 5 with
+# 0.12; 0.2: 12, 0.05: 5 but the corner's relMAE up 0.2-2 points), lit as the point is.
+FACING_THICKNESS = 0.12
 # More rotations than the 4x4 pattern's 16, over passes (the paper's temporal accumulation, its
 # section 6: 6 rotations x 16 spatial offsets): each pass turns the pattern by a further fraction of
 # its step and the estimate is the passes' mean. `alight render` takes STILL_FRAMES passes in one
@@ -129,6 +148,57 @@ def slice_occluded_direction(cos_h1, cos_h2, gamma, projected_length=1.0):
     return tuple(np.asarray(projected_length) * ((a[k] - lo[k]) + (hi[k] - b[k])) for k in range(2))
 
 
+def band_weight(cos_from, cos_to, gamma, side, projected_length=1.0):
+    """common/gtao.glsl gtao_band_weight: the cosine-weighted share (times |n_p|) of one side's
+    band between two horizon cosines (the lower first; ``side`` +1: h = acos, -1: h = -acos),
+    both clamped to the projected normal's hemisphere: what the sample that raised the horizon
+    from the first to the second occludes (render/gtao.frag horizon_cos weights that occluder's
+    normal by it). From -1 up to a side's horizon the bands sum to that side's occluded share."""
+    side = float(side)
+    gamma = np.asarray(gamma, np.float64)
+    a = side * np.arccos(np.clip(cos_from, -1.0, 1.0))
+    b = side * np.arccos(np.clip(cos_to, -1.0, 1.0))
+    limit = gamma + side * 0.5 * np.pi
+    clamp = np.minimum if side > 0 else np.maximum
+    a, b = clamp(a, limit), clamp(b, limit)
+    return np.asarray(projected_length) * (inner_integral(a, gamma) - inner_integral(b, gamma))
+
+
+# The facing occluders' own light is held to the point's where their V is below the point's: ramped
+# in over this range of (their V - the point's) (common/occlusion.glsl screen_facing_light).
+FACING_RAMP = (-0.1, 0.05)
+
+
+def smoothstep(edge0, edge1, x):
+    t = np.clip((np.asarray(x, np.float64) - edge0) / (edge1 - edge0), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def facing_light(by_occluders, as_point, occluder_visibility, visibility):
+    """The light / pi on the occluders that face the point on screen (common/gtao.glsl
+    gtao_facing_light, through common/occlusion.glsl screen_facing_light): their own (``by_occluders``, the sky their normals see) where their V
+    is above the point's, no more than the point's own (``as_point``) where it is below."""
+    by_occluders = np.asarray(by_occluders, np.float64)
+    t = smoothstep(*FACING_RAMP, np.asarray(occluder_visibility, np.float64) - visibility)
+    return np.minimum(by_occluders, as_point) * (1.0 - t) + by_occluders * t
+
+
+def occluders_reflectance(albedo, visibility):
+    """a V / (1 - a (1 - V)): what occluders of albedo ``albedo`` and visibility V reflect of the
+    light on them / pi, their own occluders' bounces as a series (common/occlusion.glsl)."""
+    albedo = np.asarray(albedo, np.float64)
+    return albedo * visibility / np.maximum(1.0 - albedo * (1.0 - visibility), 1e-3)
+
+
+def occluder_radiance(albedo, facing_share, occluder_visibility, visibility, by_occluders, as_point):
+    """What the occluded share sees / pi (common/occlusion.glsl screen_occluder_radiance): the
+    facing share lit by facing_light through their V, the rest lit as the point is through its V."""
+    lit = facing_light(by_occluders, as_point, occluder_visibility, visibility)
+    rest = occluders_reflectance(albedo, visibility) * np.asarray(as_point, np.float64)
+    facing = occluders_reflectance(albedo, occluder_visibility) * lit
+    return rest * (1.0 - facing_share) + facing * facing_share
+
+
 def bent_normal(n, occluded_sum):
     """The mean unoccluded direction from the occluded directions' sum (mean over slices of
     ``slice_occluded_direction``, in the world): the whole hemisphere sums to 2/3 n in this
@@ -150,3 +220,15 @@ def rotation_offset(k: int, passes: int) -> tuple[float, float]:
     reversed_k = int(format(k % (1 << bits), f"0{bits}b")[::-1], 2)
     return reversed_k / float(1 << bits) / 16.0, (k * 0.6180339887) % 1.0
 
+
+
+def falloff_weight(delta, v, radius, thickness, thin):
+    """common/gtao.glsl gtao_falloff_weight: how much an occluder at ``delta`` from the point
+    counts (1 within 0.75 ``radius``, 0 beyond it), the part of its distance along ``v`` (toward
+    the eye) beyond ``thickness`` stretched by 1 + ``thin``."""
+    delta = np.asarray(delta, np.float64)
+    v = np.asarray(v, np.float64)
+    along = np.sum(delta * v, axis=-1)
+    across = np.linalg.norm(delta - along[..., None] * v, axis=-1)
+    along = along + thin * np.maximum(along - thickness, 0.0)
+    return np.clip((radius - np.hypot(across, along)) / (0.25 * radius), 0.0, 1.0)

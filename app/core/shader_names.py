@@ -149,12 +149,22 @@ SHADER_OPTIONS: dict[str, str] = {
                       "(app/core/sky_weight.py, common/occlusion.glsl)",
     "HAS_SCREEN_AO": "screen-space GTAO's visibility is read per pixel (app/render/screen_ao.py, "
                      "common/occlusion.glsl)",
-    "GTAO_OCCLUDERS": "GTAO's occluded share sees the occluders' radiance, E/pi facing back along the mean "
-                      "occluded direction (common/occlusion.glsl)",
+    "GTAO_OCCLUDERS": "GTAO's occluded share sees the occluders' radiance, lit by the sky their own normals "
+                      "see where the screen shows them facing the point, else as the point is "
+                      "(common/occlusion.glsl)",
+    "GTAO_FACING_RAMP_LOW": "with GTAO_OCCLUDERS: where the facing occluders' V less the point's is below this, "
+                            "their light is held to the point's (app/core/gtao.py FACING_RAMP)",
+    "GTAO_FACING_RAMP_HIGH": "... and above this, their own",
     "GTAO_MULTI_BOUNCE": "GTAO's visibility takes the paper's albedo fit of the occluders' interreflections "
                          "(common/gtao.glsl)",
     "GTAO_SLICES": "GTAO's slice directions per pixel (render/gtao.frag; app/core/gtao.py SLICES)",
     "GTAO_STEPS": "GTAO's depth samples per side of a slice (render/gtao.frag; app/core/gtao.py STEPS)",
+    "GTAO_THICKNESS": "GTAO's occluders are taken as solid this share of their part's size (bounding-box "
+                      "diagonal) behind their front in view depth (render/gtao.frag; app/core/gtao.py THICKNESS)",
+    "GTAO_FACING_THICKNESS": "GTAO's facing occluders light the band only down to this share of their part's "
+                             "size behind their front (render/gtao.frag; app/core/gtao.py FACING_THICKNESS)",
+    "GTAO_THIN_OCCLUDER": "GTAO's falloff stretches an occluder's depth in front of the point beyond "
+                          "GTAO_THICKNESS by 1 + this (common/gtao.glsl gtao_falloff_weight; app/core/gtao.py THIN_OCCLUDER)",
     # Views and passes.
     "DEBUG_VIEW": "the editor's debug views are compiled in (u_debug_view picks one)",
     "SPHERE_IMPOSTOR": "the built-in sphere drawn as an impostor with this many samples a pixel",

@@ -40,11 +40,15 @@ UNIT_VISIBILITY = UNIT_SCENE_BEHIND + 7   # the visibility buffer (alight.render
 # its own passes read the depth and the raw visibility from, and the earlier passes' mean.
 UNIT_SCREEN_AO, UNIT_SCREEN_AO_WORK = UNIT_SCENE_BEHIND + 8, UNIT_SCENE_BEHIND + 9
 UNIT_SCREEN_AO_HISTORY = UNIT_SCREEN_AO_WORK + 1
+# ... and the same three for the occluders' normals (the forward pass's, the raw's while denoising;
+# the earlier passes' mean), and the prepass's face normals the search reads.
+UNIT_SCREEN_AO_OCCLUDERS, UNIT_SCREEN_AO_OCCLUDERS_HISTORY = UNIT_SCREEN_AO_HISTORY + 1, UNIT_SCREEN_AO_HISTORY + 2
+UNIT_SCREEN_AO_NORMALS = UNIT_SCREEN_AO_HISTORY + 3
 # moderngl binds every texture it creates or writes on ctx.default_texture_unit (its scratch unit,
 # by default the last fragment unit: 31 here, which was UNIT_STRETCHED_LOBE_A: a clearcoat map
 # uploaded at its first draw replaced the lobe table). ForwardRenderer moves it past every unit above
 # (GL 4.5 guarantees 80 combined units).
-UNIT_SCRATCH = UNIT_SCREEN_AO_HISTORY + 1
+UNIT_SCRATCH = UNIT_SCREEN_AO_NORMALS + 1
 # Every sampler gets its own unit: samplers left at the default unit 0 with different types
 # (samplerCube and sampler2D) make every draw call fail with GL_INVALID_OPERATION.
 SAMPLER_UNITS = {
@@ -58,6 +62,7 @@ SAMPLER_UNITS = {
     "u_stretched_lobe_a": UNIT_STRETCHED_LOBE_A, "u_stretched_lobe_b": UNIT_STRETCHED_LOBE_B,
     "u_shadow_atlas": UNIT_SHADOW_ATLAS, "u_shadow_depth": UNIT_SHADOW_DEPTH,
     "u_visibility": UNIT_VISIBILITY, "u_screen_ao": UNIT_SCREEN_AO,
+    "u_screen_ao_occluders": UNIT_SCREEN_AO_OCCLUDERS,
 }
 
 

@@ -20,26 +20,30 @@ import moderngl
 import numpy as np
 
 from alight.core import gtao
-from alight.render.bindings import UNIT_SCREEN_AO, UNIT_SCREEN_AO_HISTORY, UNIT_SCREEN_AO_WORK
+from alight.render.bindings import (UNIT_SCREEN_AO, UNIT_SCREEN_AO_HISTORY, UNIT_SCREEN_AO_NORMALS,
+                                    UNIT_SCREEN_AO_OCCLUDERS, UNIT_SCREEN_AO_OCCLUDERS_HISTORY, UNIT_SCREEN_AO_WORK)
 
 
 @dataclass
 class ScreenAOTargets:
-    """The pass's textures at one draw size: the prepass's world positions (and its depth
-    buffer), the raw and the denoised visibility."""
+    """The pass's textures at one draw size: the prepass's world positions and face normals (and
+    its depth buffer), the raw and the denoised visibility and occluders' normals."""
 
     size: tuple[int, int]
     depth: moderngl.Renderbuffer
     positions: moderngl.Texture
+    normals: moderngl.Texture
     depth_fbo: moderngl.Framebuffer
     raw: moderngl.Texture
+    raw_occluders: moderngl.Texture
     raw_fbo: moderngl.Framebuffer
     visibility: list          # two textures: the passes' mean so far and the next one (ping-pong)
+    occluders: list           # ... and the occluders' normals beside each
     visibility_fbo: list
 
     def release(self) -> None:
-        for x in (self.depth_fbo, self.raw_fbo, *self.visibility_fbo, self.depth, self.positions, self.raw,
-                  *self.visibility):
+        for x in (self.depth_fbo, self.raw_fbo, *self.visibility_fbo, self.depth, self.positions, self.normals,
+                  self.raw, self.raw_occluders, *self.visibility, *self.occluders):
             x.release()
 
 
@@ -54,9 +58,21 @@ def defines(occluded: str = "occluders") -> dict:
     d = {"HAS_SCREEN_AO": None}
     if occluded == "occluders":
         d["GTAO_OCCLUDERS"] = None
+        d["GTAO_FACING_RAMP_LOW"], d["GTAO_FACING_RAMP_HIGH"] = (repr(float(x)) for x in gtao.FACING_RAMP)
     elif occluded == "multi_bounce":
         d["GTAO_MULTI_BOUNCE"] = None
     return d
+
+
+def part_size(gpu_part, part) -> float:
+    """A part's bounding-box diagonal (world units), kept with its GPU buffers: as thick as GTAO
+    takes an occluder of it to be (render/gtao.frag; app/core/gtao.py THICKNESS)."""
+    size = getattr(gpu_part, "gtao_size", None)
+    if size is None:
+        p = np.asarray(part.positions, np.float64)
+        size = float(np.linalg.norm(p.max(0) - p.min(0))) if len(p) else 0.0
+        gpu_part.gtao_size = size
+    return size
 
 
 class ScreenAO:
@@ -81,17 +97,23 @@ class ScreenAO:
             # World positions in float32 (render/gtao_depth.frag: a 24-bit depth unprojected
             # made an open floor occlude itself).
             positions = self.ctx.texture(size, 4, dtype="f4")
-            # (the occluded directions' sum in xyz, V in w: render/gtao.frag)
+            # (unit face normals: half floats are enough; render/gtao_depth.frag)
+            normals = self.ctx.texture(size, 4, dtype="f2")
+            # (the occluded directions' sum in xyz, V in w; the occluders' normals' weighted sum in
+            # xyz, the weights' sum in w: render/gtao.frag)
             raw = self.ctx.texture(size, 4, dtype="f4")
+            raw_occluders = self.ctx.texture(size, 4, dtype="f2")
             visibility = [self.ctx.texture(size, 4, dtype="f4") for _ in range(2)]
-            for tex in (raw, *visibility):
+            occluders = [self.ctx.texture(size, 4, dtype="f2") for _ in range(2)]
+            for tex in (normals, raw, raw_occluders, *visibility, *occluders):
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             positions.filter = (moderngl.LINEAR, moderngl.LINEAR)    # (the samples: gtao.frag)
             positions.repeat_x = positions.repeat_y = False
             self.targets = t = ScreenAOTargets(
-                size, depth, positions, self.ctx.framebuffer(color_attachments=[positions], depth_attachment=depth), raw,
-                self.ctx.framebuffer(color_attachments=[raw]), visibility,
-                [self.ctx.framebuffer(color_attachments=[v]) for v in visibility])
+                size, depth, positions, normals,
+                self.ctx.framebuffer(color_attachments=[positions, normals], depth_attachment=depth), raw,
+                raw_occluders, self.ctx.framebuffer(color_attachments=[raw, raw_occluders]), visibility, occluders,
+                [self.ctx.framebuffer(color_attachments=[v, o]) for v, o in zip(visibility, occluders)])
             self.passes = 0
         return t
 
@@ -127,20 +149,31 @@ class ScreenAO:
             passes = total = gtao.STILL_FRAMES
             self.refining = False
         if passes == 0:
-            t.visibility[self.latest].use(UNIT_SCREEN_AO)
+            self._bind_result(t)
             return t.visibility[self.latest]
         ctx.viewport = (0, 0, size[0], size[1])
         if not continued:
             self._positions(r, t, gpu_parts, parts, view_projection)
         for _ in range(passes):
             self._pass(r, t, view_projection, inverse_vp, camera, pixel_scale, radius, total)
-        t.visibility[self.latest].use(UNIT_SCREEN_AO)    # what the forward pass reads (u_screen_ao)
+        self._bind_result(t)
         return t.visibility[self.latest]
+
+    def _bind_result(self, t: ScreenAOTargets) -> None:
+        """What the forward pass reads: u_screen_ao, u_screen_ao_occluders (common/occlusion.glsl)."""
+        t.visibility[self.latest].use(UNIT_SCREEN_AO)
+        t.occluders[self.latest].use(UNIT_SCREEN_AO_OCCLUDERS)
 
     @property
     def visibility(self) -> moderngl.Texture | None:
         """The last draw's visibility (the passes' mean): occluded directions' sum in xyz, V in w."""
         return None if self.targets is None else self.targets.visibility[self.latest]
+
+    @property
+    def occluders(self) -> moderngl.Texture | None:
+        """The last draw's occluders' normals (the passes' mean): their sum weighted by the
+        occluded share each hides in xyz, the weights' sum in w (render/gtao.frag)."""
+        return None if self.targets is None else self.targets.occluders[self.latest]
 
     def _positions(self, r, t: ScreenAOTargets, gpu_parts, parts, view_projection) -> None:
         """The prepass: the opaque parts' world positions at each pixel."""
@@ -155,6 +188,7 @@ class ScreenAO:
 
         for gpu_part, part in zip(gpu_parts, parts):
             set_culling(ctx, gpu_part, part)     # the forward pass's culling: the same front surface
+            prog["u_part_size"] = part_size(gpu_part, part)
             gpu_part.vao_for(prog).render(moderngl.TRIANGLES)
         ctx.disable(moderngl.CULL_FACE)
         ctx.disable(moderngl.DEPTH_TEST)
@@ -167,9 +201,17 @@ class ScreenAO:
         vp = np.ascontiguousarray(view_projection, np.float32).tobytes()
         ivp = np.ascontiguousarray(inverse_vp, np.float32).tobytes()
         search = r.program("render/fullscreen.vert", "render/gtao.frag",
-                           {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS})
+                           {"GTAO_SLICES": gtao.SLICES, "GTAO_STEPS": gtao.STEPS,
+                            "GTAO_THICKNESS": repr(float(gtao.THICKNESS)),
+                            "GTAO_THIN_OCCLUDER": repr(float(gtao.THIN_OCCLUDER)),
+                            "GTAO_FACING_THICKNESS": repr(float(gtao.FACING_THICKNESS))})
         t.positions.use(UNIT_SCREEN_AO_WORK)
         search["u_positions"] = UNIT_SCREEN_AO_WORK
+        t.normals.use(UNIT_SCREEN_AO_NORMALS)
+        search["u_normals"] = UNIT_SCREEN_AO_NORMALS
+        t.visibility[self.latest].use(UNIT_SCREEN_AO_HISTORY)    # (the occluders' own V: gtao.frag)
+        search["u_history"] = UNIT_SCREEN_AO_HISTORY
+        search["u_has_history"] = k > 0
         search["u_inverse_vp"].write(ivp)
         search["u_view_projection"].write(vp)
         search["u_camera_position"] = tuple(float(x) for x in camera.position)
@@ -182,11 +224,15 @@ class ScreenAO:
         denoise = r.program("render/fullscreen.vert", "render/gtao_denoise.frag")
         t.raw.use(UNIT_SCREEN_AO)
         denoise["u_raw"] = UNIT_SCREEN_AO
+        t.raw_occluders.use(UNIT_SCREEN_AO_OCCLUDERS)
+        denoise["u_raw_occluders"] = UNIT_SCREEN_AO_OCCLUDERS
         denoise["u_positions"] = UNIT_SCREEN_AO_WORK
         denoise["u_camera_position"] = tuple(float(x) for x in camera.position)
         history = self.latest
         t.visibility[history].use(UNIT_SCREEN_AO_HISTORY)
         denoise["u_history"] = UNIT_SCREEN_AO_HISTORY
+        t.occluders[history].use(UNIT_SCREEN_AO_OCCLUDERS_HISTORY)
+        denoise["u_history_occluders"] = UNIT_SCREEN_AO_OCCLUDERS_HISTORY
         denoise["u_history_weight"] = k / (k + 1.0)
         self.latest = 1 - history
         t.visibility_fbo[self.latest].use()

@@ -213,6 +213,9 @@ float combined_visibility(Surface s, vec3 n) {
 // Screen-space GTAO (app/render/screen_ao.py): the cosine-weighted visibility at this pixel, from
 // the depth of the opaque parts drawn this frame.
 uniform sampler2D u_screen_ao;
+// The occluders' face normals, each turned toward this pixel and weighted by the share of it
+// that it hides (xyz), and the weights' sum (w): render/gtao.frag.
+uniform sampler2D u_screen_ao_occluders;
 
 // As combined_visibility: the smaller of GTAO's and the glTF occlusion texture's (the texture is
 // the mesh's own baked AO: a product would darken the same crease twice), clamped to [0, 1].
@@ -234,6 +237,60 @@ vec3 screen_visible_irradiance(vec3 n, float visibility) {
     vec3 hidden = visible_cone_radiance(screen_occluded_direction(n), 1.0 - visibility);
     return max(irradiance_at(n, false) - (1.0 - visibility) * hidden, vec3(0.0));
 }
+
+#ifdef GTAO_OCCLUDERS
+// The occluders' light / pi (the sky's and the suns', per unit V) as this point's own: the sky
+// it sees per unit V (screen_visible_irradiance: Jimenez et al. 2016's multi-bounce assumption,
+// that the occluders see as the point does) and the suns on surfaces facing back along d
+// (unshadowed: the occluders' own shadows are not known here).
+vec3 screen_light_as_point(vec3 n, float visibility) {
+    return screen_visible_irradiance(n, visibility) / max(visibility, 1e-3)
+           + suns_irradiance_over_pi(-screen_occluded_direction(n));
+}
+
+// The occluders that face the point on screen (render/gtao.frag horizon_cos): their share of the
+// occluded directions (x, 0..1) and their own mean V (y); the direction of their mean normal in
+// `along` (their bent normals where the pass had earlier passes of the view), n where none.
+vec2 screen_facing_occluders(vec3 n, float visibility, out vec3 along) {
+    vec4 o = texelFetch(u_screen_ao_occluders, ivec2(gl_FragCoord.xy), 0);
+    vec3 mean = o.w > 1e-4 ? o.xyz / o.w : vec3(0.0);
+    float length_mean = length(mean);
+    along = length_mean > 1e-4 ? mean / length_mean : n;
+    return vec2(clamp(o.w / max(1.0 - visibility, 1e-3), 0.0, 1.0), min(length_mean, 1.0));
+}
+
+// The facing occluders' light / pi per unit V: the sky they see by their own normals (the
+// visible cone's radiance about their mean, of their V: a corner's floor sees the sky overhead,
+// the shader ball's bowl underside the dark ground) and the suns on them (unshadowed).
+vec3 screen_light_by_occluders(vec3 along, float occluder_visibility) {
+    return visible_cone_radiance(along, occluder_visibility) + suns_irradiance_over_pi(along);
+}
+
+// Where the facing occluders see no more of the sky than the point (their V below its V, ramped
+// in over GTAO_FACING_RAMP_LOW..HIGH: app/core/gtao.py FACING_RAMP; the numpy twin facing_light),
+// no more light than the point's own (as_point): they stand in the same
+// enclosure, so their normals' open hemisphere overstates what reaches them (the shader ball's
+// base under the bowl, facing up at its neck: 1.5x the path tracer's light on the neck, brighter
+// than --occlusion off). Where they see more (a corner's floor beside its wall) their own light.
+vec3 screen_facing_light(vec3 by_occluders, vec3 as_point, float occluder_visibility, float visibility) {
+    return gtao_facing_light(by_occluders, as_point, occluder_visibility, visibility,
+                             vec2(GTAO_FACING_RAMP_LOW, GTAO_FACING_RAMP_HIGH));
+}
+
+// What the occluded share sees / pi (occlude_environment's GTAO_OCCLUDERS; numpy twin
+// app/core/gtao.py occluder_radiance): the occluders'
+// radiance, this surface's albedo through the bake's series (occluders_reflectance) over the
+// light on them; the share that faces the point on screen lit by the occluders' own normals and
+// V (screen_facing_light), the rest (faces the screen does not hold) as the point is.
+vec3 screen_occluder_radiance(vec3 albedo, vec3 n, float visibility) {
+    vec3 along;
+    vec2 facing = screen_facing_occluders(n, visibility, along);
+    vec3 as_point = screen_light_as_point(n, visibility);
+    vec3 lit = screen_facing_light(screen_light_by_occluders(along, facing.y), as_point, facing.y, visibility);
+    return mix(occluders_reflectance(albedo, visibility) * as_point, occluders_reflectance(albedo, facing.y) * lit,
+               facing.x);
+}
+#endif
 
 // The bent normal (the mean unoccluded direction): the whole hemisphere's cosine-weighted sum
 // of directions is 2/3 n in GTAO's measure, so the visible ones sum to 2/3 n minus the occluded
@@ -334,15 +391,15 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     // GTAO's V and mean occluded direction d. GTAO_OCCLUDERS, the bake's terms: the visible share
     // sees the visible cone's radiance about the bent normal (visible_cone_radiance: a bowl's floor
     // sees the bright sky overhead, not the map's dark ground), the occluded share the occluders'
-    // radiance as the bake's bounce does, the occluders lit by the sky as this point is (the sky
-    // it sees per unit V, screen_visible_irradiance: Jimenez et al. 2016's multi-bounce
-    // assumption, that the occluders see as the point does) and by the suns as surfaces facing
-    // back along d, with this surface's albedo through the bake's series
-    // (occluders_reflectance, their visibility taken as V). Lit by E(-d)/pi instead (surfaces
-    // facing back along d, open to the sky), the occluders under the shader ball's bowl and in its
-    // groove, which see little of it, shone: rings brighter than --occlusion off on the neck
-    // (up to 1.56x at 384 px under royal_esplanade) and the groove's lip. Else V scales E(n)/pi,
-    // with the paper's multi-bounce fit where GTAO_MULTI_BOUNCE.
+    // radiance as the bake's bounce does (screen_occluder_radiance): the occluders the screen
+    // shows facing the point lit by the sky their own normals see (a corner's floor, under the
+    // sky, lights its walls), held to the point's own light where they see no more sky than it
+    // does; the rest lit as the point is (Jimenez et al. 2016's multi-bounce assumption). Lit by
+    // E(-d)/pi for all (surfaces facing back along d, open to the sky), the occluders under the
+    // shader ball's bowl and in its groove, which see little of it, shone: rings brighter than
+    // --occlusion off on the neck (up to 1.56x at 384 px under royal_esplanade); lit as the point
+    // for all, the corner's walls missed the floor's light (benchmarks/results/gtao.md).
+    // Else V scales E(n)/pi, with the paper's multi-bounce fit where GTAO_MULTI_BOUNCE.
     // The specular lobe keeps its share inside the visibility cone about the bent normal (n
     // without GTAO_OCCLUDERS; specular_occlusion, the bake's cone-cone term), the rest sees the
     // occluders (black without GTAO_OCCLUDERS).
@@ -350,11 +407,7 @@ void occlude_environment(Surface s, vec3 n, vec3 r, vec3 specular_albedo, bool w
     vec3 occluder = vec3(0.0);
     vec3 bent = n;
 #if defined(GTAO_OCCLUDERS)
-    // (plus the suns on surfaces facing back along d, unshadowed: the occluders' own shadows are
-    // not known here; the corner's sunlit floor lights its walls)
-    occluder = occluders_reflectance(occluder_albedo(s, specular_albedo), visibility)
-               * (screen_visible_irradiance(n, visibility) / max(visibility, 1e-3)
-                  + suns_irradiance_over_pi(-screen_occluded_direction(n)));
+    occluder = screen_occluder_radiance(occluder_albedo(s, specular_albedo), n, visibility);
     bent = screen_bent_normal(n);
     irradiance = visibility * visible_cone_radiance(bent, visibility) + (1.0 - visibility) * occluder;
 #elif defined(GTAO_MULTI_BOUNCE)

@@ -8,6 +8,9 @@
 #include "common/gtao.glsl"
 
 uniform sampler2D u_positions;   // the prepass's world positions (w = 1 where a surface is)
+uniform sampler2D u_normals;     // the prepass's face normals (either side); w: their part's size
+uniform sampler2D u_history;     // the earlier passes' mean (render/gtao_denoise.frag): V at the occluders
+uniform bool u_has_history;      // false in a view's first pass
 uniform mat4 u_inverse_vp;       // NDC -> world (a tile's: the whole image's, off centre)
 uniform vec3 u_camera_position;
 uniform mat4 u_view_projection;
@@ -17,6 +20,7 @@ uniform float u_max_radius_px;
 uniform vec2 u_rotation_offset;  // this pass's turn of the pattern: slice angle (x pi / GTAO_SLICES), step jitter
 
 layout(location = 0) out vec4 out_visibility;   // the occluded directions' cosine-weighted sum (world), V
+layout(location = 1) out vec4 out_occluders;    // the facing occluders' V times normal (world), their share: horizon_cos
 
 vec3 world_at(vec2 pixel, float ndc_depth) {
     vec2 size = vec2(textureSize(u_positions, 0));
@@ -68,10 +72,33 @@ float sample_offset_px(int j, float jitter, float radius_px) {
     return max(radius_px * s * s, 1.0);
 }
 
-// The largest horizon cosine to v along one side of the slice (screen direction omega); the
-// occluders fade out between 0.75 and 1 times `radius` (world units), so that the search's end
-// does not draw a line.
-float horizon_cos(vec2 origin, vec2 omega, float radius_px, vec3 centre, vec3 v, float jitter, float radius) {
+// The occluder at pixel p (position s) as the point at `centre` sees it: its V times its normal
+// (V and bent normal, app/core/gtao.py bent_normal, from the view's earlier passes: the bake
+// lights its hits by their bent normals), or 0 where its face is turned away (the point then
+// sees a face behind it that the screen does not hold: a bowl's near wall seen from its floor
+// over the rim; common/occlusion.glsl lights that share as before). In a view's first pass V is
+// 1 and the normal the face's: main then takes this point's V for it, the paper's assumption
+// that the occluders see as the point does.
+vec3 facing_occluder(ivec2 p, vec3 s, vec3 centre) {
+    vec3 n = texelFetch(u_normals, p, 0).xyz;
+    if (dot(n, centre - s) <= 0.0) return vec3(0.0);
+    if (!u_has_history) return n;
+    vec4 earlier = texelFetch(u_history, p, 0);
+    vec3 b = (2.0 / 3.0) * n - earlier.xyz;
+    return max(earlier.w, 1e-3) * (dot(b, n) > 1e-6 ? normalize(b) : n);   // (0 would read as turned away)
+}
+
+// The largest horizon cosine to v along one side of the slice (screen direction omega, side +1
+// or -1 for gtao_band_weight); the occluders fade out between 0.75 and 1 times `radius` (world
+// units), so that the search's end does not draw a line, and those more than GTAO_THICKNESS times
+// their part's size in front of the point sooner (common/gtao.glsl gtao_falloff_weight: a sphere of
+// a grid in front of another across a gap is thin, not a height field's top; one mesh's walls,
+// with no part of their own, still are). Each sample that raises the horizon and
+// faces the point adds (its V times its normal, 1) to `occluders`, weighted by the band of
+// directions it raised the horizon over (those that, on a height field, see it): the near
+// occluders count as much as the point sees of them, not only the farthest that sets the horizon.
+float horizon_cos(vec2 origin, vec2 omega, float radius_px, vec3 centre, vec3 v, float jitter, float radius,
+                  float gamma, float side, float projected_length, inout vec4 occluders) {
     float best = -1.0;
     vec2 size = vec2(textureSize(u_positions, 0));
     for (int j = 0; j < GTAO_STEPS; ++j) {
@@ -87,8 +114,25 @@ float horizon_cos(vec2 origin, vec2 omega, float radius_px, vec3 centre, vec3 v,
         vec3 delta = s - centre;
         float dist = length(delta);
         if (dist < 1e-6) continue;
-        float weight = clamp((radius - dist) / (0.25 * radius), 0.0, 1.0);
-        best = max(best, mix(-1.0, dot(delta, v) / dist, weight));
+        float thickness = GTAO_THICKNESS * texelFetch(u_normals, ivec2(q), 0).w;   // (its part's size)
+        float weight = gtao_falloff_weight(delta, v, radius, thickness, GTAO_THIN_OCCLUDER);
+        float c = mix(-1.0, dot(delta, v) / dist, weight);
+        if (c > best) {
+            // The facing occluder's own light reaches only the band from its front down to
+            // GTAO_FACING_THICKNESS of its part's size behind it (along the view ray): below that
+            // the screen does not say what the point sees (the corner's wall above the box sees
+            // the box's dim back face and the gap's floor, not its sunlit top), lit as the point.
+            vec3 back = s + normalize(s - u_camera_position) * (GTAO_FACING_THICKNESS / GTAO_THICKNESS) * thickness;
+            vec3 to_back = back - centre;
+            float c_back = mix(-1.0, dot(to_back, v) / max(length(to_back), 1e-6), weight);
+            float w = gtao_band_weight(max(best, min(c_back, c)), c, gamma, side, projected_length);
+            if (w > 0.0) {
+                ivec2 p = ivec2(q);
+                vec3 facing = facing_occluder(p, s, centre);
+                if (dot(facing, facing) > 0.0) occluders += w * vec4(facing, 1.0);
+            }
+            best = c;
+        }
     }
     return best;
 }
@@ -99,6 +143,7 @@ void main() {
     vec3 centre = position_at(p, covered);
     if (!covered) {
         out_visibility = vec4(0.0, 0.0, 0.0, 1.0);
+        out_occluders = vec4(0.0);
         return;
     }
     vec3 v = normalize(u_camera_position - centre);
@@ -115,6 +160,7 @@ void main() {
     vec2 origin = vec2(p) + 0.5;
     float visibility = 0.0;
     vec3 occluded = vec3(0.0);
+    vec4 occluders = vec4(0.0);    // (horizon_cos)
     for (int i = 0; i < GTAO_SLICES; ++i) {
         float phi = (float(i) + noise.x) * 3.14159265 / float(GTAO_SLICES);
         vec2 omega = vec2(cos(phi), sin(phi));
@@ -127,14 +173,17 @@ void main() {
         float length_n = length(projected);
         float cos_n = clamp(dot(projected, v) / max(length_n, 1e-6), -1.0, 1.0);
         float gamma = sign(dot(projected, direction)) * acos(cos_n);
-        float c2 = horizon_cos(origin, omega, radius_px, centre, v, noise.y, radius);
-        float c1 = horizon_cos(origin, -omega, radius_px, centre, v, noise.y, radius);
+        float c2 = horizon_cos(origin, omega, radius_px, centre, v, noise.y, radius, gamma, 1.0, length_n, occluders);
+        float c1 = horizon_cos(origin, -omega, radius_px, centre, v, noise.y, radius, gamma, -1.0, length_n, occluders);
         visibility += gtao_slice_visibility(c1, c2, gamma, length_n);
         vec2 o = gtao_slice_occluded_direction(c1, c2, gamma, length_n);
         occluded += direction * o.x + v * o.y;
     }
+    // (a view's first pass: the occluders see as this point does, the paper's assumption)
+    if (!u_has_history) occluders.xyz *= visibility / float(GTAO_SLICES);
     // Not clamped here: the mean of 2 slices is 1 over an open pixel only on average (1.07 for
     // a normal 69 degrees from v), and render/gtao_denoise.frag's mean over 16 rotations is the
     // estimate (clamped per pixel first, an open floor seen at a slant came out 0.96).
     out_visibility = vec4(occluded, visibility) / float(GTAO_SLICES);
+    out_occluders = occluders / float(GTAO_SLICES);
 }
