@@ -552,3 +552,16 @@ def test_a_ground_with_nothing_to_catch_says_so(shared_data, out_dir):
     lit = run("render", "--mesh", duck, "--ground", "--light", "directional:dir=-0.5,-1,-0.3", "--quality", "low",
               "--size", "48", "--out", str(out_dir / "b.png"))
     assert lit.returncode == 0 and "--ground" not in lit.stderr, lit.stderr
+
+
+@pytest.mark.parametrize("flag,what", [("--mesh", "mesh"), ("--env", "environment"), ("--out", "output")])
+def test_an_empty_path_is_said_to_be_empty(tmp_path, flag, what):
+    """A path left empty (a script's unset variable: --mesh "$DIR/") is named as empty, not as
+    the current folder ('': is a folder) or a missing file with no name: one line, exit 2."""
+    args = {"--mesh": "sphere", "--env": "studio", "--out": str(tmp_path / "x.png")}
+    args[flag] = ""
+    result = run("render", "--size", "16", *[x for kv in args.items() for x in kv])
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"alight: error: {what}: the path is empty"), result.stderr
+    assert not list(tmp_path.iterdir())

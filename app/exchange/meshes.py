@@ -53,6 +53,8 @@ def load_mesh(spec: str) -> Mesh:
     """A built-in mesh by name, or a mesh file flattened to world-space parts."""
     if spec in _BUILDERS:
         return _BUILDERS[spec]()
+    if not str(spec).strip():   # (Path('') is '.', the current folder: "is a folder" named nothing)
+        raise AlightError(f"mesh: the path is empty (a built-in: {', '.join(BUILTIN_MESHES)}; or a mesh file)")
     path = Path(spec)
     ext = path.suffix.lower()
     if path.is_dir():

@@ -46,6 +46,8 @@ def check_output_path(path: str | os.PathLike, suffixes=IMAGE_SUFFIXES) -> Path:
     """Refuse a bad output path before any work is done: unknown suffix, missing folder."""
     from alight.errors import AlightError
 
+    if not str(path).strip():
+        raise AlightError(f"output: the path is empty (use a {' or '.join(suffixes)} file)")
     p = Path(path)
     if p.suffix.lower() not in suffixes:
         raise AlightError(f"{p}: unsupported output format '{p.suffix}' (use {' or '.join(suffixes)})")

@@ -79,6 +79,8 @@ def load_environment(spec: str, max_width: int = MAX_WIDTH) -> Environment:
     """
     if str(spec) == "studio":
         return studio_environment()
+    if not str(spec).strip():
+        raise AlightError("environment: the path is empty ('studio', or an equirectangular .hdr/.exr file)")
     path = os.fspath(spec)
     if max_width < 2:
         raise ValueError("max_width must be >= 2")
