@@ -179,3 +179,32 @@ def test_a_bad_setting_in_the_session_file_is_one_warning(tmp_path, monkeypatch)
     warning = restore_session(fresh, OrbitCamera())
     assert "tonemap 'sepia'" in warning and "\n" not in warning
     assert fresh.env_rotation_deg == 0.0 and fresh.display.tonemap == "aces"   # the settings left as they were
+
+
+def test_the_preset_file_field_follows_the_material_until_typed_in(display, tmp_path):
+    """A new user clicked 'save preset' with the field left at material.json: the aluminium saved
+    was renamed 'material' and the library asked to replace its 'material'. The field now shows
+    the material's name (aluminium.json) until the artist types in it; a save keeps the name."""
+    file = tmp_path / "preset_field.py"
+    file.write_text(
+        "import os\n"
+        "from alight.frontends.editor.ui_test import editor\n"
+        "def test_field(ctx):\n"
+        "    panel, s = editor().panel, editor().state\n"
+        "    ctx.set_ref('alight')\n"
+        "    ctx.item_click('**/aluminium')\n"
+        "    ctx.yield_(2)\n"
+        "    assert panel.preset_path == 'aluminium.json', panel.preset_path\n"
+        "    ctx.item_click('**/save preset')\n"
+        "    ctx.yield_(2)\n"
+        "    assert os.path.isfile('aluminium.json') and s.material.name == 'aluminium', (s.message, s.error)\n"
+        "    ctx.item_click('**/gold')\n"
+        "    ctx.yield_(2)\n"
+        "    assert panel.preset_path == 'gold.json', panel.preset_path\n"
+        "    ctx.item_input_value('**/preset file', 'mine.json')\n"
+        "    ctx.item_click('**/copper')\n"
+        "    ctx.yield_(2)\n"
+        "    assert panel.preset_path == 'mine.json', panel.preset_path\n")
+    result = ui_test(tmp_path, file, "--new")
+    assert result.returncode == 0 and "1 passed, 0 failed" in result.stdout, result.stdout[-3000:] + result.stderr[-3000:]
+    assert (tmp_path / "aluminium.json").is_file() and not (tmp_path / "material.json").exists()

@@ -147,6 +147,13 @@ KEPT_PATH_FIELDS = ("preset_path", "gltf_path")
 DEFAULT_PATHS = {"preset_path": "material.json", "gltf_path": "material.gltf"}
 
 
+def preset_file_name(name: str) -> str:
+    """A material's name as a preset file in the working folder: 'gold' -> gold.json; the
+    characters a file name cannot safely hold as '_'; the default material's material.json."""
+    stem = "".join(c if c.isalnum() or c in "._- " else "_" for c in name.strip()).strip(". ")
+    return f"{stem if stem and name != 'default' else 'material'}.json"
+
+
 def read_for_upload(spec: str):
     """On the file-jobs thread: the mesh (EditorState's read_mesh) and the CPU side of its GPU
     upload (alight.render.mesh_upload.prepare_upload)."""
@@ -190,6 +197,10 @@ class Panel:
         self._pointer_kept = (0.0, 0.0)   # where the pointer was when last inside the list with places kept
         # Each path field's last path that worked (_attempt): a failed one is not left showing.
         self._good = {"preset_path": self.preset_path, "gltf_path": self.gltf_path}
+        # The 'preset file' field follows the material's name (gold.json) until the artist types
+        # in it: left at material.json, 'save preset' renamed the aluminium it saved to
+        # 'material' and asked to replace the library's 'material' (a new user's trial).
+        self._auto_preset_path = self.preset_path
         from alight.frontends.editor.file_jobs import FileJobs
 
         self.file_jobs = FileJobs()   # 'open mesh' and 'export glTF' on a worker thread (file_jobs.py)
@@ -443,6 +454,7 @@ class Panel:
         if imgui.button("redo"):
             s.step_history(win.history, redo=True)
         # A file to write (save, export): Enter does nothing here (widgets.text_field says why).
+        self._follow_material_name(s.material.name)
         _, self.preset_path = imgui.input_text("preset file", self.preset_path)
         if imgui.button("save preset"):
             self._attempt(s, "preset_path", lambda: self._save_preset(s))
@@ -455,6 +467,16 @@ class Panel:
         _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
         if imgui.button("export glTF"):   # the mesh with the material and its maps (.gltf or .glb)
             self._export_gltf(s)
+
+    def _follow_material_name(self, name: str) -> None:
+        """The 'preset file' field as ``preset_file_name(name)`` while it holds the name it was
+        last given so (not typed, not restored from a session as another name)."""
+        if self.preset_path != self._auto_preset_path:
+            return
+        auto = preset_file_name(name)
+        if self._good.get("preset_path") == self.preset_path:
+            self._good["preset_path"] = auto   # (a failed save goes back to what is shown)
+        self.preset_path = self._auto_preset_path = auto
 
     def _save_preset(self, s) -> None:
         """'save preset': the file (a .json with maps loaded: the factors, and the status row
@@ -541,7 +563,10 @@ class Panel:
     def kept_paths(self) -> dict:
         """The 'preset file' and 'glTF file' fields for the next session: the paths that last
         worked (a typed path that failed is not kept, as it is not left showing)."""
-        return {field: self._good[field] for field in KEPT_PATH_FIELDS}
+        kept = {field: self._good[field] for field in KEPT_PATH_FIELDS}
+        if self.preset_path == self._auto_preset_path == kept["preset_path"]:
+            kept["preset_path"] = DEFAULT_PATHS["preset_path"]   # (following the name: the next session too)
+        return kept
 
     def restore_paths(self, paths: dict) -> None:
         """The fields of a saved session (``kept_paths``); entries that are not text are skipped."""
