@@ -3,14 +3,14 @@ alight.render.normal_spread): DamagedHelmet orbiting in small steps, each bias's
 against a supersampled truth's. Prints one table; asserts nothing (results/normal_lod_shimmer.md).
 
     PYTHONPATH=... .venv/bin/python benchmarks/bench_normal_lod_shimmer.py [--size 128] [--frames 42]
-        [--step 0.2] [--biases 0,-0.5,-1] [--strip DIR]
+        [--start 30] [--step 0.2] [--biases 0,-0.5,-1] [--strip DIR]
 
 DamagedHelmet with its own materials under royal_esplanade_1k, through ``alight.Renderer``
 (4x MSAA, quality medium, background transparent so alpha is the coverage; occlusion and shadows
 off, so nothing but the shading at the pixels changes between the runs), the camera orbiting from
-30 degrees by ``--step`` degrees a frame at elevation 10. For each bias a Renderer of its own, the
-module constant set before its first render and kept while it renders (variants.py reads it when
-the parts' programs are chosen; 0 compiles no define). The truth: bias 0 rendered at 4x the size
+``--start`` degrees (30) by ``--step`` degrees a frame at elevation 10. For each bias a Renderer
+of its own, the module constant set before its first render and kept while it renders
+(variants.py reads it when the parts' programs are chosen; 0 compiles no define). The truth: bias 0 rendered at 4x the size
 and box-averaged 4x4 in linear radiance (the pixel's footprint supersampled: the filtered answer's
 own temporal behaviour, what a moving image should do).
 
@@ -21,10 +21,11 @@ and over the triples: in linear luminance (relative to the truth's mean luminanc
 pixels) and in display sRGB (ACES, the sRGB curve: metrics.tonemapped_srgb, 0-255), with the share
 of pixel-triples whose sRGB second difference exceeds 4/255 (a step one sees). Regions: the whole
 helmet, and the glossy pixels (G-buffer roughness below 0.1 at the middle frame, bias 0, 1x: the
-visor and the polished metal). Each figure is also given as a ratio to the truth's.
+visor and the polished metal) and the rest. Each figure is also given as a ratio to the truth's.
 
-``--strip DIR`` writes DIR/shimmer_visor_<size>.png: a crop around the visor over 8 consecutive
-frames (columns), bias 0, each other bias and the truth (rows), sRGB, enlarged 4x.
+``--strip DIR`` writes DIR/shimmer_visor_<size>_<start>.png: a crop around the visor over 8
+consecutive frames (columns), bias 0, the lowest bias and the truth (rows), sRGB, enlarged 4x; and
+DIR/shimmer_map_<size>_<start>.png: each image's mean sRGB second difference per pixel, side by side.
 """
 
 from __future__ import annotations
@@ -46,7 +47,8 @@ GLOSSY = 0.1          # G-buffer roughness below this: the glossy region (as ben
 VISIBLE = 4.0         # an sRGB second difference above this (of 255) counts as a visible step
 
 
-def frames(bias: float, size: int, count: int, step: float, render_size: int, gbuffer: bool = False):
+def frames(bias: float, size: int, count: int, start: float, step: float, render_size: int,
+           gbuffer: bool = False):
     """(count, render_size, render_size, 4) linear frames with NORMAL_MAP_LOD_BIAS = ``bias``, and
     with ``gbuffer`` the (count, size, size) roughness of the G-buffer at ``size``."""
     import alight
@@ -62,7 +64,7 @@ def frames(bias: float, size: int, count: int, step: float, render_size: int, gb
         r.set_occlusion("off").set_shadows("off")
         with r:
             for i in range(count):
-                r.set_camera(orbit_deg=START_DEG + i * step, elevation_deg=ELEVATION_DEG)
+                r.set_camera(orbit_deg=start + i * step, elevation_deg=ELEVATION_DEG)
                 out.append(r.render(render_size, render_size, linear=True).astype(np.float32))
                 if gbuffer:
                     with r._renderer.ctx:
@@ -124,10 +126,28 @@ def strip(seq: dict[str, np.ndarray], glossy: np.ndarray, path: Path, columns: i
           f"y {y0}-{y0 + 2 * half} of {size} px)")
 
 
+def flicker_map(seq: dict[str, np.ndarray], interior: np.ndarray, path: Path, zoom: int = 2) -> None:
+    """Each image's mean sRGB second difference per pixel over the triples (white: 16/255 and
+    above), side by side, the helmet's interior only."""
+    from alight.accuracy.metrics import tonemapped_srgb
+    from alight.exchange.output import write_image
+
+    inside = interior.all(axis=0)
+    tiles = []
+    for s in seq.values():
+        srgb = np.stack([tonemapped_srgb(f) for f in s]) * 255.0
+        d2 = np.abs(srgb[:-2] - 2 * srgb[1:-1] + srgb[2:]).mean(axis=(0, -1))
+        tiles.append(np.pad(np.where(inside, np.clip(d2 / 16.0, 0, 1), 0.15), 2, constant_values=1.0))
+    image = np.repeat(np.repeat(np.concatenate(tiles, axis=1), zoom, axis=0), zoom, axis=1)
+    write_image(path, np.repeat((image * 255 + 0.5).astype(np.uint8)[..., None], 3, axis=2), linear=False)
+    print(f"wrote {path} (left to right: {', '.join(seq)}; mean sRGB second difference, white >= 16/255)")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", type=int, default=128)
     ap.add_argument("--frames", type=int, default=42, help="frames rendered (frames - 2 triples)")
+    ap.add_argument("--start", type=float, default=START_DEG, help="the orbit's first angle, degrees")
     ap.add_argument("--step", type=float, default=0.2, help="degrees of orbit a frame")
     ap.add_argument("--biases", default="0,-0.5,-1", help="comma-separated NORMAL_MAP_LOD_BIAS values")
     ap.add_argument("--strip", metavar="DIR", help="write a PNG strip of visor crops over consecutive frames")
@@ -135,17 +155,18 @@ def main(argv=None) -> int:
     biases = [float(b) for b in args.biases.split(",")]
 
     seq: dict[str, np.ndarray] = {}
-    start = time.perf_counter()
+    t0 = time.perf_counter()
     rough = None
     for b in biases:
-        seq[f"bias {b:g}"], g = frames(b, args.size, args.frames, args.step, args.size, gbuffer=rough is None and b == 0)
+        seq[f"bias {b:g}"], g = frames(b, args.size, args.frames, args.start, args.step, args.size,
+                                       gbuffer=rough is None and b == 0)
         rough = g if g is not None else rough
-        print(f"bias {b:g}: {time.perf_counter() - start:.0f} s", flush=True)
-    truth, _ = frames(0.0, args.size, args.frames, args.step, args.size * SUPERSAMPLE)
+        print(f"bias {b:g}: {time.perf_counter() - t0:.0f} s", flush=True)
+    truth, _ = frames(0.0, args.size, args.frames, args.start, args.step, args.size * SUPERSAMPLE)
     seq["truth"] = box(truth, SUPERSAMPLE)
-    print(f"truth: {time.perf_counter() - start:.0f} s", flush=True)
+    print(f"truth: {time.perf_counter() - t0:.0f} s", flush=True)
     if rough is None:
-        _, rough = frames(0.0, args.size, args.frames, args.step, args.size, gbuffer=True)
+        _, rough = frames(0.0, args.size, args.frames, args.start, args.step, args.size, gbuffer=True)
 
     names = list(seq)
     base = names[0]
@@ -158,9 +179,9 @@ def main(argv=None) -> int:
         covered &= s[..., 3] > 0.999
     interior = covered[:-2] & covered[1:-1] & covered[2:]
     glossy = interior & (rough[1:-1] < GLOSSY)
-    regions = {"helmet": interior, f"glossy r<{GLOSSY:g}": glossy}
+    regions = {"helmet": interior, f"glossy r<{GLOSSY:g}": glossy, f"r>={GLOSSY:g}": interior & ~glossy}
     print(f"\nDamagedHelmet {args.size} px, royal_esplanade_1k, 4x MSAA, occlusion and shadows off; "
-          f"orbit {START_DEG:g} + {args.step:g} deg a frame, elevation {ELEVATION_DEG:g}, {args.frames} frames "
+          f"orbit {args.start:g} + {args.step:g} deg a frame, elevation {ELEVATION_DEG:g}, {args.frames} frames "
           f"({args.frames - 2} triples); truth: bias 0 at {SUPERSAMPLE}x, box-averaged")
     print(f"pixels a triple: helmet {interior.sum() / len(interior):.0f}, glossy {glossy.sum() / len(glossy):.0f}")
     print("| region | image | flicker, linear lum. (% of mean) | / truth | flicker, sRGB (of 255) | / truth | "
@@ -176,7 +197,8 @@ def main(argv=None) -> int:
     if args.strip:
         Path(args.strip).mkdir(parents=True, exist_ok=True)
         keep = [n for n in names if n in (base, "truth") or n == f"bias {min(biases):g}"]
-        strip({n: seq[n] for n in keep}, glossy[0], Path(args.strip) / f"shimmer_visor_{args.size}.png")
+        strip({n: seq[n] for n in keep}, glossy[0], Path(args.strip) / f"shimmer_visor_{args.size}_{args.start:g}.png")
+        flicker_map(seq, interior, Path(args.strip) / f"shimmer_map_{args.size}_{args.start:g}.png")
     return 0
 
 
