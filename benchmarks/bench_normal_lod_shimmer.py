@@ -3,16 +3,18 @@ alight.render.normal_spread): DamagedHelmet orbiting in small steps, each bias's
 against a supersampled truth's. Prints one table; asserts nothing (results/normal_lod_shimmer.md).
 
     PYTHONPATH=... .venv/bin/python benchmarks/bench_normal_lod_shimmer.py [--size 128] [--frames 42]
-        [--start 30] [--step 0.2] [--biases 0,-0.5,-1] [--strip DIR]
+        [--start 30] [--step 0.2] [--biases 0,-0.5,-1] [--supersample 4]
+        [--strip DIR]
 
 DamagedHelmet with its own materials under royal_esplanade_1k, through ``alight.Renderer``
 (4x MSAA, quality medium, background transparent so alpha is the coverage; occlusion and shadows
 off, so nothing but the shading at the pixels changes between the runs), the camera orbiting from
 ``--start`` degrees (30) by ``--step`` degrees a frame at elevation 10. For each bias a Renderer
 of its own, the module constant set before its first render and kept while it renders
-(variants.py reads it when the parts' programs are chosen; 0 compiles no define). The truth: bias 0 rendered at 4x the size
-and box-averaged 4x4 in linear radiance (the pixel's footprint supersampled: the filtered answer's
-own temporal behaviour, what a moving image should do).
+(variants.py reads it when the parts' programs are chosen; 0 compiles no define). The truth:
+bias 0 rendered at 4x the size (``--supersample``) and box-averaged 4x4 in linear radiance (the
+pixel's footprint supersampled: the filtered answer's own temporal behaviour, what a moving image
+should do; at 4x it still flickers, so the ratios to it are lower bounds: results page).
 
 Flicker, per consecutive triple of frames, is the second difference |I_t - 2 I_{t+1} + I_{t+2}|
 (smooth motion at a constant speed cancels; a highlight that pops in and out of a pixel does not),
@@ -150,6 +152,7 @@ def main(argv=None) -> int:
     ap.add_argument("--start", type=float, default=START_DEG, help="the orbit's first angle, degrees")
     ap.add_argument("--step", type=float, default=0.2, help="degrees of orbit a frame")
     ap.add_argument("--biases", default="0,-0.5,-1", help="comma-separated NORMAL_MAP_LOD_BIAS values")
+    ap.add_argument("--supersample", type=int, default=SUPERSAMPLE, help="the truth's size factor (box-averaged)")
     ap.add_argument("--strip", metavar="DIR", help="write a PNG strip of visor crops over consecutive frames")
     args = ap.parse_args(argv)
     biases = [float(b) for b in args.biases.split(",")]
@@ -162,8 +165,8 @@ def main(argv=None) -> int:
                                        gbuffer=rough is None and b == 0)
         rough = g if g is not None else rough
         print(f"bias {b:g}: {time.perf_counter() - t0:.0f} s", flush=True)
-    truth, _ = frames(0.0, args.size, args.frames, args.start, args.step, args.size * SUPERSAMPLE)
-    seq["truth"] = box(truth, SUPERSAMPLE)
+    truth, _ = frames(0.0, args.size, args.frames, args.start, args.step, args.size * args.supersample)
+    seq["truth"] = box(truth, args.supersample)
     print(f"truth: {time.perf_counter() - t0:.0f} s", flush=True)
     if rough is None:
         _, rough = frames(0.0, args.size, args.frames, args.start, args.step, args.size, gbuffer=True)
@@ -182,7 +185,7 @@ def main(argv=None) -> int:
     regions = {"helmet": interior, f"glossy r<{GLOSSY:g}": glossy, f"r>={GLOSSY:g}": interior & ~glossy}
     print(f"\nDamagedHelmet {args.size} px, royal_esplanade_1k, 4x MSAA, occlusion and shadows off; "
           f"orbit {args.start:g} + {args.step:g} deg a frame, elevation {ELEVATION_DEG:g}, {args.frames} frames "
-          f"({args.frames - 2} triples); truth: bias 0 at {SUPERSAMPLE}x, box-averaged")
+          f"({args.frames - 2} triples); truth: bias 0 at {args.supersample}x, box-averaged")
     print(f"pixels a triple: helmet {interior.sum() / len(interior):.0f}, glossy {glossy.sum() / len(glossy):.0f}")
     print("| region | image | flicker, linear lum. (% of mean) | / truth | flicker, sRGB (of 255) | / truth | "
           f"share > {VISIBLE:g}/255 | / truth |")
