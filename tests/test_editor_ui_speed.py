@@ -83,3 +83,15 @@ def test_a_screenshot_clicked_is_named_first_in_the_status_row(display, tmp_path
                        ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert result.stdout.startswith("ok: the row shows 'wrote alight-screenshot-2.png"), result.stdout
+
+
+def test_a_file_dropped_while_a_frame_polls_is_drawn_without_input(display, tmp_path):
+    """A real XDND drop of an .hdr delivered in a frame's after-draw poll, the pointer still where
+    it let go: the editor's loop bakes and draws the new map with no further input (a new user's
+    drop said "opened" and the old map stayed until the mouse moved; it stays 0 frames without
+    the fix). tests/editor_x_events_drop_in_frame.py."""
+    hdr = REPO.parent / "shared" / "data" / "env" / "quarry_01_1k.hdr"
+    result = run_check("editor_x_events_drop_in_frame.py", display, args=(str(hdr),), timeout=600,
+                       ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: dropped"), result.stdout

@@ -1064,7 +1064,13 @@ class EditorWindow:
             self.frame()
             return True
         background = self._background_pending()
-        self._woken = False
+        if self._woken:
+            # A callback in the last frame's after-draw poll (a drop, the pointer entering): its
+            # frame now. Cleared unseen here, a dropped .hdr said "opened" and stayed off screen
+            # until the mouse moved (tests/editor_x_events_drop_in_frame.py).
+            self._woken = False
+            self.frame()
+            return True
         self.idle_waits += 1
         self.glfw.wait_events_timeout(BACKGROUND_FRAME_S if background else IDLE_WAIT_S)
         if self._last_swap is not None:
