@@ -225,7 +225,7 @@ def _render_bias(lit, path, bias: float, size: int = SIZE):
 
 
 def test_the_normal_map_is_fetched_one_level_finer(lit, tmp_path):
-    # NORMAL_MAP_LOD_BIAS (mesh_material.glsl sample_map_sharper): stripes 8 texels wide, read
+    # NORMAL_MAP_LOD_BIAS (mesh_material.glsl normal_from_map): stripes 8 texels wide, read
     # about 3.2 levels up at SIZE. Without the bias the fetch blends level 3 (one stripe a texel)
     # with level 4 (both stripes' mean: flat), so the tilts fade; one level finer reads levels 2
     # and 3, both striped, so the pixels see the tilts. Magnified (level 0 either way) the bias

@@ -126,7 +126,7 @@ SHADER_OPTIONS: dict[str, str] = {
     "NORMAL_FLAT_LENGTH": "a decoded normal this short reads as (0, 0, 1), and |Na| is clipped to it "
                           "(render/normal_spread.comp; alight.render.normal_spread FLAT_LENGTH)",
     "NORMAL_MAP_LOD_BIAS": "the normal maps' level-of-detail bias, log2 (alight.render.normal_spread, "
-                          "common/mesh_material.glsl sample_map_sharper)",
+                          "common/mesh_material.glsl normal_from_map)",
     "MATERIAL_MAPS_MASK": "the maps present, a bit each (map_mask)",
     "MAP_MIRROR_S_MASK": "maps whose sampler mirrors in s",
     "MAP_MIRROR_T_MASK": "maps whose sampler mirrors in t",

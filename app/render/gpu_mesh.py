@@ -263,6 +263,12 @@ def texture_key(info, srgb: bool, spread: float | None = None) -> tuple:
     return key if spread is None else (*key, "spread", float(spread))
 
 
+def spread_of(key: tuple) -> float | None:
+    """The scale a texture's spread is measured at, from its ``texture_key`` (its "spread"
+    entry), or None for a texture without."""
+    return key[4] if len(key) > 3 and key[3] == "spread" else None
+
+
 def upload_normal_map(ctx: moderngl.Context, image: np.ndarray, scale: float, mipmaps: bool = True) -> moderngl.Texture:
     """A normal map as ``upload_image`` makes it (RGB the same: level 0 as the file has it with
     A = 0, GL's generate_mipmap), then the spread of its normals at ``scale`` written into A of

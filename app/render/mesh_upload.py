@@ -23,7 +23,7 @@ The CLI, the API and batch never call these: they upload in the frame (``upload_
 
 from __future__ import annotations
 
-from alight.render.gpu_mesh import SRGB_MAPS
+from alight.render.gpu_mesh import SRGB_MAPS, spread_of
 from alight.render.mip_levels import mip_levels
 from alight.render.normal_spread_pass import BAND_TEXELS, spread_bands
 
@@ -125,12 +125,6 @@ class MeshUpload:
         for tex in self.made.values():
             tex.release()
         self.made, self.spreads = {}, {}
-
-
-def spread_of(key: tuple) -> float | None:
-    """The scale a texture's spread is measured at, from its key (gpu_mesh.texture_key's
-    "spread" entry), or None for a texture without."""
-    return key[4] if len(key) > 3 and key[3] == "spread" else None
 
 
 def prepare_upload(mesh) -> MeshUpload:

@@ -45,7 +45,7 @@ FLAT_LENGTH = 1e-6
 # the file's A) and compiles NORMAL_MAP_TOKSVIG nowhere: the old shading, for measurements
 # (bench_helmet_split.py --no-toksvig, the tests). Set it before a mesh is uploaded.
 NORMAL_MAP_TOKSVIG = True
-# The normal maps' level-of-detail bias (log2; mesh_material.glsl sample_map_sharper, compiled in
+# The normal maps' level-of-detail bias (log2; mesh_material.glsl normal_from_map, compiled in
 # as NORMAL_MAP_LOD_BIAS where a part has one; 0: none): one level finer, so the fetch's
 # trilinear kernel spans about the pixel's box rather than twice it. DamagedHelmet against the
 # path tracer (results/helmet_split.md): -1 took 20.2% to 17.7% binned at 128 px, 15.3% to 14.3%

@@ -146,7 +146,7 @@ def part_defines(scene, gpu_part, part, user_maps: set[str]) -> dict:
         # the normal map's spread widens the roughness (alight.render.normal_spread)
         defines["NORMAL_MAP_TOKSVIG"] = 1
     if normal_spread.NORMAL_MAP_LOD_BIAS and present & set(SPREAD_MAPS):
-        # the normal maps are fetched one level finer (mesh_material.glsl sample_map_sharper)
+        # the normal maps are fetched one level finer (mesh_material.glsl normal_from_map)
         defines["NORMAL_MAP_LOD_BIAS"] = f"{normal_spread.NORMAL_MAP_LOD_BIAS:.6f}"
     defines.update(material_defines([part_material(scene, part)[0]]))
     return defines

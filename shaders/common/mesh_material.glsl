@@ -252,37 +252,24 @@ float mirrored_repeat(float x) {
     return 1.0 - abs(mod(x, 2.0) - 1.0);
 }
 
-// A map's texel at its coordinates. Mirrored axes are folded here and sampled with the
-// unfolded derivatives, so the mip level does not jump at the folds.
-vec4 sample_map(sampler2D map, int bit, int slot) {
+// A map's texel at its coordinates, its level of detail moved by lod_bias (log2; negative:
+// finer). Mirrored axes are folded here and sampled with the unfolded derivatives (scaled to
+// match the bias), so the mip level does not jump at the folds.
+vec4 sample_map_biased(sampler2D map, int bit, int slot, float lod_bias) {
     vec2 uv = map_uv(bit, slot);
     if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
         vec2 folded = uv;
         if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
         if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
-        return textureGrad(map, folded, dFdx(uv), dFdy(uv));
-    }
-    return texture(map, uv);
-}
-
-#ifdef NORMAL_MAP_LOD_BIAS
-// sample_map with the level of detail moved by NORMAL_MAP_LOD_BIAS (log2; negative: finer). For
-// the normal maps: trilinear filtering's kernel (a bilinear tent at the level whose texel spans
-// the pixel, blended with the next coarser) is about twice the pixel's box across, and the
-// shading is not linear in the normal, so a near-mirror's relief under the pixel was averaged
-// away (results/helmet_split.md). The mirrored wrap's gradients are scaled to match.
-vec4 sample_map_sharper(sampler2D map, int bit, int slot) {
-    vec2 uv = map_uv(bit, slot);
-    if (((MAP_MIRROR_S_MASK | MAP_MIRROR_T_MASK) & bit) != 0) {
-        vec2 folded = uv;
-        if ((MAP_MIRROR_S_MASK & bit) != 0) folded.x = mirrored_repeat(uv.x);
-        if ((MAP_MIRROR_T_MASK & bit) != 0) folded.y = mirrored_repeat(uv.y);
-        float scale = exp2(NORMAL_MAP_LOD_BIAS);
+        float scale = exp2(lod_bias);
         return textureGrad(map, folded, dFdx(uv) * scale, dFdy(uv) * scale);
     }
-    return texture(map, uv, NORMAL_MAP_LOD_BIAS);
+    return texture(map, uv, lod_bias);
 }
-#endif
+
+vec4 sample_map(sampler2D map, int bit, int slot) {
+    return sample_map_biased(map, bit, slot, 0.0);
+}
 
 // The interpolated normal, or the face normal from screen derivatives where it is zero (bad
 // meshes), facing the viewer's side.
@@ -333,7 +320,11 @@ float normal_map_widening = 0.0;   // the base normal map's A, set by shading_no
 // the texel's A (the spread, under NORMAL_MAP_TOKSVIG).
 vec3 normal_from_map(sampler2D map, int bit, int slot, float scale, vec3 n, out float widening) {
 #ifdef NORMAL_MAP_LOD_BIAS
-    vec4 texel = sample_map_sharper(map, bit, slot);
+    // One level finer: trilinear filtering's kernel (a bilinear tent at the level whose texel
+    // spans the pixel, blended with the next coarser) is about twice the pixel's box across, and
+    // the shading is not linear in the normal, so a near-mirror's relief under the pixel was
+    // averaged away (results/helmet_split.md).
+    vec4 texel = sample_map_biased(map, bit, slot, NORMAL_MAP_LOD_BIAS);
 #else
     vec4 texel = sample_map(map, bit, slot);
 #endif
