@@ -158,16 +158,18 @@ def test_quality_auto_says_where_its_figures_come_from(out_dir):
 
 # --- --camera gltf and the camera's aspect ratio ----------------------------------------------
 
-def _camera_file(path: Path, aspect: float) -> Path:
+def _camera_file(path: Path, aspect: float | None, name: str | None = "Shot") -> Path:
     """A 4x2 plane filling a 2:1 camera exactly (yfov 2 atan(1/4), at z = 4): its corners touch
-    the frame's corners."""
+    the frame's corners. ``aspect`` None: the camera gives no aspectRatio (it is optional)."""
     g = Gltf()
     pos, nor, uv, idx = grid_plane(4, 2.0)
     pos = pos * np.array([2.0, 1.0, 1.0])
     g.mesh([{"attributes": {"POSITION": g.accessor(pos, FLOAT, bounds=True), "NORMAL": g.accessor(nor)},
              "indices": g.accessor(idx.reshape(-1), UINT)}])
-    g.doc["cameras"] = [{"type": "perspective",
-                         "perspective": {"yfov": 2 * float(np.arctan(0.25)), "aspectRatio": aspect, "znear": 0.1}}]
+    perspective = {"yfov": 2 * float(np.arctan(0.25)), "znear": 0.1}
+    if aspect is not None:
+        perspective["aspectRatio"] = aspect
+    g.doc["cameras"] = [{"type": "perspective", "perspective": perspective, **({"name": name} if name else {})}]
     g.node(camera=0, translation=[0.0, 0.0, 4.0])
     return g.save(path)
 
@@ -179,40 +181,74 @@ def _size_of(png: Path) -> tuple[int, int]:
         return im.size
 
 
-def test_gltf_camera_takes_its_aspect_from_one_side(tmp_path, out_dir):
-    mesh = _camera_file(tmp_path / "cam.glb", 2.0)
-    out = out_dir / "c.png"
-    proc = run("render", "--mesh", mesh, "--camera", "gltf", "--size", "64", "--quality", "low", "--aa", "none",
+def _warnings(proc) -> list[str]:
+    assert "Traceback" not in proc.stderr, proc.stderr
+    return [ln for ln in proc.stderr.splitlines() if ln.startswith("alight: warning:")]
+
+
+def _render_through_camera(mesh: Path, out: Path, *size) -> subprocess.CompletedProcess:
+    return run("render", "--mesh", mesh, "--camera", "gltf", *size, "--quality", "low", "--aa", "none",
                "--out", out)
+
+
+def test_gltf_camera_takes_its_aspect_from_one_side_and_says_so(tmp_path, out_dir):
+    """--size 64 asks for 64x64 by the help's first words; the camera's 1.5 makes it 64x43, which
+    one line says, naming the file, the camera and the size (a new user's trial found it silent)."""
+    mesh = _camera_file(tmp_path / "cam.gltf", 1.5)
+    out = out_dir / "c.png"
+    proc = _render_through_camera(mesh, out, "--size", "64")
     assert proc.returncode == 0, proc.stderr
-    assert "warning" not in proc.stderr
+    assert _size_of(out) == (64, 43)
+    warnings = _warnings(proc)
+    assert warnings == [f"alight: warning: --camera gltf: {mesh}'s camera 'Shot' has aspect ratio 1.5, so the image "
+                        f"is 64x43 (give --size WxH to choose both)"], warnings
+
+
+def test_gltf_camera_without_a_name_is_called_by_its_number(tmp_path, out_dir):
+    mesh = _camera_file(tmp_path / "cam.glb", 2.0, name=None)
+    out = out_dir / "c.png"
+    proc = _render_through_camera(mesh, out, "--size", "64")
+    assert proc.returncode == 0, proc.stderr
     assert _size_of(out) == (64, 32)
+    warnings = _warnings(proc)
+    assert len(warnings) == 1 and f"{mesh}'s camera 0 has aspect ratio 2, so the image is 64x32" in warnings[0]
 
 
 def test_gltf_camera_warns_when_the_size_crops(tmp_path, out_dir):
     mesh = _camera_file(tmp_path / "cam.glb", 2.0)
     out = out_dir / "c.png"
-    proc = run("render", "--mesh", mesh, "--camera", "gltf", "--size", "64x64", "--quality", "low", "--aa", "none",
-               "--out", out)
+    proc = _render_through_camera(mesh, out, "--size", "64x64")
     assert proc.returncode == 0, proc.stderr
-    warnings = [ln for ln in proc.stderr.splitlines() if ln.startswith("alight: warning:")]
-    assert len(warnings) == 1 and "aspect ratio 2" in warnings[0] and "cut off" in warnings[0], warnings
+    warnings = _warnings(proc)
+    assert len(warnings) == 1, warnings
+    assert "camera 'Shot' has aspect ratio 2 but --size 64x64 is 1" in warnings[0], warnings
+    assert "keeps the camera's vertical field of view, so its sides are cut off" in warnings[0], warnings
     assert _size_of(out) == (64, 64)
 
 
-def test_gltf_camera_without_aspect_keeps_the_square(tmp_path, out_dir):
-    g = Gltf()
-    pos, nor, uv, idx = grid_plane(2, 2.0)
-    g.mesh([{"attributes": {"POSITION": g.accessor(pos, FLOAT, bounds=True), "NORMAL": g.accessor(nor)},
-             "indices": g.accessor(idx.reshape(-1), UINT)}])
-    g.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]
-    g.node(camera=0, translation=[0.0, 0.0, 4.0])
-    mesh = g.save(tmp_path / "sq.glb")
-    out = out_dir / "s.png"
-    proc = run("render", "--mesh", mesh, "--camera", "gltf", "--size", "32", "--quality", "low", "--aa", "none",
-               "--out", out)
-    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
-    assert _size_of(out) == (32, 32)
+def test_gltf_camera_warns_when_the_size_widens(tmp_path, out_dir):
+    mesh = _camera_file(tmp_path / "cam.glb", 1.5)
+    out = out_dir / "c.png"
+    proc = _render_through_camera(mesh, out, "--size", "64x32")
+    assert proc.returncode == 0, proc.stderr
+    warnings = _warnings(proc)
+    assert len(warnings) == 1 and "so its sides are widened beyond the camera's frame" in warnings[0], warnings
+    assert _size_of(out) == (64, 32)
+
+
+@pytest.mark.parametrize("aspect, size, expected", [
+    (1.5, ["--size", "60x40"], (60, 40)),        # WxH that is the camera's ratio
+    (1.5, ["--size", "64x43"], (64, 43)),        # ... to the nearest pixel
+    (None, ["--size", "32"], (32, 32)),          # no aspectRatio: the square --size promises
+    (1.0, ["--size", "32"], (32, 32)),           # a square camera: the square --size promises
+], ids=["wxh-matches", "wxh-rounded", "no-aspect", "square-camera"])
+def test_gltf_camera_says_nothing_when_the_size_is_what_was_asked(tmp_path, out_dir, aspect, size, expected):
+    mesh = _camera_file(tmp_path / "cam.glb", aspect)
+    out = out_dir / "c.png"
+    proc = _render_through_camera(mesh, out, *size)
+    assert proc.returncode == 0, proc.stderr
+    assert "warning" not in proc.stderr, proc.stderr
+    assert _size_of(out) == expected
 
 
 @pytest.mark.parametrize("command, args, names", [

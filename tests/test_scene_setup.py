@@ -97,7 +97,8 @@ def test_render_and_reference_build_the_same_scene(flags, tmp_path):
             assert np.array_equal(a.positions, b.positions) and np.array_equal(a.indices, b.indices)
     if "--camera" in flags:
         assert (r.width, r.height) == ((64, 32) if flags[-1] == "64" else (64, 64))
-        assert len(r_said) == (flags[-1] == "64x64")    # the cropped size is said, the one side is not
+        # Both differ from the size asked for (the one side is not square, 64x64 is cropped): one line each.
+        assert len(r_said) == 1 and ("so the image is 64x32" if flags[-1] == "64" else "cut off") in r_said[0]
 
 
 def test_the_scene_check_can_fail():
@@ -120,7 +121,8 @@ def test_render_and_reference_print_the_same_warnings(tmp_path):
 
 
 def test_reference_takes_the_gltf_cameras_aspect_as_render_does(tmp_path):
-    """--size W with --camera gltf: both images are W x W / aspect (the reference used to be square)."""
+    """--size W with --camera gltf: both images are W x W / aspect (the reference used to be square),
+    and both say so in the same one line."""
     import OpenImageIO as oiio
 
     from PIL import Image
@@ -130,7 +132,9 @@ def test_reference_takes_the_gltf_cameras_aspect_as_render_does(tmp_path):
     rendered = run("render", *common, "--quality", "low", "--aa", "none", "--out", tmp_path / "r.png")
     referenced = run("reference", *common, "--integrator", "exact", "--out", tmp_path / "f.exr")
     assert rendered.returncode == 0 and referenced.returncode == 0, rendered.stderr + referenced.stderr
-    assert not warnings(rendered.stderr) and not warnings(referenced.stderr)
+    said = warnings(rendered.stderr)
+    assert len(said) == 1 and "has aspect ratio 2, so the image is 32x16" in said[0], said
+    assert warnings(referenced.stderr) == said
     with Image.open(tmp_path / "r.png") as im:
         assert im.size == (32, 16)
     spec = oiio.ImageInput.open(str(tmp_path / "f.exr")).spec()

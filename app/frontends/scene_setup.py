@@ -176,26 +176,47 @@ def flag_camera(args, mesh, aspect: float):
 
 
 def camera_size(args, mesh, width: int, height: int, report: Report) -> tuple[int, int]:
-    """The image size for --camera gltf: a --size of one side takes the camera's aspect ratio
-    (glTF's perspective.aspectRatio, or xmag/ymag), as viewers do; a size that does not match
-    it is kept and reported (the vertical field of view is the camera's, so the sides are cut or
-    widened)."""
+    """The image size for --camera gltf: a --size of one side (or none) takes the camera's
+    aspect ratio (glTF's perspective.aspectRatio, or xmag/ymag), as viewers do; a WxH that does
+    not match it is kept (the camera's vertical field of view, or ymag, is kept, so the sides are
+    cut or widened). Either way the picture is not the WxH or the square --size's help promises
+    by default, so each says so in one line (``camera_size_line``)."""
     if args.camera == "auto" or mesh is None:
         return width, height
-    from alight.exchange.camera_aspect import gltf_camera_aspects
+    from alight.exchange.camera_aspect import gltf_camera_frames
 
     kind, _, index = args.camera.partition(":")
     try:
-        aspect = gltf_camera_aspects(args.mesh)[int(index) if index else 0]
+        n = int(index) if index else 0
+        frame = gltf_camera_frames(args.mesh)[n]
     except (IndexError, ValueError):
         return width, height        # flag_camera says what is wrong with the spec
-    if aspect is None:
+    if frame.aspect is None:
         return width, height
-    if getattr(args.size, "one_side", False):
-        return width, max(1, round(width / aspect))
-    if abs(width / height - aspect) > 0.5 / height * aspect + 1e-9:
-        side = "cut off" if width / height < aspect else "widened beyond the camera's frame"
-        report(f"--camera {args.camera}: {args.mesh}'s camera has aspect ratio {aspect:.4g} but --size "
-               f"{width}x{height} is {width / height:.4g}: the image's sides are {side}; give --size {width} "
-               f"to take the camera's aspect")
+    one_side = getattr(args.size, "one_side", False)
+    if one_side:
+        height = max(1, round(width / frame.aspect))
+    line = camera_size_line(args.camera, args.mesh, n, frame, (width, height), one_side)
+    if line:
+        report(line)
     return width, height
+
+
+def camera_size_line(spec: str, path: str, n: int, frame, size: tuple[int, int], one_side: bool) -> str | None:
+    """The one warning line for --camera ``spec``'s image size, or None where the image is what
+    --size asked for and fits the camera (a one-side --size on a square camera, a matching WxH)."""
+    camera = f"{path}'s camera " + (f"'{frame.name}'" if frame.name else str(n))
+    aspect = frame.aspect
+    width, height = size
+    if one_side:
+        if width == height:
+            return None
+        return (f"--camera {spec}: {camera} has aspect ratio {aspect:.4g}, so the image is {width}x{height} "
+                f"(give --size WxH to choose both)")
+    if abs(width / height - aspect) <= 0.5 / height * aspect + 1e-9:
+        return None
+    kept = "vertical extent (ymag)" if frame.orthographic else "vertical field of view"
+    side = "cut off" if width / height < aspect else "widened beyond the camera's frame"
+    return (f"--camera {spec}: {camera} has aspect ratio {aspect:.4g} but --size {width}x{height} is "
+            f"{width / height:.4g}: the image keeps the camera's {kept}, so its sides are {side} "
+            f"(give --size {width} to take the camera's aspect ratio)")
