@@ -73,6 +73,40 @@ def test_the_session_keeps_the_turntable_and_the_anti_aliasing(tmp_path, monkeyp
     assert turntable.frames == 10
 
 
+def test_the_session_keeps_the_debug_view(tmp_path, monkeypatch):
+    """The debug view sits with the tone map and the anti-aliasing, which the session keeps: an
+    artist who left 'roughness' (or the prefiltered radiance at mip 3.5) on finds it on again. It is
+    kept by name; a session from before, without it, opens on the shaded view."""
+    from alight.core.shader_names import DEBUG_VIEWS
+    from alight.frontends.editor.camera import OrbitCamera
+    from alight.frontends.editor.session import restore_session, save_session, session_path
+    from alight.frontends.editor.state import EditorState
+
+    monkeypatch.setenv("ALIGHT_CONFIG_DIR", str(tmp_path))
+    mip_view = DEBUG_VIEWS.index("prefiltered radiance at mip")
+    save_session(EditorState(debug_view=mip_view, debug_mip=3.5), OrbitCamera())
+    data = json.loads(session_path().read_text())
+    assert (data["settings"]["debug_view"], data["settings"]["debug_mip"]) == ("prefiltered radiance at mip", 3.5)
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert (fresh.debug_view, fresh.debug_mip) == (mip_view, 3.5)
+    assert fresh.scene(None).debug_view == mip_view   # (what the view draws)
+    # A session from before it was kept: the shaded view, the rest of the settings restored.
+    del data["settings"]["debug_view"], data["settings"]["debug_mip"]
+    data["settings"]["env_rotation_deg"] = 30.0
+    session_path().write_text(json.dumps(data))
+    fresh = EditorState()
+    assert restore_session(fresh, OrbitCamera()) == ""
+    assert (fresh.debug_view, fresh.debug_mip, fresh.env_rotation_deg) == (0, 0.0, 30.0)
+    # Edited by hand: one line naming it; the settings left as they were, as for the others.
+    data["settings"]["debug_view"] = "wireframe"
+    session_path().write_text(json.dumps(data))
+    fresh = EditorState()
+    warning = restore_session(fresh, OrbitCamera())
+    assert "debug_view 'wireframe' is not one of shaded, " in warning and "\n" not in warning, warning
+    assert (fresh.debug_view, fresh.env_rotation_deg) == (0, 0.0)
+
+
 def test_a_warning_of_a_dropped_file_is_in_the_message(tmp_path):
     """A dropped or typed file's warnings (EditorState.open_file: mesh, environment, material
     files) are in the status row's message, one or several."""

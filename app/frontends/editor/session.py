@@ -1,7 +1,7 @@
-"""The last session (mesh, environment, material, camera, the view's settings, the turntable's
-frames and file, the panel's preset and glTF file fields), so the editor reopens where the artist
-left it. A JSON file in the user's config folder (``alight.paths.config_dir``), written atomically
-on close."""
+"""The last session (mesh, environment, material, camera, the view's settings and debug view,
+the turntable's frames and file, the panel's preset and glTF file fields), so the editor reopens
+where the artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``),
+written atomically on close."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 
 from alight.core.material import material_from_dict
+from alight.core.shader_names import DEBUG_VIEWS
 from alight.core.texture_maps import MAP_SLOTS, TextureMaps
 from alight.errors import AlightError
 from alight.exchange.output import write_text_atomic
@@ -64,6 +65,8 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
                          "use_file_materials": own_materials, "aa": state.aa,
+                         # By name: a view added to DEBUG_VIEWS later does not shift a kept one.
+                         "debug_view": DEBUG_VIEWS[state.debug_view], "debug_mip": state.debug_mip,
                          "display": dataclasses.asdict(state.display),
                          "lights": [dataclasses.asdict(light) for light in state.lights]},
             "compare": compare_dict}
@@ -227,6 +230,9 @@ def _read_settings(data: dict):
               "ground": bool(data.get("ground", False))}
     if "aa" in data:   # the anti-aliasing (older sessions lack it: the command line's stays)
         values["aa"] = choice(data["aa"], EDITOR_AA, "aa")
+    if "debug_view" in data:   # (older sessions lack it and its mip: the shaded view stays)
+        values["debug_view"] = DEBUG_VIEWS.index(choice(data["debug_view"], DEBUG_VIEWS, "debug_view"))
+        values["debug_mip"] = number(data.get("debug_mip", 0.0), "debug_mip")
     d = data["display"]
     display = Display(tonemap=choice(d["tonemap"], TONEMAPS, "tonemap"), exposure=number(d["exposure"], "exposure"),
                       background=choice(d["background"], BACKGROUNDS, "background"),
