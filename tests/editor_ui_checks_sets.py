@@ -8,6 +8,9 @@ looks at the view's pixels, the fields the panel shows or the file written.
   the same preset, no map of the first left in a slot the second leaves empty;
 - the 'texture set' field names the set loaded, and both map fields are empty after a preset
   click;
+- several files loaded as a set: the field names their shared name, count and folder (it showed
+  the first file's path, read as the one map loaded), its tooltip lists each file with its
+  slots, and 'load set' on the field as shown loads the same files again;
 - Ctrl+Z says in the status row where it went (it kept saying 'applied silver');
 - 'save preset' to NAME.json names the material NAME, so the library entry and the file agree,
   and the entry it adds moves no control below the library's list; a name typed into 'name' is
@@ -101,6 +104,39 @@ def test_the_set_fields_name_what_is_loaded(ctx):
         (panel.set_path, panel.map_path)
     _ctrl_z(ctx)
     assert panel.set_path == rock and s.texture_maps.paths(), panel.set_path   # undo brings the set back
+    ctx.item_close("**/texture maps")
+
+
+def test_a_set_of_files_is_named_by_its_stem_and_count_with_the_files_in_the_tooltip(ctx):
+    import alight.frontends.editor.panel as panel_module
+
+    s, panel = editor().state, editor().panel
+    wood, _ = _sets()
+    files = [os.path.join(wood, f"wood_{suffix}.png") for suffix in ("BaseColor", "Roughness", "Normal")]
+    ctx.set_ref("alight")
+    ctx.item_open("**/texture maps")
+    _load_set(ctx, ";".join(files))
+    assert not s.error and set(s.texture_maps.paths()) == {"base_color", "roughness", "normal"}, \
+        (s.error, s.texture_maps)
+    assert panel.set_path == f"wood_* (3 maps) in {wood}", panel.set_path
+    shown = []
+    keep = panel_module.tooltip
+    panel_module.tooltip = lambda text: (shown.append(text), keep(text))
+    try:
+        ctx.mouse_move("**/texture set")
+        ctx.yield_(3)
+    finally:
+        panel_module.tooltip = keep
+    assert shown and shown[-1].startswith(f"3 maps in {wood}:\n  wood_BaseColor.png: base colour\n"), shown[-1:]
+    assert "  wood_Normal.png: normal (tangent)\n  wood_Roughness.png: roughness (grey)\n\n" in shown[-1], shown[-1]
+    s.message = ""
+    maps = s.texture_maps
+    ctx.item_click("**/load set")   # the field as shown: the same three files again, not an error
+    ctx.yield_(2)
+    assert not s.error and s.message.startswith("texture set: "), (s.error, s.message)
+    assert s.texture_maps == maps and panel.set_path == f"wood_* (3 maps) in {wood}", panel.set_path
+    ctx.item_click("**/copper")   # (the next checks start without maps)
+    ctx.yield_(2)
     ctx.item_close("**/texture maps")
 
 

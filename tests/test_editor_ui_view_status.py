@@ -180,4 +180,5 @@ def test_the_session_keeps_the_texture_sets_folder_and_the_armed_slot(tmp_path, 
     session_path().write_text(json.dumps(data))
     fresh = EditorState()
     assert restore_session(fresh, OrbitCamera()) == ""
-    assert ";" in fresh.texture_set_text() and fresh.armed_slot == "base_color", fresh.texture_set_text()
+    assert fresh.texture_set_text() == f"moss_* (2 maps) in {folder}" and fresh.armed_slot == "base_color", \
+        fresh.texture_set_text()

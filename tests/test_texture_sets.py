@@ -429,6 +429,50 @@ def test_editor_drop_of_several_files_is_a_texture_set(tmp_path, validate):
     assert EditorState().open_file(str(tmp_path / "look.json"))
 
 
+def test_editor_texture_set_field_names_a_set_of_files_by_its_stem_and_count(tmp_path):
+    """A set loaded as files (a drop of several, files typed with ';', an older session) showed
+    their paths one after another, and the field's width the first: one map's path, read as the
+    one map loaded. It names the set (the files' shared name, their count, their folder), the
+    tooltip lists each file with its slots, and 'load set' on the field as shown reads the files."""
+    from alight.frontends.cli import build_parser
+    from alight.frontends.editor.run import build_state
+    from alight.frontends.editor.state import EditorState
+
+    c = canonical()
+    folder = tmp_path / "Bricks"
+    names = {"Bricks_2K_Color.png": "color", "Bricks_2K_NormalGL.png": "normal", "Bricks_2K_ORM.png": "orm",
+             "Bricks_2K_Height.png": "rough"}
+    write_set(folder, names, c)
+    paths = sorted(str(p) for p in folder.iterdir())
+    s = EditorState()
+    s.open_texture_set(paths)   # (the height map is left out: three maps)
+    assert s.texture_set_text() == f"Bricks_2K_* (3 maps) in {folder}", s.texture_set_text()
+    assert s.texture_set_spec().split(";") == [str(folder / n) for n in
+                                               ("Bricks_2K_Color.png", "Bricks_2K_NormalGL.png", "Bricks_2K_ORM.png")]
+    assert s.texture_set_listing().splitlines() == [
+        f"3 maps in {folder}:", "  Bricks_2K_Color.png: base colour", "  Bricks_2K_NormalGL.png: normal (tangent)",
+        "  Bricks_2K_ORM.png: metal-rough (G rough, B metal), occlusion (R)"], s.texture_set_listing()
+    again = EditorState()
+    again.open_texture_set(s.texture_set_spec().split(";"))
+    assert again.texture_maps == s.texture_maps
+    # The folder read as a set: the field names the folder, as before (and 'alight edit --texture-set').
+    s.open_texture_folder(str(folder))
+    assert s.texture_set_text() == s.texture_set_spec() == str(folder)
+    assert s.texture_set_listing().startswith(f"3 maps in {folder}:\n")
+    started = build_state(build_parser().parse_args(["edit", "--texture-set", str(folder)]))
+    assert started.texture_set_text() == str(folder), started.texture_set_text()
+    # One map: its path. Files sharing no name, or in two folders: the count and where.
+    s = EditorState()
+    s.set_map("roughness", str(folder / "Bricks_2K_Height.png"))
+    assert s.texture_set_text() == s.texture_set_spec() == str(folder / "Bricks_2K_Height.png")
+    assert s.texture_set_listing() == f"1 map in {folder}:\n  Bricks_2K_Height.png: roughness (grey)"
+    s.set_map("base_color", write(folder / "albedo.png", c["color"]))
+    assert s.texture_set_text() == f"2 maps in {folder}", s.texture_set_text()
+    s.set_map("normal", write(tmp_path / "other" / "normal.png", c["normal"]))
+    assert s.texture_set_text() == "3 maps from 2 folders", s.texture_set_text()
+    assert str(tmp_path / "other" / "normal.png") + ": normal (tangent)" in s.texture_set_listing()
+
+
 def test_editor_opens_a_texture_set_maps_and_a_saved_gltf_as_render_does(tmp_path, display):
     """``alight edit --texture-set / --map / --preset FILE.gltf`` (screenshots under Xvfb): the
     set, its maps one by one and the exported file give the same picture."""

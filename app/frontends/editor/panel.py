@@ -645,11 +645,16 @@ class Panel:
         # A whole set at once, each file to its slot by its name (as a drop of several files).
         self.set_path, set_entered = text_field("texture set", self.set_path)
         if imgui.is_item_hovered():
-            tooltip("a folder of maps, or image files separated by ';' (or drop them on the view "
-                              "together): each goes to its slot by its name (NAME_BaseColor, _Normal, "
-                              "_Roughness, _Metallic, _AO, _ORM, ...); the material takes the set's name")
+            listing = s.texture_set_listing()
+            tooltip((listing + "\n\n" if listing else "")
+                    + "a folder of maps, or image files separated by ';' (or drop them on the view "
+                      "together): each goes to its slot by its name (NAME_BaseColor, _Normal, "
+                      "_Roughness, _Metallic, _AO, _ORM, ...); the material takes the set's name")
         if (imgui.button("load set") or set_entered) and self.set_path.strip():
-            self._attempt(s, "set_path", lambda: self._load_texture_set(s, self.set_path))
+            # The field as the set filled it names several files by their shared name and count,
+            # which no path reads: loaded again, it is those files.
+            typed = s.texture_set_spec() if self.set_path == self._set_shown else self.set_path
+            self._attempt(s, "set_path", lambda: self._load_texture_set(s, typed))
         imgui.same_line()
         if imgui.button("browse set"):   # any image of the set: its folder is loaded
             self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,

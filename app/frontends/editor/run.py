@@ -146,6 +146,10 @@ def _start_maps(state: EditorState, maps, args) -> None:
         state.map_images = load_map_images(maps)
         state.texture_maps = maps
         texture_set = getattr(args, "texture_set", None)
+        if texture_set:   # the 'texture set' field names the folder, as for one loaded in the panel
+            from alight.paths import absolute
+
+            state.texture_set_folder = absolute(texture_set)
         if texture_set and args.preset is None:
             name = set_name([], texture_set)
             if name and name.isprintable():

@@ -492,16 +492,58 @@ class EditorState:
             raise AlightError(f"{folder}: no image files in the folder")
         return self.open_texture_set(files, folder)
 
+    def texture_set_files(self) -> list[str]:
+        """The loaded maps' files, each once (an ORM fills two slots), sorted; [] for images
+        inside a .glb/.gltf (a library entry): no files to name or load again."""
+        paths = sorted(set(self.texture_maps.paths().values()))
+        return [] if any("#" in os.path.basename(p) for p in paths) else paths
+
+    def _set_folder_whole(self, paths: list[str]) -> bool:
+        folder = self.texture_set_folder
+        return bool(folder and paths and all(os.path.dirname(p) == folder.rstrip(os.sep) for p in paths))
+
     def texture_set_text(self) -> str:
         """What the 'texture set' field shows for the maps loaded: the folder they were read from
-        while every map is in it, else the files separated by '; ' ('' without maps)."""
-        paths = sorted(set(self.texture_maps.paths().values()))
-        if any("#" in os.path.basename(p) for p in paths):
-            return ""   # images inside a .glb/.gltf (a library entry): no folder or files to load again
-        folder = self.texture_set_folder
-        if folder and paths and all(os.path.dirname(p) == folder.rstrip(os.sep) for p in paths):
-            return folder
-        return "; ".join(paths)
+        while every map is in it, one map's path, or, for several files, their shared name, their
+        count and their folder (``Bricks_2K_* (4 maps) in /x/bricks``): their paths one after
+        another showed only the first in the field, which read as the one map loaded. '' without
+        maps. 'load set' on it unchanged loads ``texture_set_spec()``."""
+        paths = self.texture_set_files()
+        if self._set_folder_whole(paths):
+            return self.texture_set_folder
+        if len(paths) <= 1:
+            return paths[0] if paths else ""
+        folders = {os.path.dirname(p) for p in paths}
+        if len(folders) > 1:
+            return f"{len(paths)} maps from {len(folders)} folders"
+        names = [os.path.basename(p) for p in paths]
+        stem = os.path.commonprefix(names)
+        # Cut back to a separator: 'rock_' of rock_diff and rocky_nor is not a name they share.
+        cut = max(stem.rfind(c) for c in "_-. ") + 1
+        stem = stem[:cut] if cut else ""
+        return f"{stem + '* (' if stem else ''}{len(paths)} maps{')' if stem else ''} in {folders.pop()}"
+
+    def texture_set_spec(self) -> str:
+        """The 'texture set' field's text as 'load set' reads it, for the maps loaded: the folder
+        ``texture_set_text`` shows, else the files separated by ';'."""
+        paths = self.texture_set_files()
+        return self.texture_set_folder if self._set_folder_whole(paths) else ";".join(paths)
+
+    def texture_set_listing(self) -> str:
+        """The maps loaded, a line each with the slots it fills (the 'texture set' field's
+        tooltip: the field names the set, this the files in it); '' without maps."""
+        from alight.core.texture_maps import SLOT_LABELS
+
+        paths = self.texture_set_files()
+        if not paths:
+            return ""
+        slots: dict[str, list[str]] = {}
+        for slot, path in self.texture_maps.paths().items():
+            slots.setdefault(path, []).append(SLOT_LABELS[slot])
+        folders = {os.path.dirname(p) for p in paths}
+        one = folders.pop() if len(folders) == 1 else ""
+        head = f"{len(paths)} map{'s' if len(paths) > 1 else ''}" + (f" in {one}:" if one else ":")
+        return "\n".join([head] + [f"  {os.path.basename(p) if one else p}: {', '.join(slots[p])}" for p in paths])
 
     def open_file(self, path: str) -> bool:
         """A dropped or typed file, by its suffix. Returns False (and sets ``error``) on failure."""
