@@ -111,9 +111,9 @@ def upload(renderer, rounds: int) -> None:
     from alight.exchange.meshes import load_mesh
     from alight.render.gpu_mesh import upload_image, upload_normal_map
 
-    ctx = renderer._renderer.ctx
+    ctx, shaders = renderer._renderer.ctx, renderer._renderer.shaders
     info = next(part.material.textures()["normal"] for part in load_mesh(str(HELMET)).parts)
-    ways = {"with spread": lambda: upload_normal_map(ctx, info.image, 1.0),
+    ways = {"with spread": lambda: upload_normal_map(ctx, shaders, info.image, 1.0),
             "GL mips": lambda: upload_image(ctx, info.image, False)}
     wall: dict[str, list[float]] = {name: [] for name in ways}
     cpu: dict[str, list[float]] = {name: [] for name in ways}

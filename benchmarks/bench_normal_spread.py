@@ -34,8 +34,9 @@ HELMET = DATA / "models" / "DamagedHelmet" / "DamagedHelmet.gltf"
 HERE = Path(__file__).resolve().parent
 
 
-def cpu_upload(ctx, image, scale: float, mipmaps: bool = True):
-    """The upload before the GPU pass: the numpy twin's levels, each written."""
+def cpu_upload(ctx, shaders, image, scale: float, mipmaps: bool = True):
+    """The upload before the GPU pass: the numpy twin's levels, each written (``shaders``:
+    upload_normal_map's, unused: no pass runs)."""
     from alight.core.gpu import write_rgba8
     from alight.render.gpu_mesh import level_texture, upload_image
     from alight.render.normal_spread import normal_map_levels, without_spread
@@ -61,13 +62,15 @@ def spread(values: list[float]) -> str:
 
 
 def per_map(rounds: int) -> None:
-    from alight.core.gpu import create_headless_context
+    from alight.core.gpu import ShaderLibrary, create_headless_context
     from alight.exchange.meshes import load_mesh
     from alight.render.gpu_mesh import upload_image, upload_normal_map
 
     ctx = create_headless_context()
+    shaders = ShaderLibrary(ctx)
     image = load_mesh(str(HELMET)).parts[0].material.textures()["normal"].image
-    ways = {"cpu": lambda: cpu_upload(ctx, image, 1.0), "gpu": lambda: upload_normal_map(ctx, image, 1.0),
+    ways = {"cpu": lambda: cpu_upload(ctx, shaders, image, 1.0),
+            "gpu": lambda: upload_normal_map(ctx, shaders, image, 1.0),
             "plain": lambda: upload_image(ctx, image, False)}
     for way in ways.values():   # the pass compiled, the driver's first uses behind us
         way().release()
@@ -90,6 +93,7 @@ def per_map(rounds: int) -> None:
     ratio_cpu = [g / c for g, c in zip(cpu["gpu"], cpu["cpu"])]
     print(f"gpu / cpu per round: wall {statistics.median(ratio_wall):.2f} ({min(ratio_wall):.2f}-{max(ratio_wall):.2f}), "
           f"CPU {statistics.median(ratio_cpu):.2f} ({min(ratio_cpu):.2f}-{max(ratio_cpu):.2f})")
+    shaders.reload()
     ctx.release()
 
 

@@ -201,7 +201,7 @@ def test_the_define_and_the_upload_only_where_a_part_has_a_normal_map(tmp_path):
                 assert all(np.array_equal(a[..., :3], b[..., :3]) and not a[..., 3].any()
                            for a, b in zip(levels, want))
                 while upload.next < len(upload.pieces):
-                    upload.step(r.ctx, r.meshes, r.shadow_maps)
+                    upload.step(r.ctx, r.shaders, r.meshes, r.shadow_maps)
                 staged = [read_rgba8(r.ctx, upload.made[0], n) for n in range(len(want))]
                 upload.drop()
                 assert all(np.array_equal(a, b) for a, b in zip(staged, want))

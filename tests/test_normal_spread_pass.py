@@ -47,7 +47,7 @@ def _random_normals(shape, seed: int) -> np.ndarray:
 def test_the_gpu_levels_are_the_numpy_twins(shape, scale):
     r = renderer()
     image = _random_normals(shape, sum(shape))
-    tex = upload_normal_map(r.ctx, image, scale)
+    tex = upload_normal_map(r.ctx, r.shaders, image, scale)
     got = _gpu_levels(r.ctx, tex, level_count(shape[::-1]))
     tex.release()
     _assert_twins(got, normal_map_levels(image, scale), f"{shape} scale {scale}")
@@ -61,7 +61,7 @@ def test_damaged_helmets_normal_map_on_the_gpu_is_the_numpy_twin(shared_data):
     image = mesh.parts[0].material.textures()["normal"].image
     assert image.shape[:2] == (2048, 2048)
     for scale in (1.0, 0.6):
-        tex = upload_normal_map(r.ctx, image, scale)
+        tex = upload_normal_map(r.ctx, r.shaders, image, scale)
         got = _gpu_levels(r.ctx, tex, 12)
         tex.release()
         differ = _assert_twins(got, normal_map_levels(image, scale), f"helmet at {scale}")
@@ -71,7 +71,7 @@ def test_damaged_helmets_normal_map_on_the_gpu_is_the_numpy_twin(shared_data):
 def test_a_side_that_is_not_a_power_of_two_keeps_a_at_zero():
     r = renderer()
     image = _random_normals((48, 64), 5)
-    tex = upload_normal_map(r.ctx, image, 1.0)
+    tex = upload_normal_map(r.ctx, r.shaders, image, 1.0)
     assert not any(read_rgba8(r.ctx, tex, n)[..., 3].any() for n in range(level_count((64, 48))))
     tex.release()
 
@@ -97,7 +97,7 @@ def test_the_staged_upload_writes_the_spread_in_bands_of_steps():
     steps = []
     while upload.next < len(upload.pieces):
         first = upload.next
-        upload.step(r.ctx, None, None)   # (the parts' buffers come after: not reached here)
+        upload.step(r.ctx, r.shaders, None, None)   # (the parts' buffers come after: not reached here)
         steps.append(range(first, upload.next))
         assert len(steps) < 100
     bands = spread_bands((2048, 1024), 12)
@@ -129,15 +129,49 @@ def test_the_shader_takes_the_twins_constants():
     assert float(defines["NORMAL_FLAT_LENGTH"]) == normal_spread.FLAT_LENGTH
 
 
-def test_the_pass_is_compiled_again_when_its_source_changes(monkeypatch):
-    # (the editor's shader reload: the pass is kept per context, with its source's digest)
-    from alight.render import normal_spread, normal_spread_pass
+def test_the_pass_is_compiled_again_when_its_source_changes(tmp_path, monkeypatch):
+    # (the editor's shader reload: a new library from the files as saved, ForwardRenderer.use_shaders;
+    # the uploads take the pass from the renderer's library, and the twin's constants are its defines)
+    import shutil
+
+    from alight.core.gpu import ShaderLibrary
+    from alight.paths import shader_dir
+    from alight.render import normal_spread
+    from alight.render.normal_spread_pass import SHADER
 
     r = renderer()
-    first = normal_spread_pass._program(r.ctx)
-    assert normal_spread_pass._program(r.ctx) is first
-    monkeypatch.setattr(normal_spread, "SPREAD_FLOOR", 2e-6)   # another define: another text
-    again = normal_spread_pass._program(r.ctx)
-    assert again is not first and type(first.mglo).__name__ == "InvalidObject"
-    monkeypatch.undo()
-    assert normal_spread_pass._program(r.ctx) is not again
+    root = tmp_path / "shaders"
+    shutil.copytree(shader_dir(), root)
+    image = _random_normals((64, 64), 3)
+
+    def staged_a() -> np.ndarray:
+        """A of level 1, the map uploaded by the renderer's staged steps (as the editor does)."""
+        from alight.core.mesh import TextureInfo
+        from alight.render.gpu_mesh import texture_key
+        from alight.render.mip_levels import mip_levels
+        from alight.render.normal_spread import without_spread
+
+        info = TextureInfo(image)
+        upload = MeshUpload(None, [(texture_key(info, False, 1.0), info, False,
+                                    mip_levels(without_spread(image), False))], False)
+        while upload.next < len(upload.pieces):
+            r.upload_step(upload)   # (the parts' buffers come after: not reached here)
+        a = read_rgba8(r.ctx, upload.made[0], 1)[..., 3]
+        upload.drop()
+        return a
+
+    try:
+        r.use_shaders(ShaderLibrary(r.ctx, root))
+        first = staged_a()
+        assert first.any()
+        monkeypatch.setattr(normal_spread, "SPREAD_FLOOR", 2.0)   # another define: another program
+        assert not staged_a().any()
+        monkeypatch.undo()
+        assert np.array_equal(staged_a(), first)
+        source = root / SHADER
+        source.write_text(source.read_text(encoding="utf-8").replace("code / 255.0", "0.0"), encoding="utf-8")
+        assert np.array_equal(staged_a(), first)   # compiled, kept until the library is replaced
+        r.use_shaders(ShaderLibrary(r.ctx, root))
+        assert not staged_a().any()
+    finally:
+        r.use_shaders(ShaderLibrary(r.ctx))   # back to the repository's shaders

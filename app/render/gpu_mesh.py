@@ -9,6 +9,7 @@ import dataclasses
 import moderngl
 import numpy as np
 
+from alight.core.gpu import ShaderLibrary
 from alight.core.mesh import is_closed
 from alight.core.texture_footprint import anisotropy_for_view, footprints
 from alight.render.normal_spread import spread_scale, without_spread
@@ -215,10 +216,11 @@ MIN_FILTERS = {"nearest": moderngl.NEAREST, "linear": moderngl.LINEAR,
 class MeshTextures:
     """A mesh's textures, one per (image, colour space, sampler): parts sharing an image share
     its upload. REPEAT and CLAMP_TO_EDGE are the texture's wrap state; MIRRORED_REPEAT is folded
-    in the shader (mesh_material.glsl), so its axis is clamped here."""
+    in the shader (mesh_material.glsl), so its axis is clamped here. ``shaders``: the renderer's
+    library, which compiles a normal map's spread pass (upload_normal_map)."""
 
-    def __init__(self, ctx: moderngl.Context):
-        self.ctx = ctx
+    def __init__(self, ctx: moderngl.Context, shaders: ShaderLibrary):
+        self.ctx, self.shaders = ctx, shaders
         self._textures: dict[tuple, moderngl.Texture] = {}
 
     def get(self, info, srgb: bool, spread: float | None = None) -> moderngl.Texture:
@@ -231,7 +233,7 @@ class MeshTextures:
             if spread is None:
                 tex = upload_image(self.ctx, info.image, srgb, mipmaps=sampler.mipmaps)
             else:
-                tex = upload_normal_map(self.ctx, info.image, spread, mipmaps=sampler.mipmaps)
+                tex = upload_normal_map(self.ctx, self.shaders, info.image, spread, mipmaps=sampler.mipmaps)
             tex = self._textures[key] = self.sampled(tex, sampler)
         return tex
 
@@ -269,16 +271,18 @@ def spread_of(key: tuple) -> float | None:
     return key[4] if len(key) > 3 and key[3] == "spread" else None
 
 
-def upload_normal_map(ctx: moderngl.Context, image: np.ndarray, scale: float, mipmaps: bool = True) -> moderngl.Texture:
+def upload_normal_map(ctx: moderngl.Context, shaders: ShaderLibrary, image: np.ndarray, scale: float,
+                      mipmaps: bool = True) -> moderngl.Texture:
     """A normal map as ``upload_image`` makes it (RGB the same: level 0 as the file has it with
     A = 0, GL's generate_mipmap), then the spread of its normals at ``scale`` written into A of
-    each level from 1 on, on the GPU (alight.render.normal_spread_pass; its numpy twin
-    alight.render.normal_spread). A side that is not a power of two: GL's mips with A = 0 (no
-    widening), as before. GL work: the thread that owns ``ctx``."""
+    each level from 1 on, on the GPU by the pass ``shaders`` compiles (the renderer's library;
+    alight.render.normal_spread_pass; its numpy twin alight.render.normal_spread). A side that is
+    not a power of two: GL's mips with A = 0 (no widening), as before. GL work: the thread that
+    owns ``ctx``. Raises ShaderCompileError where the pass's source does not compile."""
     tex = upload_image(ctx, without_spread(image), False, mipmaps)
     h, w = image.shape[:2]
     if mipmaps and not (h & (h - 1) or w & (w - 1)):
-        SpreadWriter(ctx, tex, (w, h), level_count((w, h)), scale).write_all()
+        SpreadWriter(ctx, shaders, tex, (w, h), level_count((w, h)), scale).write_all()
     return tex
 
 
@@ -337,8 +341,9 @@ class GpuMeshes:
     built-in sphere's stand-ins (coarser levels, the impostor's proxy: alight.render.sphere_impostor)
     and the user-loaded texture maps (Scene.texture_maps), uploaded once per decoded image."""
 
-    def __init__(self, ctx: moderngl.Context):
+    def __init__(self, ctx: moderngl.Context, shaders: ShaderLibrary):
         self.ctx = ctx
+        self.shaders = shaders   # the renderer's library (``use_shaders``): its normal maps' spread pass
         self._meshes: dict[int, tuple[object, list[GpuPart], MeshTextures]] = {}
         # The built-in sphere's stand-ins, by the mesh's id and a key (segments, "proxy").
         self._stand_ins: dict[tuple[int, object], tuple[object, list[GpuPart], MeshTextures]] = {}
@@ -355,7 +360,7 @@ class GpuMeshes:
             # run draws many; an evicted one uploads again when next drawn).
             while len(self._meshes) >= MAX_UPLOADED_MESHES:
                 release_mesh(self._meshes.pop(next(iter(self._meshes))))
-            textures = MeshTextures(self.ctx)
+            textures = MeshTextures(self.ctx, self.shaders)
             entry = (mesh, [GpuPart(self.ctx, part, textures) for part in mesh.parts], textures)
             mark_mesh_uv_features(entry[1])
         self._meshes[id(mesh)] = entry    # last: the most recently drawn
@@ -392,7 +397,7 @@ class GpuMeshes:
         if entry is None:
             part = mesh.parts[0]
             stand_in = dataclasses.replace(make_part(), material=part.material, name=part.name, element=part.element)
-            textures = MeshTextures(self.ctx)
+            textures = MeshTextures(self.ctx, self.shaders)
             entry = self._stand_ins[(id(mesh), key)] = (mesh, [GpuPart(self.ctx, stand_in, textures)], textures)
         return entry[1][0]
 
@@ -412,7 +417,7 @@ class GpuMeshes:
                 if entry is not None:
                     entry[1].release()
                 tex = (upload_image(self.ctx, image, srgb=key[1]) if spread is None
-                       else upload_normal_map(self.ctx, image, spread))
+                       else upload_normal_map(self.ctx, self.shaders, image, spread))
                 entry = self._map_textures[key] = (image, tex)
             out[slot] = entry[1]
         return out
@@ -421,6 +426,12 @@ class GpuMeshes:
         """Release the uploaded maps whose path is not in ``keep_paths``."""
         for key in [k for k in self._map_textures if k[0] not in keep_paths]:
             self._map_textures.pop(key)[1].release()
+
+    def use_shaders(self, shaders: ShaderLibrary) -> None:
+        """Upload with ``shaders`` from now on (the renderer switched libraries); the meshes are
+        released (``release_meshes``), the user's maps stay."""
+        self.shaders = shaders
+        self.release_meshes()
 
     def release_meshes(self) -> None:
         """Release every uploaded mesh and stand-in (their vertex arrays belong to programs that a

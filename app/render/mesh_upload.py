@@ -65,8 +65,9 @@ class MeshUpload:
         self.steps = 0
         self.done = False
 
-    def step(self, ctx, meshes, shadow_maps) -> bool:
-        """Write pieces up to STEP_BYTES (at least one); once all are written, make the parts'
+    def step(self, ctx, shaders, meshes, shadow_maps) -> bool:
+        """Write pieces up to STEP_BYTES (at least one; a normal map's spread by the pass that
+        ``shaders``, the renderer's library, compiles); once all are written, make the parts'
         buffers and hand everything to ``meshes`` (GpuMeshes) and ``shadow_maps``. True when whole."""
         from alight.core.gpu import write_rgba8
         from alight.render.gpu_mesh import MeshTextures, level_texture, upload_image
@@ -84,7 +85,7 @@ class MeshUpload:
                 # the band's level reads the levels written before it (all of them, RGB and A)
                 if t not in self.spreads:
                     h, w = levels[0].shape[:2]
-                    self.spreads[t] = SpreadWriter(ctx, self.made[t], (w, h), len(levels), spread_of(key))
+                    self.spreads[t] = SpreadWriter(ctx, shaders, self.made[t], (w, h), len(levels), spread_of(key))
                 writer = self.spreads[t]
                 if y0 < 0:
                     writer.allocate()
@@ -110,7 +111,7 @@ class MeshUpload:
             self.next += 1
         if self.next < len(self.pieces) or written:
             return False   # the parts' buffers in a frame of their own
-        textures = MeshTextures(ctx)
+        textures = MeshTextures(ctx, shaders)
         for t, tex in self.made.items():
             textures.adopt(self.textures[t][0], tex)
         meshes.adopt(self.mesh, textures)

@@ -11,17 +11,17 @@ the CPU.
 Every call here is GL work: it runs on the thread that owns the context (the frame's upload,
 or the editor's ``Renderer.upload_step``). ``SpreadWriter.write`` does one band of one level, so
 a caller that must keep drawing frames splits the work (alight.render.mesh_upload).
+
+The pass is compiled by the renderer's ShaderLibrary, as every other program: the editor's shader
+reload (a new library, ``ForwardRenderer.use_shaders``) recompiles it from the saved file.
 """
 
 from __future__ import annotations
 
-import weakref
-
 import moderngl
 import numpy as np
 
-from alight.core.gpu import GL_RGBA8, GL_RGBA32F, ShaderCompileError, first_error_line, load_source, \
-    rgba32f_texture, translate_log
+from alight.core.gpu import GL_RGBA8, GL_RGBA32F, ShaderLibrary, rgba32f_texture
 from alight.render import normal_spread
 
 SHADER = "render/normal_spread.comp"
@@ -31,11 +31,6 @@ GROUP = 8   # the shader's local size, in texels each way
 # a quarter of it per band keeps one band near 10 ms on llvmpipe (four level-0 texels decoded each).
 BAND_TEXELS = 1 << 18
 
-# The compiled pass of each context with its source's digest (compiled on first use, again when
-# the shader's text changes, as the editor's shader reload expects; gone with the context).
-_programs: "weakref.WeakKeyDictionary[moderngl.Context, tuple[str, moderngl.ComputeShader]]" = \
-    weakref.WeakKeyDictionary()
-
 
 def spread_defines() -> dict[str, str]:
     """The twin's constants as the shader's defines (shader_names.SHADER_OPTIONS declares them):
@@ -43,22 +38,6 @@ def spread_defines() -> dict[str, str]:
     return {"NORMAL_SPREAD_MAX": repr(float(normal_spread.MAX_SPREAD)),
             "NORMAL_SPREAD_FLOOR": repr(float(normal_spread.SPREAD_FLOOR)),
             "NORMAL_FLAT_LENGTH": repr(float(normal_spread.FLAT_LENGTH))}
-
-
-def _program(ctx: moderngl.Context) -> moderngl.ComputeShader:
-    src = load_source(SHADER, spread_defines())
-    digest = src.digest()
-    known = _programs.get(ctx)
-    if known is not None and known[0] == digest:
-        return known[1]
-    try:
-        prog = ctx.compute_shader(src.text)
-    except Exception as exc:
-        raise ShaderCompileError(first_error_line(translate_log(str(exc), src.files))) from None
-    if known is not None:
-        known[1].release()
-    _programs[ctx] = (digest, prog)
-    return prog
 
 
 def level_size(size: tuple[int, int], level: int) -> tuple[int, int]:
@@ -86,16 +65,18 @@ def spread_bands(size: tuple[int, int], levels: int, band_texels: int = BAND_TEX
 class SpreadWriter:
     """The spread of one normal map texture's ``levels`` levels (level 0 (w, h) = ``size``, an
     RGBA8 texture with every level allocated and RGB written), measured at normalTexture.scale
-    ``scale``. ``bands``: ``spread_bands``; ``write(i)`` runs band i, in order. The means (an
-    RGBA32F texture of the levels from 1 on: 5.3 MiB for a 2048^2 map) are made by the first band
-    and freed by ``release()``; ``write_all`` releases them itself."""
+    ``scale``, by the pass that ``shaders`` (the renderer's library, on ``ctx``) compiles.
+    ``bands``: ``spread_bands``; ``write(i)`` runs band i, in order. The means (an RGBA32F texture
+    of the levels from 1 on: 5.3 MiB for a 2048^2 map) are made by the first band and freed by
+    ``release()``; ``write_all`` releases them itself. ``write`` raises ShaderCompileError where
+    the pass's source does not compile."""
 
-    def __init__(self, ctx: moderngl.Context, tex: moderngl.Texture, size: tuple[int, int], levels: int,
-                 scale: float, band_texels: int = BAND_TEXELS):
-        self.ctx, self.tex, self.size, self.levels, self.scale = ctx, tex, size, levels, float(scale)
+    def __init__(self, ctx: moderngl.Context, shaders: ShaderLibrary, tex: moderngl.Texture, size: tuple[int, int],
+                 levels: int, scale: float, band_texels: int = BAND_TEXELS):
+        self.ctx, self.shaders, self.tex, self.size, self.levels = ctx, shaders, tex, size, levels
+        self.scale = float(scale)
         self.bands = spread_bands(size, levels, band_texels)
         self._means = None
-        self._prog = None    # the pass, looked up by the first band
 
     def allocate(self) -> None:
         """Make the means texture (``write`` does it if not done): 30-70 ms on llvmpipe for a 2048^2
@@ -106,7 +87,8 @@ class SpreadWriter:
     def write(self, band: int) -> None:
         """Band ``band`` of ``bands``: its texels' means into the means texture, their A into the map."""
         level, y0, y1 = self.bands[band]
-        prog = self._prog = self._prog or _program(self.ctx)
+        # looked up per band, not kept: a library reloaded meanwhile released what it compiled
+        prog = self.shaders.compute(SHADER, spread_defines())
         self.allocate()
         first = level == 1
         # the source: level 0's texels for level 1, else the level above's means

@@ -110,7 +110,7 @@ class ForwardRenderer:
         self.bake_cache = BakeCache() if bake_cache == "default" else bake_cache
         self.bakes_run = 0
         self.bakes_loaded = 0
-        self.meshes = GpuMeshes(self.ctx)      # uploaded meshes and maps (alight.render.gpu_mesh)
+        self.meshes = GpuMeshes(self.ctx, self.shaders)   # uploaded meshes and maps (alight.render.gpu_mesh)
         self.draws = FullscreenDraws(self.ctx)
         self.lights = LightsBlock(self.ctx)    # punctual.glsl's Lights block
         # Meshes drawn with the visibility bake (Scene.occlusion; alight.render.visibility_parts).
@@ -231,7 +231,7 @@ class ForwardRenderer:
         self.tables.use_shaders(shaders)
         self.draws.release_vaos()
         self._units_assigned.clear()
-        self.meshes.release_meshes()
+        self.meshes.use_shaders(shaders)
         old.reload()
 
     def transmission_lut(self) -> moderngl.Texture:
@@ -454,7 +454,7 @@ class ForwardRenderer:
         are all written, the mesh's buffers. Returns True when ``upload.mesh`` is whole on the
         GPU, drawn from then on with no upload in its frame. For a front end that keeps drawing
         frames meanwhile (the editor); ``upload.drop()`` releases an upload left unfinished."""
-        return upload.step(self.ctx, self.meshes, self.shadow_maps)
+        return upload.step(self.ctx, self.shaders, self.meshes, self.shadow_maps)
 
     def _gpu_mesh(self, mesh) -> list[GpuPart]:
         return self.meshes.parts(mesh)
