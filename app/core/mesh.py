@@ -568,6 +568,18 @@ def _edge_keys(welded: np.ndarray, n: int) -> np.ndarray:
     return keys
 
 
+def _welded_edge_keys(positions, indices) -> tuple[np.ndarray, np.ndarray] | None:
+    """(rows, keys): the faces left after the weld as original indices (_welded_faces) and their
+    edges' keys (_edge_keys); None where no face is left (or none was given). The welded faces,
+    as long as ``rows``, are dropped before returning: the keys are the caller's largest array."""
+    if len(indices) == 0:
+        return None
+    rows, welded, n = _welded_faces(positions, indices)
+    if len(welded) == 0:
+        return None
+    return rows, _edge_keys(welded, n)
+
+
 def _paired(keys: np.ndarray) -> bool:
     """Whether sorted edge keys (_edge_keys) are all in pairs (2k, 2k + 1): once forward, once
     backward; a third use of an edge or a repeated direction breaks the pattern of some pair."""
@@ -585,15 +597,13 @@ def is_closed(positions: np.ndarray, indices: np.ndarray) -> bool:
     the edges keyed ``2 (min n + max) + (a < b)`` checks both at once, so the test costs a few
     1-D sorts (about a second for 4M triangles) instead of row-wise uniques and set lookups.
     ``closed_edges`` answers the same with the faces at each edge, for the shadow test."""
-    if len(indices) == 0:
-        return False
-    _, welded, n = _welded_faces(positions, indices)
-    if len(welded) == 0:
+    found = _welded_edge_keys(positions, indices)
+    if found is None:
         return False
     # The keys array is the only one as long as all the edges (a 4M-triangle mesh's peak stays
     # near 100 MiB here): sorted in place, no permutation kept.
-    keys = _edge_keys(welded, n)
-    del welded
+    keys = found[1]
+    del found
     keys.sort()
     return _paired(keys)
 
@@ -637,13 +647,10 @@ def closed_edges(positions: np.ndarray, indices: np.ndarray, pack: bool = True) 
     sort's permutation where is_closed sorts the keys in place (8 bytes more an edge), so the
     culling decision alone keeps is_closed. ``pack``: False always takes the argsort
     (_sorted_with_positions; tests)."""
-    if len(indices) == 0:
+    found = _welded_edge_keys(positions, indices)
+    if found is None:
         return None
-    rows, welded, n = _welded_faces(positions, indices)
-    if len(rows) == 0:
-        return None
-    keys = _edge_keys(welded, n)
-    del welded
+    rows, keys = found
     count = len(rows)
     order = _sorted_with_positions(keys, pack)
     if order is None:
