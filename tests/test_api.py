@@ -34,13 +34,13 @@ def test_unknown_attribute_is_an_attribute_error():
 def test_hundred_materials_under_one_environment_bake_once(monkeypatch, tmp_path):
     monkeypatch.setenv("ALIGHT_CACHE_DIR", str(tmp_path))   # an empty bake cache: the first render bakes
     calls = []
-    real = alight.render.renderer.bake_environment
+    real = alight.render.renderer.bake_steps   # (ForwardRenderer.bake runs its steps to their end)
 
     def counting(*args, **kwargs):
         calls.append(args[2].content_hash)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(alight.render.renderer, "bake_environment", counting)
+    monkeypatch.setattr(alight.render.renderer, "bake_steps", counting)
     with Renderer(16, quality="low") as r:
         r.set_environment("studio")
         centres = set()

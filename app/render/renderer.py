@@ -41,7 +41,7 @@ from alight.core.gpu import ShaderLibrary, create_headless_context
 from alight.core.material import Material
 from alight.core.scene import Camera, Display, Scene, default_camera
 from alight.core.sphere_lod import MAX_SILHOUETTE_ERROR_PX
-from alight.ibl.bake import QUALITY, BakeQuality, IBLMaps, bake_environment, bake_steps
+from alight.ibl.bake import QUALITY, BakeQuality, IBLMaps, bake_steps, run_to_completion
 from alight.ibl.bake_cache import BakeCache, load_bake, save_bake
 from alight.render import passes, variants
 from alight.render.bindings import UNIT_SCRATCH, LightsBlock, LookupTables, assign_units
@@ -168,16 +168,9 @@ class ForwardRenderer:
             self.ctx.__enter__()    # eglMakeCurrent; the same context again costs next to nothing
 
     def bake(self, env, quality: BakeQuality | str = "medium") -> IBLMaps:
-        self.make_current()
-        q = QUALITY[quality] if isinstance(quality, str) else quality
-        key = (env.content_hash, q)
-        if key not in self._bakes:
-            maps = self._load_bake(env, q)
-            if maps is None:
-                maps = bake_environment(self.ctx, self.shaders, env, q, self.luts)
-                self._keep_bake(env, maps)
-            self._remember_bake(key, maps)
-        return self._bakes[key]
+        """The maps of ``env`` at ``quality`` (a name of QUALITY, or a BakeQuality): ``bake_steps``
+        run to its end, kept in memory and in the disk cache."""
+        return run_to_completion(self.bake_steps(env, quality))
 
     def bake_steps(self, env, quality: BakeQuality | str = "medium"):
         """``bake`` in steps (alight.ibl.bake.bake_steps): yields (fraction, label) between GPU passes
