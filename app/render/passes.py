@@ -97,6 +97,16 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
     blending = has_blending_parts(scene)
     strips = plan.strips()
     shading = []    # each tile's (r.last_vbuffer, r.last_mesh_shading_reason)
+
+    def read_into(strip: np.ndarray | None, fbo, t, dtype: str, np_dtype) -> np.ndarray:
+        """The strip with tile ``t`` of ``fbo`` read into it; a single tile is the image itself
+        (copied: read_tile gives a read-only view of the read's bytes, rows reversed)."""
+        block = read_tile(fbo, t, dtype, np_dtype)
+        if plan.single:
+            return block.copy()
+        strip[:, t.x:t.x + t.width] = block
+        return strip
+
     for number, tiles in enumerate(strips):
         rows = tiles[0].height
         linear = np.empty((rows, width, 4), np.float32) if read_linear and not plan.single else None
@@ -116,17 +126,9 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
                     tonemap(r, targets.radiance, scene.display, targets.display_fbo, opaque=opaque)
             shading.append((r.last_vbuffer, r.last_mesh_shading_reason))
             if read_linear:
-                block = read_tile(targets.radiance_fbo, t, "f4", np.float32)
-                if plan.single:
-                    linear = block.copy()
-                else:
-                    linear[:, t.x:t.x + t.width] = block
+                linear = read_into(linear, targets.radiance_fbo, t, "f4", np.float32)
             if read_srgb:
-                block = read_tile(targets.display_fbo, t, "f1", np.uint8)
-                if plan.single:
-                    srgb = block.copy()
-                else:
-                    srgb[:, t.x:t.x + t.width] = block
+                srgb = read_into(srgb, targets.display_fbo, t, "f1", np.uint8)
         if linear is not None and scene.view == "probe":
             linear[linear[:, :, 3] == 0.0] = 0.0  # docs/conventions.md: probe background radiance is 0
         if number == len(strips) - 1:   # (before the last yield: a caller may stop there)
