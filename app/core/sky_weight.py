@@ -102,7 +102,7 @@ def uniform_texels(value=(1.0, 1.0, 1.0), size: int = SKY_TEXELS) -> np.ndarray:
 def ray_directions(normals: np.ndarray, angles: np.ndarray, rays: int) -> np.ndarray:
     """(N, R, 3) world directions of each vertex's rays: visibility.cosine_directions(rays) about
     +Z, turned onto the unit normal in the frame spun by the vertex's angle (as the bake's
-    _chunk_rays)."""
+    _ray_chunks)."""
     n = np.asarray(normals, np.float64)
     t, b = _frame(n)
     c, s = np.cos(angles)[:, None], np.sin(angles)[:, None]

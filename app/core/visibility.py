@@ -755,21 +755,17 @@ class _Occluders:
         (N, R) or -1, Embree's u, v (N, R, 2), the unoccluded directions' sum (N, 3)). Leaves
         ``covered_share`` (N,): the share of the rays that hit a triangle's inside (``outward``)
         or any triangle closer than ``near`` (``_covered``)."""
-        local = cosine_directions(rays).astype(np.float32)
         count = len(origins)
         hit = np.empty((count, rays), np.int32)
         uv = np.empty((count, rays, 2), np.float32)
         open_sum = np.zeros((count, 3), np.float64)
         covered = np.zeros(count, np.float64)
-        chunk = max(1, 262_144 // rays)
-        for s0 in range(0, count, chunk):
-            n = normals[s0:s0 + chunk]
-            d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
+        for rows, d, o in _ray_chunks(origins, normals, rays, rng):
             prim, u, v = _cast(self.scene, o, d, self.normals, eps, one_way=self.one_way)
-            hit[s0:s0 + chunk] = prim.reshape(len(n), rays)
-            uv[s0:s0 + chunk] = np.stack([u, v], axis=-1).reshape(len(n), rays, 2)
-            open_sum[s0:s0 + chunk] = (d * (prim < 0)[:, None]).reshape(len(n), rays, 3).sum(axis=1)
-            covered[s0:s0 + chunk] = _covered(self, prim, u, v, o, d).reshape(len(n), rays).mean(axis=1)
+            hit[rows] = prim.reshape(-1, rays)
+            uv[rows] = np.stack([u, v], axis=-1).reshape(-1, rays, 2)
+            open_sum[rows] = (d * (prim < 0)[:, None]).reshape(-1, rays, 3).sum(axis=1)
+            covered[rows] = _covered(self, prim, u, v, o, d).reshape(-1, rays).mean(axis=1)
         self.covered_share = covered
         return hit, uv, open_sum
 
@@ -801,19 +797,26 @@ def _outside_sign(positions: np.ndarray, normals: np.ndarray, indices: np.ndarra
     return np.where(np.einsum("ij,ij->i", n, vn) < 0.0, -1.0, 1.0)
 
 
-def _chunk_rays(local: np.ndarray, origins: np.ndarray, normals: np.ndarray, rng) -> tuple[np.ndarray, np.ndarray]:
-    """The rays of a chunk of origins: ``local`` (R, 3) directions about +Z turned onto each normal
-    in a frame spun by a random angle per origin (one ``rng.uniform`` draw of len(origins): the same
-    sequence wherever it is called, so a bake stays reproducible), as (C * R, 3) directions and
-    (C * R, 3) origins."""
-    t, b = _frame(normals)
-    angle = rng.uniform(0.0, 2.0 * math.pi, len(normals))
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    t, b = c * t + s * b, c * b - s * t
-    frame = np.stack([t, b, normals], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
-    d = np.ascontiguousarray((local @ frame).reshape(-1, 3))
-    o = np.ascontiguousarray(np.repeat(origins, len(local), axis=0))
-    return d, o
+def _ray_chunks(origins: np.ndarray, normals: np.ndarray, rays: int, rng):
+    """``rays`` cosine-weighted rays about each of the (N, 3) ``normals`` from its origin, a chunk
+    of origins at a time (about 262K rays: one Embree call's arrays stay bounded): yields (rows,
+    d, o), ``rows`` the chunk's slice of the N, ``d`` and ``o`` its (C * R, 3) float32 directions
+    and origins, origin by origin. The directions are cosine_directions(rays) about +Z turned onto
+    each normal in a frame spun by a random angle per origin (one ``rng.uniform`` draw of C per
+    chunk: the same sequence wherever it is called, so a bake stays reproducible)."""
+    local = cosine_directions(rays).astype(np.float32)
+    chunk = max(1, 262_144 // rays)
+    for s0 in range(0, len(origins), chunk):
+        rows = slice(s0, s0 + chunk)
+        n = normals[rows]
+        t, b = _frame(n)
+        angle = rng.uniform(0.0, 2.0 * math.pi, len(n))
+        c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+        t, b = c * t + s * b, c * b - s * t
+        frame = np.stack([t, b, n], axis=1).astype(np.float32)        # (C, 3, 3): rows t, b, n
+        d = np.ascontiguousarray((local @ frame).reshape(-1, 3))
+        o = np.ascontiguousarray(np.repeat(origins[rows], rays, axis=0))
+        yield rows, d, o
 
 
 def _free_rays(occluders, see_through, through_of_triangle, origins, normals, rays: int, rng, eps: float):
@@ -824,24 +827,20 @@ def _free_rays(occluders, see_through, through_of_triangle, origins, normals, ra
     if see_through is None:
         hit, _, open_sum = occluders.hemisphere(origins, normals, rays, rng, eps)
         return (hit < 0).astype(np.float64), open_sum, occluders.covered_share
-    local = cosine_directions(rays).astype(np.float32)
     count = len(origins)
     free = np.empty((count, rays), np.float64)
     open_sum = np.zeros((count, 3), np.float64)
     back = np.zeros(count, np.float64)
-    chunk = max(1, 262_144 // rays)
-    for s0 in range(0, count, chunk):
-        n = normals[s0:s0 + chunk]
-        d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
+    for rows, d, o in _ray_chunks(origins, normals, rays, rng):
         w = np.ones(len(d))
         if occluders is not None:
             prim, u, v = _cast(occluders.scene, o, d, occluders.normals, eps, one_way=occluders.one_way)
             w = (prim < 0).astype(np.float64)
-            back[s0:s0 + chunk] = _covered(occluders, prim, u, v, o, d).reshape(len(n), rays).mean(axis=1)
+            back[rows] = _covered(occluders, prim, u, v, o, d).reshape(-1, rays).mean(axis=1)
         prim_t, _, _ = _cast(see_through.scene, o, d, see_through.normals, eps, one_way=see_through.one_way)
         w = w * np.where(prim_t < 0, 1.0, through_of_triangle[np.maximum(prim_t, 0)])
-        free[s0:s0 + chunk] = w.reshape(len(n), rays)
-        open_sum[s0:s0 + chunk] = (d * w[:, None]).reshape(len(n), rays, 3).sum(axis=1)
+        free[rows] = w.reshape(-1, rays)
+        open_sum[rows] = (d * w[:, None]).reshape(-1, rays, 3).sum(axis=1)
     return free, open_sum, back
 
 
@@ -1180,15 +1179,11 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
     origins = np.concatenate([_origins(positions[a:b], all_n[a:b], f, eps)
                               for f, a, b in zip(faces, offsets[:-1], offsets[1:])])
     rng = np.random.default_rng(seed)
-    local = cosine_directions(bounce_rays).astype(np.float32)
     count = len(positions)
     total = np.zeros((count, MAX_SUNS), np.float64)
     hits = np.zeros(count, np.int64)
     kept = []                       # per chunk: the hitting rays' vertex, triangle and barycentrics
-    chunk = max(1, 262_144 // bounce_rays)
-    for s0 in range(0, count, chunk):
-        n = all_n[s0:s0 + chunk].astype(np.float32)
-        d, o = _chunk_rays(local, origins[s0:s0 + chunk], n, rng)
+    for rows, d, o in _ray_chunks(origins, all_n.astype(np.float32), bounce_rays, rng):
         prim, u, v = _cast(refined.scene, o, d, refined.normals, eps, one_way=refined.one_way)
         ray = np.nonzero(prim >= 0)[0]
         if not len(ray):
@@ -1197,7 +1192,7 @@ def bake_sun_bounce(parts: list[PartVisibility], directions, bounce_rays: int = 
         point = tri[:, 0] + u[ray, None] * (tri[:, 1] - tri[:, 0]) + v[ray, None] * (tri[:, 2] - tri[:, 0])
         face_n = refined.normals[prim[ray]].astype(np.float64)
         face_n *= np.where(np.einsum("ij,ij->i", face_n, d[ray]) > 0.0, -1.0, 1.0)[:, None]   # the side seen
-        vertex = s0 + ray // bounce_rays
+        vertex = rows.start + ray // bounce_rays
         hits += np.bincount(vertex, minlength=count)
         kept.append((vertex, prim[ray], u[ray], v[ray]))
         start = (point + 2.0 * eps * face_n).astype(np.float32)
