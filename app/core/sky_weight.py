@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from alight.core.shading import rotate_world_to_map
-from alight.core.visibility import _frame, _origins, _Transmittance, cosine_directions, merged_parts
+from alight.core.visibility import _frame, _origins, _Transmittance, cosine_directions, fill_rings, merged_parts
 from alight.core.visibility import on_welded, welded  # noqa: F401  (the weight's fill and smoothing run welded)
 from alight.core.visibility import sky_visibility  # noqa: F401  (the shader term's twin lives with the others)
 
@@ -141,42 +141,20 @@ def sky_rays(parts, rays: int, seed: int = SKY_SEED, light_through=None) -> list
 
 # ---- the weight -----------------------------------------------------------------------------
 
-def _neighbour_edges(faces: np.ndarray, count: int) -> np.ndarray:
-    """(E, 2) both ways (from, to), each mesh edge once per direction."""
+def _neighbour_edges(faces: np.ndarray) -> np.ndarray:
+    """(E, 2) both ways (from, to), each edge of the (M, 3) ``faces`` once per direction."""
     f = np.asarray(faces, np.int64).reshape(-1, 3)
     e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     e = np.unique(np.sort(e, axis=1), axis=0)
     return np.concatenate([e, e[:, ::-1]])
 
 
-def fill_from_neighbours(values: np.ndarray, faces: np.ndarray, unknown: np.ndarray) -> np.ndarray:
-    """``values`` (N, C) with the ``unknown`` rows replaced, ring by ring, by the mean of their
-    already known neighbours' rows (the bake's _fill_covered, without its direction). A region
-    with no known neighbour keeps its own rows."""
-    out = np.array(values, np.float64, copy=True)
-    unknown = np.asarray(unknown, bool).copy()
-    if not unknown.any() or unknown.all():
-        return out
-    edges = _neighbour_edges(faces, len(out))
-    count = len(out)
-    while unknown.any():
-        e = edges[unknown[edges[:, 1]] & ~unknown[edges[:, 0]]]
-        if not len(e):
-            break
-        n = np.bincount(e[:, 1], minlength=count)
-        sums = np.column_stack([np.bincount(e[:, 1], out[e[:, 0], k], minlength=count) for k in range(out.shape[1])])
-        ring = n > 0
-        out[ring] = sums[ring] / n[ring, None]
-        unknown &= ~ring
-    return out
-
-
-def smooth(values: np.ndarray, faces: np.ndarray, rounds: int) -> np.ndarray:
-    """``rounds`` rounds of each row becoming the mean of itself and its mesh neighbours."""
+def smooth(values: np.ndarray, edges: np.ndarray, rounds: int) -> np.ndarray:
+    """``rounds`` rounds of each row becoming the mean of itself and its mesh neighbours
+    (``edges``: ``_neighbour_edges``)."""
     out = np.array(values, np.float64, copy=True)
     if rounds <= 0 or not len(out):
         return out
-    edges = _neighbour_edges(faces, len(out))
     count = len(out)
     degree = np.bincount(edges[:, 1], minlength=count).astype(np.float64)
     for _ in range(rounds):
@@ -223,7 +201,9 @@ def sky_weight(free: np.ndarray, angles: np.ndarray, normals: np.ndarray, faces:
     ids = None if positions is None else welded(positions, n)
 
     def fill_and_smooth(v, f):
-        return smooth(fill_from_neighbours(v, f, v[:, 3] <= 0.0), f, rounds)
+        # the rows none of whose rays escape take their neighbours' (as the bake's _fill_covered, no direction)
+        edges = _neighbour_edges(f)
+        return smooth(fill_rings(v, v[:, 3] <= 0.0, edges), edges, rounds)
 
     return on_welded(values, faces, ids, fill_and_smooth).astype(np.float32)
 

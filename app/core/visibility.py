@@ -868,12 +868,19 @@ def _fill_covered(values: np.ndarray, faces: np.ndarray, buried: np.ndarray, uni
     those triangles sees (lightmap bakers dilate valid texels into those inside geometry alike).
     A buried region with no open neighbour keeps its own values. ``unit`` False: the direction
     is a mean of unit vectors (the bounce's), averaged as it is."""
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    return fill_rings(values, buried, np.concatenate([edges, edges[:, ::-1]]), unit)
+
+
+def fill_rings(values: np.ndarray, unknown: np.ndarray, edges: np.ndarray, unit: bool = False) -> np.ndarray:
+    """``values`` (N, C) as float64 with the ``unknown`` (N,) rows replaced, ring by ring, by the
+    mean of their already known neighbours' rows along ``edges`` ((E, 2) (from, to), both ways; an
+    edge listed twice weighs twice). ``unit``: columns 0-2 are a direction, renormalised each ring
+    (kept as given where the mean vanishes). A region with no known neighbour keeps its own rows."""
     out = np.array(values, np.float64, copy=True)
-    unknown = np.asarray(buried, bool).copy()
+    unknown = np.asarray(unknown, bool).copy()
     if not unknown.any() or unknown.all():
         return out
-    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    edges = np.concatenate([edges, edges[:, ::-1]])            # both ways: (from, to)
     count = len(out)
     while unknown.any():
         e = edges[unknown[edges[:, 1]] & ~unknown[edges[:, 0]]]   # known -> unknown
