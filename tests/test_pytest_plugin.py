@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -100,6 +101,58 @@ def test_relative_error_is_what_it_says(tmp_path):
         _assert_image_matches(expected[:, :4], tmp_path / "g.exr", "rel", 0.02, False)
     with pytest.raises(ValueError):
         _assert_image_matches(expected, tmp_path / "g.exr", "mse", None, False)
+
+
+DUCK_INNER = '''
+import os
+
+def test_duck(alight_renderer, assert_image_matches):
+    r = alight_renderer
+    r.aa = os.environ.get("AA", "msaa")
+    r.set_mesh(os.environ["DUCK"]).set_environment("studio")
+    r.set_camera(orbit_deg=float(os.environ.get("ORBIT", "0")), distance=12)  # small in the frame
+    if os.environ.get("RED"):
+        r.set_material(base_color=(1, 0, 0), use_file_materials=False)
+    assert_image_matches(r.render(256, 256), "goldens/duck.png")
+'''
+
+
+def test_a_small_object_changed_fails_and_legit_noise_passes(pytester, monkeypatch, shared_data):
+    """Duck.glb small in the frame turned red moves the frame's rel error only 0.017 (< 0.02):
+    the local (per-block) criterion catches it; an unchanged render, a camera moved 1e-4 and
+    another anti-aliasing (as another GPU rasterises edges) still pass."""
+    pytester.makepyfile(test_duck=DUCK_INNER)
+    monkeypatch.setenv("DUCK", str(shared_data / "models" / "Duck.glb"))
+
+    def run(*args, **env):
+        for k in ("AA", "ORBIT", "RED"):
+            monkeypatch.delenv(k, raising=False)
+        for k, v in env.items():
+            monkeypatch.setenv(k, v)
+        return pytester.runpytest_subprocess("-p", "no:cacheprovider", *args)
+
+    run("--alight-update-goldens").assert_outcomes(passed=1)
+    run().assert_outcomes(passed=1)
+    run(ORBIT="1e-4").assert_outcomes(passed=1)
+    run(AA="none").assert_outcomes(passed=1)
+    red = run(RED="1")
+    red.assert_outcomes(failed=1)
+    red.stdout.fnmatch_lines(["*duck.png: local error * (rel error of the 16x16 block at *) > local tolerance 0.25*"])
+    # Loosened: per call, and for the project through the ini option.
+    pytester.makeini("[pytest]\nalight_local_tolerance = inf\n")
+    run(RED="1").assert_outcomes(passed=1)
+
+
+def test_local_error_is_the_worst_blocks_rel_error(tmp_path):
+    expected = np.full((40, 40, 3), 0.5, np.float32)
+    _assert_image_matches(expected, tmp_path / "g.exr", "rel", None, update=True)
+    spot = expected.copy()
+    spot[30:38, 30:38] = 1.0  # 64 pixels off by 0.5: rel 0.02, a block's rel 0.25..1
+    assert _assert_image_matches(spot, tmp_path / "g.exr", "rel", 0.05, False, local_tolerance=math.inf) \
+        == pytest.approx(64 * 0.5 / 1600 / 0.5)
+    # The last column and row of blocks end at the image's edge: the spot lies in the block at 24.
+    with pytest.raises(AssertionError, match=r"local error 0.25 \(rel error of the 16x16 block at x=24, y=24\)"):
+        _assert_image_matches(spot, tmp_path / "g.exr", "rel", 0.05, False, local_tolerance=0.2)
 
 
 def test_entry_point_is_declared():
