@@ -155,6 +155,35 @@ def test_local_error_is_the_worst_blocks_rel_error(tmp_path):
         _assert_image_matches(spot, tmp_path / "g.exr", "rel", 0.05, False, local_tolerance=0.2)
 
 
+FORMAT_INNER = '''
+import os
+
+def test_format(alight_renderer, assert_image_matches):
+    r = alight_renderer
+    r.set_mesh("sphere").set_environment("studio").set_material("gold")
+    assert_image_matches(r.render(16, 16, linear=bool(os.environ.get("HDR"))), os.environ["GOLDEN"])
+'''
+
+
+@pytest.mark.parametrize("hdr, golden, words", [
+    ("1", "g.png", "a float (linear) image needs a .exr golden, not .png"),
+    ("", "g.exr", "a uint8 (sRGB) image needs a .png golden, not .exr"),
+    ("", "g.jpg", "a uint8 (sRGB) image needs a .png golden, not .jpg (lossy formats*"),
+], ids=["float-png", "uint8-exr", "jpg"])
+def test_a_golden_format_that_cannot_hold_the_image_is_refused(pytester, monkeypatch, hdr, golden, words):
+    """At update time (nothing written) and at compare time, in one line."""
+    pytester.makepyfile(test_format=FORMAT_INNER)
+    monkeypatch.setenv("HDR", hdr)
+    monkeypatch.setenv("GOLDEN", golden)
+    for args in (("--alight-update-goldens",), ()):
+        result = pytester.runpytest_subprocess("-p", "no:cacheprovider", *args)
+        result.assert_outcomes(failed=1)
+        result.stdout.fnmatch_lines([f"*{golden}: {words}"])
+        assert not (pytester.path / golden).exists()
+    with pytest.raises(pytest.fail.Exception, match="actual is uint16"):
+        _assert_image_matches(np.zeros((4, 4, 3), np.uint16), pytester.path / "g.png", "rel", None, True)
+
+
 def test_entry_point_is_declared():
     project = tomllib.loads((REPO / "pyproject.toml").read_text())
     assert project["project"]["entry-points"]["pytest11"]["alight"] == "alight.frontends.pytest_plugin"

@@ -113,6 +113,7 @@ def _assert_image_matches(actual, golden: Path, metric: str, tolerance: float | 
     if actual.ndim != 3 or actual.shape[2] not in (3, 4):
         raise ValueError(f"actual: expected an (H, W, 3|4) image, got shape {actual.shape}")
     hdr = actual.dtype.kind == "f"
+    _check_format(actual, golden, hdr)
     if update or not golden.exists():
         if not update:
             pytest.fail(f"{golden}: no golden image (run pytest --alight-update-goldens to write it)")
@@ -163,6 +164,21 @@ def _local_error(a: np.ndarray, e: np.ndarray) -> tuple[float, tuple[int, int]]:
             - sat[ys[:, None] + bh, xs[None, :]] + sat[ys[:, None], xs[None, :]])
     i, j = np.unravel_index(int(np.argmax(sums)), sums.shape)
     return float(sums[i, j] / (bh * bw) / max(float(np.abs(e).mean()), 1e-12)), (int(xs[j]), int(ys[i]))
+
+
+def _check_format(actual: np.ndarray, golden: Path, hdr: bool) -> None:
+    """Refuse a golden format that cannot hold the image as it is, at update and compare alike:
+    a float render written to .png is clipped and sRGB-encoded, so it never matches again, and
+    a lossy .jpg golden differs from the render it was written from."""
+    suffix = golden.suffix.lower()
+    if not hdr and actual.dtype != np.uint8:
+        pytest.fail(f"{golden}: actual is {actual.dtype}; give a uint8 sRGB image (.png golden) or a "
+                    f"float linear one (.exr golden)", pytrace=False)
+    want = ".exr" if hdr else ".png"
+    if suffix != want:
+        kind = "a float (linear) image needs" if hdr else "a uint8 (sRGB) image needs"
+        lossy = " (lossy formats change the pixels they store)" if suffix in (".jpg", ".jpeg", ".webp") else ""
+        pytest.fail(f"{golden}: {kind} a {want} golden, not {suffix or 'no extension'}{lossy}", pytrace=False)
 
 
 def _read(path: Path) -> np.ndarray:
