@@ -67,9 +67,14 @@ def test_goldens_written_matched_and_a_wrong_render_fails(run_inner, pytester, h
         assert path.is_file(), kind
     diff = oiio.ImageInput.open(str(pytester.path / "goldens" / "ball.diff.png")).read_image()
     assert diff.max() > 0.5  # the difference image shows the difference
-    # The golden itself is untouched by a failure, and updating accepts the new look.
+    # The golden itself is untouched by a failure, and updating accepts the new look; a pass
+    # and an update each remove the failure images an earlier run left.
     run_inner(**env).assert_outcomes(passed=1)
+    assert not list((pytester.path / "goldens").glob("ball.*.png"))
+    run_inner(PRESET="silver", **env).assert_outcomes(failed=1)
+    assert len(list((pytester.path / "goldens").glob("ball.*.png"))) == 3
     run_inner("--alight-update-goldens", PRESET="silver", **env).assert_outcomes(passed=1)
+    assert not list((pytester.path / "goldens").glob("ball.*.png"))
     run_inner(PRESET="silver", **env).assert_outcomes(passed=1)
 
 
@@ -97,8 +102,10 @@ def test_relative_error_is_what_it_says(tmp_path):
     assert _assert_image_matches(expected * 1.01, tmp_path / "g.exr", "rel", 0.02, False) == pytest.approx(0.01, rel=1e-4)
     with pytest.raises(AssertionError, match="rel error 0.03"):
         _assert_image_matches(expected * 1.03, tmp_path / "g.exr", "rel", 0.02, False)
-    with pytest.raises(AssertionError, match="size 4x8"):
+    with pytest.raises(AssertionError, match=r"size 4x8 differs from the golden's 8x8; "
+                                             r"wrote g.actual.png, g.expected.png in "):
         _assert_image_matches(expected[:, :4], tmp_path / "g.exr", "rel", 0.02, False)
+    assert not (tmp_path / "g.diff.png").exists()
     with pytest.raises(ValueError):
         _assert_image_matches(expected, tmp_path / "g.exr", "mse", None, False)
 
@@ -182,6 +189,23 @@ def test_a_golden_format_that_cannot_hold_the_image_is_refused(pytester, monkeyp
         assert not (pytester.path / golden).exists()
     with pytest.raises(pytest.fail.Exception, match="actual is uint16"):
         _assert_image_matches(np.zeros((4, 4, 3), np.uint16), pytester.path / "g.png", "rel", None, True)
+
+
+def test_diff_image_has_a_fixed_scale(tmp_path):
+    """A 1-level difference looks faint, 50 levels white, whatever the largest difference."""
+    expected = np.full((8, 8, 3), 100, np.uint8)
+    _assert_image_matches(expected, tmp_path / "g.png", "rel", None, update=True)
+    actual = expected.copy()
+    actual[:, :4] += 1
+    with pytest.raises(AssertionError, match=r"white 0.25 x the golden's mean"):
+        _assert_image_matches(actual, tmp_path / "g.png", "rel", 0.0, False, local_tolerance=math.inf)
+    faint = oiio.ImageInput.open(str(tmp_path / "g.diff.png")).read_image(format=oiio.UINT8)
+    assert faint[0, 0, 0] == round(1 / (0.25 * 100) * 255) and faint[0, 7, 0] == 0
+    actual[:, 4:] += 50
+    with pytest.raises(AssertionError):
+        _assert_image_matches(actual, tmp_path / "g.png", "rel", 0.0, False, local_tolerance=math.inf)
+    both = oiio.ImageInput.open(str(tmp_path / "g.diff.png")).read_image(format=oiio.UINT8)
+    assert both[0, 0, 0] == faint[0, 0, 0] and both[0, 7, 0] == 255
 
 
 def test_entry_point_is_declared():

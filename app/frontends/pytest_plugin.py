@@ -9,7 +9,9 @@ Fixtures:
 
 ``pytest --alight-update-goldens`` writes the current render as the golden instead of
 comparing. On a mismatch ``<golden>.actual.png``, ``<golden>.expected.png`` and
-``<golden>.diff.png`` are written beside the golden image.
+``<golden>.diff.png`` are written beside the golden image (a size mismatch writes no diff);
+a golden that passes or is updated has its old ones removed. The ``rel`` diff image is
+|actual - expected| on a fixed scale: black 0, white 0.25 x the golden's mean.
 
 Metrics: ``rel`` (relative mean absolute error: mean |a - e| / mean |e| over RGB) and ``flip``
 (mean NVIDIA FLIP error, from the optional ``flip-evaluator`` package). Either way a comparison
@@ -35,6 +37,9 @@ DEFAULT_TOLERANCE = {"rel": 0.02, "flip": 0.05}
 # blocks let those reach 0.29. docs/guides/pytest-plugin.md gives the measurements.
 BLOCK = 16
 DEFAULT_LOCAL_TOLERANCE = 0.25
+# The rel diff image's white, as a share of the golden's mean: DEFAULT_LOCAL_TOLERANCE, so a
+# block that is white throughout fails the local check.
+DIFF_SCALE = 0.25
 _UPDATE = False  # set from --alight-update-goldens by pytest_configure
 _LOCAL_TOLERANCE = DEFAULT_LOCAL_TOLERANCE  # set from the alight_local_tolerance ini option
 
@@ -119,29 +124,31 @@ def _assert_image_matches(actual, golden: Path, metric: str, tolerance: float | 
             pytest.fail(f"{golden}: no golden image (run pytest --alight-update-goldens to write it)")
         golden.parent.mkdir(parents=True, exist_ok=True)
         write_image(golden, actual.astype(np.float32) if hdr else actual.astype(np.uint8), linear=hdr)
+        _remove_failure(golden)
         return 0.0
     expected = _read(golden)
     a, e = _as_float(actual), _as_float(expected)
     if a.shape != e.shape:
-        _write_failure(golden, a, e, None, hdr)
+        wrote = _write_failure(golden, a, e, None, hdr, metric)
         raise AssertionError(f"{golden}: size {a.shape[1]}x{a.shape[0]} differs from the golden's "
-                             f"{e.shape[1]}x{e.shape[0]}")
+                             f"{e.shape[1]}x{e.shape[0]}; {wrote}")
     if metric == "rel":
         diff = np.abs(a - e)
         error = float(diff.mean() / max(float(np.abs(e).mean()), 1e-12))
-        diff_image = diff / max(float(diff.max()), 1e-12)
+        # A fixed scale, so that a faint difference looks faint: white is DIFF_SCALE x the
+        # golden's mean, an error that fails the local check when a whole block has it.
+        diff_image = diff / (DIFF_SCALE * max(float(np.abs(e).mean()), 1e-12))
     else:
         error, diff_image = _flip(a, e, hdr)
     if not error <= tol:
-        paths = _write_failure(golden, a, e, diff_image, hdr)
-        raise AssertionError(f"{golden}: {metric} error {error:.4g} > tolerance {tol:g}; "
-                             f"wrote {', '.join(p.name for p in paths)} in {golden.parent}")
+        wrote = _write_failure(golden, a, e, diff_image, hdr, metric)
+        raise AssertionError(f"{golden}: {metric} error {error:.4g} > tolerance {tol:g}; {wrote}")
     local, (x, y) = _local_error(a, e)
     if not local <= local_tol:
-        paths = _write_failure(golden, a, e, diff_image, hdr)
+        wrote = _write_failure(golden, a, e, diff_image, hdr, metric)
         raise AssertionError(f"{golden}: local error {local:.4g} (rel error of the {BLOCK}x{BLOCK} block at "
-                             f"x={x}, y={y}) > local tolerance {local_tol:g}; "
-                             f"wrote {', '.join(p.name for p in paths)} in {golden.parent}")
+                             f"x={x}, y={y}) > local tolerance {local_tol:g}; {wrote}")
+    _remove_failure(golden)
     return error
 
 
@@ -210,8 +217,20 @@ def _flip(a: np.ndarray, e: np.ndarray, hdr: bool) -> tuple[float, np.ndarray]:
     return float(mean), np.asarray(error_map, np.float32)
 
 
-def _write_failure(golden: Path, a, e, diff, hdr: bool) -> list[Path]:
-    """actual / expected / diff as 8-bit PNGs people can open (HDR images clipped to [0,1])."""
+def _failure_paths(golden: Path) -> list[Path]:
+    stem = golden.with_suffix("")
+    return [Path(f"{stem}.{kind}.png") for kind in ("actual", "expected", "diff")]
+
+
+def _remove_failure(golden: Path) -> None:
+    """A passing or updated golden's failure images from an earlier run would only mislead."""
+    for path in _failure_paths(golden):
+        path.unlink(missing_ok=True)
+
+
+def _write_failure(golden: Path, a, e, diff, hdr: bool, metric: str) -> str:
+    """actual / expected / diff as 8-bit PNGs people can open (HDR images clipped to [0,1]);
+    returns the words that say where they are and the diff image's scale."""
     from alight.core.shading import linear_to_srgb
     from alight.exchange.output import write_image
 
@@ -221,11 +240,15 @@ def _write_failure(golden: Path, a, e, diff, hdr: bool) -> list[Path]:
             x = linear_to_srgb(x)
         return (np.asarray(x) * 255.0 + 0.5).astype(np.uint8)
 
-    stem = golden.with_suffix("")
-    out = [Path(f"{stem}.actual.png"), Path(f"{stem}.expected.png")]
+    _remove_failure(golden)   # a size mismatch writes no diff: an older one would not match
+    out = _failure_paths(golden)
     write_image(out[0], png(a), linear=False)
     write_image(out[1], png(e), linear=False)
+    scale = ""
     if diff is not None:
-        out.append(Path(f"{stem}.diff.png"))
         write_image(out[2], (np.clip(diff, 0, 1) * 255.0 + 0.5).astype(np.uint8), linear=False)
-    return out
+        scale = (f" (diff: |actual - expected|, black 0 to white {DIFF_SCALE:g} x the golden's mean)"
+                 if metric == "rel" else " (diff: the FLIP error map, magma, 0 to 1)")
+    else:
+        out = out[:2]
+    return f"wrote {', '.join(p.name for p in out)} in {golden.parent}{scale}"
