@@ -208,6 +208,58 @@ def test_diff_image_has_a_fixed_scale(tmp_path):
     assert both[0, 0, 0] == faint[0, 0, 0] and both[0, 7, 0] == 255
 
 
+def test_a_failure_shows_the_test_not_the_plugin_and_an_update_says_how_many(run_inner, pytester):
+    written = run_inner("--alight-update-goldens")
+    written.assert_outcomes(passed=1)
+    written.stdout.fnmatch_lines(["alight: wrote 1 golden"])
+    wrong = run_inner(PRESET="silver")
+    wrong.assert_outcomes(failed=1)
+    text = wrong.stdout.str()
+    # The test's own line, then the message: none of the plugin's source.
+    assert "assert_image_matches(r.render(48, 48)" in text and "def _assert_image_matches" not in text, text
+    assert "pytest_plugin.py" not in text, text
+    run_inner().assert_outcomes(passed=1)
+    assert "alight: wrote" not in run_inner().stdout.str()
+
+
+SETTINGS_INNER = '''
+import os
+
+def test_settings(alight_renderer):
+    w, h, quality = os.environ["WANT"].split(",")
+    assert (alight_renderer.width, alight_renderer.height, alight_renderer.quality) == (int(w), int(h), quality)
+'''
+
+
+def test_renderer_size_and_quality_from_ini_and_command_line(pytester, monkeypatch):
+    pytester.makepyfile(test_settings=SETTINGS_INNER)
+
+    def run(want, *args):
+        monkeypatch.setenv("WANT", want)
+        return pytester.runpytest_subprocess("-p", "no:cacheprovider", *args)
+
+    run("256,256,low").assert_outcomes(passed=1)
+    pytester.makeini("[pytest]\nalight_size = 64x32\nalight_quality = medium\n")
+    run("64,32,medium").assert_outcomes(passed=1)
+    run("40,40,high", "--alight-size=40", "--alight-quality=high").assert_outcomes(passed=1)
+    bad = run("0,0,low", "--alight-size=big")
+    assert bad.ret == pytest.ExitCode.USAGE_ERROR
+    bad.stderr.fnmatch_lines(["*--alight-size: 'big' is not a size (W or WxH, in pixels)"])
+    pytester.makeini("[pytest]\nalight_quality = best\n")
+    bad = run("0,0,low")
+    assert bad.ret == pytest.ExitCode.USAGE_ERROR
+    bad.stderr.fnmatch_lines(["*ini option alight_quality: 'best' is not one of low, medium, high, auto"])
+
+
+def test_quality_choices_are_the_renderers():
+    from typing import get_args
+
+    from alight.frontends.api import Quality
+    from alight.frontends.pytest_plugin import QUALITIES
+
+    assert QUALITIES == get_args(Quality)
+
+
 def test_entry_point_is_declared():
     project = tomllib.loads((REPO / "pyproject.toml").read_text())
     assert project["project"]["entry-points"]["pytest11"]["alight"] == "alight.frontends.pytest_plugin"

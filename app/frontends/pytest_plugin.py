@@ -2,13 +2,14 @@
 
 Fixtures:
   ``alight_renderer``        one :class:`alight.frontends.api.Renderer` for the session (256x256, low
-                             quality bakes); its scene state carries over between tests, so
-                             set what a test depends on.
+                             quality bakes; ini options ``alight_size`` and ``alight_quality``, or
+                             ``--alight-size`` and ``--alight-quality``); its scene state carries
+                             over between tests, so set what a test depends on.
   ``assert_image_matches``   :func:`assert_image_matches` with relative golden paths taken
                              from the test file's folder and ``--alight-update-goldens`` applied.
 
 ``pytest --alight-update-goldens`` writes the current render as the golden instead of
-comparing. On a mismatch ``<golden>.actual.png``, ``<golden>.expected.png`` and
+comparing, and ends with ``alight: wrote N goldens``. On a mismatch ``<golden>.actual.png``, ``<golden>.expected.png`` and
 ``<golden>.diff.png`` are written beside the golden image (a size mismatch writes no diff);
 a golden that passes or is updated has its old ones removed. The ``rel`` diff image is
 |actual - expected| on a fixed scale: black 0, white 0.25 x the golden's mean.
@@ -40,7 +41,12 @@ DEFAULT_LOCAL_TOLERANCE = 0.25
 # The rel diff image's white, as a share of the golden's mean: DEFAULT_LOCAL_TOLERANCE, so a
 # block that is white throughout fails the local check.
 DIFF_SCALE = 0.25
+# alight.frontends.api.Quality's values (a test keeps them equal): the plugin checks the
+# option before the session imports the renderer.
+QUALITIES = ("low", "medium", "high", "auto")
 _UPDATE = False  # set from --alight-update-goldens by pytest_configure
+_WRITTEN = 0  # goldens written this session, for the terminal summary
+_RENDERER_SETTINGS = pytest.StashKey[tuple]()  # ((w, h), quality) for alight_renderer
 _LOCAL_TOLERANCE = DEFAULT_LOCAL_TOLERANCE  # set from the alight_local_tolerance ini option
 
 
@@ -48,6 +54,12 @@ def pytest_addoption(parser) -> None:
     group = parser.getgroup("alight")
     group.addoption("--alight-update-goldens", action="store_true", default=False,
                     help="write renders compared by assert_image_matches as the new golden images")
+    group.addoption("--alight-size", default=None, metavar="W[xH]",
+                    help="alight_renderer's default render size (ini alight_size; default 256)")
+    group.addoption("--alight-quality", default=None, choices=QUALITIES,
+                    help="alight_renderer's bake quality (ini alight_quality; default low)")
+    parser.addini("alight_size", default="256", help="alight_renderer's default render size, W or WxH")
+    parser.addini("alight_quality", default="low", help=f"alight_renderer's bake quality: {', '.join(QUALITIES)}")
     parser.addini("alight_local_tolerance", default=str(DEFAULT_LOCAL_TOLERANCE),
                   help="assert_image_matches' default local tolerance: the largest rel error of a "
                        f"{BLOCK}x{BLOCK} block (inf turns the local check off)")
@@ -57,6 +69,28 @@ def pytest_configure(config) -> None:
     global _UPDATE, _LOCAL_TOLERANCE
     _UPDATE = bool(config.getoption("alight_update_goldens", default=False))
     _LOCAL_TOLERANCE = _ini_float(config, "alight_local_tolerance")
+    quality = config.getoption("alight_quality", default=None) or config.getini("alight_quality")
+    if quality not in QUALITIES:   # --alight-quality's choices are checked by its parser
+        raise pytest.UsageError(f"ini option alight_quality: {quality!r} is not one of {', '.join(QUALITIES)}")
+    config.stash[_RENDERER_SETTINGS] = (_renderer_size(config), quality)
+
+
+def _renderer_size(config) -> tuple[int, int]:
+    option = config.getoption("alight_size", default=None)
+    text, where = (option, "--alight-size") if option else (config.getini("alight_size"), "ini option alight_size")
+    w, _, h = str(text).strip().lower().partition("x")
+    try:
+        size = (int(w), int(h or w))
+    except ValueError:
+        size = (0, 0)
+    if min(size) < 1:
+        raise pytest.UsageError(f"{where}: {text!r} is not a size (W or WxH, in pixels)")
+    return size
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
+    if config.getoption("alight_update_goldens", default=False):
+        terminalreporter.write_line(f"alight: wrote {_WRITTEN} golden{'' if _WRITTEN == 1 else 's'}")
 
 
 def _ini_float(config, name: str) -> float:
@@ -68,11 +102,13 @@ def _ini_float(config, name: str) -> float:
 
 
 @pytest.fixture(scope="session")
-def alight_renderer():
-    """A headless renderer shared by the session; released at its end."""
+def alight_renderer(pytestconfig):
+    """A headless renderer shared by the session (size and quality from the alight_size and
+    alight_quality ini options or --alight-size/--alight-quality); released at its end."""
     from alight.frontends.api import Renderer
 
-    with Renderer(256, 256, quality="low") as r:
+    (w, h), quality = pytestconfig.stash[_RENDERER_SETTINGS]
+    with Renderer(w, h, quality=quality) as r:
         yield r
 
 
@@ -85,6 +121,7 @@ def _assert_image_matches_fixture(request):
 
     def check(actual, golden_path, metric: str = "rel", tolerance: float | None = None,
               local_tolerance: float | None = None) -> float:
+        __tracebackhide__ = True  # a failure shows the test's line, not the plugin's source
         golden = Path(golden_path)
         return _assert_image_matches(actual, golden if golden.is_absolute() else here / golden, metric,
                                      tolerance, update, local_tolerance)
@@ -103,11 +140,14 @@ def assert_image_matches(actual: np.ndarray, golden_path: str | os.PathLike, met
     On failure the actual, expected and difference images are written beside the golden and
     an AssertionError says where.
     """
+    __tracebackhide__ = True
     return _assert_image_matches(actual, Path(golden_path), metric, tolerance, _UPDATE, local_tolerance)
 
 
 def _assert_image_matches(actual, golden: Path, metric: str, tolerance: float | None, update: bool,
                           local_tolerance: float | None = None) -> float:
+    __tracebackhide__ = True
+    global _WRITTEN
     from alight.exchange.output import write_image
 
     if metric not in METRICS:
@@ -125,6 +165,7 @@ def _assert_image_matches(actual, golden: Path, metric: str, tolerance: float | 
         golden.parent.mkdir(parents=True, exist_ok=True)
         write_image(golden, actual.astype(np.float32) if hdr else actual.astype(np.uint8), linear=hdr)
         _remove_failure(golden)
+        _WRITTEN += 1
         return 0.0
     expected = _read(golden)
     a, e = _as_float(actual), _as_float(expected)
@@ -177,6 +218,7 @@ def _check_format(actual: np.ndarray, golden: Path, hdr: bool) -> None:
     """Refuse a golden format that cannot hold the image as it is, at update and compare alike:
     a float render written to .png is clipped and sRGB-encoded, so it never matches again, and
     a lossy .jpg golden differs from the render it was written from."""
+    __tracebackhide__ = True
     suffix = golden.suffix.lower()
     if not hdr and actual.dtype != np.uint8:
         pytest.fail(f"{golden}: actual is {actual.dtype}; give a uint8 sRGB image (.png golden) or a "
@@ -189,6 +231,7 @@ def _check_format(actual: np.ndarray, golden: Path, hdr: bool) -> None:
 
 
 def _read(path: Path) -> np.ndarray:
+    __tracebackhide__ = True
     import OpenImageIO as oiio
 
     image = oiio.ImageInput.open(str(path))
@@ -208,6 +251,7 @@ def _as_float(image: np.ndarray) -> np.ndarray:
 
 
 def _flip(a: np.ndarray, e: np.ndarray, hdr: bool) -> tuple[float, np.ndarray]:
+    __tracebackhide__ = True
     try:
         import flip_evaluator
     except ImportError:
