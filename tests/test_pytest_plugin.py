@@ -260,6 +260,24 @@ def test_quality_choices_are_the_renderers():
     assert QUALITIES == get_args(Quality)
 
 
+def test_flip_evaluator_is_a_dependency_and_its_absence_says_so(run_inner, pytester):
+    """pyproject, the plugin's docstring and the guide agree: a dependency, not optional."""
+    import alight.frontends.pytest_plugin as plugin
+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())
+    assert any(d.startswith("flip-evaluator") for d in project["project"]["dependencies"])
+    guide = (REPO / "docs" / "guides" / "pytest-plugin.md").read_text()
+    for text in (plugin.__doc__, guide):
+        assert "a dependency of alight" in text and "optional" not in text
+    # An environment without it (an install with --no-deps): one line naming the golden.
+    pytester.makeconftest("import sys\nsys.modules['flip_evaluator'] = None  # import fails\n")
+    run_inner("--alight-update-goldens").assert_outcomes(passed=1)
+    missing = run_inner(METRIC="flip")
+    missing.assert_outcomes(failed=1)
+    missing.stdout.fnmatch_lines(["*ball.png: metric 'flip' needs the flip-evaluator package, a dependency of "
+                                  "alight missing from this environment (pip install flip-evaluator)"])
+
+
 def test_entry_point_is_declared():
     project = tomllib.loads((REPO / "pyproject.toml").read_text())
     assert project["project"]["entry-points"]["pytest11"]["alight"] == "alight.frontends.pytest_plugin"

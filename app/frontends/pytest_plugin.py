@@ -9,14 +9,15 @@ Fixtures:
                              from the test file's folder and ``--alight-update-goldens`` applied.
 
 ``pytest --alight-update-goldens`` writes the current render as the golden instead of
-comparing, and ends with ``alight: wrote N goldens``. On a mismatch ``<golden>.actual.png``, ``<golden>.expected.png`` and
-``<golden>.diff.png`` are written beside the golden image (a size mismatch writes no diff);
-a golden that passes or is updated has its old ones removed. The ``rel`` diff image is
+comparing, and ends with ``alight: wrote N goldens``. On a mismatch ``<golden>.actual.png``,
+``<golden>.expected.png`` and ``<golden>.diff.png`` are written beside the golden image (a size
+mismatch writes no diff); a golden that passes or is updated has its old ones removed. The ``rel`` diff image is
 |actual - expected| on a fixed scale: black 0, white 0.25 x the golden's mean.
 
 Metrics: ``rel`` (relative mean absolute error: mean |a - e| / mean |e| over RGB) and ``flip``
-(mean NVIDIA FLIP error, from the optional ``flip-evaluator`` package). Either way a comparison
-also fails when the worst 16x16 block's rel error exceeds the local tolerance (default 0.25,
+(mean NVIDIA FLIP error, from the ``flip-evaluator`` package: a dependency of alight; an
+environment without it fails a ``flip`` comparison with a line that says so). Either way a
+comparison also fails when the worst 16x16 block's rel error exceeds the local tolerance (default 0.25,
 ini option ``alight_local_tolerance``): a frame's mean hides a small object's change.
 """
 
@@ -180,7 +181,7 @@ def _assert_image_matches(actual, golden: Path, metric: str, tolerance: float | 
         # golden's mean, an error that fails the local check when a whole block has it.
         diff_image = diff / (DIFF_SCALE * max(float(np.abs(e).mean()), 1e-12))
     else:
-        error, diff_image = _flip(a, e, hdr)
+        error, diff_image = _flip(a, e, hdr, golden)
     if not error <= tol:
         wrote = _write_failure(golden, a, e, diff_image, hdr, metric)
         raise AssertionError(f"{golden}: {metric} error {error:.4g} > tolerance {tol:g}; {wrote}")
@@ -250,12 +251,15 @@ def _as_float(image: np.ndarray) -> np.ndarray:
     return rgb.astype(np.float32) / 255.0 if rgb.dtype.kind in "ui" else rgb.astype(np.float32)
 
 
-def _flip(a: np.ndarray, e: np.ndarray, hdr: bool) -> tuple[float, np.ndarray]:
+def _flip(a: np.ndarray, e: np.ndarray, hdr: bool, golden: Path) -> tuple[float, np.ndarray]:
     __tracebackhide__ = True
     try:
         import flip_evaluator
     except ImportError:
-        pytest.fail("metric 'flip' needs the flip-evaluator package (pip install flip-evaluator)")
+        # A dependency of alight, but an install made with --no-deps (or a package removed since)
+        # lacks it; rel comparisons need nothing from it.
+        pytest.fail(f"{golden}: metric 'flip' needs the flip-evaluator package, a dependency of alight "
+                    f"missing from this environment (pip install flip-evaluator)", pytrace=False)
     error_map, mean, _ = flip_evaluator.evaluate(np.ascontiguousarray(e), np.ascontiguousarray(a),
                                                  "HDR" if hdr else "LDR", applyMagma=True)
     return float(mean), np.asarray(error_map, np.float32)
