@@ -59,6 +59,10 @@ class Renderer:
                  aa: AA = "msaa", tonemap: str = "aces", exposure: float = 0.0, background: str = "env",
                  error_budget: float = 0.02, mesh_shading: str = "auto"):
         self.width, self.height = _size(width, width if height is None else height)
+        # What reset() goes back to (the pytest plugin's fixture resets the shared renderer per test).
+        self._initial = dict(width=self.width, height=self.height, quality=quality, aa=aa, tonemap=tonemap,
+                             exposure=exposure, background=background, error_budget=float(error_budget),
+                             mesh_shading=mesh_shading)
         self.quality = quality
         # quality="auto": app/accuracy/auto_quality.py chooses per render within this error budget (a
         # fraction); the last choice is kept in self.last_auto_choice.
@@ -75,13 +79,32 @@ class Renderer:
         self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
         self.bakes_done = 0    # how many bakes actually ran (misses of the memory and disk caches)
         self._mesh: Mesh | None = None
+        self._sphere: Mesh | None = None   # the constructor's mesh, kept so reset() need not rebuild it
         self._framing_checked: Mesh | None = None   # the mesh framing_warnings last looked at
-        self._env: Environment | None = _studio()
+        self.reset()
+
+    def reset(self) -> "Renderer":
+        """Go back to the constructor's state: its size, quality, aa, mesh_shading and display
+        (tonemap, exposure, background), the built-in sphere, the default material with no maps
+        and no field overrides (a mesh file's own materials on), the default camera, the studio
+        environment (no rotation, intensity 1), no lights, the camera view, the default IBL model,
+        shadows, ground and occlusion. The GL context, the programs, the bakes and the loaded
+        meshes are kept, so a reset costs no bake of the studio again (``bakes_done`` goes on
+        counting). The pytest plugin's ``alight_renderer`` fixture resets before each test."""
+        init = self._initial
+        self.width, self.height = init["width"], init["height"]
+        self.quality, self.aa, self.mesh_shading = init["quality"], init["aa"], init["mesh_shading"]
+        self.error_budget = init["error_budget"]
+        self.last_auto_choice = None
+        self.last_texture_set = None
+        self._framing_checked = None
+        self._env = _studio()   # the one shared studio: its content hash finds the bake already made
         self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
-                           display=Display(tonemap=tonemap, exposure=exposure, background=background),
-                           occlusion="auto")
-        self.set_display(tonemap=tonemap, exposure=exposure, background=background)
-        self.set_mesh("sphere")
+                           display=Display(), occlusion="auto")
+        self.set_display(tonemap=init["tonemap"], exposure=init["exposure"], background=init["background"])
+        if self._sphere is None:
+            self._sphere = load_scene_mesh("sphere", warn)
+        return self.set_mesh(self._sphere)
 
     # --- lifetime ------------------------------------------------------------------------
 
@@ -116,7 +139,13 @@ class Renderer:
     def set_mesh(self, mesh: str | os.PathLike | Mesh) -> "Renderer":
         """'sphere', 'cube', 'plane', 'shader_ball', 'rounded_cube', 'drape', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
         What the file is drawn without is said on stderr, one ``alight: warning:`` line each, once
-        per process (alight.errors.warn)."""
+        per process (alight.errors.warn).
+
+        The material is left as it is, as ``alight render``'s flags combine whatever their order: a
+        file's own materials are drawn unless a material, texture set or maps was given to
+        ``set_material`` (then that material is drawn on every part: ``set_material("gold")``
+        then ``set_mesh("Duck.glb")`` is a gold duck, as ``alight render --mesh Duck.glb --preset
+        gold``); ``set_material(use_file_materials=True)`` or ``reset()`` gives the file's own back."""
         if isinstance(mesh, Mesh):
             self._mesh = mesh
             for line in mesh.warnings:
@@ -167,8 +196,10 @@ class Renderer:
         (glTF's convention) before ``fields`` apply. A new material without maps clears the
         maps; with no material, only fields, the current material and maps are edited.
 
-        A material given here replaces a mesh file's own materials unless ``use_file_materials``
-        is True. Errors: AlightError of one line (a bad slot, a missing file).
+        A material, a texture set or maps given here replace a mesh file's own materials on every
+        part unless ``use_file_materials`` is True, whether set before or after ``set_mesh``, as
+        ``alight render --mesh Duck.glb --preset gold`` draws a gold duck.
+        Errors: AlightError of one line (a bad slot, a missing file).
         """
         from alight.core.material_fields import NAMES
         from alight.core.texture_maps import map_factors

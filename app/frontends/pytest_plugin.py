@@ -3,8 +3,9 @@
 Fixtures:
   ``alight_renderer``        one :class:`alight.frontends.api.Renderer` for the session (256x256, low
                              quality bakes; ini options ``alight_size`` and ``alight_quality``, or
-                             ``--alight-size`` and ``--alight-quality``); its scene state carries
-                             over between tests, so set what a test depends on.
+                             ``--alight-size`` and ``--alight-quality``), reset (``Renderer.reset``)
+                             before each test: a test starts from the constructor's scene whatever
+                             the one before set, and the GL context, programs and bakes are kept.
   ``assert_image_matches``   :func:`assert_image_matches` with relative golden paths taken
                              from the test file's folder and ``--alight-update-goldens`` applied.
 
@@ -103,14 +104,22 @@ def _ini_float(config, name: str) -> float:
 
 
 @pytest.fixture(scope="session")
-def alight_renderer(pytestconfig):
-    """A headless renderer shared by the session (size and quality from the alight_size and
-    alight_quality ini options or --alight-size/--alight-quality); released at its end."""
+def _alight_session_renderer(pytestconfig):
+    """The one renderer (its context, programs and bakes) of the session, its size and quality from
+    the alight_size and alight_quality ini options or --alight-size/--alight-quality; released at
+    its end."""
     from alight.frontends.api import Renderer
 
     (w, h), quality = pytestconfig.stash[_RENDERER_SETTINGS]
     with Renderer(w, h, quality=quality) as r:
         yield r
+
+
+@pytest.fixture
+def alight_renderer(_alight_session_renderer):
+    """The session's renderer, reset to the constructor's scene for this test: a mesh, material
+    or camera one test set never reaches the next (a gold duck with its head cut off)."""
+    return _alight_session_renderer.reset().open()   # open(): a test that closed it leaves it usable
 
 
 @pytest.fixture(name="assert_image_matches")

@@ -1,0 +1,53 @@
+"""alight.Renderer's scene state (app/frontends/api.py): reset to the constructor's scene, the
+orbit camera framed at render, fields on a file's own materials, a Camera's clip planes fitted
+to the mesh, a closed renderer, sizes and names checked as given, and the docstrings."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import alight
+from alight import Renderer
+from alight.core.material import Material
+from alight.errors import AlightError
+
+REPO = Path(__file__).resolve().parents[1]
+ALPHA_BLEND = "models/khronos/AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb"
+TINY = "models/khronos/MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb"
+
+
+def test_reset_goes_back_to_the_constructors_scene_without_a_bake(shared_data):
+    """A scene set by one user of a shared renderer (the plugin's fixture) never reaches the
+    next after reset(): the image is the constructor's again, and the studio is not baked again."""
+    with Renderer(32, quality="low", tonemap="agx", background="transparent") as r:
+        first = r.render()
+        bakes = r.bakes_done
+        r.set_mesh(str(shared_data / "models" / "Duck.glb")).set_material("gold", roughness=0.5).set_camera(orbit_deg=90)
+        r.set_environment(None).add_light("point:pos=2,3,4:intensity=30").set_shadows("on", ground=True)
+        r.set_display(tonemap="none", exposure=2.0, background="env").set_ibl_model("lecture")
+        r.width, r.aa, r.quality = 48, "none", "medium"
+        assert r.reset() is r
+        assert (r.width, r.height, r.aa, r.quality) == (32, 32, "msaa", "low")
+        assert r.material == Material() and r.texture_maps is None and r.scene.use_file_materials
+        assert r.scene.camera is None and r.scene.lights == [] and r.scene.material_overrides == {}
+        assert (r.scene.display.tonemap, r.scene.display.exposure, r.scene.display.background) == \
+            ("agx", 0.0, "transparent")
+        np.testing.assert_array_equal(r.render(), first)
+        assert r.bakes_done == bakes     # the same studio: its bake is reused, not made again
+        # set_mesh on a glTF after reset draws the file's own materials, not the last test's gold.
+        r.set_mesh(str(shared_data / "models" / "Duck.glb"))
+        assert r.scene.use_file_materials
+
+
+def test_a_material_set_before_or_after_set_mesh_replaces_the_files_own(shared_data):
+    """As `alight render --mesh Duck.glb --preset gold` (a gold duck), whatever the order."""
+    with Renderer(32, quality="low") as r:
+        duck = str(shared_data / "models" / "Duck.glb")
+        before = r.set_material("gold").set_mesh(duck).render()
+        after = r.reset().set_mesh(duck).set_material("gold").render()
+        own = r.reset().set_mesh(duck).render()
+        np.testing.assert_array_equal(before, after)
+        assert np.abs(own.astype(int) - after.astype(int)).max() > 50
