@@ -51,3 +51,16 @@ def test_a_material_set_before_or_after_set_mesh_replaces_the_files_own(shared_d
         own = r.reset().set_mesh(duck).render()
         np.testing.assert_array_equal(before, after)
         assert np.abs(own.astype(int) - after.astype(int)).max() > 50
+
+
+def test_orbit_camera_is_framed_for_the_renders_own_size(shared_data):
+    """set_camera(orbit_deg=...) on a square renderer, then a tall render: framed for the tall
+    image (it was framed for the constructor's square and cropped the model at the sides)."""
+    with Renderer(64, quality="low", background="transparent") as r:
+        r.set_mesh(str(shared_data / ALPHA_BLEND)).set_camera(orbit_deg=0)
+        alpha = r.render(32, 64)[:, :, 3]
+        assert alpha.max() == 255
+        assert alpha[:, 0].max() == 0 and alpha[:, -1].max() == 0, "the model is cut at the image's sides"
+        # ... and for the mesh of the render, not the one set before the camera.
+        r.set_mesh("sphere").set_camera(orbit_deg=0).set_mesh(str(shared_data / ALPHA_BLEND))
+        np.testing.assert_array_equal(r.render(32, 64)[:, :, 3], alpha)

@@ -81,6 +81,9 @@ class Renderer:
         self._mesh: Mesh | None = None
         self._sphere: Mesh | None = None   # the constructor's mesh, kept so reset() need not rebuild it
         self._framing_checked: Mesh | None = None   # the mesh framing_warnings last looked at
+        # set_camera(orbit_deg=...)'s arguments: the camera is framed at each render, for that
+        # render's size and the mesh of that moment (None: no orbit camera).
+        self._orbit: dict | None = None
         self.reset()
 
     def reset(self) -> "Renderer":
@@ -97,6 +100,7 @@ class Renderer:
         self.error_budget = init["error_budget"]
         self.last_auto_choice = None
         self.last_texture_set = None
+        self._orbit = None
         self._framing_checked = None
         self._env = _studio()   # the one shared studio: its content hash finds the bake already made
         self.scene = Scene(mesh=None, material=Material(), use_file_materials=True, ibl_enabled=True,
@@ -145,7 +149,8 @@ class Renderer:
         file's own materials are drawn unless a material, texture set or maps was given to
         ``set_material`` (then that material is drawn on every part: ``set_material("gold")``
         then ``set_mesh("Duck.glb")`` is a gold duck, as ``alight render --mesh Duck.glb --preset
-        gold``); ``set_material(use_file_materials=True)`` or ``reset()`` gives the file's own back."""
+        gold``); ``set_material(use_file_materials=True)`` or ``reset()`` gives the file's own back.
+        The camera (None or an orbit) is framed for the new mesh at the next render."""
         if isinstance(mesh, Mesh):
             self._mesh = mesh
             for line in mesh.warnings:
@@ -293,20 +298,68 @@ class Renderer:
     def set_camera(self, camera: Camera | None = None, *, orbit_deg: float | None = None,
                    elevation_deg: float = 0.0, distance: float | None = None, fov_deg: float = 35.0,
                    target=None) -> "Renderer":
-        """A Camera, None (frame the mesh from +Z, a built-in from its 3/4 view, Mesh.view), or ``orbit_deg``: look at ``target`` (default:
-        the mesh's centre) from a direction turned that many degrees about +Y from +Z
-        (right-handed), raised by ``elevation_deg``, at ``distance`` (default: framing the mesh),
-        with a vertical field of view of ``fov_deg``. A mesh file's own cameras are
-        ``r.mesh.cameras`` (glTF)."""
+        """A Camera, None (frame the mesh from +Z, a built-in from its 3/4 view, Mesh.view), or
+        ``orbit_deg``: look at ``target`` (x, y, z; default: the mesh's centre) from a direction
+        turned that many degrees about +Y from +Z (right-handed), raised by ``elevation_deg``, at
+        ``distance`` (scene units; default: framing the mesh), with a vertical field of view of
+        ``fov_deg`` degrees. Like None, the orbit camera is framed at each render, for that
+        render's size (``render(w, h)``, not the constructor's) and the mesh set at that time,
+        so a later ``set_mesh`` is framed too. A mesh file's own cameras are ``r.mesh.cameras`` (glTF). Raises AlightError for a
+        non-finite angle, distance or field of view."""
         if orbit_deg is not None:
-            from alight.core.scene import orbit_camera
-
-            centre, radius = self._mesh.bounding_sphere() if self._mesh is not None else ((0, 0, 0), 1.0)
-            camera = orbit_camera(centre, radius, self.width / self.height, orbit_deg, elevation_deg,
-                                  distance, fov_deg, target,
-                                  corners=self._mesh.corners() if self._mesh is not None else None)
+            values = {"orbit_deg": orbit_deg, "elevation_deg": elevation_deg, "fov_deg": fov_deg}
+            if distance is not None:
+                values["distance"] = distance
+            for name, value in values.items():
+                try:
+                    ok = np.isfinite(float(value))
+                except (TypeError, ValueError):
+                    ok = False
+                if not ok:
+                    raise AlightError(f"set_camera: {name}={value!r} is not a finite number")
+            if not 0.0 < float(fov_deg) < 180.0:
+                raise AlightError(f"set_camera: fov_deg={fov_deg!r} must be between 0 and 180 degrees")
+            if distance is not None and not float(distance) > 0.0:
+                raise AlightError(f"set_camera: distance={distance!r} must be > 0")
+            self._orbit = dict(orbit_deg=float(orbit_deg), elevation_deg=float(elevation_deg),
+                               distance=None if distance is None else float(distance), fov_y_deg=float(fov_deg),
+                               target=None if target is None else tuple(float(x) for x in target))
+            camera = self._orbit_camera(self.width, self.height)
+        else:
+            self._orbit = None
         self.scene.camera = camera
         return self
+
+    def _orbit_camera(self, w: int, h: int) -> Camera:
+        """set_camera(orbit_deg=...)'s camera framed for a w x h image of the current mesh."""
+        from alight.core.scene import orbit_camera
+
+        mesh = self._mesh
+        centre, radius = mesh.bounding_sphere() if mesh is not None else ((0, 0, 0), 1.0)
+        return orbit_camera(centre, radius, w / h, corners=mesh.corners() if mesh is not None else None,
+                            **self._orbit)
+
+    def _render_camera(self, w: int, h: int) -> Camera | None:
+        """The camera of a w x h render: the orbit camera framed for this size, else the scene's."""
+        if self.scene.view != "camera":
+            return self.scene.camera
+        if self._orbit is not None:
+            return self._orbit_camera(w, h)
+        return self.scene.camera
+        centre, radius = self._mesh.bounding_sphere()
+        if camera.near is None or camera.far is None:
+            near, far = camera.fit_clip(centre, radius)
+            if camera.near is not None:     # one plane given: the fitted other stays beyond it
+                near, far = camera.near, max(far, camera.near * 2.0)
+            elif camera.far is not None:
+                near, far = min(near, camera.far * 0.5), camera.far
+            camera = replace(camera, near=near, far=far)
+        d = float(np.linalg.norm(np.asarray(camera.position, np.float64) - np.asarray(centre, np.float64)))
+        if d + radius < camera.near or d - radius > camera.far:
+            warn(f"set_camera: the mesh lies outside the camera's clip range (near {camera.near:g}, far "
+                 f"{camera.far:g}; the mesh is {max(d - radius, 0.0):.3g} to {d + radius:.3g} away), so none of "
+                 f"it is drawn; leave near and far unset (None) to fit them to the mesh")
+        return camera
 
     @property
     def mesh(self) -> Mesh | None:
@@ -375,7 +428,10 @@ class Renderer:
             for line in framing_warnings(self._mesh, self._mesh.source, None,
                                          "set_camera(orbit_deg=0, elevation_deg=30)"):
                 warn(line)   # as alight render says it (app/frontends/scene_setup.py)
-        frame = self._frame(w, h, linear=linear, srgb=not linear)
+        from dataclasses import replace
+
+        scene = replace(self.scene, camera=self._render_camera(w, h))
+        frame = self._frame(w, h, linear=linear, srgb=not linear, scene=scene)
         idle = getattr(self._renderer, "last_ground_idle", "")
         if idle:   # in the setters' words (the renderer leaves its words to each front end)
             why = "set_shadows('off')" if idle == "shadows off" else \
@@ -411,14 +467,13 @@ class Renderer:
         write_image(out, pixels, linear=exr)
         return out
 
-    def _frame(self, w: int, h: int, linear: bool, srgb: bool):
-
+    def _frame(self, w: int, h: int, linear: bool, srgb: bool, scene: Scene):
         self.open()
         with _keep_current_context():
             self._renderer.ctx.__enter__()  # another renderer in this process may have made its own current
-            return self._frame_current(w, h, linear, srgb)
+            return self._frame_current(w, h, linear, srgb, scene)
 
-    def _frame_current(self, w: int, h: int, linear: bool, srgb: bool):
+    def _frame_current(self, w: int, h: int, linear: bool, srgb: bool, scene: Scene):
         from alight.ibl.bake import QUALITY
 
         r = self._renderer
@@ -427,18 +482,18 @@ class Renderer:
         r.mesh_shading = self.mesh_shading
         maps = None
         if self.quality == "auto":
-            return self._frame_auto(w, h, linear, srgb)
-        if self._env is not None and self.scene.ibl_enabled:
+            return self._frame_auto(w, h, linear, srgb, scene)
+        if self._env is not None and scene.ibl_enabled:
             before = r.bakes_run
             quality = self.quality if not isinstance(self.quality, str) else QUALITY.get(self.quality)
             if quality is None:
                 raise AlightError(f"quality: {self.quality!r} is not one of {', '.join(QUALITY)}")
             maps = r.bake(self._env, quality)
             self.bakes_done += r.bakes_run - before
-        return r.render(self.scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
+        return r.render(scene, maps, w, h, aa=self.aa, read_linear=linear, read_srgb=srgb)
 
 
-    def _frame_auto(self, w: int, h: int, linear: bool, srgb: bool):
+    def _frame_auto(self, w: int, h: int, linear: bool, srgb: bool, scene: Scene):
         """quality="auto": the cheapest measured bake within error_budget for this scene."""
         from dataclasses import replace
 
@@ -449,7 +504,6 @@ class Renderer:
         )
 
         r = self._renderer
-        scene = self.scene
         on = self._env is not None and scene.ibl_enabled and scene.env_intensity > 0.0
         features = None
         if on:
