@@ -64,3 +64,20 @@ def test_orbit_camera_is_framed_for_the_renders_own_size(shared_data):
         # ... and for the mesh of the render, not the one set before the camera.
         r.set_mesh("sphere").set_camera(orbit_deg=0).set_mesh(str(shared_data / ALPHA_BLEND))
         np.testing.assert_array_equal(r.render(32, 64)[:, :, 3], alpha)
+
+
+def test_fields_without_a_material_apply_to_a_files_own_materials(shared_data):
+    """set_material(base_color=...) on a glTF drawn with its own materials changes the picture
+    (it was a silent no-op), as `alight render --mesh Duck.glb --base-color ...` does; the file's
+    own materials stay on (the duck keeps its texture); a new material ends the overrides."""
+    with Renderer(32, quality="low") as r:
+        r.set_mesh(str(shared_data / "models" / "Duck.glb"))
+        own = r.render().astype(int)
+        blue = r.set_material(base_color=(0.1, 0.1, 0.9), roughness=0.2).render().astype(int)
+        assert r.scene.use_file_materials and r.material.base_color == (0.1, 0.1, 0.9)
+        assert r.scene.material_overrides == {"base_color": (0.1, 0.1, 0.9), "roughness": 0.2}
+        assert np.abs(own - blue).max() > 50
+        mean_before, mean_after = own[..., :3].reshape(-1, 3).mean(0), blue[..., :3].reshape(-1, 3).mean(0)
+        assert mean_after[2] - mean_after[0] > mean_before[2] - mean_before[0]   # bluer
+        r.set_material("gold")
+        assert r.scene.material_overrides == {} and not r.scene.use_file_materials

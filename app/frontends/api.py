@@ -203,7 +203,11 @@ class Renderer:
 
         A material, a texture set or maps given here replace a mesh file's own materials on every
         part unless ``use_file_materials`` is True, whether set before or after ``set_mesh``, as
-        ``alight render --mesh Duck.glb --preset gold`` draws a gold duck.
+        ``alight render --mesh Duck.glb --preset gold`` draws a gold duck. Fields given with no
+        material edit the current material and, where a file's own materials are drawn, apply on
+        top of them too (kept in ``scene.material_overrides`` until a new material or ``reset``),
+        as ``alight render --mesh Duck.glb --roughness 0.2`` does: ``set_material(roughness=0.2)``
+        on the duck keeps its texture and changes its roughness, never nothing.
         Errors: AlightError of one line (a bad slot, a missing file).
         """
         from alight.core.material_fields import NAMES
@@ -249,6 +253,11 @@ class Renderer:
         if loaded:
             base = with_overrides(base, **map_factors(loaded))
         self.scene.material = with_overrides(base, **fields) if fields else base
+        if material is not None:
+            self.scene.material_overrides = {}
+        elif fields:   # on the file's own materials too (app/render/variants.py part_material), as the CLI's flags
+            self.scene.material_overrides = {**self.scene.material_overrides,
+                                             **{k: v for k, v in fields.items() if k != "name"}}
         if current is not None and current.paths():
             self.scene.texture_maps, self.scene.texture_images = current, load_map_images(current)
         else:
