@@ -81,3 +81,20 @@ def test_fields_without_a_material_apply_to_a_files_own_materials(shared_data):
         assert mean_after[2] - mean_after[0] > mean_before[2] - mean_before[0]   # bluer
         r.set_material("gold")
         assert r.scene.material_overrides == {} and not r.scene.use_file_materials
+
+
+def test_a_camera_without_clip_planes_fits_them_to_a_tiny_model(shared_data, capfd):
+    """A 5 mm model seen from 1.6 cm: a Camera with near/far unset fits them and draws it; a
+    fixed 0.05..100 range misses all of it, and says so in one warning line."""
+    with Renderer(32, quality="low", background="transparent") as r:
+        r.set_mesh(str(shared_data / TINY))
+        centre, radius = r.mesh.bounding_sphere()
+        eye = tuple(float(x) for x in np.asarray(centre) + (0.0, 0.0, 3.0 * radius))
+        fitted = r.set_camera(alight.Camera(position=eye, target=tuple(centre))).render()
+        assert (fitted[:, :, 3] > 0).mean() > 0.2
+        assert "clip range" not in capfd.readouterr().err
+        fixed = r.set_camera(alight.Camera(position=eye, target=tuple(centre), near=0.05, far=100.0)).render()
+        assert fixed[:, :, 3].max() == 0
+        lines = [x for x in capfd.readouterr().err.splitlines() if "clip range" in x]
+        assert len(lines) == 1 and lines[0].startswith("alight: warning: set_camera: the mesh lies outside "
+                                                       "the camera's clip range (near 0.05, far 100;"), lines

@@ -26,16 +26,50 @@ BACKGROUNDS = ("env", "blur", "color", "transparent")
 LIGHT_KINDS = ("point", "directional", "spot")
 
 
+# The clip planes of a Camera given none, where nothing fits them to a mesh (the renderer's
+# own callers; alight.Renderer fits them, Camera.fit_clip).
+DEFAULT_NEAR, DEFAULT_FAR = 0.05, 100.0
+
+
 @dataclass
 class Camera:
+    """A pinhole (or orthographic) camera in world space: right-handed, +Y up, the default
+    camera on +Z looking down -Z (docs/conventions.md). Lengths are in the mesh's units (glTF:
+    metres), angles in degrees.
+
+    - ``position``, ``target``: (x, y, z) of the eye and of the point it looks at; they must differ.
+    - ``up``: (x, y, z), the direction that is up in the image; not parallel to target - position.
+    - ``fov_y_deg``: the vertical field of view in degrees (the horizontal one follows from the
+      image's aspect ratio); ignored when ``ortho_half_height`` is set.
+    - ``near``, ``far``: the clip planes, distances from the eye along the view direction
+      (0 < near < far); what lies outside is not drawn. None (the default): ``alight.Renderer``
+      fits them to the mesh's bounding sphere at each render (``fit_clip``), so a 5 mm model
+      and a 50 m one both show; a range that misses the whole mesh is said in one warning
+      line. Elsewhere None is 0.05 and 100.
+    - ``ortho_half_height``: an orthographic camera showing this half height (glTF's
+      ``ymag``); None: perspective.
+
+    ``alight.Renderer.set_camera(Camera(...))`` uses it; ``set_camera(orbit_deg=...)`` builds one
+    that frames the mesh.
+    """
+
     position: tuple[float, float, float] = (0.0, 0.0, 4.0)
     target: tuple[float, float, float] = (0.0, 0.0, 0.0)
     up: tuple[float, float, float] = (0.0, 1.0, 0.0)
     fov_y_deg: float = 35.0
-    near: float = 0.05
-    far: float = 100.0
+    near: float | None = None
+    far: float | None = None
     # glTF orthographic cameras: the view's half height (ymag); None: perspective (fov_y_deg).
     ortho_half_height: float | None = None
+
+    def fit_clip(self, center, radius: float) -> tuple[float, float]:
+        """(near, far) enclosing a sphere of ``radius`` at ``center`` seen from ``position``, with
+        frame_camera's margins (room for a ground under the model); near stays above 1/10000 of
+        far for the depth buffer's precision, also with the eye inside the sphere."""
+        radius = max(float(radius), 1e-9)
+        d = float(np.linalg.norm(np.asarray(self.position, np.float64) - np.asarray(center, np.float64)))
+        far = d + radius * 4.0
+        return max(d - radius * 1.5, far * 1e-4), far
 
     def view_matrix(self) -> np.ndarray:
         """pyrr's row-vector layout: upload as is for GLSL's column-vector ``M * v``."""
@@ -43,12 +77,13 @@ class Camera:
                                             np.array(self.up), dtype=np.float32)
 
     def projection_matrix(self, aspect: float) -> np.ndarray:
+        near = DEFAULT_NEAR if self.near is None else self.near
+        far = DEFAULT_FAR if self.far is None else self.far
         if self.ortho_half_height is not None:
             h = self.ortho_half_height
-            return pyrr.matrix44.create_orthogonal_projection(-h * aspect, h * aspect, -h, h, self.near, self.far,
+            return pyrr.matrix44.create_orthogonal_projection(-h * aspect, h * aspect, -h, h, near, far,
                                                               dtype=np.float32)
-        return pyrr.matrix44.create_perspective_projection(self.fov_y_deg, aspect, self.near, self.far,
-                                                           dtype=np.float32)
+        return pyrr.matrix44.create_perspective_projection(self.fov_y_deg, aspect, near, far, dtype=np.float32)
 
     def view_projection(self, aspect: float) -> np.ndarray:
         return pyrr.matrix44.multiply(self.view_matrix(), self.projection_matrix(aspect))
