@@ -114,7 +114,9 @@ def test_close_releases_and_reopens():
         assert r.is_open
     assert not r.is_open
     r.close()  # idempotent
-    assert r.render().shape == (16, 16, 4)  # opens a fresh context when used again
+    with pytest.raises(AlightError, match="closed"):   # no context opened behind the user's back
+        r.render()
+    assert r.open().render().shape == (16, 16, 4)  # opened again, explicitly
     r.close()
 
 

@@ -98,3 +98,32 @@ def test_a_camera_without_clip_planes_fits_them_to_a_tiny_model(shared_data, cap
         lines = [x for x in capfd.readouterr().err.splitlines() if "clip range" in x]
         assert len(lines) == 1 and lines[0].startswith("alight: warning: set_camera: the mesh lies outside "
                                                        "the camera's clip range (near 0.05, far 100;"), lines
+
+
+def test_rendering_after_the_with_block_is_an_error(tmp_path):
+    """Leaving `with` released the context; a render then opened a new one that nothing
+    released. Now one alight.Error, nothing written; open() (or `with r:`) opens it again."""
+    with Renderer(16, quality="low") as r:
+        r.render()
+    with pytest.raises(AlightError, match=r"^render: this Renderer is closed") as exc:
+        r.render()
+    assert "\n" not in str(exc.value)
+    with pytest.raises(AlightError, match="closed"):
+        r.save(tmp_path / "x.png")
+    assert not (tmp_path / "x.png").exists() and not r.is_open
+    with r:
+        assert r.render().shape == (16, 16, 4)
+    assert not r.is_open
+
+
+@pytest.mark.parametrize("size, said", [((0, 0), "size: 0x0 "), ((7, 0), "size: 7x0 "), ((0, 7), "size: 0x7 ")])
+def test_render_size_is_checked_as_given(size, said):
+    r = Renderer(16, quality="low")
+    with pytest.raises(AlightError, match="^" + said + "must have sides 1..16384$"):
+        r.render(*size)
+
+
+def test_a_misspelt_environment_gets_the_suggestion_batch_gives():
+    r = Renderer(16, quality="low")
+    with pytest.raises(AlightError, match=r"^stuido: no such file; did you mean studio\?$"):
+        r.set_environment("stuido")

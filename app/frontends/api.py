@@ -77,6 +77,8 @@ class Renderer:
             raise AlightError(f"mesh_shading: {mesh_shading!r} is not one of {', '.join(MESH_SHADING)}")
         self.mesh_shading: str = mesh_shading
         self._renderer = None  # alight.render.renderer.ForwardRenderer, created lazily: importing moderngl is not free
+        # close() was called: a later render raises rather than silently open a context nobody releases.
+        self._closed = False
         self.bakes_done = 0    # how many bakes actually ran (misses of the memory and disk caches)
         self._mesh: Mesh | None = None
         self._sphere: Mesh | None = None   # the constructor's mesh, kept so reset() need not rebuild it
@@ -113,7 +115,9 @@ class Renderer:
     # --- lifetime ------------------------------------------------------------------------
 
     def open(self) -> "Renderer":
-        """Create the EGL context and programs now rather than on the first render."""
+        """Create the EGL context and programs now rather than on the first render; after
+        :meth:`close`, a fresh context (``with r:`` again does the same), released by the next close."""
+        self._closed = False
         if self._renderer is None:
             from alight.render.renderer import ForwardRenderer
 
@@ -122,7 +126,10 @@ class Renderer:
         return self
 
     def close(self) -> None:
-        """Release the GPU resources (bakes, meshes, targets, programs, the context). Idempotent."""
+        """Release the GPU resources (bakes, meshes, targets, programs, the context). Idempotent.
+        A render after it raises alight.Error until :meth:`open` (or ``with r:``) opens it again:
+        rendering would otherwise open a new context that nothing releases."""
+        self._closed = True
         r, self._renderer = self._renderer, None
         if r is not None:
             with _keep_current_context():
@@ -437,7 +444,9 @@ class Renderer:
         (H, W, 4) uint8 sRGB after exposure and tone mapping. Row 0 is the top. A flat mesh that
         the default camera (set_camera(None), on +Z) sees edge-on is said in one warning line, as
         ``alight render`` says it."""
-        w, h = _size(width or self.width, height or (self.height if width is None else width))
+        # Each side as given (render(0, 0) is refused as 0x0, not as the default width by 0).
+        w, h = _size(self.width if width is None else width,
+                     height if height is not None else (self.height if width is None else width))
         if self.scene.view == "probe" and w != h:
             raise AlightError(f"size: the probe view is square; got {w}x{h}")
         self._check_probe()
@@ -446,6 +455,9 @@ class Renderer:
             for line in framing_warnings(self._mesh, self._mesh.source, None,
                                          "set_camera(orbit_deg=0, elevation_deg=30)"):
                 warn(line)   # as alight render says it (app/frontends/scene_setup.py)
+        if self._closed:   # before the camera's warnings: nothing is drawn
+            raise AlightError("render: this Renderer is closed (its with block ended, or close() was called); "
+                              "reopen it with r.open() or `with r:`, or make a new Renderer")
         from dataclasses import replace
 
         scene = replace(self.scene, camera=self._render_camera(w, h))

@@ -43,6 +43,7 @@ from typing import Any, TextIO
 
 from alight.errors import AlightError
 from alight.frontends.batch_worker import MATERIAL_FIELDS, render_item
+from alight.frontends.scene_setup import closest_environment
 
 BATCH_MAX_SIDE = 8192   # _size_and_quality says why it is below alight render's 16384
 _KEYS = {"out", "size", "quality", "meshes", "environments", "materials", "camera_angles",
@@ -275,28 +276,9 @@ def _check_inputs_exist(source: Path, base: Path, meshes: list, envs: list, mate
                 names = ", ".join(sorted(p.stem for p in preset_dir().glob("*.json")))
                 raise AlightError(f"{source}: {where}: {text!r} is neither a preset nor a file{did_you_mean(text)} "
                                   f"(presets: {names})")
-            hint = _closest_environment(path) if where.startswith("environments") else ""
+            hint = closest_environment(path) if where.startswith("environments") else ""
             raise AlightError(f"{source}: {where}: {path}: no such file or folder{hint} "
                               f"(paths are relative to the spec's folder)")
-
-
-def _closest_environment(path: str) -> str:
-    """'; did you mean studio?' (or the closest .hdr/.exr in the folder the entry names) for a
-    misspelt environment, else ''."""
-    wanted = Path(path)
-    folder = wanted.parent
-    try:
-        files = [p.name for p in folder.iterdir() if p.suffix.lower() in (".hdr", ".exr")] if folder.is_dir() else []
-    except OSError:
-        files = []
-    close = difflib.get_close_matches(wanted.name, files, n=1) or \
-        difflib.get_close_matches(wanted.stem, [Path(f).stem for f in files], n=1)
-    if close:
-        match = next((f for f in files if f == close[0] or Path(f).stem == close[0]), close[0])
-        return f"; did you mean {folder / match}?"
-    if difflib.get_close_matches(wanted.name.lower(), ["studio"], n=1):
-        return "; did you mean studio?"
-    return ""
 
 
 def _size_and_quality(spec: dict, source: Path) -> tuple[list[int], str]:

@@ -11,8 +11,10 @@ found: the CLI prints ``alight: warning: ...`` lines, the API says each once per
 
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 from alight.errors import AlightError
@@ -99,13 +101,40 @@ def load_scene_mesh(spec: str, report: Report):
 
 
 def load_scene_environment(spec: str, report: Report):
-    """'studio' or an equirectangular map (alight.ibl.environment.load_environment), its warnings reported."""
+    """'studio' or an equirectangular map (alight.ibl.environment.load_environment), its warnings
+    reported; a missing file with the nearest name ('stuido: no such file; did you mean studio?')."""
     from alight.ibl.environment import load_environment
 
-    env = load_environment(spec)
+    try:
+        env = load_environment(spec)
+    except AlightError as e:
+        hint = closest_environment(spec) if not Path(spec).exists() else ""
+        if not hint:
+            raise
+        raise AlightError(f"{e}{hint}") from None
     for line in env.warnings:
         report(line)
     return env
+
+
+def closest_environment(path: str) -> str:
+    """'; did you mean studio?' (or the closest .hdr/.exr in the folder the entry names) for a
+    misspelt environment, else '': batch's plan, alight render's --env and
+    Renderer.set_environment say the same."""
+    wanted = Path(path)
+    folder = wanted.parent
+    try:
+        files = [p.name for p in folder.iterdir() if p.suffix.lower() in (".hdr", ".exr")] if folder.is_dir() else []
+    except OSError:
+        files = []
+    close = difflib.get_close_matches(wanted.name, files, n=1) or \
+        difflib.get_close_matches(wanted.stem, [Path(f).stem for f in files], n=1)
+    if close:
+        match = next((f for f in files if f == close[0] or Path(f).stem == close[0]), close[0])
+        return f"; did you mean {folder / match}?"
+    if difflib.get_close_matches(wanted.name.lower(), ["studio"], n=1):
+        return "; did you mean studio?"
+    return ""
 
 
 def framing_warnings(mesh, name: str, camera, way_out: str = "--elevation 30 (or --orbit)") -> list[str]:
