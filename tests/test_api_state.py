@@ -127,3 +127,16 @@ def test_a_misspelt_environment_gets_the_suggestion_batch_gives():
     r = Renderer(16, quality="low")
     with pytest.raises(AlightError, match=r"^stuido: no such file; did you mean studio\?$"):
         r.set_environment("stuido")
+
+
+def test_the_setters_and_camera_have_docstrings_and_the_guide_shows_the_options():
+    for thing, words in ((Renderer.add_light, ("point:pos=", "directional", "AlightError")),
+                         (Renderer.set_view, ("probe", "square", "AlightError")),
+                         (Renderer.set_display, ("exposure", "transparent", "AlightError")),
+                         (Renderer.reset, ("constructor",)),
+                         (alight.Camera, ("near", "far", "fov_y_deg", "degrees", "+Y up", "ortho_half_height"))):
+        doc = thing.__doc__ or ""
+        assert all(w in doc for w in words), (thing, doc)
+    guide = (REPO / "docs" / "guides" / "python-api.md").read_text()
+    for words in ('background="transparent"', "tonemap=", 'aa="', "exposure=", "reset()"):
+        assert words in guide, words

@@ -308,6 +308,17 @@ class Renderer:
         return self
 
     def add_light(self, light: Light | str) -> "Renderer":
+        """Add one punctual light to those already set (``set_lights`` replaces them; ``reset``
+        removes them): an ``alight.Light`` or a spec as ``alight render --light`` takes:
+        ``point:pos=X,Y,Z[:color=R,G,B][:intensity=I][:range=R]``,
+        ``directional:dir=X,Y,Z[:...]`` (the direction the light travels) or
+        ``spot:pos=X,Y,Z:dir=X,Y,Z[:inner=DEG][:outer=DEG][:...]`` (cone half-angles in degrees).
+        Positions in the mesh's units (world space, +Y up), colours linear R, G, B;
+        ``intensity`` is divided by the squared distance for a point or spot light (default 10)
+        and is the irradiance of a directional one (default 3). Lights add to the environment's
+        light (``set_environment(None)`` for lights alone). Raises AlightError of one line
+        naming add_light and the spec (an unknown kind or field, a bad number, a missing
+        ``pos``/``dir``)."""
         self.scene.lights.append(parse_light(light, "add_light") if isinstance(light, str) else light)
         return self
 
@@ -391,6 +402,11 @@ class Renderer:
         return self._mesh
 
     def set_view(self, view: Literal["camera", "probe"]) -> "Renderer":
+        """'camera' (the default): the mesh through the camera (``set_camera``). 'probe': the
+        material alone on a unit sphere through its own orthographic camera, the mesh and camera
+        ignored (docs/conventions.md); its images are square (``render(w, h)`` with w != h
+        raises), and a ground, shadows 'on' or occlusion 'on'/'gtao' with it raise AlightError
+        at render. Raises AlightError for another view."""
         if view not in ("camera", "probe"):
             raise AlightError(f"view: {view!r} is not 'camera' or 'probe'")
         self.scene.view = view
@@ -423,6 +439,16 @@ class Renderer:
 
     def set_display(self, *, tonemap: str | None = None, exposure: float | None = None,
                     background: str | None = None) -> "Renderer":
+        """How radiance becomes the sRGB image (a ``render(linear=True)`` or .exr is before all of
+        it but the background); each argument left None keeps its value.
+
+        ``tonemap``: one of alight.core.scene.TONEMAPS ('aces', the default; 'none' clips;
+        'neutral' is Khronos PBR Neutral; 'agx', ...). ``exposure``: in EV (stops), radiance
+        times 2**exposure before the curve (0: as is). ``background``: 'env' (the environment
+        itself, the default), 'blur' (the environment blurred), 'color' (a dark grey) or
+        'transparent' (alpha 0 where there is no mesh: ``save`` writes an RGBA .png, and
+        ``render()`` returns alpha in [:, :, 3]; use it for screenshots to composite).
+        Raises AlightError naming the field for an unknown tonemap or background."""
         d = self.scene.display
         if tonemap is not None:
             if tonemap not in TONEMAPS:
