@@ -12,7 +12,8 @@ trimesh or GL until something renders)::
 - ``Material``, ``Camera``, ``Light``: the scene's plain state (``alight.core``);
 - ``Environment``, ``load_environment``: equirectangular maps (``alight.ibl.environment``);
 - ``load_preset``, ``list_presets``, ``save_preset``: the F0 table's preset files;
-- ``Error``: what a bad input raises (one line naming the file or field, then the problem).
+- ``Error``: what a bad input raises (one line naming the file or field, then the problem);
+- ``AlightWarning``: the category of what the API says it drew without (a Python warning).
 
 The subpackages, by concern (a lower layer never imports a higher one):
 ``core`` (math, GPU context, material, scene, meshes) < ``exchange`` (files in and out) <
@@ -40,6 +41,7 @@ _LAZY = {
     "list_presets": "alight.exchange.presets",
     "save_preset": "alight.exchange.presets",
     "Error": "alight.errors",
+    "AlightWarning": "alight.errors",
 }
 __all__ = ["__version__", *_LAZY]
 

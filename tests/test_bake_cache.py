@@ -30,6 +30,7 @@ from alight.ibl.bake_cache import (
 )
 from alight.ibl.environment import load_environment
 from alight.render.renderer import ForwardRenderer
+from tests.warned import alight_warnings
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -173,11 +174,10 @@ def test_a_damaged_entry_is_baked_again_with_one_warning(cache_dir, bake_calls, 
         data = bytearray(b"not a zip at all" * 100)
     path.write_bytes(bytes(data))
     capfd.readouterr()
-    with ForwardRenderer() as r:
+    with ForwardRenderer() as r, alight_warnings() as lines:
         r.bake(env, "low")
         assert (r.bakes_run, r.bakes_loaded) == (1, 0)
     err = capfd.readouterr().err
-    lines = [line for line in err.splitlines() if line.startswith("alight: warning:")]
     assert len(lines) == 1 and "bake cache" in lines[0] and "studio" in lines[0] and "baking it again" in lines[0]
     assert "Traceback" not in err
     with ForwardRenderer() as r:     # the rebake replaced the bad entry
@@ -185,7 +185,7 @@ def test_a_damaged_entry_is_baked_again_with_one_warning(cache_dir, bake_calls, 
         assert (r.bakes_run, r.bakes_loaded) == (0, 1)
 
 
-def test_foreign_entries_are_baked_again(cache_dir, bake_calls, capfd):
+def test_foreign_entries_are_baked_again(cache_dir, bake_calls):
     """A pickle under our key (another program's value; never unpickled) and another key's
     bytes under it (a swapped file) are both refused with one warning each."""
     env = load_environment("studio")
@@ -195,21 +195,19 @@ def test_foreign_entries_are_baked_again(cache_dir, bake_calls, capfd):
         store = diskcache.Cache(str(cache_dir / "bakes"))
         store.set(key, {"something": "else"})          # pickled by diskcache
         store.close()
-        capfd.readouterr()
-        r.bake(env, q)
+        with alight_warnings() as said:
+            r.bake(env, q)
         assert (r.bakes_run, r.bakes_loaded) == (1, 0)
-        err = capfd.readouterr().err
-        assert err.count("alight: warning:") == 1 and "not an alight bake" in err
+        assert len(said) == 1 and "not an alight bake" in said[0], said
         good = diskcache.Cache(str(cache_dir / "bakes"))
         entry = good.get(key)
         other = encode_entry({**description, "environment": "0" * 64}, decode_entry(entry, description))
         good.set(key, other)
         good.close()
-    with ForwardRenderer() as r:
+    with ForwardRenderer() as r, alight_warnings() as said:
         r.bake(env, q)
         assert (r.bakes_run, r.bakes_loaded) == (1, 0)
-    err = capfd.readouterr().err
-    assert err.count("alight: warning:") == 1 and "written for another key" in err
+    assert len(said) == 1 and "written for another key" in said[0], said
 
 
 def test_the_key_changes_with_every_bake_input(cache_dir, tmp_path):
@@ -292,26 +290,29 @@ def test_two_processes_writing_at_once_neither_corrupt_nor_block(tmp_path, capfd
     # A commit holds the index's lock for milliseconds; nobody waited anywhere near the timeout.
     assert max(slowest for _, _, slowest in results) < 5.0, results
     cache = BakeCache(folder)
-    for key, seed in [(f"shared{i}", i) for i in range(3)] + [(f"own{w}-{i}", 100 * w + i)
-                                                               for w in range(2) for i in range(12)]:
-        got = cache.load(key, {"seed": seed}, key)
-        assert got is not None and np.array_equal(got["x"], _arrays(seed, 0.25)["x"]), key
-    assert "alight: warning" not in capfd.readouterr().err
+    with alight_warnings() as said:
+        for key, seed in [(f"shared{i}", i) for i in range(3)] + [(f"own{w}-{i}", 100 * w + i)
+                                                                   for w in range(2) for i in range(12)]:
+            got = cache.load(key, {"seed": seed}, key)
+            assert got is not None and np.array_equal(got["x"], _arrays(seed, 0.25)["x"]), key
+    err = capfd.readouterr().err   # (the writers' own warnings: Python's, on their stderr)
+    assert not said and "alight: warning" not in err and "AlightWarning" not in err, (said, err)
     cache.close()
 
 
 def test_an_unusable_cache_folder_warns_once_and_renders(tmp_path, monkeypatch, capfd):
+    """The API says it once however many renders (the cache is opened once), and carries on."""
     blocker = tmp_path / "a-file"
     blocker.write_text("not a folder")
     monkeypatch.setenv("ALIGHT_CACHE_DIR", str(blocker))
     import alight
 
-    with alight.Renderer(16, quality="low") as r:
+    with alight.Renderer(16, quality="low") as r, alight_warnings() as said:
         image = r.render()
         r.set_material("gold").render()
     assert image.shape == (16, 16, 4)
-    err = capfd.readouterr().err
-    assert err.count("alight: warning: bake cache") == 1 and "Traceback" not in err
+    assert [x for x in said if x.startswith("bake cache")] == said and len(said) == 1, said
+    assert "Traceback" not in capfd.readouterr().err
 
 
 def test_alight_cache_shows_and_clears(cache_dir):

@@ -238,13 +238,16 @@ def choice_seconds_of_medium(choice) -> float:
 
 
 def test_a_dropped_file_says_what_it_is_drawn_without(tmp_path, capfd):
-    """Opening (dropping) a mesh file with warnings says them on stderr and in the panel's
-    message (their text: the status row shows it), not only for the file given at start."""
+    """Opening (dropping) a mesh file with warnings says them on stderr (the editor runs under
+    the CLI's alight.errors.on_stderr) and in the panel's message (their text: the status row
+    shows it), not only for the file given at start."""
+    from alight.errors import on_stderr
     from alight.frontends.editor.state import EditorState
 
     (tmp_path / "tri3.obj").write_text("mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     state = EditorState()
-    assert state.open_file(str(tmp_path / "tri3.obj"))
+    with on_stderr():
+        assert state.open_file(str(tmp_path / "tri3.obj"))
     assert state.message.startswith("opened tri3.obj; warning: ") and "mtllib 'absent.mtl' not found" in state.message
     assert "mtllib 'absent.mtl' not found" in capfd.readouterr().err
 

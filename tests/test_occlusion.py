@@ -22,6 +22,7 @@ from alight.core.scene import Camera, Scene  # noqa: E402
 from alight.exchange.meshes import load_mesh  # noqa: E402
 from alight.ibl.environment import constant_environment  # noqa: E402
 from tests.gpu import evaluate, renderer  # noqa: E402
+from tests.warned import alight_warnings  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -257,7 +258,7 @@ def test_cli_occlusion_flag(corner_obj, tmp_path):
     assert len(bad.stderr.strip().splitlines()) == 1 and "--occlusion" in bad.stderr
 
 
-def test_auto_without_embree_renders_and_says_so(corner_obj, monkeypatch, capsys):
+def test_auto_without_embree_renders_and_says_so(corner_obj, monkeypatch):
     """'auto' never stops a render: without embreex it draws without occlusion and warns once."""
     import alight.render.visibility_parts as occlusion
 
@@ -267,10 +268,10 @@ def test_auto_without_embree_renders_and_says_so(corner_obj, monkeypatch, capsys
     mesh = load_mesh(str(corner_obj))
     runs = r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded
     scene = Scene(mesh=mesh, material=Material(), occlusion="auto")
-    r.render(scene, maps, 32, 32)
+    with alight_warnings() as said:
+        r.render(scene, maps, 32, 32)
     assert r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded == runs
-    err = capsys.readouterr().err
-    assert "without occlusion" in err and "embreex" in err and len(err.strip().splitlines()) == 1
+    assert len(said) == 1 and "without occlusion" in said[0] and "embreex" in said[0], said
 
 
 def test_auto_bakes_the_concave_scenes_only(corner_obj, tmp_path):
@@ -291,7 +292,7 @@ def test_auto_bakes_the_concave_scenes_only(corner_obj, tmp_path):
     assert vis.wants_occlusion(corner, "auto") and vis.wants_occlusion(bowl, "auto")
 
 
-def test_auto_leaves_a_huge_mesh_unbaked_and_says_so(corner_obj, monkeypatch, capsys):
+def test_auto_leaves_a_huge_mesh_unbaked_and_says_so(corner_obj, monkeypatch):
     import alight.render.visibility_parts as occlusion
 
     monkeypatch.setattr(vis, "AUTO_MAX_VERTICES", 10)
@@ -300,12 +301,12 @@ def test_auto_leaves_a_huge_mesh_unbaked_and_says_so(corner_obj, monkeypatch, ca
     maps = r.bake(constant_environment(1.0), "low")
     mesh = load_mesh(str(corner_obj))
     runs = r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded
-    r.render(Scene(mesh=mesh, material=Material(), occlusion="auto"), maps, 32, 32)
+    with alight_warnings() as said:
+        r.render(Scene(mesh=mesh, material=Material(), occlusion="auto"), maps, 32, 32)
     assert r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded == runs
-    err = capsys.readouterr().err
     # (since GTAO: drawn with screen-space occlusion instead of none, in one warning line)
-    assert "in screen space (gtao) instead of the visibility bake" in err and "--occlusion on" in err \
-        and len(err.strip().splitlines()) == 1
+    assert len(said) == 1 and "in screen space (gtao) instead of the visibility bake" in said[0] \
+        and "--occlusion on bakes it" in said[0], said
     assert r.last_occlusion_reason.startswith("gtao (auto")
 
 

@@ -141,18 +141,22 @@ def test_reference_takes_the_gltf_cameras_aspect_as_render_does(tmp_path):
     assert (spec.width, spec.height) == (32, 16)
 
 
-def test_the_api_says_a_flat_mesh_is_seen_edge_on(capfd):
+def test_the_api_says_a_flat_mesh_is_seen_edge_on():
     """alight.Renderer frames a mesh from +Z by default too, and says so for a flat one, with the
     API's way out; a built-in plane has its own view and is not warned about."""
     import alight
 
+    from tests.warned import alight_warnings
+
     with alight.Renderer(16, quality="low") as r:
         r.set_environment(None)
-        r.set_mesh("plane").render()
-        assert "edge-on" not in capfd.readouterr().err
-        r.set_mesh(FLAT).render()
-        edge_on = [line for line in capfd.readouterr().err.splitlines() if "edge-on" in line]
-        assert edge_on == [f"alight: warning: {FLAT}: the mesh is flat and the default camera (on +Z) sees it "
+        with alight_warnings() as said:
+            r.set_mesh("plane").render()
+        assert not [line for line in said if "edge-on" in line], said
+        with alight_warnings() as said:
+            r.set_mesh(FLAT).render()
+        edge_on = [line for line in said if "edge-on" in line]
+        assert edge_on == [f"{FLAT}: the mesh is flat and the default camera (on +Z) sees it "
                            "edge-on, so it may not show; set_camera(orbit_deg=0, elevation_deg=30) looks at it "
                            "from another side"]
 

@@ -83,16 +83,17 @@ def _floor_under_light(transmission: float) -> tuple[float, float]:
     return float(img[shadow].mean()), float(img[far].mean())
 
 
-def test_a_clear_part_casts_no_shadow_map_and_says_so(capsys):
-    from alight.errors import _WARNED
+def test_a_clear_part_casts_no_shadow_map_and_says_so():
+    from tests.warned import alight_warnings
 
-    _WARNED.clear()
-    dark, lit = _floor_under_light(0.0)
+    with alight_warnings() as said:
+        dark, lit = _floor_under_light(0.0)
     assert dark < 0.2 * lit          # opaque: the slab's shadow
-    assert "cast no shadow" not in capsys.readouterr().err
-    through, lit = _floor_under_light(0.9)
+    assert not [x for x in said if "cast no shadow" in x], said
+    with alight_warnings() as said:
+        through, lit = _floor_under_light(0.9)
     assert through == pytest.approx(lit, rel=0.02)
-    err = capsys.readouterr().err
+    err = "\n".join(said)
     assert err.count("glass cast no shadow") == 1 and "transmission" in err
 
 

@@ -445,18 +445,19 @@ def test_cli_vbuffer_used_says_nothing(tmp_path):
     assert not _warnings(_cli(tmp_path, _grid_file(tmp_path, 8), "--mesh-shading", "vbuffer"))
 
 
-def test_one_warning_per_render_not_per_tile(capsys):
+def test_one_warning_per_render_not_per_tile():
     """Tiles of an odd width (an even image cut in two): the forward pass in each tile, one
     warning for the render, naming the tile."""
     from tests.gpu import renderer
+    from tests.warned import alight_warnings
 
     r = renderer()
     r.mesh_shading = "vbuffer"
     try:
-        r.render(Scene(mesh=load_mesh(str(HELMET))), _maps(), 66, 64, aa="msaa", tile=(33, 64))
+        with alight_warnings() as lines:
+            r.render(Scene(mesh=load_mesh(str(HELMET))), _maps(), 66, 64, aa="msaa", tile=(33, 64))
         assert not r.last_vbuffer
     finally:
         r.mesh_shading = "auto"   # (the renderer's default)
-    lines = _warnings(capsys.readouterr().err)
     assert len(lines) == 1, lines
     assert "2 of its 2 tiles" not in lines[0] and "the tile 33x64 of the 66x64 image is odd" in lines[0], lines[0]

@@ -149,8 +149,8 @@ class Renderer:
 
     def set_mesh(self, mesh: str | os.PathLike | Mesh) -> "Renderer":
         """'sphere', 'cube', 'plane', 'shader_ball', 'rounded_cube', 'drape', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
-        What the file is drawn without is said on stderr, one ``alight: warning:`` line each, once
-        per process (alight.errors.warn).
+        What the file is drawn without is said as an ``alight.AlightWarning`` each (a Python
+        warning: alight.errors.warn); the file's own lines stay in ``self.mesh.warnings``.
 
         The material is left as it is, as ``alight render``'s flags combine whatever their order: a
         file's own materials are drawn unless a material, texture set or maps was given to
@@ -176,7 +176,7 @@ class Renderer:
                 warn(line)
         elif os.fspath(env) == "studio":
             self._env = _studio()   # built in: nothing to warn about
-        else:   # what was repaired or clamped is said (alight.errors.warn: once per process)
+        else:   # what was repaired or clamped is said (alight.errors.warn: an AlightWarning)
             self._env = load_scene_environment(os.fspath(env), warn)
         self.scene.ibl_enabled = self._env is not None
         if rotation_deg is not None:

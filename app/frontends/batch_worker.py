@@ -8,6 +8,7 @@ many items it renders. Both executors (``alight.frontends.batch`` and ``batch_ra
 
 from __future__ import annotations
 
+import contextlib
 import time
 from pathlib import Path
 from typing import Any
@@ -30,13 +31,35 @@ def render_item(item) -> tuple[str, str | None, float, list[str]]:
     batch prints each once). Never raises, so one bad item cannot stop a batch."""
     start = time.perf_counter()
     warnings: list[str] = []
+    with _said(warnings):
+        try:
+            _render(item, warnings)
+            return item.name, None, time.perf_counter() - start, warnings
+        except AlightError as e:
+            return item.name, " ".join(str(e).split()), time.perf_counter() - start, warnings
+        except Exception as e:  # a bug or a driver failure: still one line, and the batch goes on
+            return item.name, f"{type(e).__name__}: {' '.join(str(e).split())}", time.perf_counter() - start, warnings
+
+
+@contextlib.contextmanager
+def _said(lines: list[str]):
+    """The AlightWarnings issued within (a worker is not under the CLI's alight.errors.on_stderr:
+    the render's own warnings, an occlusion or shadow it drew without), added to ``lines`` for
+    the batch to print once each rather than as Python warnings on the worker's stderr."""
+    import warnings
+
+    from alight.errors import AlightWarning
+
     try:
-        _render(item, warnings)
-        return item.name, None, time.perf_counter() - start, warnings
-    except AlightError as e:
-        return item.name, " ".join(str(e).split()), time.perf_counter() - start, warnings
-    except Exception as e:  # a bug or a driver failure: still one line, and the batch goes on
-        return item.name, f"{type(e).__name__}: {' '.join(str(e).split())}", time.perf_counter() - start, warnings
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", AlightWarning)
+            yield
+    finally:   # (outside the catch: what is shown again is not caught again)
+        for w in caught:
+            if issubclass(w.category, AlightWarning):
+                lines.append(str(w.message))
+            else:   # not ours: as Python would have shown it
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def _render(item, warnings: list[str]) -> None:

@@ -6,7 +6,7 @@ warnings); the Python API (``alight.Renderer``, and through it ``alight batch``)
 with ``load_scene_mesh`` and says ``framing_warnings`` before it renders. What the picture is
 drawn without (a mesh file's repairs, an environment's clamps, a flat mesh seen edge-on, a glTF
 camera whose aspect ratio is not the image's) goes to ``report`` one line at a time, as it is
-found: the CLI prints ``alight: warning: ...`` lines, the API says each once per process.
+found: the CLI prints ``alight: warning: ...`` lines, the API issues an ``AlightWarning`` each.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from alight.errors import AlightError
+from alight.errors import AlightError, on_stderr
 from alight.frontends.cli import (
     bake,
     batch,
@@ -72,7 +72,10 @@ def _main(argv: list[str] | None) -> int:
         args = parser.parse_args(["edit"])   # with a display, plain 'alight' opens the editor
     previous = _catch_termination()
     try:
-        return COMMANDS[args.command].run(args)
+        # What a command draws without is said as 'alight: warning:' lines on stderr, once
+        # per process, not as Python warnings (the API's way: alight.errors.warn).
+        with on_stderr():
+            return COMMANDS[args.command].run(args)
     except AlightError as exc:
         print(f"alight: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2

@@ -284,6 +284,13 @@ def serve(handle, niceness: int = CHILD_NICENESS) -> int:
             os.nice(niceness)
     except OSError:
         pass
+    from alight.errors import on_stderr
+
+    with on_stderr():   # the child's warnings as the editor's own: 'alight: warning:' lines on stderr
+        return _serve(handle)
+
+
+def _serve(handle) -> int:
     jobs = _Jobs()
     while True:
         item = jobs.next()
