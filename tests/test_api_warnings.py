@@ -79,3 +79,27 @@ def test_the_cli_says_it_once_on_stderr(tmp_path):
     assert p.returncode == 0, p.stderr
     assert [x for x in p.stderr.splitlines() if "sampler" in x] == [f"alight: warning: {DUCK}: {SAMPLER}"], p.stderr
     assert "AlightWarning" not in p.stderr
+
+
+def test_api_warnings_name_the_api_not_the_command_line(tmp_path):
+    """Through the API a warning names Renderer.set_mesh (or a value that fits both front ends),
+    not a CLI flag: a new user was told '--occlusion on bakes it' and 'render the file with
+    --mesh' from Python."""
+    import numpy as np
+
+    from alight.exchange.gltf_material import import_material
+    from tests.gltf_builder import Gltf
+
+    g = Gltf()
+    t = g.image(np.full((4, 4, 3), 128, np.uint8))
+    g.use("KHR_materials_clearcoat")
+    g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t, "texCoord": 1}},
+               extensions={"KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatTexture": {"index": t}}})
+    path = g.save(tmp_path / "layered.gltf")
+    with alight_warnings() as said:
+        alight.Renderer(16).set_material(path)
+    assert len(said) == 2 and "texCoord 1" in said[0] and "clearcoat" in said[1], said
+    assert all("Renderer.set_mesh" in x and "--" not in x for x in said), said
+    with alight_warnings() as said:
+        import_material(path)   # (a library function: both ways named)
+    assert len(said) == 1 and "Renderer.set_mesh" in said[0], said

@@ -304,9 +304,10 @@ def test_auto_leaves_a_huge_mesh_unbaked_and_says_so(corner_obj, monkeypatch):
     with alight_warnings() as said:
         r.render(Scene(mesh=mesh, material=Material(), occlusion="auto"), maps, 32, 32)
     assert r.visibility_parts.bakes_run + r.visibility_parts.bakes_loaded == runs
-    # (since GTAO: drawn with screen-space occlusion instead of none, in one warning line)
+    # (since GTAO: drawn with screen-space occlusion instead of none, in one warning line; worded
+    # as the value, so it fits the CLI's --occlusion and the API's set_occlusion alike)
     assert len(said) == 1 and "in screen space (gtao) instead of the visibility bake" in said[0] \
-        and "--occlusion on bakes it" in said[0], said
+        and "occlusion 'on' bakes it" in said[0] and "--occlusion" not in said[0], said
     assert r.last_occlusion_reason.startswith("gtao (auto")
 
 
@@ -394,5 +395,5 @@ def test_cli_warns_of_a_huge_mesh_only_where_it_would_need_occlusion(tmp_path, s
         assert not warned, p.stderr
         assert "occlusion: gtao" not in p.stderr
     else:
-        assert len(warned) == 1 and "--occlusion on bakes it" in warned[0], p.stderr
+        assert len(warned) == 1 and "occlusion 'on' bakes it" in warned[0], p.stderr
         assert "occlusion: gtao (auto: the mesh has more vertices than auto bakes" in p.stderr, p.stderr

@@ -213,8 +213,8 @@ def import_material(path: str | os.PathLike, index: int = 0, warn_textures: bool
         from alight.errors import warn
 
         warn(f"{Path(path).name}: materials[{index}]: {', '.join(textures)} not taken (import_material reads "
-             "factors; alight.exchange.material_files.load_material_file reads the maps too, or render the "
-             "file with --mesh)")
+             "factors; alight.exchange.material_files.load_material_file reads the maps too, or load the file "
+             "as the mesh: --mesh, Renderer.set_mesh)")
     return material
 
 

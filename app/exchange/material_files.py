@@ -33,9 +33,11 @@ def is_gltf(path: str | os.PathLike) -> bool:
     return Path(os.fspath(path)).suffix.lower() in GLTF_SUFFIXES
 
 
-# How a warning tells where a layer's textures are used: the CLI's words by default; the editor
-# passes its own (its messages name its controls, not flags).
+# How a warning tells where a layer's textures (or a second uv set's) are used: the CLI's words
+# by default; the editor and the Python API pass their own (their messages name their controls
+# and methods, not flags).
 MESH_HINT = "render the file with --mesh to use them"
+API_MESH_HINT = "load the file with Renderer.set_mesh to use them"
 
 
 def load_material_file(name_or_path: str | os.PathLike, index: int = 0,
@@ -77,7 +79,7 @@ def _maps(gm: dict, doc: dict, source: str, index: int, mesh_hint: str = MESH_HI
         tex_coord = (ext or {}).get("texCoord", info.get("texCoord", 0))
         if tex_coord != 0:
             warnings.append(f"{source}: {element}: texCoord {tex_coord}: alight's material maps read TEXCOORD_0 only; "
-                            f"left out (render the file with --mesh to use it)")
+                            f"left out ({mesh_hint})")
             continue
         if isinstance(ext, dict):
             if ext.get("rotation", 0.0):

@@ -219,7 +219,7 @@ class Renderer:
         """
         from alight.core.material_fields import NAMES
         from alight.core.texture_maps import map_factors
-        from alight.exchange.material_files import load_material_file
+        from alight.exchange.material_files import API_MESH_HINT, load_material_file
 
         for key in fields:
             if key not in NAMES and key != "name":
@@ -236,7 +236,7 @@ class Renderer:
         elif isinstance(material, Material):
             base, current = validate_material(material), None
         else:
-            base, current, warnings = load_material_file(material)
+            base, current, warnings = load_material_file(material, mesh_hint=API_MESH_HINT)
             for line in warnings:
                 warn(line)
         loaded: set[str] = set()

@@ -270,8 +270,9 @@ def casters(scene) -> list[bool]:
     cast = [t < CASTER_MAX_THROUGH for t in through]
     skipped = [p.name or str(i) for i, (p, c) in enumerate(zip(scene.mesh.parts, cast)) if not c]
     if skipped:
-        # (under --shadows auto a map's sun turns shadows on unasked: the line says why they are drawn)
-        why = " (shadows are on: --shadows auto draws them for a light or the map's sun)" if scene.shadows == "auto" else ""
+        # (under shadows 'auto' a map's sun turns shadows on unasked: the line says why they are
+        # drawn, in words that fit --shadows and set_shadows alike)
+        why = " (shadows are on: shadows 'auto' draws them for a light or the map's sun)" if scene.shadows == "auto" else ""
         warn(f"{scene.mesh.source}: part(s) {', '.join(skipped)} cast no shadow: they let at least "
              f"{CASTER_MAX_THROUGH:g} of the light through (transmission or alpha blending), which a shadow map "
              f"cannot weigh{why}")

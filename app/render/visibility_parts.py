@@ -288,10 +288,12 @@ class OcclusionParts:
                  f"needs embreex (pip install embreex)")
             return drawn
         if mode == "auto" and auto_too_big(mesh):
-            # (the scene pass draws it with screen-space GTAO instead: screen_wanted)
+            # (the scene pass draws it with screen-space GTAO instead: screen_wanted). Worded as
+            # the value, not a flag, so it reads right from the CLI (--occlusion on) and the API
+            # (set_occlusion('on')) alike.
             warn(f"{mesh.source}: occlusion of the environment light in screen space (gtao) instead of the "
                  f"visibility bake: {sum(len(p.positions) for p in mesh.parts)} vertices are more than "
-                 f"--occlusion auto bakes ({AUTO_MAX_VERTICES}); --occlusion on bakes it")
+                 f"occlusion 'auto' bakes ({AUTO_MAX_VERTICES}); occlusion 'on' bakes it")
             return drawn
         entry = self._parts.get(id(mesh))
         if entry is None or entry[0] is not mesh or entry[2] != through:
