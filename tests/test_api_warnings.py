@@ -16,8 +16,8 @@ from tests.warned import alight_warnings
 
 REPO = Path(__file__).resolve().parents[1]
 DUCK = REPO.parent / "shared" / "data" / "models" / "Duck.glb"
-SAMPLER = ("textures[0]: sampler {'magFilter': 9729, 'minFilter': 9986, 'wrapS': 10497, 'wrapT': 10497} "
-           "is drawn as repeat, trilinear")
+SAMPLER = ("textures[0]: sampler minFilter NEAREST_MIPMAP_LINEAR is drawn as minFilter LINEAR_MIPMAP_LINEAR "
+           "(a material's maps are drawn repeat, trilinear; the file loaded as the mesh draws its samplers as given)")
 
 INNER = f'''
 import pytest
@@ -26,11 +26,11 @@ import alight
 DUCK = {str(DUCK)!r}
 
 def test_first(alight_renderer):
-    with pytest.warns(alight.AlightWarning, match="sampler"):
+    with pytest.warns(alight.AlightWarning, match="NEAREST_MIPMAP_LINEAR"):
         alight_renderer.set_material(DUCK)
 
 def test_second_sees_it_too(alight_renderer):
-    with pytest.warns(alight.AlightWarning, match="sampler"):
+    with pytest.warns(alight.AlightWarning, match="NEAREST_MIPMAP_LINEAR"):
         alight_renderer.set_material(DUCK)
 
 def test_uncaught(alight_renderer):
@@ -46,7 +46,7 @@ def test_warnings_are_python_warnings_in_every_pytest_test(pytester):
     plugin = [] if _plugin_installed() else ["-p", "alight.frontends.pytest_plugin"]
     run = pytester.runpytest_subprocess(*plugin, "-p", "no:cacheprovider")
     run.assert_outcomes(passed=3, warnings=1)
-    run.stdout.fnmatch_lines(["*test_uncaught*", "*AlightWarning: *Duck.glb: textures[[]0[]]: sampler*"])
+    run.stdout.fnmatch_lines(["*test_uncaught*", "*AlightWarning: *Duck.glb: textures[[]0[]]: sampler minFilter*"])
     strict = pytester.runpytest_subprocess(*plugin, "-p", "no:cacheprovider", "-W", "error::alight.AlightWarning")
     strict.assert_outcomes(passed=2, failed=1)
     strict.stdout.fnmatch_lines(["*FAILED*test_uncaught*AlightWarning*"])
@@ -58,8 +58,9 @@ def _plugin_installed() -> bool:
     return any(ep.name == "alight" for ep in entry_points(group="pytest11"))
 
 
-def test_the_api_warns_per_call_site():
-    """catch_warnings sees each call's warning (no once-a-process memory), from the user's line."""
+def test_the_api_warns_per_call_site_and_names_the_sampler():
+    """catch_warnings sees each call's warning (no once-a-process memory); the sampler's enums
+    are named as the glTF spec names them (it showed {'minFilter': 9986, ...})."""
     r = alight.Renderer(16)
     for _ in range(2):
         with warnings.catch_warnings(record=True) as caught:
@@ -69,6 +70,14 @@ def test_the_api_warns_per_call_site():
         assert [str(w.message) for w in said] == [f"{DUCK}: {SAMPLER}"], [str(w.message) for w in caught]
         assert said[0].filename == __file__   # the user's line, not alight's
     assert issubclass(alight.AlightWarning, UserWarning)
+
+
+def test_the_mesh_draws_its_samplers_so_loading_it_says_nothing():
+    """set_mesh(Duck.glb) draws the file's own sampler (alight.render.gpu_mesh), so only
+    set_material, whose maps are drawn repeat/trilinear, warns about it."""
+    with alight_warnings() as said:
+        alight.Renderer(16).set_mesh(DUCK)
+    assert not [x for x in said if "sampler" in x], said
 
 
 def test_the_cli_says_it_once_on_stderr(tmp_path):

@@ -27,6 +27,10 @@ _SLOTS = (("pbrMetallicRoughness", "baseColorTexture", "base_color"),
           (None, "normalTexture", "normal"), (None, "occlusionTexture", "occlusion"),
           (None, "emissiveTexture", "emissive"))
 _DEFAULT_SAMPLER = {"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}
+# The glTF sampler enums (the spec's names for OpenGL's values), so a warning names them.
+GL_SAMPLER_NAMES = {9728: "NEAREST", 9729: "LINEAR", 9984: "NEAREST_MIPMAP_NEAREST",
+                    9985: "LINEAR_MIPMAP_NEAREST", 9986: "NEAREST_MIPMAP_LINEAR", 9987: "LINEAR_MIPMAP_LINEAR",
+                    33071: "CLAMP_TO_EDGE", 33648: "MIRRORED_REPEAT", 10497: "REPEAT"}
 
 
 def is_gltf(path: str | os.PathLike) -> bool:
@@ -89,9 +93,15 @@ def _maps(gm: dict, doc: dict, source: str, index: int, mesh_hint: str = MESH_HI
             transforms.add(((1.0, 1.0), (0.0, 0.0)))
         s = tex.get("sampler")
         if isinstance(s, int) and 0 <= s < len(samplers):
-            given = {k: samplers[s].get(k, _DEFAULT_SAMPLER[k]) for k in _DEFAULT_SAMPLER}
-            if given != _DEFAULT_SAMPLER:
-                warnings.append(f"{source}: textures[{t}]: sampler {given} is drawn as repeat, trilinear")
+            differ = [k for k in _DEFAULT_SAMPLER if samplers[s].get(k, _DEFAULT_SAMPLER[k]) != _DEFAULT_SAMPLER[k]]
+            if differ:
+                # Only a material file's maps: the file's own mesh draws its samplers as given
+                # (alight.render.gpu_mesh), so loading it as a mesh says nothing.
+                given = ", ".join(f"{k} {_gl_name(samplers[s][k])}" for k in differ)
+                drawn = ", ".join(f"{k} {_gl_name(_DEFAULT_SAMPLER[k])}" for k in differ)
+                warnings.append(f"{source}: textures[{t}]: sampler {given} is drawn as {drawn} (a material's "
+                                f"maps are drawn repeat, trilinear; the file loaded as the mesh draws its samplers "
+                                f"as given)")
         if slot == "normal" and info.get("scale", 1.0) != 1.0:
             warnings.append(f"{source}: {element}: scale {info['scale']} is drawn as 1")
         if slot == "occlusion" and info.get("strength", 1.0) != 1.0:
@@ -114,6 +124,10 @@ def _maps(gm: dict, doc: dict, source: str, index: int, mesh_hint: str = MESH_HI
         if isinstance(e, dict) and any(k.endswith("Texture") for k in e):
             warnings.append(f"{source}: {where}: {name}'s textures are drawn without ({mesh_hint})")
     return maps, warnings
+
+
+def _gl_name(value) -> str:
+    return GL_SAMPLER_NAMES.get(value, repr(value))
 
 
 def _image_path(image: dict, i: int, source: str) -> str:
