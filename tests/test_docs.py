@@ -103,7 +103,20 @@ def test_mkdocs_builds_strict(tmp_path):
     assert built.returncode == 0, log[-6000:]
     warnings = [line for line in log.splitlines() if line.startswith(("WARNING", "ERROR"))]
     assert not warnings, "\n".join(warnings)
-    assert (tmp_path / "site" / "reference" / "api" / "index.html").read_text().count("set_material") > 0
+    api = (tmp_path / "site" / "reference" / "api" / "index.html").read_text()
+    assert api.count("set_material") > 0
+    # The docstrings are Markdown (mkdocstrings' google style): a Sphinx role such as :meth:`render`
+    # showed on the page as written (the Renderer's own docstring did).
+    assert not re.search(r":(meth|func|class|attr|mod):", api), re.findall(r".{40}:(?:meth|func|class):.{40}", api)
+
+
+def test_no_docstring_uses_a_sphinx_role():
+    """mkdocstrings renders docstrings as Markdown, where :meth:`x` is literal text: the package's
+    docstrings say ``x`` (or link) instead, on the reference pages and off them."""
+    role = re.compile(r":(meth|func|class|attr|mod|obj|data|exc):`")
+    found = [f"{path.relative_to(REPO)}:{n}" for path in sorted((REPO / "app").rglob("*.py"))
+             for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if role.search(line)]
+    assert not found, found
 
 
 def test_the_shaders_readme_lists_every_shader():

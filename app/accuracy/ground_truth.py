@@ -18,7 +18,7 @@ linear in four per-point sums over the texels (W_t = L_t dOmega_t, RGB):
     L_o = emissive + (1 - m) base/pi (1 - F0)(S1 - S2) + F0 S3 + (1 - F0) S4
 
 S1 and S2 do not depend on the material at all, and S3, S4 only on the roughness, so one pass
-over the texels (:func:`ground_truth_terms`) serves any number of materials and several
+over the texels (``ground_truth_terms``) serves any number of materials and several
 roughness values. The texel sums are chunked over points: each chunk is a few (p, T) float32
 arrays (T = texels), bounded by ``_CHUNK_ELEMS``, so memory stays well under 1.5 GB whatever the
 number of points. n.l and l.v come from matmuls; v.h = sqrt((1 + l.v)/2) and
@@ -216,8 +216,8 @@ def transmission_terms(radiance, normals, views, roughness, ior: float = 1.5, th
     with the thin-walled BTDF (``thin``) or the refracting one at index ``ior`` (v outside, index
     1), k = r^2/2, Fc = (1 - v.h)^5 at the BTDF's own half vector (``alight.core.btdf``). Since
     1 - F = (1 - F0)(1 - Fc), the transmitted radiance is (1 - m) t c T (1 - F0) S_T: see
-    :func:`transmission_combine`. Same chunking, guards and roughness limits as
-    :func:`ground_truth_terms`; the refracting lobe is narrower than the reflected one by about
+    ``transmission_combine``. Same chunking, guards and roughness limits as
+    ``ground_truth_terms``; the refracting lobe is narrower than the reflected one by about
     (ior - 1) / (2 ior), so ``check_transmission_lobe`` refuses lobes under a texel's scale.
     """
     rs = tuple(_check_roughness(r) for r in np.atleast_1d(np.asarray(roughness, dtype=np.float64)))
@@ -292,9 +292,9 @@ def transmission_terms(radiance, normals, views, roughness, ior: float = 1.5, th
 def dispersion_transmission_terms(radiance, normals, views, roughness, ior: float, dispersion: float,
                                   rotation_deg: float = 0.0, intensity: float = 1.0) -> np.ndarray:
     """KHR_materials_dispersion's S_T (R, P, 3) (docs/layer_dispersion.md): channel c of
-    :func:`transmission_terms` for the refracting BTDF at that channel's index
+    ``transmission_terms`` for the refracting BTDF at that channel's index
     (``alight.core.layers.dispersion.dispersion_iors``). Combine with
-    :func:`transmission_combine` as the undispersed S_T."""
+    ``transmission_combine`` as the undispersed S_T."""
     from alight.core.layers.dispersion import dispersion_iors
 
     iors = dispersion_iors(ior, dispersion)
@@ -323,7 +323,7 @@ def transmission_combine(reflection: np.ndarray | tuple, s_t: np.ndarray, base_c
     """L_o with transmission (docs/layer_transmission.md): the reflected part with its diffuse scaled by
     (1 - transmission), plus (1 - m) t c T (1 - F0) S_T. ``reflection`` is ``GroundTruthTerms.combine
     (..., parts=True)``'s (diffuse, specular); ``s_t`` one roughness's (P, 3) of
-    :func:`transmission_terms`; ``attenuation`` the Beer-Lambert transmittance T (RGB)."""
+    ``transmission_terms``; ``attenuation`` the Beer-Lambert transmittance T (RGB)."""
     diffuse, specular = reflection
     base = np.asarray(base_color, dtype=np.float64)
     m = float(metallic)

@@ -14,7 +14,7 @@ What the file says is the picture is what is loaded:
 Files are read in strips of scanlines (or rows of tiles), repaired strip by strip (NaN/Inf/
 negative texels set to 0, texels above ``RADIANCE_MAX`` clamped to it) and, when wider than
 ``max_width``, box-reduced strip by strip, so a huge map never sits in memory at full
-resolution. Every problem with a file becomes one :class:`AlightError` line naming the file
+resolution. Every problem with a file becomes one ``AlightError`` line naming the file
 first; every repair becomes one warning line.
 """
 

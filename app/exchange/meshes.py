@@ -4,7 +4,7 @@ STL by trimesh, with what trimesh leaves out added here: vertex colours (PLY ``r
 with options (``alight.exchange.mtl``: ``-o``/``-s`` become the map's texture transform).
 
 trimesh is imported lazily inside the loader so that start-up and the built-in meshes never pay
-for it. Every problem with a file becomes a one-line :class:`AlightError` naming the file.
+for it. Every problem with a file becomes a one-line ``AlightError`` naming the file.
 """
 
 from __future__ import annotations

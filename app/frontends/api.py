@@ -9,7 +9,7 @@
             r.save(f"{name}.png")
 
 The GL context and shader programs are created once (on the first render); bakes are cached
-per environment content and quality by :class:`alight.render.renderer.ForwardRenderer`, so any number of
+per environment content and quality by ``alight.render.renderer.ForwardRenderer``, so any number of
 materials under one environment cost one bake. Leaving the ``with`` block (or ``close()``)
 releases every GPU resource.
 """
@@ -48,8 +48,8 @@ AA = Literal["none", "msaa", "ssaa"]
 class Renderer:
     """A headless renderer with its own scene state.
 
-    Parameters are the defaults for :meth:`render`; every ``set_*`` method returns ``self`` so
-    calls can be chained. Nothing touches the GPU until the first render (or :meth:`open`).
+    Parameters are the defaults for ``render()``; every ``set_*`` method returns ``self`` so
+    calls can be chained. Nothing touches the GPU until the first render (or ``open()``).
     ``mesh_shading`` (also an attribute): how a mesh file is shaded under msaa, 'auto' (the
     default: from a visibility buffer where the mesh has under 3 estimated covered pixels per
     triangle, alight.render.vbuffer), 'forward' or 'vbuffer'.

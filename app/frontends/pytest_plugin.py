@@ -1,12 +1,12 @@
 """pytest plugin (entry point ``pytest11: alight``): headless renders in other projects' tests.
 
 Fixtures:
-  ``alight_renderer``        one :class:`alight.frontends.api.Renderer` for the session (256x256, low
+  ``alight_renderer``        one ``alight.frontends.api.Renderer`` for the session (256x256, low
                              quality bakes; ini options ``alight_size`` and ``alight_quality``, or
                              ``--alight-size`` and ``--alight-quality``), reset (``Renderer.reset``)
                              before each test: a test starts from the constructor's scene whatever
                              the one before set, and the GL context, programs and bakes are kept.
-  ``assert_image_matches``   :func:`assert_image_matches` with relative golden paths taken
+  ``assert_image_matches``   ``assert_image_matches`` with relative golden paths taken
                              from the test file's folder and ``--alight-update-goldens`` applied.
 
 ``pytest --alight-update-goldens`` writes the current render as the golden instead of

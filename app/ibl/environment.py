@@ -6,7 +6,7 @@ texels and directions is docs/conventions.md's (see ``alight.core.shading.direct
 
 Files are read by ``alight.exchange.environment_files`` (oriented as the file says, the display
 window as the picture, the first part with R, G, B; in strips, repaired, box-reduced when wider
-than ``max_width``); every problem with a file becomes one :class:`AlightError` line
+than ``max_width``); every problem with a file becomes one ``AlightError`` line
 naming the file first, every repair one warning line.
 """
 
