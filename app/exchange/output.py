@@ -11,12 +11,16 @@ from pathlib import Path
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path`` (same suffix, so writers pick the format by it);
-    rename it over ``path`` only when the block finishes without an exception."""
+    rename it over ``path`` only when the block finishes without an exception. The temporary
+    file, ``.NAME.XXXXXXXX.tmp.SUFFIX``, is removed on any exception, KeyboardInterrupt included
+    (the CLI raises one on SIGTERM: app/frontends/cli/termination.py); only a process killed
+    without unwinding (SIGKILL, or SIGTERM where no handler is set, as under the Python API)
+    leaves it behind."""
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=directory)
-    os.close(fd)
-    try:
+    try:   # from the file's creation on: a Ctrl-C at any point after it leaves no temporary file
+        os.close(fd)
         yield Path(tmp)
         # mkstemp makes the file private (0600); give it the mode an ordinary write would have:
         # the replaced file's own, else the default under the user's umask.
