@@ -116,7 +116,7 @@ class Renderer:
 
     def open(self) -> "Renderer":
         """Create the EGL context and programs now rather than on the first render; after
-        :meth:`close`, a fresh context (``with r:`` again does the same), released by the next close."""
+        ``close``, a fresh context (``with r:`` again does the same), released by the next close."""
         self._closed = False
         if self._renderer is None:
             from alight.render.renderer import ForwardRenderer
@@ -127,7 +127,7 @@ class Renderer:
 
     def close(self) -> None:
         """Release the GPU resources (bakes, meshes, targets, programs, the context). Idempotent.
-        A render after it raises alight.Error until :meth:`open` (or ``with r:``) opens it again:
+        A render after it raises alight.Error until ``open`` (or ``with r:``) opens it again:
         rendering would otherwise open a new context that nothing releases."""
         self._closed = True
         r, self._renderer = self._renderer, None
