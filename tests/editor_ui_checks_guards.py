@@ -57,6 +57,36 @@ def test_save_preset_to_json_with_maps_writes_the_factors_and_says_so(ctx):
     ctx.item_click("**/clear")   # the base colour slot's (the first row's)
 
 
+def test_save_preset_of_a_texture_set_keeps_its_look_in_the_factors_and_no_maps_in_the_library(ctx):
+    """DamagedHelmet's five maps as a set, then 'save preset' and 'load preset': the factors the
+    set left at glTF's 1 came back alone as a white, fully metallic, self-lit helmet, and the
+    library got a 15 MB .glb of the maps. Now the preset holds the maps' average look (emissive
+    from the map's mostly dark median), and the library's copy is what the preset holds."""
+    from alight.frontends.editor import library
+    from alight.frontends.editor.ui_test import editor
+
+    s = editor().state
+    helmet = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..", "shared", "data",
+                          "models", "DamagedHelmet")
+    ctx.set_ref("alight")
+    s.open_texture_set([os.path.join(helmet, f) for f in sorted(os.listdir(helmet)) if f.endswith(".jpg")])
+    assert len(s.texture_maps.paths()) == 5 and s.material.emissive == (1.0, 1.0, 1.0), s.texture_maps
+    ctx.yield_(2)
+    path = os.path.join(OUT, "helmet_look.json")
+    ctx.item_input_value("**/preset file", path)
+    ctx.item_click("**/save preset")
+    assert not s.error, s.error
+    assert "5 maps left out" in s.message and "average look" in s.message, s.message
+    entry = library.library_dir() / f"helmet_look{library.LIBRARY_SUFFIX}"
+    assert entry.is_file() and entry.stat().st_size < 20_000, (entry, s.message)   # factors, no images
+    ctx.item_click("**/load preset")
+    assert not s.error and not s.texture_maps.paths(), (s.error, s.texture_maps)
+    m = s.material
+    assert max(m.emissive) < 0.05, m.emissive            # the visor's glow does not light the whole helmet
+    assert max(m.base_color) < 0.6 and m.metallic < 0.9, (m.base_color, m.metallic)
+    assert 0.2 < m.roughness < 0.95, m.roughness
+
+
 def test_export_gltf_with_the_files_own_materials_shown_keeps_them_and_says_what_it_left_out(ctx):
     """With a textured file's own materials in the view, the export keeps them (the Duck's
     material and its texture) and the status row says in one line what the file brought that

@@ -102,3 +102,40 @@ def map_factors(slots) -> dict:
     for slot in slots:
         out.update(SLOT_FACTORS.get(slot, {}))
     return out
+
+
+def factors_without_maps(material, maps: TextureMaps, images: dict):
+    """The factors that draw ``material`` without its maps closest to how it looks with them
+    (a .json preset holds factors only): each scaled factor times its map's mean texel (colour
+    maps decoded from sRGB first), except the emissive factor, times the map's median: an
+    emissive map lights a few spots and leaves the rest dark, and its mean spread over the whole
+    surface read as a self-lit object. glTF sets a loaded map's factor to 1 (``map_factors``),
+    so the factors alone drew DamagedHelmet white, fully metallic and glowing. Normal and
+    occlusion maps have no factor to carry. ``images``: path -> (H, W, 4) uint8, as
+    ``EditorState.map_images``; a slot whose image is missing keeps its factor."""
+    import numpy as np
+
+    from alight.core.shading import srgb_to_linear
+
+    def texels(slot):
+        image = images.get(getattr(maps, slot))
+        if image is None or not getattr(maps, slot):
+            return None
+        rgb = np.asarray(image)[..., :3].reshape(-1, 3).astype(np.float64) / 255.0
+        return srgb_to_linear(rgb) if slot in SRGB_SLOTS else rgb
+
+    fields = {}
+    if (t := texels("base_color")) is not None:
+        fields["base_color"] = tuple(float(f * v) for f, v in zip(material.base_color, t.mean(axis=0)))
+    metallic, roughness = material.metallic, material.roughness
+    if (t := texels("metallic_roughness")) is not None:
+        roughness, metallic = roughness * float(t[:, 1].mean()), metallic * float(t[:, 2].mean())
+    if (t := texels("metallic")) is not None:   # (over a metal-rough map: replaces its B, as drawn)
+        metallic = material.metallic * float(t[:, 0].mean())
+    if (t := texels("roughness")) is not None:
+        roughness = material.roughness * float(t[:, 0].mean())
+    if (metallic, roughness) != (material.metallic, material.roughness):
+        fields.update(metallic=metallic, roughness=roughness)
+    if (t := texels("emissive")) is not None:
+        fields["emissive"] = tuple(float(f * v) for f, v in zip(material.emissive, np.median(t, axis=0)))
+    return replace(material, **fields)

@@ -31,6 +31,7 @@ class LibraryPanel:
         self.clicked = None               # the entry clicked this frame, applied by apply_click
         self._renamed = None              # the name of the entry a save wrote, for the material (ditto)
         self.pending = ""                 # an entry's name to replace once the artist confirms
+        self.pending_factors_only = False   # ... and whether it is a .json preset's copy (``save``)
 
     def rescan(self, force: bool = False) -> None:
         now = time.monotonic()
@@ -125,24 +126,27 @@ class LibraryPanel:
         except AlightError as exc:
             s.fail(exc)
 
-    def save(self, s, name: str, replace: bool = False, rename: bool = True) -> bool:
+    def save(self, s, name: str, replace: bool = False, rename: bool = True, factors_only: bool = False) -> bool:
         """The material and its maps into the library as NAME.glb; the panel's message says where.
         An entry of that name holding another material is replaced only once the artist says so
         (``draw_confirm``'s dialog, then ``replace``): a save is not undoable. Returns whether it
-        was written now."""
+        was written now. ``factors_only`` ('save preset' to a .json): the entry holds what the
+        preset file holds, no maps (with them, a 15 MB .glb of DamagedHelmet's maps appeared
+        beside a 1 KB preset, unasked)."""
         try:
             stem = library.entry_name(name)
+            material, maps = (s.preset_material(), TextureMaps()) if factors_only else (s.material, s.texture_maps)
             # The entry's material is named as the entry: a click on it later names the material
             # so, and the next save goes back to this entry, not to the name the work began with.
             # ('save preset' names it itself: a name typed into 'name' stays, rename False.)
-            named = dataclasses.replace(s.material, name=stem) if rename and s.material.name != stem else s.material
+            named = dataclasses.replace(material, name=stem) if rename and material.name != stem else material
             existing = library.library_dir() / f"{stem}{library.LIBRARY_SUFFIX}"
-            same = any(e.name == stem and library.holds(e, named, s.texture_maps) for e in self.entries)
+            same = any(e.name == stem and library.holds(e, named, maps) for e in self.entries)
             if existing.is_file() and not same and not replace:
-                self.pending = stem
+                self.pending, self.pending_factors_only = stem, factors_only
                 s.error, s.message = "", f"'{stem}' is in the library already: replace it?"
                 return False
-            path = library.save_entry(named, s.texture_maps, name)
+            path = library.save_entry(named, maps, name)
         except AlightError as exc:
             s.fail(exc)
             self.name = ""   # the field shows the material's name again, not the name that failed
@@ -168,7 +172,7 @@ class LibraryPanel:
         imgui.text(f"The library has a material named '{self.pending}'. Replace it with this one?")
         if imgui.button(f"replace {self.pending}"):
             name, self.pending = self.pending, ""
-            self.save(s, name, replace=True)
+            self.save(s, name, replace=True, factors_only=self.pending_factors_only)
             imgui.close_current_popup()
         imgui.same_line()
         if imgui.button("keep the old one") or imgui.is_key_pressed(imgui.Key.escape, False):

@@ -479,8 +479,9 @@ class Panel:
         self.preset_path = self._auto_preset_path = auto
 
     def _save_preset(self, s) -> None:
-        """'save preset': the file (a .json with maps loaded: the factors, and the status row
-        says the maps were left out), then a copy into the library under the file's name."""
+        """'save preset': the file (a .json with maps loaded: the factors that look closest
+        without them, and the status row says the maps were left out), then a copy of what the
+        file holds into the library under the file's name."""
         stem = Path(self.preset_path).stem
         if stem and stem.isprintable() and s.material.name not in (stem, s.typed_name):
             # The file and its library entry are named by the file: the material inside takes
@@ -492,7 +493,10 @@ class Panel:
         except AlightError as exc:
             s.fail(exc)
             return
-        saved = self.library.save(s, self.preset_path, rename=False)   # a saved material is in the library too
+        from alight.exchange.material_files import is_gltf
+
+        # A saved material is in the library too, as the file holds it (a .json: no maps).
+        saved = self.library.save(s, self.preset_path, rename=False, factors_only=not is_gltf(self.preset_path))
         if not s.error:
             done = f"saved {self.preset_path}{f' ({note})' if note else ''}"
             s.message = f"{done} and {s.message.removeprefix('saved ')}" if saved else f"{done}; {s.message}"

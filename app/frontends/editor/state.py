@@ -406,21 +406,32 @@ class EditorState:
     def save_material(self, path: str) -> str:
         """The material with its maps: .gltf (images beside it) or .glb with the mesh shown, so
         the file reopens (here, in ``alight render --preset/--mesh``, other viewers) as drawn.
-        A .json preset holds factors only: with maps loaded it is written with the factors, and
-        the returned note (else '') says the maps were left out and where they are kept. (The
-        CLI's ``alight export`` still refuses: it has no status row to say so.)"""
+        A .json preset holds factors only: with maps loaded it is written with the factors that
+        look closest without them (``preset_material``), and the returned note (else '') says
+        the maps were left out and where they are kept. (The CLI's ``alight export`` still
+        refuses: it has no status row to say so.)"""
         from alight.exchange.material_files import is_gltf, save_material_file
 
         gltf = is_gltf(path)
         left_out = {} if gltf else self.texture_maps.paths()
-        save_material_file(self.material, path, self.texture_maps if gltf else None,
-                           mesh=self.mesh if gltf else None)
+        save_material_file(self.material if gltf else self.preset_material(), path,
+                           self.texture_maps if gltf else None, mesh=self.mesh if gltf else None)
         self.mark_saved()
         if not left_out:
             return ""
         n = len(left_out)
-        return (f"factors only: {n} map{'s' if n > 1 else ''} left out "
-                f"({', '.join(left_out)}); save as .gltf or .glb to keep them")
+        return (f"factors only: {n} map{'s' if n > 1 else ''} left out ({', '.join(left_out)}), "
+                f"their average look kept in the factors; save as .gltf or .glb to keep them")
+
+    def preset_material(self):
+        """The material as a .json preset holds it: without maps, the factors that draw it
+        closest to how it looks with them (alight.core.texture_maps.factors_without_maps: the
+        glTF factors of 1 alone drew a white, metallic, self-lit object)."""
+        from alight.core.texture_maps import factors_without_maps
+
+        if not self.texture_maps.paths():
+            return self.material
+        return factors_without_maps(self.material, self.texture_maps, self.map_images)
 
     def export_gltf(self, path: str) -> str:
         """The mesh with what the view draws on it, and the edited material with its maps, as
