@@ -388,3 +388,30 @@ def _own_loop_checks() -> int:
 
 if __name__ == "__main__":
     sys.exit(1 if _own_loop_checks() else 0)
+
+
+def _wait_for_mesh(ctx, s, spec: str) -> None:
+    for _ in range(600):
+        if s.mesh_spec and os.path.basename(str(s.mesh_spec)) == os.path.basename(spec):
+            break
+        ctx.yield_(1)
+    ctx.yield_(2)
+
+
+def test_a_mesh_without_its_material_says_it_is_drawn_with_the_panels_material(ctx):
+    """singlevn.obj's .mtl is missing: the editor draws it with the panel's material (the view
+    showed copper) while the status row said "drawn with the default material" (alight render's
+    words, where no --preset means the default). The row now says what the view shows."""
+    from alight.frontends.editor.ui_test import editor
+
+    w = editor()
+    s = w.state
+    shared = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "..", "shared", "data")
+    ctx.set_ref("alight")
+    ctx.item_click("**/copper")
+    path = os.path.abspath(os.path.join(shared, "bad", "singlevn.obj"))
+    w.drop([path])   # (the scene: a dropped file, as the trial did)
+    _wait_for_mesh(ctx, s, path)
+    shown = w.panel.shown_status
+    assert "surface.mtl" in shown and "drawn with the panel's material" in shown, shown
+    assert "default material" not in shown, shown
