@@ -415,3 +415,29 @@ def test_a_mesh_without_its_material_says_it_is_drawn_with_the_panels_material(c
     shown = w.panel.shown_status
     assert "surface.mtl" in shown and "drawn with the panel's material" in shown, shown
     assert "default material" not in shown, shown
+
+
+def test_front_view_brings_back_a_one_sided_sheet_seen_from_behind(ctx):
+    """A flat glTF sheet (single-sided: its back is culled) opened after an orbit behind the
+    last mesh was invisible, and F framed it from the same direction. Opened now it is seen
+    from in front; orbited behind it, the panel's 'front view' frames it from its face."""
+    import trimesh
+
+    from alight.frontends.editor.ui_test import editor
+
+    w = editor()
+    s = w.state
+    sheet = os.path.join(OUT, "sheet.glb")
+    trimesh.Trimesh([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], [[0, 1, 2], [0, 2, 3]]).export(sheet)
+    ctx.set_ref("alight")
+    w.orbit.yaw_deg, w.orbit.pitch_deg = 160.0, 10.0   # (the scene: an orbit behind the last mesh)
+    w.drop([sheet])
+    _wait_for_mesh(ctx, s, sheet)
+    assert float(w.orbit.direction() @ np.array([0.0, 0.0, 1.0])) > 0.5, (w.orbit.yaw_deg, w.orbit.pitch_deg)
+    w.orbit.yaw_deg, w.orbit.pitch_deg = 200.0, -20.0   # orbited behind it again
+    ctx.item_open("**/Environment")
+    ctx.item_click("**/front view")
+    ctx.yield_(2)
+    assert abs(w.orbit.yaw_deg) < 1e-6 and abs(w.orbit.pitch_deg) < 1e-6, (w.orbit.yaw_deg, w.orbit.pitch_deg)
+    assert float(w.orbit.direction()[2]) > 0.999
+

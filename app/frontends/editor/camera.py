@@ -58,6 +58,14 @@ class OrbitCamera:
     def zoom(self, wheel: float) -> None:
         self.distance = max(self.radius * 0.05, self.distance * 0.9 ** wheel)
 
+    def look_from(self, direction) -> None:
+        """Yaw and pitch so the eye sits along ``direction`` from the target (the distance kept;
+        the pitch stops short of the poles, as ``orbit``)."""
+        d = np.asarray(direction, dtype=np.float64)
+        d = d / max(float(np.linalg.norm(d)), 1e-12)
+        self.yaw_deg = math.degrees(math.atan2(d[0], d[2])) if abs(d[1]) < 1.0 - 1e-9 else self.yaw_deg
+        self.pitch_deg = max(-89.0, min(89.0, math.degrees(math.asin(max(-1.0, min(1.0, float(d[1])))))))
+
     def direction(self) -> np.ndarray:
         """The unit vector from the target toward the eye (3,)."""
         offset = self._offset()

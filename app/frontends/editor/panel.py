@@ -761,6 +761,13 @@ class Panel:
         self.mesh_path, entered = text_field("mesh", self.mesh_path)
         if imgui.button("open mesh") or entered:
             self._open_mesh(s)
+        imgui.same_line()
+        # The way back from an orbit that lost the mesh (a one-sided sheet seen from behind shows
+        # nothing, and F frames it from the same direction).
+        if imgui.button("front view") and s.mesh is not None:
+            win.frame_mesh(front=True)
+        if imgui.is_item_hovered():
+            tooltip("frame the mesh from its front (a flat mesh: its face; else +Z, level); key Home")
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
         if imgui.is_item_hovered():
             tooltip("or Shift + right drag in the view")

@@ -410,6 +410,8 @@ class EditorWindow:
         if not io.want_capture_keyboard:
             if imgui.is_key_pressed(imgui.Key.f):
                 self.frame_mesh()
+            if imgui.is_key_pressed(imgui.Key.home):
+                self.frame_mesh(front=True)
             if imgui.is_key_pressed(imgui.Key.f12):
                 self.screenshot_request = self.next_screenshot_name()
             if imgui.is_key_pressed(imgui.Key.t) and not io.key_ctrl:
@@ -429,7 +431,19 @@ class EditorWindow:
         if s.lights_follow_env and last is not None and last != s.env_rotation_deg:
             s.lights = turn_lights(s.lights, wrapped_delta(last, s.env_rotation_deg))
 
-    def frame_mesh(self) -> None:
+    def frame_mesh(self, new: bool = False, front: bool = False) -> None:
+        """Fit the mesh in the view from the current direction (F). ``front`` (Home, the panel's
+        'front view'): from the mesh's front first, its face for a flat mesh, +Z, level, else.
+        ``new`` (a mesh just opened): a flat mesh whose back would face the view is seen from the
+        mirrored direction in front of it instead: a one-sided sheet opened after an orbit behind
+        the last mesh was invisible, and F kept the direction."""
+        mesh = self.state.mesh
+        facing = front_normal(mesh) if mesh is not None and (new or front) else None
+        if front:
+            self.orbit.look_from(facing if facing is not None else (0.0, 0.0, 1.0))
+        elif facing is not None and float(facing @ self.orbit.direction()) < 0.0:
+            d = self.orbit.direction()
+            self.orbit.look_from(d - 2.0 * float(facing @ d) * facing)
         if self.state.mesh is not None:
             center, radius = self.state.mesh.bounding_sphere()
             w, h = self.view_area()
@@ -700,7 +714,7 @@ class EditorWindow:
                 view = getattr(self.state.mesh, "view", None)
                 if view is not None:   # a built-in preview mesh: from its 3/4 view (Mesh.view)
                     self.orbit.yaw_deg, self.orbit.pitch_deg = float(view[0]), float(view[1])
-                self.frame_mesh()   # a new mesh: frame it once
+                self.frame_mesh(new=True)   # a new mesh: frame it once
         if 0 in self.size:    # minimised
             return None
         window = self.size if full else self.view_area()   # the screenshot is the view at window size
@@ -1144,3 +1158,19 @@ class EditorWindow:
         self.ctx.release()
         self.glfw.destroy_window(self.window)
         self.glfw.terminate()
+
+
+def front_normal(mesh):
+    """The side a flat mesh shows its front faces to (the area-weighted sum of its
+    counter-clockwise faces' normals, unit), or None for a mesh with depth or whose faces cancel."""
+    import numpy as np
+
+    if mesh.flat_normal() is None:
+        return None
+    total = np.zeros(3)
+    for part in mesh.parts:
+        p = part.positions.astype(np.float64)
+        a, b, c = (p[part.indices[:, k]] for k in range(3))
+        total += np.cross(b - a, c - a).sum(axis=0)
+    norm = float(np.linalg.norm(total))
+    return total / norm if norm > 0.0 else None
