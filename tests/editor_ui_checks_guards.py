@@ -441,3 +441,29 @@ def test_front_view_brings_back_a_one_sided_sheet_seen_from_behind(ctx):
     assert abs(w.orbit.yaw_deg) < 1e-6 and abs(w.orbit.pitch_deg) < 1e-6, (w.orbit.yaw_deg, w.orbit.pitch_deg)
     assert float(w.orbit.direction()[2]) > 0.999
 
+
+def test_collapsing_a_section_at_the_bottom_of_the_scrolled_panel_moves_nothing_above_it(ctx):
+    """The panel scrolled to its end, a click closes Performance near the bottom: the content
+    lost the section's height, imgui clamped the scroll and every control above (the clicked
+    header too) moved down ~160 px under the pointer; the trial's next click, 2.5 s later,
+    opened the wrong dropdown. The header and the sections above stay where they were."""
+    ctx.set_ref("alight")
+    for name in ("Environment", "Lights", "Display & camera", "Compare"):
+        ctx.item_open(f"**/{name}")
+    ctx.item_open("**/Performance")
+    ctx.scroll_to_bottom("//alight")
+    ctx.yield_(3)
+    window = ctx.get_window_by_ref("//alight")
+    assert window.scroll.y > 0, window.scroll.y
+    before = {name: ctx.item_info(f"**/{name}").rect_full.min.y for name in ("Display & camera", "Performance")}
+    ctx.item_click("**/Performance")
+    ctx.yield_(4)
+    after = {name: ctx.item_info(f"**/{name}").rect_full.min.y for name in ("Display & camera", "Performance")}
+    assert all(abs(after[k] - before[k]) < 1.0 for k in before), (before, after)
+    # Scrolled up, the space left at the end goes: the panel's end is its content again.
+    ctx.scroll_to_top("//alight")
+    ctx.yield_(3)
+    from alight.frontends.editor.ui_test import editor
+
+    assert editor().panel._slack == 0.0, editor().panel._slack
+    ctx.item_open("**/Performance")

@@ -230,9 +230,13 @@ class Panel:
         self._follow_maps(s)
         headers = []   # each section header's height: the layout's signature (press_guard.py)
 
+        collapsed = []   # a header closed by a click this frame (the slack below keeps the scroll)
+
         def header(label, flags=0):
             opened = imgui.collapsing_header(label, flags)
             headers.append(round(imgui.get_item_rect_min().y))
+            if imgui.is_item_toggled_open() and not opened:
+                collapsed.append(label)
             return opened
 
         if header("Material", imgui.TreeNodeFlags_.default_open):
@@ -256,6 +260,7 @@ class Panel:
 
             self.chart_view = getattr(self, "chart_view", None) or ChartView()
             self.chart_view.draw()
+        self._keep_scroll(imgui, bool(collapsed))
         # Where the controls are this frame: a press aimed at another layout is not delivered.
         self.layout = PanelLayout(round(imgui.get_scroll_y()), tuple(headers), round(imgui.get_cursor_pos_y()))
         imgui.end()
@@ -264,6 +269,28 @@ class Panel:
         self.library.draw_confirm(s)
         self.browser.draw()
         close_popup_on_escape()
+
+    def _keep_scroll(self, imgui, collapsed: bool) -> None:
+        """Empty space at the panel's end as tall as the content a header's collapse took away,
+        while the scroll needs it: collapsing a section near the bottom of the scrolled panel
+        shrank the content, imgui clamped the scroll, and every control (the clicked header
+        too) moved down ~160 px under the pointer; the artist's next click opened the wrong
+        dropdown. Kept so, the header stays under the pointer (as file managers and Blender
+        do); the space goes as the artist scrolls up into the content."""
+        end = imgui.get_cursor_pos_y()
+        last_end, last_slack = getattr(self, "_content_end", None), getattr(self, "_slack", 0.0)
+        slack = 0.0
+        scroll = imgui.get_scroll_y()
+        if scroll > 0.0 and last_end is not None:
+            # imgui's scroll limit, from last frame's content, less what the content lost since:
+            # the limit this frame without the space. What the scroll is past it, the space keeps.
+            limit = imgui.get_scroll_max_y() - (last_end + last_slack - end)
+            slack = max(0.0, scroll - limit)
+            if not collapsed:   # (it only shrinks, as the artist scrolls up: no other change grows it)
+                slack = min(slack, last_slack)
+        if slack > 0.0:
+            imgui.dummy(imgui.ImVec2(1.0, slack))
+        self._slack, self._content_end = slack, end
 
     def _status_line(self, s, win) -> str:
         """The panel's menu bar, one row of a fixed height that never scrolls: the error (red),
