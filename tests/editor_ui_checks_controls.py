@@ -83,6 +83,16 @@ def test_mouse_wheel_zooms_and_middle_drag_pans(ctx):
     ctx.mouse_wheel_y(-3.0)
     ctx.yield_(2)
     assert abs(win.orbit.distance - distance) < 1e-6 * distance, (win.orbit.distance, distance)
+    # Zooming out stops at ten framed distances: 60 clicks out left a dot (the trial), and the
+    # ball is still there to zoom back to.
+    for _ in range(20):
+        ctx.mouse_wheel_y(-3.0)
+    ctx.yield_(2)
+    assert abs(win.orbit.distance - 10.0 * distance) < 1e-6 * distance, (win.orbit.distance, distance)
+    assert _covered(view(ctx)).sum() > 0.005 * framed.sum()
+    ctx.key_press(imgui.Key.f)
+    ctx.yield_(2)
+    assert abs(win.orbit.distance - distance) < 1e-6 * distance, (win.orbit.distance, distance)
     # A middle drag pans: the target moves and the ball with it (a drag to the right, the ball right).
     ctx.mouse_move_to_pos(centre)
     ctx.mouse_drag_with_delta(imgui.ImVec2(60, 0), imgui.MouseButton_.middle)

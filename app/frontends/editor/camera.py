@@ -10,6 +10,11 @@ import numpy as np
 from alight.core.scene import Camera
 
 
+# The farthest the wheel zooms out, in framed distances: the framed mesh is a tenth of its
+# framed size there, still seen and picked up again in a few clicks.
+ZOOM_OUT_LIMIT = 10.0
+
+
 @dataclass
 class OrbitCamera:
     target: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -18,6 +23,7 @@ class OrbitCamera:
     distance: float = 4.0
     fov_y_deg: float = 35.0
     radius: float = 1.0        # the framed object's size: sets near/far and pan speed
+    framed_distance: float = 0.0   # the last frame()'s distance (0: none yet): the zoom's outer limit
 
     def _offset(self) -> np.ndarray:
         y, p = math.radians(self.yaw_deg), math.radians(self.pitch_deg)
@@ -56,7 +62,10 @@ class OrbitCamera:
         self.target = tuple(np.asarray(self.target) + (-dx_px * right + dy_px * up) * scale)
 
     def zoom(self, wheel: float) -> None:
-        self.distance = max(self.radius * 0.05, self.distance * 0.9 ** wheel)
+        # Out to ZOOM_OUT_LIMIT times the framed distance (60 wheel clicks out left a dot, and
+        # the way back as many); a camera never framed (a restored session's) by the radius.
+        far = ZOOM_OUT_LIMIT * (self.framed_distance or 4.0 * self.radius)
+        self.distance = min(max(self.radius * 0.05, self.distance * 0.9 ** wheel), max(far, self.distance))
 
     def look_from(self, direction) -> None:
         """Yaw and pitch so the eye sits along ``direction`` from the target (the distance kept;
@@ -80,4 +89,5 @@ class OrbitCamera:
         self.radius = max(float(radius), 1e-6)
         direction = self.direction()
         self.distance = fit_distance(center, self.radius, self.fov_y_deg, aspect, direction, corners, margin)
+        self.framed_distance = self.distance
         self.target = tuple(float(x) for x in center)
