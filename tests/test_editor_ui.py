@@ -208,3 +208,35 @@ def test_the_preset_file_field_follows_the_material_until_typed_in(display, tmp_
     result = ui_test(tmp_path, file, "--new")
     assert result.returncode == 0 and "1 passed, 0 failed" in result.stdout, result.stdout[-3000:] + result.stderr[-3000:]
     assert (tmp_path / "aluminium.json").is_file() and not (tmp_path / "material.json").exists()
+
+
+def test_the_preset_file_field_follows_a_set_dropped_while_the_field_is_in_use(display, tmp_path):
+    """A new user's first run (no session): the 'preset file' field clicked (nothing typed),
+    then DamagedHelmet's maps dropped as a set. The field in use handed imgui's copy of
+    material.json back over the set's name and never followed again: 'save preset' wrote
+    material.json and a library 'material', and the gold preset later still said material.json.
+    It follows the set's name (Default.json), a save keeps it, and the next preset's too."""
+    helmet = REPO.parent / "shared" / "data" / "models" / "DamagedHelmet"
+    file = tmp_path / "preset_field_drop.py"
+    file.write_text(
+        "import os\n"
+        "from alight.frontends.editor.ui_test import editor\n"
+        "def test_field(ctx):\n"
+        "    w = editor()\n"
+        "    panel, s = w.panel, w.state\n"
+        "    ctx.set_ref('alight')\n"
+        "    ctx.item_click('**/preset file')\n"
+        f"    helmet = {str(helmet)!r}\n"
+        "    w.drop([os.path.join(helmet, f) for f in sorted(os.listdir(helmet)) if f.endswith('.jpg')])\n"
+        "    ctx.yield_(3)\n"
+        "    assert s.material.name == 'Default' and panel.preset_path == 'Default.json', panel.preset_path\n"
+        "    ctx.item_click('**/save preset')\n"
+        "    ctx.yield_(2)\n"
+        "    assert os.path.isfile('Default.json') and not s.error, (s.message, s.error)\n"
+        "    ctx.item_click('**/gold')\n"
+        "    ctx.yield_(2)\n"
+        "    assert panel.preset_path == 'gold.json', panel.preset_path\n")
+    result = ui_test(tmp_path, file)   # (no --new: a first run, no session in the fresh config folder)
+    assert result.returncode == 0 and "1 passed, 0 failed" in result.stdout, result.stdout[-3000:] + result.stderr[-3000:]
+    assert not (tmp_path / "material.json").exists()
+    assert not list((tmp_path / "data").rglob("material.glb")), list((tmp_path / "data").rglob("*.glb"))

@@ -481,8 +481,15 @@ class Panel:
         if imgui.button("redo"):
             s.step_history(win.history, redo=True)
         # A file to write (save, export): Enter does nothing here (widgets.text_field says why).
-        self._follow_material_name(s.material.name)
-        _, self.preset_path = imgui.input_text("preset file", self.preset_path)
+        if self._follow_material_name(s.material.name) and imgui.get_id("preset file") == imgui.internal.get_active_id():
+            # The field in use (clicked, nothing typed) shows imgui's copy of the old name and
+            # hands it back: a texture set dropped then put material.json back and the field
+            # never followed again ('save preset' wrote material.json and a library
+            # 'material'). Let go of it, so it shows the new name.
+            imgui.internal.clear_active_id()
+        changed, typed = imgui.input_text("preset file", self.preset_path)
+        if changed:   # (typed: from now on the field is the artist's)
+            self.preset_path = typed
         if imgui.button("save preset"):
             self._attempt(s, "preset_path", lambda: self._save_preset(s))
         imgui.same_line()
@@ -495,15 +502,18 @@ class Panel:
         if imgui.button("export glTF"):   # the mesh with the material and its maps (.gltf or .glb)
             self._export_gltf(s)
 
-    def _follow_material_name(self, name: str) -> None:
+    def _follow_material_name(self, name: str) -> bool:
         """The 'preset file' field as ``preset_file_name(name)`` while it holds the name it was
-        last given so (not typed, not restored from a session as another name)."""
+        last given so (not typed, not restored from a session as another name). Returns whether
+        the field's text changed."""
         if self.preset_path != self._auto_preset_path:
-            return
+            return False
         auto = preset_file_name(name)
         if self._good.get("preset_path") == self.preset_path:
             self._good["preset_path"] = auto   # (a failed save goes back to what is shown)
+        changed = auto != self.preset_path
         self.preset_path = self._auto_preset_path = auto
+        return changed
 
     def _save_preset(self, s) -> None:
         """'save preset': the file (a .json with maps loaded: the factors that look closest
