@@ -150,10 +150,15 @@ def test_browse_env_and_a_slots_load_through_the_built_in_browser(ctx):
     # 'browse env' lists LDR images too (an environment, display-referred, as `alight render
     # --env` takes them; a new user found only .hdr/.exr there): the red PNG picked by its row.
     sky = _png(os.path.join(OUT, "browse", "skies", "red_sky.png"), (230, 20, 20), (32, 16))
+    # Only 2:1 pictures, as the loader takes: a screenshot beside the skies is not listed (it was,
+    # and refused when picked).
+    _png(os.path.join(OUT, "browse", "skies", "alight-screenshot-1.png"), (90, 90, 90), (64, 36))
     ctx.item_open("**/Environment")
     ctx.item_click("**/browse env")
     ctx.set_ref(BROWSER)
     ctx.item_input_value("path", os.path.dirname(sky))
+    ctx.yield_(2)
+    assert not ctx.item_exists("**/alight-screenshot-1.png") and ctx.item_exists("**/red_sky.png")
     ctx.item_click("**/red_sky.png")
     assert not browser.visible and os.path.abspath(s.env_spec) == os.path.abspath(sky), \
         (s.env_spec, s.error, browser.visible, str(browser.directory), browser.suffixes)

@@ -234,6 +234,26 @@ def repair_radiance(rgb: np.ndarray, repairs: Repairs) -> np.ndarray:
     return rgb
 
 
+def may_be_equirect(path: str) -> bool:
+    """Whether a file browser should offer ``path`` as an environment: an 8-bit picture
+    (.png, .jpg, ...) only where its header says 2:1, as ``read_equirect`` requires (a user's
+    1280x720 screenshots were listed beside the skies, each refused when picked); .hdr, .exr and
+    the rest are offered (their headers are left to the reader)."""
+    from alight.exchange.images import IMAGE_SUFFIXES
+
+    suffix = os.path.splitext(str(path))[1].lower()
+    if suffix not in IMAGE_SUFFIXES or suffix in (".hdr", ".exr"):
+        return True
+    try:
+        from PIL import Image
+
+        with Image.open(path) as image:   # (the header only: no pixels decoded)
+            width, height = image.size
+    except Exception:   # unreadable by PIL: the reader may still take it (OpenImageIO)
+        return True
+    return width == 2 * height
+
+
 def read_equirect(path: str, max_width: int) -> tuple[np.ndarray, list[str]]:
     """The file's radiance as an (H, W, 3) float32 array (row 0 = +Y) and the warnings (repairs,
     the part chosen). See the module docstring for what is read and how."""

@@ -30,16 +30,20 @@ class FileBrowser:
         self.suffixes: tuple[str, ...] = ()
         self.typed = ""
         self.on_pick: Callable[[str], None] | None = None
+        self.accept: Callable[[str], bool] | None = None
 
     @property
     def busy(self) -> bool:
         return self.dialog is not None or self.visible
 
     def open(self, title: str, suffixes: tuple[str, ...], on_pick: Callable[[str], None],
-             start: str = "") -> None:
+             start: str = "", accept: Callable[[str], bool] | None = None) -> None:
+        """``accept``: a finer test than the suffix for the built-in browser's list (a native
+        dialog filters by suffix alone)."""
         if self.busy:
             return
         self.title, self.suffixes, self.on_pick = title, tuple(s.lower() for s in suffixes), on_pick
+        self.accept = accept
         if start and Path(start).expanduser().parent.is_dir():
             self.directory = Path(start).expanduser().resolve().parent
         if self.native:
@@ -64,7 +68,8 @@ class FileBrowser:
                     try:
                         if entry.is_dir():
                             folders.append(entry.name)
-                        elif not self.suffixes or entry.name.lower().endswith(self.suffixes):
+                        elif (not self.suffixes or entry.name.lower().endswith(self.suffixes)) \
+                                and (self.accept is None or self.accept(entry.path)):
                             files.append(entry.name)
                     except OSError:
                         continue

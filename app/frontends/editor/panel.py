@@ -660,12 +660,12 @@ class Panel:
                 imgui.tree_pop()
         return m
 
-    def _browse(self, label: str, suffixes: tuple[str, ...], on_pick) -> None:
+    def _browse(self, label: str, suffixes: tuple[str, ...], on_pick, accept=None) -> None:
         """A button opening the file browser (file_browser.py: native dialog or built-in)."""
         from imgui_bundle import imgui
 
         if imgui.button(label):
-            self.browser.open(label, suffixes, on_pick)
+            self.browser.open(label, suffixes, on_pick, accept=accept)
 
     def _texture_maps(self, s) -> None:
         """A row per slot: the drop target (radio), the file, load and clear; then the tiling."""
@@ -775,7 +775,11 @@ class Panel:
         # (an LDR image is an environment too, display-referred, as `alight render --env` takes it)
         from alight.exchange.images import IMAGE_SUFFIXES
 
-        self._browse("browse env", (".hdr", ".exr", *(x for x in IMAGE_SUFFIXES if x != ".exr")), s.open_environment)
+        from alight.exchange.environment_files import may_be_equirect
+
+        # (only 2:1 pictures among the 8-bit ones: the user's screenshots were listed too)
+        self._browse("browse env", (".hdr", ".exr", *(x for x in IMAGE_SUFFIXES if x != ".exr")), s.open_environment,
+                     accept=may_be_equirect)
         imgui.same_line()
         if imgui.button("studio"):
             try:
