@@ -131,3 +131,42 @@ def test_one_f0_channel_sets_the_ior_from_the_luminance_and_undo_rounds_as_the_w
     ctx.item_input_value("**/ior", 1.5)
     f0 = s.material.specular_f0
     assert f0[0] > 2 * f0[1] and abs(0.2126 * f0[0] + 0.7152 * f0[1] + 0.0722 * f0[2] - 0.04) < 1e-3, f0
+
+
+def test_undo_takes_back_the_last_light_edit_before_an_older_material_edit(ctx):
+    """A preset click, then a spot light added and its intensity typed: Ctrl+Z takes back the
+    intensity, then the light, then the preset (the file's own materials back), in that order;
+    Ctrl+Shift+Z brings them back the same way. (The light stayed at 500 and Ctrl+Z reached past
+    it to the preset.)"""
+    s = editor().state
+    ctx.set_ref("alight")
+    if not s.use_file_materials:
+        ctx.item_check(BOX)
+    ctx.item_click("**/gold")
+    assert not s.use_file_materials and s.material.name == "gold", s.message
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    ctx.item_click("**/add spot")
+    ctx.yield_(2)
+    assert len(s.lights) == n + 1 and s.lights[n].kind == "spot", s.lights
+    added = s.lights[n].intensity
+    ctx.item_input_value(f"**/$${n}/intensity", 500.0)
+    ctx.yield_(2)
+    assert s.lights[n].intensity == 500.0, s.lights[n]
+    _undo(ctx)
+    assert len(s.lights) == n + 1 and s.lights[n].intensity == added, s.lights
+    assert s.material.name == "gold" and not s.use_file_materials, s.message
+    assert s.message == f"undo: light {n} intensity 500 -> {added:g}", s.message
+    _undo(ctx)
+    assert len(s.lights) == n and s.material.name == "gold", (s.lights, s.message)
+    assert s.message == f"undo: light {n} (spot) removed", s.message
+    _undo(ctx)
+    assert s.use_file_materials and len(s.lights) == n, s.message
+    assert s.message == "undo: the mesh file's own materials (was gold)", s.message
+    for _ in range(3):
+        _undo(ctx, redo=True)
+    assert s.material.name == "gold" and not s.use_file_materials, s.message
+    assert len(s.lights) == n + 1 and s.lights[n].intensity == 500.0, (s.lights, s.message)
+    assert s.message == f"redo: light {n} intensity {added:g} -> 500", s.message
+    ctx.set_ref("alight")
+    ctx.item_close("**/Lights")

@@ -195,6 +195,7 @@ class Panel:
         self._removed = []   # (index, light, height): removed lights' places, kept while the pointer is there
         self._place_tops = {}   # each place's top on screen in the frame drawn last (its index in _removed)
         self._pointer_kept = (0.0, 0.0)   # where the pointer was when last inside the list with places kept
+        self._steps_seen = 0   # EditorState.history_steps when the lights were drawn last
         # Each path field's last path that worked (_attempt): a failed one is not left showing.
         self._good = {"preset_path": self.preset_path, "gltf_path": self.gltf_path}
         # The 'preset file' field follows the material's name (gold.json) until the artist types
@@ -868,6 +869,10 @@ class Panel:
         _, s.ibl_enabled = imgui.checkbox("image-based lighting", s.ibl_enabled)
         # The fields narrower here, so the longest label ends at the panel's edge, not past it.
         imgui.push_item_width(-(imgui.calc_text_size(LONGEST_LIGHT_LABEL).x + imgui.get_style().item_inner_spacing.x))
+        if s.history_steps != self._steps_seen:
+            # An undo or redo put the lights as they were: a removed light's 'restore' would bring
+            # back one the step may have restored already (the history holds removals now).
+            self._steps_seen, self._removed, self._place_tops = s.history_steps, [], {}
         remove = None
         top = imgui.get_cursor_screen_pos().y
         # Lights are replaced, not mutated, so the renderer's "lights changed?" check stays honest.

@@ -107,16 +107,20 @@ class EditorState:
     open_mesh_async: object = field(default=None, repr=False, compare=False)
 
     @property
-    def look(self) -> tuple[Material, TextureMaps, bool]:
-        """What undo/redo acts on: the material's factors, its maps and the 'mesh file's own
-        materials' box (an edit that unticked it is undone with it ticked again)."""
-        return (self.material, self.texture_maps, self.use_file_materials)
+    def look(self) -> tuple[Material, TextureMaps, bool, tuple]:
+        """What undo/redo acts on: the material's factors, its maps, the 'mesh file's own
+        materials' box (an edit that unticked it is undone with it ticked again) and the lights
+        (Lights replaced, never changed in place: an artist's Ctrl+Z after a light edit takes that edit back, not an older
+        material edit under it)."""
+        return (self.material, self.texture_maps, self.use_file_materials, tuple(self.lights))
 
     @look.setter
     def look(self, value: tuple) -> None:
         self.material, self.texture_maps = value[0], value[1]
         if len(value) > 2:
             self.use_file_materials = value[2]
+        if len(value) > 3 and tuple(self.lights) != value[3]:
+            self.lights = list(value[3])   # a new list: the renderer's "lights changed?" check compares values
 
     def edit_mark(self) -> tuple:
         """What ``untick_own_for_edit`` compares with after an edit: the look, the steps, the message."""
@@ -372,6 +376,9 @@ class EditorState:
         if self.look == before:
             self.message = f"nothing to {where}" + (
                 " (A's snapshot or preset and the compare mode are not undo steps)" if split else "")
+            return
+        if tuple(self.look[:3]) == tuple(before[:3]):   # a light's step: the material's name says nothing
+            self.message = f"{where}: {lights_change(before[3], self.look[3])}"
             return
         self.message = f"{where}: {now} ({look_change(before, self.look)})"
         if self.compare.mode == "reference":
@@ -767,6 +774,33 @@ def look_change(before: tuple, after: tuple, most: int = 3) -> str:
     return ", ".join(changes[:most]) + (f" and {len(changes) - most} more" if len(changes) > most else "")
 
 
+_LIGHT_LABELS = {"vector": "position", "inner_cone_deg": "inner cone", "outer_cone_deg": "outer cone"}
+
+
+def lights_change(before: tuple, after: tuple) -> str:
+    """What an undo or redo step did to the lights, for the status row: the light it took away or
+    brought back ('light 3 (spot) removed'), else the fields of the light that changed, a number's
+    old and new value ('light 3 intensity 500 -> 30')."""
+    if len(after) != len(before):
+        gone = len(after) < len(before)
+        longer, shorter = (before, after) if gone else (after, before)
+        i = next((k for k in range(len(shorter)) if shorter[k] != longer[k]), len(shorter))
+        return f"light {i} ({longer[i].kind}) {'removed' if gone else 'back'}"
+    for i, (a, b) in enumerate(zip(before, after)):
+        if a == b:
+            continue
+        changes = []
+        for f in dataclasses.fields(b):
+            x, y = getattr(a, f.name), getattr(b, f.name)
+            if x != y:
+                label = _LIGHT_LABELS.get(f.name, f.name.replace("_", " "))
+                if f.name == "vector" and b.kind == "directional":
+                    label = "direction"
+                changes.append(f"{label} {_value(x)} -> {_value(y)}" if isinstance(y, (int, float)) else label)
+        return f"light {i} " + ", ".join(changes)
+    return "no visible change"
+
+
 def _finite(value: str, edit: str) -> float:
     x = float(value)
     if not math.isfinite(x):
@@ -775,8 +809,9 @@ def _finite(value: str, edit: str) -> float:
 
 
 class History:
-    """Undo/redo of material edits as snapshots of EditorState.look (the Material and the
-    TextureMaps are frozen, so a snapshot is the value).
+    """Undo/redo of material and light edits, in the order made, as snapshots of
+    EditorState.look (the Material, the TextureMaps are frozen and the Lights are replaced, never changed in place, so a snapshot is
+    the value).
 
     A drag of a slider is one step: ``settle`` records a step only once no widget is active.
     """
@@ -789,7 +824,7 @@ class History:
     def settle(self, current, editing: bool) -> None:
         if editing or current == self.committed:
             return
-        if tuple(current[:2]) == tuple(self.committed[:2]):
+        if tuple(current[:2]) == tuple(self.committed[:2]) and tuple(current[3:]) == tuple(self.committed[3:]):
             # The 'own materials' box alone (its click, a mesh opened): no step of its own, but
             # the snapshot keeps it, so the next edit's undo brings the box back as it was.
             self.committed = current
@@ -797,6 +832,16 @@ class History:
         self.undo_stack.append(self.committed)
         self.redo_stack.clear()
         self.committed = current
+
+    def turn_lights(self, turn) -> None:
+        """The lights turned with the environment (env_turn.py): not an undo step, so every
+        snapshot's lights turn too; an undo of an older edit then leaves them where the
+        environment put them, not where they were before its turn."""
+        def turned(look):
+            return (*look[:3], tuple(turn(list(look[3])))) if len(look) > 3 else look
+        self.committed = turned(self.committed)
+        self.undo_stack[:] = [turned(look) for look in self.undo_stack]
+        self.redo_stack[:] = [turned(look) for look in self.redo_stack]
 
     def undo(self, current) -> tuple:
         return self._step(current, self.undo_stack, self.redo_stack)

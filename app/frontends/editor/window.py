@@ -429,7 +429,9 @@ class EditorWindow:
         s = self.state
         last, self._env_rotation_seen = getattr(self, "_env_rotation_seen", None), s.env_rotation_deg
         if s.lights_follow_env and last is not None and last != s.env_rotation_deg:
-            s.lights = turn_lights(s.lights, wrapped_delta(last, s.env_rotation_deg))
+            delta = wrapped_delta(last, s.env_rotation_deg)
+            s.lights = turn_lights(s.lights, delta)
+            self.history.turn_lights(lambda lights: turn_lights(lights, delta))
 
     def frame_mesh(self, new: bool = False, front: bool = False) -> None:
         """Fit the mesh in the view from the current direction (F). ``front`` (Home, the panel's
