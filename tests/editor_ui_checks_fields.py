@@ -79,3 +79,30 @@ def test_a_long_tooltip_wraps_inside_the_window(ctx):
     inner = tip.size.x - 2.0 * imgui.get_style().window_padding.x
     assert tip.content_size.x <= inner + 1.0, f"the tooltip's text is {tip.content_size.x:.0f} px in {inner:.0f}"
     assert tip.content_size.y >= 2.0 * imgui.get_font_size(), f"one line ({tip.content_size.y:.0f} px high)"
+
+
+def test_a_typed_out_of_range_number_is_clamped_and_a_valid_edit_clears_the_error(ctx):
+    """Ctrl+click roughness, type -0.3: clamped to 0 as imgui's AlwaysClamp sliders do (it was
+    refused with 'panel: field ...' in red). An error shown (a map file that is not there) goes
+    with the next valid edit, typed or dragged: a success replaces it (it stayed on screen)."""
+    from imgui_bundle import imgui
+
+    s, panel = editor().state, editor().panel
+    ctx.set_ref("alight")
+    ctx.item_input_value("**/roughness", -0.3)
+    ctx.yield_(2)
+    assert s.material.roughness == 0.0 and not s.error, (s.material.roughness, s.error)
+    ctx.item_open("**/texture maps")
+    for edit in (lambda: ctx.item_input_value("**/roughness", 0.6),
+                 lambda: ctx.item_drag_with_delta("**/roughness", imgui.ImVec2(-400.0, 0.0))):
+        ctx.item_input_value("**/map file", os.path.join(OUT, "no_such_map.png"))
+        ctx.yield_(2)
+        assert s.error and panel.shown_status.startswith("error: "), panel.shown_status
+        assert not s.error.startswith("panel"), s.error
+        before = s.material.roughness
+        edit()
+        ctx.yield_(2)
+        assert s.material.roughness != before and not s.error, (s.material.roughness, s.error)
+        assert not panel.shown_status.startswith("error"), panel.shown_status
+    assert s.material.roughness == 0.0, s.material.roughness
+    ctx.item_close("**/texture maps")

@@ -233,8 +233,10 @@ PRESET_NAMES: tuple[str, ...] = (
 
 
 def _fail(source: str, message: str) -> AlightError:
-    # A newline in a file name must not break the one-line message contract.
-    return AlightError(f"{source}: {message}".replace("\n", "\\n").replace("\r", "\\r"))
+    # A newline in a file name must not break the one-line message contract. No source (the
+    # editor's panel): the field names itself, and a prefix would name nothing the artist sees.
+    text = f"{source}: {message}" if source else message
+    return AlightError(text.replace("\n", "\\n").replace("\r", "\\r"))
 
 
 def _type_name(value: Any) -> str:

@@ -48,7 +48,7 @@ def _edited(m, **fields):
     """An edit of specular F0 or ior with the rule applied (alight.core.material.with_overrides);
     a value out of range keeps the material as it was (the caller validates and reports)."""
     try:
-        return with_overrides(m, "panel", **fields)
+        return with_overrides(m, "", **fields)   # (no prefix: _fail)
     except AlightError:
         return dataclasses.replace(m, **fields)
 
@@ -109,7 +109,9 @@ def layer_row(row: LayerRow, m):
     elif row.widget == "angle":
         changed, new = imgui.slider_angle(row.label, value, -180.0, 180.0)
     elif row.widget == "slider":
-        changed, new = imgui.slider_float(row.label, value, row.low, row.high, row.fmt)
+        # (Typed values clamped to the field's range, as metallic's and roughness's sliders.)
+        changed, new = imgui.slider_float(row.label, value, row.low, row.high, row.fmt,
+                                          imgui.SliderFlags_.always_clamp)
     else:
         if row.switch:   # the field's infinite default is 'off': a checkbox, then the drag when on
             changed, on = imgui.checkbox(row.switch, value != float("inf"))
@@ -429,10 +431,13 @@ class Panel:
         changed, col = imgui.color_edit3("base colour (sRGB)", _srgb(m.base_color))
         if changed:
             m = dataclasses.replace(m, base_color=_linear(col))
-        changed, v = imgui.slider_float("metallic", m.metallic, 0.0, 1.0)
+        # A number typed into a slider (Ctrl+click) is clamped to its range, as imgui's AlwaysClamp
+        # sliders do: a slider's ends are the model's, so -0.3 means 0, not an error to retype.
+        clamp = imgui.SliderFlags_.always_clamp
+        changed, v = imgui.slider_float("metallic", m.metallic, 0.0, 1.0, flags=clamp)
         if changed:
             m = dataclasses.replace(m, metallic=v)
-        changed, v = imgui.slider_float("roughness", m.roughness, 0.0, 1.0)
+        changed, v = imgui.slider_float("roughness", m.roughness, 0.0, 1.0, flags=clamp)
         if changed:
             m = dataclasses.replace(m, roughness=v)
         # specular F0 and ior are one interface (alight.core.material's rule): editing one sets the other.
@@ -460,7 +465,9 @@ class Panel:
             s.apply_preset(picked)
         elif m != s.material:
             try:
-                s.material = validate_material(tidy_edit(s.material, m), "panel")
+                s.material = validate_material(tidy_edit(s.material, m), "")   # (no prefix: _fail)
+                # A valid edit is a success: the error a refused value left (-0.3 typed) goes.
+                s.error = ""
             except AlightError as exc:
                 s.fail(exc)
         self.library.apply_click(s)
