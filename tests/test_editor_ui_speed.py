@@ -95,3 +95,13 @@ def test_a_file_dropped_while_a_frame_polls_is_drawn_without_input(display, tmp_
                        ALIGHT_CONFIG_DIR=str(tmp_path / "config"), ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert result.stdout.startswith("ok: dropped"), result.stdout
+
+
+def test_a_slow_clicks_change_is_drawn_without_input(display, tmp_path):
+    """'save to library' clicked by real X events, the write slow (a loaded machine), the pointer
+    then still: the status row and the library box show the save without further input (they
+    stayed as before until the mouse moved). tests/editor_x_events_save_in_frame.py."""
+    result = run_check("editor_x_events_save_in_frame.py", display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+                       ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_LIBRARY_DIR=str(tmp_path / "library"))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: the row shows 'saved to the library: "), result.stdout

@@ -1074,10 +1074,18 @@ class EditorWindow:
         """One turn of the interactive loop: a frame when something needs one, else a wait for
         events (IDLE_AFTER_S says when). Returns whether a frame was drawn."""
         now = time.monotonic()
-        if self._needs_full_rate():
+        active = self._needs_full_rate()
+        if active:
             self._last_active = now
         if now - self._last_active < IDLE_AFTER_S:
+            shown = self._shown_key()
             self.frame()
+            if active:
+                # Counted from the frame's end: a click's frame that wrote a file on a loaded
+                # machine outlasted IDLE_AFTER_S, and the loop waited for input before the frame
+                # that shows what it changed (tests/editor_x_events_save_in_frame.py).
+                self._last_active = time.monotonic()
+            self._woken |= self._shown_key() != shown
             return True
         background = self._background_pending()
         if self._woken:
@@ -1100,9 +1108,19 @@ class EditorWindow:
             self._answered -= 1
         if self._woken or answered or self.key_events.pending or background or self.file_watcher.has_changed() \
                 or self.check_shaders() or self.should_close():
+            shown = self._shown_key()
             self.frame()
+            self._woken |= self._shown_key() != shown
             return True
         return False
+
+    def _shown_key(self) -> tuple:
+        """What the panel draws before the work that may change it in a frame: the status row
+        (drawn first) and the library's entries (a save rescans them after the box is drawn).
+        A frame that changed them draws one more (``tick``), whatever changed them: a worker's
+        result taken mid-frame, a click's save, a bake's end."""
+        s = self.state
+        return (s.error, s.message, len(self.panel.library.entries), self.panel.library.name)
 
     def _needs_full_rate(self) -> bool:
         """Input waiting, the camera moving, a job that advances a slice a frame, or a view that
