@@ -105,3 +105,13 @@ def test_a_slow_clicks_change_is_drawn_without_input(display, tmp_path):
                        ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_LIBRARY_DIR=str(tmp_path / "library"))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     assert result.stdout.startswith("ok: the row shows 'saved to the library: "), result.stdout
+
+
+def test_f12_works_with_a_field_focused_and_a_click_in_the_view_takes_the_keyboard(display, tmp_path):
+    """Real X events: 'water' typed into 'library name', the pointer over the view, F12 writes a
+    screenshot (it did nothing, silently); a click in the view, then F frames the mesh and types
+    nothing into the field. tests/editor_x_events_focus_keys.py."""
+    result = run_check("editor_x_events_focus_keys.py", display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+                       ALIGHT_CACHE_DIR=str(tmp_path / "cache"), ALIGHT_LIBRARY_DIR=str(tmp_path / "library"))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: F12 wrote alight-screenshot-1.png"), result.stdout

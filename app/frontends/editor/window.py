@@ -407,13 +407,15 @@ class EditorWindow:
                 self.orbit.pan(dx, dy, self.size[1])
             if io.mouse_wheel:
                 self.orbit.zoom(io.mouse_wheel)
+        # F12 is never text: it writes the screenshot whatever field has the keyboard (with a
+        # field focused it did nothing and said nothing). Letters and Ctrl+Z stay the field's.
+        if imgui.is_key_pressed(imgui.Key.f12):
+            self.screenshot_request = self.next_screenshot_name()
         if not io.want_capture_keyboard:
             if imgui.is_key_pressed(imgui.Key.f):
                 self.frame_mesh()
             if imgui.is_key_pressed(imgui.Key.home):
                 self.frame_mesh(front=True)
-            if imgui.is_key_pressed(imgui.Key.f12):
-                self.screenshot_request = self.next_screenshot_name()
             if imgui.is_key_pressed(imgui.Key.t) and not io.key_ctrl:
                 self.turntable_request = True
             if io.key_ctrl and imgui.is_key_pressed(imgui.Key.z):
