@@ -170,3 +170,26 @@ def test_undo_takes_back_the_last_light_edit_before_an_older_material_edit(ctx):
     assert s.message == f"redo: light {n} intensity {added:g} -> 500", s.message
     ctx.set_ref("alight")
     ctx.item_close("**/Lights")
+
+
+def test_undo_after_a_setting_says_the_setting_stayed(ctx):
+    """The exposure is no undo step: a Ctrl+Z after it changed takes back the older preset click
+    and says the exposure stayed (it reached past it without a word)."""
+    s = editor().state
+    ctx.set_ref("alight")
+    if not s.use_file_materials:
+        ctx.item_check(BOX)
+    ctx.item_click("**/copper")   # (gold may be the material already: no step)
+    ctx.yield_(2)
+    ctx.item_open("**/Display & camera")
+    ctx.item_input_value("**/exposure (EV)", 1.5)
+    ctx.yield_(2)
+    assert s.display.exposure == 1.5, s.display
+    _undo(ctx)
+    assert s.use_file_materials and s.display.exposure == 1.5, s.message
+    assert s.message == ("undo: the mesh file's own materials (was copper); not undone: exposure "
+                         "(not in the history)"), s.message
+    _undo(ctx, redo=True)
+    assert s.message == "redo: copper (was the mesh file's own materials)", s.message
+    ctx.set_ref("alight")
+    ctx.item_close("**/Display & camera")

@@ -122,6 +122,15 @@ class EditorState:
         if len(value) > 3 and tuple(self.lights) != value[3]:
             self.lights = list(value[3])   # a new list: the renderer's "lights changed?" check compares values
 
+    def settings(self) -> dict:
+        """The view's settings that are no undo steps, by the panel's words: an undo after one of
+        them changed says it stayed (``step_history``), not reaching past it silently."""
+        d = self.display
+        return {"tone map": d.tonemap, "exposure": d.exposure, "background": (d.background, d.background_color),
+                "environment rotation": self.env_rotation_deg, "environment intensity": self.env_intensity,
+                "image-based lighting": self.ibl_enabled, "ground": self.ground, "shadows": self.shadows,
+                "occlusion": self.occlusion, "quality": self.quality, "anti-aliasing": self.aa}
+
     def edit_mark(self) -> tuple:
         """What ``untick_own_for_edit`` compares with after an edit: the look, the steps, the message."""
         return (self.look, self.history_steps, self.message)
@@ -361,6 +370,17 @@ class EditorState:
         self.sync_map_images()
         if leaving_saved:
             self.saved_material, self.saved_texture_maps = self.material, self.texture_maps
+        # Settings changed since the history's last step stay as they are: the row says so after
+        # the step (an exposure change, then Ctrl+Z, took back an older edit without a word).
+        now_settings, seen = self.settings(), history.settings_seen
+        history.settings_seen = now_settings
+        stayed = [k for k, v in now_settings.items() if seen is not None and seen.get(k) != v]
+        self._step_message(before, word)
+        if stayed and not self.error:
+            self.message += f"; not undone: {', '.join(stayed)} (not in the history)"
+
+    def _step_message(self, before: tuple, word: str) -> None:
+        """The status row after an undo or redo step (``step_history``)."""
         # The status row said what the step took back ('applied silver'): it says where it is now
         # and what changed, so two steps over one material's fields do not read the same.
         maps = len(self.texture_maps.paths())
@@ -818,6 +838,7 @@ class History:
 
     def __init__(self, look):
         self.committed = look
+        self.settings_seen = None   # EditorState.settings() at the last step (the window notes it)
         self.undo_stack: list = []
         self.redo_stack: list = []
 

@@ -880,7 +880,11 @@ class EditorWindow:
         self._turn_lights_with_env()
         self.check_shaders()
         self.check_files()
+        committed = self.history.committed
         self.history.settle(self.state.look, self.imgui.is_any_item_active())
+        if self.history.committed is not committed or self.history.settings_seen is None:
+            # The settings a step was taken with: an undo after they changed says they stayed.
+            self.history.settings_seen = self.state.settings()
         self.state.sync_map_images()   # undo/redo may bring back a map not decoded now
 
     def render_scene(self) -> None:
