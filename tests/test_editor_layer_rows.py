@@ -30,6 +30,9 @@ class FakeImgui:
     class Cond_:
         always = 1
 
+    class SliderFlags_:
+        always_clamp = 1 << 4
+
     def __init__(self, edit: str | None = None):
         self.edit, self.drawn, self.tooltips, self.sections = edit, [], {}, {}
         self._last = None
