@@ -13,35 +13,11 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
-from x_events import XTest, open_editor, place_window, record_rects, settle  # noqa: E402
+from x_events import XTest, click_at, frames_over, open_editor, place_window, press_key, record_rects, settle  # noqa: E402
 
 FIELD = "library name"
-
-
-def turns(win, seconds: float) -> None:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        win.tick()
-
-
-def click(win, pointer, x: int, y: int) -> None:
-    pointer.move(x, y)
-    pointer.sync()
-    win.tick()
-    for down in (True, False):
-        pointer.button(down)
-        pointer.sync()
-        win.tick()
-
-
-def key(win, pointer, name: str) -> None:
-    for down in (True, False):
-        pointer.key(name, down)
-        pointer.sync()
-        win.tick()
 
 
 def main() -> int:
@@ -74,7 +50,7 @@ def main() -> int:
                 break
         pointer.type("water")
         pointer.sync()
-        turns(win, 1.0)
+        frames_over(win, 1.0)
         typed = win.panel.library.name
         if "water" not in typed or not imgui.get_io().want_text_input:
             print(f"the field did not take the typing: {typed!r} (text input {imgui.get_io().want_text_input}, "
@@ -84,9 +60,9 @@ def main() -> int:
         vx, vy = x0 + view_w // 3, y0 + view_h // 2
         pointer.move(vx, vy)   # over the view, no click: the field keeps the keyboard
         pointer.sync()
-        turns(win, 0.3)
-        key(win, pointer, "F12")
-        turns(win, 3.0)
+        frames_over(win, 0.3)
+        press_key(win, pointer, "F12")
+        frames_over(win, 3.0)
         shots = [n for n in os.listdir(folder) if n.endswith(".png")]
         if not shots:
             print(f"F12 with '{FIELD}' focused wrote no screenshot (status row: "
@@ -97,13 +73,13 @@ def main() -> int:
             return 1
         win.orbit.zoom(-6.0)   # (the camera backed away: F's frame_mesh is seen to act)
         turned = win.orbit.render_flags(win.view_area())
-        click(win, pointer, vx, vy)
-        turns(win, 0.3)
+        click_at(win, pointer, vx, vy)
+        frames_over(win, 0.3)
         if imgui.get_io().want_text_input:
             print("a click in the view left the keyboard with the field")
             return 1
-        key(win, pointer, "f")
-        turns(win, 0.5)
+        press_key(win, pointer, "f")
+        frames_over(win, 0.5)
         if win.panel.library.name != typed:
             print(f"F after a click in the view typed into the field: {win.panel.library.name!r}")
             return 1

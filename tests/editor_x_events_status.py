@@ -16,23 +16,16 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # run by path
-from x_events import XTest, open_editor, place_window, record_rects, settle  # noqa: E402
+from x_events import XTest, click_at, open_editor, place_window, record_rects, settle  # noqa: E402
 
 LABEL = "screenshot (F12)"
 WAIT_S = 3.0    # the pointer kept still this long after the click
 
 
 def click(win, pointer, x0: int, y0: int, rect) -> None:
-    """A real press and release at the middle of ``rect`` (window coordinates; the window at
-    x0, y0), a turn of the editor's loop after each."""
+    """A real click at the middle of ``rect`` (window coordinates; the window at x0, y0)."""
     left, top, right, bottom = rect
-    pointer.move(x0 + int((left + right) / 2), y0 + int((top + bottom) / 2))
-    pointer.sync()
-    win.tick()
-    for down in (True, False):
-        pointer.button(down)
-        pointer.sync()
-        win.tick()
+    click_at(win, pointer, x0 + int((left + right) / 2), y0 + int((top + bottom) / 2))
 
 
 def main() -> int:

@@ -104,6 +104,26 @@ def settle(win, turns: int = 20000) -> bool:
     return False
 
 
+def click_at(win, pointer, x: int, y: int) -> None:
+    """A real press and release at screen point (x, y), a turn of the editor's loop after the
+    move and after each of them (the hover drawn before the press, as a hand's click)."""
+    pointer.move(x, y)
+    pointer.sync()
+    win.tick()
+    for down in (True, False):
+        pointer.button(down)
+        pointer.sync()
+        win.tick()
+
+
+def press_key(win, pointer, keysym: str) -> None:
+    """A real key press and release, a turn of the editor's loop after each."""
+    for down in (True, False):
+        pointer.key(keysym, down)
+        pointer.sync()
+        win.tick()
+
+
 def frames_over(win, wait_s: float) -> tuple[int, int]:
     """Turns of the editor's own loop for ``wait_s`` seconds: (frames drawn, waits for events)."""
     import time
