@@ -81,6 +81,7 @@ class Renderer:
         self._closed = False
         self.bakes_done = 0    # how many bakes actually ran (misses of the memory and disk caches)
         self._mesh: Mesh | None = None
+        self._frame_of: tuple | None = None   # (mesh, its _mesh_frame), for the mesh it was made of
         self._sphere: Mesh | None = None   # the constructor's mesh, kept so reset() need not rebuild it
         self._framing_checked: Mesh | None = None   # the mesh framing_warnings last looked at
         # set_camera(orbit_deg=...)'s arguments: the camera is framed at each render, for that
@@ -164,6 +165,7 @@ class Renderer:
                 warn(line)
         else:
             self._mesh = load_scene_mesh(os.fspath(mesh), warn)
+        self._frame_of = None   # made again even for the same Mesh: its vertices may have been edited
         self.scene.mesh = self._mesh
         return self
 
@@ -363,10 +365,19 @@ class Renderer:
         """set_camera(orbit_deg=...)'s camera framed for a w x h image of the current mesh."""
         from alight.core.scene import orbit_camera
 
-        mesh = self._mesh
-        centre, radius = mesh.bounding_sphere() if mesh is not None else ((0, 0, 0), 1.0)
-        return orbit_camera(centre, radius, w / h, corners=mesh.corners() if mesh is not None else None,
-                            **self._orbit)
+        if self._mesh is None:
+            return orbit_camera((0, 0, 0), 1.0, w / h, corners=None, **self._orbit)
+        centre, radius, corners = self._mesh_frame()
+        return orbit_camera(centre, radius, w / h, corners=corners, **self._orbit)
+
+    def _mesh_frame(self) -> tuple[np.ndarray, float, np.ndarray]:
+        """The current mesh's bounding sphere (centre, radius) and box corners (8, 3), kept for
+        that mesh: each render frames its camera with them, and each is a pass over every vertex
+        (0.38 s a render for a 2.6M-vertex icosphere on this 2-core machine)."""
+        if self._frame_of is None or self._frame_of[0] is not self._mesh:
+            centre, radius = self._mesh.bounding_sphere()
+            self._frame_of = (self._mesh, (centre, radius, self._mesh.corners()))
+        return self._frame_of[1]
 
     def _render_camera(self, w: int, h: int) -> Camera | None:
         """The camera of a w x h render: the orbit camera framed for this size; a Camera whose
@@ -382,7 +393,7 @@ class Renderer:
         camera = self.scene.camera
         if camera is None or self._mesh is None:
             return camera
-        centre, radius = self._mesh.bounding_sphere()
+        centre, radius, _ = self._mesh_frame()
         if camera.near is None or camera.far is None:
             near, far = camera.fit_clip(centre, radius)
             if camera.near is not None:     # one plane given: the fitted other stays beyond it
