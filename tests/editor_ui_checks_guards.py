@@ -401,7 +401,8 @@ def _wait_for_mesh(ctx, s, spec: str) -> None:
 def test_a_mesh_without_its_material_says_it_is_drawn_with_the_panels_material(ctx):
     """singlevn.obj's .mtl is missing: the editor draws it with the panel's material (the view
     showed copper) while the status row said "drawn with the default material" (alight render's
-    words, where no --preset means the default). The row now says what the view shows."""
+    words, where no --preset means the default). The reader now says "the current material",
+    true in every front end."""
     from alight.frontends.editor.ui_test import editor
 
     w = editor()
@@ -413,7 +414,7 @@ def test_a_mesh_without_its_material_says_it_is_drawn_with_the_panels_material(c
     w.drop([path])   # (the scene: a dropped file, as the trial did)
     _wait_for_mesh(ctx, s, path)
     shown = w.panel.shown_status
-    assert "surface.mtl" in shown and "drawn with the panel's material" in shown, shown
+    assert "surface.mtl" in shown and "drawn with the current material" in shown, shown
     assert "default material" not in shown, shown
 
 

@@ -199,8 +199,8 @@ def test_file_warnings_reach_the_api_user_once(tmp_path):
     with alight_warnings() as said:
         for _ in range(2):
             r.set_mesh(tmp_path / "tri2.obj")
-    assert said == [f"{tmp_path / 'tri2.obj'}: mtllib 'nowhere.mtl' not found; its materials are drawn "
-                    "with the default material"]
+    assert said == [f"{tmp_path / 'tri2.obj'}: mtllib 'nowhere.mtl' not found; the parts using its materials "
+                    "are drawn with the current material (the default unless one is set)"]
     r.close()
 
 

@@ -479,7 +479,8 @@ def test_obj_with_a_missing_mtllib_says_so_once(tmp_path):
     (tmp_path / "here.mtl").write_text("newmtl red\nKd 1 0 0\n")
     mesh = load_mesh(str(tmp_path / "tri.obj"))
     assert [w for w in mesh.warnings if "mtllib" in w] == [
-        f"{tmp_path / 'tri.obj'}: mtllib 'gone.mtl' not found; its materials are drawn with the default material"]
+        f"{tmp_path / 'tri.obj'}: mtllib 'gone.mtl' not found; the parts using its materials are drawn with "
+        "the current material (the default unless one is set)"]
     (tmp_path / "gone.mtl").write_text("newmtl blue\nKd 0 0 1\n")
     assert load_mesh(str(tmp_path / "tri.obj")).warnings == []
 

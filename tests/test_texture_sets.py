@@ -307,6 +307,38 @@ def test_saved_material_reopens_to_the_same_pixels(tmp_path, suffix, validate):
     assert relative_mae(by_file, render(tmp_path / "plain.exr", "--mesh", saved, "--preset", "gold")) > 0.02
 
 
+def test_jpeg_maps_leave_as_the_same_jpeg_files_and_converted_ones_as_png(tmp_path, validate):
+    """A JPEG set (as photo-scanned sets come) was re-encoded as PNG on export: several times
+    the size, and slow. A map that loads unconverted leaves as its own bytes; the DirectX normal
+    (its green flipped on load) and the packed metal-roughness leave as PNG of what is drawn."""
+    c = canonical()
+    folder = tmp_path / "set"
+    folder.mkdir()
+    for name, what in {"Rock_1K-Color.jpg": "color", "Rock_1K-NormalDX.jpg": "normal_dx",
+                       "Rock_1K-Roughness.jpg": "rough", "Rock_1K-AmbientOcclusion.jpg": "ao"}.items():
+        made = dx(c["normal"]) if what == "normal_dx" else c[what]
+        Image.fromarray(np.ascontiguousarray(made)).save(folder / name, quality=90)
+    original = render(tmp_path / "original.exr", "--texture-set", folder)
+    saved = tmp_path / "out" / "saved.gltf"
+    saved.parent.mkdir()
+    proc = run("export", "--texture-set", folder, "--mesh", "sphere", "--out", saved)
+    assert proc.returncode == 0, proc.stderr
+    report = validate(saved)[0]
+    assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
+    names = sorted(p.name for p in saved.parent.iterdir())
+    assert names == sorted(["saved.gltf", "saved.bin", "saved_base_color.jpg", "saved_occlusion.jpg",
+                            "saved_normal.png", "saved_metallic_roughness.png"]), names
+    assert (saved.parent / "saved_base_color.jpg").read_bytes() == (folder / "Rock_1K-Color.jpg").read_bytes()
+    assert (saved.parent / "saved_occlusion.jpg").read_bytes() == (folder / "Rock_1K-AmbientOcclusion.jpg").read_bytes()
+    images = _json(saved)["images"]
+    assert sorted(i["uri"] for i in images) == sorted(n for n in names if n.startswith("saved_"))
+    assert relative_mae(render(tmp_path / "preset.exr", "--preset", saved), original) <= TOL
+    glb = tmp_path / "saved.glb"
+    assert run("export", "--texture-set", folder, "--mesh", "sphere", "--out", glb).returncode == 0
+    assert sorted(i["mimeType"] for i in _json(glb)["images"]) == ["image/jpeg", "image/jpeg", "image/png", "image/png"]
+    assert relative_mae(render(tmp_path / "preset_glb.exr", "--preset", glb), original) <= TOL
+
+
 def test_material_only_gltf_and_tiling_round_trip(tmp_path, validate):
     """A material-only .gltf (no mesh) keeps maps and KHR_texture_transform tiling."""
     from alight.core.material import Material

@@ -190,6 +190,27 @@ def _as_loaded(info) -> tuple[bytes, str] | None:
     return (data, "image/jpeg" if data[:3] == JPEG_MAGIC else "image/png") if same else None
 
 
+def _map_file(path: str | None, image: np.ndarray) -> tuple[bytes, str] | None:
+    """(the map file's bytes, their mimeType) where the file is a PNG or JPEG that decodes to the
+    RGB drawn with every alpha 255, so a JPEG map stays the JPEG it was (a PNG re-encode of a
+    2048^2 photo map is several times its size and slow); None for a converted map (normal_dx,
+    gloss, a packed metallic-roughness), an image inside a glTF file, or any other format."""
+    from alight.exchange.gltf import JPEG_MAGIC, PNG_MAGIC, decode_image
+
+    if not path or "#images[" in path:
+        return None
+    try:
+        data = Path(path).read_bytes()
+        if not (data[:8] == PNG_MAGIC or data[:3] == JPEG_MAGIC):
+            return None
+        decoded = decode_image(data, path)
+    except (OSError, AlightError):
+        return None
+    same = (decoded.shape[:2] == image.shape[:2] and bool((decoded[:, :, 3] == 255).all())
+            and np.array_equal(decoded[:, :, :3], image[:, :, :3]))
+    return (data, "image/jpeg" if data[:3] == JPEG_MAGIC else "image/png") if same else None
+
+
 def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]:
     images, notes = map_images(maps)
     if not images:
@@ -198,7 +219,9 @@ def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]
     for slot in ("base_color", "metallic_roughness", "normal", "occlusion", "emissive"):
         if slot not in images:
             continue
-        index = b.texture(_png(images[slot], 3), f"{stem}_{slot}.png", glb)
+        data, mime = _map_file(getattr(maps, slot, None), images[slot]) or (_png(images[slot], 3), "image/png")
+        suffix = ".jpg" if mime == "image/jpeg" else ".png"
+        index = b.texture(data, f"{stem}_{slot}{suffix}", glb, mime=mime)
         info = _texture_info(maps, index)
         if slot == "base_color":
             pbr["baseColorTexture"] = info

@@ -32,6 +32,9 @@ from alight.core.preview_meshes import drape, rounded_cube, shader_ball
 from alight.errors import AlightError
 
 MESH_EXTENSIONS = (".obj", ".gltf", ".glb", ".ply", ".stl")
+# What a part without a material of its own is drawn with, in words true for every front end:
+# the editor draws the panel's material, 'alight render' its --preset's, the API set_material's.
+CURRENT_MATERIAL = "the current material (the default unless one is set)"
 
 
 _BUILDERS: dict[str, Callable[[], Mesh]] = {"sphere": sphere, "cube": cube, "plane": plane,
@@ -100,7 +103,8 @@ def load_mesh(spec: str) -> Mesh:
             from alight.exchange.mtl import missing_libraries
 
             _attach_diffuse_maps(spec, path, extras, textures)
-            warnings += [f"{spec}: mtllib '{name}' not found; its materials are drawn with the default material"
+            warnings += [f"{spec}: mtllib '{name}' not found; the parts using its materials are drawn with "
+                         f"{CURRENT_MATERIAL}"
                          for name in missing_libraries(path)]
             # What trimesh repairs as it parses without a word: only the text can tell.
             (short, line), (bad_colors, colour_line) = _obj_text_checks(path)
@@ -169,7 +173,7 @@ def _unknown_materials(spec: str, path: Path, usemtl: dict[str, int]) -> list[st
     listed = ", ".join(f"'{name}' (line {line})" for name, line in unknown[:5])
     more = f" and {len(unknown) - 5} more" if len(unknown) > 5 else ""
     return [f"{spec}: usemtl {listed}{more}: {where} {'it' if len(unknown) == 1 else 'them'}; drawn with "
-            f"the default material"]
+            f"{CURRENT_MATERIAL}"]
 
 
 def _part_from_trimesh(spec: str, name: str, geom, transform: np.ndarray,

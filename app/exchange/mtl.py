@@ -74,7 +74,7 @@ def _libraries(obj_path: Path) -> list[Path]:
 
 def missing_libraries(obj_path: Path) -> list[str]:
     """The names of the MTL files an OBJ's ``mtllib`` statements give that are not there (their
-    materials are then drawn with the default material: worth one warning line)."""
+    materials are then drawn with the current material: worth one warning line)."""
     return list(dict.fromkeys(lib.name for lib in _libraries(obj_path) if not lib.is_file()))
 
 

@@ -14,7 +14,7 @@ vertices would be smoothed whatever the file's smoothing groups say. This pass r
   share the vertex. The normals are appended as ``vn`` lines and every index is written
   absolute (negative, relative indices resolved first).
 
-It also lists ``usemtl`` names no MTL defines (they are drawn with the default material).
+It also lists ``usemtl`` names no MTL defines (they are drawn with the current material).
 A file whose faces are all triangles with normals is left as it is (``rewrite`` None), so the
 common exported mesh costs one scan.
 """

@@ -228,10 +228,9 @@ class EditorState:
         # As 'alight render' draws a file: its own materials where it has any (the panel's
         # checkbox switches to the panel's material), the panel's where it has none.
         self.use_file_materials = any(part.material is not None for part in mesh.parts)
-        # The readers say a part without its material is drawn "with the default material", as
-        # 'alight render' draws it; the editor draws the panel's material there (its checkbox
-        # 'mesh file's own materials' decides only for parts that have one).
-        self._say([line.replace("with the default material", "with the panel's material") for line in mesh.warnings])
+        # A part without its material is drawn with "the current material": here the panel's (its
+        # checkbox 'mesh file's own materials' decides only for parts that have one).
+        self._say(mesh.warnings)
 
     def load_env(self, spec: str) -> None:
         from alight.ibl.environment import load_environment
