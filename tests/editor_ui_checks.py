@@ -365,6 +365,43 @@ def test_add_a_spot_light_and_aim_it(ctx):
 SHARED = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data"))
 
 
+def test_an_added_light_shows_on_a_large_mesh_far_away_under_a_bright_map(ctx):
+    """'add spot' gave a fixed intensity at a fixed place aimed at the origin: under a bright map
+    it barely showed, and on a mesh elsewhere or of another size not at all. It is now placed
+    about the mesh and gives it twice the map's mean irradiance."""
+    s = editor().state
+    cube = os.path.join(OUT, "large_far_cube.obj")
+    corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    faces = ["1 2 4 3", "5 7 8 6", "1 5 6 2", "3 4 8 7", "1 3 7 5", "2 6 8 4"]
+    with open(cube, "w") as f:
+        f.writelines(f"v {40 + 10 * x} {10 * y} {10 * z}\n" for x, y, z in corners)
+        f.writelines(f"f {face}\n" for face in faces)
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    type_path(ctx, "**/env file", os.path.join(SHARED, "env", "royal_esplanade_1k.hdr"))
+    ctx.item_click("**/open env")
+    type_path(ctx, "**/mesh", cube)
+    ctx.item_click("**/open mesh")
+    files_done(ctx)
+    assert s.mesh_spec == cube, (s.mesh_spec, s.error)
+    ctx.item_close("**/Environment")
+    ctx.item_open("**/Lights")
+    n = len(s.lights)
+    before = ball(view(ctx)).mean()
+    ctx.item_click("**/add spot")
+    assert len(s.lights) == n + 1 and s.lights[-1].kind == "spot", s.lights
+    lit = ball(view(ctx)).mean()
+    print(f"added spot on the far cube under royal_esplanade: {before:.1f} -> {lit:.1f}")
+    assert lit > 1.2 * before, (lit, before)
+    ctx.item_click(f"$${n}/remove")
+    ctx.item_close("**/Lights")
+    ctx.item_open("**/Environment")
+    ctx.item_click("**/studio")
+    ctx.combo_click("preview mesh/sphere")
+    ctx.item_close("**/Environment")
+    assert s.env_spec == "studio" and s.mesh_spec == "sphere", (s.env_spec, s.mesh_spec)
+
+
 def test_clearcoat_layer_section(ctx):
     s = editor().state
     ctx.set_ref("alight")

@@ -207,3 +207,29 @@ def test_the_editors_flags_are_read_back_as_its_scene():
         assert dataclasses.replace(got.display, blur_roughness=0) == dataclasses.replace(want.display, blur_roughness=0), \
             (fields, flags)
         assert (args.quality, args.aa) == (state.quality, state.aa), (fields, flags)
+
+
+@pytest.mark.parametrize("kind", ["point", "spot", "directional"])
+@pytest.mark.parametrize("centre, radius", [((0.0, 0.0, 0.0), 1.0), ((40.0, -3.0, 7.0), 10.0), ((0.01, 0.0, 0.0), 0.005)])
+def test_an_added_light_gives_the_mesh_the_irradiance_asked_for(kind, centre, radius):
+    """alight.core.scene.added_light (the editor's 'add point/spot/directional'): the light faces
+    the mesh's centre from a distance in proportion to its radius, and its irradiance there is the
+    one asked for, whatever the mesh's size and place."""
+    from alight.core.scene import added_light
+
+    light = added_light(kind, centre, radius, 3.5)
+    if kind == "directional":
+        assert light.intensity == pytest.approx(3.5)
+        return
+    to_centre = np.asarray(centre) - np.asarray(light.vector)
+    d = float(np.linalg.norm(to_centre))
+    assert 2.0 * radius < d < 6.0 * radius, (d, radius)
+    assert light.intensity / d ** 2 == pytest.approx(3.5)
+    if kind == "spot":   # its axis on the centre
+        np.testing.assert_allclose(light.direction, to_centre / d, atol=1e-9)
+
+
+def test_the_mean_irradiance_of_a_constant_map_is_pi_times_its_radiance():
+    from alight.ibl.environment import mean_irradiance
+
+    assert mean_irradiance(np.full((64, 128, 3), 0.7, np.float32)) == pytest.approx(np.pi * 0.7, rel=1e-6)

@@ -139,6 +139,16 @@ STUDIO = {
 }
 
 
+def mean_irradiance(radiance: np.ndarray) -> float:
+    """The irradiance an equirect map (H, W, 3) gives a surface, averaged over every facing:
+    pi times its solid-angle weighted mean radiance (the mean of cos+ over the sphere is 1/4),
+    the mean of the three channels. W/m^2 for radiance in W/(m^2 sr)."""
+    h = radiance.shape[0]
+    weight = np.sin((np.arange(h) + 0.5) / h * np.pi)
+    rows = radiance.mean(axis=(1, 2), dtype=np.float64)
+    return float(np.pi * (rows * weight).sum() / weight.sum())
+
+
 def _smoothstep(e0, e1, x):
     t = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
     return t * t * (3.0 - 2.0 * t)

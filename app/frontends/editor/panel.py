@@ -14,7 +14,7 @@ from alight.core.ibl_models import IBL_MODELS
 from alight.core.visibility import OCCLUSION_MODES
 from alight.core.mesh import BUILTIN_MESHES
 from alight.core.material import validate_material, with_overrides
-from alight.core.scene import BACKGROUNDS, TONEMAPS, Light
+from alight.core.scene import BACKGROUNDS, TONEMAPS
 from alight.core.shading import linear_to_srgb, srgb_to_linear
 from alight.core.texture_maps import MAP_SLOTS, SLOT_LABELS
 from alight.errors import AlightError
@@ -893,12 +893,13 @@ class Panel:
             if imgui.small_button("remove"):
                 remove = i
             label = "direction (light travels)" if light.kind == "directional" else "position"
-            c1, vec = imgui.drag_float3(label, list(light.vector), 0.05)
+            # Drag speeds in proportion: an added light sits and shines by the mesh's size.
+            c1, vec = imgui.drag_float3(label, list(light.vector), max(0.05, 0.01 * max(map(abs, light.vector))))
             # Linear RGB, shown as 0-1 floats: 0-255 bytes would read as sRGB, as the base colour's do.
             c2, col = imgui.color_edit3("colour", list(light.color), imgui.ColorEditFlags_.float)
             if imgui.is_item_hovered():
                 tooltip("the light's colour, linear RGB (times its intensity)")
-            c3, inten = imgui.drag_float("intensity", light.intensity, 0.1, 0.0, 1000.0)
+            c3, inten = imgui.drag_float("intensity", light.intensity, max(0.1, 0.005 * light.intensity), 0.0, 1e6)
             if c1 or c2 or c3:
                 if light.kind == "directional" and not any(vec):
                     vec = list(light.vector)   # a zero direction has no meaning
@@ -946,14 +947,13 @@ class Panel:
             self._close_up_places()
         added = None
         if imgui.button("add point"):
-            added = Light("point", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0), 10.0)
+            added = s.added_light("point")
         imgui.same_line()
         if imgui.button("add directional"):
-            added = Light("directional", (0.0, -1.0, -1.0), (1.0, 1.0, 1.0), 2.0)
+            added = s.added_light("directional")
         imgui.same_line()
-        if imgui.button("add spot"):   # above and in front, pointing at the origin
-            added = Light("spot", (0.0, 3.0, 3.0), (1.0, 1.0, 1.0), 30.0,
-                          direction=(0.0, -0.7071, -0.7071), inner_cone_deg=15.0, outer_cone_deg=30.0)
+        if imgui.button("add spot"):   # above and in front, pointing at the mesh
+            added = s.added_light("spot")
         if added is not None:   # (the status row kept saying the last material step)
             s.lights.append(added)
             s.error, s.message = "", f"added light {len(s.lights) - 1}: {added.kind}"

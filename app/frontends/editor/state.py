@@ -99,6 +99,7 @@ class EditorState:
     # Loaded CPU data (numpy arrays, no GL): set only by the loaders below.
     mesh: object = None
     env: object = None
+    _fill_of: tuple = field(default=(None, 0.0), repr=False, compare=False)   # (env, its mean irradiance): added_light's
     map_images: dict = field(default_factory=dict)   # path -> decoded image, for texture_maps
     map_conversions: dict = field(default_factory=dict)   # path -> the conversion its image was decoded with
     # Set by the window: opens a mesh file off the UI thread (Panel.open_mesh, file_jobs.py) for a
@@ -231,6 +232,24 @@ class EditorState:
         # A part without its material is drawn with "the current material": here the panel's (its
         # checkbox 'mesh file's own materials' decides only for parts that have one).
         self._say(mesh.warnings)
+
+    def added_light(self, kind: str) -> Light:
+        """A new light that shows: about the mesh's bounds, twice the environment's mean
+        irradiance at its centre (as a key light over the fill; at least 1 with no image-based
+        light). ``alight.core.scene.added_light`` does the placing."""
+        from alight.core.scene import added_light
+        from alight.ibl.environment import mean_irradiance
+
+        if self.mesh is not None:
+            centre, radius = self.mesh.bounding_sphere()
+        else:   # the built-in sphere
+            centre, radius = (0.0, 0.0, 0.0), 1.0
+        fill = 0.0
+        if self.ibl_enabled and self.env is not None:
+            if self._fill_of[0] is not self.env:
+                self._fill_of = (self.env, mean_irradiance(self.env.radiance))
+            fill = self._fill_of[1] * self.env_intensity
+        return added_light(kind, centre, radius, max(2.0 * fill, 1.0))
 
     def load_env(self, spec: str) -> None:
         from alight.ibl.environment import load_environment
