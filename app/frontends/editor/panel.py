@@ -903,15 +903,22 @@ class Panel:
             if c1 or c2 or c3:
                 if light.kind == "directional" and not any(vec):
                     vec = list(light.vector)   # a zero direction has no meaning
-                # replace, not rebuild: a spot keeps its direction, cones and range
-                light = dataclasses.replace(light, vector=tuple(vec), color=tuple(max(0.0, x) for x in col),
-                                            intensity=max(0.0, inten))
+                # replace, not rebuild: a spot keeps its direction, cones and range; and only the
+                # field edited (the widgets hand back float32s: an intensity edit changed the
+                # position in its last digits, and undo said so)
+                light = dataclasses.replace(light, vector=tuple(vec) if c1 else light.vector,
+                                            color=tuple(max(0.0, x) for x in col) if c2 else light.color,
+                                            intensity=max(0.0, inten) if c3 else light.intensity)
             if light.kind == "spot":
                 c4, axis = imgui.drag_float3("direction (spot points)", list(light.direction), 0.02)
                 c5, inner = imgui.slider_float("inner cone", light.inner_cone_deg, 0.0, 90.0, "%.1f deg")
                 c6, outer = imgui.slider_float("outer cone", light.outer_cone_deg, 0.0, 90.0, "%.1f deg")
                 if (c4 and any(axis)) or c5 or c6:
-                    light = dataclasses.replace(light, direction=tuple(axis) if any(axis) else light.direction,
+                    if not c4 or not any(axis):
+                        axis = light.direction
+                    if not (c5 or c6):
+                        inner, outer = light.inner_cone_deg, light.outer_cone_deg
+                    light = dataclasses.replace(light, direction=tuple(axis),
                                                 inner_cone_deg=min(inner, outer), outer_cone_deg=max(outer, 1e-3))
             if light != s.lights[i]:
                 s.lights[i] = light

@@ -249,7 +249,9 @@ class EditorState:
             if self._fill_of[0] is not self.env:
                 self._fill_of = (self.env, mean_irradiance(self.env.radiance))
             fill = self._fill_of[1] * self.env_intensity
-        return added_light(kind, centre, radius, max(2.0 * fill, 1.0))
+        light = added_light(kind, centre, radius, max(2.0 * fill, 1.0))
+        # Three significant digits: the panel's intensity field reads 38.5, not 38.4537.
+        return dataclasses.replace(light, intensity=float(f"{light.intensity:.3g}"))
 
     def load_env(self, spec: str) -> None:
         from alight.ibl.environment import load_environment
