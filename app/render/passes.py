@@ -118,7 +118,8 @@ def frame_strips(r, scene, maps: IBLMaps | None, plan: TilePlan, targets: Target
                 frame = draw_scene(r, scene, maps, targets, targets.draw, view=view, background=False, still=True)
                 resolve(r, frame, scene, maps, targets, read_linear, read_srgb)
             elif aa == "none" and read_srgb and not read_linear and opaque and scene.view != "probe" \
-                    and not scene.ground:   # (the ground darkens radiance: it blends before the tone map)
+                    and not scene.ground and not blending:
+                # (the ground darkens radiance and blended parts blend radiance: before the tone map)
                 draw_scene(r, scene, maps, targets, targets.display_draw(), scene.display, view=view, still=True)
             else:
                 draw_scene(r, scene, maps, targets, targets.draw, view=view, still=True)

@@ -346,7 +346,8 @@ class ForwardRenderer:
         """What ``draw_hdr`` then ``tonemap`` (opaque) leave in ``targets.display``, in one pass:
         the scene's programs tone map as they write (common/output_encoding.glsl), so neither the
         float image nor the tone map pass is needed (the editor's view). Without anti-aliasing
-        only: a resolve must average radiance, not display values.
+        only: a resolve must average radiance, not display values; and without parts that blend,
+        the ground, transmission or the probe (those go through radiance and the tone map pass).
 
         ``into``: a framebuffer with a depth buffer (the editor's window) to draw the one pass
         into instead of ``targets.display``, at its bottom-left, targets' size. Returns the
@@ -358,11 +359,12 @@ class ForwardRenderer:
         write stage applies the sRGB curve (GL 4.5 section 17.3.7). A GPU does that for free;
         llvmpipe's encoder is a polynomial, 2.1 ms cheaper than the shader's pow() on a
         860x720 frame, within 1 LSB of the exact curve (on the editor's ball a fifth of the values
-        1 LSB off; tests/editor_window_checks.py bounds it). Not with parts that blend: GL would blend them in
-        linear space, the shader-encoded path blends sRGB values."""
-        if targets.aa != "none" or scene.view == "probe" or variants.transmissive_parts(scene) or scene.ground:
+        1 LSB off; tests/editor_window_checks.py bounds it)."""
+        if targets.aa != "none" or scene.view == "probe" or variants.transmissive_parts(scene) or scene.ground \
+                or variants.has_blending_parts(scene):
             # (transmissive parts read the opaque parts' radiance, which must not be tone mapped;
-            # the ground darkens radiance, before the tone map)
+            # the ground darkens radiance, and blended parts blend radiance, before the tone map,
+            # as every other anti-aliasing mode does: the one pass wrote them opaque)
             self.draw_hdr(scene, maps, targets)
             # A transparent background keeps the coverage as alpha, as the one pass below does
             # (the editor shows it over a checkerboard; opaque, MSAA's view was black there).
@@ -370,7 +372,7 @@ class ForwardRenderer:
                          opaque=scene.display.background != "transparent")
             return targets.display_fbo
         fbo = into or targets.display_draw()
-        srgb = into is not None and into_encodes_srgb and not variants.has_blending_parts(scene)
+        srgb = into is not None and into_encodes_srgb
         if srgb:
             self.ctx.enable_direct(GL_FRAMEBUFFER_SRGB)
         try:
