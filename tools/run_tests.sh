@@ -8,7 +8,12 @@
 set -u
 cd "$(dirname "$0")/.."
 failed_files=()
-for file in tests/test_*.py; do
+files=(tests/test_*.py)
+n=0
+for file in "${files[@]}"; do
+  n=$((n + 1))
+  # Which file runs, and how far the run is: pytest -q prints only dots and a count.
+  echo "run_tests: [$n/${#files[@]}] $file"
   .venv/bin/python -m pytest -q -p no:cacheprovider "$file" "$@"
   rc=$?
   # 5: no test selected in this file (with -k): not a failure.

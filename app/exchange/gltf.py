@@ -2,7 +2,7 @@
 document, numpy decodes the accessors (``alight.exchange.gltf_accessors``), Pillow the images,
 and ``alight.core.mikktspace`` makes the tangents a file leaves out. (pygltflib was measured and
 left out: its dataclasses-json parse of MetalRoughSpheresNoTextures' 625 objects took about 2 s
-where json.loads takes milliseconds, and it decodes no accessor; see README, "What alight reads".)
+where json.loads takes milliseconds, and it decodes no accessor; see docs/guides/files.md, "Which library does what, and why".)
 
 What the specification's MUSTs ask of a viewer is done here (section numbers of glTF 2.0):
 the default scene's node hierarchy with TRS or matrix transforms (3.5), a mirroring transform

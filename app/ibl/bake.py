@@ -87,8 +87,8 @@ FETCH_REACH = 1.15
 
 
 # The one place where bake quality is chosen. 'medium' is the default: it keeps the probe within
-# 1.6% of the converged split sum at roughness >= 0.25 on every shared map (README, "Accuracy
-# and speed"; tests/test_probe_accuracy.py) and bakes a 1k map in 0.3-0.4 s (warm, LUT cached)
+# 1.6% of the converged split sum at roughness >= 0.25 on every shared map (docs/explanation/accuracy.md, "Implementation
+# error"; tests/test_probe_accuracy.py) and bakes a 1k map in 0.3-0.4 s (warm, LUT cached)
 # on 2-core llvmpipe, the prefilter being two thirds of it (benchmarks/bench_render.py).
 QUALITY: dict[str, BakeQuality] = {
     "low": BakeQuality(
