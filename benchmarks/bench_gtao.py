@@ -8,10 +8,13 @@ relMAE against app/accuracy/path_trace.py (bench_occlusion.py's scenes, cameras,
 and reference cache). Cost: frames alternated off / on / gtao (A B C, several rounds; process CPU
 time and wall, medians and ranges) on DamagedHelmet and, off / gtao only, on a large mesh
 (MetalRoughSpheresNoTextures, 1M triangles: its bake is the 97 s that AUTO_MAX_VERTICES avoids).
-Writes benchmarks/results/gtao.md (--out) and the renders as PNG beside the references; asserts
-nothing.
+The gtao column's 4x4 bins are also counted by their ratio to the path tracer (luminance; the
+bins where gtao differs from off, i.e. where the pass darkens or lights anything): above 1.2x and
+1.1x, below 0.8x and 0.9x, the counts benchmarks/results/gtao.md quotes for the corner's glow and
+band. Writes benchmarks/results/gtao.md (--out) and the renders as PNG beside the references;
+asserts nothing.
 
-    .venv/bin/python benchmarks/bench_gtao.py --references DIR [--maps a,b] [--size 96] [--samples 64]
+    .venv/bin/python benchmarks/bench_gtao.py --references DIR [--maps a,b] [--size 96] [--samples 64] [--skip-cost]
 """
 
 from __future__ import annotations
@@ -43,6 +46,23 @@ def srgb_png(path: Path, linear: np.ndarray) -> None:
     Image.fromarray((np.clip(x, 0, 1) * 255 + 0.5).astype(np.uint8)).save(path)
 
 
+BIN_LIMITS = (("> 1.2x", 1.2, 1), ("> 1.1x", 1.1, 1), ("< 0.8x", 0.8, -1), ("< 0.9x", 0.9, -1))
+
+
+def bin_counts(img: np.ndarray, off: np.ndarray, ref: np.ndarray, k: int = 4) -> tuple[int, ...]:
+    """The k x k bins where ``img`` differs from ``off``, and how many of them lie beyond each of
+    BIN_LIMITS as a ratio of their mean luminance (RGB mean) to the reference's."""
+    def binned(x):
+        y = x[..., :3].mean(-1)
+        h, w = (y.shape[0] // k) * k, (y.shape[1] // k) * k
+        return y[:h, :w].reshape(h // k, k, w // k, k).mean((1, 3))
+
+    b, o, r = binned(img), binned(off), binned(ref)
+    moved = b != o
+    q = b[moved] / np.maximum(r[moved], 1e-6)
+    return (int(moved.sum()), *[int((side * (q - limit) > 0).sum()) for _, limit, side in BIN_LIMITS])
+
+
 def errors(folder: Path, size: int, samples: int, maps: list[str], renderer) -> list[tuple]:
     from alight.accuracy.binned import binned_relative_mae
     from alight.ibl.environment import load_environment
@@ -55,7 +75,7 @@ def errors(folder: Path, size: int, samples: int, maps: list[str], renderer) -> 
             mesh = load_scene_mesh(name, folder)
             ref = reference(folder, name, mesh, env_name, env, size, samples)
             srgb_png(folder / f"{name}__{env_name}__reference.png", ref)
-            errs = {}
+            errs, images = {}, {}
             for label in MODES:
                 # The multi-bounce switch reaches the pass through ScreenAO (made on the first gtao frame).
                 if label.startswith("gtao") and renderer.screen_ao is None:
@@ -68,9 +88,12 @@ def errors(folder: Path, size: int, samples: int, maps: list[str], renderer) -> 
                 if renderer.screen_ao is not None:
                     renderer.screen_ao.occluded = "occluders"
                 errs[label] = 100.0 * binned_relative_mae(img, ref, 4)
+                images[label] = img
                 srgb_png(folder / f"{name}__{env_name}__{label.replace(', ', '_').replace(' ', '-')}.png", img)
-            rows.append((name, env_name, *[errs[m] for m in MODES]))
-            print(f"{name:7s} {env_name:28s} " + "  ".join(f"{m} {errs[m]:5.1f}%" for m in MODES), flush=True)
+            counts = bin_counts(images["gtao"], images["off"], ref)
+            rows.append((name, env_name, *[errs[m] for m in MODES], counts))
+            print(f"{name:7s} {env_name:28s} " + "  ".join(f"{m} {errs[m]:5.1f}%" for m in MODES)
+                  + f"  gtao bins {counts}", flush=True)
     return rows
 
 
@@ -112,6 +135,7 @@ def main() -> None:
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--frame", type=int, default=256)
     p.add_argument("--skip-big", action="store_true")
+    p.add_argument("--skip-cost", action="store_true", help="the error half only")
     p.add_argument("--out", default="gtao.md")
     args = p.parse_args()
     os.environ.setdefault("ALIGHT_CACHE_DIR", tempfile.mkdtemp(prefix="alight-bench-cache-"))
@@ -123,12 +147,14 @@ def main() -> None:
     renderer = ForwardRenderer()
     maps = [m for m in args.maps.split(",") if m]
     rows = errors(args.references, args.size, args.samples, maps, renderer)
-    env = load_environment(str(ENV_DIR / maps[0]))
-    baked = renderer.bake(env, "medium")
-    lines_cost = [cost(renderer, baked, load_mesh(str(DATA / "models" / "DamagedHelmet" / "DamagedHelmet.gltf")),
-                       "DamagedHelmet", args.frame, args.rounds, ("off", "on", "gtao"))]
-    print(lines_cost[-1], flush=True)
-    if not args.skip_big:
+    lines_cost = []
+    if not args.skip_cost:
+        env = load_environment(str(ENV_DIR / maps[0]))
+        baked = renderer.bake(env, "medium")
+        lines_cost.append(cost(renderer, baked, load_mesh(str(DATA / "models" / "DamagedHelmet" / "DamagedHelmet.gltf")),
+                               "DamagedHelmet", args.frame, args.rounds, ("off", "on", "gtao")))
+        print(lines_cost[-1], flush=True)
+    if not args.skip_cost and not args.skip_big:
         lines_cost.append(cost(renderer, baked, load_mesh(str(BIG)), "MetalRoughSpheresNoTextures", args.frame,
                                args.rounds, ("off", "gtao")))
         print(lines_cost[-1], flush=True)
@@ -139,10 +165,15 @@ def main() -> None:
              "pixel, seed 0, 8 bounces; binned 4x4 linear relMAE; alight: medium bake, default IBL model, MSAA; "
              "grey dielectric (0.7, roughness 0.5); bench_occlusion.py's cameras.", "",
              "| scene | environment | " + " % | ".join(MODES) + " % |", "|---|---|" + "---|" * len(MODES)]
-    lines += ["| " + " | ".join([a, b] + [f"{x:.1f}" for x in rest]) + " |" for a, b, *rest in rows]
-    lines += ["", f"Cost per frame (`render`, sRGB read back, MSAA, {maps[0]}): alternated A B C, medians of process "
-              "CPU time (ranges) and wall; 2-core shared machine, llvmpipe.", "",
-              "| mesh | frame | rounds | per mode | ratios | warm-up |", "|---|---|---|---|---|---|", *lines_cost]
+    lines += ["| " + " | ".join([a, b] + [f"{x:.1f}" for x in rest]) + " |" for a, b, *rest, _ in rows]
+    lines += ["", "gtao's 4x4 bins (luminance) where it differs from off, by their ratio to the path tracer:", "",
+              "| scene | environment | bins | " + " | ".join(label for label, _, _ in BIN_LIMITS) + " |",
+              "|---|---|---|" + "---|" * len(BIN_LIMITS)]
+    lines += ["| " + " | ".join([a, b] + [str(x) for x in counts]) + " |" for a, b, *_, counts in rows]
+    if lines_cost:
+        lines += ["", f"Cost per frame (`render`, sRGB read back, MSAA, {maps[0]}): alternated A B C, medians of process "
+                  "CPU time (ranges) and wall; 2-core shared machine, llvmpipe.", "",
+                  "| mesh | frame | rounds | per mode | ratios | warm-up |", "|---|---|---|---|---|---|", *lines_cost]
     text = "\n".join(lines) + "\n"
     print(text)
     (HERE / "results").mkdir(exist_ok=True)
