@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
+BYTE, SHORT = 5120, 5122
 _TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
 
 
@@ -36,7 +37,8 @@ class Gltf:
                  sparse: tuple | None = None, view: int | None = None) -> int:
         """An accessor over ``array`` (N, k) stored as ``component``; ``sparse``: (indices, values)
         substituted over it (``array`` then the dense base, or None for all zeros)."""
-        dtype = {FLOAT: np.float32, UBYTE: np.uint8, USHORT: np.uint16, UINT: np.uint32}[component]
+        dtype = {FLOAT: np.float32, UBYTE: np.uint8, USHORT: np.uint16, UINT: np.uint32, BYTE: np.int8,
+                 SHORT: np.int16}[component]
         a = np.asarray(array)
         a = a.reshape(len(a), -1) if a.ndim > 1 else a.reshape(-1, 1)
         acc = {"componentType": component, "count": len(a), "type": _TYPES[a.shape[1]]}

@@ -53,6 +53,7 @@ SUPPORTED = {
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_transmission",
     "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_dispersion",
     "KHR_materials_diffuse_transmission",
+    "EXT_mesh_gpu_instancing",   # each instance drawn as a copy of its node's mesh (_Reader._instances)
 }
 # The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
@@ -678,6 +679,7 @@ class _Reader:
         visited: set[int] = set()
         worlds: dict[int, np.ndarray] = {}
         placed: list[tuple[int, int, np.ndarray]] = []   # (node, mesh, world), placed once all worlds are known
+        instanced: dict[int, np.ndarray] = {}   # node -> its EXT_mesh_gpu_instancing transforms (K, 4, 4)
         stack = [(int(r), np.eye(4)) for r in reversed(roots)]
         while stack:
             index, parent = stack.pop()
@@ -691,6 +693,9 @@ class _Reader:
             worlds[index] = world
             if node.mesh is not None:
                 placed.append((index, int(node.mesh), world))
+                instances = self._instances(node, index)
+                if instances is not None:
+                    instanced[index] = instances
             if node.camera is not None:
                 cameras.append((int(node.camera), world))
             light_ref = (node.extensions or {}).get("KHR_lights_punctual")
@@ -700,7 +705,8 @@ class _Reader:
                 stack.append((int(child), world))
         # A model far from the file's origin is moved near it (with its cameras and lights, below)
         # before its positions become float32; a skin's joints move with it.
-        origin = far_origin([world[:3, 3] for _, _, world in placed])
+        origin = far_origin([t for index, _, world in placed for t in
+                             ((world @ instanced[index])[:, :3, 3] if index in instanced else [world[:3, 3]])])
         shift = np.eye(4)
         shift[:3, 3] = -origin
         for index, mesh_index, world in placed:
@@ -710,7 +716,12 @@ class _Reader:
             skin = self._skin_matrices(node, index, worlds) if node.skin is not None else None
             if skin is not None:
                 skin = shift @ skin
-            parts.extend(self._place(mesh_index, shift @ world, name, weights, skin))
+            instances = instanced.get(index)
+            if skin is not None and instances is not None:
+                self.warn(f"instanced-skin:{index}", f"nodes[{index}]: EXT_mesh_gpu_instancing on a skinned mesh; "
+                                                     f"drawn once, as its skin places it")
+                instances = None
+            parts.extend(self._place(mesh_index, shift @ world, name, weights, skin, instances))
         if doc.animations:
             n = len(doc.animations)
             self.warn("animations", f"animations: {n} animation{'s' if n != 1 else ''} not played; "
@@ -729,6 +740,47 @@ class _Reader:
                     animations=len(doc.animations or []))
         mesh.cameras = [self._camera(i, shift @ world, mesh) for i, world in cameras]
         return mesh
+
+    def _instances(self, node, index: int) -> np.ndarray | None:
+        """A node's EXT_mesh_gpu_instancing transforms (K, 4, 4), each T * R * S of its
+        TRANSLATION, ROTATION (xyzw) and SCALE accessors (any subset; all of the same count), or
+        None when the node has no such attributes. The mesh is drawn once per instance, under
+        node_world * instance; attributes named with a leading underscore are the application's
+        and are ignored."""
+        ext = (node.extensions or {}).get("EXT_mesh_gpu_instancing")
+        if not isinstance(ext, dict):
+            return None
+        where = f"nodes[{index}].extensions.EXT_mesh_gpu_instancing"
+        attributes = ext.get("attributes")
+        if not isinstance(attributes, dict):
+            raise fail(self.source, where, "attributes must be an object of accessor indices")
+        widths = {"TRANSLATION": 3, "ROTATION": 4, "SCALE": 3}
+        values = {}
+        for name, width in widths.items():
+            accessor = attributes.get(name)
+            if accessor is None:
+                continue
+            element = f"{where}.attributes.{name}"
+            acc = self._accessor(accessor, element)
+            if acc.componentType != 5126 and not (name == "ROTATION" and acc.normalized):
+                raise fail(self.source, element, "must be FLOAT" + (" or a normalized BYTE or SHORT"
+                                                                    if name == "ROTATION" else ""))
+            array = self.acc.read(int(accessor), element).astype(np.float64)
+            if array.shape[1] != width:
+                raise fail(self.source, element, f"must be VEC{width}")
+            if not np.isfinite(array).all():
+                raise fail(self.source, element, "contains NaN or Inf")
+            values[name] = array
+        if not values:
+            return None
+        counts = {name: len(a) for name, a in values.items()}
+        if len(set(counts.values())) > 1:
+            said = ", ".join(f"{name} {n}" for name, n in counts.items())
+            raise fail(self.source, where, f"the attributes' accessors must have one count; they have {said}")
+        count = next(iter(counts.values()))
+        return _trs_matrices(values.get("TRANSLATION", np.zeros((count, 3))),
+                             values.get("ROTATION", np.tile([0.0, 0.0, 0.0, 1.0], (count, 1))),
+                             values.get("SCALE", np.ones((count, 3))))
 
     def _morph_weights(self, node, index: int, mesh_index: int) -> tuple[float, ...]:
         """The morph weights a node draws its mesh with: node.weights, else mesh.weights."""
@@ -806,8 +858,13 @@ class _Reader:
         return per_vertex
 
     def _place(self, mesh_index: int, world: np.ndarray, name: str, weights: tuple[float, ...] = (),
-               skin: np.ndarray | None = None) -> list[MeshPart]:
+               skin: np.ndarray | None = None, instances: np.ndarray | None = None) -> list[MeshPart]:
+        """A mesh's primitives as world-space parts: under ``world``, under each vertex's skinning
+        matrix (``skin``), or once per instance under ``world @ instances[k]`` (EXT_mesh_gpu_instancing:
+        each part then holds every instance's copy, transformed in one batch)."""
         meshes = self.doc.meshes or []
+        if instances is not None and not len(instances):
+            return []
         if not 0 <= mesh_index < len(meshes):
             raise fail(self.source, f"meshes[{mesh_index}]", "does not exist")
         if not np.isfinite(world).all():
@@ -819,7 +876,11 @@ class _Reader:
                 continue
             element = f"meshes[{mesh_index}].primitives[{p}]"
             per_vertex = self._skinned(local, skin, element) if skin is not None else None
-            if per_vertex is None:
+            group = per_vertex is None and instances is not None   # one (K, 3, 3) per instance
+            if group:
+                mats = world[None] @ instances
+                m, t = mats[:, :3, :3], mats[:, :3, 3]
+            elif per_vertex is None:
                 m, t = world[None, :3, :3], world[None, :3, 3]
             else:
                 m, t = per_vertex[:, :3, :3], per_vertex[:, :3, 3]
@@ -829,7 +890,11 @@ class _Reader:
             det = np.einsum("ni,ni->n", m[:, 0], cof[:, 0])
             sign = np.where(det < 0, -1.0, 1.0)
             faces = local.indices
-            if len(sign) == 1:
+            n = len(local.positions)
+            if group:   # instance k's vertices follow instance k-1's; a mirroring one reverses its winding
+                faces = np.where((sign < 0)[:, None, None], faces[None, :, ::-1], faces[None])
+                faces = (faces + (np.arange(len(sign)) * n)[:, None, None]).reshape(-1, 3)
+            elif len(sign) == 1:
                 faces = faces[:, ::-1] if sign[0] < 0 else faces
             else:
                 faces = np.where((sign[faces[:, 0]] < 0)[:, None], faces[:, ::-1], faces)
@@ -837,34 +902,47 @@ class _Reader:
             # A node without a transform (most big scans) keeps the decoded arrays as they are:
             # their normals are unit already (_decode_primitive), and each pass over millions of
             # float64 rows costs a fraction of a second and its copy.
-            identity = per_vertex is None and np.array_equal(world, np.eye(4))
+            identity = per_vertex is None and not group and np.array_equal(world, np.eye(4))
+            move = _apply_each if group else _apply
             if identity:
                 normals = local.normals
             else:
-                normals, ok = _normalize(_apply(cof, local.normals))
+                normals, ok = _normalize(move(cof, local.normals))
                 normals[~ok] = (0.0, 1.0, 0.0)
             tangents = None
             if local.tangents is not None:
-                t_xyz, t_ok = _normalize(_apply(m, local.tangents[:, :3]))
+                t_xyz, t_ok = _normalize(move(m, local.tangents[:, :3]))
                 t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
                 t_xyz, t_ok = _normalize(t_xyz)
                 if not t_ok.all():
                     axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
                     fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
                     t_xyz[~t_ok] = fallback[~t_ok]
-                w = local.tangents[:, 3:4] * sign[:, None]
+                w = ((local.tangents[None, :, 3:4] * sign[:, None, None]).reshape(-1, 1) if group
+                     else local.tangents[:, 3:4] * sign[:, None])
                 tangents = np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32)
+            copies = len(sign) if group else 1
+
+            def tiled(a: np.ndarray | None) -> np.ndarray | None:
+                return None if a is None else np.ascontiguousarray(np.tile(a, (copies, 1)) if group else a,
+                                                                   dtype=np.float32)
+
+            if identity:
+                positions = local.positions
+            elif group:
+                positions = move(m, local.positions) + np.repeat(t, n, axis=0)
+            else:
+                positions = _apply(m, local.positions) + t
             out.append(MeshPart(
                 name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
-                positions=np.ascontiguousarray(local.positions if identity else _apply(m, local.positions) + t,
-                                               dtype=np.float32),
+                positions=np.ascontiguousarray(positions, dtype=np.float32),
                 normals=np.ascontiguousarray(normals, dtype=np.float32),
-                uvs=np.ascontiguousarray(local.uvs, dtype=np.float32),
+                uvs=tiled(local.uvs),
                 tangents=tangents,
                 indices=np.ascontiguousarray(faces, dtype=np.uint32),
                 material=local.material,
-                uvs1=None if local.uvs1 is None else np.ascontiguousarray(local.uvs1, dtype=np.float32),
-                colors=None if local.colors is None else np.ascontiguousarray(local.colors, dtype=np.float32),
+                uvs1=tiled(local.uvs1),
+                colors=tiled(local.colors),
                 element=element,
             ))
         return out
@@ -919,6 +997,31 @@ class _Reader:
 def _apply(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) vectors times (1, 3, 3) one matrix or (N, 3, 3) one a vertex."""
     return rows_times(v, m[0]) if len(m) == 1 else np.einsum("nij,nj->ni", m, v)
+
+
+def _apply_each(m: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(N, 3) vectors under each of (K, 3, 3) matrices: (K * N, 3), instance k's rows k*N.. (K+1)*N-1."""
+    v = np.asarray(v, np.float64)
+    out = (v[None, :, 0:1] * m[:, None, :, 0] + v[None, :, 1:2] * m[:, None, :, 1]
+           + v[None, :, 2:3] * m[:, None, :, 2])
+    return out.reshape(-1, 3)
+
+
+def _trs_matrices(t: np.ndarray, q: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """(K, 4, 4) matrices T * R * S from (K, 3) translations, (K, 4) xyzw quaternions (normalized
+    here; a zero one is the identity) and (K, 3) scales, as _local_matrix makes one."""
+    norm = np.linalg.norm(q, axis=1, keepdims=True)
+    q = np.where(norm > 0, q / np.where(norm > 0, norm, 1.0), [0.0, 0.0, 0.0, 1.0])
+    x, y, z, w = q.T
+    r = np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1),
+    ], axis=1)
+    out = np.tile(np.eye(4), (len(t), 1, 1))
+    out[:, :3, :3] = r * s[:, None, :]
+    out[:, :3, 3] = t
+    return out
 
 
 def _missing_image_file(base: Path, uri: str) -> Path | None:
