@@ -204,6 +204,10 @@ class MeshPart:
     uvs1: np.ndarray | None = None  # (N, 2) float32, TEXCOORD_1
     colors: np.ndarray | None = None  # (N, 4) float32, linear RGBA
     element: str = ""
+    # KHR_materials_variants: {variant index: the material that variant gives this part}, and
+    # None: the part's own material (the file's, drawn without a variant). Empty for parts of a
+    # file without variants. select_variant swaps ``material`` from it.
+    variant_materials: dict = field(default_factory=dict)
 
 
 def single_sided(part) -> bool:
@@ -262,6 +266,10 @@ class Mesh:
     # alight.core.scene.orbit_camera takes them: a 3/4 view, so a cube is not a square and a
     # plane not an edge. None: from +Z, the default camera (docs/conventions.md).
     view: tuple[float, float] | None = None
+    # KHR_materials_variants: the file's variant names, in its order ([] without the extension),
+    # and the one whose materials the parts hold (None: each part's own; select_variant).
+    variants: list[str] = field(default_factory=list)
+    variant: str | None = None
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """World-space min and max corners over all parts."""
@@ -676,3 +684,39 @@ def far_origin(translations) -> np.ndarray:
         return np.zeros(3)
     centre = np.mean(np.asarray(translations, np.float64), axis=0)
     return centre if np.isfinite(centre).all() and np.abs(centre).max() > FAR_FROM_ORIGIN else np.zeros(3)
+
+
+def select_variant(mesh: Mesh, name: str | None) -> Mesh:
+    """``mesh`` with KHR_materials_variants' variant ``name`` active: a Mesh whose parts hold the
+    materials that variant maps them to, and their own material where it maps none (the
+    extension's rule); ``name`` None: every part's own material. The geometry is shared, not
+    copied; ``mesh`` is left as it is (the same mesh comes back when nothing changes). Raises
+    AlightError of one line for a mesh without variants or a name it does not have (listing the
+    names it has)."""
+    import copy
+
+    from alight.errors import AlightError
+
+    if name == mesh.variant:
+        return mesh
+    if name is not None:
+        if not mesh.variants:
+            raise AlightError(f"{mesh.source}: has no material variants (KHR_materials_variants) to choose "
+                              f"{name!r} from")
+        if name not in mesh.variants:
+            raise AlightError(f"{mesh.source}: no material variant named {name!r}; the file's variants: "
+                              + ", ".join(repr(v) for v in mesh.variants))
+    index = None if name is None else mesh.variants.index(name)
+    parts = []
+    for part in mesh.parts:
+        choices = part.variant_materials
+        material = choices.get(index, choices.get(None, part.material)) if choices else part.material
+        if material is part.material:
+            parts.append(part)
+            continue
+        moved = copy.copy(part)   # (not dataclasses.replace: it would read, so make, lazy tangents)
+        moved.material = material
+        parts.append(moved)
+    out = copy.copy(mesh)
+    out.parts, out.variant = parts, name
+    return out

@@ -54,6 +54,7 @@ SUPPORTED = {
     "KHR_materials_volume", "KHR_materials_iridescence", "KHR_materials_dispersion",
     "KHR_materials_diffuse_transmission",
     "EXT_mesh_gpu_instancing",   # each instance drawn as a copy of its node's mesh (_Reader._instances)
+    "KHR_materials_variants",    # every material a variant picks is read; none active unless chosen (select_variant)
 }
 # The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
@@ -236,6 +237,7 @@ class _Reader:
         self._materials: dict[int, FileMaterial] = {}
         self._locals: dict[tuple, _Local | None] = {}
         self._check_extensions()
+        self.variants = _variant_names(doc, spec)
 
     # --- messages ------------------------------------------------------------------------
 
@@ -466,6 +468,32 @@ class _Reader:
         self._materials[index] = fm
         return fm
 
+    def variant_materials(self, mesh_index: int, prim_index: int) -> dict[int, FileMaterial]:
+        """KHR_materials_variants: {variant index: material} of a primitive's mappings (every
+        material a variant can pick is read here, used or not without a variant)."""
+        prim = self.doc.meshes[mesh_index].primitives[prim_index]
+        ext = (prim.extensions or {}).get("KHR_materials_variants")
+        if ext is None:
+            return {}
+        where = f"meshes[{mesh_index}].primitives[{prim_index}].extensions.KHR_materials_variants"
+        mappings = ext.get("mappings") if isinstance(ext, dict) else None
+        if not isinstance(mappings, list):
+            raise fail(self.source, where, "mappings must be a list")
+        out: dict[int, FileMaterial] = {}
+        for k, mapping in enumerate(mappings):
+            at = f"{where}.mappings[{k}]"
+            if not isinstance(mapping, dict) or not isinstance(mapping.get("material"), int) \
+                    or not isinstance(mapping.get("variants"), list):
+                raise fail(self.source, at, "needs a material index and a list of variant indices")
+            for v in mapping["variants"]:
+                if not isinstance(v, int) or not 0 <= v < len(self.variants):
+                    raise fail(self.source, at, f"variant {v!r} does not exist (the file has "
+                                                f"{len(self.variants)} variants)")
+                if v in out:
+                    raise fail(self.source, at, f"variant {v} ({self.variants[v]!r}) is mapped twice")
+                out[v] = self.material(mapping["material"])
+        return out
+
     # --- geometry --------------------------------------------------------------------------
 
     def primitive(self, mesh_index: int, prim_index: int, weights: tuple[float, ...] = ()) -> _Local | None:
@@ -570,6 +598,9 @@ class _Reader:
             self.warn(f"uv1:{element}", f"{element}: a texture reads texCoord 1 but there is no TEXCOORD_1; "
                                         f"TEXCOORD_0 is used")
         normal_info = material.normal_texture if material is not None else None
+        if normal_info is None:   # a variant's material may have the normal map (KHR_materials_variants)
+            normal_info = next((m.normal_texture for m in self.variant_materials(mesh_index, prim_index).values()
+                                if m.normal_texture is not None), None)
         if tangents is not None:
             t_xyz, t_ok = _normalize(tangents[:, :3])
             tangents = np.concatenate([t_xyz, np.where(tangents[:, 3:4] < 0, -1.0, 1.0)], axis=1)
@@ -737,7 +768,7 @@ class _Reader:
             if light.kind != "directional":
                 light.vector = tuple(float(x) for x in np.asarray(light.vector, np.float64) - origin)
         mesh = Mesh(parts, self.source, lights=lights, warnings=self.warnings, origin=tuple(map(float, origin)),
-                    animations=len(doc.animations or []))
+                    animations=len(doc.animations or []), variants=list(self.variants))
         mesh.cameras = [self._camera(i, shift @ world, mesh) for i, world in cameras]
         return mesh
 
@@ -945,6 +976,9 @@ class _Reader:
                 colors=tiled(local.colors),
                 element=element,
             ))
+            choices = self.variant_materials(mesh_index, p)
+            if choices:
+                out[-1].variant_materials = {None: local.material, **choices}
         return out
 
     def _camera(self, index: int, world: np.ndarray, mesh: Mesh) -> Camera:
@@ -997,6 +1031,29 @@ class _Reader:
 def _apply(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) vectors times (1, 3, 3) one matrix or (N, 3, 3) one a vertex."""
     return rows_times(v, m[0]) if len(m) == 1 else np.einsum("nij,nj->ni", m, v)
+
+
+def _variant_names(doc, source: str) -> list[str]:
+    """KHR_materials_variants' variant names, in the file's order ([] without the extension)."""
+    ext = (doc.extensions or {}).get("KHR_materials_variants")
+    if ext is None:
+        return []
+    variants = ext.get("variants") if isinstance(ext, dict) else None
+    if not isinstance(variants, list):
+        raise fail(source, "extensions.KHR_materials_variants", "variants must be a list")
+    names = []
+    for i, v in enumerate(variants):
+        if not isinstance(v, dict) or not isinstance(v.get("name"), str):
+            raise fail(source, f"extensions.KHR_materials_variants.variants[{i}]", "has no name")
+        names.append(v["name"])
+    return names
+
+
+def gltf_variant_names(path: str | os.PathLike) -> list[str]:
+    """A glTF file's KHR_materials_variants names from its JSON alone (no accessor or image is
+    read): how alight batch checks --variant against each mesh before rendering."""
+    doc, _ = read_document(Path(path), str(path))
+    return _variant_names(doc, str(path))
 
 
 def _apply_each(m: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ from typing import Iterable, Literal
 import numpy as np
 
 from alight.core.material import Material, validate_material, with_overrides
-from alight.core.mesh import Mesh
+from alight.core.mesh import Mesh, select_variant
 from alight.core.texture_maps import TextureMaps
 from alight.core.scene import (
     BACKGROUNDS,
@@ -148,7 +148,7 @@ class Renderer:
 
     # --- scene state ---------------------------------------------------------------------
 
-    def set_mesh(self, mesh: str | os.PathLike | Mesh) -> "Renderer":
+    def set_mesh(self, mesh: str | os.PathLike | Mesh, *, variant: str | None = None) -> "Renderer":
         """'sphere', 'cube', 'plane', 'shader_ball', 'rounded_cube', 'drape', a mesh file (.obj .gltf .glb .ply .stl), or a loaded Mesh.
         What the file is drawn without is said as an ``alight.AlightWarning`` each (a Python
         warning: alight.errors.warn); the file's own lines stay in ``self.mesh.warnings``.
@@ -158,15 +158,37 @@ class Renderer:
         ``set_material`` (then that material is drawn on every part: ``set_material("gold")``
         then ``set_mesh("Duck.glb")`` is a gold duck, as ``alight render --mesh Duck.glb --preset
         gold``); ``set_material(use_file_materials=True)`` or ``reset()`` gives the file's own back.
-        The camera (None or an orbit) is framed for the new mesh at the next render."""
+        The camera (None or an orbit) is framed for the new mesh at the next render.
+
+        ``variant``: a glTF file's material variant (KHR_materials_variants) to draw, by name, as
+        ``alight render --variant NAME`` (``set_variant`` switches it later; the names are
+        ``r.mesh.variants``). An error of one line where the file has no variants or no such name."""
         if isinstance(mesh, Mesh):
-            self._mesh = mesh
+            self._mesh = mesh if variant is None else select_variant(mesh, variant)
             for line in mesh.warnings:
                 warn(line)
         else:
-            self._mesh = load_scene_mesh(os.fspath(mesh), warn)
+            loaded = load_scene_mesh(os.fspath(mesh), warn)
+            self._mesh = loaded if variant is None else select_variant(loaded, variant)
         self._frame_of = None   # made again even for the same Mesh: its vertices may have been edited
         self.scene.mesh = self._mesh
+        return self
+
+    def set_variant(self, name: str | None) -> "Renderer":
+        """Draw the current mesh's material variant ``name`` (KHR_materials_variants; the names
+        are ``r.mesh.variants``), or with None each part's own material again. Only the parts'
+        materials change: the geometry is the same arrays, and the camera's framing is kept. An
+        error of one line (AlightError) where the mesh has no variants or no such name, listing
+        the names it has."""
+        if self._mesh is None:
+            raise AlightError("set_variant: no mesh is set (set_mesh first)")
+        chosen = select_variant(self._mesh, name)
+        if self._frame_of is not None and self._frame_of[0] is self._mesh:
+            self._frame_of = (chosen, self._frame_of[1])   # the same vertices: the same frame
+        if self._framing_checked is self._mesh:
+            self._framing_checked = chosen
+        self._mesh = chosen
+        self.scene.mesh = chosen
         return self
 
     def set_environment(self, env: str | os.PathLike | Environment | None, *, rotation_deg: float | None = None,

@@ -45,6 +45,8 @@ from alight.errors import AlightError
 from alight.frontends.batch_worker import MATERIAL_FIELDS, render_item
 from alight.frontends.scene_setup import closest_environment
 
+# The materials entry that draws each mesh file's own materials (the default material on a built-in).
+OWN = "own"
 BATCH_MAX_SIDE = 8192   # _size_and_quality says why it is below alight render's 16384
 _KEYS = {"out", "size", "quality", "meshes", "environments", "materials", "camera_angles",
          "environment_angles", "contact_sheet", "turntable", "aa", "tonemap", "background", "shadows", "ground",
@@ -71,6 +73,7 @@ class Item:
     shadows: str = "auto"     # alight.render.shadows
     ground: bool = False      # alight.render.ground
     mesh_shading: str = "auto"   # alight.render.vbuffer: auto, forward or vbuffer
+    variant: str | None = None   # the meshes' material variant (KHR_materials_variants; --variant)
     inputs: list[str] = field(default_factory=list)  # files whose change makes the output stale
     label: str = ""
 
@@ -161,6 +164,9 @@ def _material_inputs(m: Any, base: Path) -> tuple[Any, list[str]]:
     """The material with file paths made absolute, and the files it depends on."""
     from alight.paths import preset_dir
 
+    if m == OWN:
+        return m, []
+
     def one(text: str) -> tuple[str, str | None]:
         preset = preset_dir() / f"{text}.json"
         if preset.is_file():
@@ -193,8 +199,10 @@ def _material_inputs(m: Any, base: Path) -> tuple[Any, list[str]]:
     return m, deps
 
 
-def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> Plan:
-    """Every item of a spec, named, with its inputs (no rendering)."""
+def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None, variant: str | None = None) -> Plan:
+    """Every item of a spec, named, with its inputs (no rendering). ``variant``: alight batch
+    --variant, the material variant every mesh is drawn with (each mesh must have it; checked
+    here from the files' JSON), its name added to the meshes' names in the outputs."""
     from alight.core.mesh import BUILTIN_MESHES
 
     source = Path(spec_path)
@@ -209,12 +217,15 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
     size, quality = _size_and_quality(spec, source)
     meshes = _list(spec, "meshes", ["sphere"], source)
     envs = _list(spec, "environments", ["studio"], source)
-    materials = _list(spec, "materials", ["gold"], source, (str, dict))
+    materials = _list(spec, "materials", [OWN] if variant is not None else ["gold"], source, (str, dict))
     cams = _list(spec, "camera_angles", [0], source, (int, float))
     env_angles = _list(spec, "environment_angles", [0], source, (int, float))
     options = _item_options(spec, source)
     out_dir = Path(out) if out is not None else base / str(spec.get("out", source.stem))
     mesh_names, env_names, mat_names = _output_names(meshes, envs, materials, source)
+    if variant is not None:
+        _check_variant(source, base, meshes, materials, variant)
+        mesh_names = [f"{n}-{_slug(variant)}" for n in mesh_names]
 
     spec_deps = [str(source)]
     _check_inputs_exist(source, base, meshes, envs, materials)
@@ -226,7 +237,8 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
         deps = spec_deps + mat_deps + [p for p in (mesh, env) if p not in BUILTIN_MESHES and p != "studio"]
         return Item(name=out_path.relative_to(out_dir).as_posix(), out=str(out_path), mesh=mesh, environment=env,
                     material=material, camera_deg=float(cam), environment_deg=float(env_deg),
-                    size=(size[0], size[1]), quality=quality, inputs=deps, label=label, **options)
+                    size=(size[0], size[1]), quality=quality, inputs=deps, label=label, variant=variant,
+                    **options)
 
     stills = []
     for (mi, ei, ki), cam, env_deg in itertools.product(
@@ -251,6 +263,28 @@ def plan(spec_path: str | os.PathLike, out: str | os.PathLike | None = None) -> 
                 paths.append(p)
             animations.append(Animation(out_dir / "turntable" / f"{stem}.{fmt}", paths, float(fps)))
     return Plan(source, out_dir, stills, frames, animations, bool(spec.get("contact_sheet", True)))
+
+
+def _check_variant(source: Path, base: Path, meshes: list, materials: list, variant: str) -> None:
+    """--variant checked before anything renders: a material entry that draws the meshes' own
+    materials ("own"), and every mesh a glTF file with a variant of that name. One line each."""
+    from alight.core.mesh import BUILTIN_MESHES
+    from alight.exchange.gltf import gltf_variant_names
+
+    if OWN not in materials:
+        raise AlightError(f"{source}: --variant {variant}: every material of the spec replaces the meshes' own "
+                          f"materials, so no variant would show; add \"{OWN}\" to 'materials'")
+    for i, m in enumerate(meshes):
+        path = _resolve(base, m, BUILTIN_MESHES)
+        where = f"{source}: meshes[{i}]: --variant {variant}"
+        if m in BUILTIN_MESHES or Path(path).suffix.lower() not in (".gltf", ".glb"):
+            raise AlightError(f"{where}: {m} has no material variants (KHR_materials_variants is glTF's)")
+        names = gltf_variant_names(path)
+        if not names:
+            raise AlightError(f"{where}: {m} has no material variants (KHR_materials_variants)")
+        if variant not in names:
+            raise AlightError(f"{where}: {m} has no material variant named {variant!r}; its variants: "
+                              + ", ".join(repr(n) for n in names))
 
 
 def _check_inputs_exist(source: Path, base: Path, meshes: list, envs: list, materials: list) -> None:
@@ -517,8 +551,8 @@ def summary(result: Result) -> str:
 
 
 def main(spec: str, executor: str = "local", workers: int | None = None, force: bool = False,
-         out: str | None = None, log: TextIO = sys.stderr) -> int:
+         out: str | None = None, log: TextIO = sys.stderr, variant: str | None = None) -> int:
     """The CLI's entry: 0 when everything was written, 1 when an item failed."""
-    result = run(plan(spec, out), executor, workers, force, log)
+    result = run(plan(spec, out, variant), executor, workers, force, log)
     print(summary(result), file=log)
     return 1 if result.failed else 0

@@ -63,6 +63,7 @@ def _said(lines: list[str]):
 
 
 def _render(item, warnings: list[str]) -> None:
+    from alight.core.mesh import select_variant
     from alight.exchange.meshes import load_mesh
     from alight.frontends.api import Renderer
     from alight.ibl.environment import load_environment
@@ -74,12 +75,15 @@ def _render(item, warnings: list[str]) -> None:
     meshes, envs = _WORKER["meshes"], _WORKER["envs"]
     if item.mesh not in meshes:
         meshes[item.mesh] = load_mesh(item.mesh)
+    variant = getattr(item, "variant", None)
+    if (item.mesh, variant) not in meshes:   # one Mesh per variant, so its upload is kept too
+        meshes[(item.mesh, variant)] = select_variant(meshes[item.mesh], variant)
     if item.environment not in envs:
         envs[item.environment] = load_environment(item.environment)
     warnings.extend([*meshes[item.mesh].warnings, *envs[item.environment].warnings])
     r.quality, r.aa, r.mesh_shading = item.quality, item.aa, item.mesh_shading
     r.width, r.height = item.size
-    r.set_mesh(meshes[item.mesh]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)
+    r.set_mesh(meshes[(item.mesh, variant)]).set_environment(envs[item.environment], rotation_deg=item.environment_deg)
     material, maps = _material(item.material)
     r.set_material(material, **maps).set_display(tonemap=item.tonemap, background=item.background)
     r.set_shadows(item.shadows, ground=item.ground)
@@ -92,6 +96,10 @@ def _material(m: Any) -> tuple[Any, dict]:
     """The item's material for ``Renderer.set_material``: (a preset name or file, a .gltf/.glb
     with its maps, or a Material) and the keywords on top: texture_set and maps (the slots they
     load get factor 1), then the spec's fields, which win."""
+    if m == "own":   # alight.frontends.batch.OWN: each mesh file's own materials
+        from alight.core.material import Material
+
+        return Material(), {"use_file_materials": True}
     if isinstance(m, str):
         return m, {}
     if "from" in m or "preset" in m:

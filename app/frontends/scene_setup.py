@@ -45,7 +45,11 @@ def scene_from_flags(args, size: tuple[int, int], look, report: Report, **fields
     material, overrides, texture_maps = look
     check_probe_flags(args)
     lights = [parse_light(spec) for spec in args.light]
-    mesh = load_scene_mesh(args.mesh, report) if args.view == "camera" else None
+    variant = getattr(args, "variant", None)
+    mesh = load_scene_mesh(args.mesh, report, variant) if args.view == "camera" else None
+    if variant is not None and (args.preset is not None or texture_maps is not None):
+        report(f"--variant {variant}: changes nothing here: the material flags' material replaces the file's "
+               f"materials (leave out --preset, --texture-set and --map to see the variant)")
     if mesh is not None and not args.light and not args.no_file_lights:
         lights = list(mesh.lights)
     width, height = camera_size(args, mesh, *size, report)
@@ -84,17 +88,27 @@ def check_probe_flags(args) -> None:
          "the probe view has no mesh to occlude"),
         (f"--mesh-shading {getattr(args, 'mesh_shading', 'auto')}",
          getattr(args, "mesh_shading", "auto") != "auto", "the probe view draws no mesh"),
+        (f"--variant {getattr(args, 'variant', None)}", getattr(args, "variant", None) is not None,
+         "the probe view draws no mesh, so none of a file's material variants"),
     ]
     for flag, given, why in asked:
         if given:
             raise AlightError(f"{flag}: not with --view probe ({why}); use --view camera")
 
 
-def load_scene_mesh(spec: str, report: Report):
-    """A built-in or a mesh file (alight.exchange.meshes.load_mesh), its warnings reported."""
+def load_scene_mesh(spec: str, report: Report, variant: str | None = None):
+    """A built-in or a mesh file (alight.exchange.meshes.load_mesh), its warnings reported;
+    ``variant``: the file's material variant of that name made active (alight.core.mesh.select_variant;
+    an error of one line, naming --variant, where the file has none or no such name)."""
+    from alight.core.mesh import select_variant
     from alight.exchange.meshes import load_mesh
 
     mesh = load_mesh(spec)
+    if variant is not None:
+        try:
+            mesh = select_variant(mesh, variant)
+        except AlightError as e:
+            raise AlightError(f"--variant {variant}: {e}") from None
     for line in mesh.warnings:
         report(line)
     return mesh

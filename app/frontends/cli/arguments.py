@@ -87,6 +87,9 @@ def _add_scene_options(p: argparse.ArgumentParser, views: bool = True) -> None:
     g.add_argument("--mesh", default="sphere",
                    help="a built-in (sphere, cube, plane, shader_ball, rounded_cube, drape) or a mesh file "
                         "(.obj .gltf .glb .ply .stl) (default: sphere)")
+    g.add_argument("--variant", metavar="NAME",
+                   help="a glTF file's material variant (KHR_materials_variants) to draw, by name "
+                        "(default: each part's own material)")
     g.add_argument("--env", default="studio",
                    help="'studio' (built in) or an equirectangular .hdr/.exr map, 2:1 (default: studio)")
     g.add_argument("--env-rotation", type=_number("--env-rotation"), default=0.0, metavar="DEG",

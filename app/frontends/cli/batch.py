@@ -20,6 +20,10 @@ def add_parser(sub) -> None:
     bt.add_argument("--workers", type=int, default=None, metavar="N", help="worker processes (default: CPU count)")
     bt.add_argument("--force", action="store_true", help="render every item even if its output is up to date")
     bt.add_argument("--out", metavar="DIR", help="output folder (default: the spec's 'out')")
+    bt.add_argument("--variant", metavar="NAME",
+                    help="draw every mesh with its glTF material variant NAME (KHR_materials_variants; each mesh "
+                         "must have it), with the spec's \"own\" material entry (the default then); NAME is "
+                         "added to the meshes' output names")
 
 
 def run(args) -> int:
@@ -32,7 +36,7 @@ def run(args) -> int:
     if args.ray_address:
         os.environ["ALIGHT_RAY_ADDRESS"] = args.ray_address
 
-    return batch_main(args.spec, args.executor, args.workers, args.force, args.out)
+    return batch_main(args.spec, args.executor, args.workers, args.force, args.out, variant=args.variant)
 
 
 COMMAND = Command("batch", add_parser, run)

@@ -142,6 +142,8 @@ def close_popup_on_escape() -> None:
         imgui.internal.close_popups_except_modals()
 
 
+# The variant list's first entry: no variant, each part's own material.
+VARIANT_OWN = "(each part's own)"
 # The path fields kept across sessions (the others follow what is loaded: mesh, env, maps).
 KEPT_PATH_FIELDS = ("preset_path", "gltf_path")
 # Their defaults: names in the working folder of the moment, kept so in the session (an editor
@@ -559,6 +561,28 @@ class Panel:
         s.error = ""
         self.file_jobs.export(self.gltf_path, s.export_job(self.gltf_path))
 
+    def _variant_row(self, s) -> None:
+        """The mesh file's material variants (KHR_materials_variants), a list shown only when the
+        mesh has some: its parts' own materials, then each variant by name (alight edit --variant)."""
+        from imgui_bundle import imgui
+
+        names = list(getattr(s.mesh, "variants", None) or [])
+        if not names:
+            return
+        items = [VARIANT_OWN, *names]
+        current = 0 if s.mesh.variant is None else 1 + names.index(s.mesh.variant)
+        changed, i = imgui.combo("variant", current, items)
+        if changed and 0 <= i < len(items) and i != current:
+            try:
+                s.set_variant(None if i == 0 else names[i - 1])
+                s.error, s.message = "", f"variant: {items[i]}" + (
+                    "" if s.use_file_materials else " (shown with 'mesh file's own materials and maps' ticked)")
+            except AlightError as exc:
+                s.fail(exc)
+        if imgui.is_item_hovered():
+            tooltip("the glTF file's material variants (KHR_materials_variants): each part drawn with the "
+                    "material the variant gives it, its own where the variant gives none")
+
     def _open_mesh(self, s) -> None:
         """'open mesh' (or Enter in its field): the file read by a worker thread (file_jobs.py),
         assigned when a frame takes it; a second open while one runs wins."""
@@ -817,6 +841,7 @@ class Panel:
             win.frame_mesh(front=True)
         if imgui.is_item_hovered():
             tooltip("frame the mesh from its front (a flat mesh: its face; else +Z, level); key Home")
+        self._variant_row(s)
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
         if imgui.is_item_hovered():
             tooltip("or Shift + right drag in the view")

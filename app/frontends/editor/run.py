@@ -38,6 +38,11 @@ def build_state(args) -> EditorState:
     from alight.core.mesh import BUILTIN_MESHES
 
     state.use_file_materials = args.preset is None and maps is None and args.mesh not in BUILTIN_MESHES
+    if getattr(args, "variant", None) is not None:   # as 'alight render --variant'
+        try:
+            state.set_variant(args.variant)
+        except AlightError as e:
+            raise AlightError(f"--variant {args.variant}: {e}") from None
     # The rest of 'alight render''s scene options, as it reads them. Lights: --light replaces the
     # editor's three (state.default_lights); without it a glTF's own lights do, as in 'render'.
     state.env_rotation_deg, state.env_intensity = args.env_rotation, args.env_intensity

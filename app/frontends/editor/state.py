@@ -253,6 +253,14 @@ class EditorState:
         # Three significant digits: the panel's intensity field reads 38.5, not 38.4537.
         return dataclasses.replace(light, intensity=float(f"{light.intensity:.3g}"))
 
+    def set_variant(self, name: str | None) -> None:
+        """The mesh file's material variant (KHR_materials_variants) by name; None: each part's
+        own material (alight.core.mesh.select_variant: the same geometry, other materials).
+        Errors: AlightError of one line listing the file's variants."""
+        from alight.core.mesh import select_variant
+
+        self.mesh = select_variant(self.mesh, name)
+
     def load_env(self, spec: str) -> None:
         from alight.ibl.environment import load_environment
 

@@ -711,6 +711,8 @@ class EditorWindow:
         something it depends on changed; then put the tone-mapped image into the default framebuffer.
         (While the artist orbits every frame redraws; a still view costs only the copy.)
         ``full``: the window's size whatever the scales (screenshots)."""
+        if self.state.mesh is not self._framed_mesh and _same_geometry(self.state.mesh, self._framed_mesh):
+            self._framed_mesh = self.state.mesh   # another material variant of it: the view stays
         if self.state.mesh is not self._framed_mesh:
             if getattr(self.orbit, "restored", False):   # the last session's camera, kept once
                 self.orbit.restored, self._framed_mesh = False, self.state.mesh
@@ -1200,3 +1202,11 @@ def front_normal(mesh):
         total += np.cross(b - a, c - a).sum(axis=0)
     norm = float(np.linalg.norm(total))
     return total / norm if norm > 0.0 else None
+
+
+def _same_geometry(a, b) -> bool:
+    """Whether two meshes are one geometry with other materials (alight.core.mesh.select_variant
+    shares the parts' arrays): a variant switch keeps the artist's view rather than framing anew."""
+    if a is None or b is None or len(a.parts) != len(b.parts):
+        return False
+    return all(p.positions is q.positions for p, q in zip(a.parts, b.parts))
