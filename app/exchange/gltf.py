@@ -56,6 +56,19 @@ SUPPORTED = {
     "EXT_mesh_gpu_instancing",   # each instance drawn as a copy of its node's mesh (_Reader._instances)
     "KHR_materials_variants",    # every material a variant picks is read; none active unless chosen (select_variant)
 }
+# Metadata: what these hold changes no pixel, so a file using (or requiring) one is drawn as
+# without it and nothing is said. Each specification's own words:
+METADATA = {
+    # XMP packets (title, author, licence) on the asset, scenes, nodes, meshes, materials: "Metadata
+    # has no normative effect on the glTF asset appearance and rendering" (Blender writes it).
+    "KHR_xmp_json_ld",
+    "KHR_xmp",                  # its archived predecessor, the same sentence
+    "FB_geometry_metadata",     # a scene's vertex and primitive counts and bounds, for choosing a scene
+    "AGI_stk_metadata",         # STK's solar panel groups and sensor no-obscuration flags
+    "EXT_structural_metadata",  # schemas and property tables of features (3D Tiles); read by no shader
+    "EXT_mesh_features",        # feature IDs per vertex, texel or instance, which index that metadata
+}
+SUPPORTED |= METADATA
 # The layers' textures alight draws: FileMaterial slot -> (extension, textureInfo key).
 LAYER_TEXTURES = {
     "clearcoat": ("KHR_materials_clearcoat", "clearcoatTexture"),
