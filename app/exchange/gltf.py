@@ -86,6 +86,8 @@ LAYER_TEXTURES = {
     "specular": ("KHR_materials_specular", "specularTexture"),
     "specular_color": ("KHR_materials_specular", "specularColorTexture"),
 }
+# EXT_mesh_gpu_instancing: about this many vertices' copies are transformed in one batch.
+INSTANCE_BATCH_VERTICES = 1 << 15
 # Compression a file cannot be read without: refused in one line when no library decodes it.
 COMPRESSION = {"KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu"}
 
@@ -947,36 +949,28 @@ class _Reader:
             # their normals are unit already (_decode_primitive), and each pass over millions of
             # float64 rows costs a fraction of a second and its copy.
             identity = per_vertex is None and not group and np.array_equal(world, np.eye(4))
-            move = _apply_each if group else _apply
-            if identity:
-                normals = local.normals
-            else:
-                normals, ok = _normalize(move(cof, local.normals))
-                normals[~ok] = (0.0, 1.0, 0.0)
-            tangents = None
-            if local.tangents is not None:
-                t_xyz, t_ok = _normalize(move(m, local.tangents[:, :3]))
-                t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
-                t_xyz, t_ok = _normalize(t_xyz)
-                if not t_ok.all():
-                    axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-                    fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
-                    t_xyz[~t_ok] = fallback[~t_ok]
-                w = ((local.tangents[None, :, 3:4] * sign[:, None, None]).reshape(-1, 1) if group
-                     else local.tangents[:, 3:4] * sign[:, None])
-                tangents = np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32)
             copies = len(sign) if group else 1
+            if not group:
+                positions, normals, tangents = _moved(local, m, t, cof, sign, identity)
+            else:
+                # Instances a batch at a time, each batch one vectorised transform of every array,
+                # so its float64 temporaries stay in the cache: 2000 instances of 1225 vertices
+                # load in 1.3 s here, where all at once took 6.0 s and 2000 plain nodes take 1.8 s.
+                positions, normals = np.empty((copies * n, 3), np.float32), np.empty((copies * n, 3), np.float32)
+                tangents = None if local.tangents is None else np.empty((copies * n, 4), np.float32)
+                step = max(1, INSTANCE_BATCH_VERTICES // max(n, 1))
+                for a in range(0, copies, step):
+                    b = min(a + step, copies)
+                    rows = slice(a * n, b * n)
+                    positions[rows], normals[rows], batch_tangents = _moved(local, m[a:b], t[a:b], cof[a:b],
+                                                                             sign[a:b], False, instanced=True)
+                    if tangents is not None:
+                        tangents[rows] = batch_tangents
 
             def tiled(a: np.ndarray | None) -> np.ndarray | None:
                 return None if a is None else np.ascontiguousarray(np.tile(a, (copies, 1)) if group else a,
                                                                    dtype=np.float32)
 
-            if identity:
-                positions = local.positions
-            elif group:
-                positions = move(m, local.positions) + np.repeat(t, n, axis=0)
-            else:
-                positions = _apply(m, local.positions) + t
             out.append(MeshPart(
                 name=f"{name}.{p}" if len(meshes[mesh_index].primitives) > 1 else name,
                 positions=np.ascontiguousarray(positions, dtype=np.float32),
@@ -1069,12 +1063,44 @@ def gltf_variant_names(path: str | os.PathLike) -> list[str]:
     return _variant_names(doc, str(path))
 
 
+def _moved(local: _Local, m: np.ndarray, t: np.ndarray, cof: np.ndarray, sign: np.ndarray, identity: bool,
+           instanced: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """A primitive's positions, normals and tangents (float32) under ``m`` and ``t``: one matrix
+    (1, 3, 3), one a vertex (N, 3, 3), or with ``instanced`` one an instance (K, 3, 3), the copies
+    one after another. ``cof``: the normals' matrices (cofactors times sign(det)); ``sign``: the
+    determinants' signs, which flip the bitangent (w) of a mirrored copy."""
+    move = _apply_each if instanced else _apply
+    if identity:
+        normals = local.normals
+    else:
+        normals, ok = _normalize(move(cof, local.normals))
+        normals[~ok] = (0.0, 1.0, 0.0)
+    tangents = None
+    if local.tangents is not None:
+        t_xyz, t_ok = _normalize(move(m, local.tangents[:, :3]))
+        t_xyz = t_xyz - normals * np.sum(normals * t_xyz, axis=1, keepdims=True)
+        t_xyz, t_ok = _normalize(t_xyz)
+        if not t_ok.all():
+            axis = np.where((np.abs(normals[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+            fallback, _ = _normalize(axis - normals * np.sum(normals * axis, axis=1, keepdims=True))
+            t_xyz[~t_ok] = fallback[~t_ok]
+        w = ((local.tangents[None, :, 3:4] * sign[:, None, None]).reshape(-1, 1) if instanced
+             else local.tangents[:, 3:4] * sign[:, None])
+        tangents = np.ascontiguousarray(np.concatenate([t_xyz, w], axis=1), dtype=np.float32)
+    if identity:
+        positions = local.positions
+    elif instanced:
+        positions = move(m, local.positions) + np.repeat(t, len(local.positions), axis=0)
+    else:
+        positions = _apply(m, local.positions) + t
+    return (np.ascontiguousarray(positions, dtype=np.float32), np.ascontiguousarray(normals, dtype=np.float32),
+            tangents)
+
+
 def _apply_each(m: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) vectors under each of (K, 3, 3) matrices: (K * N, 3), instance k's rows k*N.. (K+1)*N-1."""
-    v = np.asarray(v, np.float64)
-    out = (v[None, :, 0:1] * m[:, None, :, 0] + v[None, :, 1:2] * m[:, None, :, 1]
-           + v[None, :, 2:3] * m[:, None, :, 2])
-    return out.reshape(-1, 3)
+    # (a stacked matmul: 0.12 ms for 26 x 1225 rows here, where rows_times' broadcasting took 2 ms)
+    return (np.asarray(v, np.float64) @ m.transpose(0, 2, 1)).reshape(-1, 3)
 
 
 def _trs_matrices(t: np.ndarray, q: np.ndarray, s: np.ndarray) -> np.ndarray:
