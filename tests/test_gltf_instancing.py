@@ -136,3 +136,32 @@ def test_mismatched_counts_refused_in_one_line(tmp_path):
     (line,) = proc.stderr.strip().splitlines()
     assert line.startswith("alight: error:") and "bad.glb" in line and "EXT_mesh_gpu_instancing" in line
     assert "TRANSLATION 3" in line and "ROTATION 4" in line and "SCALE 4" in line
+
+
+def test_instancing_on_a_skinned_node_draws_it_once_and_says_so(tmp_path):
+    """A skin places its mesh by its joints (the node's own transform takes no part), so the
+    instances have nothing to multiply: the skinned mesh is drawn once, with one warning line."""
+    import json
+    import struct
+
+    from alight.exchange.meshes import load_mesh
+    from tests.test_gltf_rest_pose import skin_files
+
+    skinned, _ = skin_files(tmp_path)
+    data = skinned.read_bytes()
+    (length,) = struct.unpack_from("<I", data, 12)
+    doc = json.loads(data[20:20 + length])
+    node = next(n for n in doc["nodes"] if "skin" in n)
+    position = doc["meshes"][node["mesh"]]["primitives"][0]["attributes"]["POSITION"]   # a FLOAT VEC3 accessor
+    node["extensions"] = {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": position}}}
+    doc["extensionsUsed"] = ["EXT_mesh_gpu_instancing"]
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    rest = data[20 + length:]
+    instanced = tmp_path / "skinned_instanced.glb"
+    instanced.write_bytes(struct.pack("<III", 0x46546C67, 2, 20 + len(text) + len(rest))
+                          + struct.pack("<II", len(text), 0x4E4F534A) + text + rest)
+    plain, mesh = load_mesh(str(skinned)), load_mesh(str(instanced))
+    assert len(mesh.warnings) == 1 and "EXT_mesh_gpu_instancing" in mesh.warnings[0] and "once" in mesh.warnings[0]
+    assert [len(p.positions) for p in mesh.parts] == [len(p.positions) for p in plain.parts]
+    np.testing.assert_array_equal(mesh.parts[0].positions, plain.parts[0].positions)
