@@ -55,6 +55,7 @@ SUPPORTED = {
     "KHR_materials_diffuse_transmission",
     "EXT_mesh_gpu_instancing",   # each instance drawn as a copy of its node's mesh (_Reader._instances)
     "KHR_materials_variants",    # every material a variant picks is read; none active unless chosen (select_variant)
+    "KHR_node_visibility",       # a node with visible false hides its meshes and lights and its descendants'
 }
 # Metadata: what these hold changes no pixel, so a file using (or requiring) one is drawn as
 # without it and nothing is said. Each specification's own words:
@@ -726,9 +727,10 @@ class _Reader:
         worlds: dict[int, np.ndarray] = {}
         placed: list[tuple[int, int, np.ndarray]] = []   # (node, mesh, world), placed once all worlds are known
         instanced: dict[int, np.ndarray] = {}   # node -> its EXT_mesh_gpu_instancing transforms (K, 4, 4)
-        stack = [(int(r), np.eye(4)) for r in reversed(roots)]
+        hidden = 0   # meshes KHR_node_visibility hides (said when nothing else is drawn)
+        stack = [(int(r), np.eye(4), True) for r in reversed(roots)]
         while stack:
-            index, parent = stack.pop()
+            index, parent, visible = stack.pop()
             if not 0 <= index < len(nodes):
                 raise fail(self.source, f"nodes[{index}]", "does not exist")
             if index in visited:
@@ -737,7 +739,12 @@ class _Reader:
             node = nodes[index]
             world = parent @ _local_matrix(node, self.source, index)
             worlds[index] = world
-            if node.mesh is not None:
+            # KHR_node_visibility: a node is drawn only if it and every ancestor are visible; its
+            # meshes and lights go, its cameras stay (and a hidden skeleton still poses a skin).
+            visible = visible and _node_visible(node, self.source, index)
+            if node.mesh is not None and not visible:
+                hidden += 1
+            elif node.mesh is not None:
                 placed.append((index, int(node.mesh), world))
                 instances = self._instances(node, index)
                 if instances is not None:
@@ -745,10 +752,10 @@ class _Reader:
             if node.camera is not None:
                 cameras.append((int(node.camera), world))
             light_ref = (node.extensions or {}).get("KHR_lights_punctual")
-            if isinstance(light_ref, dict) and light_ref.get("light") is not None:
+            if visible and isinstance(light_ref, dict) and light_ref.get("light") is not None:
                 lights.append(self._light(int(light_ref["light"]), light_defs, world))
             for child in reversed(node.children or []):
-                stack.append((int(child), world))
+                stack.append((int(child), world, visible))
         # A model far from the file's origin is moved near it (with its cameras and lights, below)
         # before its positions become float32; a skin's joints move with it.
         origin = far_origin([t for index, _, world in placed for t in
@@ -773,6 +780,9 @@ class _Reader:
             self.warn("animations", f"animations: {n} animation{'s' if n != 1 else ''} not played; "
                                     f"the rest pose the nodes give is drawn")
         if not parts:
+            if hidden and not placed:
+                raise AlightError(f"{self.source}: every node that places a mesh is hidden (KHR_node_visibility "
+                                  f"visible false on it or an ancestor): nothing to draw")
             if doc.meshes and not placed:   # (the meshes' accessors were never read: say what is missing)
                 n = len(doc.meshes)
                 where = f" of scenes[{scene_index}]" if scenes else ""
@@ -1153,6 +1163,17 @@ def _triangles(indices: np.ndarray, mode: int) -> np.ndarray:
         return np.stack([indices[i], indices[i + 1 + i % 2], indices[i + 2 - i % 2]], axis=1)
     # TRIANGLE_FAN: p_i = {v_{i+1}, v_{i+2}, v_0}
     return np.stack([indices[i + 1], indices[i + 2], np.full_like(i, indices[0])], axis=1)
+
+
+def _node_visible(node, source: str, index: int) -> bool:
+    """KHR_node_visibility's ``visible`` (default true) on one node; not a boolean: refused."""
+    ext = (node.extensions or {}).get("KHR_node_visibility")
+    if not isinstance(ext, dict) or "visible" not in ext:
+        return True
+    if not isinstance(ext["visible"], bool):
+        raise fail(source, f"nodes[{index}].extensions.KHR_node_visibility.visible",
+                   f"must be true or false, not {ext['visible']!r}")
+    return ext["visible"]
 
 
 def _local_matrix(node, source: str, index: int) -> np.ndarray:
