@@ -19,6 +19,7 @@ from alight.core.shading import linear_to_srgb, srgb_to_linear
 from alight.core.texture_maps import MAP_SLOTS, SLOT_LABELS
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
+from alight.exchange.meshes import MESH_EXTENSIONS
 from alight.exchange.presets import list_presets, load_preset
 from alight.frontends.editor.file_browser import FileBrowser
 from alight.frontends.editor.layer_rows import FINITE_START, SECTIONS, LayerRow
@@ -588,6 +589,12 @@ class Panel:
         assigned when a frame takes it; a second open while one runs wins."""
         self.open_mesh(s, self.mesh_path)
 
+    def _browsed_mesh(self, s, path: str) -> None:
+        """The file picked in 'browse mesh': shown in the 'mesh' field and opened as 'open mesh'
+        opens it (a failure puts the field back on the mesh that last opened)."""
+        self.mesh_path = path
+        self._open_mesh(s)
+
     def open_mesh(self, s, spec: str, then=None, own_materials: bool = True) -> None:
         """``spec`` read on the worker thread: the button, a dropped mesh file, --script open= and
         mesh=, and the last session's mesh at start-up (EditorState.open_mesh_async; ``then``:
@@ -834,6 +841,9 @@ class Panel:
         self.mesh_path, entered = text_field("mesh", self.mesh_path)
         if imgui.button("open mesh") or entered:
             self._open_mesh(s)
+        imgui.same_line()
+        # A mesh picked in the browser opens as a typed one does (on the file-jobs thread).
+        self._browse("browse mesh", MESH_EXTENSIONS, lambda path: self._browsed_mesh(s, path))
         imgui.same_line()
         # The way back from an orbit that lost the mesh (a one-sided sheet seen from behind shows
         # nothing, and F frames it from the same direction).

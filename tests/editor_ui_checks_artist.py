@@ -1,0 +1,58 @@
+"""An artist's trial's leftovers, operated by the Dear ImGui Test Engine in a 700 px wide window
+(a 350 px panel). Run by tests/test_editor_ui_artist.py as ``alight edit --new --size 700x500
+--ui-test tests/editor_ui_checks_artist.py`` under Xvfb; not collected by pytest. The one setting
+made directly is the file browser's kind (the built-in one: a native dialog is another program).
+
+- 'browse mesh': the built-in browser lists the mesh files alight reads, a row's click opens the
+  file as 'open mesh' does (on the file-jobs thread);
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from alight.frontends.editor.ui_test import editor, files_done, view
+
+OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # the run's folder (the editor's cwd too)
+BROWSER = "###file browser"   # the built-in browser's window (its title changes, its ID does not)
+
+
+def test_browse_mesh_opens_the_picked_file(ctx):
+    import trimesh
+
+    win = editor()
+    s, panel = win.state, win.panel
+    panel.browser.native = False   # the built-in browser (a native dialog is another program)
+    folder = os.path.join(OUT, "browse_mesh", "meshes")
+    os.makedirs(folder, exist_ok=True)
+    cube = os.path.join(folder, "box.obj")
+    trimesh.creation.box((1.2, 1.2, 1.2)).export(cube)
+    with open(os.path.join(folder, "notes.txt"), "w") as f:   # not a mesh: not listed
+        f.write("not a mesh\n")
+    ctx.set_ref("alight")
+    sphere = view(ctx).astype(np.float64)
+    ctx.item_open("**/Environment")
+    ctx.item_click("**/browse mesh")
+    browser = panel.browser
+    assert browser.visible and set(browser.suffixes) == {".gltf", ".glb", ".obj", ".ply", ".stl"}, browser.suffixes
+    ctx.set_ref(BROWSER)
+    try:
+        ctx.item_input_value("path", os.path.join(OUT, "browse_mesh"))   # a folder: the browser goes there
+        ctx.item_click("**/[meshes]")
+        assert browser.entries()[1] == ["box.obj"], browser.entries()
+        ctx.item_click("**/box.obj")
+    finally:   # a failure here must not leave the browser open for the next checks
+        if browser.visible:
+            ctx.item_click("cancel")
+    assert not browser.visible
+    files_done(ctx)
+    assert s.mesh_spec == cube and panel.mesh_path == cube, (s.mesh_spec, panel.mesh_path, s.error)
+    assert panel.shown_status.startswith(f"opened mesh {cube}"), panel.shown_status
+    boxed = view(ctx).astype(np.float64)
+    assert np.abs(boxed - sphere).mean() > 1.0   # the box, not the sphere
+    ctx.set_ref("alight")
+    ctx.combo_click("preview mesh/sphere")
+    assert s.mesh_spec == "sphere", s.error
+    ctx.item_close("**/Environment")
