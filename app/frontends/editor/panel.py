@@ -193,6 +193,8 @@ class Panel:
         self.shown_f0 = ""      # the F0 line drawn last frame (tests read it)
         self.preset_columns, self.preset_overflow = 3, 0.0   # the preset table drawn last frame (tests read it)
         self.shown_job_status = ""   # the status row's last "opening .../exporting ..." (tests read it)
+        self.sections_open = {}         # each section header's open state, drawn last (the session keeps it)
+        self._sections_restored = {}    # the last session's, applied as the headers are next drawn
         self.browser = FileBrowser()   # native dialog, or the built-in browser where none exists
         self._sections_for = None      # the loaded material the layer sections were opened for
         self.library = LibraryPanel()  # saved materials with thumbnails (library_panel.py)
@@ -239,7 +241,10 @@ class Panel:
         collapsed = []   # a header closed by a click this frame (the slack below keeps the scroll)
 
         def header(label, flags=0):
+            if label in self._sections_restored:   # as the last session left it (session.py)
+                imgui.set_next_item_open(self._sections_restored.pop(label), imgui.Cond_.always)
             opened = imgui.collapsing_header(label, flags)
+            self.sections_open[label] = bool(opened)
             headers.append(round(imgui.get_item_rect_min().y))
             if imgui.is_item_toggled_open() and not opened:
                 collapsed.append(label)
@@ -639,6 +644,17 @@ class Panel:
             then, self.file_jobs.then = self.file_jobs.then, None
             if then is not None:
                 then()
+
+    def kept_sections(self) -> dict:
+        """Which of the panel's sections (Material, Environment, ...) are open, for the next
+        session: as drawn last, and a restored one not drawn since as it was restored."""
+        return {**self._sections_restored, **self.sections_open}
+
+    def restore_sections(self, sections: dict) -> None:
+        """A saved session's open sections (``kept_sections``), applied as the panel is next
+        drawn; entries that are not a true or false are skipped."""
+        self._sections_restored.update({k: v for k, v in sections.items()
+                                        if isinstance(k, str) and isinstance(v, bool)})
 
     def kept_paths(self) -> dict:
         """The 'preset file' and 'glTF file' fields for the next session: the paths that last

@@ -1,5 +1,6 @@
 """The last session (mesh, environment, material, camera, the view's settings and debug view,
-the turntable's frames and file, the panel's preset and glTF file fields), so the editor reopens
+its render and motion scales, the turntable's frames and file, the panel's preset and glTF file
+fields and which of its sections are open), so the editor reopens
 where the artist left it. A JSON file in the user's config folder (``alight.paths.config_dir``),
 written atomically on close."""
 
@@ -22,6 +23,8 @@ CAMERA_FIELDS = ("target", "yaw_deg", "pitch_deg", "distance", "fov_y_deg", "rad
 # The view's settings kept beside the material and camera (with the display and the lights).
 SETTING_FIELDS = ("env_rotation_deg", "env_intensity", "ibl_enabled", "ibl_model", "multiple_scattering",
                   "lights_follow_env", "occlusion", "shadows", "ground")
+# The view's scales, kept from 0.25 to 1 as the panel's sliders are (older sessions lack them).
+SCALE_FIELDS = ("render_scale", "motion_scale", "adaptive_motion")
 EDITOR_AA = ("none", "msaa")   # the editor's anti-aliasing (alight edit --aa, the panel's combo)
 
 
@@ -65,6 +68,8 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
             "camera": {k: getattr(orbit, k) for k in CAMERA_FIELDS},
             "settings": {**{k: getattr(state, k) for k in SETTING_FIELDS},
                          "use_file_materials": own_materials, "aa": state.aa,
+                         # The view's resolution and its scale while moving (fixed or adaptive).
+                         **{k: getattr(state, k) for k in SCALE_FIELDS},
                          # By name: a view added to DEBUG_VIEWS later does not shift a kept one.
                          "debug_view": DEBUG_VIEWS[state.debug_view], "debug_mip": state.debug_mip,
                          "display": dataclasses.asdict(state.display),
@@ -75,6 +80,7 @@ def save_session(state, orbit, turntable=None, panel=None) -> None:
     if panel is not None:
         data["files"] = {k: output(v, DEFAULT_PATHS.get(k)) if isinstance(v, str) else v
                          for k, v in panel.kept_paths().items()}
+        data["sections"] = panel.kept_sections()   # which of the panel's sections are open
     path = session_path()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(data, indent=1))
@@ -162,6 +168,9 @@ def restore_session(state, orbit, turntable=None, panel=None) -> str:
     files = data.get("files")
     if panel is not None and isinstance(files, dict):   # (older sessions lack it: the defaults stay)
         panel.restore_paths(files)
+    sections = data.get("sections")
+    if panel is not None and isinstance(sections, dict):   # (older sessions lack it: the defaults stay)
+        panel.restore_sections(sections)
     camera = data.get("camera")
     if isinstance(camera, dict):
         try:
@@ -230,6 +239,11 @@ def _read_settings(data: dict):
               "ground": bool(data.get("ground", False))}
     if "aa" in data:   # the anti-aliasing (older sessions lack it: the command line's stays)
         values["aa"] = choice(data["aa"], EDITOR_AA, "aa")
+    for k in ("render_scale", "motion_scale"):   # (older sessions lack them: the command line's stay)
+        if k in data:
+            values[k] = min(1.0, max(0.25, number(data[k], k)))
+    if "adaptive_motion" in data:
+        values["adaptive_motion"] = bool(data["adaptive_motion"])
     if "debug_view" in data:   # (older sessions lack it and its mip: the shaded view stays)
         values["debug_view"] = DEBUG_VIEWS.index(choice(data["debug_view"], DEBUG_VIEWS, "debug_view"))
         values["debug_mip"] = number(data.get("debug_mip", 0.0), "debug_mip")
