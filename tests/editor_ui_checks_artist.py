@@ -5,15 +5,21 @@ made directly is the file browser's kind (the built-in one: a native dialog is a
 
 - 'browse mesh': the built-in browser lists the mesh files alight reads, a row's click opens the
   file as 'open mesh' does (on the file-jobs thread);
+- the status row: an error naming a long path is drawn with "..." for its middle (not cut silently at the
+  panel's edge), hovering it shows it whole;
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
 import numpy as np
 
 from alight.frontends.editor.ui_test import editor, files_done, view
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))   # this file is loaded by path
+from editor_ui_helpers import capture  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # the run's folder (the editor's cwd too)
 BROWSER = "###file browser"   # the built-in browser's window (its title changes, its ID does not)
@@ -56,3 +62,38 @@ def test_browse_mesh_opens_the_picked_file(ctx):
     ctx.combo_click("preview mesh/sphere")
     assert s.mesh_spec == "sphere", s.error
     ctx.item_close("**/Environment")
+
+
+def test_a_long_error_is_cut_with_dots_and_shown_whole_on_hover(ctx):
+    win = editor()
+    s, panel = win.state, win.panel
+    missing = os.path.join(OUT, "a folder with a rather long name", "and another one below it",
+                           "studio_lighting_for_the_product_shots_final_v3.hdr")
+    ctx.set_ref("alight")
+    ctx.item_open("**/Environment")
+    ctx.item_input_value("**/env file", missing)   # Enter opens it
+    ctx.yield_(2)
+    assert s.error and missing in s.error, s.error
+    whole = panel.shown_status
+    assert whole == f"error: {s.error}", whole
+    row = panel.shown_row
+    assert row.startswith("error: ") and "..." in row and len(row) < len(whole), row
+    assert row.endswith("no such file"), row   # the problem stays in view, the path's middle goes
+    head, tail = row.split("...", 1)
+    assert whole.startswith(head) and whole.endswith(tail), (row, whole)
+    capture(ctx, "long_error.png")   # (to look at: the path's middle '...', the row inside the panel)
+    # Hovering the row shows it whole.
+    bar = ctx.get_window_by_ref("//alight").menu_bar_rect()
+    ctx.mouse_move_to_pos(imgui_vec(bar.min.x + 40.0, 0.5 * (bar.min.y + bar.max.y)))
+    ctx.yield_(3)
+    assert panel.status_tooltip == whole, (panel.status_tooltip, whole)
+    capture(ctx, "long_error_hovered.png")
+    ctx.item_click("**/studio")
+    assert not s.error, s.error
+    ctx.item_close("**/Environment")
+
+
+def imgui_vec(x: float, y: float):
+    from imgui_bundle import imgui
+
+    return imgui.ImVec2(x, y)

@@ -159,6 +159,35 @@ def preset_file_name(name: str) -> str:
     return f"{stem if stem and name != 'default' else 'material'}.json"
 
 
+def fit_text(text: str, width: float) -> str:
+    """``text`` as it fits in ``width`` pixels of the current font: whole, or its start and its
+    end with "..." between them (a long path's middle goes: the error's problem at the end of
+    the row, 'no such file', stays in view)."""
+    from imgui_bundle import imgui
+
+    def fits(s: str) -> bool:
+        return imgui.calc_text_size(s).x <= width
+
+    if fits(text):
+        return text
+
+    def longest(make, n: int) -> int:   # the largest k <= n with make(k) fitting (0 if none)
+        lo, hi = 0, n
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            lo, hi = (mid, hi) if fits(make(mid)) else (lo, mid - 1)
+        return lo
+
+    # The end takes up to half the room, the start what is left.
+    half = width / 2.0
+    tail = 0
+    while tail < len(text) and imgui.calc_text_size(text[len(text) - tail - 1:]).x <= half:
+        tail += 1
+    end = text[len(text) - tail:] if tail else ""
+    head = longest(lambda k: text[:k] + "..." + end, len(text) - tail)
+    return text[:head] + "..." + end
+
+
 def read_for_upload(spec: str):
     """On the file-jobs thread: the mesh (EditorState's read_mesh) and the CPU side of its GPU
     upload (alight.render.mesh_upload.prepare_upload)."""
@@ -190,6 +219,8 @@ class Panel:
         self._set_shown = ""    # the texture set the 'texture set' field was last set from
         self.shown_error = ""   # the error line drawn last frame (what the artist sees; tests read it)
         self.shown_status = ""  # the status row's text drawn last frame (tests read it)
+        self.shown_row = ""     # ... as drawn: a long one's middle as "..." to fit the row (tests read it)
+        self.status_tooltip = ""   # the status row's tooltip shown last (the whole row; tests read it)
         self.shown_f0 = ""      # the F0 line drawn last frame (tests read it)
         self.preset_columns, self.preset_overflow = 3, 0.0   # the preset table drawn last frame (tests read it)
         self.shown_job_status = ""   # the status row's last "opening .../exporting ..." (tests read it)
@@ -309,7 +340,8 @@ class Panel:
         (green) followed by what runs in the background (grey: the occlusion bake, a new look's
         shaders compiling), else nothing; so a save or an
         error is seen wherever the panel is scrolled, and the rows below never move when one
-        appears or goes. A long line is cut at the panel's edge; hovering it shows it whole.
+        appears or goes. A line longer than the row is drawn with its middle as "..." (its start and
+        its end in view); hovering it shows it whole.
         Returns the row's text."""
         from imgui_bundle import imgui
 
@@ -317,12 +349,19 @@ class Panel:
             return ""
         shown, hovered = "", False
         jobs = self.file_jobs.status()
+        # The row's right end: a text longer than the room is drawn with "..." for its middle
+        # (it was cut silently at the edge: an artist read a cut path as the whole error, its
+        # 'no such file' out of view), whole in the tooltip on hover.
+        right = imgui.get_window_pos().x + imgui.get_window_width() - imgui.get_style().window_padding.x
+        drawn = []   # the texts as drawn (tests read them: shown_row)
         if s.error:
             shown = f"error: {s.error}"
-            imgui.text_colored(imgui.ImVec4(*ERROR_RGBA), shown)
+            drawn.append(fit_text(shown, right - imgui.get_cursor_screen_pos().x))
+            imgui.text_colored(imgui.ImVec4(*ERROR_RGBA), drawn[-1])
         elif jobs:   # 'open mesh' or 'export glTF' on its worker thread (file_jobs.py)
             shown = self.shown_job_status = jobs
-            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), shown)
+            drawn.append(fit_text(shown, right - imgui.get_cursor_screen_pos().x))
+            imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), drawn[-1])
         elif win.bake_progress is not None:   # the bake runs between frames; the old maps light the view
             fraction, label = win.bake_progress
             shown = f"baking {s.quality}: {label}"
@@ -342,15 +381,22 @@ class Panel:
                 if getattr(getattr(win, "variant_warmup", None), "showing_old", False) else ""
             parts = [(text, kind) for text, kind in ((s.message, "message"), (compiling, "note"), (baking, "note"))
                      if text]
+            # The notes keep their room after the message (cut first where there is none).
+            spacing = imgui.get_style().item_spacing.x
+            notes = sum(imgui.calc_text_size(text).x + spacing for text, kind in parts if kind == "note")
             for i, (text, kind) in enumerate(parts):
                 if i:
                     imgui.same_line()
+                room = right - imgui.get_cursor_screen_pos().x
                 if kind == "message":
-                    imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), text)
+                    drawn.append(fit_text(text, max(room - notes, 0.5 * room)))
+                    imgui.text_colored(imgui.ImVec4(*MESSAGE_RGBA), drawn[-1])
                 else:
-                    imgui.text_disabled(text)
+                    drawn.append(fit_text(text, room))
+                    imgui.text_disabled(drawn[-1])
                 hovered = hovered or imgui.is_item_hovered()
             shown = " | ".join(text for text, _ in parts)
+        self.shown_row = " | ".join(drawn)
         hovered = hovered or imgui.is_item_hovered()
         if shown and hovered:
             # The line whole, wrapped to the window's width (a set's assignment outgrew it); a
@@ -359,7 +405,8 @@ class Panel:
             imgui.set_next_window_pos(imgui.ImVec2(0.0, imgui.get_item_rect_max().y + 2.0))
             imgui.begin_tooltip()
             imgui.push_text_wrap_pos(width - 2.0 * imgui.get_style().window_padding.x)
-            imgui.text_unformatted(s.error if s.error else shown.replace(" | ", "\n"))
+            self.status_tooltip = f"error: {s.error}" if s.error else shown.replace(" | ", "\n")
+            imgui.text_unformatted(self.status_tooltip)
             imgui.pop_text_wrap_pos()
             imgui.end_tooltip()
         imgui.end_menu_bar()
