@@ -7,6 +7,8 @@ made directly is the file browser's kind (the built-in one: a native dialog is a
   file as 'open mesh' does (on the file-jobs thread);
 - the status row: an error naming a long path is drawn with "..." for its middle (not cut silently at the
   panel's edge), hovering it shows it whole;
+- the Compare section's 'A preset' combo names A from its first frame ('pick a preset', the
+  snapshot, the preset), never an empty box;
 """
 
 from __future__ import annotations
@@ -97,3 +99,24 @@ def imgui_vec(x: float, y: float):
     from imgui_bundle import imgui
 
     return imgui.ImVec2(x, y)
+
+
+def test_compare_a_preset_names_a_from_its_first_frame(ctx):
+    win = editor()
+    s, panel = win.state, win.panel
+    ctx.set_ref("alight")
+    ctx.item_open("**/Compare")
+    ctx.combo_click("compare/material")
+    ctx.yield_(1)
+    assert s.compare.a_material is None
+    assert panel.shown_a_preview == "pick a preset", panel.shown_a_preview
+    ctx.item_click("**/copper")
+    ctx.item_input_value("**/roughness", 0.45)   # no preset now
+    ctx.item_click("**/snapshot A")
+    ctx.yield_(1)
+    assert panel.shown_a_preview == "snapshot of copper", panel.shown_a_preview
+    ctx.combo_click("A preset/gold")
+    ctx.yield_(1)
+    assert s.compare.a_label == "preset gold" and panel.shown_a_preview == "gold", panel.shown_a_preview
+    ctx.combo_click("compare/off")
+    ctx.item_close("**/Compare")

@@ -218,9 +218,15 @@ def draw_section(win, presets) -> None:
         current = next((k for k, (_, m, *_) in enumerate(presets) if m == c.a_material), -1)
         imgui.same_line()
         imgui.set_next_item_width(-80)
-        changed, k = imgui.combo("A preset", current, names)
-        if changed and 0 <= k < len(presets):
-            set_preset(c, presets[k][1], presets[k][0])
+        # The preview says what A is (imgui.combo's, from the list's index, was empty whenever A
+        # was no preset of the list: before any pick, a snapshot, a restored A).
+        preview = names[current] if current >= 0 else (c.a_label if c.a_material is not None else "pick a preset")
+        win.panel.shown_a_preview = preview   # (the checks read it)
+        if imgui.begin_combo("A preset", preview):
+            for k, name in enumerate(names):
+                if imgui.selectable(name, k == current)[0]:
+                    set_preset(c, presets[k][1], presets[k][0])
+            imgui.end_combo()
         if c.a_material is None:
             imgui.text_disabled("A: press 'snapshot A' or pick a preset")
     elif c.mode == "ibl model":
