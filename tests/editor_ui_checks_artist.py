@@ -9,6 +9,7 @@ made directly is the file browser's kind (the built-in one: a native dialog is a
   panel's edge), hovering it shows it whole;
 - the Compare section's 'A preset' combo names A from its first frame ('pick a preset', the
   snapshot, the preset), never an empty box;
+- at this width the rows' labels end inside the panel.
 """
 
 from __future__ import annotations
@@ -25,6 +26,11 @@ from editor_ui_helpers import capture  # noqa: E402
 
 OUT = os.environ.get("ALIGHT_UI_TEST_OUT", ".")   # the run's folder (the editor's cwd too)
 BROWSER = "###file browser"   # the built-in browser's window (its title changes, its ID does not)
+
+
+def _panel_right(ctx) -> float:
+    """The panel's inner right edge (where its rows are clipped), window coordinates."""
+    return ctx.get_window_by_ref("//alight").inner_clip_rect.max.x
 
 
 def test_browse_mesh_opens_the_picked_file(ctx):
@@ -120,3 +126,43 @@ def test_compare_a_preset_names_a_from_its_first_frame(ctx):
     assert s.compare.a_label == "preset gold" and panel.shown_a_preview == "gold", panel.shown_a_preview
     ctx.combo_click("compare/off")
     ctx.item_close("**/Compare")
+
+
+def test_labels_end_inside_the_panel_at_700_px(ctx):
+    """Each row's label ends left of the panel's right edge (at imgui's default widths, 65% of
+    the panel, 'scale while moving' and 'turntable frames' ran past it)."""
+    from imgui_bundle import imgui
+    from imgui_bundle.imgui import test_engine as te
+
+    style = imgui.get_style()
+
+    win = editor()
+    assert win.panel_width() == 350, win.panel_width()
+    ctx.set_ref("alight")
+    # A row's last item, where the label is not one (a colour's swatch, a number's '+' button).
+    last = {"base colour (sRGB)": "base colour (sRGB)/##ColorButton", "turntable frames": "turntable frames/+"}
+    rows = {"Material": ("base colour (sRGB)", "preset file", "glTF file", "name", "metallic", "roughness", "ior"),
+            "Environment": ("env file", "mesh", "preview mesh", "rotation", "intensity", "background",
+                            "IBL model", "occlusion", "shadows", "bake quality"),
+            "Display & camera": ("tone map", "exposure (EV)", "debug view", "anti-aliasing", "render scale",
+                                 "field of view", "turntable frames", "turntable file")}
+    for section, labels in rows.items():
+        ctx.item_open(f"**/{section}")
+        if section == "Display & camera" and win.state.adaptive_motion:
+            ctx.item_click("**/###adaptive_motion")   # 'scale while moving' shows when it is off
+            labels = labels + ("scale while moving",)
+        ctx.yield_(2)
+        right = _panel_right(ctx)
+        for label in labels:
+            ref = last.get(label, label)
+            ctx.scroll_to_item_y(ref)   # (the rows are the panel's own, no '**/' search)
+            info = ctx.item_info(ref, te.TestOpFlags_.no_error)
+            assert info.id_ != 0, f"no row '{label}' in {section}"
+            # (The engine's rect is the widget's frame; its label follows it, inner spacing apart.)
+            end = info.rect_full.max.x + style.item_inner_spacing.x + imgui.calc_text_size(label).x
+            assert end <= right + 0.5, (label, end, right)
+        capture(ctx, f"labels_{section.split()[0].lower()}.png")
+        if section == "Display & camera":
+            ctx.item_click("**/###adaptive_motion")
+        if section != "Material":
+            ctx.item_close(f"**/{section}")

@@ -1,6 +1,6 @@
 """Leftovers of an artist's trial, through the real widgets under Xvfb: 'browse mesh', a long
-status row and the Compare section's 'A preset' (tests/editor_ui_checks_artist.py, the Test
-Engine); which panel sections are open and the
+status row, the Compare section's 'A preset' and the labels at 700 px
+(tests/editor_ui_checks_artist.py, the Test Engine); which panel sections are open and the
 render, motion and adaptive scales kept across sessions (three runs of the editor: set through
 the widgets, reopened, and reopened from a session file of before they were kept)."""
 

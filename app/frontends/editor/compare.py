@@ -25,7 +25,7 @@ from alight.core.ibl_models import IBL_MODELS
 from alight.core.material import Material
 from alight.core.texture_maps import TextureMaps
 from alight.errors import AlightError
-from alight.frontends.editor.widgets import tooltip
+from alight.frontends.editor.widgets import note, tooltip
 
 MODES = ("off", "material", "ibl model", "reference")
 # A left-button press this close to the divider (window pixels) drags it instead of orbiting.
@@ -228,7 +228,7 @@ def draw_section(win, presets) -> None:
                     set_preset(c, presets[k][1], presets[k][0])
             imgui.end_combo()
         if c.a_material is None:
-            imgui.text_disabled("A: press 'snapshot A' or pick a preset")
+            note("A: press 'snapshot A' or pick a preset")
     elif c.mode == "ibl model":
         models = tuple(IBL_MODELS)
         changed, k = imgui.combo("A IBL model", models.index(c.a_ibl_model), models)
@@ -250,15 +250,15 @@ def draw_section(win, presets) -> None:
         view = win.compare_view
         if view.reference_progress is not None:
             imgui.progress_bar(view.reference_progress, imgui.ImVec2(-1, 0), "summing the reference")
-        imgui.text_disabled("A: the exact sum, started when the view stands still"
+        note("A: the exact sum, started when the view stands still"
                             + (f" (last: {view.reference_seconds:.1f} s)" if view.reference_seconds else ""))
     if c.mode != "off":
         changed, v = imgui.slider_float("divider", c.divider, 0.0, 1.0)
         if changed:
             c.divider = v
         a, b = half_names(s)
-        imgui.text_disabled(f"{a} (left)   {b} (right)")
-        imgui.text_disabled("move the divider: left drag on its line in the view")
+        note(f"{a} (left)   {b} (right)")
+        note("move the divider: left drag on its line in the view")
 
 
 # --- the session ------------------------------------------------------------------------------

@@ -26,7 +26,7 @@ from alight.frontends.editor.layer_rows import FINITE_START, SECTIONS, LayerRow
 from alight.frontends.editor.library_panel import ICON, LibraryPanel
 from alight.frontends.editor.press_guard import PanelLayout
 from alight.frontends.editor.state import DEBUG_VIEWS
-from alight.frontends.editor.widgets import text_field, tooltip
+from alight.frontends.editor.widgets import note, text_field, tooltip
 from alight.ibl.bake import QUALITY
 from alight.render.shadows import SHADOW_MODES
 
@@ -38,6 +38,10 @@ MESSAGE_RGBA = (0.45, 0.85, 0.45, 1.0)
 # hid (0.5 put it over the 5). A thin, half-transparent one leaves the digits readable.
 SLIDER_GRAB_PX, SLIDER_GRAB_ALPHA = 4.0, 0.45
 LONGEST_LIGHT_LABEL = "direction (light travels)"
+# The panel's longest labels beside a widget outside the lights and layer sections (which size
+# their own): at a 700 px window (a 350 px panel) imgui's 65% widgets left them ~90 px and
+# 'turntable frames' read 'turntable fram' (a trial); the widgets narrow to leave them room.
+LONG_LABELS = ("base colour (sRGB)", "scale while moving", "screenshot size", "turntable frames")
 _DRAG_MAX = 1e9   # imgui's bound for a drag whose range is open above (an inf bound is not safe in imgui)
 
 
@@ -265,6 +269,7 @@ class Panel:
                     | imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.menu_bar)
         self.shown_error = s.error   # (file jobs: taken by EditorWindow.build_frame before, with or without the panel)
         self.shown_status = self._status_line(s, win)
+        imgui.push_item_width(self.item_width())
         self._follow_loaded(s)
         self._follow_maps(s)
         headers = []   # each section header's height: the layout's signature (press_guard.py)
@@ -302,6 +307,7 @@ class Panel:
 
             self.chart_view = getattr(self, "chart_view", None) or ChartView()
             self.chart_view.draw()
+        imgui.pop_item_width()
         self._keep_scroll(imgui, bool(collapsed))
         # Where the controls are this frame: a press aimed at another layout is not delivered.
         self.layout = PanelLayout(round(imgui.get_scroll_y()), tuple(headers), round(imgui.get_cursor_pos_y()))
@@ -311,6 +317,16 @@ class Panel:
         self.library.draw_confirm(s)
         self.browser.draw()
         close_popup_on_escape()
+
+    @staticmethod
+    def item_width() -> float:
+        """The panel's widget width: imgui's default (65% of the panel), less where the panel is
+        too narrow for LONG_LABELS beside it (not below 40% of the row)."""
+        from imgui_bundle import imgui
+
+        avail = imgui.get_content_region_avail().x
+        room = max(imgui.calc_text_size(label).x for label in LONG_LABELS) + imgui.get_style().item_inner_spacing.x
+        return max(min(0.65 * imgui.get_window_width(), avail - room), 0.4 * avail)
 
     def _keep_scroll(self, imgui, collapsed: bool) -> None:
         """Empty space at the panel's end as tall as the content a header's collapse took away,
@@ -784,7 +800,7 @@ class Panel:
 
         maps = s.texture_maps
         if s.use_file_materials:
-            imgui.text_disabled("parts with a material of their own use the file's maps")
+            note("parts with a material of their own use the file's maps")
         # A whole set at once, each file to its slot by its name (as a drop of several files).
         self.set_path, set_entered = text_field("texture set", self.set_path)
         if imgui.is_item_hovered():
@@ -803,7 +819,7 @@ class Panel:
             self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,
                               lambda path: self._browsed_set(s, os.path.dirname(path)))
         imgui.same_line()
-        imgui.text_disabled("a folder, files split by ';', or a drop")
+        note("a folder, files split by ';', or a drop")
         for slot in MAP_SLOTS:
             imgui.push_id(slot)
             if imgui.radio_button("##armed", s.armed_slot == slot):
@@ -918,7 +934,7 @@ class Panel:
         _, s.env_rotation_deg = imgui.slider_float("rotation", s.env_rotation_deg, -180.0, 180.0)
         if imgui.is_item_hovered():
             tooltip("or Shift + right drag in the view")
-        imgui.text_disabled("turn the environment: Shift + right drag in the view")
+        note("turn the environment: Shift + right drag in the view")
         _, s.lights_follow_env = imgui.checkbox("lights turn with the environment", s.lights_follow_env)
         if imgui.is_item_hovered():
             tooltip("the drag and the rotation slider turn every light about the vertical axis "
@@ -1146,8 +1162,8 @@ class Panel:
         from alight.frontends.editor import turntable
 
         turntable.draw_controls(win)   # frames, file, the button (T), progress
-        imgui.text_disabled("orbit: left drag  pan: right/middle drag  zoom: wheel")
-        imgui.text_disabled("turn the environment: Shift + right drag")
+        note("orbit: left drag  pan: right/middle drag  zoom: wheel")
+        note("turn the environment: Shift + right drag")
 
     def _performance(self, win) -> None:
         from imgui_bundle import imgui, implot

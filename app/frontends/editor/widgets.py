@@ -44,3 +44,13 @@ def text_field(label: str, value: str) -> tuple[str, bool]:
 
     entered, value = imgui.input_text(label, value, imgui.InputTextFlags_.enter_returns_true)
     return value, bool(entered)
+
+
+def note(text: str) -> None:
+    """A grey line of help, wrapped at the panel's edge (not cut there in a narrow window: at
+    700 px 'zoom: wheel' was past the edge)."""
+    from imgui_bundle import imgui
+
+    imgui.push_text_wrap_pos(0.0)
+    imgui.text_disabled(text)
+    imgui.pop_text_wrap_pos()
