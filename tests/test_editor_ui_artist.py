@@ -2,7 +2,8 @@
 status row, the Compare section's 'A preset' and the labels at 700 px
 (tests/editor_ui_checks_artist.py, the Test Engine); which panel sections are open and the
 render, motion and adaptive scales kept across sessions (three runs of the editor: set through
-the widgets, reopened, and reopened from a session file of before they were kept)."""
+the widgets, reopened, and reopened from a session file of before they were kept); the Home key
+as a real X event (tests/editor_x_events_home.py)."""
 
 from __future__ import annotations
 
@@ -91,3 +92,14 @@ def test_sections_and_scales_survive_close_and_reopen(display, tmp_path):
     session_file.write_text(json.dumps(old))
     third = ui_test(tmp_path, tmp_path / "third.py", size="640x400")
     assert third.returncode == 0, third.stdout + third.stderr
+
+
+def test_home_frames_a_one_sided_sheet_from_its_face(display, tmp_path):
+    """The Home key, a real X key event into the editor's own loop: a single-sided sheet seen
+    from behind (nothing drawn) is framed from its face. tests/editor_x_events_home.py."""
+    from x_events import run_check
+
+    result = run_check("editor_x_events_home.py", display, ALIGHT_CONFIG_DIR=str(tmp_path / "config"),
+                       ALIGHT_CACHE_DIR=str(tmp_path / "cache"))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    assert result.stdout.startswith("ok: Home framed the sheet from its face"), result.stdout
