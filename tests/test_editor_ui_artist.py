@@ -63,6 +63,26 @@ def test_defaults(ctx):
     assert s.material.name == 'kept', s.material.name   # the rest of the old session restored
 """
 
+FLAGS_WIN = """
+from alight.frontends.editor.ui_test import editor
+def test_typed_flags_win(ctx):
+    ctx.yield_(2)
+    s = editor().state
+    got = (s.aa, s.quality, round(s.motion_scale, 6), s.adaptive_motion)
+    assert got == ('none', 'low', 0.75, False), got
+    assert round(s.render_scale, 6) == 0.6, s.render_scale   # (not on the command line: the session's)
+    ctx.set_ref('alight')
+    ctx.item_open('**/Display & camera')
+    ctx.combo_click('anti-aliasing/msaa')   # what the next plain start reopens
+"""
+
+SESSION_AA = """
+from alight.frontends.editor.ui_test import editor
+def test_session_aa(ctx):
+    ctx.yield_(2)
+    assert editor().state.aa == 'msaa', editor().state.aa
+"""
+
 OPENED = {"Material": False, "Environment": True, "Lights": False, "Display & camera": True,
           "Compare": False, "Performance": False, "Accuracy chart": False}
 DEFAULT_OPEN = {"Material": True, "Environment": False, "Lights": False, "Display & camera": False,
@@ -92,6 +112,23 @@ def test_sections_and_scales_survive_close_and_reopen(display, tmp_path):
     session_file.write_text(json.dumps(old))
     third = ui_test(tmp_path, tmp_path / "third.py", size="640x400")
     assert third.returncode == 0, third.stdout + third.stderr
+
+
+def test_view_options_typed_on_the_command_line_win_over_the_last_session(display, tmp_path):
+    """The last session reopens only without scene options, and it used to set the anti-aliasing,
+    bake quality and motion scale over the ones typed: `alight edit --aa none` after a session
+    with msaa opened with msaa. A typed one wins; an option not typed is the session's; a plain
+    start reopens what the session kept."""
+    (tmp_path / "first.py").write_text(f"OPENED = {OPENED!r}\n{SET_THEM}")
+    (tmp_path / "flags.py").write_text(FLAGS_WIN)
+    (tmp_path / "plain.py").write_text(SESSION_AA)
+    first = ui_test(tmp_path, tmp_path / "first.py", "--new", "--aa", "msaa", "--quality", "high", size="640x400")
+    assert first.returncode == 0, first.stdout + first.stderr
+    flags = ui_test(tmp_path, tmp_path / "flags.py", "--aa", "none", "--quality", "low", "--motion-scale", "0.75",
+                    size="640x400")
+    assert flags.returncode == 0, flags.stdout + flags.stderr
+    plain = ui_test(tmp_path, tmp_path / "plain.py", size="640x400")
+    assert plain.returncode == 0, plain.stdout + plain.stderr
 
 
 def test_home_frames_a_one_sided_sheet_from_its_face(display, tmp_path):

@@ -19,13 +19,14 @@ def add_parser(sub) -> None:
                        description="The material editor: a window with a live preview and a panel. "
                                    "Drop .hdr/.exr, mesh or preset .json files on it.")
     _add_scene_options(e, views=False)
-    e.add_argument("--quality", choices=QUALITIES + ("auto",), default="medium",
+    # --quality and --aa default to None so that one given wins over the last session's (run.py).
+    e.add_argument("--quality", choices=QUALITIES + ("auto",), default=None,
                    help="bake quality; auto: the cheapest measured bake within 2%% for the environment and "
                         "the kind of material, shown in the panel (default: medium)")
     _add_occlusion_option(e, editor=True)
     _add_shadow_options(e, editor=True)
     e.add_argument("--size", type=_size, default=(1280, 720), metavar="W|WxH", help="window size (default: 1280x720)")
-    e.add_argument("--aa", choices=("none", "msaa"), default="none",
+    e.add_argument("--aa", choices=("none", "msaa"), default=None,
                    help="anti-aliasing of the preview (default: none; msaa costs ~2x on llvmpipe)")
     e.add_argument("--motion-scale", type=_number("--motion-scale", 0.25, 1.0), default=None, metavar="X",
                    help="the view's resolution while the camera moves, relative to the view area; a still "

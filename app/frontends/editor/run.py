@@ -19,7 +19,7 @@ def build_state(args) -> EditorState:
     if args.view != "camera":   # (refused before anything is loaded)
         raise AlightError("edit: --view probe is 'alight render''s; the editor shows the camera view")
     # --motion-scale fixes the scale while moving; without it the scale adapts to hold 30 FPS.
-    state = EditorState(quality=args.quality, aa=args.aa, motion_scale=args.motion_scale or 0.5,
+    state = EditorState(quality=args.quality or "medium", aa=args.aa or "none", motion_scale=args.motion_scale or 0.5,
                         adaptive_motion=args.motion_scale is None, occlusion=getattr(args, "occlusion", "auto"),
                         shadows=getattr(args, "shadows", "auto"), ground=getattr(args, "ground", False))
     material, _, maps = build_look(args)
@@ -67,14 +67,16 @@ def run(args) -> int:
         ui_tests = ui_test.load_tests(args.ui_test)
     state = build_state(args)
     if ui_tests is not None:   # under hello_imgui's runner (ui_test.py says why)
-        return ui_test.run(state, args.size, ui_tests, restore=not args.new and _no_scene_options(args))
+        restore = not args.new and _no_scene_options(args)
+        return ui_test.run(state, args.size, ui_tests,
+                           restore=(lambda win: open_last_session(win, state, args)) if restore else None)
     size = (1280, 720) if args.benchmark else args.size
     # Interactive only (screenshots and benchmarks must not depend on the last session), and
     # only with no scene given on the command line.
     interactive = not (args.benchmark or args.screenshot or args.script)
     win = EditorWindow(state, size, show_panel=not args.no_panel, ini_path=_imgui_ini() if interactive else None)
     if interactive and not args.new and _no_scene_options(args):
-        open_last_session(win, state)
+        open_last_session(win, state, args)
     try:
         if args.benchmark:
             return _benchmark(win, args.frames or 120)
@@ -107,14 +109,22 @@ def run(args) -> int:
         win.close()
 
 
-def open_last_session(win, state) -> None:
+def open_last_session(win, state, args=None) -> None:
     """The last session reopened into the window's state; its mesh file is read on the panel's
-    worker (the window draws meanwhile, session.restore_session)."""
+    worker (the window draws meanwhile, session.restore_session). ``args``: the command line,
+    whose view options given (--aa, --quality, --motion-scale) win over the session's."""
     from alight.frontends.editor.session import restore_session
 
     warning = restore_session(state, win.orbit, win.turntable, win.panel)
     if warning:
         state.error = " ".join(warning.split())
+    if args is not None:   # (the session kept the last ones; a flag typed now is what is wanted)
+        if args.aa is not None:
+            state.aa = args.aa
+        if args.quality is not None:
+            state.quality = args.quality
+        if args.motion_scale is not None:
+            state.motion_scale, state.adaptive_motion = args.motion_scale, False
     win.history.committed = state.look
 
 

@@ -95,10 +95,11 @@ def load_tests(path: str) -> list[tuple[str, object]]:
     return tests
 
 
-def run(state, size: tuple[int, int], tests, restore: bool) -> int:
+def run(state, size: tuple[int, int], tests, restore=None) -> int:
     """Open the editor under hello_imgui's runner with the test engine, run ``tests`` (pairs of
-    name and function), save the session, close. Returns 0 if all passed, else 1 (a line per
-    failure on stderr)."""
+    name and function), save the session, close. ``restore``: None, or ``f(window)`` reopening
+    the last session as `alight edit` does (run.open_last_session). Returns 0 if all passed,
+    else 1 (a line per failure on stderr)."""
     global _window
     from imgui_bundle import hello_imgui, imgui
 
@@ -133,13 +134,8 @@ def run(state, size: tuple[int, int], tests, restore: bool) -> int:
             startup_error.append(exc)
             params.app_shall_exit = True
             return
-        if restore:
-            from alight.frontends.editor.session import restore_session
-
-            warning = restore_session(state, _window.orbit, _window.turntable, _window.panel)
-            if warning:
-                state.error = " ".join(warning.split())
-            _window.history.committed = state.look
+        if restore is not None:
+            restore(_window)
         # The restored mesh, read on the panel's worker, in place before the first test.
         _window.finish_file_jobs()
         # The environment's first bake done before the tests start: while it runs, its progress
