@@ -2,10 +2,9 @@
 other tools write them, on real models (Duck, CesiumMilkTruck), through ``alight render``.
 
 The files come from glTF Transform (its CLI's ``instance``; its library, @gltf-transform/core and
-/extensions, driven by tests/gltf_transform_edit.cjs) and gltfpack (``-mi``; and its pass over a
-variants file), installed into
-tools/node as tools/setup.sh does; without npm (or node) these tests skip. Each file renders like
-a control written by the same tool without the extension.
+/extensions, driven by tests/gltf_transform_edit.cjs) and gltfpack (``-mi``, and its pass over a
+variants file), installed into tools/node as tools/setup.sh does; without npm (or node) these
+tests skip. Each file renders like a control written by the same tool without the extension.
 
 Instanced copies render like the same copies on plain nodes within 1.5% relMAE, not bit for bit:
 the instances are one part, the plain nodes twenty, and the anisotropic filtering level is chosen
