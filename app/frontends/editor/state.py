@@ -56,6 +56,17 @@ def read_mesh(spec: str):
     return load_mesh(spec)
 
 
+def short_warning(line: str) -> str:
+    """A reader's warning line for the status row: the file named by its name, not its absolute
+    path ('/long/path/to/x.exr: 2-part file: ...' -> 'x.exr: 2-part file: ...'). The row
+    already says which file was opened, and a path in front pushed the warning itself out of
+    the panel's width (stderr keeps the whole line)."""
+    path, sep, rest = line.partition(": ")
+    if sep and os.path.isabs(path) and os.path.basename(path):
+        return f"{os.path.basename(path)}: {rest}"
+    return line
+
+
 @dataclass
 class EditorState:
     mesh_spec: str = "sphere"
@@ -282,8 +293,9 @@ class EditorState:
 
     def with_warnings(self, message: str) -> str:
         """``message`` with the last file's warnings, for the status row (hovering it shows the
-        line whole): 'opened X; warning: TEXT', or 'opened X; 2 warnings: A | B'."""
-        lines = self.warning_lines
+        line whole): 'opened X; warning: TEXT', or 'opened X; 2 warnings: A | B'; each warning
+        names its file by its name (short_warning)."""
+        lines = [short_warning(line) for line in self.warning_lines]
         if not lines:
             return message
         if len(lines) == 1:
