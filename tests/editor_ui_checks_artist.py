@@ -66,6 +66,19 @@ def test_browse_mesh_opens_the_picked_file(ctx):
     assert panel.shown_status.startswith(f"opened mesh {cube}"), panel.shown_status
     boxed = view(ctx).astype(np.float64)
     assert np.abs(boxed - sphere).mean() > 1.0   # the box, not the sphere
+    # Browsing again starts in the open mesh's folder (it stayed wherever the browser was last:
+    # at first the working directory, four clicks from a user's models).
+    from pathlib import Path
+
+    browser.directory = Path(OUT)   # (the browser elsewhere, as after another row's pick)
+    ctx.set_ref("alight")
+    ctx.item_click("**/browse mesh")
+    try:
+        assert browser.visible and browser.directory == Path(folder).resolve(), browser.directory
+    finally:
+        if browser.visible:
+            ctx.set_ref(BROWSER)
+            ctx.item_click("cancel")
     ctx.set_ref("alight")
     ctx.combo_click("preview mesh/sphere")
     assert s.mesh_spec == "sphere", s.error

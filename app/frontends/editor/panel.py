@@ -19,7 +19,7 @@ from alight.core.shading import linear_to_srgb, srgb_to_linear
 from alight.core.texture_maps import MAP_SLOTS, SLOT_LABELS
 from alight.errors import AlightError
 from alight.exchange.images import IMAGE_SUFFIXES
-from alight.exchange.meshes import MESH_EXTENSIONS
+from alight.exchange.meshes import MESH_EXTENSIONS, is_builtin
 from alight.exchange.presets import list_presets, load_preset
 from alight.frontends.editor.file_browser import FileBrowser
 from alight.frontends.editor.layer_rows import FINITE_START, SECTIONS, LayerRow
@@ -576,7 +576,7 @@ class Panel:
             self._attempt(s, "preset_path", lambda: s.open_file(self.preset_path))
         imgui.same_line()
         self._browse("browse files", (".hdr", ".exr", ".obj", ".gltf", ".glb", ".ply", ".stl", ".json"),
-                     s.open_file)
+                     s.open_file, start=self.preset_path)
         _, self.gltf_path = imgui.input_text("glTF file", self.gltf_path)
         if imgui.button("export glTF"):   # the mesh with the material and its maps (.gltf or .glb)
             self._export_gltf(s)
@@ -778,12 +778,14 @@ class Panel:
                 imgui.tree_pop()
         return m
 
-    def _browse(self, label: str, suffixes: tuple[str, ...], on_pick, accept=None) -> None:
-        """A button opening the file browser (file_browser.py: native dialog or built-in)."""
+    def _browse(self, label: str, suffixes: tuple[str, ...], on_pick, accept=None, start: str = "") -> None:
+        """A button opening the file browser (file_browser.py: native dialog or built-in) in the
+        folder of ``start`` (the file the row holds now; '' keeps the browser's last folder: it
+        opened in the working directory, four clicks from the user's maps)."""
         from imgui_bundle import imgui
 
         if imgui.button(label):
-            self.browser.open(label, suffixes, on_pick, accept=accept)
+            self.browser.open(label, suffixes, on_pick, start=start, accept=accept)
 
     def _texture_maps(self, s) -> None:
         """A row per slot: the drop target (radio), the file, load and clear; then the tiling."""
@@ -817,7 +819,8 @@ class Panel:
         imgui.same_line()
         if imgui.button("browse set"):   # any image of the set: its folder is loaded
             self.browser.open("texture set: pick any of its maps", IMAGE_SUFFIXES,
-                              lambda path: self._browsed_set(s, os.path.dirname(path)))
+                              lambda path: self._browsed_set(s, os.path.dirname(path)),
+                              start=os.path.join(s.texture_set_folder, "any") if s.texture_set_folder else "")
         imgui.same_line()
         note("a folder, files split by ';', or a drop")
         for slot in MAP_SLOTS:
@@ -828,7 +831,10 @@ class Panel:
                 tooltip("a dropped image file goes into this slot")
             imgui.same_line()
             if imgui.small_button("load"):
-                self.browser.open(f"load {SLOT_LABELS[slot]} map", IMAGE_SUFFIXES, loader(slot))
+                # (in the folder of this slot's map, or of any map already loaded)
+                near = getattr(maps, slot) or next(iter(maps.paths().values()), "")
+                self.browser.open(f"load {SLOT_LABELS[slot]} map", IMAGE_SUFFIXES, loader(slot),
+                                  start=near.split("#images[")[0])
             imgui.same_line()
             path = getattr(maps, slot)
             if imgui.small_button("clear") and path:
@@ -897,7 +903,7 @@ class Panel:
 
         # (only 2:1 pictures among the 8-bit ones: the user's screenshots were listed too)
         self._browse("browse env", (".hdr", ".exr", *(x for x in IMAGE_SUFFIXES if x != ".exr")), s.open_environment,
-                     accept=may_be_equirect)
+                     accept=may_be_equirect, start="" if s.env_spec == "studio" else s.env_spec)
         imgui.same_line()
         if imgui.button("studio"):
             try:
@@ -922,7 +928,8 @@ class Panel:
             self._open_mesh(s)
         imgui.same_line()
         # A mesh picked in the browser opens as a typed one does (on the file-jobs thread).
-        self._browse("browse mesh", MESH_EXTENSIONS, lambda path: self._browsed_mesh(s, path))
+        self._browse("browse mesh", MESH_EXTENSIONS, lambda path: self._browsed_mesh(s, path),
+                     start="" if is_builtin(s.mesh_spec) else s.mesh_spec)
         imgui.same_line()
         # The way back from an orbit that lost the mesh (a one-sided sheet seen from behind shows
         # nothing, and F frames it from the same direction).
