@@ -178,15 +178,25 @@ class _Builder:
 def _as_loaded(info) -> tuple[bytes, str] | None:
     """(the file's bytes, their mimeType) where ``info.encoded`` decodes to ``info.image`` (a
     decode is much cheaper than a PNG encode of the same pixels); else None."""
-    from alight.exchange.gltf import JPEG_MAGIC, decode_image
+    return _encoded_if_same(info.encoded, info.image, "export")
 
-    data = info.encoded
-    if not data:
+
+def _encoded_if_same(data: bytes | None, image: np.ndarray, where: str, rgb: bool = False) -> tuple[bytes, str] | None:
+    """(``data``, its mimeType) where the PNG or JPEG bytes decode to ``image`` (``rgb``: to its
+    RGB, with every alpha 255, as a map exported as RGB), else None."""
+    from alight.exchange.gltf import JPEG_MAGIC, PNG_MAGIC, decode_image
+
+    if not data or not (data[:8] == PNG_MAGIC or data[:3] == JPEG_MAGIC):
         return None
     try:
-        same = np.array_equal(decode_image(data, "export"), info.image)
+        decoded = decode_image(data, where)
     except AlightError:
         return None
+    if rgb:
+        same = (decoded.shape[:2] == image.shape[:2] and bool((decoded[:, :, 3] == 255).all())
+                and np.array_equal(decoded[:, :, :3], image[:, :, :3]))
+    else:
+        same = np.array_equal(decoded, image)
     return (data, "image/jpeg" if data[:3] == JPEG_MAGIC else "image/png") if same else None
 
 
@@ -195,20 +205,13 @@ def _map_file(path: str | None, image: np.ndarray) -> tuple[bytes, str] | None:
     RGB drawn with every alpha 255, so a JPEG map stays the JPEG it was (a PNG re-encode of a
     2048^2 photo map is several times its size and slow); None for a converted map (normal_dx,
     gloss, a packed metallic-roughness), an image inside a glTF file, or any other format."""
-    from alight.exchange.gltf import JPEG_MAGIC, PNG_MAGIC, decode_image
-
     if not path or "#images[" in path:
         return None
     try:
         data = Path(path).read_bytes()
-        if not (data[:8] == PNG_MAGIC or data[:3] == JPEG_MAGIC):
-            return None
-        decoded = decode_image(data, path)
-    except (OSError, AlightError):
+    except OSError:
         return None
-    same = (decoded.shape[:2] == image.shape[:2] and bool((decoded[:, :, 3] == 255).all())
-            and np.array_equal(decoded[:, :, :3], image[:, :, :3]))
-    return (data, "image/jpeg" if data[:3] == JPEG_MAGIC else "image/png") if same else None
+    return _encoded_if_same(data, image, path, rgb=True)
 
 
 def _add_maps(b: _Builder, maps: TextureMaps, stem: str, glb: bool) -> list[str]:

@@ -169,26 +169,20 @@ def fit_text(text: str, width: float) -> str:
     the row, 'no such file', stays in view)."""
     from imgui_bundle import imgui
 
-    def fits(s: str) -> bool:
-        return imgui.calc_text_size(s).x <= width
-
-    if fits(text):
+    if imgui.calc_text_size(text).x <= width:
         return text
 
-    def longest(make, n: int) -> int:   # the largest k <= n with make(k) fitting (0 if none)
+    def longest(make, n: int, room: float) -> int:   # the largest k <= n with make(k) in room (0 if none)
         lo, hi = 0, n
         while lo < hi:
             mid = (lo + hi + 1) // 2
-            lo, hi = (mid, hi) if fits(make(mid)) else (lo, mid - 1)
+            lo, hi = (mid, hi) if imgui.calc_text_size(make(mid)).x <= room else (lo, mid - 1)
         return lo
 
     # The end takes up to half the room, the start what is left.
-    half = width / 2.0
-    tail = 0
-    while tail < len(text) and imgui.calc_text_size(text[len(text) - tail - 1:]).x <= half:
-        tail += 1
+    tail = longest(lambda k: text[len(text) - k:], len(text), width / 2.0)
     end = text[len(text) - tail:] if tail else ""
-    head = longest(lambda k: text[:k] + "..." + end, len(text) - tail)
+    head = longest(lambda k: text[:k] + "..." + end, len(text) - tail, width)
     return text[:head] + "..." + end
 
 
